@@ -1,0 +1,45 @@
+/* One axis's control loop over the HAL. */
+#include "bristle/br_axis.h"
+
+#include <stddef.h>
+
+br_status_t br_axis_init(br_axis_t *a, const br_hal_t *hal, const br_ctrl_cfg_t *ctrl_cfg)
+{
+    if (a == NULL || hal == NULL || hal->encoder_read == NULL || hal->pwm_write == NULL ||
+        hal->tick_wait == NULL) {
+        return BR_E_NULL;
+    }
+    a->ready = 0;
+    br_status_t st = br_ctrl_init(&a->ctrl, ctrl_cfg);
+    if (st != BR_OK) {
+        return st;
+    }
+    a->hal = hal;
+    a->last = (br_ctrl_out_t){0};
+    a->ready = 1;
+    return BR_OK;
+}
+
+br_status_t br_axis_step(br_axis_t *a, const br_ref_t *ref, float comp_N)
+{
+    if (a == NULL || ref == NULL) {
+        return BR_E_NULL;
+    }
+    if (!a->ready) {
+        return BR_E_STATE;
+    }
+    int32_t counts = 0;
+    br_status_t st = a->hal->encoder_read(a->hal->ctx, &counts);
+    if (st != BR_OK) {
+        /* no position: command zero torque rather than act on stale data */
+        (void)a->hal->pwm_write(a->hal->ctx, 0.0f);
+        return st;
+    }
+    br_ctrl_in_t in = {counts, ref->ref_counts, ref->ref_frac_counts, ref->ref_omega_radps, comp_N};
+    st = br_ctrl_step(&a->ctrl, &in, &a->last);
+    if (st != BR_OK) {
+        (void)a->hal->pwm_write(a->hal->ctx, 0.0f);
+        return st;
+    }
+    return a->hal->pwm_write(a->hal->ctx, a->last.duty);
+}

@@ -1,0 +1,173 @@
+#!/usr/bin/env python3
+"""H-infinity state-feedback synthesis for one axis with integral action
+(thesis eq. 7); writes firmware/gen/br_hinf_gains.h.
+
+Augmented model, x = [e_theta, e_omega, eps] (motor side, eps = int e_theta dt):
+    dx/dt = A x + B1 w + B2 u,   z = [Cz x; Dz u]
+    A  = [[0, 1, 0], [0, -L^2 sigma2 / Jeff, 0], [1, 0, 0]]
+    B2 = [0, 1/Jeff, 0]^T,  B1 = (L Fs) B2  (friction torque, w = 1 <-> stiction)
+    Cz = diag(c_theta, c_omega, c_eps),  Dz = 1/u_norm
+For a given gamma the stabilising solution X >= 0 of
+    A'X + XA + X (B1 B1'/gamma^2 - B2 R^-1 B2') X + Cz'Cz = 0,  R = Dz'Dz
+exists iff gamma > gamma_min; it is found from the stable invariant subspace
+of the Hamiltonian. gamma_min is found by bisection (the gamma-iteration), the
+design uses gamma = margin * gamma_min, and K = -R^-1 B2' X (u = K x).
+The closed-loop H-infinity norm from w to z is then computed independently
+(Hamiltonian bisection) and checked to be below gamma; the sampled loop
+(ZOH plant, rectangular integral, backward-difference velocity) is checked
+at each period in check_dt_s.
+
+Usage: synth_hinf.py [--out FILE] [--report]"""
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+import scipy.linalg as sla
+
+import machine
+
+GEN_DIR = os.path.join(machine.HERE, "..", "gen")
+
+
+def plant(p):
+    L, J = p["L_mprad"], p["Jeff_kgm2"]
+    A = np.array([[0.0, 1.0, 0.0], [0.0, -L * L * p["sigma2_Nspm"] / J, 0.0], [1.0, 0.0, 0.0]])
+    B2 = np.array([[0.0], [1.0 / J], [0.0]])
+    return A, B2
+
+
+def riccati(A, B1, B2, C, R, gamma):
+    """Stabilising X of the H-inf ARE, or None when gamma is not achievable."""
+    n = A.shape[0]
+    S = B1 @ B1.T / gamma**2 - B2 @ np.linalg.solve(R, B2.T)
+    H = np.block([[A, S], [-C.T @ C, -A.T]])
+    ev, V = np.linalg.eig(H)
+    scale = max(1.0, np.max(np.abs(ev)))
+    if np.min(np.abs(ev.real)) < 1e-9 * scale:
+        return None  # eigenvalues on the imaginary axis
+    stable = ev.real < 0
+    if np.count_nonzero(stable) != n:
+        return None
+    V1, V2 = V[:n, stable], V[n:, stable]
+    if np.linalg.cond(V1) > 1e12:
+        return None
+    X = np.real(V2 @ np.linalg.inv(V1))
+    X = 0.5 * (X + X.T)
+    if np.min(np.linalg.eigvalsh(X)) < -1e-9 * np.max(np.abs(X)):
+        return None  # not positive semidefinite
+    return X
+
+
+def hinf_norm(A, B, C, D, tol=1e-7):
+    """H-infinity norm of a stable continuous system by Hamiltonian bisection."""
+    w = np.logspace(-3, 6, 2000)
+    lo = max(np.linalg.norm(C @ np.linalg.solve(1j * wi * np.eye(A.shape[0]) - A, B) + D, 2) for wi in w)
+    hi = 10.0 * lo + 1e-12
+    while (hi - lo) > tol * hi:
+        g = 0.5 * (lo + hi)
+        # no imaginary-axis eigenvalue <=> norm < g (D = 0 here)
+        Hm = np.block([[A, B @ B.T / g**2], [-C.T @ C, -A.T]])
+        ev = np.linalg.eigvals(Hm)
+        if np.any(np.abs(ev.real) < 1e-8 * max(1.0, np.max(np.abs(ev)))):
+            lo = g
+        else:
+            hi = g
+    return hi
+
+
+def sampled_loop(p, K, dt):
+    """Discrete closed loop as implemented: ZOH plant, eps += e dt, omega = dtheta/dt.
+    State [theta_k, omega_k, eps_k, theta_{k-1}]; returns (Phi, Gamma_w, Cd)."""
+    A, B2 = plant(p)
+    Ap, Bp = A[:2, :2], B2[:2]
+    M = sla.expm(np.block([[Ap, Bp], [np.zeros((1, 3))]]) * dt)
+    Ad, Bd = M[:2, :2], M[:2, 2:]
+    k0, k1, k2 = K
+    # u_k = k0 th_k + k1 (th_k - th_{k-1})/dt + k2 eps_k
+    Ku = np.array([[k0 + k1 / dt, 0.0, k2, -k1 / dt]])
+    Phi = np.zeros((4, 4))
+    Phi[:2, :2] = Ad
+    Phi[:2, :] += Bd @ Ku
+    Phi[2, :] = [dt, 0.0, 1.0, 0.0]
+    Phi[3, :] = [1.0, 0.0, 0.0, 0.0]
+    Gw = np.zeros((4, 1))
+    Gw[:2] = Bd * (p["L_mprad"] * p["Fs_N"])
+    return Phi, Gw, Ku
+
+
+def design(p, wts):
+    A, B2 = plant(p)
+    B1 = B2 * (p["L_mprad"] * p["Fs_N"])
+    C = np.diag(wts["Cz_diag"])
+    R = np.array([[1.0 / wts["u_norm_Nm"] ** 2]])
+    lo, hi = 1e-9, 1e9
+    assert riccati(A, B1, B2, C, R, hi) is not None, "weights admit no stabilising design"
+    for _ in range(200):  # gamma-iteration: bisection on log(gamma)
+        g = np.sqrt(lo * hi)
+        if riccati(A, B1, B2, C, R, g) is None:
+            lo = g
+        else:
+            hi = g
+        if hi / lo < 1.0 + 1e-9:
+            break
+    gamma_min = hi
+    gamma = wts["gamma_margin"] * gamma_min
+    X = riccati(A, B1, B2, C, R, gamma)
+    K = (-np.linalg.solve(R, B2.T @ X)).ravel()
+    Acl = A + B2 @ K[None, :]
+    Ccl = np.vstack([C, (np.sqrt(R) @ K[None, :])])
+    norm = hinf_norm(Acl, B1, Ccl, np.zeros((4, 1)))
+    assert np.all(np.linalg.eigvals(Acl).real < 0), "closed loop unstable"
+    assert norm <= gamma * (1 + 1e-6), "closed-loop norm %g exceeds gamma %g" % (norm, gamma)
+    checks = []
+    for dt in wts["check_dt_s"]:
+        Phi, Gw, Ku = sampled_loop(p, K, dt)
+        rho = np.max(np.abs(np.linalg.eigvals(Phi)))
+        assert rho < 1.0, "sampled loop unstable at dt=%g" % dt
+        Cd = np.vstack([np.hstack([C, np.zeros((3, 1))]), np.sqrt(R) @ Ku])
+        th = np.linspace(1e-4, np.pi, 4000)
+        dnorm = max(np.linalg.norm(Cd @ np.linalg.solve(np.exp(1j * t) * np.eye(4) - Phi, Gw), 2) for t in th)
+        checks.append((dt, rho, dnorm))
+    return dict(K=K, gamma_min=gamma_min, gamma=gamma, norm=norm,
+                poles=np.linalg.eigvals(Acl), checks=checks)
+
+
+def render(d, wts):
+    poles = ", ".join("%.2f%+.2fj" % (z.real / (2 * np.pi), z.imag / (2 * np.pi)) for z in sorted(d["poles"], key=lambda z: (z.real, z.imag)))
+    lines = [
+        "/* generated by firmware/design/synth_hinf.py from hinf_weights.json and",
+        " * reference_machine.json -- do not edit; regenerate with `make regen` */",
+        "/* H-infinity state feedback with integral action (thesis eq. 7), u = K x,",
+        " * x = [e_theta (rad), e_omega (rad/s), eps (rad s)], torque in N m.",
+        " * weights Cz = diag(%s), Dz = 1/%s N m" % (", ".join(repr(c) for c in wts["Cz_diag"]), repr(wts["u_norm_Nm"])),
+        " * gamma_min = %.6g, gamma = %.6g, closed-loop norm = %.6g" % (d["gamma_min"], d["gamma"], d["norm"]),
+        " * continuous closed-loop poles (Hz): %s" % poles,
+    ]
+    for dt, rho, dn in d["checks"]:
+        lines.append(" * sampled at %g ms: spectral radius %.6f, norm %.6g" % (dt * 1e3, rho, dn))
+    lines += [" */", "#ifndef BR_HINF_GAINS_H", "#define BR_HINF_GAINS_H", "",
+              "/* initializer for br_ctrl_cfg_t.K */",
+              "#define BR_HINF_K { %s, %s, %s }" % tuple(machine.c_float(k) for k in d["K"]),
+              "", "#endif", ""]
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", default=os.path.join(GEN_DIR, "br_hinf_gains.h"))
+    ap.add_argument("--weights", default=os.path.join(machine.HERE, "hinf_weights.json"))
+    a = ap.parse_args()
+    with open(a.weights) as f:
+        wts = json.load(f)
+    d = design(machine.load(), wts)
+    text = render(d, wts)
+    with open(a.out, "w") as f:
+        f.write(text)
+    sys.stdout.write("K = %s\ngamma_min = %.6g, gamma = %.6g, closed-loop norm = %.6g\n" % (
+        d["K"], d["gamma_min"], d["gamma"], d["norm"]))
+
+
+if __name__ == "__main__":
+    main()
