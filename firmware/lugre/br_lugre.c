@@ -46,9 +46,10 @@ float br_lugre_z_advance_m(const br_lugre_cfg_t *cfg, float z_m, float dx_m, flo
     if (dx_m == 0.0f) {
         return z_m;
     }
-    /* eq. 4 over displacement: z1 = zss + (z0 - zss) exp(-sigma0 |dx| / g), zss = sgn(dx) g / sigma0 */
+    /* eq. 4 over displacement: z1 = zss + (z0 - zss) exp(-sigma0 |dx| / g), zss = sgn(dx) g / sigma0,
+     * written as z0 + (zss - z0)(1 - exp(-r)) so that small moves keep full float precision */
     float zss = copysignf(g_N / cfg->sigma0_Npm, dx_m);
-    return zss + (z_m - zss) * expf(-cfg->sigma0_Npm * fabsf(dx_m) / g_N);
+    return z_m + (zss - z_m) * -expm1f(-cfg->sigma0_Npm * fabsf(dx_m) / g_N);
 }
 
 br_status_t br_lugre_init(br_lugre_t *s, const br_lugre_cfg_t *cfg)

@@ -110,11 +110,11 @@ static void bounded_step(const br_model_t *m, const float x[BR_NX], float u, flo
             /* eq. 4 over displacement: z1 = zss + (z0 - zss) e^{-r}, r = sigma0 |dx| / g_p */
             float zss = copysignf(gp / c->sigma0_Npm, dx);
             float r = c->sigma0_Npm * fabsf(dx) / gp;
-            float e = expf(-r);
-            z1 = zss + (z0 - zss) * e;
-            /* integral of z over the step: h (zss + (z0 - zss) (1 - e^{-r}) / r) */
-            /* (1 - e^{-r}) / r, by its series where r underflows the division */
-            float q = (r > 1e-6f) ? -expm1f(-r) / r : 1.0f - 0.5f * r;
+            float one_minus_e = -expm1f(-r);
+            z1 = z0 + (zss - z0) * one_minus_e; /* same, without cancellation for small r */
+            /* integral of z over the step: h (zss + (z0 - zss) (1 - e^{-r}) / r);
+             * (1 - e^{-r}) / r by its series where r would underflow the division */
+            float q = (r > 1e-6f) ? one_minus_e / r : 1.0f - 0.5f * r;
             zint = h * (zss + (z0 - zss) * q);
         } else {
             z1 = z0;

@@ -88,7 +88,7 @@ static void substep(br_plant_t *p, double tau, double h)
             const double zss = copysign(g / c->sigma0_Npm, dx);
             const double r = c->sigma0_Npm * fabs(dx) / g;
             const double q = -expm1(-r); /* 1 - e^{-r} */
-            z1 = zss + (z0 - zss) * exp(-r);
+            z1 = z0 + (zss - z0) * q;
             /* integral of z over the substep (velocity held): h (zss + (z0 - zss) q / r) */
             zint = h * (zss + (z0 - zss) * (r > 1e-12 ? q / r : 1.0 - 0.5 * r));
         } else {

@@ -40,7 +40,8 @@ float br_lugre_force_N(const br_lugre_cfg_t *cfg, float z_m, float zdot_mps);
 /* Exact solution of eq. 4 written over displacement instead of time
  * (dz/dx = 1 - sigma0 sgn(dx) z / g) for a level g held over the move dx:
  *   z1 = s g/sigma0 + (z0 - s g/sigma0) exp(-sigma0 |dx| / g),  s = sgn(dx).
- * Unconditionally bounded: |z1| <= max(|z0|, g/sigma0) at any speed. */
+ * Unconditionally bounded: |z1| <= max(|z0|, g/sigma0) at any speed.
+ * Evaluated as z0 + (zss - z0)(1 - e^{-r}) with expm1 (no cancellation for small moves). */
 float br_lugre_z_advance_m(const br_lugre_cfg_t *cfg, float z_m, float dx_m, float g_N);
 
 br_status_t br_lugre_init(br_lugre_t *s, const br_lugre_cfg_t *cfg);

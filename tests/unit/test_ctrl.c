@@ -1,0 +1,164 @@
+/* Controller (eq. 7): guards, control law, saturation with anti-windup,
+ * wrap-safe velocity, compensation input. */
+#include "br_test.h"
+
+#include "bristle/br_ctrl.h"
+
+static br_ctrl_cfg_t cfg(void)
+{
+    br_ctrl_cfg_t c = {{-0.5f, -0.01f, -10.0f}, 1e-3f, 0.64f, 0.64f, 6.0e-6f, 1.27e-3f};
+    return c;
+}
+
+static br_ctrl_in_t in_at(int32_t enc, int32_t ref)
+{
+    br_ctrl_in_t in = {enc, ref, 0.0f, 0.0f, 0.0f};
+    return in;
+}
+
+static void test_init_guards(void **st)
+{
+    (void)st;
+    br_ctrl_t c;
+    br_ctrl_cfg_t k;
+    assert_int_equal(br_ctrl_init(NULL, &k), BR_E_NULL);
+    assert_int_equal(br_ctrl_init(&c, NULL), BR_E_NULL);
+    k = cfg(); assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    k = cfg(); k.K[0] = NAN;             assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    k = cfg(); k.K[2] = INFINITY;        assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    k = cfg(); k.dt_s = 0.0f;            assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    k = cfg(); k.dt_s = NAN;             assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    k = cfg(); k.tau_max_Nm = 0.0f;      assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    k = cfg(); k.tau_max_Nm = -1.0f;     assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    k = cfg(); k.tau_max_Nm = 0.7f;      assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM); /* > full duty */
+    k = cfg(); k.tau_per_duty_Nm = 0.0f; assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    k = cfg(); k.rad_per_count = 0.0f;   assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    k = cfg(); k.lead_mprad = -1e-3f;    assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
+    br_ctrl_in_t in = in_at(0, 0);
+    br_ctrl_out_t out;
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_STATE); /* last init failed */
+}
+
+static void test_control_law(void **st)
+{
+    (void)st;
+    br_ctrl_t c;
+    br_ctrl_cfg_t k = cfg();
+    br_ctrl_out_t out;
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    /* first call primes the velocity: omega = 0; e = (100 - 50 - 0.25) counts */
+    br_ctrl_in_t in = {100, 50, 0.25f, 0.0f, 0.0f};
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    double e = 49.75 * 6.0e-6;
+    BR_ASSERT_NEAR(out.e_theta_rad, e, 1e-6 * e);
+    BR_ASSERT_NEAR(out.tau_Nm, -0.5 * e, 1e-6 * 0.5 * e);
+    BR_ASSERT_NEAR(out.duty, -0.5 * e / 0.64, 1e-6 * 0.5 * e / 0.64);
+    BR_ASSERT_NEAR(c.eps_rads, e * 1e-3, 1e-6 * e * 1e-3);
+    /* second call: 10 counts moved in 1 ms, reference velocity 0.02 rad/s */
+    in.enc_counts = 110;
+    in.ref_omega_radps = 0.02f;
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    double e2 = 59.75 * 6.0e-6, w = 10 * 6.0e-6 / 1e-3;
+    BR_ASSERT_NEAR(out.omega_radps, w, 1e-6 * w);
+    BR_ASSERT_NEAR(out.tau_Nm, -0.5 * e2 - 0.01 * (w - 0.02) - 10.0 * e * 1e-3, 1e-6 * 0.5 * e2);
+    assert_int_equal(out.saturated, 0);
+}
+
+static void test_compensation_adds_torque(void **st)
+{
+    (void)st;
+    br_ctrl_t c;
+    br_ctrl_cfg_t k = cfg();
+    br_ctrl_out_t out;
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    br_ctrl_in_t in = {0, 0, 0.0f, 0.0f, 18.0f};
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    BR_ASSERT_NEAR(out.tau_Nm, 1.27e-3 * 18.0, 1e-6 * 1.27e-3 * 18.0); /* tau = L F_comp */
+}
+
+static void test_saturation_and_antiwindup(void **st)
+{
+    (void)st;
+    br_ctrl_t c;
+    br_ctrl_cfg_t k = cfg();
+    br_ctrl_out_t out;
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    /* a huge error: u = -0.5 * (-2e6 * 6e-6) = 6 N m > 0.64 */
+    br_ctrl_in_t in = in_at(0, 2000000);
+    for (int i = 0; i < 100; i++) {
+        assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+        assert_int_equal(out.saturated, 1);
+        BR_ASSERT_NEAR(out.tau_Nm, 0.64f, 0.0);
+        BR_ASSERT_NEAR(out.duty, 1.0, 0.0);
+    }
+    /* integrating would push deeper into saturation: eps held at zero */
+    BR_ASSERT_NEAR(c.eps_rads, 0.0, 0.0);
+    /* saturated but the error now reduces the command: the integral runs */
+    c.eps_rads = -1.0f;           /* u = -10 * -1 = 10 N m, saturated high */
+    in = in_at(1000, 0);          /* e > 0: K2 e < 0, opposite to u */
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    assert_int_equal(out.saturated, 1);
+    BR_ASSERT_NEAR(c.eps_rads, -1.0 + 1000 * 6.0e-6 * 1e-3, 1e-7);
+    /* negative side */
+    br_ctrl_t c2;
+    assert_int_equal(br_ctrl_init(&c2, &k), BR_OK);
+    in = in_at(2000000, 0);
+    assert_int_equal(br_ctrl_step(&c2, &in, &out), BR_OK);
+    BR_ASSERT_NEAR(out.duty, -1.0, 0.0);
+    BR_ASSERT_NEAR(c2.eps_rads, 0.0, 0.0);
+}
+
+static void test_velocity_across_wrap(void **st)
+{
+    (void)st;
+    br_ctrl_t c;
+    br_ctrl_cfg_t k = cfg();
+    br_ctrl_out_t out;
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    br_ctrl_in_t in = in_at(INT32_MAX - 4, INT32_MAX - 4);
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    /* the counter wraps: +10 counts, and the reference wraps with it */
+    in = in_at(INT32_MIN + 5, INT32_MIN + 5);
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    BR_ASSERT_NEAR(out.omega_radps, 10 * 6.0e-6 / 1e-3, 1e-6 * 0.06);
+    BR_ASSERT_NEAR(out.e_theta_rad, 0.0, 0.0);
+    /* reference on the other side of the wrap: error of 3 counts */
+    in = in_at(INT32_MIN + 1, INT32_MAX - 1);
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    BR_ASSERT_NEAR(out.e_theta_rad, 3 * 6.0e-6, 1e-6 * 18e-6);
+}
+
+static void test_step_rejects_bad_input(void **st)
+{
+    (void)st;
+    br_ctrl_t c;
+    br_ctrl_cfg_t k = cfg();
+    br_ctrl_out_t out;
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    br_ctrl_in_t in = in_at(10, 0);
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    float eps = c.eps_rads;
+    const float bad[] = {NAN, INFINITY, -INFINITY};
+    for (int i = 0; i < 3; i++) {
+        in = in_at(10, 0); in.comp_N = bad[i];
+        assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_INPUT);
+        assert_true(out.tau_Nm == 0.0f && out.duty == 0.0f);
+        in = in_at(10, 0); in.ref_frac_counts = bad[i];
+        assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_INPUT);
+        in = in_at(10, 0); in.ref_omega_radps = bad[i];
+        assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_INPUT);
+    }
+    assert_true(c.eps_rads == eps);
+    assert_int_equal(br_ctrl_step(&c, NULL, &out), BR_E_NULL);
+    assert_int_equal(br_ctrl_step(&c, &in, NULL), BR_E_NULL);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_init_guards),           cmocka_unit_test(test_control_law),
+        cmocka_unit_test(test_compensation_adds_torque), cmocka_unit_test(test_saturation_and_antiwindup),
+        cmocka_unit_test(test_velocity_across_wrap),  cmocka_unit_test(test_step_rejects_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

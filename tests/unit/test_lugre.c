@@ -1,0 +1,144 @@
+/* LuGre module: configuration guards, eqs. 3-5, bounded bristle update. */
+#include "br_test.h"
+
+#include "br_reference_machine.h"
+#include "bristle/br_lugre.h"
+
+static br_lugre_cfg_t ref_cfg(void)
+{
+    br_lugre_cfg_t c = {BR_REF_SIGMA0_NPM_F, BR_REF_SIGMA1_NSPM_F, BR_REF_FC_N_F, BR_REF_FS_N_F, BR_REF_VS_MPS_F};
+    return c;
+}
+
+static void test_init_accepts_reference(void **st)
+{
+    (void)st;
+    br_lugre_t s;
+    br_lugre_cfg_t c = ref_cfg();
+    assert_int_equal(br_lugre_init(&s, &c), BR_OK);
+    assert_true(s.z_m == 0.0f);
+}
+
+static void test_init_guards(void **st)
+{
+    (void)st;
+    br_lugre_t s;
+    br_lugre_cfg_t c;
+    assert_int_equal(br_lugre_init(NULL, &c), BR_E_NULL);
+    assert_int_equal(br_lugre_init(&s, NULL), BR_E_NULL);
+    /* each field: zero/negative where it must be positive, non-finite everywhere */
+    c = ref_cfg(); c.sigma0_Npm = 0.0f;       assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.sigma0_Npm = -1.0f;      assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.sigma0_Npm = NAN;        assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.sigma1_Nspm = -1.0f;     assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.sigma1_Nspm = INFINITY;  assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.Fc_N = 0.0f;             assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.Fc_N = NAN;              assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.Fs_N = 6.0f;             assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM); /* < Fc */
+    c = ref_cfg(); c.Fs_N = INFINITY;         assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.vs_mps = 0.0f;           assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    c = ref_cfg(); c.vs_mps = NAN;            assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
+    /* sigma1 = 0 and Fs = Fc are physical (no damping, no Stribeck dip) */
+    c = ref_cfg(); c.sigma1_Nspm = 0.0f; c.Fs_N = c.Fc_N; assert_int_equal(br_lugre_init(&s, &c), BR_OK);
+}
+
+static void test_stribeck_curve(void **st)
+{
+    (void)st;
+    br_lugre_cfg_t c = ref_cfg();
+    /* eq. 5: g(0) = Fs, g(vs) = Fc + (Fs - Fc)/e, g(large) = Fc, even in v */
+    BR_ASSERT_NEAR(br_lugre_g_N(&c, 0.0f), 18.0, 1e-5);
+    BR_ASSERT_NEAR(br_lugre_g_N(&c, 2e-5f), 7.0 + 11.0 * exp(-1.0), 1e-5);
+    BR_ASSERT_NEAR(br_lugre_g_N(&c, -2e-5f), 7.0 + 11.0 * exp(-1.0), 1e-5);
+    BR_ASSERT_NEAR(br_lugre_g_N(&c, 0.05f), 7.0, 1e-5);
+}
+
+static void test_rate_and_force(void **st)
+{
+    (void)st;
+    br_lugre_cfg_t c = ref_cfg();
+    /* eq. 4 at the steady deflection g/sigma0 is zero; eq. 3 then gives g */
+    float zss = 7.0f / 4.0e6f;
+    BR_ASSERT_NEAR(br_lugre_zdot_mps(&c, zss, 0.01f, 7.0f), 0.0, 1e-9);
+    BR_ASSERT_NEAR(br_lugre_force_N(&c, zss, 0.0f), 7.0, 1e-5);
+    /* at z = 0 the rate is v and the force is sigma1 v */
+    BR_ASSERT_NEAR(br_lugre_zdot_mps(&c, 0.0f, 1e-4f, 18.0f), 1e-4, 1e-4 * 1e-7);
+    BR_ASSERT_NEAR(br_lugre_force_N(&c, 0.0f, 1e-4f), 0.2, 1e-6);
+}
+
+static void test_steady_sliding_reaches_g(void **st)
+{
+    (void)st;
+    br_lugre_t s;
+    br_lugre_cfg_t c = ref_cfg();
+    assert_int_equal(br_lugre_init(&s, &c), BR_OK);
+    float F = 0.0f;
+    /* 30 ms at 1e-3 m/s: 30 um of travel, 17 bristle lengths (g/sigma0 = 1.75 um) */
+    for (int k = 0; k < 300; k++) assert_int_equal(br_lugre_step(&s, 1e-3f, 1e-4f, &F), BR_OK);
+    BR_ASSERT_NEAR(F, br_lugre_g_N(&c, 1e-3f), 1e-3);
+    for (int k = 0; k < 300; k++) assert_int_equal(br_lugre_step(&s, -1e-3f, 1e-4f, &F), BR_OK);
+    BR_ASSERT_NEAR(F, -br_lugre_g_N(&c, 1e-3f), 1e-3);
+}
+
+static void test_presliding_is_a_spring(void **st)
+{
+    (void)st;
+    br_lugre_t s;
+    br_lugre_cfg_t c = ref_cfg();
+    assert_int_equal(br_lugre_init(&s, &c), BR_OK);
+    float F = 0.0f;
+    /* 10 nm of displacement at rest-like speed: z = (Fs/sigma0)(1 - exp(-sigma0 dx / Fs)),
+     * F ~ sigma0 dx (0.04 N), far below Fs */
+    assert_int_equal(br_lugre_step(&s, 1e-8f, 1.0f, &F), BR_OK);
+    BR_ASSERT_NEAR(s.z_m, 18.0 / 4e6 * (1.0 - exp(-4e6 * 1e-8 / 18.0)), 1e-8 * 1e-6);
+    BR_ASSERT_NEAR(br_lugre_force_N(&c, s.z_m, 0.0f), 0.04, 1e-4);
+}
+
+static void test_bounded_at_any_speed(void **st)
+{
+    (void)st;
+    br_lugre_t s;
+    br_lugre_cfg_t c = ref_cfg();
+    assert_int_equal(br_lugre_init(&s, &c), BR_OK);
+    const float speeds[] = {0.05f, 1.0f, 10.0f, -10.0f, 0.05f, -0.05f};
+    float F = 0.0f;
+    /* a h = sigma0 |v| h / g reaches 5.7e6 at 10 m/s and 1 ms: explicit RK4 would diverge */
+    for (unsigned i = 0; i < sizeof speeds / sizeof speeds[0]; i++) {
+        for (int k = 0; k < 50; k++) {
+            assert_int_equal(br_lugre_step(&s, speeds[i], 1e-3f, &F), BR_OK);
+            assert_true(isfinite(F));
+            assert_true(fabsf(s.z_m) <= BR_REF_FS_N_F / BR_REF_SIGMA0_NPM_F * 1.0001f);
+        }
+        BR_ASSERT_NEAR(F, copysign(7.0, speeds[i]), 1e-3 * 7.0 + 0.0);
+    }
+}
+
+static void test_step_rejects_bad_input(void **st)
+{
+    (void)st;
+    br_lugre_t s;
+    br_lugre_cfg_t c = ref_cfg();
+    float F = 123.0f;
+    s.ready = 0;
+    assert_int_equal(br_lugre_step(&s, 0.0f, 1e-3f, &F), BR_E_STATE);
+    assert_int_equal(br_lugre_init(&s, &c), BR_OK);
+    assert_int_equal(br_lugre_step(&s, 1e-4f, 1e-3f, &F), BR_OK);
+    float z = s.z_m;
+    assert_int_equal(br_lugre_step(&s, NAN, 1e-3f, &F), BR_E_INPUT);
+    assert_int_equal(br_lugre_step(&s, INFINITY, 1e-3f, &F), BR_E_INPUT);
+    assert_int_equal(br_lugre_step(&s, 1e-4f, 0.0f, &F), BR_E_INPUT);
+    assert_int_equal(br_lugre_step(&s, 1e-4f, NAN, &F), BR_E_INPUT);
+    assert_int_equal(br_lugre_step(&s, 1e-4f, 1e-3f, NULL), BR_E_NULL);
+    assert_true(s.z_m == z); /* state untouched by rejected steps */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_init_accepts_reference), cmocka_unit_test(test_init_guards),
+        cmocka_unit_test(test_stribeck_curve),         cmocka_unit_test(test_rate_and_force),
+        cmocka_unit_test(test_steady_sliding_reaches_g), cmocka_unit_test(test_presliding_is_a_spring),
+        cmocka_unit_test(test_bounded_at_any_speed),   cmocka_unit_test(test_step_rejects_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,181 @@
+/* Estimation model (eq. 6): guards, right-hand side, discretisation accuracy
+ * against a fine double-precision integration, boundedness at speed. */
+#include "br_test.h"
+
+#include "br_reference_machine.h"
+#include "bristle/br_model.h"
+
+static br_model_cfg_t ref_cfg(float dt)
+{
+    br_model_cfg_t c;
+    c.J_kgm2 = BR_REF_J_KGM2_F;
+    c.M_kg = BR_REF_M_KG_F;
+    c.lead_mprad = BR_REF_LEAD_MPRAD_F;
+    c.sigma2_Nspm = BR_REF_SIGMA2_NSPM_F;
+    c.lugre = (br_lugre_cfg_t){BR_REF_SIGMA0_NPM_F, BR_REF_SIGMA1_NSPM_F, BR_REF_FC_N_F, BR_REF_FS_N_F,
+                               BR_REF_VS_MPS_F};
+    c.dt_s = dt;
+    return c;
+}
+
+static void test_init_guards(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c;
+    assert_int_equal(br_model_init(NULL, &c), BR_E_NULL);
+    assert_int_equal(br_model_init(&m, NULL), BR_E_NULL);
+    c = ref_cfg(1e-3f); assert_int_equal(br_model_init(&m, &c), BR_OK);
+    c = ref_cfg(1e-3f); c.J_kgm2 = 0.0f;         assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(1e-3f); c.J_kgm2 = NAN;          assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(1e-3f); c.M_kg = -1.0f;          assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(1e-3f); c.M_kg = INFINITY;       assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(1e-3f); c.lead_mprad = 0.0f;     assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(1e-3f); c.sigma2_Nspm = -0.1f;   assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(1e-3f); c.sigma2_Nspm = NAN;     assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(0.0f);                           assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(-1e-3f);                         assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(NAN);                            assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ref_cfg(1e-3f); c.lugre.sigma0_Npm = 0.0f; assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    assert_int_equal(m.ready, 0);
+}
+
+static void test_deriv_eq6(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = ref_cfg(1e-3f);
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    const double L = BR_REF_LEAD_MPRAD, J = BR_REF_J_KGM2 + L * L * BR_REF_M_KG;
+    float x[BR_NX] = {0.1f, 2.0f, 1e-6f, 12.0f}, dx[BR_NX];
+    br_model_deriv(&m, x, 0.05f, dx);
+    double v = L * 2.0, zd = v - 4e6 * fabs(v) * 1e-6 / 12.0, fnl = 4e6 * 1e-6 + 2e3 * zd;
+    BR_ASSERT_NEAR(dx[0], 2.0, 1e-6);
+    BR_ASSERT_NEAR(dx[1], (0.05 - L * (50.0 * L * 2.0 + fnl)) / J, 1e-4 * fabs(dx[1]));
+    BR_ASSERT_NEAR(dx[2], zd, 1e-6 * fabs(zd));
+    BR_ASSERT_NEAR(dx[3], 0.0, 0.0);
+    BR_ASSERT_NEAR(br_model_fnl_N(&m, x), fnl, 1e-5 * fabs(fnl));
+}
+
+/* Double-precision RK4 of eq. 6 with n substeps: the accuracy reference. */
+static void fine_step(const double p[4], double u, double dt, int n, double out[4])
+{
+    const double L = BR_REF_LEAD_MPRAD, J = BR_REF_J_KGM2 + L * L * BR_REF_M_KG;
+    double x[4] = {p[0], p[1], p[2], p[3]}, h = dt / n;
+    for (int s = 0; s < n; s++) {
+        double k[4][4], xs[4];
+        for (int st = 0; st < 4; st++) {
+            const double a = st == 0 ? 0.0 : (st == 3 ? 1.0 : 0.5);
+            for (int i = 0; i < 4; i++) xs[i] = x[i] + (st ? a * h * k[st - 1][i] : 0.0);
+            double v = L * xs[1], zd = v - 4e6 * fabs(v) * xs[2] / xs[3];
+            k[st][0] = xs[1];
+            k[st][1] = (u - L * (50.0 * L * xs[1] + 4e6 * xs[2] + 2e3 * zd)) / J;
+            k[st][2] = zd;
+            k[st][3] = 0.0;
+        }
+        for (int i = 0; i < 4; i++) x[i] += h / 6.0 * (k[0][i] + 2 * k[1][i] + 2 * k[2][i] + k[3][i]);
+    }
+    for (int i = 0; i < 4; i++) out[i] = x[i];
+}
+
+static void test_rk4_accuracy_slow(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = ref_cfg(1e-3f);
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    /* circle speeds (|v| <= 8e-5 m/s): one 1 ms step vs 1000 fine substeps */
+    const float cases[][5] = {{0.0f, 0.0f, 0.0f, 18.0f, 0.01f},
+                              {0.5f, 0.06f, 1.0e-6f, 9.0f, 0.0055f},
+                              {0.5f, -0.06f, 1.5e-6f, 7.5f, -0.02f}};
+    for (unsigned i = 0; i < 3; i++) {
+        float x[BR_NX] = {cases[i][0], cases[i][1], cases[i][2], cases[i][3]}, xn[BR_NX];
+        double xd[4] = {x[0], x[1], x[2], x[3]}, ref[4];
+        assert_int_equal(br_model_step(&m, x, cases[i][4], xn), BR_OK);
+        fine_step(xd, cases[i][4], 1e-3, 1000, ref);
+        /* 1e-3 of the step's displacement, plus float32 rounding of theta */
+        BR_ASSERT_NEAR(xn[0], ref[0], 1e-3 * fabs(ref[0] - xd[0]) + 2.4e-7 * fabs(xd[0]));
+        /* 1 % of the step's change (case 3 crosses omega = 0, where |omega| has a kink) */
+        BR_ASSERT_NEAR(xn[1], ref[1], 1e-2 * fabs(ref[1] - xd[1]) + 1e-5);
+        /* the kink of |omega| makes RK4 first order across a reversal: 1e-3 of z there */
+        BR_ASSERT_NEAR(xn[2], ref[2], 1e-2 * fabs(ref[2] - xd[2]) + (i == 2 ? 1e-3 * fabs(xd[2]) : 1e-12));
+    }
+}
+
+static void test_bounded_at_speed(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = ref_cfg(1.5e-3f);
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    /* 0.05 m/s and beyond: a h = 43 at 0.05 m/s, far outside RK4's region */
+    const float omegas[] = {39.27f, -39.27f, 400.0f, -4000.0f};
+    for (unsigned i = 0; i < 4; i++) {
+        float x[BR_NX] = {0.0f, omegas[i], -1.0e-6f, 7.0f}, xn[BR_NX];
+        /* torque that holds the speed: viscous + Coulomb */
+        float u = BR_REF_LEAD_MPRAD_F * BR_REF_LEAD_MPRAD_F * 50.0f * omegas[i] +
+                  copysignf(BR_REF_LEAD_MPRAD_F * 7.0f, omegas[i]);
+        for (int k = 0; k < 1000; k++) {
+            assert_int_equal(br_model_step(&m, x, u, xn), BR_OK);
+            for (int j = 0; j < BR_NX; j++) x[j] = xn[j];
+            assert_true(fabsf(x[BR_X_Z]) <= 7.0f / 4.0e6f * 1.0001f + 1.0e-6f);
+        }
+        /* steady sliding: the speed is held and the friction is Coulomb */
+        BR_ASSERT_NEAR(x[BR_X_OMEGA], omegas[i], 1e-3 * fabs(omegas[i]));
+        BR_ASSERT_NEAR(br_model_fnl_N(&m, x), copysign(7.0, omegas[i]), 0.01);
+    }
+}
+
+static void test_switch_is_continuous(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = ref_cfg(1e-3f);
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    /* just below and just above the RK4 limit a h = 2 the two schemes agree */
+    const double L = BR_REF_LEAD_MPRAD;
+    float w_lim = (float)(2.0 * 7.0 / (4e6 * L * 1e-3));
+    float xa[BR_NX] = {0.0f, 0.999f * w_lim, 7.0f / 4.0e6f, 7.0f}, xb[BR_NX] = {0.0f, 1.001f * w_lim, 7.0f / 4.0e6f, 7.0f};
+    float na[BR_NX], nb[BR_NX];
+    float u = (float)(L * L * 50.0) * w_lim + (float)(L * 7.0);
+    assert_int_equal(br_model_step(&m, xa, u, na), BR_OK);
+    assert_int_equal(br_model_step(&m, xb, u, nb), BR_OK);
+    BR_ASSERT_NEAR(na[BR_X_OMEGA] / xa[BR_X_OMEGA], nb[BR_X_OMEGA] / xb[BR_X_OMEGA], 1e-3);
+    BR_ASSERT_NEAR(na[BR_X_Z], nb[BR_X_Z], 1e-3 * 7.0 / 4.0e6);
+}
+
+static void test_step_rejects_bad_input(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = ref_cfg(1e-3f);
+    float x[BR_NX] = {1.0f, 0.1f, 1e-6f, 10.0f}, xn[BR_NX];
+    m.ready = 0;
+    assert_int_equal(br_model_step(&m, x, 0.0f, xn), BR_E_STATE);
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    assert_int_equal(br_model_step(&m, x, NAN, xn), BR_E_INPUT);
+    assert_true(xn[0] == x[0] && xn[1] == x[1] && xn[2] == x[2] && xn[3] == x[3]);
+    x[BR_X_GP] = 0.0f;
+    assert_int_equal(br_model_step(&m, x, 0.0f, xn), BR_E_INPUT);
+    x[BR_X_GP] = -3.0f;
+    assert_int_equal(br_model_step(&m, x, 0.0f, xn), BR_E_INPUT);
+    x[BR_X_GP] = 10.0f;
+    x[BR_X_OMEGA] = INFINITY;
+    assert_int_equal(br_model_step(&m, x, 0.0f, xn), BR_E_INPUT);
+    assert_true(isinf(xn[BR_X_OMEGA]) && xn[BR_X_GP] == 10.0f); /* passed through unchanged */
+    x[BR_X_OMEGA] = 0.1f;
+    /* a torque that overflows float in one step is caught, the state kept */
+    assert_int_equal(br_model_step(&m, x, 3.0e38f, xn), BR_E_NUMERIC);
+    assert_true(xn[0] == x[0] && xn[1] == x[1]);
+    assert_int_equal(br_model_step(&m, NULL, 0.0f, xn), BR_E_NULL);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_init_guards),          cmocka_unit_test(test_deriv_eq6),
+        cmocka_unit_test(test_rk4_accuracy_slow),    cmocka_unit_test(test_bounded_at_speed),
+        cmocka_unit_test(test_switch_is_continuous), cmocka_unit_test(test_step_rejects_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
