@@ -47,7 +47,8 @@ int main(int argc, char **argv)
     }
     br_circle_cfg_t cfg = br_circle_cfg_thesis();
     br_circle_result_t r;
-    int rc = br_circle_run(&cfg, tr, &r);
+    br_circle_csv_header(tr);
+    int rc = br_circle_run(&cfg, br_circle_csv_sink, tr, &r);
     fclose(tr);
     if (rc != 0) return 1;
 

@@ -69,7 +69,15 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     return 0;
 }
 
-int br_circle_run(const br_circle_cfg_t *c, FILE *trace, br_circle_result_t *res)
+void br_circle_csv_header(FILE *f) { fprintf(f, "t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y\n"); }
+
+void br_circle_csv_sink(void *user, const br_circle_sample_t *s)
+{
+    fprintf((FILE *)user, "%.6f,%.9e,%.9e,%.9e,%.9e,%.6e,%.6f,%.6f,%.6f,%.6f\n", s->t_s, s->ref_m[0], s->ref_m[1],
+            s->pos_m[0], s->pos_m[1], s->radial_err_m, s->duty[0], s->duty[1], s->fnl_N[0], s->fnl_N[1]);
+}
+
+int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, br_circle_result_t *res)
 {
     if (!(c->radius_m > 0.0 && c->period_s > 0.0 && c->duration_s > 0.0 && c->dt_s > 0.0)) {
         fprintf(stderr, "br_circle: radius, period, duration and dt must be > 0\n");
@@ -80,33 +88,32 @@ int br_circle_run(const br_circle_cfg_t *c, FILE *trace, br_circle_result_t *res
     const long n = lround(c->duration_s / c->dt_s);
     double sum2 = 0.0, emax = 0.0;
     int nsat = 0;
-    if (trace) fprintf(trace, "t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y\n");
     for (long k = 0; k <= n; k++) {
         const double t = (double)k * c->dt_s;
-        double ref_m[2], pos[2];
+        br_circle_sample_t s;
+        s.t_s = t;
         int sat = 0;
         for (int i = 0; i < 2; i++) {
             uint32_t tick;
             ax[i].hal.tick_wait(ax[i].hal.ctx, &tick);
-            pos[i] = br_plant_pos_m(&ax[i].plant);
-            br_ref_t r = axis_ref(c, ax[i].phase, t, &ref_m[i]);
+            s.pos_m[i] = br_plant_pos_m(&ax[i].plant);
+            s.fnl_N[i] = ax[i].plant.fnl_N;
+            br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
             br_status_t st = br_axis_step(&ax[i].axis, &r, 0.0f);
             if (st != BR_OK) {
                 fprintf(stderr, "br_circle: axis %d step failed at t=%.4f s (status %d)\n", i, t, (int)st);
                 return -1;
             }
             sat |= ax[i].axis.last.saturated;
+            s.duty[i] = (double)ax[i].axis.last.duty;
         }
         /* contour error of a circle: radial deviation from the radius */
-        const double er = hypot(pos[0], pos[1]) - c->radius_m;
+        const double er = hypot(s.pos_m[0], s.pos_m[1]) - c->radius_m;
+        s.radial_err_m = er;
         sum2 += er * er;
         if (fabs(er) > emax) emax = fabs(er);
         nsat += sat;
-        if (trace) {
-            fprintf(trace, "%.6f,%.9e,%.9e,%.9e,%.9e,%.6e,%.6f,%.6f,%.6f,%.6f\n", t, ref_m[0], ref_m[1], pos[0],
-                    pos[1], er, (double)ax[0].axis.last.duty, (double)ax[1].axis.last.duty, ax[0].plant.fnl_N,
-                    ax[1].plant.fnl_N);
-        }
+        if (sink) sink(user, &s);
     }
     res->n_samples = n + 1;
     res->contour_rms_m = sqrt(sum2 / (double)(n + 1));

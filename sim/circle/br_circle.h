@@ -31,9 +31,25 @@ typedef struct {
 /* The thesis experiment with the reference machine and the H-inf gains. */
 br_circle_cfg_t br_circle_cfg_thesis(void);
 
-/* Runs the experiment. If trace is not NULL, writes one CSV row per period:
- * t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y. Returns 0, or -1
- * with a message on stderr on an invalid configuration or a firmware error. */
-int br_circle_run(const br_circle_cfg_t *cfg, FILE *trace, br_circle_result_t *res);
+/* One control period of both axes (load side, true plant positions). */
+typedef struct {
+    double t_s;
+    double ref_m[2];     /* x, y reference */
+    double pos_m[2];     /* x, y plant position */
+    double radial_err_m; /* hypot(x, y) - A: + is outward */
+    double duty[2];
+    double fnl_N[2];     /* true LuGre force of each axis */
+} br_circle_sample_t;
+
+typedef void (*br_circle_sink_t)(void *user, const br_circle_sample_t *s);
+
+/* Runs the experiment, calling sink (if not NULL) once per period. Returns 0,
+ * or -1 with a message on stderr on an invalid configuration or a firmware error. */
+int br_circle_run(const br_circle_cfg_t *cfg, br_circle_sink_t sink, void *user, br_circle_result_t *res);
+
+/* A sink writing CSV rows t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y
+ * to the FILE * given as user; br_circle_csv_header writes the header line. */
+void br_circle_csv_header(FILE *f);
+void br_circle_csv_sink(void *user, const br_circle_sample_t *s);
 
 #endif

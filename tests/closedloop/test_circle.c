@@ -1,0 +1,86 @@
+/* The thesis circle on the simulator with the H-inf-only controller
+ * (section 5): contour RMS near the published figure, outward quadrant
+ * glitches after the reversals, no saturation; and the same gains at 1.5 ms. */
+#include "br_test.h"
+
+#include "br_circle.h"
+
+#define THESIS_HINF_ONLY_RMS_M 2.4e-6
+
+/* Reversals of the circle x = A sin(2 pi t / 8), y = A cos(2 pi t / 8):
+ * y at t = 4 s, x at t = 2 and 6 s (t = 0 is the start, excluded). */
+static const double reversal_s[] = {2.0, 4.0, 6.0};
+#define N_REV 3
+#define WINDOW_S 0.8
+
+typedef struct {
+    double max_out[N_REV], max_in[N_REV];
+} glitch_t;
+
+static void glitch_sink(void *user, const br_circle_sample_t *s)
+{
+    glitch_t *g = user;
+    for (int i = 0; i < N_REV; i++) {
+        if (s->t_s >= reversal_s[i] && s->t_s < reversal_s[i] + WINDOW_S) {
+            if (s->radial_err_m > g->max_out[i]) g->max_out[i] = s->radial_err_m;
+            if (-s->radial_err_m > g->max_in[i]) g->max_in[i] = -s->radial_err_m;
+        }
+    }
+}
+
+static void test_hinf_only_reproduces_thesis(void **st)
+{
+    (void)st;
+    br_circle_cfg_t c = br_circle_cfg_thesis();
+    br_circle_result_t r;
+    glitch_t g = {{0}, {0}};
+    assert_int_equal(br_circle_run(&c, glitch_sink, &g, &r), 0);
+    print_message("H-inf only: contour RMS %.3e m (thesis %.1e), max %.3e m\n", r.contour_rms_m,
+                  THESIS_HINF_ONLY_RMS_M, r.max_err_m);
+    assert_int_equal(r.n_samples, 8001);
+    assert_true(fabs(r.contour_rms_m / THESIS_HINF_ONLY_RMS_M - 1.0) <= 0.30);
+    assert_int_equal(r.saturated_steps, 0);
+    for (int i = 0; i < N_REV; i++) {
+        print_message("reversal at %.0f s: outward %.2f um, inward %.2f um\n", reversal_s[i], g.max_out[i] * 1e6,
+                      g.max_in[i] * 1e6);
+        /* an outward glitch of a few um after each reversal, larger than any inward excursion */
+        assert_true(g.max_out[i] > 2e-6);
+        assert_true(g.max_out[i] > 1.5 * g.max_in[i]);
+    }
+}
+
+static void test_same_gains_at_pf_period(void **st)
+{
+    (void)st;
+    /* the PF runs at 1.5 ms: the H-inf loop must stay stable and comparable there */
+    br_circle_cfg_t c = br_circle_cfg_thesis();
+    c.dt_s = 1.5e-3;
+    br_circle_result_t r;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 0);
+    print_message("H-inf only at 1.5 ms: contour RMS %.3e m\n", r.contour_rms_m);
+    assert_true(r.contour_rms_m < 2.0 * THESIS_HINF_ONLY_RMS_M);
+    assert_int_equal(r.saturated_steps, 0);
+}
+
+static void test_rejects_bad_experiment(void **st)
+{
+    (void)st;
+    br_circle_cfg_t c = br_circle_cfg_thesis();
+    br_circle_result_t r;
+    c.dt_s = 0.0;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+    c = br_circle_cfg_thesis();
+    c.plant.sigma0_Npm = -1.0;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+    c = br_circle_cfg_thesis();
+    c.K[0] = NAN;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_hinf_only_reproduces_thesis),
+                                       cmocka_unit_test(test_same_gains_at_pf_period),
+                                       cmocka_unit_test(test_rejects_bad_experiment)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
