@@ -1,6 +1,8 @@
 /* make demo: the thesis's X-Y circle experiment on the simulator.
- * Usage: br_demo_circle --out DIR
- * Writes DIR/trace_<controller>.csv and DIR/summary.json, prints the table. */
+ * Usage: br_demo_circle --out DIR [--gains K0,K1,K2] [--dt SECONDS] [--nsub N]
+ * Writes DIR/trace_<controller>.csv and DIR/summary.json, prints the table.
+ * --gains, --dt and --nsub override the generated H-inf gains, the 1 ms period
+ * and the plant's substeps per period (for design and accuracy studies). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <stdio.h>
@@ -24,16 +26,32 @@ static int make_dir(const char *d)
 int main(int argc, char **argv)
 {
     const char *out = NULL;
+    br_circle_cfg_t cfg = br_circle_cfg_thesis();
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
             out = argv[++i];
+        } else if (strcmp(argv[i], "--gains") == 0 && i + 1 < argc) {
+            if (sscanf(argv[++i], "%f,%f,%f", &cfg.K[0], &cfg.K[1], &cfg.K[2]) != 3) {
+                fprintf(stderr, "br_demo_circle: --gains needs three comma-separated numbers\n");
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--dt") == 0 && i + 1 < argc) {
+            if (sscanf(argv[++i], "%lf", &cfg.dt_s) != 1) {
+                fprintf(stderr, "br_demo_circle: --dt needs a number of seconds\n");
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--nsub") == 0 && i + 1 < argc) {
+            if (sscanf(argv[++i], "%d", &cfg.plant.n_sub) != 1) {
+                fprintf(stderr, "br_demo_circle: --nsub needs an integer\n");
+                return 2;
+            }
         } else {
-            fprintf(stderr, "usage: %s --out DIR\n", argv[0]);
-            return 2;
+            out = NULL;
+            break;
         }
     }
     if (out == NULL) {
-        fprintf(stderr, "usage: %s --out DIR\n", argv[0]);
+        fprintf(stderr, "usage: %s --out DIR [--gains K0,K1,K2] [--dt SECONDS] [--nsub N]\n", argv[0]);
         return 2;
     }
     if (make_dir(out) != 0) return 1;
@@ -45,7 +63,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "br_demo_circle: cannot write %s: %s\n", path, strerror(errno));
         return 1;
     }
-    br_circle_cfg_t cfg = br_circle_cfg_thesis();
     br_circle_result_t r;
     br_circle_csv_header(tr);
     int rc = br_circle_run(&cfg, br_circle_csv_sink, tr, &r);
