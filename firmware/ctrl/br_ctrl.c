@@ -45,6 +45,8 @@ br_status_t br_ctrl_step(br_ctrl_t *c, const br_ctrl_in_t *in, br_ctrl_out_t *ou
     if (!isfinite(in->ref_frac_counts) || !isfinite(in->ref_omega_radps) || !isfinite(in->comp_N)) {
         out->tau_Nm = 0.0f;
         out->duty = 0.0f;
+        out->e_theta_rad = 0.0f;
+        out->omega_radps = 0.0f;
         out->saturated = 0;
         return BR_E_INPUT;
     }

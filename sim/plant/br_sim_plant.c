@@ -32,6 +32,8 @@ br_plant_cfg_t br_plant_cfg_reference(void)
     return c;
 }
 
+static double lugre_force(const br_plant_t *p);
+
 static int bad(const char *what)
 {
     fprintf(stderr, "br_plant_init: invalid %s\n", what);
@@ -62,7 +64,7 @@ int br_plant_init(br_plant_t *p, const br_plant_cfg_t *cfg, const br_plant_state
     /* eq. 1: effective inertia seen by the motor */
     p->Jeff_kgm2 = cfg->J_kgm2 + cfg->lead_mprad * cfg->lead_mprad * cfg->M_kg;
     p->tau_Nm = 0.0;
-    p->fnl_N = 0.0;
+    p->fnl_N = lugre_force(p);
     return 0;
 }
 
@@ -70,6 +72,15 @@ int br_plant_init(br_plant_t *p, const br_plant_cfg_t *cfg, const br_plant_state
 static double stribeck_g(const br_plant_cfg_t *c, double v)
 {
     return c->Fc_N + (c->Fs_N - c->Fc_N) * exp(-fabs(v) / c->vs_mps);
+}
+
+/* eq. 3 at the current state */
+static double lugre_force(const br_plant_t *p)
+{
+    const br_plant_cfg_t *c = &p->cfg;
+    const double v = c->lead_mprad * p->x.omega_radps;
+    const double g = stribeck_g(c, v);
+    return c->sigma0_Npm * p->x.z_m + c->sigma1_Nspm * (v - c->sigma0_Npm * fabs(v) * p->x.z_m / g);
 }
 
 static void substep(br_plant_t *p, double tau, double h)
@@ -116,10 +127,7 @@ void br_plant_step(br_plant_t *p, double duty, double dt_s)
         substep(p, tau, h);
     }
     p->tau_Nm = tau;
-    /* eq. 3 at the end of the step */
-    const double L = c->lead_mprad, v = L * p->x.omega_radps;
-    const double g = stribeck_g(c, v);
-    p->fnl_N = c->sigma0_Npm * p->x.z_m + c->sigma1_Nspm * (v - c->sigma0_Npm * fabs(v) * p->x.z_m / g);
+    p->fnl_N = lugre_force(p); /* eq. 3 at the end of the step */
 }
 
 int32_t br_plant_encoder(const br_plant_t *p)

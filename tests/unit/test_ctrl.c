@@ -20,7 +20,7 @@ static void test_init_guards(void **st)
 {
     (void)st;
     br_ctrl_t c;
-    br_ctrl_cfg_t k;
+    br_ctrl_cfg_t k = cfg();
     assert_int_equal(br_ctrl_init(NULL, &k), BR_E_NULL);
     assert_int_equal(br_ctrl_init(&c, NULL), BR_E_NULL);
     k = cfg(); assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
@@ -142,7 +142,7 @@ static void test_step_rejects_bad_input(void **st)
     for (int i = 0; i < 3; i++) {
         in = in_at(10, 0); in.comp_N = bad[i];
         assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_INPUT);
-        assert_true(out.tau_Nm == 0.0f && out.duty == 0.0f);
+        assert_true(out.tau_Nm == 0.0f && out.duty == 0.0f && out.e_theta_rad == 0.0f && out.omega_radps == 0.0f);
         in = in_at(10, 0); in.ref_frac_counts = bad[i];
         assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_INPUT);
         in = in_at(10, 0); in.ref_omega_radps = bad[i];

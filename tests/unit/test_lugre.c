@@ -23,7 +23,7 @@ static void test_init_guards(void **st)
 {
     (void)st;
     br_lugre_t s;
-    br_lugre_cfg_t c;
+    br_lugre_cfg_t c = ref_cfg();
     assert_int_equal(br_lugre_init(NULL, &c), BR_E_NULL);
     assert_int_equal(br_lugre_init(&s, NULL), BR_E_NULL);
     /* each field: zero/negative where it must be positive, non-finite everywhere */

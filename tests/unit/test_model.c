@@ -22,7 +22,7 @@ static void test_init_guards(void **st)
 {
     (void)st;
     br_model_t m;
-    br_model_cfg_t c;
+    br_model_cfg_t c = ref_cfg(1e-3f);
     assert_int_equal(br_model_init(NULL, &c), BR_E_NULL);
     assert_int_equal(br_model_init(&m, NULL), BR_E_NULL);
     c = ref_cfg(1e-3f); assert_int_equal(br_model_init(&m, &c), BR_OK);

@@ -10,7 +10,7 @@ static void test_init_guards(void **st)
 {
     (void)st;
     br_plant_t p;
-    br_plant_cfg_t c;
+    br_plant_cfg_t c = br_plant_cfg_reference();
     const br_plant_state_t bad_x = {NAN, 0.0, 0.0};
     c = br_plant_cfg_reference(); assert_int_equal(br_plant_init(&p, &c, &rest), 0);
     assert_int_equal(br_plant_init(NULL, &c, &rest), -1);
@@ -132,6 +132,16 @@ static void test_encoder_quantisation_and_wrap(void **st)
     assert_int_equal(br_plant_encoder(&p), INT32_MIN + 5);
 }
 
+static void test_initial_force_matches_state(void **st)
+{
+    (void)st;
+    br_plant_t p;
+    br_plant_cfg_t c = br_plant_cfg_reference();
+    br_plant_state_t x0 = {0.0, 0.0, 1.0e-6};
+    assert_int_equal(br_plant_init(&p, &c, &x0), 0);
+    BR_ASSERT_NEAR(p.fnl_N, c.sigma0_Npm * 1.0e-6, 1e-12); /* eq. 3 at rest */
+}
+
 static void test_nonfinite_duty_is_zero_torque(void **st)
 {
     (void)st;
@@ -150,6 +160,7 @@ int main(void)
         cmocka_unit_test(test_init_guards),          cmocka_unit_test(test_sticks_below_stiction),
         cmocka_unit_test(test_half_step_at_speed),   cmocka_unit_test(test_bounded_at_full_duty),
         cmocka_unit_test(test_encoder_quantisation_and_wrap), cmocka_unit_test(test_nonfinite_duty_is_zero_torque),
+        cmocka_unit_test(test_initial_force_matches_state),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,103 @@
+# bristle: top-level entry points, a thin wrapper over the CMake presets
+# (CMakePresets.json). `make help` lists the targets; V=1 shows the commands.
+SHELL := bash
+.SHELLFLAGS := -euo pipefail -c
+.DEFAULT_GOAL := help
+.DELETE_ON_ERROR:
+.SUFFIXES:
+MAKEFLAGS += --no-print-directory
+
+V ?= 0
+ifeq ($(V),1)
+  Q :=
+  NINJA_QUIET :=
+else
+  Q := @
+  NINJA_QUIET := -- --quiet
+endif
+
+JOBS       ?= 2
+PYTHON     := .venv/bin/python
+IMAGE      := build/cm7-release/hal/stm32h7/br_image_stm32h7.elf
+FLASH_KIB  := 2048
+RAM_KIB    := 128
+DEMO_OUT   := out/demo
+
+# $(call configure,<preset>): cmake --preset, output shown only on failure.
+# Always run: cheap when nothing changed, and it picks up edited presets.
+define configure
+	$(Q)echo "== configure $(1)"
+	$(Q)log="$$(cmake --preset $(1) 2>&1)" || { echo "$$log"; echo "configure $(1) failed" >&2; exit 1; }
+endef
+
+# $(call build,<preset>)
+define build
+	$(Q)echo "== build $(1)"
+	$(Q)cmake --build --preset $(1) $(NINJA_QUIET)
+endef
+
+# Flash = text + data (the .data image is stored in flash), RAM = data + bss
+# (bss includes the reserved stack), from arm-none-eabi-size (Berkeley format).
+define print_size
+	$(Q)test -f $(IMAGE) || { echo "no firmware image at $(IMAGE)" >&2; exit 1; }
+	$(Q)arm-none-eabi-size $(IMAGE) | awk -v fk=$(FLASH_KIB) -v rk=$(RAM_KIB) -v img=$(IMAGE) ' \
+	  NR == 2 { f = $$1 + $$2; r = $$2 + $$3; ok = 1; \
+	    printf "firmware %s\n", img; \
+	    printf "  flash: %7d bytes (text %d + data %d)  %5.2f%% of %d KiB\n", f, $$1, $$2, 100 * f / (fk * 1024), fk; \
+	    printf "  RAM:   %7d bytes (data %d + bss %d)   %5.2f%% of %d KiB DTCM\n", r, $$2, $$3, 100 * r / (rk * 1024), rk } \
+	  END { exit ok ? 0 : 1 }'
+endef
+
+.PHONY: help deps build test demo firmware regen clean distclean
+
+help:
+	@echo "bristle targets:"
+	@echo "  make deps      install Debian packages and the pinned .venv (cmake/setup-deps.sh)"
+	@echo "  make build     configure + build host-debug (ASan + UBSan)"
+	@echo "  make test      host-debug build + ctest, then the firmware image and its size"
+	@echo "  make demo      host-release build, run the circle demo into $(DEMO_OUT), plot it"
+	@echo "  make firmware  cross build (cm7-release) and print flash / RAM use"
+	@echo "  make regen     regenerate the H-infinity gains and the golden traces"
+	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
+	@echo "  V=1 shows the commands; JOBS=n sets the ctest parallelism (default 2)"
+
+deps:
+	$(Q)cmake/setup-deps.sh
+
+build: deps
+	$(call configure,host-debug)
+	$(call build,host-debug)
+
+test: deps
+	$(call configure,host-debug)
+	$(call build,host-debug)
+	$(Q)echo "== test host-debug"
+	$(Q)ctest --preset host-debug --output-on-failure -j$(JOBS)
+	$(call configure,cm7-release)
+	$(call build,cm7-release)
+	$(print_size)
+
+demo: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== demo -> $(DEMO_OUT)"
+	$(Q)mkdir -p $(DEMO_OUT)
+	$(Q)build/host-release/sim/br_demo_circle --out $(DEMO_OUT)
+	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_demo.py $(DEMO_OUT)
+
+firmware: deps
+	$(call configure,cm7-release)
+	$(call build,cm7-release)
+	$(print_size)
+
+regen: deps
+	$(Q)echo "== regen: gains"
+	$(Q)$(PYTHON) firmware/design/synth_hinf.py
+	$(Q)echo "== regen: golden traces"
+	$(Q)$(PYTHON) golden/gen_traces.py
+
+clean:
+	$(Q)rm -rf build out
+
+distclean: clean
+	$(Q)rm -rf .venv

@@ -1,0 +1,131 @@
+"""Four-state estimation model of one ball-screw axis (thesis eq. 6),
+float64 golden reference.
+
+State x = [theta (rad), omega (rad/s), z (m), g_p (N)] on the motor side,
+input u = motor torque (N m), held over the step h:
+
+    dtheta/dt = omega
+    domega/dt = (u - L (sigma2 L omega + f_nl)) / Jeff,   Jeff = J + L^2 M
+    dz/dt     = L omega - sigma0 L |omega| z / g_p
+    dg_p/dt   = 0
+    f_nl      = sigma0 z + sigma1 (L omega - sigma0 L |omega| z / g_p)
+
+Discretisation: classic RK4 while the bristle rate times the step,
+a h = sigma0 L |omega| h / g_p, is <= 2 both at the start and at the RK4 end
+point; otherwise the bounded displacement-exact scheme (B2 below).
+"""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .lugre import LugreParams
+
+BR_OK = 0
+BR_E_INPUT = -3
+
+BRANCH_RK4 = 0
+BRANCH_BOUNDED = 1
+BRANCH_INVALID = -1
+
+RK4_AH_MAX = 2.0
+BOUNDED_PASSES = 3
+
+
+@dataclass(frozen=True)
+class ModelParams:
+    J: float       # motor + screw inertia, kg m^2
+    M: float       # table mass, kg
+    L: float       # lead / (2 pi), m/rad
+    sigma2: float  # viscous friction, N s/m
+    lugre: LugreParams
+
+    @property
+    def Jeff(self):
+        return self.J + self.L * self.L * self.M
+
+    @classmethod
+    def from_machine(cls, m):
+        return cls(J=m["J_kgm2"], M=m["M_kg"], L=m["L_mprad"],
+                   sigma2=m["sigma2_Nspm"], lugre=LugreParams.from_machine(m))
+
+
+def fnl(p, x):
+    """Lumped friction f_nl(x) = sigma0 z + sigma1 dz/dt (eqs. 3, 4 with g = g_p)."""
+    _, w, z, gp = x
+    s0, s1, L = p.lugre.sigma0, p.lugre.sigma1, p.L
+    zd = L * w - s0 * L * abs(w) * z / gp
+    return s0 * z + s1 * zd
+
+
+def deriv(p, x, u):
+    """Eq. 6 right-hand side f(x, u)."""
+    _, w, z, gp = x
+    s0, s1, L = p.lugre.sigma0, p.lugre.sigma1, p.L
+    zd = L * w - s0 * L * abs(w) * z / gp          # eq. 4 on the load side
+    f = s0 * z + s1 * zd                           # eq. 3
+    wd = (u - L * (p.sigma2 * L * w + f)) / p.Jeff  # rigid body
+    return np.array([w, wd, zd, 0.0], dtype=np.float64)
+
+
+def rk4(p, x, u, h):
+    """Classic four-stage Runge-Kutta step of eq. 6 with u held."""
+    x = np.asarray(x, dtype=np.float64)
+    k1 = deriv(p, x, u)
+    k2 = deriv(p, x + (h / 2.0) * k1, u)
+    k3 = deriv(p, x + (h / 2.0) * k2, u)
+    k4 = deriv(p, x + h * k3, u)
+    return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+
+def bounded(p, x, u, h):
+    """B2: displacement-exact bristle update + trapezoidal rigid body.
+
+    Three fixed-point passes on the mean velocity wm (first pass wm = omega0):
+        dth  = wm h,  dx = L dth,  r = sigma0 |dx| / g_p
+        z1   = zss + (z - zss) e,              zss = sgn(dx) g_p / sigma0, e = exp(-r)
+        zint = h (zss + (z - zss) (1 - e) / r) (= integral of z over the step)
+        (dx = 0: z1 = z, zint = z h)
+        w1   = w + (u h - L^2 sigma2 dth - L (sigma0 zint + sigma1 (z1 - z))) / Jeff
+        wm   = (w + w1) / 2
+    The result uses dth, w1, z1 of the last pass; g_p is unchanged."""
+    theta, w, z, gp = (float(v) for v in x)
+    s0, s1, L = p.lugre.sigma0, p.lugre.sigma1, p.L
+    Jeff = p.Jeff
+    wm = w
+    for _ in range(BOUNDED_PASSES):
+        dth = wm * h
+        dx = L * dth
+        r = s0 * abs(dx) / gp
+        if dx != 0.0:
+            zss = (1.0 if dx > 0.0 else -1.0) * gp / s0
+            e = math.exp(-r)
+            z1 = zss + (z - zss) * e
+            zint = h * (zss + (z - zss) * (1.0 - e) / r)
+        else:
+            z1 = z
+            zint = z * h
+        w1 = w + (u * h - L * L * p.sigma2 * dth - L * (s0 * zint + s1 * (z1 - z))) / Jeff
+        wm = (w + w1) / 2.0
+    return np.array([theta + dth, w1, z1, gp], dtype=np.float64)
+
+
+def ah(p, w, gp, h):
+    """Bristle rate times the step: sigma0 L |omega| h / g_p."""
+    return p.lugre.sigma0 * p.L * abs(w) * h / gp
+
+
+def step(p, x, u, h):
+    """One discretisation step of eq. 6 over h with u held.
+
+    Returns (status, x_next, branch). Invalid input (a non-finite entry of x
+    or u, or g_p <= 0) gives (BR_E_INPUT, x, BRANCH_INVALID)."""
+    x = np.asarray(x, dtype=np.float64)
+    if not (np.all(np.isfinite(x)) and math.isfinite(u)) or not x[3] > 0.0:
+        return BR_E_INPUT, x.copy(), BRANCH_INVALID
+    x1 = rk4(p, x, u, h)
+    # RK4 only while a h <= 2 at the start and at the RK4 end point
+    # (a NaN end point compares false and falls to the bounded scheme).
+    if ah(p, x[1], x[3], h) <= RK4_AH_MAX and ah(p, x1[1], x[3], h) <= RK4_AH_MAX:
+        return BR_OK, x1, BRANCH_RK4
+    return BR_OK, bounded(p, x, u, h), BRANCH_BOUNDED

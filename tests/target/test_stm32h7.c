@@ -1,0 +1,433 @@
+/* STM32H743 port logic against fake register blocks in RAM: register
+ * programming at init, encoder counts across counter wraps (32-bit TIM2 and
+ * the 16-bit extension), PWM duty mapping, SysTick polling, init guards.
+ *
+ * A fake block is plain memory: COUNTFLAG is not cleared by a read and
+ * counters do not run, so each test sets the registers a real peripheral
+ * would change. */
+#include "br_test.h"
+
+#include <string.h>
+
+#include "bristle/br_encoder.h"
+#include "bristle/br_stm32h7.h"
+
+typedef struct {
+    br_stm32h7_tim_t tim1;
+    br_stm32h7_tim_t tim2;
+    br_stm32h7_systick_t systick;
+} fake_regs_t;
+
+/* 480 MHz core, 240 MHz timer clock, 20 kHz PWM, 1 kHz control. */
+static br_stm32h7_cfg_t cfg_for(fake_regs_t *f)
+{
+    br_stm32h7_cfg_t c;
+    memset(&c, 0, sizeof c);
+    c.pwm_tim = &f->tim1;
+    c.enc_tim = &f->tim2;
+    c.systick = &f->systick;
+    c.cpu_clock_hz = 480000000u;
+    c.tim_clock_hz = 240000000u;
+    c.pwm_hz = 20000u;
+    c.control_hz = 1000u;
+    c.enc_counter_bits = 32u;
+    c.enc_filter = 3u;
+    c.deadtime_ticks = 48u;
+    return c;
+}
+
+static void fake_fill(fake_regs_t *f, unsigned char pattern)
+{
+    memset(f, pattern, sizeof *f);
+}
+
+static void port_up(br_stm32h7_t *port, fake_regs_t *f, uint32_t enc_bits)
+{
+    fake_fill(f, 0);
+    br_stm32h7_cfg_t c = cfg_for(f);
+    c.enc_counter_bits = enc_bits;
+    assert_int_equal(br_stm32h7_init(port, &c), BR_OK);
+}
+
+/* ---- init ------------------------------------------------------------- */
+
+static void test_init_programs_registers(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    fake_fill(&f, 0);
+    f.tim2.SMCR = 0x00010007u; /* stale SMS bits, incl. SMS[3], must be replaced */
+    f.systick.CTRL = BR_SYSTICK_CTRL_TICKINT;
+    br_stm32h7_cfg_t c = cfg_for(&f);
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_OK);
+
+    /* encoder: mode 3, both inputs on their own pins, filter, full range, running */
+    assert_int_equal(f.tim2.SMCR & BR_TIM_SMCR_SMS_Msk, 3u);
+    assert_int_equal(f.tim2.CCMR1, 0x3131u); /* CC1S=01 IC1F=3, CC2S=01 IC2F=3 */
+    assert_int_equal(f.tim2.CCER & (BR_TIM_CCER_CC1P | BR_TIM_CCER_CC2P), 0u);
+    assert_int_equal(f.tim2.ARR, 0xFFFFFFFFu);
+    assert_int_equal(f.tim2.PSC, 0u);
+    assert_int_equal(f.tim2.CNT, 0u);
+    assert_true((f.tim2.CR1 & BR_TIM_CR1_CEN) != 0u);
+
+    /* PWM: centre-aligned 20 kHz at 240 MHz -> ARR = 240e6 / (2 * 20e3) = 6000 */
+    assert_int_equal(f.tim1.PSC, 0u);
+    assert_int_equal(f.tim1.ARR, 6000u);
+    assert_int_equal(port.pwm_arr, 6000u);
+    assert_int_equal(f.tim1.CR1 & BR_TIM_CR1_CMS_Msk, BR_TIM_CR1_CMS_CENTER1);
+    assert_true((f.tim1.CR1 & BR_TIM_CR1_ARPE) != 0u);
+    assert_true((f.tim1.CR1 & BR_TIM_CR1_CEN) != 0u);
+    assert_int_equal(f.tim1.CCMR1, 0x6868u); /* OC1M = OC2M = PWM1, preload on */
+    assert_int_equal(f.tim1.CCER, BR_TIM_CCER_CC1E | BR_TIM_CCER_CC1NE | BR_TIM_CCER_CC2E | BR_TIM_CCER_CC2NE);
+    assert_true((f.tim1.BDTR & BR_TIM_BDTR_MOE) != 0u);
+    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, 48u);
+    assert_int_equal(f.tim1.CCR1, 0u);
+    assert_int_equal(f.tim1.CCR2, 0u);
+    assert_true((f.tim1.EGR & BR_TIM_EGR_UG) != 0u);
+
+    /* SysTick: processor clock, 480000 cycles per tick, polled (no interrupt) */
+    assert_int_equal(f.systick.LOAD, 479999u);
+    assert_int_equal(f.systick.CTRL, BR_SYSTICK_CTRL_CLKSOURCE | BR_SYSTICK_CTRL_ENABLE);
+
+    /* 16-bit encoder timer: ARR = 0xFFFF */
+    port_up(&port, &f, 16u);
+    assert_int_equal(f.tim2.ARR, 0xFFFFu);
+}
+
+static void test_init_pwm_prescaler(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    fake_fill(&f, 0);
+    br_stm32h7_cfg_t c = cfg_for(&f);
+    c.pwm_hz = 1000u; /* 120000 ticks per half period > 16 bits: PSC = 1, ARR = 60000 */
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_OK);
+    assert_int_equal(f.tim1.PSC, 1u);
+    assert_int_equal(f.tim1.ARR, 60000u);
+    /* reset clock of the image: 64 MHz timers, 20 kHz -> ARR 1600 */
+    c.cpu_clock_hz = 64000000u;
+    c.tim_clock_hz = 64000000u;
+    c.pwm_hz = 20000u;
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_OK);
+    assert_int_equal(f.tim1.PSC, 0u);
+    assert_int_equal(f.tim1.ARR, 1600u);
+    assert_int_equal(f.systick.LOAD, 63999u);
+}
+
+/* Each rejected configuration leaves every register untouched and the port
+ * unusable. */
+static void expect_rejected(const br_stm32h7_cfg_t *c, fake_regs_t *f, br_status_t want)
+{
+    br_stm32h7_t port;
+    fake_regs_t before;
+    int32_t counts = 0;
+    uint32_t tick = 0u;
+    memcpy(&before, f, sizeof before);
+    port.ready = 1;
+    assert_int_equal(br_stm32h7_init(&port, c), want);
+    assert_int_equal(memcmp(&before, f, sizeof before), 0);
+    assert_int_equal(br_stm32h7_encoder_read(&port, &counts), BR_E_STATE);
+    assert_int_equal(br_stm32h7_pwm_write(&port, 0.0f), BR_E_STATE);
+    assert_int_equal(br_stm32h7_tick_wait(&port, &tick), BR_E_STATE);
+}
+
+static void test_init_guards(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    fake_fill(&f, 0xA5);
+    br_stm32h7_cfg_t c = cfg_for(&f);
+
+    assert_int_equal(br_stm32h7_init(NULL, &c), BR_E_NULL);
+    assert_int_equal(br_stm32h7_init(&port, NULL), BR_E_NULL);
+
+    c = cfg_for(&f); c.pwm_tim = NULL;        expect_rejected(&c, &f, BR_E_NULL);
+    c = cfg_for(&f); c.enc_tim = NULL;        expect_rejected(&c, &f, BR_E_NULL);
+    c = cfg_for(&f); c.systick = NULL;        expect_rejected(&c, &f, BR_E_NULL);
+    c = cfg_for(&f); c.enc_tim = &f.tim1;     expect_rejected(&c, &f, BR_E_PARAM); /* one timer, two jobs */
+    c = cfg_for(&f); c.cpu_clock_hz = 0u;     expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.tim_clock_hz = 0u;     expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.pwm_hz = 0u;           expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.control_hz = 0u;       expect_rejected(&c, &f, BR_E_PARAM);
+    /* PWM too fast for the timer clock: 240 MHz / (2 * 1.5 MHz) = 80 steps < 100 */
+    c = cfg_for(&f); c.pwm_hz = 1500000u;     expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.pwm_hz = 1200000u;     /* exactly 100 steps: accepted */
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_OK);
+    fake_fill(&f, 0xA5);
+    c = cfg_for(&f); c.pwm_hz = 300000000u;   expect_rejected(&c, &f, BR_E_PARAM); /* > clock */
+    /* tick: the period must be a whole number of cycles, >= 1000, <= 2^24 */
+    c = cfg_for(&f); c.control_hz = 7u;       expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.control_hz = 10u;      expect_rejected(&c, &f, BR_E_PARAM); /* 48e6 > 2^24 */
+    c = cfg_for(&f); c.control_hz = 960000u;  expect_rejected(&c, &f, BR_E_PARAM); /* 500 cycles */
+    c = cfg_for(&f); c.enc_counter_bits = 24u; expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.enc_counter_bits = 0u; expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.enc_filter = 16u;      expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.deadtime_ticks = 128u; expect_rejected(&c, &f, BR_E_PARAM);
+}
+
+static void test_null_and_state(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    br_hal_t hal;
+    int32_t counts;
+    uint32_t tick;
+    memset(&port, 0, sizeof port);
+    assert_int_equal(br_stm32h7_hal(&port, &hal), BR_E_STATE);
+    assert_int_equal(br_stm32h7_pwm_disable(&port), BR_E_STATE);
+    port_up(&port, &f, 32u);
+    assert_int_equal(br_stm32h7_encoder_read(NULL, &counts), BR_E_NULL);
+    assert_int_equal(br_stm32h7_encoder_read(&port, NULL), BR_E_NULL);
+    assert_int_equal(br_stm32h7_pwm_write(NULL, 0.0f), BR_E_NULL);
+    assert_int_equal(br_stm32h7_pwm_disable(NULL), BR_E_NULL);
+    assert_int_equal(br_stm32h7_tick_wait(NULL, &tick), BR_E_NULL);
+    assert_int_equal(br_stm32h7_tick_wait(&port, NULL), BR_E_NULL);
+    assert_int_equal(br_stm32h7_hal(NULL, &hal), BR_E_NULL);
+    assert_int_equal(br_stm32h7_hal(&port, NULL), BR_E_NULL);
+    assert_int_equal(br_stm32h7_rcc_enable(NULL), BR_E_NULL);
+    assert_int_equal(br_stm32h7_gpio_af(NULL, 0u, 1u), BR_E_NULL);
+    assert_int_equal(br_stm32h7_count_ext_init(NULL, 16u, 0u), BR_E_NULL);
+}
+
+/* ---- encoder ------------------------------------------------------------ */
+
+/* Moves the fake 32-bit counter in steps across INT32_MAX -> INT32_MIN and
+ * 0xFFFFFFFF -> 0: the counts equal the counter and every difference is the
+ * step. */
+static void test_encoder_32bit_wrap(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    port_up(&port, &f, 32u);
+    const uint32_t starts[] = {0x7FFFF000u, 0xFFFFF000u};
+    const int32_t steps[] = {1000, -1000, 4093};
+    for (size_t s = 0; s < 2; ++s) {
+        for (size_t d = 0; d < 3; ++d) {
+            uint32_t raw = starts[s];
+            int32_t prev = 0;
+            f.tim2.CNT = raw;
+            assert_int_equal(br_stm32h7_encoder_read(&port, &prev), BR_OK);
+            assert_int_equal((uint32_t)prev, raw);
+            for (int k = 0; k < 10; ++k) {
+                int32_t now = 0;
+                raw += (uint32_t)steps[d];
+                f.tim2.CNT = raw;
+                assert_int_equal(br_stm32h7_encoder_read(&port, &now), BR_OK);
+                assert_int_equal((uint32_t)now, raw);
+                assert_int_equal(br_counts_delta(now, prev), steps[d]);
+                prev = now;
+            }
+        }
+    }
+}
+
+/* A 16-bit timer: the port's extension keeps continuous counts through many
+ * counter wraps, forwards and back. */
+static void test_encoder_16bit_extension(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    port_up(&port, &f, 16u);
+    int64_t pos = 0;
+    int32_t counts = 0;
+    const int32_t steps[] = {20000, 32767, -32767, -12345, 7};
+    for (size_t d = 0; d < sizeof steps / sizeof steps[0]; ++d) {
+        for (int k = 0; k < 25; ++k) {
+            pos += steps[d];
+            /* the timer holds pos mod 2^16; bits 16..31 of CNT read as 0 */
+            f.tim2.CNT = (uint32_t)((uint64_t)pos & 0xFFFFu);
+            assert_int_equal(br_stm32h7_encoder_read(&port, &counts), BR_OK);
+            assert_int_equal(counts, (int32_t)pos);
+        }
+    }
+    /* bits above the counter width are ignored */
+    f.tim2.CNT = 0xABCD0000u | (uint32_t)((uint64_t)pos & 0xFFFFu);
+    assert_int_equal(br_stm32h7_encoder_read(&port, &counts), BR_OK);
+    assert_int_equal(counts, (int32_t)pos);
+}
+
+/* The generic extension: past the int32 range it wraps like a free-running
+ * int32 counter (br_counts_delta stays exact); a move of exactly half the
+ * counter range is read backwards (the documented limit). */
+static void test_count_ext_generic(void **st)
+{
+    (void)st;
+    br_stm32h7_count_ext_t e;
+    assert_int_equal(br_stm32h7_count_ext_init(&e, 1u, 0u), BR_E_PARAM);
+    assert_int_equal(br_stm32h7_count_ext_init(&e, 33u, 0u), BR_E_PARAM);
+
+    assert_int_equal(br_stm32h7_count_ext_init(&e, 16u, 0xFFF0u), BR_OK);
+    uint32_t raw = 0xFFF0u;
+    uint64_t total = 0xFFF0u;
+    int32_t prev = (int32_t)0xFFF0;
+    for (int k = 0; k < 100000; ++k) { /* 3e9 counts: beyond INT32_MAX */
+        raw = (raw + 30000u) & 0xFFFFu;
+        total += 30000u;
+        int32_t now = br_stm32h7_count_ext_update(&e, raw);
+        assert_int_equal(br_counts_delta(now, prev), 30000);
+        assert_int_equal((uint32_t)now, (uint32_t)total);
+        prev = now;
+    }
+
+    /* 12-bit counter, half-range limit */
+    assert_int_equal(br_stm32h7_count_ext_init(&e, 12u, 0u), BR_OK);
+    assert_int_equal(br_stm32h7_count_ext_update(&e, 2047u), 2047);
+    assert_int_equal(br_stm32h7_count_ext_update(&e, 0u), 0);
+    assert_int_equal(br_stm32h7_count_ext_update(&e, 2048u), -2048);
+    assert_int_equal(br_stm32h7_count_ext_update(&e, 4095u), -1);
+    assert_int_equal(br_stm32h7_count_ext_update(&e, 1u), 1);
+
+    /* 32-bit counter: the extension is the counter itself */
+    assert_int_equal(br_stm32h7_count_ext_init(&e, 32u, 0x7FFFFFFFu), BR_OK);
+    assert_int_equal(br_stm32h7_count_ext_update(&e, 0x80000000u), INT32_MIN);
+    assert_int_equal(br_stm32h7_count_ext_update(&e, 0xFFFFFFFFu), -1);
+    assert_int_equal(br_stm32h7_count_ext_update(&e, 0x00000002u), 2);
+}
+
+/* ---- PWM ------------------------------------------------------------------- */
+
+static void expect_duty(br_stm32h7_t *port, fake_regs_t *f, float duty, br_status_t want, uint32_t ccr1,
+                        uint32_t ccr2)
+{
+    f->tim1.CCR1 = 0xDEADu; /* stale values must be overwritten */
+    f->tim1.CCR2 = 0xBEEFu;
+    assert_int_equal(br_stm32h7_pwm_write(port, duty), want);
+    assert_int_equal(f->tim1.CCR1, ccr1);
+    assert_int_equal(f->tim1.CCR2, ccr2);
+}
+
+static void test_pwm_duty_mapping(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    port_up(&port, &f, 32u); /* ARR = 6000 */
+    expect_duty(&port, &f, 0.0f, BR_OK, 0u, 0u);
+    expect_duty(&port, &f, -0.0f, BR_OK, 0u, 0u);
+    expect_duty(&port, &f, 0.5f, BR_OK, 3000u, 0u);
+    expect_duty(&port, &f, -0.5f, BR_OK, 0u, 3000u);
+    expect_duty(&port, &f, 1.0f, BR_OK, 6000u, 0u);
+    expect_duty(&port, &f, -1.0f, BR_OK, 0u, 6000u);
+    expect_duty(&port, &f, 0.25f, BR_OK, 1500u, 0u);
+    expect_duty(&port, &f, 1.0e-4f, BR_OK, 1u, 0u);     /* 0.6 steps rounds to 1 */
+    expect_duty(&port, &f, 1.7f, BR_OK, 6000u, 0u);     /* clamped */
+    expect_duty(&port, &f, -1.7f, BR_OK, 0u, 6000u);
+    expect_duty(&port, &f, 1.0e30f, BR_OK, 6000u, 0u);
+    expect_duty(&port, &f, NAN, BR_E_INPUT, 0u, 0u);    /* rejected: output 0 */
+    expect_duty(&port, &f, INFINITY, BR_E_INPUT, 0u, 0u);
+    expect_duty(&port, &f, -INFINITY, BR_E_INPUT, 0u, 0u);
+
+    /* safe stop: duty 0 and the main output enable cleared */
+    f.tim1.CCR1 = 100u;
+    assert_int_equal(br_stm32h7_pwm_disable(&port), BR_OK);
+    assert_int_equal(f.tim1.CCR1, 0u);
+    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_MOE, 0u);
+    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, 48u);
+}
+
+/* ---- tick ------------------------------------------------------------------ */
+
+static void test_tick_polling(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    uint32_t tick = 99u;
+    port_up(&port, &f, 32u);
+
+    /* no wrap within LOAD + 1 polls: SysTick is not running */
+    assert_int_equal(br_stm32h7_tick_wait(&port, &tick), BR_E_STATE);
+    assert_int_equal(tick, 99u);
+
+    /* COUNTFLAG present: the tick is taken and indexed 0, 1, 2, ... The fake
+     * keeps the flag (hardware clears it on the read), so each call here sees
+     * it on entry, which the port counts as an overrun. */
+    for (uint32_t k = 0; k < 3u; ++k) {
+        f.systick.CTRL |= BR_SYSTICK_CTRL_COUNTFLAG;
+        assert_int_equal(br_stm32h7_tick_wait(&port, &tick), BR_OK);
+        assert_int_equal(tick, k);
+        assert_int_equal(port.overruns, k + 1u);
+    }
+    f.systick.CTRL &= ~BR_SYSTICK_CTRL_COUNTFLAG;
+    assert_int_equal(br_stm32h7_tick_wait(&port, &tick), BR_E_STATE);
+    assert_int_equal(port.next_tick, 3u);
+    /* init restarts the index */
+    port_up(&port, &f, 32u);
+    f.systick.CTRL |= BR_SYSTICK_CTRL_COUNTFLAG;
+    assert_int_equal(br_stm32h7_tick_wait(&port, &tick), BR_OK);
+    assert_int_equal(tick, 0u);
+}
+
+/* ---- br_hal_t and board helpers ------------------------------------------ */
+
+static void test_hal_adapter(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    br_hal_t hal;
+    int32_t counts = 0;
+    uint32_t tick = 0u;
+    port_up(&port, &f, 32u);
+    assert_int_equal(br_stm32h7_hal(&port, &hal), BR_OK);
+    assert_ptr_equal(hal.ctx, &port);
+    f.tim2.CNT = 0xFFFFFFFEu;
+    assert_int_equal(hal.encoder_read(hal.ctx, &counts), BR_OK);
+    assert_int_equal(counts, -2);
+    assert_int_equal(hal.pwm_write(hal.ctx, -0.5f), BR_OK);
+    assert_int_equal(f.tim1.CCR2, 3000u);
+    assert_int_equal(hal.pwm_write(hal.ctx, NAN), BR_E_INPUT);
+    assert_int_equal(f.tim1.CCR2, 0u);
+    f.systick.CTRL |= BR_SYSTICK_CTRL_COUNTFLAG;
+    assert_int_equal(hal.tick_wait(hal.ctx, &tick), BR_OK);
+}
+
+static void test_rcc_and_gpio(void **st)
+{
+    (void)st;
+    br_stm32h7_rcc_t rcc;
+    br_stm32h7_gpio_t gpio;
+    memset(&rcc, 0, sizeof rcc);
+    rcc.APB2ENR = 0x100u; /* other enables are kept */
+    assert_int_equal(br_stm32h7_rcc_enable(&rcc), BR_OK);
+    assert_int_equal(rcc.AHB4ENR, BR_RCC_AHB4ENR_GPIOAEN | BR_RCC_AHB4ENR_GPIOBEN);
+    assert_int_equal(rcc.APB1LENR, BR_RCC_APB1LENR_TIM2EN);
+    assert_int_equal(rcc.APB2ENR, 0x100u | BR_RCC_APB2ENR_TIM1EN);
+
+    memset(&gpio, 0, sizeof gpio);
+    gpio.MODER = 0xFFFFFFFFu; /* reset state of most ports: analog */
+    gpio.AFR[1] = 0xFFFFFFFFu;
+    assert_int_equal(br_stm32h7_gpio_af(&gpio, 9u, 1u), BR_OK); /* PA9 TIM1_CH2 */
+    assert_int_equal(gpio.MODER, 0xFFFBFFFFu);                  /* bits 19:18 = 10 */
+    assert_int_equal(gpio.AFR[1], 0xFFFFFF1Fu);                 /* pin 9 -> AFRH nibble 1 */
+    assert_int_equal((gpio.OSPEEDR >> 18) & 3u, 2u);
+    assert_int_equal(br_stm32h7_gpio_af(&gpio, 0u, 1u), BR_OK);
+    assert_int_equal(gpio.AFR[0] & 0xFu, 1u);
+    assert_int_equal(gpio.MODER & 3u, 2u);
+    assert_int_equal(br_stm32h7_gpio_af(&gpio, 16u, 1u), BR_E_PARAM);
+    assert_int_equal(br_stm32h7_gpio_af(&gpio, 3u, 16u), BR_E_PARAM);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_init_programs_registers),
+        cmocka_unit_test(test_init_pwm_prescaler),
+        cmocka_unit_test(test_init_guards),
+        cmocka_unit_test(test_null_and_state),
+        cmocka_unit_test(test_encoder_32bit_wrap),
+        cmocka_unit_test(test_encoder_16bit_extension),
+        cmocka_unit_test(test_count_ext_generic),
+        cmocka_unit_test(test_pwm_duty_mapping),
+        cmocka_unit_test(test_tick_polling),
+        cmocka_unit_test(test_hal_adapter),
+        cmocka_unit_test(test_rcc_and_gpio),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
