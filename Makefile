@@ -57,7 +57,7 @@ help:
 	@echo "  make test      host-debug build + ctest, then the firmware image and its size"
 	@echo "  make demo      host-release build, run the circle demo into $(DEMO_OUT), plot it"
 	@echo "  make firmware  cross build (cm7-release) and print flash / RAM use"
-	@echo "  make regen     regenerate the H-infinity gains and the golden traces"
+	@echo "  make regen     regenerate the generated headers and the golden traces"
 	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
 	@echo "  V=1 shows the commands; JOBS=n sets the ctest parallelism (default 2)"
 
@@ -91,7 +91,8 @@ firmware: deps
 	$(print_size)
 
 regen: deps
-	$(Q)echo "== regen: gains"
+	$(Q)echo "== regen: machine parameters, gains"
+	$(Q)$(PYTHON) firmware/design/gen_machine.py
 	$(Q)$(PYTHON) firmware/design/synth_hinf.py
 	$(Q)echo "== regen: golden traces"
 	$(Q)$(PYTHON) golden/gen_traces.py
