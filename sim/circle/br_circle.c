@@ -61,7 +61,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     cc.tau_per_duty_Nm = (float)c->plant.tau_per_duty_Nm;
     cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
     cc.lead_mprad = (float)c->plant.lead_mprad;
-    br_status_t st = br_axis_init(&a->axis, &a->hal, &cc);
+    br_status_t st = br_axis_init(&a->axis, &a->hal, &cc, NULL);
     if (st != BR_OK) {
         fprintf(stderr, "br_circle: controller init failed (status %d)\n", (int)st);
         return -1;
@@ -99,7 +99,7 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             s.pos_m[i] = br_plant_pos_m(&ax[i].plant);
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
-            br_status_t st = br_axis_step(&ax[i].axis, &r, 0.0f);
+            br_status_t st = br_axis_step(&ax[i].axis, &r);
             if (st != BR_OK) {
                 fprintf(stderr, "br_circle: axis %d step failed at t=%.4f s (status %d)\n", i, t, (int)st);
                 return -1;

@@ -43,15 +43,15 @@ static void test_init_guards(void **st)
     br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
     br_axis_t a;
     br_ctrl_cfg_t k = cfg();
-    assert_int_equal(br_axis_init(&a, NULL, &k), BR_E_NULL);
+    assert_int_equal(br_axis_init(&a, NULL, &k, NULL), BR_E_NULL);
     br_hal_t h2 = hal; h2.pwm_write = NULL;
-    assert_int_equal(br_axis_init(&a, &h2, &k), BR_E_NULL);
+    assert_int_equal(br_axis_init(&a, &h2, &k, NULL), BR_E_NULL);
     h2 = hal; h2.encoder_read = NULL;
-    assert_int_equal(br_axis_init(&a, &h2, &k), BR_E_NULL);
+    assert_int_equal(br_axis_init(&a, &h2, &k, NULL), BR_E_NULL);
     k.dt_s = 0.0f;
-    assert_int_equal(br_axis_init(&a, &hal, &k), BR_E_PARAM);
+    assert_int_equal(br_axis_init(&a, &hal, &k, NULL), BR_E_PARAM);
     br_ref_t r = {0, 0.0f, 0.0f};
-    assert_int_equal(br_axis_step(&a, &r, 0.0f), BR_E_STATE);
+    assert_int_equal(br_axis_step(&a, &r), BR_E_STATE);
 }
 
 static void test_step_writes_duty(void **st)
@@ -61,9 +61,9 @@ static void test_step_writes_duty(void **st)
     br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
     br_axis_t a;
     br_ctrl_cfg_t k = cfg();
-    assert_int_equal(br_axis_init(&a, &hal, &k), BR_OK);
+    assert_int_equal(br_axis_init(&a, &hal, &k, NULL), BR_OK);
     br_ref_t r = {0, 0.0f, 0.0f};
-    assert_int_equal(br_axis_step(&a, &r, 0.0f), BR_OK);
+    assert_int_equal(br_axis_step(&a, &r), BR_OK);
     assert_int_equal(f.writes, 1);
     BR_ASSERT_NEAR(f.duty, -0.5 * 1000 * 6.0e-6 / 0.64, 1e-7);
 }
@@ -75,22 +75,73 @@ static void test_encoder_fault_zeroes_pwm(void **st)
     br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
     br_axis_t a;
     br_ctrl_cfg_t k = cfg();
-    assert_int_equal(br_axis_init(&a, &hal, &k), BR_OK);
+    assert_int_equal(br_axis_init(&a, &hal, &k, NULL), BR_OK);
     br_ref_t r = {0, 0.0f, 0.0f};
-    assert_int_equal(br_axis_step(&a, &r, 0.0f), BR_OK);
+    assert_int_equal(br_axis_step(&a, &r), BR_OK);
     assert_true(f.duty != 0.0f);
     f.enc_status = BR_E_INPUT;
-    assert_int_equal(br_axis_step(&a, &r, 0.0f), BR_E_INPUT);
+    assert_int_equal(br_axis_step(&a, &r), BR_E_INPUT);
     assert_true(f.duty == 0.0f);
-    /* a non-finite compensation: zero duty, status passed up */
-    f.enc_status = BR_OK;
-    assert_int_equal(br_axis_step(&a, &r, NAN), BR_E_INPUT);
+}
+
+typedef struct {
+    float F;
+    br_status_t st;
+    br_meas_t y;
+    float u_prev;
+    int calls;
+} fake_est_t;
+
+static br_status_t fake_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    fake_est_t *e = ctx;
+    e->y = *y;
+    e->u_prev = u_prev_Nm;
+    e->calls++;
+    *F_hat_N = e->F;
+    return e->st;
+}
+
+static void test_estimator_drives_compensation(void **st)
+{
+    (void)st;
+    fake_t f = {0, BR_OK, 0.0f, 0};
+    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
+    fake_est_t e = {10.0f, BR_OK, {0, 0.0f}, 0.0f, 0};
+    br_est_t est = {&e, fake_est_step};
+    br_axis_t a;
+    br_ctrl_cfg_t k = cfg();
+    br_est_t bad = {&e, NULL};
+    assert_int_equal(br_axis_init(&a, &hal, &k, &bad), BR_E_NULL);
+    assert_int_equal(br_axis_init(&a, &hal, &k, &est), BR_OK);
+    br_ref_t r = {0, 0.0f, 0.0f};
+    assert_int_equal(br_axis_step(&a, &r), BR_OK);
+    /* zero error: the duty is the compensation alone, L F / tau_per_duty */
+    BR_ASSERT_NEAR(f.duty, 1.27e-3 * 10.0 / 0.64, 1e-7);
+    assert_int_equal(e.y.counts, 0);
+    BR_ASSERT_NEAR(e.y.frac, 0.5, 0.0);
+    BR_ASSERT_NEAR(e.u_prev, 0.0, 0.0);
+    /* the next call sees the torque applied over the last period */
+    assert_int_equal(br_axis_step(&a, &r), BR_OK);
+    BR_ASSERT_NEAR(e.u_prev, 1.27e-3 * 10.0, 1e-9);
+    /* an estimator failure: zero duty, status passed up, and the torque it will
+     * see next time is the zero that was really applied */
+    e.st = BR_E_NUMERIC;
+    assert_int_equal(br_axis_step(&a, &r), BR_E_NUMERIC);
+    assert_true(f.duty == 0.0f);
+    e.st = BR_OK;
+    assert_int_equal(br_axis_step(&a, &r), BR_OK);
+    BR_ASSERT_NEAR(e.u_prev, 0.0, 0.0);
+    /* a non-finite estimate is refused by the controller: zero duty */
+    e.F = NAN;
+    assert_int_equal(br_axis_step(&a, &r), BR_E_INPUT);
     assert_true(f.duty == 0.0f);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_init_guards), cmocka_unit_test(test_step_writes_duty),
-                                       cmocka_unit_test(test_encoder_fault_zeroes_pwm)};
+                                       cmocka_unit_test(test_encoder_fault_zeroes_pwm),
+                                       cmocka_unit_test(test_estimator_drives_compensation)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

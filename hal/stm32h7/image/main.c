@@ -95,13 +95,13 @@ int main(void)
     (void)br_stm32h7_gpio_af(gpiob, 14u, 1u); /* TIM1_CH2N */
 
     if (br_stm32h7_init(&port, &port_cfg) != BR_OK || br_stm32h7_hal(&port, &hal) != BR_OK ||
-        br_axis_init(&axis, &hal, &ctrl_cfg) != BR_OK || br_refgen_init(&refgen, &ref_cfg) != BR_OK) {
+        br_axis_init(&axis, &hal, &ctrl_cfg, NULL) != BR_OK || br_refgen_init(&refgen, &ref_cfg) != BR_OK) {
         br_image_halt(&port);
     }
 
     for (;;) {
         if (hal.tick_wait(hal.ctx, &tick) != BR_OK || br_refgen_step(&refgen, &ref) != BR_OK ||
-            br_axis_step(&axis, &ref, 0.0f) != BR_OK) {
+            br_axis_step(&axis, &ref) != BR_OK) {
             br_image_halt(&port);
         }
     }
