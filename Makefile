@@ -94,6 +94,7 @@ regen: deps
 	$(Q)echo "== regen: machine parameters, gains"
 	$(Q)$(PYTHON) firmware/design/gen_machine.py
 	$(Q)$(PYTHON) firmware/design/synth_hinf.py
+	$(Q)$(PYTHON) firmware/design/gen_noise.py
 	$(Q)echo "== regen: golden traces"
 	$(Q)$(PYTHON) golden/gen_traces.py
 

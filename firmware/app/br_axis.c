@@ -44,17 +44,21 @@ br_status_t br_axis_step(br_axis_t *a, const br_ref_t *ref)
         /* the estimator sees the count's centre and the torque of the last period */
         const br_meas_t y = {counts, 0.5f};
         st = a->est.step(a->est.ctx, &y, a->last.tau_Nm, &a->F_hat_N);
-        if (st != BR_OK) {
+        /* an outlier measurement is skipped by the estimator, whose prediction
+         * stays usable: control goes on and the status is passed up */
+        if (st != BR_OK && st != BR_E_OUTLIER) {
             (void)a->hal->pwm_write(a->hal->ctx, 0.0f);
             a->last.tau_Nm = 0.0f;
             return st;
         }
     }
+    const br_status_t est_st = st;
     br_ctrl_in_t in = {counts, ref->ref_counts, ref->ref_frac_counts, ref->ref_omega_radps, a->F_hat_N};
     st = br_ctrl_step(&a->ctrl, &in, &a->last);
     if (st != BR_OK) {
         (void)a->hal->pwm_write(a->hal->ctx, 0.0f);
         return st;
     }
-    return a->hal->pwm_write(a->hal->ctx, a->last.duty);
+    st = a->hal->pwm_write(a->hal->ctx, a->last.duty);
+    return (st != BR_OK) ? st : est_st;
 }

@@ -2,7 +2,9 @@
 #include "br_circle.h"
 
 #include <math.h>
+#include <stdlib.h>
 
+#include "br_circle_est.h"
 #include "br_hal_sim.h"
 #include "br_hinf_gains.h"
 #include "br_reference_machine.h"
@@ -10,18 +12,39 @@
 
 #define BR_PI 3.14159265358979323846
 
-br_circle_cfg_t br_circle_cfg_thesis(void)
+const char *br_circle_ctrl_name(br_circle_ctrl_t c)
+{
+    switch (c) {
+    case BR_CTRL_HINF_ONLY: return "hinf_only";
+    case BR_CTRL_HINF_PF: return "hinf_pf";
+    case BR_CTRL_HINF_TRUE: return "hinf_true";
+    }
+    return "unknown";
+}
+
+br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
 {
     br_circle_cfg_t c;
     static const float K[3] = BR_HINF_K;
     c.radius_m = 1.0e-4;
     c.period_s = 8.0;
     c.duration_s = 8.0;
-    c.dt_s = 1.0e-3;
-    c.controller = BR_CTRL_HINF_ONLY;
+    /* thesis section 5: 1.5 ms for the PF, 1 ms for the others */
+    c.dt_s = (controller == BR_CTRL_HINF_PF) ? 1.5e-3 : 1.0e-3;
+    c.controller = controller;
     c.plant = br_plant_cfg_reference();
     for (int i = 0; i < 3; i++) c.K[i] = K[i];
+    c.pf = br_circle_pf_cfg_default((float)c.dt_s);
     return c;
+}
+
+/* The limit: an "estimator" that reads the plant's true friction at t_k. */
+static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    (void)y;
+    (void)u_prev_Nm;
+    *F_hat_N = (float)((const br_plant_t *)ctx)->fnl_N;
+    return BR_OK;
 }
 
 typedef struct {
@@ -29,6 +52,7 @@ typedef struct {
     br_hal_sim_t port;
     br_hal_t hal;
     br_axis_t axis;
+    br_pf_t *pf; /* owned, BR_CTRL_HINF_PF only */
     double phase;
 } axis_sim_t;
 
@@ -51,6 +75,7 @@ static br_ref_t axis_ref(const br_circle_cfg_t *c, double phase, double t, doubl
 static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
 {
     a->phase = phase;
+    a->pf = NULL;
     br_plant_state_t x0 = {c->radius_m * sin(phase) / c->plant.lead_mprad, 0.0, 0.0};
     if (br_plant_init(&a->plant, &c->plant, &x0) != 0) return -1;
     if (br_hal_sim_init(&a->port, &a->plant, c->dt_s, &a->hal) != BR_OK) return -1;
@@ -61,7 +86,31 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     cc.tau_per_duty_Nm = (float)c->plant.tau_per_duty_Nm;
     cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
     cc.lead_mprad = (float)c->plant.lead_mprad;
-    br_status_t st = br_axis_init(&a->axis, &a->hal, &cc, NULL);
+    br_est_t est = {NULL, NULL};
+    br_status_t st = BR_OK;
+    switch (c->controller) {
+    case BR_CTRL_HINF_ONLY:
+        break;
+    case BR_CTRL_HINF_TRUE:
+        est = (br_est_t){&a->plant, oracle_step};
+        break;
+    case BR_CTRL_HINF_PF:
+        if (fabs((double)c->pf.model.dt_s - c->dt_s) > 1e-9) {
+            fprintf(stderr, "br_circle: the PF's period %g s differs from the control period %g s\n",
+                    (double)c->pf.model.dt_s, c->dt_s);
+            return -1;
+        }
+        a->pf = calloc(1, sizeof *a->pf);
+        if (a->pf == NULL) return -1;
+        st = br_pf_init(a->pf, &c->pf);
+        est = (br_est_t){a->pf, br_pf_est_step};
+        break;
+    }
+    if (st != BR_OK) {
+        fprintf(stderr, "br_circle: estimator init failed (status %d)\n", (int)st);
+        return -1;
+    }
+    st = br_axis_init(&a->axis, &a->hal, &cc, est.step ? &est : NULL);
     if (st != BR_OK) {
         fprintf(stderr, "br_circle: controller init failed (status %d)\n", (int)st);
         return -1;
@@ -69,12 +118,22 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     return 0;
 }
 
-void br_circle_csv_header(FILE *f) { fprintf(f, "t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y\n"); }
+void br_circle_csv_header(FILE *f)
+{
+    fprintf(f, "t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y,fhat_x,fhat_y,gp_x,gp_y\n");
+}
 
 void br_circle_csv_sink(void *user, const br_circle_sample_t *s)
 {
-    fprintf((FILE *)user, "%.6f,%.9e,%.9e,%.9e,%.9e,%.6e,%.6f,%.6f,%.6f,%.6f\n", s->t_s, s->ref_m[0], s->ref_m[1],
-            s->pos_m[0], s->pos_m[1], s->radial_err_m, s->duty[0], s->duty[1], s->fnl_N[0], s->fnl_N[1]);
+    FILE *f = user;
+    fprintf(f, "%.6f,%.9e,%.9e,%.9e,%.9e,%.6e,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f", s->t_s, s->ref_m[0], s->ref_m[1],
+            s->pos_m[0], s->pos_m[1], s->radial_err_m, s->duty[0], s->duty[1], s->fnl_N[0], s->fnl_N[1],
+            s->F_hat_N[0], s->F_hat_N[1]);
+    for (int i = 0; i < 2; i++) {
+        if (s->pf[i]) fprintf(f, ",%.6f", (double)br_pf_estimate(s->pf[i])->mean[BR_X_GP]);
+        else fprintf(f, ",");
+    }
+    fprintf(f, "\n");
 }
 
 int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, br_circle_result_t *res)
@@ -84,10 +143,12 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
         return -1;
     }
     axis_sim_t ax[2];
-    if (axis_init(&ax[0], c, 0.0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI) != 0) return -1;
+    ax[0].pf = ax[1].pf = NULL;
+    int rc = -1;
+    if (axis_init(&ax[0], c, 0.0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI) != 0) goto done;
     const long n = lround(c->duration_s / c->dt_s);
     double sum2 = 0.0, emax = 0.0;
-    int nsat = 0;
+    int nsat = 0, nout = 0;
     for (long k = 0; k <= n; k++) {
         const double t = (double)k * c->dt_s;
         br_circle_sample_t s;
@@ -100,12 +161,16 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
             br_status_t st = br_axis_step(&ax[i].axis, &r);
-            if (st != BR_OK) {
+            if (st == BR_E_OUTLIER) {
+                nout++; /* the estimator skipped the update; control went on */
+            } else if (st != BR_OK) {
                 fprintf(stderr, "br_circle: axis %d step failed at t=%.4f s (status %d)\n", i, t, (int)st);
-                return -1;
+                goto done;
             }
             sat |= ax[i].axis.last.saturated;
             s.duty[i] = (double)ax[i].axis.last.duty;
+            s.F_hat_N[i] = (double)ax[i].axis.F_hat_N;
+            s.pf[i] = ax[i].pf;
         }
         /* contour error of a circle: radial deviation from the radius */
         const double er = hypot(s.pos_m[0], s.pos_m[1]) - c->radius_m;
@@ -119,5 +184,10 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     res->contour_rms_m = sqrt(sum2 / (double)(n + 1));
     res->max_err_m = emax;
     res->saturated_steps = nsat;
-    return 0;
+    res->outlier_steps = nout;
+    rc = 0;
+done:
+    free(ax[0].pf);
+    free(ax[1].pf);
+    return rc;
 }

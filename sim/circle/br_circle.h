@@ -7,9 +7,19 @@
 #include <stdio.h>
 
 #include "bristle/br_ctrl.h"
+#include "bristle/br_pf.h"
 #include "plant/br_sim_plant.h"
 
-typedef enum { BR_CTRL_HINF_ONLY = 0 } br_circle_ctrl_t;
+/* The controllers of thesis section 5, plus the limit: compensation with the
+ * plant's true friction (an oracle no real machine has). */
+typedef enum {
+    BR_CTRL_HINF_ONLY = 0,
+    BR_CTRL_HINF_PF = 1,
+    BR_CTRL_HINF_TRUE = 2
+} br_circle_ctrl_t;
+
+/* Name used in summary.json and file names: "hinf_only", "hinf_pf", ... */
+const char *br_circle_ctrl_name(br_circle_ctrl_t c);
 
 typedef struct {
     double radius_m;     /* A */
@@ -19,6 +29,7 @@ typedef struct {
     br_circle_ctrl_t controller;
     br_plant_cfg_t plant; /* both axes alike */
     float K[3];          /* state-feedback gains */
+    br_pf_cfg_t pf;      /* BR_CTRL_HINF_PF: the filter (its model.dt_s must equal dt_s) */
 } br_circle_cfg_t;
 
 typedef struct {
@@ -26,10 +37,13 @@ typedef struct {
     double max_err_m;       /* max |radial error| */
     long n_samples;
     int saturated_steps;    /* periods where either axis saturated */
+    int outlier_steps;      /* axis-periods whose measurement the estimator rejected */
 } br_circle_result_t;
 
-/* The thesis experiment with the reference machine and the H-inf gains. */
-br_circle_cfg_t br_circle_cfg_thesis(void);
+/* The thesis experiment with the reference machine, the H-inf gains and the
+ * given controller at its thesis period (1 ms; 1.5 ms and 1500 particles for
+ * the PF). */
+br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller);
 
 /* One control period of both axes (load side, true plant positions). */
 typedef struct {
@@ -39,6 +53,8 @@ typedef struct {
     double radial_err_m; /* hypot(x, y) - A: + is outward */
     double duty[2];
     double fnl_N[2];     /* true LuGre force of each axis */
+    double F_hat_N[2];   /* the compensation used (0 for H-inf only) */
+    const br_pf_t *pf[2]; /* the filters after this period's step (PF only, else NULL) */
 } br_circle_sample_t;
 
 typedef void (*br_circle_sink_t)(void *user, const br_circle_sample_t *s);
@@ -47,8 +63,9 @@ typedef void (*br_circle_sink_t)(void *user, const br_circle_sample_t *s);
  * or -1 with a message on stderr on an invalid configuration or a firmware error. */
 int br_circle_run(const br_circle_cfg_t *cfg, br_circle_sink_t sink, void *user, br_circle_result_t *res);
 
-/* A sink writing CSV rows t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y
- * to the FILE * given as user; br_circle_csv_header writes the header line. */
+/* A sink writing CSV rows t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y,
+ * fhat_x,fhat_y,gp_x,gp_y (gp: the PF's mean g_p, else empty) to the FILE *
+ * given as user; br_circle_csv_header writes the header line. */
 void br_circle_csv_header(FILE *f);
 void br_circle_csv_sink(void *user, const br_circle_sample_t *s);
 

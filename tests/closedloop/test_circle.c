@@ -31,7 +31,7 @@ static void glitch_sink(void *user, const br_circle_sample_t *s)
 static void test_hinf_only_reproduces_thesis(void **st)
 {
     (void)st;
-    br_circle_cfg_t c = br_circle_cfg_thesis();
+    br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     br_circle_result_t r;
     glitch_t g = {{0}, {0}};
     assert_int_equal(br_circle_run(&c, glitch_sink, &g, &r), 0);
@@ -53,7 +53,7 @@ static void test_same_gains_at_pf_period(void **st)
 {
     (void)st;
     /* the PF runs at 1.5 ms: the H-inf loop must stay stable and comparable there */
-    br_circle_cfg_t c = br_circle_cfg_thesis();
+    br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     c.dt_s = 1.5e-3;
     br_circle_result_t r;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 0);
@@ -65,14 +65,14 @@ static void test_same_gains_at_pf_period(void **st)
 static void test_rejects_bad_experiment(void **st)
 {
     (void)st;
-    br_circle_cfg_t c = br_circle_cfg_thesis();
+    br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     br_circle_result_t r;
     c.dt_s = 0.0;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
-    c = br_circle_cfg_thesis();
+    c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     c.plant.sigma0_Npm = -1.0;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
-    c = br_circle_cfg_thesis();
+    c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     c.K[0] = NAN;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
 }

@@ -1,0 +1,100 @@
+/* Particle filter for the friction of one axis (thesis sections 2.3, 4), float32.
+ *
+ * Particles x_j = [theta, omega, z, g_p] of the eq. 6 model (br_model.h).
+ * One step at t_k, with measurement y_k and the torque u_{k-1} of the last period:
+ *   1. predict    x_j <- f_d(x_j, u_{k-1}) + sqrt(Q) n_j     n_j from the ROM table
+ *   2. weigh      l_j = -(theta_j - y_k)^2 / (2 R),  w_j = e^(l_j - max l)   (max-shifted)
+ *   3. quantise   W_j = floor(w_j 2^16) (the best particle has W = 2^16 > 0)
+ *   4. resample   xi_i = (i + 1/2) / m; particle i copies the j with
+ *                 C_{j-1} <= xi_i C_m < C_j, C_j = W_0 + ... + W_j, in integers
+ *   5. estimate   mean of the particles, F_hat = mean of f_nl(x_j) (eq. 6)
+ * theta is stored relative to the latest measured count (an integer origin),
+ * so float32 keeps sub-nanometre resolution at any travel.
+ * See docs/modules/pf.md. */
+#ifndef BR_PF_H
+#define BR_PF_H
+
+#include <stdint.h>
+
+#include "bristle/br_est.h"
+#include "bristle/br_model.h"
+#include "bristle/br_status.h"
+
+#ifndef BR_PF_MAX_PARTICLES
+#define BR_PF_MAX_PARTICLES 2048u
+#endif
+/* weight quantisation: W in [0, 2^16]; C_m <= 2^16 m fits uint32 */
+#define BR_PF_W_BITS 16u
+#if BR_PF_MAX_PARTICLES > 65535u
+#error "BR_PF_MAX_PARTICLES must fit the uint16 resampling indices"
+#endif
+
+typedef struct {
+    br_model_cfg_t model;    /* eq. 6 model; model.dt_s is the PF's period */
+    uint32_t n_particles;    /* m, 1..BR_PF_MAX_PARTICLES */
+    float q_var[BR_NX];      /* process noise variance per step: rad^2, (rad/s)^2, m^2, N^2; >= 0 */
+    float r_var_rad2;        /* measurement noise variance, > 0 */
+    float gp0_N;             /* initial g_p, in [gp_min_N, gp_max_N] */
+    float x0_std[BR_NX];     /* initial spread around [y_0, 0, 0, gp0]; >= 0 */
+    float gp_min_N;          /* g_p is kept in [gp_min_N, gp_max_N], 0 < min < max */
+    float gp_max_N;
+    float outlier_sigma;     /* |y - theta_j| > outlier_sigma sqrt(R) for every j: outlier, > 0 */
+    uint32_t reanchor_after; /* consecutive outliers before the cloud is re-anchored on y, >= 1 */
+    float rad_per_count;     /* encoder resolution, > 0 */
+    const float *noise;      /* standard-normal ROM table (e.g. br_noise_table) */
+    uint32_t noise_len;      /* its length, a power of two >= 2 */
+} br_pf_cfg_t;
+
+typedef struct {
+    float mean[BR_NX];       /* particle mean; theta relative to origin_counts */
+    int32_t origin_counts;   /* integer origin of theta */
+    float F_hat_N;           /* mean f_nl over particles */
+    float ess;               /* effective sample size of the step's weights, 1..m */
+} br_pf_est_t;
+
+typedef struct {
+    br_pf_cfg_t cfg;
+    br_model_t model;
+    float q_std[BR_NX];
+    float inv_2r;                 /* 1 / (2 R) */
+    float outlier_l;              /* -outlier_sigma^2 / 2: log-weight threshold */
+    uint32_t noise_pos;           /* table position, advances every step */
+    int32_t origin_counts;
+    float prev_frac;              /* the last measurement's fraction */
+    uint32_t n_outliers;          /* consecutive outlier steps */
+    int primed;                   /* particles drawn around the first measurement */
+    /* particles (structure of arrays): current set, and the predicted set */
+    float x[BR_NX][BR_PF_MAX_PARTICLES];
+    float xp[BR_NX][BR_PF_MAX_PARTICLES];
+    float fnl[BR_PF_MAX_PARTICLES];   /* f_nl of the predicted particles */
+    float l[BR_PF_MAX_PARTICLES];     /* log-weights */
+    uint32_t W[BR_PF_MAX_PARTICLES];  /* quantised weights */
+    uint16_t idx[BR_PF_MAX_PARTICLES];/* resampling indices of the last step */
+    br_pf_est_t est;
+    int ready;
+} br_pf_t;
+
+br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg);
+
+/* One filter step (see above). Statuses: BR_E_INPUT for a non-finite u or
+ * frac outside [0, 1] (state untouched); BR_E_OUTLIER when y is further than
+ * outlier_sigma from every particle (no weighting: the valid predicted
+ * particles are kept with equal weights; after reanchor_after consecutive
+ * outliers the cloud is re-anchored, its mean theta moved to y and its mean
+ * omega to the measured velocity, so the filter regains lock);
+ * BR_E_NUMERIC when every predicted particle is non-finite (the previous set is
+ * kept). In every case the particles stay finite. */
+br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm);
+
+/* Deterministic systematic resampling in integer arithmetic: for the weights
+ * W[0..m-1] (not all zero) writes idx[i] = the j with C_{j-1} <= t_i < C_j,
+ * t_i = floor((2 i + 1) C_m / (2 m)). Identical on every target. */
+br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx);
+
+/* The last step's estimate. */
+const br_pf_est_t *br_pf_estimate(const br_pf_t *pf);
+
+/* br_est_t binding: ctx is a br_pf_t *. */
+br_status_t br_pf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
+
+#endif

@@ -1,0 +1,100 @@
+/* Unscented Kalman filter for the friction of one axis (thesis sections 2.3, 4), float32.
+ *
+ * State x = [theta, omega, z, g_p] of the eq. 6 model (br_model.h), mean x and
+ * covariance P (4 x 4), 2n + 1 = 9 sigma points of the scaled unscented
+ * transform. One step at t_k, with measurement y_k and the torque u_{k-1}:
+ *   1. sigma points  X_0 = x, X_i = x + c S_i, X_{i+n} = x - c S_i,
+ *                    P = S S^T (Cholesky), c = sqrt(n + lambda),
+ *                    lambda = alpha^2 (n + kappa) - n; g_p clamped to [gp_min, gp_max]
+ *   2. predict       Y_j = f_d(X_j, u_{k-1})               (br_model_step)
+ *                    x- = sum_j Wm_j Y_j,  P- = sum_j Wc_j (Y_j - x-)(Y_j - x-)^T + Q
+ *   3. update        h(x) = theta is linear: S = P-_00 + R, K = P-_{:,0} / S,
+ *                    x+ = x- + K (y - theta-), P+ = (I - K H) P- (I - K H)^T + K R K^T
+ *                    (Joseph form), then symmetrised
+ *   4. estimate      F_hat = sum_j Wm_j f_nl(X+_j) over the posterior sigma points
+ * A failed Cholesky (pivot <= 0 or non-finite) resets P to diag(p0_var),
+ * keeping the mean, and reports BR_E_NUMERIC.
+ * theta is stored relative to an integer origin (the latest accepted count),
+ * as in the PF, so float32 keeps sub-count resolution at any travel.
+ * See docs/modules/ukf.md. */
+#ifndef BR_UKF_H
+#define BR_UKF_H
+
+#include <stdint.h>
+
+#include "bristle/br_est.h"
+#include "bristle/br_model.h"
+#include "bristle/br_status.h"
+
+/* number of sigma points, 2 n + 1 */
+#define BR_UKF_NSIG (2 * BR_NX + 1)
+
+typedef struct {
+    br_model_cfg_t model;    /* eq. 6 model; model.dt_s is the UKF's period */
+    float q_var[BR_NX];      /* process noise variance per step: rad^2, (rad/s)^2, m^2, N^2; >= 0 */
+    float r_var_rad2;        /* measurement noise variance, > 0 */
+    float gp0_N;             /* initial g_p, in [gp_min_N, gp_max_N] */
+    float p0_var[BR_NX];     /* initial (and recovery) variances P0 = diag(p0_var), > 0 */
+    float gp_min_N;          /* g_p of every sigma point and of the mean kept in */
+    float gp_max_N;          /*   [gp_min_N, gp_max_N], 0 < min < max */
+    float outlier_sigma;     /* |y - theta-| > outlier_sigma sqrt(S): outlier, > 0 */
+    float rad_per_count;     /* encoder resolution, > 0 */
+    float alpha;             /* sigma-point spread, in (0, 1]; 1 recommended in float32 */
+    float beta;              /* prior-distribution weight, >= 0 (2 for a Gaussian) */
+    float kappa;             /* secondary scaling, n + kappa > 0 (so n + lambda > 0) */
+} br_ukf_cfg_t;
+
+typedef struct {
+    float mean[BR_NX];       /* posterior mean; theta relative to origin_counts */
+    float var[BR_NX];        /* diag(P) */
+    int32_t origin_counts;   /* integer origin of theta */
+    float F_hat_N;           /* unscented mean of f_nl over the posterior sigma points */
+    float innov_rad;         /* last innovation y - theta- (0 on the priming step) */
+    float innov_var_rad2;    /* its predicted variance S = P-_00 + R */
+} br_ukf_est_t;
+
+typedef struct {
+    br_ukf_cfg_t cfg;
+    br_model_t model;
+    float c_sigma;                   /* sqrt(n + lambda) */
+    float wm0, wc0, wi;              /* weights: Wm_0, Wc_0, and Wm_i = Wc_i = W for i >= 1 */
+    float cmm;                       /* beta - alpha^2: the m m^T term of P- about the central point */
+    float out_s2;                    /* outlier_sigma^2 */
+    float x[BR_NX];                  /* mean; theta relative to origin_counts */
+    float P[BR_NX][BR_NX];           /* covariance, symmetric positive definite */
+    float S[BR_NX][BR_NX];           /* scratch: Cholesky factor of the last factorised P (lower) */
+    float X[BR_UKF_NSIG][BR_NX];     /* sigma points (scratch; after a step without error, the posterior's) */
+    float Y[BR_UKF_NSIG][BR_NX];     /* scratch: propagated sigma points of the last step */
+    int32_t origin_counts;
+    uint32_t n_recover;              /* Cholesky recoveries since init */
+    int primed;                      /* x, P set from the first measurement */
+    br_ukf_est_t est;
+    int ready;
+} br_ukf_t;
+
+br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg);
+
+/* One filter step (see above). The first step after init primes
+ * x = [frac rpc, 0, 0, gp0] (origin = counts), P = diag(p0_var), no predict.
+ * Statuses:
+ *   BR_E_NULL / BR_E_STATE  NULL argument / not initialised;
+ *   BR_E_INPUT    non-finite u, or frac non-finite or outside [0, 1]: state untouched;
+ *   BR_E_OUTLIER  |y - theta-| > outlier_sigma sqrt(S): the prediction is kept
+ *                 (origin unchanged), no update;
+ *   BR_E_NUMERIC  a non-finite prediction or update: the previous x, P and
+ *                 origin are kept; or a Cholesky failure: P was reset to
+ *                 diag(p0_var) with the mean kept (the step otherwise completed). */
+br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm);
+
+/* Fixed-size 4 x 4 Cholesky factorisation A = L L^T (L lower, upper part
+ * zeroed). BR_E_NUMERIC on a pivot <= 0 or a non-finite value (L then undefined). */
+br_status_t br_ukf_chol4(const float A[BR_NX][BR_NX], float L[BR_NX][BR_NX]);
+
+/* The last step's estimate (NULL for a NULL filter). */
+const br_ukf_est_t *br_ukf_estimate(const br_ukf_t *ukf);
+
+/* br_est_t binding: ctx is a br_ukf_t *. *F_hat_N is written on BR_OK and on
+ * BR_E_OUTLIER (the prediction's estimate), as for the PF. */
+br_status_t br_ukf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
+
+#endif

@@ -1,0 +1,392 @@
+/* Unscented Kalman filter for the friction of one axis, float32. See br_ukf.h
+ * and docs/modules/ukf.md. */
+#include "bristle/br_ukf.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "bristle/br_encoder.h"
+
+static int finite_nonneg(float v) { return isfinite(v) && v >= 0.0f; }
+static int finite_pos(float v) { return isfinite(v) && v > 0.0f; }
+static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
+
+static int vec_finite(const float v[BR_NX])
+{
+    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]) && isfinite(v[3]);
+}
+
+static int mat_finite(const float A[BR_NX][BR_NX])
+{
+    int ok = 1;
+    for (int i = 0; i < BR_NX; i++) {
+        ok = ok && vec_finite(A[i]);
+    }
+    return ok;
+}
+
+static br_status_t check_cfg(const br_ukf_cfg_t *cfg)
+{
+    for (int i = 0; i < BR_NX; i++) {
+        if (!finite_nonneg(cfg->q_var[i]) || !finite_pos(cfg->p0_var[i])) {
+            return BR_E_PARAM;
+        }
+    }
+    if (!finite_pos(cfg->r_var_rad2) || !finite_pos(cfg->outlier_sigma) || !finite_pos(cfg->rad_per_count)) {
+        return BR_E_PARAM;
+    }
+    if (!finite_pos(cfg->gp_min_N) || !isfinite(cfg->gp_max_N) || !(cfg->gp_max_N > cfg->gp_min_N) ||
+        !(cfg->gp0_N >= cfg->gp_min_N && cfg->gp0_N <= cfg->gp_max_N)) {
+        return BR_E_PARAM;
+    }
+    /* scaled UT: alpha in (0, 1], beta >= 0, n + lambda = alpha^2 (n + kappa) > 0 */
+    if (!finite_pos(cfg->alpha) || cfg->alpha > 1.0f || !finite_nonneg(cfg->beta) || !isfinite(cfg->kappa) ||
+        !((float)BR_NX + cfg->kappa > 0.0f)) {
+        return BR_E_PARAM;
+    }
+    return BR_OK;
+}
+
+br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
+{
+    if (ukf == NULL || cfg == NULL) {
+        return BR_E_NULL;
+    }
+    ukf->ready = 0;
+    br_status_t st = check_cfg(cfg);
+    if (st != BR_OK) {
+        return st;
+    }
+    st = br_model_init(&ukf->model, &cfg->model);
+    if (st != BR_OK) {
+        return st;
+    }
+    const float n = (float)BR_NX;
+    /* scaled UT (Julier 2002): lambda = alpha^2 (n + kappa) - n, so n + lambda = alpha^2 (n + kappa) */
+    const float n_lam = cfg->alpha * cfg->alpha * (n + cfg->kappa);
+    const float lambda = n_lam - n;
+    /* weights: Wm_0 = lambda / (n + lambda), Wc_0 = Wm_0 + 1 - alpha^2 + beta, W_i = 1 / (2 (n + lambda)) */
+    const float wm0 = lambda / n_lam;
+    const float wc0 = wm0 + 1.0f - cfg->alpha * cfg->alpha + cfg->beta;
+    const float wi = 0.5f / n_lam;
+    if (!finite_pos(n_lam) || !isfinite(wm0) || !isfinite(wc0) || !finite_pos(wi)) {
+        return BR_E_PARAM;
+    }
+    ukf->cfg = *cfg;
+    ukf->c_sigma = sqrtf(n_lam);
+    ukf->wm0 = wm0;
+    ukf->wc0 = wc0;
+    ukf->wi = wi;
+    ukf->cmm = cfg->beta - cfg->alpha * cfg->alpha;
+    ukf->out_s2 = cfg->outlier_sigma * cfg->outlier_sigma;
+    for (int i = 0; i < BR_NX; i++) {
+        ukf->x[i] = 0.0f;
+        for (int j = 0; j < BR_NX; j++) {
+            ukf->P[i][j] = (i == j) ? cfg->p0_var[i] : 0.0f;
+            ukf->S[i][j] = 0.0f;
+        }
+    }
+    ukf->x[BR_X_GP] = cfg->gp0_N;
+    for (int s = 0; s < BR_UKF_NSIG; s++) {
+        for (int i = 0; i < BR_NX; i++) {
+            ukf->X[s][i] = ukf->x[i];
+            ukf->Y[s][i] = ukf->x[i];
+        }
+    }
+    ukf->origin_counts = 0;
+    ukf->n_recover = 0u;
+    ukf->primed = 0;
+    ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->gp0_N},
+                              {cfg->p0_var[0], cfg->p0_var[1], cfg->p0_var[2], cfg->p0_var[3]},
+                              0, 0.0f, 0.0f, 0.0f};
+    ukf->ready = 1;
+    return BR_OK;
+}
+
+br_status_t br_ukf_chol4(const float A[BR_NX][BR_NX], float L[BR_NX][BR_NX])
+{
+    if (A == NULL || L == NULL) {
+        return BR_E_NULL;
+    }
+    for (int i = 0; i < BR_NX; i++) {
+        for (int j = 0; j < BR_NX; j++) {
+            L[i][j] = 0.0f;
+        }
+    }
+    for (int j = 0; j < BR_NX; j++) {
+        /* Cholesky-Banachiewicz: L_jj = sqrt(A_jj - sum_{k<j} L_jk^2) */
+        float d = A[j][j];
+        for (int k = 0; k < j; k++) {
+            d -= L[j][k] * L[j][k];
+        }
+        if (!(d > 0.0f) || !isfinite(d)) {
+            return BR_E_NUMERIC;
+        }
+        const float ljj = sqrtf(d);
+        L[j][j] = ljj;
+        /* L_ij = (A_ij - sum_{k<j} L_ik L_jk) / L_jj, i > j; a non-finite entry
+         * reaches the pivot of row i and is caught there */
+        for (int i = j + 1; i < BR_NX; i++) {
+            float s = A[i][j];
+            for (int k = 0; k < j; k++) {
+                s -= L[i][k] * L[j][k];
+            }
+            L[i][j] = s / ljj;
+        }
+    }
+    return BR_OK;
+}
+
+/* P0 = diag(p0_var): the initial covariance and the recovery point. */
+static void reset_cov(const br_ukf_cfg_t *cfg, float P[BR_NX][BR_NX])
+{
+    for (int i = 0; i < BR_NX; i++) {
+        for (int j = 0; j < BR_NX; j++) {
+            P[i][j] = (i == j) ? cfg->p0_var[i] : 0.0f;
+        }
+    }
+}
+
+/* Sigma points of (x, P) into ukf->X, factor into ukf->S. On a failed Cholesky
+ * P is reset to diag(p0_var) (x kept) and BR_E_NUMERIC returned; the points are
+ * then those of the reset P, so they are always usable. */
+static br_status_t sigma_points(br_ukf_t *ukf, const float x[BR_NX], float P[BR_NX][BR_NX])
+{
+    br_status_t st = br_ukf_chol4((const float(*)[BR_NX])P, ukf->S);
+    if (st != BR_OK) {
+        /* recovery: P <- diag(p0_var), whose factor is diag(sqrt(p0_var)) */
+        reset_cov(&ukf->cfg, P);
+        for (int i = 0; i < BR_NX; i++) {
+            for (int j = 0; j < BR_NX; j++) {
+                ukf->S[i][j] = (i == j) ? sqrtf(ukf->cfg.p0_var[i]) : 0.0f;
+            }
+        }
+        ukf->n_recover++;
+        st = BR_E_NUMERIC;
+    }
+    const float c = ukf->c_sigma;
+    for (int i = 0; i < BR_NX; i++) {
+        ukf->X[0][i] = x[i];
+    }
+    for (int k = 0; k < BR_NX; k++) {
+        /* X_{1+k} = x + c S_k, X_{1+n+k} = x - c S_k (S_k: column k of the factor) */
+        for (int i = 0; i < BR_NX; i++) {
+            const float d = c * ukf->S[i][k];
+            ukf->X[1 + k][i] = x[i] + d;
+            ukf->X[1 + BR_NX + k][i] = x[i] - d;
+        }
+    }
+    /* the model needs g_p > 0: every sigma point's g_p in [gp_min, gp_max] */
+    for (int s = 0; s < BR_UKF_NSIG; s++) {
+        ukf->X[s][BR_X_GP] = clampf(ukf->X[s][BR_X_GP], ukf->cfg.gp_min_N, ukf->cfg.gp_max_N);
+    }
+    return st;
+}
+
+
+/* Unscented mean of f_nl (eq. 6) over the sigma points in ukf->X:
+ * F_hat = sum_j Wm_j f_nl(X_j), written as f_0 + sum_{j>=1} W_j (f_j - f_0)
+ * (sum Wm = 1) so that a large |Wm_0| (small alpha) does not cancel in float32. */
+static float fnl_unscented(const br_ukf_t *ukf)
+{
+    const float f0 = br_model_fnl_N(&ukf->model, ukf->X[0]);
+    float df = 0.0f;
+    for (int s = 1; s < BR_UKF_NSIG; s++) {
+        df += br_model_fnl_N(&ukf->model, ukf->X[s]) - f0;
+    }
+    return f0 + ukf->wi * df;
+}
+
+/* The estimate of the committed x, P, origin. */
+static void set_estimate(br_ukf_t *ukf, float F_hat_N, float innov, float innov_var)
+{
+    ukf->est.F_hat_N = F_hat_N;
+    for (int i = 0; i < BR_NX; i++) {
+        ukf->est.mean[i] = ukf->x[i];
+        ukf->est.var[i] = ukf->P[i][i];
+    }
+    ukf->est.origin_counts = ukf->origin_counts;
+    ukf->est.innov_rad = innov;
+    ukf->est.innov_var_rad2 = innov_var;
+}
+
+/* First measurement: x = [frac rpc, 0, 0, gp0] relative to origin = counts, P = P0. */
+static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
+{
+    ukf->origin_counts = y->counts;
+    ukf->x[BR_X_THETA] = y->frac * ukf->cfg.rad_per_count;
+    ukf->x[BR_X_OMEGA] = 0.0f;
+    ukf->x[BR_X_Z] = 0.0f;
+    ukf->x[BR_X_GP] = ukf->cfg.gp0_N;
+    reset_cov(&ukf->cfg, ukf->P);
+    (void)sigma_points(ukf, ukf->x, ukf->P); /* diagonal with p0_var > 0: cannot fail */
+    set_estimate(ukf, fnl_unscented(ukf), 0.0f, 0.0f);
+    ukf->primed = 1;
+    return BR_OK;
+}
+
+/* P <- (P + P^T) / 2 */
+static void symmetrise(float P[BR_NX][BR_NX])
+{
+    for (int i = 0; i < BR_NX; i++) {
+        for (int j = i + 1; j < BR_NX; j++) {
+            const float m = 0.5f * (P[i][j] + P[j][i]);
+            P[i][j] = m;
+            P[j][i] = m;
+        }
+    }
+}
+
+br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
+{
+    if (ukf == NULL || y == NULL) {
+        return BR_E_NULL;
+    }
+    if (!ukf->ready) {
+        return BR_E_STATE;
+    }
+    if (!isfinite(u_prev_Nm) || !isfinite(y->frac) || y->frac < 0.0f || y->frac > 1.0f) {
+        return BR_E_INPUT;
+    }
+    if (!ukf->primed) {
+        return prime(ukf, y);
+    }
+    const float rpc = ukf->cfg.rad_per_count;
+
+    /* 1. sigma points of the posterior (x, P) of the last step; a failed
+     *    Cholesky resets P (kept in ukf->P: the recovery outlives a later failure) */
+    const br_status_t st_chol = sigma_points(ukf, ukf->x, ukf->P);
+
+    /* 2. predict every sigma point through eq. 6 discretised: Y_j = f_d(X_j, u_{k-1}) */
+    for (int s = 0; s < BR_UKF_NSIG; s++) {
+        if (br_model_step(&ukf->model, ukf->X[s], u_prev_Nm, ukf->Y[s]) != BR_OK) {
+            return BR_E_NUMERIC; /* x, P (possibly reset) and origin kept */
+        }
+    }
+    /* predicted mean x- = sum_j Wm_j Y_j = Y_0 + m, m = sum_{j>=1} W (Y_j - Y_0) (sum Wm = 1) */
+    float xm[BR_NX], mdev[BR_NX];
+    for (int i = 0; i < BR_NX; i++) {
+        float d = 0.0f;
+        for (int s = 1; s < BR_UKF_NSIG; s++) {
+            d += ukf->Y[s][i] - ukf->Y[0][i];
+        }
+        mdev[i] = ukf->wi * d;
+        xm[i] = ukf->Y[0][i] + mdev[i];
+    }
+    /* predicted covariance P- = sum_j Wc_j (Y_j - x-)(Y_j - x-)^T + Q, evaluated about
+     * the central point (d_j = Y_j - Y_0) as the algebraically equal
+     *   P- = sum_{j>=1} W d_j d_j^T + (beta - alpha^2) m m^T + Q,
+     * which has no large |Wc_0| to cancel in float32 and is PSD for beta >= alpha^2 */
+    float Pm[BR_NX][BR_NX];
+    for (int i = 0; i < BR_NX; i++) {
+        for (int j = 0; j <= i; j++) {
+            Pm[i][j] = ukf->cmm * mdev[i] * mdev[j];
+        }
+    }
+    for (int s = 1; s < BR_UKF_NSIG; s++) {
+        float d[BR_NX];
+        for (int i = 0; i < BR_NX; i++) {
+            d[i] = ukf->Y[s][i] - ukf->Y[0][i];
+        }
+        for (int i = 0; i < BR_NX; i++) {
+            for (int j = 0; j <= i; j++) {
+                Pm[i][j] += ukf->wi * d[i] * d[j];
+            }
+        }
+    }
+    for (int i = 0; i < BR_NX; i++) {
+        Pm[i][i] += ukf->cfg.q_var[i];
+        for (int j = 0; j < i; j++) {
+            Pm[j][i] = Pm[i][j];
+        }
+    }
+    if (!vec_finite(xm) || !mat_finite((const float(*)[BR_NX])Pm)) {
+        return BR_E_NUMERIC;
+    }
+
+    /* 3. measurement: theta re-expressed relative to the new origin y.counts
+     *    (wrap-safe integer delta); y_rel = frac rpc, innovation nu = y_rel - theta- */
+    const float shift = (float)br_counts_delta(y->counts, ukf->origin_counts) * rpc;
+    const float theta_new = xm[BR_X_THETA] - shift;
+    const float nu = y->frac * rpc - theta_new;
+    /* innovation variance S = H P- H^T + R = P-_00 + R (h(x) = theta) */
+    const float S = Pm[0][0] + ukf->cfg.r_var_rad2;
+    if (!isfinite(nu) || !finite_pos(S)) {
+        return BR_E_NUMERIC;
+    }
+    br_status_t verdict = BR_OK;
+    if (nu * nu > ukf->out_s2 * S) {
+        /* outlier: keep the prediction in the old origin's frame, no update */
+        verdict = BR_E_OUTLIER;
+    } else {
+        /* gain K = P- H^T / S = P-_{:,0} / S; mean x+ = x- + K nu (theta in the new frame) */
+        float K[BR_NX];
+        for (int i = 0; i < BR_NX; i++) {
+            K[i] = Pm[i][0] / S;
+        }
+        xm[BR_X_THETA] = theta_new;
+        for (int i = 0; i < BR_NX; i++) {
+            xm[i] += K[i] * nu;
+        }
+        /* Joseph form P+ = A P- A^T + R K K^T, A = I - K H, H = e_0^T:
+         *   (A P-)_ij = P-_ij - K_i P-_0j,  (A P- A^T)_ij = (A P-)_ij - (A P-)_i0 K_j */
+        float AP[BR_NX][BR_NX];
+        for (int i = 0; i < BR_NX; i++) {
+            for (int j = 0; j < BR_NX; j++) {
+                AP[i][j] = Pm[i][j] - K[i] * Pm[0][j];
+            }
+        }
+        const float r = ukf->cfg.r_var_rad2;
+        for (int i = 0; i < BR_NX; i++) {
+            for (int j = 0; j < BR_NX; j++) {
+                Pm[i][j] = AP[i][j] - AP[i][0] * K[j] + r * K[i] * K[j];
+            }
+        }
+        /* P+ <- (P+ + P+^T) / 2 */
+        symmetrise(Pm);
+        /* g_p of the mean kept in [gp_min, gp_max], as the sigma points' are */
+        xm[BR_X_GP] = clampf(xm[BR_X_GP], ukf->cfg.gp_min_N, ukf->cfg.gp_max_N);
+        if (!vec_finite(xm) || !mat_finite((const float(*)[BR_NX])Pm)) {
+            return BR_E_NUMERIC;
+        }
+    }
+
+    /* 4. posterior sigma points and the unscented mean of f_nl (eq. 6);
+     *    a failed Cholesky of P+ resets Pm as in step 1 */
+    const br_status_t st_post = sigma_points(ukf, xm, Pm);
+    const float F_hat = fnl_unscented(ukf);
+    if (!isfinite(F_hat)) {
+        return BR_E_NUMERIC;
+    }
+
+    /* commit */
+    for (int i = 0; i < BR_NX; i++) {
+        ukf->x[i] = xm[i];
+        for (int j = 0; j < BR_NX; j++) {
+            ukf->P[i][j] = Pm[i][j];
+        }
+    }
+    if (verdict == BR_OK) {
+        ukf->origin_counts = y->counts;
+    }
+    set_estimate(ukf, F_hat, nu, S);
+    if (st_chol != BR_OK || st_post != BR_OK) {
+        return BR_E_NUMERIC;
+    }
+    return verdict;
+}
+
+const br_ukf_est_t *br_ukf_estimate(const br_ukf_t *ukf) { return (ukf != NULL) ? &ukf->est : NULL; }
+
+br_status_t br_ukf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    br_ukf_t *ukf = ctx;
+    if (F_hat_N == NULL) {
+        return BR_E_NULL;
+    }
+    const br_status_t st = br_ukf_step(ukf, y, u_prev_Nm);
+    if (st == BR_OK || st == BR_E_OUTLIER) { /* an outlier step still predicts */
+        *F_hat_N = ukf->est.F_hat_N;
+    }
+    return st;
+}

@@ -1,0 +1,47 @@
+/* Estimator configurations for the circle experiment (docs/modules/pf.md). */
+#include "br_circle_est.h"
+
+#include "br_noise_table.h"
+#include "br_reference_machine.h"
+
+static br_model_cfg_t model_cfg(float dt_s)
+{
+    br_model_cfg_t m;
+    m.J_kgm2 = BR_REF_J_KGM2_F;
+    m.M_kg = BR_REF_M_KG_F;
+    m.lead_mprad = BR_REF_LEAD_MPRAD_F;
+    m.sigma2_Nspm = BR_REF_SIGMA2_NSPM_F;
+    m.lugre.sigma0_Npm = BR_REF_SIGMA0_NPM_F;
+    m.lugre.sigma1_Nspm = BR_REF_SIGMA1_NSPM_F;
+    m.lugre.Fc_N = BR_REF_FC_N_F;
+    m.lugre.Fs_N = BR_REF_FS_N_F;
+    m.lugre.vs_mps = BR_REF_VS_MPS_F;
+    m.dt_s = dt_s;
+    return m;
+}
+
+br_pf_cfg_t br_circle_pf_cfg_default(float dt_s)
+{
+    const float rpc = BR_REF_RAD_PER_COUNT_F;
+    br_pf_cfg_t c;
+    c.model = model_cfg(dt_s);
+    c.n_particles = 1500u;
+    c.q_var[BR_X_THETA] = 0.01f * rpc * rpc;
+    c.q_var[BR_X_OMEGA] = 1.0e-4f;
+    c.q_var[BR_X_Z] = 1.0e-16f;
+    c.q_var[BR_X_GP] = 0.09f;
+    c.r_var_rad2 = rpc * rpc;
+    c.gp0_N = BR_REF_FS_N_F;
+    c.x0_std[BR_X_THETA] = 0.3f * rpc;
+    c.x0_std[BR_X_OMEGA] = 1.0e-3f;
+    c.x0_std[BR_X_Z] = 1.0e-7f;
+    c.x0_std[BR_X_GP] = 2.0f;
+    c.gp_min_N = 0.5f * BR_REF_FC_N_F;
+    c.gp_max_N = 1.5f * BR_REF_FS_N_F;
+    c.outlier_sigma = 30.0f;
+    c.reanchor_after = 3u;
+    c.rad_per_count = rpc;
+    c.noise = br_noise_table;
+    c.noise_len = BR_NOISE_LEN;
+    return c;
+}

@@ -1,0 +1,278 @@
+/* Particle filter: configuration guards, integer resampling, bad input,
+ * outliers, all-invalid steps, underflow-proof weights, tracking. */
+#include "br_test.h"
+
+#include <stdlib.h>
+
+#include "br_noise_table.h"
+#include "br_reference_machine.h"
+#include "bristle/br_pf.h"
+#include "plant/br_sim_plant.h"
+
+#define RPC BR_REF_RAD_PER_COUNT_F
+
+static br_pf_cfg_t cfg(uint32_t m)
+{
+    br_pf_cfg_t c;
+    c.model.J_kgm2 = BR_REF_J_KGM2_F;
+    c.model.M_kg = BR_REF_M_KG_F;
+    c.model.lead_mprad = BR_REF_LEAD_MPRAD_F;
+    c.model.sigma2_Nspm = BR_REF_SIGMA2_NSPM_F;
+    c.model.lugre = (br_lugre_cfg_t){BR_REF_SIGMA0_NPM_F, BR_REF_SIGMA1_NSPM_F, BR_REF_FC_N_F, BR_REF_FS_N_F,
+                                     BR_REF_VS_MPS_F};
+    c.model.dt_s = 1.0e-3f;
+    c.n_particles = m;
+    c.q_var[0] = 0.01f * RPC * RPC;
+    c.q_var[1] = 1.0e-5f;
+    c.q_var[2] = 1.0e-14f;
+    c.q_var[3] = 0.09f;
+    c.r_var_rad2 = 0.3f * RPC * RPC;
+    c.gp0_N = 18.0f;
+    c.x0_std[0] = 0.3f * RPC;
+    c.x0_std[1] = 1e-3f;
+    c.x0_std[2] = 1e-7f;
+    c.x0_std[3] = 2.0f;
+    c.gp_min_N = 3.5f;
+    c.gp_max_N = 27.0f;
+    c.outlier_sigma = 30.0f;
+    c.reanchor_after = 3u;
+    c.rad_per_count = RPC;
+    c.noise = br_noise_table;
+    c.noise_len = BR_NOISE_LEN;
+    return c;
+}
+
+static br_pf_t *new_pf(uint32_t m)
+{
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t c = cfg(m);
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    return pf;
+}
+
+static int all_finite(const br_pf_t *pf)
+{
+    for (uint32_t j = 0; j < pf->cfg.n_particles; j++)
+        for (int i = 0; i < BR_NX; i++)
+            if (!isfinite(pf->x[i][j])) return 0;
+    return 1;
+}
+
+static void test_init_guards(void **st)
+{
+    (void)st;
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    br_pf_cfg_t c = cfg(100);
+    assert_int_equal(br_pf_init(NULL, &c), BR_E_NULL);
+    assert_int_equal(br_pf_init(pf, NULL), BR_E_NULL);
+    c = cfg(100); c.noise = NULL;                 assert_int_equal(br_pf_init(pf, &c), BR_E_NULL);
+    c = cfg(0);                                   assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(BR_PF_MAX_PARTICLES + 1u);            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(BR_PF_MAX_PARTICLES);                 assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c = cfg(100); c.noise_len = 1000u;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* not 2^k */
+    c = cfg(100); c.noise_len = 1u;               assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    for (int i = 0; i < BR_NX; i++) {
+        c = cfg(100); c.q_var[i] = -1e-20f;       assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+        c = cfg(100); c.q_var[i] = NAN;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+        c = cfg(100); c.x0_std[i] = -1.0f;        assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    }
+    c = cfg(100); c.r_var_rad2 = 0.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.r_var_rad2 = -1.0f;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.r_var_rad2 = INFINITY;        assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.outlier_sigma = 0.0f;         assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.reanchor_after = 0u;          assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.rad_per_count = 0.0f;         assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.gp_min_N = 0.0f;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.gp_max_N = 3.0f;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* < min */
+    c = cfg(100); c.gp0_N = 30.0f;                assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* > max */
+    c = cfg(100); c.model.dt_s = 0.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.model.lugre.sigma0_Npm = -1.0f; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_STATE); /* last init failed */
+    free(pf);
+}
+
+static void test_resample_idx(void **st)
+{
+    (void)st;
+    uint16_t idx[8];
+    /* equal weights: each particle once */
+    const uint32_t eq[4] = {5, 5, 5, 5};
+    assert_int_equal(br_pf_resample_idx(eq, 4, idx), BR_OK);
+    for (int i = 0; i < 4; i++) assert_int_equal(idx[i], i);
+    /* one particle carries everything */
+    const uint32_t one[4] = {0, 0, 65536, 0};
+    assert_int_equal(br_pf_resample_idx(one, 4, idx), BR_OK);
+    for (int i = 0; i < 4; i++) assert_int_equal(idx[i], 2);
+    /* C = 1,4,4,8; t_i = floor((2i+1) 8 / 8) = 1,3,5,7 -> 1,1,3,3 */
+    const uint32_t w[4] = {1, 3, 0, 4};
+    assert_int_equal(br_pf_resample_idx(w, 4, idx), BR_OK);
+    assert_int_equal(idx[0], 1);
+    assert_int_equal(idx[1], 1);
+    assert_int_equal(idx[2], 3);
+    assert_int_equal(idx[3], 3);
+    /* the largest totals do not overflow: 65535 particles of 2^16 need 64 bits for (2i+1) C */
+    const uint32_t big[2] = {65536, 65536};
+    assert_int_equal(br_pf_resample_idx(big, 2, idx), BR_OK);
+    assert_int_equal(idx[0], 0);
+    assert_int_equal(idx[1], 1);
+    /* guards */
+    const uint32_t zero[4] = {0, 0, 0, 0};
+    assert_int_equal(br_pf_resample_idx(zero, 4, idx), BR_E_INPUT);
+    assert_int_equal(br_pf_resample_idx(w, 0, idx), BR_E_PARAM);
+    assert_int_equal(br_pf_resample_idx(NULL, 4, idx), BR_E_NULL);
+}
+
+static void test_bad_input_keeps_state(void **st)
+{
+    (void)st;
+    br_pf_t *pf = new_pf(200);
+    br_meas_t y = {1000, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK); /* primes */
+    assert_int_equal(br_pf_step(pf, &y, 0.001f), BR_OK);
+    float th0 = pf->x[0][7], gp0 = pf->x[3][7];
+    uint32_t pos = pf->noise_pos;
+    const float bad[] = {NAN, INFINITY, -INFINITY};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(br_pf_step(pf, &y, bad[k]), BR_E_INPUT);
+        br_meas_t yb = {1000, bad[k]};
+        assert_int_equal(br_pf_step(pf, &yb, 0.0f), BR_E_INPUT);
+    }
+    br_meas_t yr = {1000, 1.5f};
+    assert_int_equal(br_pf_step(pf, &yr, 0.0f), BR_E_INPUT);
+    yr.frac = -0.1f;
+    assert_int_equal(br_pf_step(pf, &yr, 0.0f), BR_E_INPUT);
+    assert_true(pf->x[0][7] == th0 && pf->x[3][7] == gp0 && pf->noise_pos == pos);
+    assert_int_equal(br_pf_step(pf, NULL, 0.0f), BR_E_NULL);
+    free(pf);
+}
+
+static void test_outlier_100_sigma(void **st)
+{
+    (void)st;
+    br_pf_t *pf = new_pf(300);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    for (int k = 0; k < 5; k++) assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    /* 100 sigma (R = 1 count^2): every particle is an outlier */
+    y.counts = 100;
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_OUTLIER);
+    assert_true(all_finite(pf));
+    assert_true(isfinite(br_pf_estimate(pf)->F_hat_N));
+    /* a single glitch: the measurement returns and tracking resumes */
+    y.counts = 0;
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    BR_ASSERT_NEAR(br_pf_estimate(pf)->mean[0] / RPC, 0.5, 1.0);
+    /* a lasting jump (the filter lost lock): re-anchored after 3 outliers */
+    y.counts = 100;
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_OUTLIER);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_OUTLIER);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_OUTLIER);
+    assert_true(all_finite(pf));
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    BR_ASSERT_NEAR(br_pf_estimate(pf)->mean[0] / RPC, 0.5, 1.0);
+    free(pf);
+}
+
+static void test_all_invalid_keeps_previous(void **st)
+{
+    (void)st;
+    br_pf_t *pf = new_pf(100);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    float th = pf->x[0][3];
+    int32_t origin = pf->origin_counts;
+    /* a torque that overflows every particle's velocity: no particle is usable */
+    y.counts = 5;
+    assert_int_equal(br_pf_step(pf, &y, 3.0e38f), BR_E_NUMERIC);
+    assert_true(all_finite(pf));
+    assert_true(pf->x[0][3] == th && pf->origin_counts == origin);
+    free(pf);
+}
+
+static void test_weights_survive_underflow(void **st)
+{
+    (void)st;
+    /* a residual of 300 counts with R = 1 count^2: e^(-l) underflows float for
+     * every particle; the max-shift keeps the best at weight 1 */
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    br_pf_cfg_t c = cfg(100);
+    c.outlier_sigma = 1e6f; /* not an outlier by configuration */
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    y.counts = 300;
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    uint32_t wmax = 0;
+    for (uint32_t j = 0; j < 100; j++) wmax = pf->W[j] > wmax ? pf->W[j] : wmax;
+    assert_int_equal(wmax, 1u << BR_PF_W_BITS);
+    assert_true(all_finite(pf));
+    assert_true(br_pf_estimate(pf)->ess >= 1.0f);
+    free(pf);
+}
+
+static void test_ess_reported(void **st)
+{
+    (void)st;
+    br_pf_t *pf = new_pf(500);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    BR_ASSERT_NEAR(br_pf_estimate(pf)->ess, 500.0, 0.0); /* freshly drawn: uniform */
+    for (int k = 0; k < 20; k++) {
+        assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+        float ess = br_pf_estimate(pf)->ess;
+        assert_true(ess >= 1.0f && ess <= 500.0f);
+    }
+    free(pf);
+}
+
+/* Friction tracking on the double-precision plant driven open loop by a slow
+ * sinusoidal torque (reversals, stiction, sliding). */
+static void test_tracks_plant_friction(void **st)
+{
+    (void)st;
+    br_pf_t *pf = new_pf(1000);
+    br_plant_t p;
+    br_plant_cfg_t pc = br_plant_cfg_reference();
+    br_plant_state_t x0 = {0.0, 0.0, 0.0};
+    assert_int_equal(br_plant_init(&p, &pc, &x0), 0);
+    double u = 0.0, se = 0.0, sf = 0.0;
+    int n = 0, n_out = 0;
+    for (int k = 0; k < 3000; k++) {
+        br_meas_t y = {br_plant_encoder(&p), 0.5f};
+        br_status_t s = br_pf_step(pf, &y, (float)u);
+        /* breakaway drops the friction from Fs to Fc within a few ms, faster than
+         * the g_p random walk: the filter may reject a few measurements there */
+        assert_true(s == BR_OK || s == BR_E_OUTLIER);
+        n_out += (s == BR_E_OUTLIER);
+        if (k >= 1000) { /* after the first breakaway */
+            double e = (double)br_pf_estimate(pf)->F_hat_N - p.fnl_N;
+            se += e * e;
+            sf += p.fnl_N * p.fnl_N;
+            n++;
+        }
+        /* 20 N peak at the load, period 1 s: sticks, breaks away, reverses,
+         * slides at up to 0.2 m/s */
+        u = 20.0 * pc.lead_mprad * sin(2.0 * 3.14159265358979 * k * 1e-3);
+        br_plant_step(&p, u / pc.tau_per_duty_Nm, 1e-3);
+    }
+    const double rel = sqrt(se / sf);
+    print_message("PF friction tracking: RMS error %.3f N, %.1f %% of the RMS friction, %d outlier steps\n",
+                  sqrt(se / n), 100.0 * rel, n_out);
+    assert_true(rel < 0.10);
+    assert_true(n_out < 100); /* of 3000 steps; measured: 52 */
+    free(pf);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_init_guards),          cmocka_unit_test(test_resample_idx),
+        cmocka_unit_test(test_bad_input_keeps_state), cmocka_unit_test(test_outlier_100_sigma),
+        cmocka_unit_test(test_all_invalid_keeps_previous), cmocka_unit_test(test_weights_survive_underflow),
+        cmocka_unit_test(test_ess_reported),         cmocka_unit_test(test_tracks_plant_friction),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
