@@ -69,11 +69,11 @@ static float noise_at(const br_pf_t *pf, uint32_t j, uint32_t i)
     return pf->cfg.noise[(pf->noise_pos + BR_NX * j + i) & (pf->cfg.noise_len - 1u)];
 }
 
-/* The table position moves on by the samples used plus one, so that the
- * particle-to-sample assignment shifts from step to step. */
+/* The table position moves on by the samples used plus noise_skip, so that
+ * the particle-to-sample assignment shifts from step to step. */
 static void noise_advance(br_pf_t *pf)
 {
-    pf->noise_pos = (pf->noise_pos + BR_NX * pf->cfg.n_particles + 1u) & (pf->cfg.noise_len - 1u);
+    pf->noise_pos = (pf->noise_pos + BR_NX * pf->cfg.n_particles + pf->cfg.noise_skip) & (pf->cfg.noise_len - 1u);
 }
 
 /* Estimate of the freshly drawn set: means and the mean of f_nl (eq. 6). */

@@ -32,7 +32,8 @@ static br_status_t check_cfg(const br_ukf_cfg_t *cfg)
             return BR_E_PARAM;
         }
     }
-    if (!finite_pos(cfg->r_var_rad2) || !finite_pos(cfg->outlier_sigma) || !finite_pos(cfg->rad_per_count)) {
+    if (!finite_pos(cfg->r_var_rad2) || !finite_pos(cfg->outlier_sigma) || !finite_pos(cfg->rad_per_count) ||
+        cfg->reanchor_after < 1u) {
         return BR_E_PARAM;
     }
     if (!finite_pos(cfg->gp_min_N) || !isfinite(cfg->gp_max_N) || !(cfg->gp_max_N > cfg->gp_min_N) ||
@@ -94,6 +95,9 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
         }
     }
     ukf->origin_counts = 0;
+    ukf->prev_counts = 0;
+    ukf->prev_frac = 0.0f;
+    ukf->n_outliers = 0u;
     ukf->n_recover = 0u;
     ukf->primed = 0;
     ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->gp0_N},
@@ -183,7 +187,6 @@ static br_status_t sigma_points(br_ukf_t *ukf, const float x[BR_NX], float P[BR_
     return st;
 }
 
-
 /* Unscented mean of f_nl (eq. 6) over the sigma points in ukf->X:
  * F_hat = sum_j Wm_j f_nl(X_j), written as f_0 + sum_{j>=1} W_j (f_j - f_0)
  * (sum Wm = 1) so that a large |Wm_0| (small alpha) does not cancel in float32. */
@@ -214,6 +217,8 @@ static void set_estimate(br_ukf_t *ukf, float F_hat_N, float innov, float innov_
 static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
 {
     ukf->origin_counts = y->counts;
+    ukf->prev_counts = y->counts;
+    ukf->prev_frac = y->frac;
     ukf->x[BR_X_THETA] = y->frac * ukf->cfg.rad_per_count;
     ukf->x[BR_X_OMEGA] = 0.0f;
     ukf->x[BR_X_Z] = 0.0f;
@@ -315,9 +320,24 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
         return BR_E_NUMERIC;
     }
     br_status_t verdict = BR_OK;
+    int32_t origin_new = y->counts;
     if (nu * nu > ukf->out_s2 * S) {
         /* outlier: keep the prediction in the old origin's frame, no update */
         verdict = BR_E_OUTLIER;
+        origin_new = ukf->origin_counts;
+        if (ukf->n_outliers + 1u >= ukf->cfg.reanchor_after) {
+            /* lost lock: re-anchor on the measurement, theta = frac rpc relative
+             * to y.counts, omega = the measured velocity over the last period
+             * (wrap-safe count difference), z and g_p means kept, P = diag(p0_var) */
+            const float dcounts = (float)br_counts_delta(y->counts, ukf->prev_counts);
+            xm[BR_X_THETA] = y->frac * rpc;
+            xm[BR_X_OMEGA] = (dcounts + (y->frac - ukf->prev_frac)) * rpc / ukf->cfg.model.dt_s;
+            reset_cov(&ukf->cfg, Pm);
+            origin_new = y->counts;
+            if (!vec_finite(xm)) {
+                return BR_E_NUMERIC;
+            }
+        }
     } else {
         /* gain K = P- H^T / S = P-_{:,0} / S; mean x+ = x- + K nu (theta in the new frame) */
         float K[BR_NX];
@@ -366,8 +386,14 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
             ukf->P[i][j] = Pm[i][j];
         }
     }
-    if (verdict == BR_OK) {
-        ukf->origin_counts = y->counts;
+    ukf->origin_counts = origin_new;
+    ukf->prev_counts = y->counts;
+    ukf->prev_frac = y->frac;
+    /* as in the PF, every further outlier in the run re-anchors again */
+    if (verdict != BR_E_OUTLIER) {
+        ukf->n_outliers = 0u;
+    } else if (ukf->n_outliers < UINT32_MAX) {
+        ukf->n_outliers++;
     }
     set_estimate(ukf, F_hat, nu, S);
     if (st_chol != BR_OK || st_post != BR_OK) {

@@ -26,6 +26,7 @@ typedef struct {
 
 static const demo_row_t rows[] = {
     {BR_CTRL_HINF_ONLY, "H-inf only", 2.4e-6},
+    {BR_CTRL_HINF_UKF, "H-inf + UKF", 1.3e-6},
     {BR_CTRL_HINF_PF, "H-inf + PF", 4.0e-7},
     {BR_CTRL_HINF_TRUE, "true friction", 0.0},
 };
@@ -119,6 +120,7 @@ int main(int argc, char **argv)
         if (dt > 0.0) {
             cfg.dt_s = dt;
             cfg.pf.model.dt_s = (float)dt;
+            cfg.ukf.model.dt_s = (float)dt;
         }
         if (nsub > 0) cfg.plant.n_sub = nsub;
         char fname[256];

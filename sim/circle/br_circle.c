@@ -16,6 +16,7 @@ const char *br_circle_ctrl_name(br_circle_ctrl_t c)
 {
     switch (c) {
     case BR_CTRL_HINF_ONLY: return "hinf_only";
+    case BR_CTRL_HINF_UKF: return "hinf_ukf";
     case BR_CTRL_HINF_PF: return "hinf_pf";
     case BR_CTRL_HINF_TRUE: return "hinf_true";
     }
@@ -35,6 +36,7 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     c.plant = br_plant_cfg_reference();
     for (int i = 0; i < 3; i++) c.K[i] = K[i];
     c.pf = br_circle_pf_cfg_default((float)c.dt_s);
+    c.ukf = br_circle_ukf_cfg_default((float)c.dt_s);
     return c;
 }
 
@@ -52,7 +54,8 @@ typedef struct {
     br_hal_sim_t port;
     br_hal_t hal;
     br_axis_t axis;
-    br_pf_t *pf; /* owned, BR_CTRL_HINF_PF only */
+    br_pf_t *pf;   /* owned, BR_CTRL_HINF_PF only */
+    br_ukf_t *ukf; /* owned, BR_CTRL_HINF_UKF only */
     double phase;
 } axis_sim_t;
 
@@ -76,6 +79,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
 {
     a->phase = phase;
     a->pf = NULL;
+    a->ukf = NULL;
     br_plant_state_t x0 = {c->radius_m * sin(phase) / c->plant.lead_mprad, 0.0, 0.0};
     if (br_plant_init(&a->plant, &c->plant, &x0) != 0) return -1;
     if (br_hal_sim_init(&a->port, &a->plant, c->dt_s, &a->hal) != BR_OK) return -1;
@@ -93,6 +97,17 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
         break;
     case BR_CTRL_HINF_TRUE:
         est = (br_est_t){&a->plant, oracle_step};
+        break;
+    case BR_CTRL_HINF_UKF:
+        if (fabs((double)c->ukf.model.dt_s - c->dt_s) > 1e-9) {
+            fprintf(stderr, "br_circle: the UKF's period %g s differs from the control period %g s\n",
+                    (double)c->ukf.model.dt_s, c->dt_s);
+            return -1;
+        }
+        a->ukf = calloc(1, sizeof *a->ukf);
+        if (a->ukf == NULL) return -1;
+        st = br_ukf_init(a->ukf, &c->ukf);
+        est = (br_est_t){a->ukf, br_ukf_est_step};
         break;
     case BR_CTRL_HINF_PF:
         if (fabs((double)c->pf.model.dt_s - c->dt_s) > 1e-9) {
@@ -131,6 +146,7 @@ void br_circle_csv_sink(void *user, const br_circle_sample_t *s)
             s->F_hat_N[0], s->F_hat_N[1]);
     for (int i = 0; i < 2; i++) {
         if (s->pf[i]) fprintf(f, ",%.6f", (double)br_pf_estimate(s->pf[i])->mean[BR_X_GP]);
+        else if (s->ukf[i]) fprintf(f, ",%.6f", (double)br_ukf_estimate(s->ukf[i])->mean[BR_X_GP]);
         else fprintf(f, ",");
     }
     fprintf(f, "\n");
@@ -144,10 +160,11 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     }
     axis_sim_t ax[2];
     ax[0].pf = ax[1].pf = NULL;
+    ax[0].ukf = ax[1].ukf = NULL;
     int rc = -1;
     if (axis_init(&ax[0], c, 0.0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI) != 0) goto done;
     const long n = lround(c->duration_s / c->dt_s);
-    double sum2 = 0.0, emax = 0.0;
+    double sum2 = 0.0, emax = 0.0, fe2 = 0.0;
     int nsat = 0, nout = 0;
     for (long k = 0; k <= n; k++) {
         const double t = (double)k * c->dt_s;
@@ -170,7 +187,9 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             sat |= ax[i].axis.last.saturated;
             s.duty[i] = (double)ax[i].axis.last.duty;
             s.F_hat_N[i] = (double)ax[i].axis.F_hat_N;
+            fe2 += (s.F_hat_N[i] - s.fnl_N[i]) * (s.F_hat_N[i] - s.fnl_N[i]);
             s.pf[i] = ax[i].pf;
+            s.ukf[i] = ax[i].ukf;
         }
         /* contour error of a circle: radial deviation from the radius */
         const double er = hypot(s.pos_m[0], s.pos_m[1]) - c->radius_m;
@@ -185,9 +204,12 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     res->max_err_m = emax;
     res->saturated_steps = nsat;
     res->outlier_steps = nout;
+    res->fhat_rms_err_N = sqrt(fe2 / (2.0 * (double)(n + 1)));
     rc = 0;
 done:
     free(ax[0].pf);
     free(ax[1].pf);
+    free(ax[0].ukf);
+    free(ax[1].ukf);
     return rc;
 }

@@ -8,14 +8,16 @@
 
 #include "bristle/br_ctrl.h"
 #include "bristle/br_pf.h"
+#include "bristle/br_ukf.h"
 #include "plant/br_sim_plant.h"
 
 /* The controllers of thesis section 5, plus the limit: compensation with the
  * plant's true friction (an oracle no real machine has). */
 typedef enum {
     BR_CTRL_HINF_ONLY = 0,
-    BR_CTRL_HINF_PF = 1,
-    BR_CTRL_HINF_TRUE = 2
+    BR_CTRL_HINF_UKF = 1,
+    BR_CTRL_HINF_PF = 2,
+    BR_CTRL_HINF_TRUE = 3
 } br_circle_ctrl_t;
 
 /* Name used in summary.json and file names: "hinf_only", "hinf_pf", ... */
@@ -30,6 +32,7 @@ typedef struct {
     br_plant_cfg_t plant; /* both axes alike */
     float K[3];          /* state-feedback gains */
     br_pf_cfg_t pf;      /* BR_CTRL_HINF_PF: the filter (its model.dt_s must equal dt_s) */
+    br_ukf_cfg_t ukf;    /* BR_CTRL_HINF_UKF: likewise */
 } br_circle_cfg_t;
 
 typedef struct {
@@ -38,6 +41,7 @@ typedef struct {
     long n_samples;
     int saturated_steps;    /* periods where either axis saturated */
     int outlier_steps;      /* axis-periods whose measurement the estimator rejected */
+    double fhat_rms_err_N;  /* RMS of (compensation - true friction) over both axes */
 } br_circle_result_t;
 
 /* The thesis experiment with the reference machine, the H-inf gains and the
@@ -55,6 +59,7 @@ typedef struct {
     double fnl_N[2];     /* true LuGre force of each axis */
     double F_hat_N[2];   /* the compensation used (0 for H-inf only) */
     const br_pf_t *pf[2]; /* the filters after this period's step (PF only, else NULL) */
+    const br_ukf_t *ukf[2]; /* likewise for the UKF */
 } br_circle_sample_t;
 
 typedef void (*br_circle_sink_t)(void *user, const br_circle_sample_t *s);

@@ -3,8 +3,12 @@
 #define BR_CIRCLE_EST_H
 
 #include "bristle/br_pf.h"
+#include "bristle/br_ukf.h"
 
 /* The PF of thesis section 5 (1500 particles) at period dt_s. */
 br_pf_cfg_t br_circle_pf_cfg_default(float dt_s);
+
+/* The UKF of thesis section 5 at period dt_s. */
+br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s);
 
 #endif

@@ -39,6 +39,7 @@ static br_pf_cfg_t cfg(uint32_t m)
     c.rad_per_count = RPC;
     c.noise = br_noise_table;
     c.noise_len = BR_NOISE_LEN;
+    c.noise_skip = 1u;
     return c;
 }
 

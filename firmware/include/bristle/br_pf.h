@@ -43,6 +43,7 @@ typedef struct {
     float rad_per_count;     /* encoder resolution, > 0 */
     const float *noise;      /* standard-normal ROM table (e.g. br_noise_table) */
     uint32_t noise_len;      /* its length, a power of two >= 2 */
+    uint32_t noise_skip;     /* extra table advance per step (indexing scheme, docs/modules/pf.md) */
 } br_pf_cfg_t;
 
 typedef struct {

@@ -8,12 +8,15 @@
  *                    lambda = alpha^2 (n + kappa) - n; g_p clamped to [gp_min, gp_max]
  *   2. predict       Y_j = f_d(X_j, u_{k-1})               (br_model_step)
  *                    x- = sum_j Wm_j Y_j,  P- = sum_j Wc_j (Y_j - x-)(Y_j - x-)^T + Q
+ *                    (evaluated about Y_0, without the large Wc_0 of a small alpha)
  *   3. update        h(x) = theta is linear: S = P-_00 + R, K = P-_{:,0} / S,
  *                    x+ = x- + K (y - theta-), P+ = (I - K H) P- (I - K H)^T + K R K^T
  *                    (Joseph form), then symmetrised
  *   4. estimate      F_hat = sum_j Wm_j f_nl(X+_j) over the posterior sigma points
  * A failed Cholesky (pivot <= 0 or non-finite) resets P to diag(p0_var),
- * keeping the mean, and reports BR_E_NUMERIC.
+ * keeping the mean, and reports BR_E_NUMERIC. An outlier (|y - theta-| >
+ * outlier_sigma sqrt(S)) skips the update; reanchor_after of them in a row
+ * re-anchor the filter on the measurement (as the PF does).
  * theta is stored relative to an integer origin (the latest accepted count),
  * as in the PF, so float32 keeps sub-count resolution at any travel.
  * See docs/modules/ukf.md. */
@@ -38,8 +41,9 @@ typedef struct {
     float gp_min_N;          /* g_p of every sigma point and of the mean kept in */
     float gp_max_N;          /*   [gp_min_N, gp_max_N], 0 < min < max */
     float outlier_sigma;     /* |y - theta-| > outlier_sigma sqrt(S): outlier, > 0 */
+    uint32_t reanchor_after; /* consecutive outliers before x is re-anchored on y, >= 1 */
     float rad_per_count;     /* encoder resolution, > 0 */
-    float alpha;             /* sigma-point spread, in (0, 1]; 1 recommended in float32 */
+    float alpha;             /* sigma-point spread, in (0, 1]; use >= 0.1 in float32 (1 recommended) */
     float beta;              /* prior-distribution weight, >= 0 (2 for a Gaussian) */
     float kappa;             /* secondary scaling, n + kappa > 0 (so n + lambda > 0) */
 } br_ukf_cfg_t;
@@ -66,6 +70,9 @@ typedef struct {
     float X[BR_UKF_NSIG][BR_NX];     /* sigma points (scratch; after a step without error, the posterior's) */
     float Y[BR_UKF_NSIG][BR_NX];     /* scratch: propagated sigma points of the last step */
     int32_t origin_counts;
+    int32_t prev_counts;             /* last measurement (accepted or not): the measured */
+    float prev_frac;                 /*   velocity for a re-anchoring */
+    uint32_t n_outliers;             /* consecutive outlier steps */
     uint32_t n_recover;              /* Cholesky recoveries since init */
     int primed;                      /* x, P set from the first measurement */
     br_ukf_est_t est;
@@ -80,7 +87,10 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg);
  *   BR_E_NULL / BR_E_STATE  NULL argument / not initialised;
  *   BR_E_INPUT    non-finite u, or frac non-finite or outside [0, 1]: state untouched;
  *   BR_E_OUTLIER  |y - theta-| > outlier_sigma sqrt(S): the prediction is kept
- *                 (origin unchanged), no update;
+ *                 (origin unchanged), no update; on the reanchor_after-th
+ *                 consecutive outlier the filter has lost lock and is
+ *                 re-anchored: origin = y.counts, x = [frac rpc, measured
+ *                 velocity, z, g_p] (z, g_p means kept), P = diag(p0_var);
  *   BR_E_NUMERIC  a non-finite prediction or update: the previous x, P and
  *                 origin are kept; or a Cholesky failure: P was reset to
  *                 diag(p0_var) with the mean kept (the step otherwise completed). */

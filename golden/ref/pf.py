@@ -1,0 +1,197 @@
+"""Particle filter for the friction of one axis (thesis sections 2.3, 4),
+float64 golden reference, written from the description in
+firmware/include/bristle/br_pf.h (not from br_pf.c).
+
+Particles x_j = [theta, omega, z, g_p] of the eq. 6 model (golden/ref/model.py),
+j = 0..m-1, theta relative to an integer origin (the latest measured count).
+The process noise is read from a standard-normal ROM table n[0..len-1]
+(len a power of two): the sample for (particle j, state i) is
+n[(pos + 4 j + i) & (len - 1)], and pos advances by 4 m + noise_skip after
+every draw (priming and every step).
+
+Priming (first measurement y = (counts, frac)):
+    x_j   = [frac rpc, 0, 0, gp0] + x0_std * n_j,   g_p clamped to [gp_min, gp_max]
+    origin = counts, estimate = the mean of the set, F_hat = mean f_nl(x_j), ESS = m.
+
+One step with y_k = (counts, frac) and the torque u_{k-1} of the last period:
+    shift = wrapdiff(counts, origin) rpc,   y = frac rpc
+    1. predict  xn_j = f_d(x_j, u) + sqrt(Q) n_j;  g_p clamped;  theta -= shift.
+                A particle whose model step fails or that is non-finite (or whose
+                f_nl is) is invalid: it keeps its previous state and weight 0.
+    2. weigh    l_j = -(theta_j - y)^2 / (2 R),  w_j = exp(l_j - max l)   (valid j)
+                max l < -outlier_sigma^2 / 2 (y further than outlier_sigma sqrt(R)
+                from every particle): outlier, every valid particle gets w = 1.
+    3. quantise W_j = floor(w_j 2^16)          (integers, the best particle 2^16)
+    4. resample particle i copies j with C_{j-1} <= xi_i C_m < C_j,
+                xi_i = (i + 1/2) / m, C_j = W_0 + ... + W_j (exact integers)
+    5. estimate mean of the resampled set, F_hat = mean of f_nl over it (eq. 6),
+                ESS = (sum w)^2 / sum w^2 of the step's weights.
+    Outliers: after reanchor_after consecutive outlier steps (and on every
+    further one) the cloud is re-anchored on y: theta shifted so that its mean
+    is y, omega so that its mean is the measured velocity
+    (shift + (frac - frac_prev) rpc) / dt, spread kept.
+    No valid particle at all: BR_E_NUMERIC, the previous set (and origin) kept.
+    Then origin = counts, frac_prev = frac.
+A non-finite u or a frac outside [0, 1]: BR_E_INPUT, nothing changes.
+"""
+import bisect
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import model as rmodel
+
+BR_OK = 0
+BR_E_INPUT = -3
+BR_E_NUMERIC = -4
+BR_E_OUTLIER = -6
+
+W_BITS = 16
+NX = 4
+
+
+@dataclass(frozen=True)
+class PfCfg:
+    model: rmodel.ModelParams
+    dt: float
+    m: int
+    q_var: tuple          # per-step process noise variances (4)
+    r_var: float          # measurement variance, rad^2
+    gp0: float
+    x0_std: tuple         # initial spread (4)
+    gp_min: float
+    gp_max: float
+    outlier_sigma: float
+    reanchor_after: int
+    rad_per_count: float
+    noise: tuple          # the ROM table, float values
+    noise_skip: int
+
+
+def wrapdiff(now, prev):
+    """now - prev modulo 2^32, read as a signed 32-bit integer."""
+    d = (int(now) - int(prev)) & 0xFFFFFFFF
+    return d - (1 << 32) if d >= (1 << 31) else d
+
+
+def resample_idx(W):
+    """Systematic resampling on integer weights: for i = 0..m-1 the j with
+    C_{j-1} <= (i + 1/2) C_m / m < C_j. Since the C_j are integers this is
+    C_{j-1} <= floor((2 i + 1) C_m / (2 m)) < C_j: the first j with C_j > t_i."""
+    m = len(W)
+    C = []
+    c = 0
+    for w in W:
+        c += int(w)
+        C.append(c)
+    total = C[-1]
+    if total <= 0:
+        raise ValueError("all weights zero")
+    return [bisect.bisect_right(C, ((2 * i + 1) * total) // (2 * m)) for i in range(m)]
+
+
+class Pf:
+    def __init__(self, cfg):
+        self.cfg = cfg
+        self.q_std = [math.sqrt(v) for v in cfg.q_var]
+        self.noise_pos = 0
+        self.origin = 0
+        self.prev_frac = 0.0
+        self.n_outliers = 0
+        self.primed = False
+        self.x = [np.zeros(NX) for _ in range(cfg.m)]
+        # outputs of the last step
+        self.xp = None          # predicted set (before resampling)
+        self.W = None           # quantised weights
+        self.idx = None         # resampling indices
+        self.mean = np.array([0.0, 0.0, 0.0, cfg.gp0])
+        self.F_hat = 0.0
+        self.ess = float(cfg.m)
+        self.reanchored = False
+
+    def _n(self, j, i):
+        c = self.cfg
+        return c.noise[(self.noise_pos + NX * j + i) & (len(c.noise) - 1)]
+
+    def _advance(self):
+        c = self.cfg
+        self.noise_pos = (self.noise_pos + NX * c.m + c.noise_skip) & (len(c.noise) - 1)
+
+    def _clamp_gp(self, v):
+        return min(max(v, self.cfg.gp_min), self.cfg.gp_max)
+
+    def _estimate(self):
+        """Mean state and mean f_nl (eq. 6) of the current set."""
+        c = self.cfg
+        s = np.zeros(NX)
+        sf = 0.0
+        for xj in self.x:
+            s = s + xj
+            sf += rmodel.fnl(c.model, xj)
+        self.mean = s / c.m
+        self.F_hat = sf / c.m
+
+    def _prime(self, counts, frac):
+        c = self.cfg
+        mu = [frac * c.rad_per_count, 0.0, 0.0, c.gp0]
+        for j in range(c.m):
+            xj = np.array([mu[i] + c.x0_std[i] * self._n(j, i) for i in range(NX)])
+            xj[3] = self._clamp_gp(xj[3])
+            self.x[j] = xj
+        self._advance()
+        self.origin = int(counts)
+        self.prev_frac = frac
+        self.primed = True
+        self._estimate()
+        self.ess = float(c.m)
+        return BR_OK
+
+    def step(self, counts, frac, u):
+        """One filter step; returns the status."""
+        if not math.isfinite(u) or not math.isfinite(frac) or not 0.0 <= frac <= 1.0:
+            return BR_E_INPUT
+        if not self.primed:
+            return self._prime(counts, frac)
+        c = self.cfg
+        rpc = c.rad_per_count
+        shift = wrapdiff(counts, self.origin) * rpc
+        y = frac * rpc
+        xp, fn, l = [], [], []
+        for j in range(c.m):
+            st, xn, _ = rmodel.step(c.model, self.x[j], u, c.dt)
+            xn = np.array([xn[i] + self.q_std[i] * self._n(j, i) for i in range(NX)])
+            xn[3] = self._clamp_gp(xn[3])
+            xn[0] -= shift
+            valid = st == rmodel.BR_OK and all(math.isfinite(v) for v in xn)
+            f = rmodel.fnl(c.model, xn) if valid else 0.0
+            valid = valid and math.isfinite(f)
+            xp.append(xn if valid else self.x[j].copy())
+            fn.append(f)
+            l.append(-((xn[0] - y) ** 2) / (2.0 * c.r_var) if valid else -math.inf)
+        self._advance()
+        self.xp, self.fnl_pred = xp, fn
+        lmax = max(l)
+        if lmax == -math.inf:
+            self.W = self.idx = None
+            return BR_E_NUMERIC
+        outlier = lmax < -0.5 * c.outlier_sigma ** 2
+        w = [0.0 if lj == -math.inf else (1.0 if outlier else math.exp(lj - lmax)) for lj in l]
+        W = [int(math.floor(wj * 2.0 ** W_BITS)) for wj in w]
+        idx = resample_idx(W)
+        self.W, self.idx = W, idx
+        self.x = [xp[k].copy() for k in idx]
+        self.n_outliers = self.n_outliers + 1 if outlier else 0
+        self.reanchored = self.n_outliers >= c.reanchor_after
+        if self.reanchored:
+            w_meas = (shift + (frac - self.prev_frac) * rpc) / c.dt
+            th = sum(xj[0] for xj in self.x) / c.m
+            om = sum(xj[1] for xj in self.x) / c.m
+            for xj in self.x:
+                xj[0] += y - th
+                xj[1] += w_meas - om
+        self.origin = int(counts)
+        self.prev_frac = frac
+        self._estimate()
+        self.ess = sum(w) ** 2 / sum(wj * wj for wj in w)
+        return BR_E_OUTLIER if outlier else BR_OK
