@@ -108,8 +108,8 @@ int main(int argc, char **argv)
     if (!js) return 1;
     fprintf(js, "{\n  \"experiment\": {\"radius_m\": 1e-4, \"period_s\": 8, \"duration_s\": 8}");
     printf("X-Y circle, radius 1.0e-04 m, period 8 s, 8 s simulated\n");
-    printf("%-14s %8s %16s %16s %16s %12s\n", "controller", "dt [ms]", "contour RMS [m]", "max error [m]",
-           "thesis RMS [m]", "/ H-inf only");
+    printf("%-14s %8s %16s %16s %16s %12s %12s\n", "controller", "dt [ms]", "contour RMS [m]", "max error [m]",
+           "thesis RMS [m]", "/ H-inf only", "F err [N]");
     double rms_hinf = 0.0;
     int ran = 0;
     for (unsigned r = 0; r < N_ROWS; r++) {
@@ -147,11 +147,13 @@ int main(int argc, char **argv)
         }
         fprintf(js,
                 ",\n  \"%s\": {\"dt_s\": %.6g, \"contour_rms_m\": %.6e, \"max_err_m\": %.6e, "
-                "\"thesis_contour_rms_m\": %s, \"saturated_steps\": %d, \"trace\": \"%s\"}",
-                name, cfg.dt_s, res.contour_rms_m, res.max_err_m, thesis_js, res.saturated_steps, fname);
+                "\"thesis_contour_rms_m\": %s, \"fhat_rms_err_N\": %.6e, \"saturated_steps\": %d, "
+                "\"outlier_steps\": %d, \"trace\": \"%s\"}",
+                name, cfg.dt_s, res.contour_rms_m, res.max_err_m, thesis_js, res.fhat_rms_err_N, res.saturated_steps,
+                res.outlier_steps, fname);
         if (rms_hinf > 0.0) snprintf(ratio, sizeof ratio, "%.3f", res.contour_rms_m / rms_hinf);
-        printf("%-14s %8.1f %16.3e %16.3e %16s %12s\n", rows[r].label, cfg.dt_s * 1e3, res.contour_rms_m,
-               res.max_err_m, thesis, ratio);
+        printf("%-14s %8.1f %16.3e %16.3e %16s %12s %12.3f\n", rows[r].label, cfg.dt_s * 1e3, res.contour_rms_m,
+               res.max_err_m, thesis, ratio, res.fhat_rms_err_N);
         fflush(stdout);
         ran++;
     }

@@ -62,6 +62,37 @@ static void test_same_gains_at_pf_period(void **st)
     assert_int_equal(r.saturated_steps, 0);
 }
 
+/* Thesis section 5 ratios to H-inf only: UKF 1.3/2.4, PF 0.4/2.4. The compensated
+ * loops must do at least as well as the thesis's, without saturating and
+ * without the estimator losing lock. */
+static double run_ratio(br_circle_ctrl_t ctrl, br_circle_result_t *r)
+{
+    br_circle_cfg_t c0 = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY), c = br_circle_cfg_thesis(ctrl);
+    br_circle_result_t r0;
+    assert_int_equal(br_circle_run(&c0, NULL, NULL, &r0), 0);
+    assert_int_equal(br_circle_run(&c, NULL, NULL, r), 0);
+    print_message("%s: contour RMS %.3e m = %.3f of H-inf only, friction estimate RMS error %.3f N, %d outliers\n",
+                  br_circle_ctrl_name(ctrl), r->contour_rms_m, r->contour_rms_m / r0.contour_rms_m,
+                  r->fhat_rms_err_N, r->outlier_steps);
+    assert_int_equal(r->saturated_steps, 0);
+    assert_int_equal(r->outlier_steps, 0);
+    return r->contour_rms_m / r0.contour_rms_m;
+}
+
+static void test_ukf_beats_thesis_ratio(void **st)
+{
+    (void)st;
+    br_circle_result_t r;
+    assert_true(run_ratio(BR_CTRL_HINF_UKF, &r) <= 1.3 / 2.4);
+}
+
+static void test_pf_beats_thesis_ratio(void **st)
+{
+    (void)st;
+    br_circle_result_t r;
+    assert_true(run_ratio(BR_CTRL_HINF_PF, &r) <= 0.4 / 2.4);
+}
+
 static void test_rejects_bad_experiment(void **st)
 {
     (void)st;
@@ -75,12 +106,21 @@ static void test_rejects_bad_experiment(void **st)
     c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     c.K[0] = NAN;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+    /* an estimator whose period is not the loop's */
+    c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
+    c.dt_s = 1e-3;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+    c = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
+    c.ukf.r_var_rad2 = -1.0f;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_hinf_only_reproduces_thesis),
                                        cmocka_unit_test(test_same_gains_at_pf_period),
+                                       cmocka_unit_test(test_ukf_beats_thesis_ratio),
+                                       cmocka_unit_test(test_pf_beats_thesis_ratio),
                                        cmocka_unit_test(test_rejects_bad_experiment)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
