@@ -170,7 +170,7 @@ class Pf:
             fn.append(f)
             l.append(-((xn[0] - y) ** 2) / (2.0 * c.r_var) if valid else -math.inf)
         self._advance()
-        self.xp, self.fnl_pred = xp, fn
+        self.xp, self.fnl_pred, self.l = xp, fn, l
         lmax = max(l)
         if lmax == -math.inf:
             self.W = self.idx = None

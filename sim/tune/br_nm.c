@@ -61,7 +61,7 @@ static void sort_simplex(int n, double s[][BR_NM_MAX_DIM], double *f)
 int br_nm_minimize(const br_nm_cfg_t *cfg, br_nm_fn fn, void *user, const double *x0, br_nm_result_t *res)
 {
     if (!cfg || !fn || !x0 || !res || cfg->n < 1 || cfg->n > BR_NM_MAX_DIM || cfg->max_fev < cfg->n + 1 ||
-        !(cfg->xatol >= 0.0) || !(cfg->fatol >= 0.0) || (!cfg->lo) != (!cfg->hi)) {
+        !(cfg->xatol >= 0.0) || !(cfg->fatol >= 0.0) || !(cfg->init_step >= 0.0) || (!cfg->lo) != (!cfg->hi)) {
         fprintf(stderr, "br_nm_minimize: invalid configuration\n");
         return -1;
     }
@@ -78,7 +78,8 @@ int br_nm_minimize(const br_nm_cfg_t *cfg, br_nm_fn fn, void *user, const double
     to_u(cfg, x0, s[0]);
     for (int i = 1; i <= n; i++) {
         memcpy(s[i], s[0], sizeof s[0]);
-        s[i][i - 1] = (s[0][i - 1] != 0.0) ? 1.05 * s[0][i - 1] : 0.00025;
+        if (cfg->init_step > 0.0) s[i][i - 1] += cfg->init_step;
+        else s[i][i - 1] = (s[0][i - 1] != 0.0) ? 1.05 * s[0][i - 1] : 0.00025;
     }
     for (int i = 0; i <= n; i++) f[i] = eval(&k, s[i]);
     sort_simplex(n, s, f);

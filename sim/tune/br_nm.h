@@ -3,7 +3,7 @@
  * Reflection, expansion, outside/inside contraction and shrink with the
  * standard coefficients (1, 2, 1/2, 1/2), the initial simplex and the stopping
  * rule of scipy.optimize.minimize(method="Nelder-Mead"): vertex i moves
- * coordinate i by 5 % (0.00025 when it is zero); stop when
+ * coordinate i by 5 % (0.00025 when it is zero; or by init_step); stop when
  * max |x_i - x_best| <= xatol and max |f_i - f_best| <= fatol, or at max_fev.
  * Box bounds by a change of variables: x = lo + (hi - lo) (1 + sin u) / 2, so
  * the simplex moves freely in u and every evaluated x lies in [lo, hi].
@@ -25,6 +25,8 @@ typedef struct {
     double xatol, fatol;         /* stopping tolerances (in x, after the change of variables) */
     int max_fev;                 /* evaluation budget */
     const double *lo, *hi;       /* optional bounds (both NULL, or both given with lo < hi) */
+    double init_step;            /* > 0: initial simplex step in u for every coordinate;
+                                    0: scipy's rule (5 %, 0.00025 at zero) */
     br_nm_progress_fn progress;
 } br_nm_cfg_t;
 

@@ -69,6 +69,9 @@ static void test_guards_and_progress(void **st)
     c.hi = hi;          assert_int_equal(br_nm_minimize(&c, bowl, &p, bad, &r), -1); /* x0 outside */
     c.xatol = -1.0;     assert_int_equal(br_nm_minimize(&c, bowl, &p, x0, &r), -1);
     c.xatol = 1e-4;
+    c.init_step = -0.1; assert_int_equal(br_nm_minimize(&c, bowl, &p, x0, &r), -1);
+    c.init_step = 0.0;
+    c.xatol = 1e-4;
     c.progress = progress;
     assert_int_equal(br_nm_minimize(&c, bowl, &p, x0, &r), 0);
     assert_true(p.calls / 1000000 == r.nit && r.nit > 0); /* one progress call per iteration */

@@ -1,0 +1,142 @@
+/* Nelder-Mead tuning of an estimator's diagonal Q and R on the simulated
+ * circle (thesis section 3.2): minimises the closed-loop contour RMS of the
+ * H-inf + PF (or + UKF) circle over the log of the noise variances.
+ *
+ * Usage: br_tune_est --est pf|ukf --out HEADER [--log CSV] [--max-fev N]
+ * Prints a progress line per iteration; writes the tuned variances as a
+ * generated header (used by sim/circle/br_circle_est.c) and, with --log, the
+ * progress (iteration, evaluations, best contour RMS, parameters) for Fig. 1.
+ * The start is the hand-tuned default; each log-variance may move 3 decades
+ * either way (bounds by the change of variables of br_nm). See docs/tuning.md. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "br_circle.h"
+#include "br_nm.h"
+
+#define MAX_P 5
+
+typedef struct {
+    int pf;                 /* 1: PF, 0: UKF */
+    br_circle_cfg_t base;
+    FILE *log;
+    double best;
+} tune_t;
+
+/* The tuned parameters: PF (q_omega, q_z, q_gp, R); UKF (q_theta, q_omega, q_z, q_gp, R). */
+static int n_params(const tune_t *t) { return t->pf ? 4 : 5; }
+
+static float *param_ptr(br_circle_cfg_t *c, int pf, int i)
+{
+    if (pf) {
+        return i < 3 ? &c->pf.q_var[i + 1] : &c->pf.r_var_rad2;
+    }
+    return i < 4 ? &c->ukf.q_var[i] : &c->ukf.r_var_rad2;
+}
+
+static const char *param_name(int pf, int i)
+{
+    static const char *const pfn[] = {"q_omega", "q_z", "q_gp", "r"};
+    static const char *const ukn[] = {"q_theta", "q_omega", "q_z", "q_gp", "r"};
+    if (i < 0 || i >= (pf ? 4 : 5)) return "?";
+    return pf ? pfn[i] : ukn[i];
+}
+
+/* objective: contour RMS (m) of the circle with the variances e^x */
+static double objective(void *user, const double *x, int n)
+{
+    tune_t *t = user;
+    br_circle_cfg_t c = t->base;
+    for (int i = 0; i < n; i++) *param_ptr(&c, t->pf, i) = (float)exp(x[i]);
+    br_circle_result_t r;
+    if (br_circle_run(&c, NULL, NULL, &r) != 0) return INFINITY;
+    return r.contour_rms_m;
+}
+
+static void progress(void *user, int iter, int nfev, const double *xb, double fb, int n)
+{
+    tune_t *t = user;
+    printf("iter %3d  evals %4d  contour RMS %.4e m ", iter, nfev, fb);
+    for (int i = 0; i < n; i++) printf(" %s=%.3g", param_name(t->pf, i), exp(xb[i]));
+    printf("\n");
+    fflush(stdout);
+    if (t->log) {
+        fprintf(t->log, "%d,%d,%.6e", iter, nfev, fb);
+        for (int i = 0; i < n; i++) fprintf(t->log, ",%.6e", exp(xb[i]));
+        fprintf(t->log, "\n");
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const char *est = NULL, *out = NULL, *log_path = NULL;
+    int max_fev = 0;
+    for (int i = 1; i + 1 < argc; i += 2) {
+        if (strcmp(argv[i], "--est") == 0) est = argv[i + 1];
+        else if (strcmp(argv[i], "--out") == 0) out = argv[i + 1];
+        else if (strcmp(argv[i], "--log") == 0) log_path = argv[i + 1];
+        else if (strcmp(argv[i], "--max-fev") == 0) max_fev = atoi(argv[i + 1]);
+        else est = NULL;
+    }
+    if (!est || !out || (strcmp(est, "pf") != 0 && strcmp(est, "ukf") != 0) || (argc % 2) != 1) {
+        fprintf(stderr, "usage: %s --est pf|ukf --out HEADER [--log CSV] [--max-fev N]\n", argv[0]);
+        return 2;
+    }
+    tune_t t;
+    t.pf = strcmp(est, "pf") == 0;
+    t.base = br_circle_cfg_thesis(t.pf ? BR_CTRL_HINF_PF : BR_CTRL_HINF_UKF);
+    t.log = NULL;
+    const int n = n_params(&t);
+    double x0[MAX_P], lo[MAX_P], hi[MAX_P];
+    for (int i = 0; i < n; i++) {
+        x0[i] = log((double)*param_ptr(&t.base, t.pf, i));
+        lo[i] = x0[i] - 3.0 * log(10.0);
+        hi[i] = x0[i] + 3.0 * log(10.0);
+    }
+    if (log_path) {
+        t.log = fopen(log_path, "w");
+        if (!t.log) {
+            fprintf(stderr, "br_tune: cannot write %s\n", log_path);
+            return 1;
+        }
+        fprintf(t.log, "iter,nfev,contour_rms_m");
+        for (int i = 0; i < n; i++) fprintf(t.log, ",%s", param_name(t.pf, i));
+        fprintf(t.log, "\n");
+    }
+    const double f0 = objective(&t, x0, n);
+    printf("tuning %s: start contour RMS %.4e m (the hand-tuned default)\n", est, f0);
+    if (t.log) fprintf(t.log, "0,1,%.6e\n", f0);
+    br_nm_cfg_t cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.n = n;
+    cfg.init_step = 0.25; /* about 0.7 decade of each variance from the start */
+    cfg.xatol = 0.01;     /* about 3 % of each variance */
+    cfg.fatol = 1e-12;    /* 1 pm of contour RMS */
+    cfg.max_fev = max_fev > 0 ? max_fev : (t.pf ? 120 : 400);
+    cfg.lo = lo;
+    cfg.hi = hi;
+    cfg.progress = progress;
+    br_nm_result_t r;
+    if (br_nm_minimize(&cfg, objective, &t, x0, &r) != 0) return 1;
+    if (t.log) fclose(t.log);
+    printf("tuned %s: contour RMS %.4e m (start %.4e m, %.1f %% lower) after %d evaluations%s\n", est, r.f, f0,
+           100.0 * (1.0 - r.f / f0), r.nfev, r.converged ? "" : " (budget reached)");
+    FILE *h = fopen(out, "w");
+    if (!h) {
+        fprintf(stderr, "br_tune: cannot write %s\n", out);
+        return 1;
+    }
+    const char *E = t.pf ? "PF" : "UKF";
+    fprintf(h, "/* generated by sim/apps/br_tune_est.c (make tune) -- do not edit */\n");
+    fprintf(h, "/* Nelder-Mead on the H-inf + %s circle: contour RMS %.4e m (start %.4e m), %d evaluations%s */\n",
+            E, r.f, f0, r.nfev, r.converged ? "" : ", budget reached");
+    fprintf(h, "#ifndef BR_%s_TUNED_H\n#define BR_%s_TUNED_H\n\n", E, E);
+    for (int i = 0; i < n; i++) {
+        fprintf(h, "#define BR_%s_TUNED_%s (%.9ef)\n", E, param_name(t.pf, i), (double)(float)exp(r.x[i]));
+    }
+    fprintf(h, "\n#endif\n");
+    fclose(h);
+    return 0;
+}

@@ -1,0 +1,542 @@
+/* make bench: host cost of the friction estimators, and their memory.
+ *
+ * 1. Records a realistic input: the x axis of the thesis circle (A sin(2 pi t / 8),
+ *    A = 1e-4 m, 8 s) on the reference plant in closed loop, H-inf + PF at
+ *    1.5 ms with the default PF (br_circle_pf_cfg_default, m = 1500), and
+ *    H-inf + UKF at 1 ms (br_circle_ukf_cfg_default). A wrapper around the
+ *    estimator records what it was given (counts, frac, u_{k-1}), what it
+ *    returned (F_hat) and the plant's true friction at t_k.
+ * 2. Replays each recording into a fresh filter, timing every br_pf_step /
+ *    br_ukf_step call with clock_gettime(CLOCK_MONOTONIC); one untimed warm-up
+ *    replay, then --reps (PF) / --ukf-reps (UKF) timed replays. The priming
+ *    step (k = 0, no prediction) is not counted. Per replay: total time of the
+ *    timed steps / (steps * m) = ns per particle-step; reported: the median
+ *    over replays and its spread (min, max), plus the per-step latency
+ *    distribution pooled over replays. Every replay must reproduce the
+ *    in-loop estimates bit for bit (the filters are deterministic).
+ * 3. Memory: sizeof(br_pf_t) at BR_PF_MAX_PARTICLES and the part of it that
+ *    m = 1500 uses, sizeof(br_ukf_t), sizeof(br_noise_table) (ROM).
+ *
+ * Usage: br_bench [--json FILE] [--record FILE] [--reps N] [--ukf-reps N]
+ *   --record  writes the PF recording as CSV (for sim/bench/pf_numpy.py): a
+ *             "# pf_cfg {...}" line with the filter's configuration, a header
+ *             line, then k,counts,frac,u_prev_Nm,fnl_true_N,fhat_c_N,status. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "br_circle.h"
+#include "br_circle_est.h"
+#include "br_hal_sim.h"
+#include "br_noise_table.h"
+#include "bristle/br_axis.h"
+
+#define BR_PI 3.14159265358979323846
+
+#ifdef NDEBUG
+#define BENCH_NDEBUG 1
+#else
+#define BENCH_NDEBUG 0
+#endif
+#ifndef BR_BENCH_BUILD
+#define BR_BENCH_BUILD "unknown"
+#endif
+
+/* ---- recording -------------------------------------------------------- */
+
+typedef struct {
+    long n, cap;
+    int32_t *counts;
+    float *frac, *u_prev, *fhat;
+    double *fnl_true;
+    int *status;
+} rec_t;
+
+static int rec_push(rec_t *r, const br_meas_t *y, float u, float fhat, double fnl, int st)
+{
+    if (r->n == r->cap) {
+        long cap = r->cap ? 2 * r->cap : 4096;
+        int32_t *c = realloc(r->counts, (size_t)cap * sizeof *c);
+        if (c) r->counts = c;
+        float *f = realloc(r->frac, (size_t)cap * sizeof *f);
+        if (f) r->frac = f;
+        float *u2 = realloc(r->u_prev, (size_t)cap * sizeof *u2);
+        if (u2) r->u_prev = u2;
+        float *h = realloc(r->fhat, (size_t)cap * sizeof *h);
+        if (h) r->fhat = h;
+        double *t = realloc(r->fnl_true, (size_t)cap * sizeof *t);
+        if (t) r->fnl_true = t;
+        int *s = realloc(r->status, (size_t)cap * sizeof *s);
+        if (s) r->status = s;
+        if (!c || !f || !u2 || !h || !t || !s) return -1;
+        r->cap = cap;
+    }
+    r->counts[r->n] = y->counts;
+    r->frac[r->n] = y->frac;
+    r->u_prev[r->n] = u;
+    r->fhat[r->n] = fhat;
+    r->fnl_true[r->n] = fnl;
+    r->status[r->n] = st;
+    r->n++;
+    return 0;
+}
+
+static void rec_free(rec_t *r)
+{
+    free(r->counts);
+    free(r->frac);
+    free(r->u_prev);
+    free(r->fhat);
+    free(r->fnl_true);
+    free(r->status);
+    memset(r, 0, sizeof *r);
+}
+
+/* Estimator wrapper: passes the call on and records it. */
+typedef struct {
+    br_est_t inner;
+    const br_plant_t *plant;
+    rec_t *rec;
+    int failed;
+} rec_est_t;
+
+static br_status_t rec_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    rec_est_t *r = ctx;
+    br_status_t st = r->inner.step(r->inner.ctx, y, u_prev_Nm, F_hat_N);
+    if (rec_push(r->rec, y, u_prev_Nm, *F_hat_N, r->plant->fnl_N, (int)st) != 0) r->failed = 1;
+    return st;
+}
+
+/* One axis (x: phase 0) of the thesis circle c in closed loop with the given
+ * estimator, recorded into rec. 0, or -1 with a message. */
+static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
+{
+    br_plant_t plant;
+    br_hal_sim_t port;
+    br_hal_t hal;
+    br_axis_t axis;
+    const br_plant_state_t x0 = {0.0, 0.0, 0.0};
+    if (br_plant_init(&plant, &c->plant, &x0) != 0) return -1;
+    if (br_hal_sim_init(&port, &plant, c->dt_s, &hal) != BR_OK) return -1;
+    br_ctrl_cfg_t cc;
+    memset(&cc, 0, sizeof cc);
+    for (int i = 0; i < 3; i++) cc.K[i] = c->K[i];
+    cc.dt_s = (float)c->dt_s;
+    cc.tau_max_Nm = (float)c->plant.tau_per_duty_Nm;
+    cc.tau_per_duty_Nm = (float)c->plant.tau_per_duty_Nm;
+    cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
+    cc.lead_mprad = (float)c->plant.lead_mprad;
+    rec_est_t wrap = {est, &plant, rec, 0};
+    const br_est_t e = {&wrap, rec_est_step};
+    if (br_axis_init(&axis, &hal, &cc, &e) != BR_OK) {
+        fprintf(stderr, "br_bench: axis init failed\n");
+        return -1;
+    }
+    const double L = c->plant.lead_mprad, rpc = 2.0 * BR_PI / c->plant.counts_per_rev;
+    const double w = 2.0 * BR_PI / c->period_s;
+    const long n = lround(c->duration_s / c->dt_s);
+    for (long k = 0; k <= n; k++) {
+        const double t = (double)k * c->dt_s;
+        uint32_t tick;
+        hal.tick_wait(hal.ctx, &tick);
+        /* reference in counts + fraction and its velocity, as in sim/circle */
+        const double counts = c->radius_m * sin(w * t) / L / rpc, whole = floor(counts);
+        const br_ref_t r = {(int32_t)whole, (float)(counts - whole), (float)(c->radius_m * w * cos(w * t) / L)};
+        const br_status_t st = br_axis_step(&axis, &r);
+        if (wrap.failed) {
+            fprintf(stderr, "br_bench: out of memory while recording\n");
+            return -1;
+        }
+        if (st != BR_OK && st != BR_E_OUTLIER) {
+            fprintf(stderr, "br_bench: axis step failed at t = %.4f s (status %d)\n", t, (int)st);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* ---- timing ----------------------------------------------------------- */
+
+static int64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + (int64_t)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* q-quantile (0..1) of v[0..n-1], sorting v in place (nearest rank). */
+static double quantile(double *v, long n, double q)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    long i = lround(q * (double)(n - 1));
+    return v[i < 0 ? 0 : (i >= n ? n - 1 : i)];
+}
+
+static double median_of(const double *v, int n)
+{
+    double s[256];
+    int k = n < 256 ? n : 256;
+    memcpy(s, v, (size_t)k * sizeof *s);
+    qsort(s, (size_t)k, sizeof *s, cmp_double);
+    return (k % 2) ? s[k / 2] : 0.5 * (s[k / 2 - 1] + s[k / 2]);
+}
+
+typedef struct {
+    int reps;
+    double per_rep_ns[256]; /* mean ns per step of each timed replay */
+    double step_p50_ns, step_p99_ns, step_max_ns;
+    long steps_timed;       /* per replay */
+    long mismatches;        /* estimates differing from the in-loop ones, over all replays */
+    long outliers, errors;  /* statuses of the last replay */
+    double fhat_rms_err_N;  /* replayed F_hat against the true friction, k >= 1 */
+} timing_t;
+
+typedef br_status_t (*init_fn)(void *state, const void *cfg);
+typedef br_status_t (*step_fn)(void *state, const br_meas_t *y, float u, float *F_hat_N);
+
+static br_status_t pf_init_w(void *s, const void *c) { return br_pf_init(s, c); }
+static br_status_t pf_step_w(void *s, const br_meas_t *y, float u, float *F)
+{
+    br_pf_t *pf = s;
+    br_status_t st = br_pf_step(pf, y, u);
+    if (st == BR_OK || st == BR_E_OUTLIER) *F = pf->est.F_hat_N;
+    return st;
+}
+static br_status_t ukf_init_w(void *s, const void *c) { return br_ukf_init(s, c); }
+static br_status_t ukf_step_w(void *s, const br_meas_t *y, float u, float *F)
+{
+    br_ukf_t *ukf = s;
+    br_status_t st = br_ukf_step(ukf, y, u);
+    if (st == BR_OK || st == BR_E_OUTLIER) *F = ukf->est.F_hat_N;
+    return st;
+}
+
+/* Replays rec into a fresh filter 1 + reps times (the first untimed).
+ * fhat_out (rec->n) receives the last replay's estimates. */
+static int time_replays(void *state, const void *cfg, init_fn init, step_fn step, const rec_t *rec, int reps,
+                        timing_t *tm, float *fhat_out)
+{
+    const long n = rec->n;
+    double *lat = malloc((size_t)(n * reps) * sizeof *lat);
+    if (!lat) return -1;
+    memset(tm, 0, sizeof *tm);
+    tm->reps = reps;
+    tm->steps_timed = n - 1;
+    for (int r = -1; r < reps; r++) {
+        if (init(state, cfg) != BR_OK) {
+            fprintf(stderr, "br_bench: filter init failed\n");
+            free(lat);
+            return -1;
+        }
+        float F = 0.0f;
+        int64_t total = 0;
+        long nout = 0, nerr = 0, mism = 0;
+        for (long k = 0; k < n; k++) {
+            const br_meas_t y = {rec->counts[k], rec->frac[k]};
+            const int64_t t0 = now_ns();
+            const br_status_t st = step(state, &y, rec->u_prev[k], &F);
+            const int64_t dt = now_ns() - t0;
+            if (k > 0) {
+                total += dt;
+                if (r >= 0) lat[(long)r * (n - 1) + (k - 1)] = (double)dt;
+            }
+            nout += (st == BR_E_OUTLIER);
+            nerr += (st != BR_OK && st != BR_E_OUTLIER);
+            mism += (F != rec->fhat[k]);
+            fhat_out[k] = F;
+        }
+        tm->mismatches += mism;
+        tm->outliers = nout;
+        tm->errors = nerr;
+        if (r >= 0) tm->per_rep_ns[r] = (double)total / (double)(n - 1);
+    }
+    const long nl = (n - 1) * reps;
+    tm->step_p50_ns = quantile(lat, nl, 0.5);
+    tm->step_p99_ns = quantile(lat, nl, 0.99);
+    tm->step_max_ns = lat[nl - 1];
+    free(lat);
+    double s2 = 0.0;
+    for (long k = 1; k < n; k++) {
+        const double e = (double)fhat_out[k] - rec->fnl_true[k];
+        s2 += e * e;
+    }
+    tm->fhat_rms_err_N = sqrt(s2 / (double)(n - 1));
+    return 0;
+}
+
+static void rep_stats(const timing_t *tm, double scale, double *med, double *mn, double *mx)
+{
+    *med = median_of(tm->per_rep_ns, tm->reps) * scale;
+    *mn = *mx = tm->per_rep_ns[0] * scale;
+    for (int r = 1; r < tm->reps; r++) {
+        const double v = tm->per_rep_ns[r] * scale;
+        if (v < *mn) *mn = v;
+        if (v > *mx) *mx = v;
+    }
+}
+
+/* ---- machine ---------------------------------------------------------- */
+
+static void cpu_model(char *buf, size_t len)
+{
+    snprintf(buf, len, "unknown");
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (!f) return;
+    char line[512];
+    while (fgets(line, sizeof line, f)) {
+        if (strncmp(line, "model name", 10) == 0) {
+            const char *p = strchr(line, ':');
+            if (p) {
+                p++;
+                while (*p == ' ' || *p == '\t') p++;
+                snprintf(buf, len, "%s", p);
+                buf[strcspn(buf, "\n")] = '\0';
+            }
+            break;
+        }
+    }
+    fclose(f);
+}
+
+/* s as a JSON string body (quotes and backslashes escaped, controls dropped) */
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"' || *s == '\\') fputc('\\', f);
+        if ((unsigned char)*s >= 0x20) fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+/* FNV-1a 64 over the table's bytes: pf_numpy.py checks its copy against it */
+static uint64_t fnv1a(const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    uint64_t h = 14695981039346656037ull;
+    for (size_t i = 0; i < n; i++) {
+        h ^= b[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+static void json_f4(FILE *f, const float *v)
+{
+    fprintf(f, "[%.9g, %.9g, %.9g, %.9g]", (double)v[0], (double)v[1], (double)v[2], (double)v[3]);
+}
+
+/* The PF configuration, every float exact (%.9g round-trips float32). */
+static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
+{
+    const br_model_cfg_t *m = &c->model;
+    fprintf(f,
+            "{\"dt_s\": %.9g, \"J_kgm2\": %.9g, \"M_kg\": %.9g, \"lead_mprad\": %.9g, \"sigma2_Nspm\": %.9g, "
+            "\"sigma0_Npm\": %.9g, \"sigma1_Nspm\": %.9g, \"Fc_N\": %.9g, \"Fs_N\": %.9g, \"vs_mps\": %.9g, "
+            "\"n_particles\": %u, \"q_var\": ",
+            (double)m->dt_s, (double)m->J_kgm2, (double)m->M_kg, (double)m->lead_mprad, (double)m->sigma2_Nspm,
+            (double)m->lugre.sigma0_Npm, (double)m->lugre.sigma1_Nspm, (double)m->lugre.Fc_N,
+            (double)m->lugre.Fs_N, (double)m->lugre.vs_mps, (unsigned)c->n_particles);
+    json_f4(f, c->q_var);
+    fprintf(f, ", \"r_var_rad2\": %.9g, \"gp0_N\": %.9g, \"x0_std\": ", (double)c->r_var_rad2, (double)c->gp0_N);
+    json_f4(f, c->x0_std);
+    fprintf(f,
+            ", \"gp_min_N\": %.9g, \"gp_max_N\": %.9g, \"outlier_sigma\": %.9g, \"reanchor_after\": %u, "
+            "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"noise_fnv1a64\": \"%016llx\"}",
+            (double)c->gp_min_N, (double)c->gp_max_N, (double)c->outlier_sigma, (unsigned)c->reanchor_after,
+            (double)c->rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip,
+            (unsigned long long)fnv1a(c->noise, (size_t)c->noise_len * sizeof *c->noise));
+}
+
+static int write_record(const char *path, const br_pf_cfg_t *cfg, const rec_t *rec, const float *fhat)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "br_bench: cannot write %s\n", path);
+        return -1;
+    }
+    fprintf(f, "# br_bench PF recording: x axis of the thesis circle, H-inf + PF in closed loop\n# pf_cfg ");
+    json_pf_cfg(f, cfg);
+    fprintf(f, "\nk,counts,frac,u_prev_Nm,fnl_true_N,fhat_c_N,status\n");
+    for (long k = 0; k < rec->n; k++) {
+        fprintf(f, "%ld,%ld,%.9g,%.9g,%.9g,%.9g,%d\n", k, (long)rec->counts[k], (double)rec->frac[k],
+                (double)rec->u_prev[k], rec->fnl_true[k], (double)fhat[k], rec->status[k]);
+    }
+    if (fclose(f) != 0) {
+        fprintf(stderr, "br_bench: error writing %s\n", path);
+        return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *json_path = NULL, *rec_path = NULL;
+    int reps = 7, ukf_reps = 21;
+    for (int i = 1; i < argc; i++) {
+        const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
+        int ok = v != NULL;
+        if (ok && strcmp(argv[i], "--json") == 0) {
+            json_path = v;
+        } else if (ok && strcmp(argv[i], "--record") == 0) {
+            rec_path = v;
+        } else if (ok && strcmp(argv[i], "--reps") == 0) {
+            ok = sscanf(v, "%d", &reps) == 1 && reps >= 1 && reps <= 256;
+        } else if (ok && strcmp(argv[i], "--ukf-reps") == 0) {
+            ok = sscanf(v, "%d", &ukf_reps) == 1 && ukf_reps >= 1 && ukf_reps <= 256;
+        } else {
+            ok = 0;
+        }
+        if (!ok) {
+            fprintf(stderr, "usage: br_bench [--json FILE] [--record FILE] [--reps 1..256] [--ukf-reps 1..256]\n");
+            return 2;
+        }
+        i++;
+    }
+
+    char cpu[256];
+    cpu_model(cpu, sizeof cpu);
+    const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    printf("bench: %s, %ld CPUs online; %s build (%s), gcc %s\n", cpu, ncpu, BENCH_NDEBUG ? "release" : "NOT a release",
+           BR_BENCH_BUILD, __VERSION__);
+    if (!BENCH_NDEBUG) printf("bench: warning: built without NDEBUG, timings are not representative\n");
+
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    br_ukf_t *ukf = calloc(1, sizeof *ukf);
+    rec_t rpf = {0}, rukf = {0};
+    float *fhat_pf = NULL, *fhat_ukf = NULL;
+    int rc = 1;
+    if (!pf || !ukf) goto done;
+
+    /* 1. recordings */
+    const br_circle_cfg_t cpf = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
+    const br_circle_cfg_t cukf = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
+    if (br_pf_init(pf, &cpf.pf) != BR_OK || br_ukf_init(ukf, &cukf.ukf) != BR_OK) {
+        fprintf(stderr, "br_bench: filter init failed\n");
+        goto done;
+    }
+    if (record_axis(&cpf, (br_est_t){pf, br_pf_est_step}, &rpf) != 0) goto done;
+    if (record_axis(&cukf, (br_est_t){ukf, br_ukf_est_step}, &rukf) != 0) goto done;
+    fhat_pf = malloc((size_t)rpf.n * sizeof *fhat_pf);
+    fhat_ukf = malloc((size_t)rukf.n * sizeof *fhat_ukf);
+    if (!fhat_pf || !fhat_ukf) goto done;
+
+    /* 2. timing */
+    const uint32_t m = cpf.pf.n_particles;
+    timing_t tpf, tukf;
+    if (time_replays(pf, &cpf.pf, pf_init_w, pf_step_w, &rpf, reps, &tpf, fhat_pf) != 0) goto done;
+    if (time_replays(ukf, &cukf.ukf, ukf_init_w, ukf_step_w, &rukf, ukf_reps, &tukf, fhat_ukf) != 0) goto done;
+    double pf_med, pf_min, pf_max, ukf_med, ukf_min, ukf_max;
+    rep_stats(&tpf, 1.0 / (double)m, &pf_med, &pf_min, &pf_max);
+    rep_stats(&tukf, 1e-3, &ukf_med, &ukf_min, &ukf_max);
+    const double pf_step_med_us = pf_med * (double)m * 1e-3;
+
+    printf("PF recording: x axis of the thesis circle, H-inf + PF in closed loop, dt %.1f ms, %ld steps\n",
+           cpf.dt_s * 1e3, rpf.n);
+    printf("PF  m = %u: %.1f ns per particle-step (median of %d replays of %ld steps; min %.1f, max %.1f)\n", m, pf_med,
+           reps, tpf.steps_timed, pf_min, pf_max);
+    printf("    one step %.1f us (median replay) = %.1f %% of the %.1f ms period; per-step p50 %.1f us, p99 %.1f us, "
+           "max %.1f us\n",
+           pf_step_med_us, 100.0 * pf_step_med_us * 1e-6 / cpf.dt_s, cpf.dt_s * 1e3, tpf.step_p50_ns * 1e-3,
+           tpf.step_p99_ns * 1e-3, tpf.step_max_ns * 1e-3);
+    printf("    replays reproduce the in-loop estimates: %s (%ld mismatches); F_hat RMS error vs true friction "
+           "%.4f N; %ld outlier, %ld error steps\n",
+           tpf.mismatches ? "NO" : "yes, bit for bit", tpf.mismatches, tpf.fhat_rms_err_N, tpf.outliers, tpf.errors);
+    printf("UKF recording: the same axis, H-inf + UKF in closed loop, dt %.1f ms, %ld steps\n", cukf.dt_s * 1e3,
+           rukf.n);
+    printf("UKF: %.3f us per step (median of %d replays of %ld steps; min %.3f, max %.3f); per-step p50 %.3f us, "
+           "p99 %.3f us, max %.1f us\n",
+           ukf_med, ukf_reps, tukf.steps_timed, ukf_min, ukf_max, tukf.step_p50_ns * 1e-3, tukf.step_p99_ns * 1e-3,
+           tukf.step_max_ns * 1e-3);
+    printf("    replays reproduce the in-loop estimates: %s (%ld mismatches); F_hat RMS error vs true friction "
+           "%.4f N; %ld outlier, %ld error steps\n",
+           tukf.mismatches ? "NO" : "yes, bit for bit", tukf.mismatches, tukf.fhat_rms_err_N, tukf.outliers,
+           tukf.errors);
+
+    /* 3. memory (host sizes; see docs/bench.md for the Cortex-M7 ones) */
+    const size_t per_particle = (sizeof(((br_pf_t *)0)->x) + sizeof(((br_pf_t *)0)->xp) +
+                                 sizeof(((br_pf_t *)0)->fnl) + sizeof(((br_pf_t *)0)->l) +
+                                 sizeof(((br_pf_t *)0)->W) + sizeof(((br_pf_t *)0)->idx)) /
+                                BR_PF_MAX_PARTICLES;
+    const size_t pf_bytes = sizeof(br_pf_t), pf_fixed = pf_bytes - per_particle * BR_PF_MAX_PARTICLES;
+    const size_t pf_used = pf_fixed + per_particle * m;
+    printf("RAM: br_pf_t %zu bytes at BR_PF_MAX_PARTICLES = %u (%zu bytes per particle + %zu fixed); "
+           "m = %u uses %zu bytes (%.1f %%)\n",
+           pf_bytes, (unsigned)BR_PF_MAX_PARTICLES, per_particle, pf_fixed, m, pf_used,
+           100.0 * (double)pf_used / (double)pf_bytes);
+    printf("     br_ukf_t %zu bytes\n", sizeof(br_ukf_t));
+    printf("ROM: br_noise_table %zu bytes (%u float32 samples)\n", sizeof br_noise_table, (unsigned)BR_NOISE_LEN);
+
+    if (rec_path && write_record(rec_path, &cpf.pf, &rpf, fhat_pf) != 0) goto done;
+    if (json_path) {
+        FILE *f = fopen(json_path, "w");
+        if (!f) {
+            fprintf(stderr, "br_bench: cannot write %s\n", json_path);
+            goto done;
+        }
+        fprintf(f, "{\n  \"machine\": {\"cpu_model\": ");
+        json_str(f, cpu);
+        fprintf(f, ", \"cpus_online\": %ld, \"compiler\": ", ncpu);
+        json_str(f, "gcc " __VERSION__);
+        fprintf(f, ", \"build\": ");
+        json_str(f, BR_BENCH_BUILD);
+        fprintf(f, ", \"ndebug\": %s},\n", BENCH_NDEBUG ? "true" : "false");
+        fprintf(f,
+                "  \"pf\": {\"input\": \"x axis of the thesis circle, H-inf + PF closed loop\", \"dt_s\": %.9g, "
+                "\"n_particles\": %u, \"steps_timed\": %ld, \"reps\": %d,\n"
+                "    \"ns_per_particle_step\": {\"median\": %.3f, \"min\": %.3f, \"max\": %.3f, \"per_rep\": [",
+                cpf.dt_s, m, tpf.steps_timed, reps, pf_med, pf_min, pf_max);
+        for (int r = 0; r < reps; r++) fprintf(f, "%s%.3f", r ? ", " : "", tpf.per_rep_ns[r] / (double)m);
+        fprintf(f,
+                "]},\n    \"step_us\": {\"median_rep_mean\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"max\": %.3f},\n"
+                "    \"replay_mismatches\": %ld, \"fhat_rms_err_N\": %.6f, \"outlier_steps\": %ld, "
+                "\"error_steps\": %ld},\n",
+                pf_step_med_us, tpf.step_p50_ns * 1e-3, tpf.step_p99_ns * 1e-3, tpf.step_max_ns * 1e-3,
+                tpf.mismatches, tpf.fhat_rms_err_N, tpf.outliers, tpf.errors);
+        fprintf(f,
+                "  \"ukf\": {\"input\": \"x axis of the thesis circle, H-inf + UKF closed loop\", \"dt_s\": %.9g, "
+                "\"steps_timed\": %ld, \"reps\": %d,\n"
+                "    \"us_per_step\": {\"median\": %.4f, \"min\": %.4f, \"max\": %.4f, \"p50\": %.4f, \"p99\": %.4f, "
+                "\"max_step\": %.3f},\n"
+                "    \"replay_mismatches\": %ld, \"fhat_rms_err_N\": %.6f, \"outlier_steps\": %ld, "
+                "\"error_steps\": %ld},\n",
+                cukf.dt_s, tukf.steps_timed, ukf_reps, ukf_med, ukf_min, ukf_max, tukf.step_p50_ns * 1e-3,
+                tukf.step_p99_ns * 1e-3, tukf.step_max_ns * 1e-3, tukf.mismatches, tukf.fhat_rms_err_N,
+                tukf.outliers, tukf.errors);
+        fprintf(f,
+                "  \"memory_host\": {\"pf_t_bytes\": %zu, \"pf_max_particles\": %u, \"pf_bytes_per_particle\": %zu, "
+                "\"pf_fixed_bytes\": %zu, \"pf_used_bytes_at_m\": %zu, \"ukf_t_bytes\": %zu, "
+                "\"noise_table_rom_bytes\": %zu, \"noise_len\": %u},\n",
+                pf_bytes, (unsigned)BR_PF_MAX_PARTICLES, per_particle, pf_fixed, pf_used, sizeof(br_ukf_t),
+                sizeof br_noise_table, (unsigned)BR_NOISE_LEN);
+        fprintf(f, "  \"pf_cfg\": ");
+        json_pf_cfg(f, &cpf.pf);
+        fprintf(f, "\n}\n");
+        if (fclose(f) != 0) {
+            fprintf(stderr, "br_bench: error writing %s\n", json_path);
+            goto done;
+        }
+    }
+    rc = (tpf.mismatches || tukf.mismatches || tpf.errors || tukf.errors) ? 1 : 0;
+    if (rc) fprintf(stderr, "br_bench: a replay differed from the closed loop or failed\n");
+done:
+    free(pf);
+    free(ukf);
+    free(fhat_pf);
+    free(fhat_ukf);
+    rec_free(&rpf);
+    rec_free(&rukf);
+    return rc;
+}

@@ -1,0 +1,417 @@
+#!/usr/bin/env python3
+"""make bench, numpy side: the particle filter of firmware/pf/br_pf.c written
+in numpy, vectorised over the particles, timed on the recording br_bench made
+(br_bench --record FILE), and compared with the C filter.
+
+Same model and algorithm as br_pf.c, in float32 throughout (as the firmware):
+  predict   eq. 6 by RK4, or, per particle (np.where on the a h <= 2 test at
+            both ends of the step), the bounded displacement-exact scheme with 3
+            fixed-point passes (br_model.c), evaluated only on the particles that
+            need it; process noise from the same ROM table
+            (firmware/design/gen_noise.py table(), checked against the C table's
+            hash), indexed (pos + 4 j + i) & (len - 1), pos += 4 m + noise_skip
+  weigh     l_j = -(theta_j - y)^2 / (2 R), w_j = br_exp_neg(l_j - max l) (the
+            firmware's deterministic exp, vectorised), outlier rule as in C
+  quantise  W_j = floor(w_j 2^16) (uint32)
+  resample  integer systematic: C = cumsum(W) (int64), t_i = floor((2 i + 1) C_m / (2 m)),
+            idx = searchsorted(C, t, side="right")
+  estimate  mean state, F_hat = mean f_nl over the resampled set, ESS,
+            re-anchoring after reanchor_after outliers
+Every operation is a float32 numpy ufunc in the order of the C code, and the
+sums run left to right (cumsum) as the C loops do, so the numpy filter
+reproduces the C one bit for bit: its F_hat equals the C F_hat (recorded by
+br_bench) at every step, which pf_numpy.py checks.
+
+Timing: one untimed warm-up over the first 200 steps, then --reps replays of
+the whole recording into a fresh filter, each timed with time.perf_counter_ns
+around the loop of steps k >= 1 (the priming step excluded, as in br_bench).
+Reported: ns per particle-step, median over replays (min, max).
+
+Usage: pf_numpy.py RECORDING [--reps N] [--c-json FILE] [--out FILE]
+  --c-json  br_bench's JSON: prints the summary table (C, numpy, ratio, UKF,
+            memory) and, with --out, writes both and the ratio to one JSON."""
+import argparse
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "firmware", "design"))
+import gen_noise  # noqa: E402
+
+F = np.float32
+# constants of the C code
+RK4_AH_MAX = F(2.0)          # BR_MODEL_RK4_AH_MAX, br_model.h
+BOUNDED_PASSES = 3           # BR_MODEL_BOUNDED_PASSES, br_model.c
+W_ONE = F(1 << 16)           # 2^BR_PF_W_BITS, br_pf.h
+BR_OK, BR_E_NUMERIC, BR_E_OUTLIER = 0, -4, -6
+
+
+def fnv1a64(b):
+    h = 14695981039346656037
+    for c in b:
+        h = ((h ^ c) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+    return h
+
+
+def seqsum(a):
+    """Sum over the last axis in float32, left to right like the C loops
+    (np.sum's pairwise summation would round differently)."""
+    return np.cumsum(a, axis=-1, dtype=F)[..., -1]
+
+
+def exp_neg(x):
+    """br_exp_neg (firmware/math/br_math.c) on a float32 array: e^x for x <= 0,
+    2^n times a degree-6 Taylor polynomial, 0 below -87 and for NaN."""
+    zero = ~(x > F(-87.0))
+    x = np.where(zero, F(0.0), np.minimum(x, F(0.0)))
+    t = x * F(1.44269504)
+    n = (t - F(0.5)).astype(np.int32)
+    f = t - n.astype(F)
+    up = f > F(0.5)
+    n = n + up
+    f = np.where(up, f - F(1.0), f)
+    y = f * F(0.693147181)
+    p = y * (F(1.0) / F(720.0)) + F(1.0) / F(120.0)
+    p = p * y + F(1.0) / F(24.0)
+    p = p * y + F(1.0) / F(6.0)
+    p = p * y + F(0.5)
+    p = p * y + F(1.0)
+    p = p * y + F(1.0)
+    scale = ((n + 127) << 23).astype(np.uint32).view(F)
+    return np.where(zero, F(0.0), p * scale)
+
+
+class NumpyPf:
+    """br_pf_t in numpy: particles as a (4, m) float32 array [theta, omega, z, g_p]."""
+
+    def __init__(self, cfg, noise):
+        self.m = m = int(cfg["n_particles"])
+        self.h = F(cfg["dt_s"])
+        self.L = F(cfg["lead_mprad"])
+        self.s0 = F(cfg["sigma0_Npm"])
+        self.s1 = F(cfg["sigma1_Nspm"])
+        J, M, s2 = F(cfg["J_kgm2"]), F(cfg["M_kg"]), F(cfg["sigma2_Nspm"])
+        self.inv_jeff = F(1.0) / (J + self.L * self.L * M)   # br_model_init
+        self.visc = self.L * self.L * s2
+        self.s0L = self.s0 * self.L
+        self.q_std = np.sqrt(np.array(cfg["q_var"], dtype=F)).reshape(4, 1)
+        self.inv_2r = F(0.5) / F(cfg["r_var_rad2"])
+        self.outlier_l = F(-0.5) * F(cfg["outlier_sigma"]) * F(cfg["outlier_sigma"])
+        self.reanchor_after = int(cfg["reanchor_after"])
+        self.rpc = F(cfg["rad_per_count"])
+        self.gp0 = F(cfg["gp0_N"])
+        self.gp_min, self.gp_max = F(cfg["gp_min_N"]), F(cfg["gp_max_N"])
+        self.x0_std = np.array(cfg["x0_std"], dtype=F).reshape(4, 1)
+        self.noise = noise
+        self.mask = len(noise) - 1
+        self.skip = int(cfg["noise_skip"])
+        self.base = (4 * np.arange(m)[None, :] + np.arange(4)[:, None]).astype(np.int64)  # [i, j] = 4 j + i
+        self.two_i1 = 2 * np.arange(m, dtype=np.int64) + 1
+        self.inv_m = F(1.0) / F(m)
+        self.pos = 0
+        self.origin = 0
+        self.prev_frac = F(0.0)
+        self.n_outliers = 0
+        self.primed = False
+        self.x = np.zeros((4, m), dtype=F)
+        self.mean = np.zeros(4, dtype=F)
+        self.F_hat = F(0.0)
+        self.ess = F(m)
+
+    def _noise(self):
+        n = self.noise[(self.pos + self.base) & self.mask]
+        self.pos = (self.pos + 4 * self.m + self.skip) & self.mask
+        return n
+
+    def _fnl(self, om, z, gp):
+        v = self.L * om
+        zdot = v - self.s0 * np.abs(v) * z / gp
+        return self.s0 * z + self.s1 * zdot
+
+    def _deriv(self, om, z, gp, u):
+        """eq. 6: (domega/dt, dz/dt); dtheta/dt = omega, dg_p/dt = 0."""
+        v = self.L * om
+        zdot = v - self.s0 * np.abs(v) * z / gp
+        fnl = self.s0 * z + self.s1 * zdot
+        return (u - self.visc * om - self.L * fnl) * self.inv_jeff, zdot
+
+    def _model_step(self, th, om, z, gp, u):
+        """br_model_step on every particle: RK4, the bounded scheme where a h > 2."""
+        h, hh = self.h, F(0.5) * self.h
+        k1w, k1z = self._deriv(om, z, gp, u)
+        om2 = om + hh * k1w
+        k2w, k2z = self._deriv(om2, z + hh * k1z, gp, u)
+        om3 = om + hh * k2w
+        k3w, k3z = self._deriv(om3, z + hh * k2z, gp, u)
+        om4 = om + h * k3w
+        k4w, k4z = self._deriv(om4, z + h * k3z, gp, u)
+        h6 = h / F(6.0)
+        th1 = th + h6 * (om + F(2.0) * om2 + F(2.0) * om3 + om4)
+        om1 = om + h6 * (k1w + F(2.0) * k2w + F(2.0) * k3w + k4w)
+        z1 = z + h6 * (k1z + F(2.0) * k2z + F(2.0) * k3z + k4z)
+        # RK4 only where a h = sigma0 L |omega| h / g_p <= 2 at both ends of the step
+        rk4 = (self.s0L * np.abs(om) * h / gp <= RK4_AH_MAX) & (self.s0L * np.abs(om1) * h / gp <= RK4_AH_MAX)
+        b = np.flatnonzero(~rk4)
+        if b.size:
+            th1[b], om1[b], z1[b] = self._bounded(th[b], om[b], z[b], gp[b], u)
+        return th1, om1, z1
+
+    def _bounded(self, th, w0, z0, gp, u):
+        """br_model.c bounded_step: z exact over the displacement, trapezoidal rigid body."""
+        h, L, s0, s1 = self.h, self.L, self.s0, self.s1
+        wm = w0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for _ in range(BOUNDED_PASSES):
+                dth = wm * h
+                dx = L * dth
+                zss = np.copysign(gp / s0, dx)
+                r = s0 * np.abs(dx) / gp
+                ome = -np.expm1(-r)
+                q = np.where(r > F(1e-6), ome / r, F(1.0) - F(0.5) * r)
+                moving = dx != F(0.0)
+                z1 = np.where(moving, z0 + (zss - z0) * ome, z0)
+                zint = np.where(moving, h * (zss + (z0 - zss) * q), z0 * h)
+                w1 = w0 + (u * h - self.visc * dth - L * (s0 * zint + s1 * (z1 - z0))) * self.inv_jeff
+                wm = F(0.5) * (w0 + w1)
+        return th + dth, w1, z1
+
+    def _prime(self, counts, frac):
+        mean = np.array([frac * self.rpc, 0.0, 0.0, self.gp0], dtype=F).reshape(4, 1)
+        x = mean + self.x0_std * self._noise()
+        x[3] = np.fmin(np.fmax(x[3], self.gp_min), self.gp_max)
+        self.x = x
+        self.origin = counts
+        self.prev_frac = frac
+        self.primed = True
+        self.mean = seqsum(x) * self.inv_m
+        self.F_hat = seqsum(self._fnl(x[1], x[2], x[3])) * self.inv_m
+        self.ess = F(self.m)
+        return BR_OK
+
+    def step(self, counts, frac, u):
+        """br_pf_step; counts a Python int, frac and u np.float32. Returns the status."""
+        if not self.primed:
+            return self._prime(counts, frac)
+        m, rpc = self.m, self.rpc
+        d = ((counts - self.origin + (1 << 31)) & 0xFFFFFFFF) - (1 << 31)   # br_counts_delta
+        shift = F(d) * rpc
+        y_rel = frac * rpc
+        x = self.x
+        # 1. predict
+        th, om, z = self._model_step(x[0], x[1], x[2], x[3], u)
+        n = self._noise()
+        th = th + self.q_std[0] * n[0]
+        om = om + self.q_std[1] * n[1]
+        z = z + self.q_std[2] * n[2]
+        gp = np.fmin(np.fmax(x[3] + self.q_std[3] * n[3], self.gp_min), self.gp_max)
+        th = th - shift
+        fnl = self._fnl(om, z, gp)
+        valid = np.isfinite(th) & np.isfinite(om) & np.isfinite(z) & np.isfinite(gp) & np.isfinite(fnl)
+        # 2. log-likelihood
+        e = th - y_rel
+        l = -(e * e) * self.inv_2r
+        xp = np.stack((th, om, z, gp))
+        n_valid = int(np.count_nonzero(valid))
+        if n_valid < m:
+            xp = np.where(valid, xp, x)
+            fnl = np.where(valid, fnl, F(0.0))
+            l = np.where(valid, l, F(-np.inf))
+        if n_valid == 0:
+            return BR_E_NUMERIC
+        lmax = l.max()
+        outlier = lmax < self.outlier_l
+        # 3. weights, quantised
+        w = valid.astype(F) if outlier else exp_neg(l - lmax)
+        W = (w * W_ONE).astype(np.uint32)
+        sw, sw2 = seqsum(w), seqsum(w * w)
+        # 4. integer systematic resampling
+        C = np.cumsum(W, dtype=np.int64)
+        idx = np.searchsorted(C, (self.two_i1 * C[-1]) // (2 * m), side="right")
+        # 5. estimate over the resampled set
+        x = xp[:, idx]
+        s = seqsum(x)
+        sf = seqsum(fnl[idx])
+        self.n_outliers = self.n_outliers + 1 if outlier else 0
+        if self.n_outliers >= self.reanchor_after:
+            omega_meas = (shift + (frac - self.prev_frac) * rpc) / self.h
+            d_th, d_om = y_rel - s[0] * self.inv_m, omega_meas - s[1] * self.inv_m
+            x[0] += d_th
+            x[1] += d_om
+            s[0] += d_th * F(m)
+            s[1] += d_om * F(m)
+        self.x = x
+        self.origin = counts
+        self.prev_frac = frac
+        self.mean = s * self.inv_m
+        self.F_hat = sf * self.inv_m
+        self.ess = sw * sw / sw2
+        return BR_E_OUTLIER if outlier else BR_OK
+
+
+def load_recording(path):
+    """(configuration, {column: array}) of a br_bench --record file."""
+    cfg, names, skip = None, None, 0
+    with open(path) as f:
+        for line in f:
+            skip += 1
+            if line.startswith("# pf_cfg "):
+                cfg = json.loads(line[len("# pf_cfg "):])
+            elif not line.startswith("#"):
+                names = line.strip().split(",")
+                break
+    if cfg is None or names is None:
+        sys.exit("pf_numpy: %s is not a br_bench --record file" % path)
+    d = np.loadtxt(path, delimiter=",", skiprows=skip, ndmin=2)
+    return cfg, {k: d[:, i] for i, k in enumerate(names)}
+
+
+def replay(cfg, noise, rec, n_steps=None):
+    """A fresh filter over the recording; returns (F_hat per step, ns of each step k >= 1, statuses)."""
+    pf = NumpyPf(cfg, noise)
+    counts = [int(c) for c in rec["counts"]]
+    frac = rec["frac"].astype(F)
+    u = rec["u_prev_Nm"].astype(F)
+    n = len(counts) if n_steps is None else n_steps
+    fhat = np.zeros(n)
+    st = np.zeros(n, dtype=int)
+    st[0] = pf.step(counts[0], frac[0], u[0])
+    fhat[0] = pf.F_hat
+    ns = np.zeros(n - 1)
+    clock = time.perf_counter_ns
+    for k in range(1, n):
+        t0 = clock()
+        s = pf.step(counts[k], frac[k], u[k])
+        ns[k - 1] = clock() - t0
+        st[k] = s
+        if s == BR_OK or s == BR_E_OUTLIER:
+            fhat[k] = pf.F_hat
+        else:
+            fhat[k] = fhat[k - 1]
+    return fhat, ns, st
+
+
+def rms(a):
+    return float(np.sqrt(np.mean(np.square(a))))
+
+
+def summary_table(c, npy, ratio):
+    pf, ukf, mem = c["pf"], c["ukf"], c["memory_host"]
+    rows = [
+        ("PF, C (host-release)", "%.1f ns / particle-step" % pf["ns_per_particle_step"]["median"],
+         "min %.1f, max %.1f; %d replays" % (pf["ns_per_particle_step"]["min"], pf["ns_per_particle_step"]["max"],
+                                          pf["reps"])),
+        ("PF, numpy (float32)", "%.1f ns / particle-step" % npy["ns_per_particle_step"]["median"],
+         "min %.1f, max %.1f; %d replays" % (npy["ns_per_particle_step"]["min"], npy["ns_per_particle_step"]["max"],
+                                          npy["reps"])),
+        ("ratio numpy / C", "%.1f x" % ratio, "medians"),
+        ("PF step, C, m = %d" % pf["n_particles"], "%.1f us" % pf["step_us"]["median_rep_mean"],
+         "of a %.1f ms period; p99 %.1f us" % (pf["dt_s"] * 1e3, pf["step_us"]["p99"])),
+        ("UKF, C", "%.3f us / step" % ukf["us_per_step"]["median"],
+         "min %.3f, max %.3f; %d replays" % (ukf["us_per_step"]["min"], ukf["us_per_step"]["max"], ukf["reps"])),
+        ("PF RAM (br_pf_t)", "%d bytes" % mem["pf_t_bytes"],
+         "at BR_PF_MAX_PARTICLES = %d; m = %d uses %d" % (mem["pf_max_particles"], pf["n_particles"],
+                                                          mem["pf_used_bytes_at_m"])),
+        ("UKF RAM (br_ukf_t)", "%d bytes" % mem["ukf_t_bytes"], ""),
+        ("PF ROM (noise table)", "%d bytes" % mem["noise_table_rom_bytes"], "%d float32" % mem["noise_len"]),
+        ("F_hat RMS error, C / numpy", "%.4f / %.4f N" % (pf["fhat_rms_err_N"], npy["fhat_rms_err_N"]),
+         "vs the true friction of the recording"),
+    ]
+    w0 = max(len(r[0]) for r in rows)
+    w1 = max(len(r[1]) for r in rows)
+    print("== bench summary (%s, %d CPUs)" % (c["machine"]["cpu_model"], c["machine"]["cpus_online"]))
+    for a, b, d in rows:
+        print("  %-*s  %*s  %s" % (w0, a, w1, b, d))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("recording")
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--c-json")
+    ap.add_argument("--out")
+    a = ap.parse_args()
+    if a.reps < 1:
+        ap.error("--reps must be >= 1")
+
+    cfg, rec = load_recording(a.recording)
+    noise = gen_noise.table(int(cfg["noise_len"]))
+    h = "%016x" % fnv1a64(noise.astype("<f4").tobytes())
+    if h != cfg["noise_fnv1a64"]:
+        sys.exit("pf_numpy: gen_noise.table() (hash %s) differs from the C table (%s)" % (h, cfg["noise_fnv1a64"]))
+    m = int(cfg["n_particles"])
+    n = len(rec["k"])
+
+    replay(cfg, noise, rec, n_steps=min(200, n))   # warm-up
+    per_rep, lat, fhat = [], [], None
+    for _ in range(a.reps):
+        fhat, ns, st = replay(cfg, noise, rec)
+        per_rep.append(float(ns.sum()) / ((n - 1) * m))
+        lat.append(ns)
+    med = statistics.median(per_rep)
+    lat = np.concatenate(lat)
+    true, fc = rec["fnl_true_N"], rec["fhat_c_N"]
+    diff = fhat[1:].astype(F).astype(float) - fc[1:].astype(F).astype(float)
+    same = int(np.count_nonzero(fhat.astype(F) == fc.astype(F)))
+    res = {
+        "dtype": "float32",
+        "numpy": np.__version__,
+        "python": platform.python_version(),
+        "steps_timed": n - 1,
+        "n_particles": m,
+        "reps": a.reps,
+        "ns_per_particle_step": {"median": med, "min": min(per_rep), "max": max(per_rep), "per_rep": per_rep},
+        "step_us": {"median_rep_mean": med * m * 1e-3, "p50": float(np.percentile(lat, 50)) * 1e-3,
+                    "p99": float(np.percentile(lat, 99)) * 1e-3, "max": float(lat.max()) * 1e-3},
+        "fhat_rms_err_N": rms(fhat[1:] - true[1:]),
+        "fhat_c_rms_err_N": rms(fc[1:] - true[1:]),
+        "fhat_vs_c_rms_N": rms(diff),
+        "fhat_vs_c_max_N": float(np.max(np.abs(diff))),
+        "fhat_identical_to_c_steps": same,
+        "steps": n,
+        "outlier_steps": int(np.count_nonzero(st == BR_E_OUTLIER)),
+        "error_steps": int(np.count_nonzero((st != BR_OK) & (st != BR_E_OUTLIER))),
+    }
+    print("PF  numpy (float32, vectorised over particles, numpy %s): %.1f ns per particle-step "
+          "(median of %d replays of %d steps; min %.1f, max %.1f)"
+          % (np.__version__, med, a.reps, n - 1, min(per_rep), max(per_rep)))
+    print("    one step %.1f us (median replay); per-step p50 %.1f us, p99 %.1f us, max %.1f us"
+          % (res["step_us"]["median_rep_mean"], res["step_us"]["p50"], res["step_us"]["p99"], res["step_us"]["max"]))
+    print("    tracks: F_hat RMS error vs true friction %.4f N (C: %.4f N); %d outlier, %d error steps"
+          % (res["fhat_rms_err_N"], res["fhat_c_rms_err_N"], res["outlier_steps"], res["error_steps"]))
+    print("    F_hat identical to the C filter's (bit for bit) at %d of %d steps; numpy - C: RMS %.2e N, max %.2e N"
+          % (same, n, res["fhat_vs_c_rms_N"], res["fhat_vs_c_max_N"]))
+    if same != n:
+        print("pf_numpy: warning: the numpy PF is not bit-identical to the C one (timing still valid if it tracks)",
+              file=sys.stderr)
+    # a filter that does not track is not worth timing
+    ok = res["error_steps"] == 0 and res["fhat_rms_err_N"] < 2.0 * res["fhat_c_rms_err_N"] + 0.05
+    if not ok:
+        print("pf_numpy: the numpy PF does not track like the C one", file=sys.stderr)
+
+    if a.c_json:
+        with open(a.c_json) as f:
+            c = json.load(f)
+        ratio = med / c["pf"]["ns_per_particle_step"]["median"]
+        summary_table(c, res, ratio)
+        if a.out:
+            out = dict(c)
+            out["pf_numpy"] = res
+            out["ratio_numpy_over_c"] = ratio
+            with open(a.out, "w") as f:
+                json.dump(out, f, indent=2)
+                f.write("\n")
+    elif a.out:
+        with open(a.out, "w") as f:
+            json.dump(res, f, indent=2)
+            f.write("\n")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
