@@ -22,6 +22,8 @@ IMAGE      := build/cm7-release/hal/stm32h7/br_image_stm32h7.elf
 FLASH_KIB  := 2048
 RAM_KIB    := 128
 DEMO_OUT   := out/demo
+BENCH_OUT  := out/bench
+BENCH      := build/host-release/sim/bench/br_bench
 
 # $(call configure,<preset>): cmake --preset, output shown only on failure.
 # Always run: cheap when nothing changed, and it picks up edited presets.
@@ -48,7 +50,7 @@ define print_size
 	  END { exit ok ? 0 : 1 }'
 endef
 
-.PHONY: help deps build test demo firmware regen clean distclean
+.PHONY: help deps build test demo bench firmware regen clean distclean
 
 help:
 	@echo "bristle targets:"
@@ -56,6 +58,7 @@ help:
 	@echo "  make build     configure + build host-debug (ASan + UBSan)"
 	@echo "  make test      host-debug build + ctest, then the firmware image and its size"
 	@echo "  make demo      host-release build, run the circle demo into $(DEMO_OUT), plot it"
+	@echo "  make bench     host-release build, time the PF (C and numpy) and the UKF, memory -> $(BENCH_OUT)/bench.json"
 	@echo "  make firmware  cross build (cm7-release) and print flash / RAM use"
 	@echo "  make regen     regenerate the generated headers and the golden traces"
 	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
@@ -84,6 +87,17 @@ demo: deps
 	$(Q)mkdir -p $(DEMO_OUT)
 	$(Q)build/host-release/sim/br_demo_circle --out $(DEMO_OUT)
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_demo.py $(DEMO_OUT)
+
+# C bench (records the input, times PF and UKF, memory), then the numpy PF on
+# the same recording; the script prints the summary table and merges both into
+# bench.json. docs/bench.md.
+bench: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== bench -> $(BENCH_OUT)"
+	$(Q)mkdir -p $(BENCH_OUT)
+	$(Q)$(BENCH) --json $(BENCH_OUT)/c.json --record $(BENCH_OUT)/pf_input.csv
+	$(Q)$(PYTHON) sim/bench/pf_numpy.py $(BENCH_OUT)/pf_input.csv --c-json $(BENCH_OUT)/c.json --out $(BENCH_OUT)/bench.json
 
 firmware: deps
 	$(call configure,cm7-release)

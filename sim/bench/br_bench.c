@@ -6,13 +6,14 @@
  *    H-inf + UKF at 1 ms (br_circle_ukf_cfg_default). A wrapper around the
  *    estimator records what it was given (counts, frac, u_{k-1}), what it
  *    returned (F_hat) and the plant's true friction at t_k.
- * 2. Replays each recording into a fresh filter, timing every br_pf_step /
- *    br_ukf_step call with clock_gettime(CLOCK_MONOTONIC); one untimed warm-up
- *    replay, then --reps (PF) / --ukf-reps (UKF) timed replays. The priming
- *    step (k = 0, no prediction) is not counted. Per replay: total time of the
- *    timed steps / (steps * m) = ns per particle-step; reported: the median
- *    over replays and its spread (min, max), plus the per-step latency
- *    distribution pooled over replays. Every replay must reproduce the
+ * 2. Replays each recording into a fresh filter (br_pf_step / br_ukf_step on
+ *    the recorded inputs): one untimed warm-up replay, then --reps (PF) /
+ *    --ukf-reps (UKF) replays whose steps k >= 1 (the priming step k = 0 has
+ *    no prediction) are timed as one block with clock_gettime(CLOCK_MONOTONIC)
+ *    and with the thread's CPU clock: block time / (steps m) = ns per
+ *    particle-step; reported: the median over replays and its spread (min,
+ *    max). One more replay times every step on its own (MONOTONIC) for the
+ *    latency distribution (p50, p99, max). Every replay must reproduce the
  *    in-loop estimates bit for bit (the filters are deterministic).
  * 3. Memory: sizeof(br_pf_t) at BR_PF_MAX_PARTICLES and the part of it that
  *    m = 1500 uses, sizeof(br_ukf_t), sizeof(br_noise_table) (ROM).
@@ -170,6 +171,26 @@ static int64_t now_ns(void)
     return (int64_t)ts.tv_sec * 1000000000 + (int64_t)ts.tv_nsec;
 }
 
+/* CPU time of this thread: unlike CLOCK_MONOTONIC it stops while the thread
+ * is descheduled, so it is the less noisy figure on a shared host */
+static int64_t cpu_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + (int64_t)ts.tv_nsec;
+}
+
+/* mean cost of one now_ns() call: each timed step includes about one */
+static double timer_overhead_ns(void)
+{
+    const int n = 200000;
+    int64_t sink = 0;
+    const int64_t t0 = now_ns();
+    for (int i = 0; i < n; i++) sink += now_ns() & 1;
+    const int64_t t1 = now_ns();
+    return (double)(t1 - t0) / (double)n + 0.0 * (double)sink;
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     const double x = *(const double *)a, y = *(const double *)b;
@@ -195,7 +216,8 @@ static double median_of(const double *v, int n)
 
 typedef struct {
     int reps;
-    double per_rep_ns[256]; /* mean ns per step of each timed replay */
+    double per_rep_ns[256]; /* mean ns per step of each timed replay (CLOCK_MONOTONIC) */
+    double per_rep_cpu_ns[256]; /* the same in thread CPU time */
     double step_p50_ns, step_p99_ns, step_max_ns;
     long steps_timed;       /* per replay */
     long mismatches;        /* estimates differing from the in-loop ones, over all replays */
@@ -223,49 +245,77 @@ static br_status_t ukf_step_w(void *s, const br_meas_t *y, float u, float *F)
     return st;
 }
 
-/* Replays rec into a fresh filter 1 + reps times (the first untimed).
- * fhat_out (rec->n) receives the last replay's estimates. */
+/* One replay of rec into a fresh filter. With lat == NULL the steps k >= 1
+ * are timed as one block (*wall_ns, *cpu_ns: per step); otherwise each step
+ * k >= 1 is timed on its own into lat[k - 1]. fhat_out (rec->n) receives the
+ * estimates; the counts of statuses and of estimates differing from the
+ * in-loop ones are added to tm. */
+static int replay(void *state, const void *cfg, init_fn init, step_fn step, const rec_t *rec, double *lat,
+                  double *wall_ns, double *cpu_ns_out, timing_t *tm, float *fhat_out)
+{
+    const long n = rec->n;
+    if (init(state, cfg) != BR_OK) {
+        fprintf(stderr, "br_bench: filter init failed\n");
+        return -1;
+    }
+    float F = 0.0f;
+    long nout = 0, nerr = 0, mism = 0;
+    int64_t w0 = 0, c0 = 0;
+    for (long k = 0; k < n; k++) {
+        const br_meas_t y = {rec->counts[k], rec->frac[k]};
+        if (k == 1 && lat == NULL) {
+            c0 = cpu_ns();
+            w0 = now_ns();
+        }
+        br_status_t st;
+        if (lat != NULL && k > 0) {
+            const int64_t t0 = now_ns();
+            st = step(state, &y, rec->u_prev[k], &F);
+            lat[k - 1] = (double)(now_ns() - t0);
+        } else {
+            st = step(state, &y, rec->u_prev[k], &F);
+        }
+        nout += (st == BR_E_OUTLIER);
+        nerr += (st != BR_OK && st != BR_E_OUTLIER);
+        mism += (F != rec->fhat[k]);
+        fhat_out[k] = F;
+    }
+    if (lat == NULL) {
+        const int64_t w1 = now_ns(), c1 = cpu_ns();
+        *wall_ns = (double)(w1 - w0) / (double)(n - 1);
+        *cpu_ns_out = (double)(c1 - c0) / (double)(n - 1);
+    }
+    tm->mismatches += mism;
+    tm->outliers = nout;
+    tm->errors = nerr;
+    return 0;
+}
+
+/* One untimed warm-up replay, reps replays timed as blocks (mean cost per
+ * step, wall and CPU time), then one replay timing every step (latency
+ * distribution; a step then also carries about one clock read). */
 static int time_replays(void *state, const void *cfg, init_fn init, step_fn step, const rec_t *rec, int reps,
                         timing_t *tm, float *fhat_out)
 {
     const long n = rec->n;
-    double *lat = malloc((size_t)(n * reps) * sizeof *lat);
+    double *lat = malloc((size_t)(n - 1) * sizeof *lat);
     if (!lat) return -1;
     memset(tm, 0, sizeof *tm);
     tm->reps = reps;
     tm->steps_timed = n - 1;
-    for (int r = -1; r < reps; r++) {
-        if (init(state, cfg) != BR_OK) {
-            fprintf(stderr, "br_bench: filter init failed\n");
-            free(lat);
-            return -1;
-        }
-        float F = 0.0f;
-        int64_t total = 0;
-        long nout = 0, nerr = 0, mism = 0;
-        for (long k = 0; k < n; k++) {
-            const br_meas_t y = {rec->counts[k], rec->frac[k]};
-            const int64_t t0 = now_ns();
-            const br_status_t st = step(state, &y, rec->u_prev[k], &F);
-            const int64_t dt = now_ns() - t0;
-            if (k > 0) {
-                total += dt;
-                if (r >= 0) lat[(long)r * (n - 1) + (k - 1)] = (double)dt;
-            }
-            nout += (st == BR_E_OUTLIER);
-            nerr += (st != BR_OK && st != BR_E_OUTLIER);
-            mism += (F != rec->fhat[k]);
-            fhat_out[k] = F;
-        }
-        tm->mismatches += mism;
-        tm->outliers = nout;
-        tm->errors = nerr;
-        if (r >= 0) tm->per_rep_ns[r] = (double)total / (double)(n - 1);
+    double w, c;
+    int bad = replay(state, cfg, init, step, rec, NULL, &w, &c, tm, fhat_out) != 0;
+    for (int r = 0; r < reps && !bad; r++) {
+        bad = replay(state, cfg, init, step, rec, NULL, &tm->per_rep_ns[r], &tm->per_rep_cpu_ns[r], tm, fhat_out) != 0;
     }
-    const long nl = (n - 1) * reps;
-    tm->step_p50_ns = quantile(lat, nl, 0.5);
-    tm->step_p99_ns = quantile(lat, nl, 0.99);
-    tm->step_max_ns = lat[nl - 1];
+    bad = bad || replay(state, cfg, init, step, rec, lat, &w, &c, tm, fhat_out) != 0;
+    if (bad) {
+        free(lat);
+        return -1;
+    }
+    tm->step_p50_ns = quantile(lat, n - 1, 0.5);
+    tm->step_p99_ns = quantile(lat, n - 1, 0.99);
+    tm->step_max_ns = lat[n - 2];
     free(lat);
     double s2 = 0.0;
     for (long k = 1; k < n; k++) {
@@ -276,12 +326,12 @@ static int time_replays(void *state, const void *cfg, init_fn init, step_fn step
     return 0;
 }
 
-static void rep_stats(const timing_t *tm, double scale, double *med, double *mn, double *mx)
+static void rep_stats(const double *per_rep, int reps, double scale, double *med, double *mn, double *mx)
 {
-    *med = median_of(tm->per_rep_ns, tm->reps) * scale;
-    *mn = *mx = tm->per_rep_ns[0] * scale;
-    for (int r = 1; r < tm->reps; r++) {
-        const double v = tm->per_rep_ns[r] * scale;
+    *med = median_of(per_rep, reps) * scale;
+    *mn = *mx = per_rep[0] * scale;
+    for (int r = 1; r < reps; r++) {
+        const double v = per_rep[r] * scale;
         if (v < *mn) *mn = v;
         if (v > *mx) *mx = v;
     }
@@ -308,6 +358,18 @@ static void cpu_model(char *buf, size_t len)
         }
     }
     fclose(f);
+}
+
+/* 1-minute load average (-1 if unknown): other processes on the CPUs skew the timings */
+static double loadavg1(void)
+{
+    double v = -1.0;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf", &v) != 1) v = -1.0;
+        fclose(f);
+    }
+    return v;
 }
 
 /* s as a JSON string body (quotes and backslashes escaped, controls dropped) */
@@ -409,8 +471,11 @@ int main(int argc, char **argv)
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
     const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    printf("bench: %s, %ld CPUs online; %s build (%s), gcc %s\n", cpu, ncpu, BENCH_NDEBUG ? "release" : "NOT a release",
-           BR_BENCH_BUILD, __VERSION__);
+    const double load0 = loadavg1();
+    printf("bench: %s, %ld CPUs online, load average %.2f; %s build (%s), gcc %s\n", cpu, ncpu, load0,
+           BENCH_NDEBUG ? "release" : "NOT a release", BR_BENCH_BUILD, __VERSION__);
+    const double tovh = timer_overhead_ns();
+    printf("bench: clock_gettime(CLOCK_MONOTONIC) costs %.1f ns per call (read per step only in the latency replay)\n", tovh);
     if (!BENCH_NDEBUG) printf("bench: warning: built without NDEBUG, timings are not representative\n");
 
     br_pf_t *pf = calloc(1, sizeof *pf);
@@ -439,15 +504,19 @@ int main(int argc, char **argv)
     if (time_replays(pf, &cpf.pf, pf_init_w, pf_step_w, &rpf, reps, &tpf, fhat_pf) != 0) goto done;
     if (time_replays(ukf, &cukf.ukf, ukf_init_w, ukf_step_w, &rukf, ukf_reps, &tukf, fhat_ukf) != 0) goto done;
     double pf_med, pf_min, pf_max, ukf_med, ukf_min, ukf_max;
-    rep_stats(&tpf, 1.0 / (double)m, &pf_med, &pf_min, &pf_max);
-    rep_stats(&tukf, 1e-3, &ukf_med, &ukf_min, &ukf_max);
+    double pf_cmed, pf_cmin, pf_cmax, ukf_cmed, ukf_cmin, ukf_cmax;
+    rep_stats(tpf.per_rep_ns, reps, 1.0 / (double)m, &pf_med, &pf_min, &pf_max);
+    rep_stats(tukf.per_rep_ns, ukf_reps, 1e-3, &ukf_med, &ukf_min, &ukf_max);
+    rep_stats(tpf.per_rep_cpu_ns, reps, 1.0 / (double)m, &pf_cmed, &pf_cmin, &pf_cmax);
+    rep_stats(tukf.per_rep_cpu_ns, ukf_reps, 1e-3, &ukf_cmed, &ukf_cmin, &ukf_cmax);
     const double pf_step_med_us = pf_med * (double)m * 1e-3;
 
     printf("PF recording: x axis of the thesis circle, H-inf + PF in closed loop, dt %.1f ms, %ld steps\n",
            cpf.dt_s * 1e3, rpf.n);
     printf("PF  m = %u: %.1f ns per particle-step (median of %d replays of %ld steps; min %.1f, max %.1f)\n", m, pf_med,
            reps, tpf.steps_timed, pf_min, pf_max);
-    printf("    one step %.1f us (median replay) = %.1f %% of the %.1f ms period; per-step p50 %.1f us, p99 %.1f us, "
+    printf("    in thread CPU time: %.1f ns per particle-step (min %.1f, max %.1f)\n", pf_cmed, pf_cmin, pf_cmax);
+    printf("    one step %.1f us (median replay) = %.1f %% of the %.1f ms period; single steps: p50 %.1f us, p99 %.1f us, "
            "max %.1f us\n",
            pf_step_med_us, 100.0 * pf_step_med_us * 1e-6 / cpf.dt_s, cpf.dt_s * 1e3, tpf.step_p50_ns * 1e-3,
            tpf.step_p99_ns * 1e-3, tpf.step_max_ns * 1e-3);
@@ -456,15 +525,17 @@ int main(int argc, char **argv)
            tpf.mismatches ? "NO" : "yes, bit for bit", tpf.mismatches, tpf.fhat_rms_err_N, tpf.outliers, tpf.errors);
     printf("UKF recording: the same axis, H-inf + UKF in closed loop, dt %.1f ms, %ld steps\n", cukf.dt_s * 1e3,
            rukf.n);
-    printf("UKF: %.3f us per step (median of %d replays of %ld steps; min %.3f, max %.3f); per-step p50 %.3f us, "
+    printf("UKF: %.3f us per step (median of %d replays of %ld steps; min %.3f, max %.3f); single steps: p50 %.3f us, "
            "p99 %.3f us, max %.1f us\n",
            ukf_med, ukf_reps, tukf.steps_timed, ukf_min, ukf_max, tukf.step_p50_ns * 1e-3, tukf.step_p99_ns * 1e-3,
            tukf.step_max_ns * 1e-3);
+    printf("    in thread CPU time: %.3f us per step (min %.3f, max %.3f)\n", ukf_cmed, ukf_cmin, ukf_cmax);
     printf("    replays reproduce the in-loop estimates: %s (%ld mismatches); F_hat RMS error vs true friction "
            "%.4f N; %ld outlier, %ld error steps\n",
            tukf.mismatches ? "NO" : "yes, bit for bit", tukf.mismatches, tukf.fhat_rms_err_N, tukf.outliers,
            tukf.errors);
 
+    const double load1 = loadavg1();
     /* 3. memory (host sizes; see docs/bench.md for the Cortex-M7 ones) */
     const size_t per_particle = (sizeof(((br_pf_t *)0)->x) + sizeof(((br_pf_t *)0)->xp) +
                                  sizeof(((br_pf_t *)0)->fnl) + sizeof(((br_pf_t *)0)->l) +
@@ -492,7 +563,10 @@ int main(int argc, char **argv)
         json_str(f, "gcc " __VERSION__);
         fprintf(f, ", \"build\": ");
         json_str(f, BR_BENCH_BUILD);
-        fprintf(f, ", \"ndebug\": %s},\n", BENCH_NDEBUG ? "true" : "false");
+        fprintf(f,
+                ", \"ndebug\": %s, \"loadavg1_start\": %.2f, \"loadavg1_end\": %.2f, "
+                "\"clock_monotonic_call_ns\": %.1f},\n",
+                BENCH_NDEBUG ? "true" : "false", load0, load1, tovh);
         fprintf(f,
                 "  \"pf\": {\"input\": \"x axis of the thesis circle, H-inf + PF closed loop\", \"dt_s\": %.9g, "
                 "\"n_particles\": %u, \"steps_timed\": %ld, \"reps\": %d,\n"
@@ -500,7 +574,10 @@ int main(int argc, char **argv)
                 cpf.dt_s, m, tpf.steps_timed, reps, pf_med, pf_min, pf_max);
         for (int r = 0; r < reps; r++) fprintf(f, "%s%.3f", r ? ", " : "", tpf.per_rep_ns[r] / (double)m);
         fprintf(f,
-                "]},\n    \"step_us\": {\"median_rep_mean\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"max\": %.3f},\n"
+                "]},\n    \"cpu_ns_per_particle_step\": {\"median\": %.3f, \"min\": %.3f, \"max\": %.3f},\n",
+                pf_cmed, pf_cmin, pf_cmax);
+        fprintf(f,
+                "    \"step_us\": {\"median_rep_mean\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"max\": %.3f},\n"
                 "    \"replay_mismatches\": %ld, \"fhat_rms_err_N\": %.6f, \"outlier_steps\": %ld, "
                 "\"error_steps\": %ld},\n",
                 pf_step_med_us, tpf.step_p50_ns * 1e-3, tpf.step_p99_ns * 1e-3, tpf.step_max_ns * 1e-3,
@@ -510,10 +587,11 @@ int main(int argc, char **argv)
                 "\"steps_timed\": %ld, \"reps\": %d,\n"
                 "    \"us_per_step\": {\"median\": %.4f, \"min\": %.4f, \"max\": %.4f, \"p50\": %.4f, \"p99\": %.4f, "
                 "\"max_step\": %.3f},\n"
+                "    \"cpu_us_per_step\": {\"median\": %.4f, \"min\": %.4f, \"max\": %.4f},\n"
                 "    \"replay_mismatches\": %ld, \"fhat_rms_err_N\": %.6f, \"outlier_steps\": %ld, "
                 "\"error_steps\": %ld},\n",
                 cukf.dt_s, tukf.steps_timed, ukf_reps, ukf_med, ukf_min, ukf_max, tukf.step_p50_ns * 1e-3,
-                tukf.step_p99_ns * 1e-3, tukf.step_max_ns * 1e-3, tukf.mismatches, tukf.fhat_rms_err_N,
+                tukf.step_p99_ns * 1e-3, tukf.step_max_ns * 1e-3, ukf_cmed, ukf_cmin, ukf_cmax, tukf.mismatches, tukf.fhat_rms_err_N,
                 tukf.outliers, tukf.errors);
         fprintf(f,
                 "  \"memory_host\": {\"pf_t_bytes\": %zu, \"pf_max_particles\": %u, \"pf_bytes_per_particle\": %zu, "

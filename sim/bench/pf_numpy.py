@@ -4,10 +4,11 @@ in numpy, vectorised over the particles, timed on the recording br_bench made
 (br_bench --record FILE), and compared with the C filter.
 
 Same model and algorithm as br_pf.c, in float32 throughout (as the firmware):
-  predict   eq. 6 by RK4, or, per particle (np.where on the a h <= 2 test at
-            both ends of the step), the bounded displacement-exact scheme with 3
-            fixed-point passes (br_model.c), evaluated only on the particles that
-            need it; process noise from the same ROM table
+  predict   eq. 6 by RK4 on every particle, then, per particle (a mask on the
+            a h <= 2 test at both ends of the step), the bounded
+            displacement-exact scheme with 3 fixed-point passes (br_model.c),
+            evaluated on the masked particles only and scattered back (as C
+            computes it only where needed); process noise from the same ROM table
             (firmware/design/gen_noise.py table(), checked against the C table's
             hash), indexed (pos + 4 j + i) & (len - 1), pos += 4 m + noise_skip
   weigh     l_j = -(theta_j - y)^2 / (2 R), w_j = br_exp_neg(l_j - max l) (the
@@ -23,9 +24,13 @@ reproduces the C one bit for bit: its F_hat equals the C F_hat (recorded by
 br_bench) at every step, which pf_numpy.py checks.
 
 Timing: one untimed warm-up over the first 200 steps, then --reps replays of
-the whole recording into a fresh filter, each timed with time.perf_counter_ns
-around the loop of steps k >= 1 (the priming step excluded, as in br_bench).
-Reported: ns per particle-step, median over replays (min, max).
+the whole recording into a fresh filter, every step k >= 1 timed with
+time.perf_counter_ns (the priming step excluded, as in br_bench). Reported:
+ns per particle-step of each replay (sum of its step times / (steps m)), the
+median over replays (min, max), the same in thread CPU time
+(time.thread_time_ns around the loop: stops while the process is descheduled),
+and the per-step latency p50 / p99 / max pooled over replays. The per-step
+clock reads (~0.1 us) are negligible against a step of ~0.5 ms.
 
 Usage: pf_numpy.py RECORDING [--reps N] [--c-json FILE] [--out FILE]
   --c-json  br_bench's JSON: prints the summary table (C, numpy, ratio, UKF,
@@ -272,7 +277,8 @@ def load_recording(path):
 
 
 def replay(cfg, noise, rec, n_steps=None):
-    """A fresh filter over the recording; returns (F_hat per step, ns of each step k >= 1, statuses)."""
+    """A fresh filter over the recording; returns (F_hat per step, wall ns of each
+    step k >= 1, thread CPU ns of steps 1.. together, statuses)."""
     pf = NumpyPf(cfg, noise)
     counts = [int(c) for c in rec["counts"]]
     frac = rec["frac"].astype(F)
@@ -284,6 +290,7 @@ def replay(cfg, noise, rec, n_steps=None):
     fhat[0] = pf.F_hat
     ns = np.zeros(n - 1)
     clock = time.perf_counter_ns
+    c0 = time.thread_time_ns()
     for k in range(1, n):
         t0 = clock()
         s = pf.step(counts[k], frac[k], u[k])
@@ -293,7 +300,8 @@ def replay(cfg, noise, rec, n_steps=None):
             fhat[k] = pf.F_hat
         else:
             fhat[k] = fhat[k - 1]
-    return fhat, ns, st
+    cpu = time.thread_time_ns() - c0
+    return fhat, ns, cpu, st
 
 
 def rms(a):
@@ -302,31 +310,41 @@ def rms(a):
 
 def summary_table(c, npy, ratio):
     pf, ukf, mem = c["pf"], c["ukf"], c["memory_host"]
+    cn, nn = pf["ns_per_particle_step"], npy["ns_per_particle_step"]
+    m = pf["n_particles"]
     rows = [
-        ("PF, C (host-release)", "%.1f ns / particle-step" % pf["ns_per_particle_step"]["median"],
-         "min %.1f, max %.1f; %d replays" % (pf["ns_per_particle_step"]["min"], pf["ns_per_particle_step"]["max"],
-                                          pf["reps"])),
-        ("PF, numpy (float32)", "%.1f ns / particle-step" % npy["ns_per_particle_step"]["median"],
-         "min %.1f, max %.1f; %d replays" % (npy["ns_per_particle_step"]["min"], npy["ns_per_particle_step"]["max"],
-                                          npy["reps"])),
-        ("ratio numpy / C", "%.1f x" % ratio, "medians"),
-        ("PF step, C, m = %d" % pf["n_particles"], "%.1f us" % pf["step_us"]["median_rep_mean"],
-         "of a %.1f ms period; p99 %.1f us" % (pf["dt_s"] * 1e3, pf["step_us"]["p99"])),
-        ("UKF, C", "%.3f us / step" % ukf["us_per_step"]["median"],
-         "min %.3f, max %.3f; %d replays" % (ukf["us_per_step"]["min"], ukf["us_per_step"]["max"], ukf["reps"])),
-        ("PF RAM (br_pf_t)", "%d bytes" % mem["pf_t_bytes"],
-         "at BR_PF_MAX_PARTICLES = %d; m = %d uses %d" % (mem["pf_max_particles"], pf["n_particles"],
-                                                          mem["pf_used_bytes_at_m"])),
-        ("UKF RAM (br_ukf_t)", "%d bytes" % mem["ukf_t_bytes"], ""),
-        ("PF ROM (noise table)", "%d bytes" % mem["noise_table_rom_bytes"], "%d float32" % mem["noise_len"]),
-        ("F_hat RMS error, C / numpy", "%.4f / %.4f N" % (pf["fhat_rms_err_N"], npy["fhat_rms_err_N"]),
-         "vs the true friction of the recording"),
+        ("", "C", "numpy", "numpy / C"),
+        ("PF ns / particle-step, wall, median", "%.1f" % cn["median"], "%.1f" % nn["median"], "%.2f x" % ratio),
+        ("  min .. max over replays", "%.1f .. %.1f" % (cn["min"], cn["max"]),
+         "%.1f .. %.1f" % (nn["min"], nn["max"]), "%d / %d replays" % (pf["reps"], npy["reps"])),
+        ("  in thread CPU time, median", "%.1f" % c["pf"]["cpu_ns_per_particle_step"]["median"],
+         "%.1f" % npy["cpu_ns_per_particle_step"]["median"],
+         "%.2f x" % (npy["cpu_ns_per_particle_step"]["median"] / c["pf"]["cpu_ns_per_particle_step"]["median"])),
+        ("PF step us (m = %d), per-step p50" % m, "%.1f" % pf["step_us"]["p50"], "%.1f" % npy["step_us"]["p50"],
+         "%.2f x" % (npy["step_us"]["p50"] / pf["step_us"]["p50"])),
+        ("  share of the %.1f ms period" % (pf["dt_s"] * 1e3), "%.1f %%" % (pf["step_us"]["p50"] * 1e-4 / pf["dt_s"]),
+         "%.1f %%" % (npy["step_us"]["p50"] * 1e-4 / pf["dt_s"]), ""),
+        ("PF F_hat RMS error vs true", "%.4f N" % pf["fhat_rms_err_N"], "%.4f N" % npy["fhat_rms_err_N"],
+         "identical %d/%d" % (npy["fhat_identical_to_c_steps"], npy["steps"])),
+        ("UKF us / step, wall, median", "%.3f" % ukf["us_per_step"]["median"], "", ""),
+        ("  min .. max over replays", "%.3f .. %.3f" % (ukf["us_per_step"]["min"], ukf["us_per_step"]["max"]), "",
+         "%d replays" % ukf["reps"]),
+        ("  in thread CPU time, median", "%.3f" % ukf["cpu_us_per_step"]["median"], "", ""),
+        ("PF RAM, br_pf_t (host sizeof)", "%d B" % mem["pf_t_bytes"], "", "at %d particles max" % mem["pf_max_particles"]),
+        ("  of which m = %d uses" % m, "%d B" % mem["pf_used_bytes_at_m"], "",
+         "%d B/particle + %d" % (mem["pf_bytes_per_particle"], mem["pf_fixed_bytes"])),
+        ("UKF RAM, br_ukf_t (host sizeof)", "%d B" % mem["ukf_t_bytes"], "", ""),
+        ("PF ROM, noise table", "%d B" % mem["noise_table_rom_bytes"], "", "%d float32" % mem["noise_len"]),
     ]
-    w0 = max(len(r[0]) for r in rows)
-    w1 = max(len(r[1]) for r in rows)
-    print("== bench summary (%s, %d CPUs)" % (c["machine"]["cpu_model"], c["machine"]["cpus_online"]))
-    for a, b, d in rows:
-        print("  %-*s  %*s  %s" % (w0, a, w1, b, d))
+    w = [max(len(r[i]) for r in rows) for i in range(4)]
+    print("== bench summary: %s, %d CPUs; C %s; numpy %s float32"
+          % (c["machine"]["cpu_model"], c["machine"]["cpus_online"], c["machine"]["build"], npy["numpy"]))
+    for r in rows:
+        print("  %-*s  %*s  %*s  %s" % (w[0], r[0], w[1], r[1], w[2], r[2], r[3]))
+    print("  load average (1 min) at start / end: C %.2f / %.2f, numpy %.2f / %.2f (%d CPUs: above ~0.5 the host "
+          "is shared and the timings are noisy)" % (c["machine"]["loadavg1_start"], c["machine"]["loadavg1_end"],
+                                                     npy["loadavg1_start"], npy["loadavg1_end"],
+                                                     c["machine"]["cpus_online"]))
 
 
 def main():
@@ -347,11 +365,13 @@ def main():
     m = int(cfg["n_particles"])
     n = len(rec["k"])
 
+    load0 = os.getloadavg()[0]
     replay(cfg, noise, rec, n_steps=min(200, n))   # warm-up
-    per_rep, lat, fhat = [], [], None
+    per_rep, per_rep_cpu, lat, fhat = [], [], [], None
     for _ in range(a.reps):
-        fhat, ns, st = replay(cfg, noise, rec)
+        fhat, ns, cpu, st = replay(cfg, noise, rec)
         per_rep.append(float(ns.sum()) / ((n - 1) * m))
+        per_rep_cpu.append(cpu / ((n - 1) * m))
         lat.append(ns)
     med = statistics.median(per_rep)
     lat = np.concatenate(lat)
@@ -362,10 +382,14 @@ def main():
         "dtype": "float32",
         "numpy": np.__version__,
         "python": platform.python_version(),
+        "loadavg1_start": load0,
+        "loadavg1_end": os.getloadavg()[0],
         "steps_timed": n - 1,
         "n_particles": m,
         "reps": a.reps,
         "ns_per_particle_step": {"median": med, "min": min(per_rep), "max": max(per_rep), "per_rep": per_rep},
+        "cpu_ns_per_particle_step": {"median": statistics.median(per_rep_cpu), "min": min(per_rep_cpu),
+                                     "max": max(per_rep_cpu)},
         "step_us": {"median_rep_mean": med * m * 1e-3, "p50": float(np.percentile(lat, 50)) * 1e-3,
                     "p99": float(np.percentile(lat, 99)) * 1e-3, "max": float(lat.max()) * 1e-3},
         "fhat_rms_err_N": rms(fhat[1:] - true[1:]),
@@ -380,6 +404,8 @@ def main():
     print("PF  numpy (float32, vectorised over particles, numpy %s): %.1f ns per particle-step "
           "(median of %d replays of %d steps; min %.1f, max %.1f)"
           % (np.__version__, med, a.reps, n - 1, min(per_rep), max(per_rep)))
+    cc = res["cpu_ns_per_particle_step"]
+    print("    in thread CPU time: %.1f ns per particle-step (min %.1f, max %.1f)" % (cc["median"], cc["min"], cc["max"]))
     print("    one step %.1f us (median replay); per-step p50 %.1f us, p99 %.1f us, max %.1f us"
           % (res["step_us"]["median_rep_mean"], res["step_us"]["p50"], res["step_us"]["p99"], res["step_us"]["max"]))
     print("    tracks: F_hat RMS error vs true friction %.4f N (C: %.4f N); %d outlier, %d error steps"
@@ -403,6 +429,8 @@ def main():
             out = dict(c)
             out["pf_numpy"] = res
             out["ratio_numpy_over_c"] = ratio
+            out["ratio_numpy_over_c_cpu"] = (res["cpu_ns_per_particle_step"]["median"]
+                                             / c["pf"]["cpu_ns_per_particle_step"]["median"])
             with open(a.out, "w") as f:
                 json.dump(out, f, indent=2)
                 f.write("\n")

@@ -175,6 +175,7 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             uint32_t tick;
             ax[i].hal.tick_wait(ax[i].hal.ctx, &tick);
             s.pos_m[i] = br_plant_pos_m(&ax[i].plant);
+            s.counts[i] = br_plant_encoder(&ax[i].plant);
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
             br_status_t st = br_axis_step(&ax[i].axis, &r);
