@@ -22,6 +22,7 @@ IMAGE      := build/cm7-release/hal/stm32h7/br_image_stm32h7.elf
 FLASH_KIB  := 2048
 RAM_KIB    := 128
 DEMO_OUT   := out/demo
+TUNE_OUT   := out/tune
 BENCH_OUT  := out/bench
 BENCH      := build/host-release/sim/bench/br_bench
 
@@ -61,6 +62,7 @@ help:
 	@echo "  make bench     host-release build, time the PF (C and numpy) and the UKF, memory -> $(BENCH_OUT)/bench.json"
 	@echo "  make firmware  cross build (cm7-release) and print flash / RAM use"
 	@echo "  make regen     regenerate the generated headers and the golden traces"
+	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates sim/circle/gen/)"
 	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
 	@echo "  V=1 shows the commands; JOBS=n sets the ctest parallelism (default 2)"
 
@@ -71,7 +73,11 @@ build: deps
 	$(call configure,host-debug)
 	$(call build,host-debug)
 
+# The release tools (the estimator tuner) are built first: the regen test of the
+# tuned configurations runs them unsanitised, at full speed.
 test: deps
+	$(call configure,host-release)
+	$(call build,host-release)
 	$(call configure,host-debug)
 	$(call build,host-debug)
 	$(Q)echo "== test host-debug"
@@ -87,6 +93,17 @@ demo: deps
 	$(Q)mkdir -p $(DEMO_OUT)
 	$(Q)build/host-release/sim/br_demo_circle --out $(DEMO_OUT)
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_demo.py $(DEMO_OUT)
+
+# Nelder-Mead tuning of the PF's and the UKF's noise variances on the circle
+# (thesis section 3.2): regenerates sim/circle/gen/br_{pf,ukf}_tuned.h, with the
+# progress logs and thesis Fig. 1 in $(TUNE_OUT). docs/tuning.md.
+tune: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)mkdir -p $(TUNE_OUT)
+	$(Q)build/host-release/sim/br_tune_est --est ukf --out sim/circle/gen/br_ukf_tuned.h --log $(TUNE_OUT)/ukf.csv
+	$(Q)build/host-release/sim/br_tune_est --est pf --out sim/circle/gen/br_pf_tuned.h --log $(TUNE_OUT)/pf.csv
+	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_tuning.py $(TUNE_OUT)/fig1_tuning.png $(TUNE_OUT)/pf.csv:"H-inf + PF" $(TUNE_OUT)/ukf.csv:"H-inf + UKF"
 
 # C bench (records the input, times PF and UKF, memory), then the numpy PF on
 # the same recording; the script prints the summary table and merges both into

@@ -97,7 +97,7 @@ int main(int argc, char **argv)
         int outliers = 0;
         for (int a = 0; a < 2; a++) {
             for (int s = 0; s < seeds; s++) {
-                br_pf_cfg_t pc = br_circle_pf_cfg_default((float)dt);
+                br_pf_cfg_t pc = br_circle_pf_cfg_tuned((float)dt);
                 pc.n_particles = m;
                 for (int i = 0; i < BR_NX; i++) pc.q_var[i] *= (float)(dt / 1.5e-3);
                 if (br_pf_init(pf, &pc) != BR_OK) return 1;

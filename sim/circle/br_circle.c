@@ -35,8 +35,8 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     c.controller = controller;
     c.plant = br_plant_cfg_reference();
     for (int i = 0; i < 3; i++) c.K[i] = K[i];
-    c.pf = br_circle_pf_cfg_default((float)c.dt_s);
-    c.ukf = br_circle_ukf_cfg_default((float)c.dt_s);
+    c.pf = br_circle_pf_cfg_tuned((float)c.dt_s);
+    c.ukf = br_circle_ukf_cfg_tuned((float)c.dt_s);
     return c;
 }
 

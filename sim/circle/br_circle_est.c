@@ -2,6 +2,8 @@
 #include "br_circle_est.h"
 
 #include "br_noise_table.h"
+#include "gen/br_pf_tuned.h"
+#include "gen/br_ukf_tuned.h"
 #include "br_reference_machine.h"
 
 static br_model_cfg_t model_cfg(float dt_s)
@@ -72,5 +74,26 @@ br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s)
     c.alpha = 1.0f;
     c.beta = 2.0f;
     c.kappa = 0.0f;
+    return c;
+}
+
+br_pf_cfg_t br_circle_pf_cfg_tuned(float dt_s)
+{
+    br_pf_cfg_t c = br_circle_pf_cfg_default(dt_s);
+    c.q_var[BR_X_OMEGA] = BR_PF_TUNED_q_omega;
+    c.q_var[BR_X_Z] = BR_PF_TUNED_q_z;
+    c.q_var[BR_X_GP] = BR_PF_TUNED_q_gp;
+    c.r_var_rad2 = BR_PF_TUNED_r;
+    return c;
+}
+
+br_ukf_cfg_t br_circle_ukf_cfg_tuned(float dt_s)
+{
+    br_ukf_cfg_t c = br_circle_ukf_cfg_default(dt_s);
+    c.q_var[BR_X_THETA] = BR_UKF_TUNED_q_theta;
+    c.q_var[BR_X_OMEGA] = BR_UKF_TUNED_q_omega;
+    c.q_var[BR_X_Z] = BR_UKF_TUNED_q_z;
+    c.q_var[BR_X_GP] = BR_UKF_TUNED_q_gp;
+    c.r_var_rad2 = BR_UKF_TUNED_r;
     return c;
 }

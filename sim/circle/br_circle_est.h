@@ -5,10 +5,16 @@
 #include "bristle/br_pf.h"
 #include "bristle/br_ukf.h"
 
-/* The PF of thesis section 5 (1500 particles) at period dt_s. */
+/* The PF of thesis section 5 (1500 particles) at period dt_s, with the
+ * hand-tuned noise variances: the start of the Nelder-Mead tuning. */
 br_pf_cfg_t br_circle_pf_cfg_default(float dt_s);
 
-/* The UKF of thesis section 5 at period dt_s. */
+/* The UKF of thesis section 5 at period dt_s, hand-tuned (the tuning's start). */
 br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s);
+
+/* The same with the variances found by Nelder-Mead (sim/circle/gen/, make tune):
+ * what the demo runs. */
+br_pf_cfg_t br_circle_pf_cfg_tuned(float dt_s);
+br_ukf_cfg_t br_circle_ukf_cfg_tuned(float dt_s);
 
 #endif
