@@ -9,7 +9,10 @@ golden/gen_traces.py (see docs/golden.md, "Estimator traces"):
   pf.csv         the reference PF (golden/ref/pf.py) on that input: status,
                  origin, noise position, max log-weight, estimate per step
   pf_w.csv       its integer weights W and resampling indices, per step
-  pf_x.csv       spot checks: a few particles every PF_X_EVERY steps
+  pf_x.csv       the whole particle set every PF_X_EVERY steps (comparison
+                 and re-synchronisation points of the C test)
+  ukf.csv        the reference UKF (golden/ref/ukf.py) on the same input:
+                 status, origin, mean, covariance, F_hat, innovation per step
 
 Same conventions as gen_traces.py (write_trace, f32, fixed seeds, '%.17g').
 """
@@ -26,6 +29,7 @@ from ref import lugre as rlugre
 from ref import model as rmodel
 from ref import pf as rpf
 from ref import plant as rplant
+from ref import ukf as rukf
 
 DESIGN_DIR = os.path.join(REPO_ROOT, "firmware", "design")
 NOISE_HEADER = os.path.join(REPO_ROOT, "firmware", "gen", "br_noise_table.h")
@@ -36,22 +40,31 @@ EST_DT = 1.5e-3
 EST_STEPS = 1600
 CIRCLE_A_M = 1.0e-4
 CIRCLE_T_S = 8.0
-# counts at the start: the encoder crosses the int32 wrap after ~0.4 s
+# counts at the start: the encoder crosses the int32 wrap at k = 407 (0.61 s)
 COUNTS0 = 2**31 - 6000
 PLANT_NSUB = 20
 TORQUE_RIPPLE_NM = 5.0e-4   # seeded white torque disturbance on the plant input
 # injected encoder faults: a one-step spike (one outlier step), then a
 # permanent slip (reanchor_after outliers, then the re-anchoring)
 SPIKE_STEP, SPIKE_COUNTS = 600, 500
-SLIP_STEP, SLIP_COUNTS = 870, 300
+SLIP_STEP, SLIP_COUNTS = 870, 1000
 
 PF_M = 128
 PF_BLOCK = 8          # particles per pf_w row
-PF_X_EVERY = 50       # pf_x: every 50th step ...
-PF_X_PARTICLES = (0, 16, 32, 48, 64, 80, 96, 112, 127)  # ... these particles
+PF_X_EVERY = 10       # pf_x: the whole particle set every 10th step
 
 
-def noise_table(f32):
+def fmt_f32(v):
+    """pf_x values: float32 (the C filter's storage, which the test restarts
+    from), printed with '%.9g', which round-trips float32 exactly."""
+    if isinstance(v, (int, np.integer)):
+        return "%d" % int(v)
+    s = "%.9g" % float(v)
+    assert np.float32(float(s)) == np.float32(v)
+    return s
+
+
+def noise_table():
     """The PF's ROM table exactly as firmware/design/gen_noise.py writes it,
     of the length in firmware/gen/br_noise_table.h (BR_NOISE_LEN)."""
     sys.path.insert(0, DESIGN_DIR)
@@ -93,12 +106,13 @@ def model_meta(mp):
 
 
 def pf_cfg(m, f32):
-    """The traced PF: the circle demo's configuration with m = 128 particles
-    and a tuning that mostly holds lock with so few (R = 10 rpc^2, q_theta =
-    rpc^2, q_gp = 1 N^2; the 1500-particle tuning loses lock every few steps
-    at m = 128). All values float32-exact."""
+    """The traced PF, modelled on the circle demo's (x0 spread, g_p range,
+    outlier gate, noise_skip) with m = 128 particles and a tuning that mostly
+    holds lock with so few (R = 10 rpc^2, q_theta = rpc^2, q_gp = 1 N^2; the
+    1500-particle tuning loses lock every few steps at m = 128). Fixed here,
+    independent of later tuning of the demo. All values float32-exact."""
     rpc = m["rad_per_count"]
-    table, crc = noise_table(f32)
+    table, crc = noise_table()
     cfg = rpf.PfCfg(
         model=model_params_f32(m, f32), dt=f32(EST_DT), m=PF_M,
         q_var=(f32(rpc * rpc), f32(5.0e-6), f32(1.0e-14), f32(1.0)),
@@ -123,7 +137,7 @@ def pf_meta(cfg, crc):
 EST_INPUT_COLUMNS = ["k", "t", "counts", "frac", "u_prev_Nm", "fault", "ref_counts",
                      "theta_rad", "omega_radps", "z_m", "fnl_N", "comp_N", "tau_Nm"]
 PF_COLUMNS = ["k", "status", "origin_counts", "noise_pos", "lmax", "theta", "omega", "z", "gp",
-              "F_hat", "ess", "n_outliers", "reanchored"]
+              "F_hat", "ess", "n_outliers", "reanchored", "F_hat_pred"]
 PF_W_COLUMNS = (["k", "j0"] + ["W%d" % i for i in range(PF_BLOCK)]
                 + ["idx%d" % i for i in range(PF_BLOCK)])
 PF_X_COLUMNS = ["k", "j", "theta", "omega", "z", "gp"]
@@ -169,13 +183,13 @@ def record(m, gt):
                         plant.z, plant.fnl, comp, tau])
         lmax = max(pf.l) if k > 0 else 0.0
         rows_pf.append([k, st, pf.origin, pf.noise_pos, lmax, *pf.mean, pf.F_hat, pf.ess,
-                        pf.n_outliers, int(pf.reanchored)])
+                        pf.n_outliers, int(pf.reanchored), pf.F_hat_pred])
         if k > 0:
             for j0 in range(0, cfg.m, PF_BLOCK):
                 rows_w.append([k, j0] + pf.W[j0:j0 + PF_BLOCK] + pf.idx[j0:j0 + PF_BLOCK])
         if k % PF_X_EVERY == 0:
-            for j in PF_X_PARTICLES:
-                rows_x.append([k, j, *pf.x[j]])
+            for j in range(cfg.m):
+                rows_x.append([k, j, *(np.float32(v) for v in pf.x[j])])
         # the plant: commanded torque plus a small seeded ripple, duty clamped
         ripple = TORQUE_RIPPLE_NM * rng.standard_normal()
         plant.step((tau + ripple) / m["tau_per_duty_Nm"], EST_DT)
@@ -188,6 +202,46 @@ def record(m, gt):
     return rows_in, rows_pf, rows_w, rows_x, meta_in, pf_meta(cfg, crc)
 
 
+def ukf_cfg(m, f32):
+    """The traced UKF: the defaults of docs/modules/ukf.md (fixed here) at the
+    input's 1.5 ms. All values float32-exact."""
+    rpc = f32(m["rad_per_count"])
+    return rukf.UkfCfg(
+        model=model_params_f32(m, f32), dt=f32(EST_DT),
+        q_var=(f32(1.0e-14), f32(1.0e-6), f32(1.0e-15), f32(0.05)),
+        r_var=f32(4.0 * rpc * rpc / 12.0), gp0=f32(12.0),
+        p0_var=(f32(rpc * rpc), f32(1.0e-4), f32(1.0e-12), f32(25.0)),
+        gp_min=f32(1.0), gp_max=f32(40.0), outlier_sigma=f32(50.0), reanchor_after=3,
+        rad_per_count=rpc, alpha=f32(1.0), beta=f32(2.0), kappa=f32(0.0))
+
+
+UKF_P_COLUMNS = ["P%d%d" % (i, j) for i in range(4) for j in range(i, 4)]
+UKF_COLUMNS = (["k", "status", "origin_counts", "n_outliers", "reanchored", "theta", "omega", "z", "gp"]
+               + UKF_P_COLUMNS + ["F_hat", "innov", "innov_var", "Pm00", "Pm11", "Pm22", "Pm33"])
+
+
+def run_ukf(cfg, rows_in):
+    u = rukf.Ukf(cfg)
+    rows = []
+    for r in rows_in:
+        k, counts, frac, u_prev = r[0], r[2], r[3], r[4]
+        st = u.step(counts, frac, u_prev)
+        assert st in (rukf.BR_OK, rukf.BR_E_OUTLIER), (k, st)
+        P = [u.P[i][j] for i in range(4) for j in range(i, 4)]
+        rows.append([k, st, u.origin, u.n_outliers, int(u.reanchored), *u.x, *P, u.F_hat, u.nu, u.S,
+                     *u.Pm_diag])
+    return rows
+
+
+def ukf_meta(cfg):
+    return model_meta(cfg.model) + [
+        ("dt_s", cfg.dt), ("q_var", cfg.q_var), ("r_var_rad2", cfg.r_var), ("gp0_N", cfg.gp0),
+        ("p0_var", cfg.p0_var), ("gp_min_N", cfg.gp_min), ("gp_max_N", cfg.gp_max),
+        ("outlier_sigma", cfg.outlier_sigma), ("reanchor_after", cfg.reanchor_after),
+        ("rad_per_count", cfg.rad_per_count), ("alpha", cfg.alpha), ("beta", cfg.beta),
+        ("kappa", cfg.kappa)]
+
+
 def generate(out_dir, m, gt):
     """Writes the estimator traces; gt is the gen_traces module (write_trace,
     f32, read_gains, SEED, SEED_OFFSET). Returns the paths."""
@@ -196,19 +250,30 @@ def generate(out_dir, m, gt):
         "Recorded closed-loop input of the estimators: x axis of the circle (A = 1e-4 m,",
         "T = 8 s) from rest at 1.5 ms, float64 plant (golden/ref/plant.py) + eq. 7",
         "(golden/ref/ctrl.py, H-inf gains) + the reference PF's compensation comp_N.",
-        "counts = encoder at t_k (fault 1: +500 count spike, fault 2: +300 count",
+        "counts = encoder at t_k (fault 1: +500 count spike, fault 2: +1000 count",
         "slip), frac = 0.5, u_prev_Nm = the torque applied over [t_{k-1}, t_k]",
         "(float32-exact); the plant also gets a seeded ripple. Plant state at t_k."])]
     paths.append(gt.write_trace(out_dir, "pf", meta_pf, PF_COLUMNS, rows_pf, [
         "golden/ref/pf.py (float64) on est_input.csv, one row per step (k = 0 primes):",
         "status, origin, noise table position after the step, max log-weight",
         "(0 when priming), mean state (theta relative to origin), F_hat, ESS,",
-        "consecutive outliers, re-anchored (0/1)."]))
+        "consecutive outliers, re-anchored (0/1), F_hat_pred = mean f_nl of the",
+        "resampled set before re-anchoring (= F_hat except on re-anchoring steps)."]))
     paths.append(gt.write_trace(out_dir, "pf_w", meta_pf, PF_W_COLUMNS, rows_w, [
         "golden/ref/pf.py on est_input.csv: integer weights W_j = floor(w_j 2^16) and",
         "resampling indices idx_i of every step k >= 1, %d particles per row" % PF_BLOCK,
         "(W_{j0+i}, idx_{j0+i}, i = 0..%d)." % (PF_BLOCK - 1)]))
-    paths.append(gt.write_trace(out_dir, "pf_x", meta_pf, PF_X_COLUMNS, rows_x, [
-        "golden/ref/pf.py on est_input.csv: particle j of the set after step k",
-        "(resampled, re-anchored), every %d steps; theta relative to the origin." % PF_X_EVERY]))
+    paths.append(gt.write_trace(out_dir, "pf_x", meta_pf + [("every", PF_X_EVERY)], PF_X_COLUMNS, rows_x, [
+        "golden/ref/pf.py on est_input.csv: the particle set after step k (resampled,",
+        "re-anchored) every %d steps, theta relative to the origin, rounded to" % PF_X_EVERY,
+        "float32 and printed with '%.9g' (exact): the C test compares its set with",
+        "it and restarts from it."], value_fmt=fmt_f32))
+    ucfg = ukf_cfg(m, gt.f32)
+    paths.append(gt.write_trace(out_dir, "ukf", ukf_meta(ucfg), UKF_COLUMNS, run_ukf(ucfg, rows_in), [
+        "golden/ref/ukf.py (float64) on est_input.csv, one row per step (k = 0 primes):",
+        "status, origin, consecutive outliers, re-anchored (0/1), posterior mean",
+        "(theta relative to origin), covariance P (upper triangle), F_hat over the",
+        "posterior sigma points, innovation nu = y - theta- and its variance S",
+        "(0 when priming), diagonal of the predicted covariance P- (incl. Q; P0 when",
+        "priming)."]))
     return paths

@@ -238,9 +238,16 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
          * theta's mean moves to y, omega's mean to the measured velocity */
         const float omega_meas = (shift + (y->frac - pf->prev_frac) * rpc) / pf->cfg.model.dt_s;
         const float d_th = y_rel - s[BR_X_THETA] * inv_m, d_om = omega_meas - s[BR_X_OMEGA] * inv_m;
+        sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
+            float xj[BR_NX];
             pf->x[BR_X_THETA][j] += d_th;
             pf->x[BR_X_OMEGA][j] += d_om;
+            for (int i = 0; i < BR_NX; i++) {
+                xj[i] = pf->x[i][j];
+            }
+            /* f_nl depends on omega: the estimate is that of the moved cloud */
+            sf += br_model_fnl_N(&pf->model, xj);
         }
         s[BR_X_THETA] += d_th * (float)m;
         s[BR_X_OMEGA] += d_om * (float)m;

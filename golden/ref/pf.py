@@ -107,8 +107,10 @@ class Pf:
         self.idx = None         # resampling indices
         self.mean = np.array([0.0, 0.0, 0.0, cfg.gp0])
         self.F_hat = 0.0
+        self.F_hat_pred = 0.0
         self.ess = float(cfg.m)
         self.reanchored = False
+        self.l = None           # log-weights of the last step
 
     def _n(self, j, i):
         c = self.cfg
@@ -145,6 +147,7 @@ class Pf:
         self.primed = True
         self._estimate()
         self.ess = float(c.m)
+        self.F_hat_pred = self.F_hat
         return BR_OK
 
     def step(self, counts, frac, u):
@@ -181,6 +184,9 @@ class Pf:
         idx = resample_idx(W)
         self.W, self.idx = W, idx
         self.x = [xp[k].copy() for k in idx]
+        # mean f_nl over the resampled set before any re-anchoring (a diagnostic
+        # column of the trace: F_hat differs from it only on re-anchoring steps)
+        self.F_hat_pred = sum(fn[k] for k in idx) / c.m
         self.n_outliers = self.n_outliers + 1 if outlier else 0
         self.reanchored = self.n_outliers >= c.reanchor_after
         if self.reanchored:

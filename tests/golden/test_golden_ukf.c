@@ -1,0 +1,343 @@
+/* Golden test: the UKF br_ukf (float32) against the float64 reference
+ * golden/ref/ukf.py, through golden/traces/est_input.csv (the recorded
+ * closed-loop input, shared with the PF test) and ukf.csv (status, origin,
+ * mean, covariance, F_hat, innovation per step). The configuration comes from
+ * the trace header. Tolerances: docs/golden.md.
+ *
+ * One-step: before every step the filter's state (x, P, origin, outlier
+ * count, last measurement; public fields of br_ukf_t) is set to the
+ * reference's previous row, rounded to float32, so the errors of one step
+ * are measured without accumulation.
+ * Free run: the filter runs the whole input from init on its own. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "bristle/br_ukf.h"
+#include "trace_reader.h"
+
+#define U32 5.9604644775390625e-08 /* float32 unit roundoff 2^-24 */
+/* Rounding-chain factors (docs/golden.md). One step is a few dozen float32
+ * operations per output (sigma points, a model step, sums over 9 points, gain
+ * and Joseph update), each <= u of its scale: 32. The free run carries the
+ * errors of earlier steps until the filter's gain corrects them; the slowest
+ * state is the random-walk g_p, measured at <= 9x its one-step error: 8 x 32. */
+#define C_ONE_STEP 32.0
+#define C_FREE_RUN 256.0
+
+typedef struct {
+    br_trace_t in, u;
+    br_ukf_cfg_t cfg;
+    int nsteps;
+    int c_counts, c_frac, c_uprev;
+    int c_st, c_org, c_nout, c_ra, c_x[BR_NX], c_P[BR_NX][BR_NX], c_F, c_nu, c_S;
+} ukf_golden_t;
+
+static void load_all(ukf_golden_t *g)
+{
+    br_trace_load(&g->in, "est_input");
+    br_trace_load(&g->u, "ukf");
+    const br_trace_t *t = &g->u;
+    double q[BR_NX], p0[BR_NX];
+    br_trace_meta_nums(t, "q_var", q, BR_NX);
+    br_trace_meta_nums(t, "p0_var", p0, BR_NX);
+    br_ukf_cfg_t c;
+    memset(&c, 0, sizeof c);
+    c.model.J_kgm2 = (float)br_trace_meta_num(t, "J_kgm2");
+    c.model.M_kg = (float)br_trace_meta_num(t, "M_kg");
+    c.model.lead_mprad = (float)br_trace_meta_num(t, "L_mprad");
+    c.model.sigma2_Nspm = (float)br_trace_meta_num(t, "sigma2_Nspm");
+    c.model.lugre.sigma0_Npm = (float)br_trace_meta_num(t, "sigma0_Npm");
+    c.model.lugre.sigma1_Nspm = (float)br_trace_meta_num(t, "sigma1_Nspm");
+    c.model.lugre.Fc_N = (float)br_trace_meta_num(t, "Fc_N");
+    c.model.lugre.Fs_N = (float)br_trace_meta_num(t, "Fs_N");
+    c.model.lugre.vs_mps = (float)br_trace_meta_num(t, "vs_mps");
+    c.model.dt_s = (float)br_trace_meta_num(t, "dt_s");
+    for (int i = 0; i < BR_NX; i++) {
+        c.q_var[i] = (float)q[i];
+        c.p0_var[i] = (float)p0[i];
+    }
+    c.r_var_rad2 = (float)br_trace_meta_num(t, "r_var_rad2");
+    c.gp0_N = (float)br_trace_meta_num(t, "gp0_N");
+    c.gp_min_N = (float)br_trace_meta_num(t, "gp_min_N");
+    c.gp_max_N = (float)br_trace_meta_num(t, "gp_max_N");
+    c.outlier_sigma = (float)br_trace_meta_num(t, "outlier_sigma");
+    c.reanchor_after = (uint32_t)br_trace_meta_num(t, "reanchor_after");
+    c.rad_per_count = (float)br_trace_meta_num(t, "rad_per_count");
+    c.alpha = (float)br_trace_meta_num(t, "alpha");
+    c.beta = (float)br_trace_meta_num(t, "beta");
+    c.kappa = (float)br_trace_meta_num(t, "kappa");
+    g->cfg = c;
+    g->nsteps = g->u.nrows;
+    assert_int_equal(g->in.nrows, g->nsteps);
+    g->c_counts = br_trace_col(&g->in, "counts");
+    g->c_frac = br_trace_col(&g->in, "frac");
+    g->c_uprev = br_trace_col(&g->in, "u_prev_Nm");
+    g->c_st = br_trace_col(t, "status");
+    g->c_org = br_trace_col(t, "origin_counts");
+    g->c_nout = br_trace_col(t, "n_outliers");
+    g->c_ra = br_trace_col(t, "reanchored");
+    const char *xn[BR_NX] = {"theta", "omega", "z", "gp"};
+    for (int i = 0; i < BR_NX; i++) {
+        g->c_x[i] = br_trace_col(t, xn[i]);
+        for (int j = i; j < BR_NX; j++) {
+            char name[8];
+            snprintf(name, sizeof name, "P%d%d", i, j);
+            g->c_P[i][j] = g->c_P[j][i] = br_trace_col(t, name);
+        }
+    }
+    g->c_F = br_trace_col(t, "F_hat");
+    g->c_nu = br_trace_col(t, "innov");
+    g->c_S = br_trace_col(t, "innov_var");
+    for (int k = 0; k < g->nsteps; k++) {
+        assert_int_equal((int)br_trace_get(&g->in, k, br_trace_col(&g->in, "k")), k);
+        assert_int_equal((int)br_trace_get(t, k, br_trace_col(t, "k")), k);
+    }
+}
+
+static void free_all(ukf_golden_t *g)
+{
+    br_trace_free(&g->in);
+    br_trace_free(&g->u);
+}
+
+static br_meas_t meas(const ukf_golden_t *g, int k)
+{
+    br_meas_t y = {(int32_t)br_trace_get(&g->in, k, g->c_counts), (float)br_trace_get(&g->in, k, g->c_frac)};
+    return y;
+}
+
+/* the reference's state after step k, rounded to float32, as the filter's state */
+static void seed(br_ukf_t *f, const ukf_golden_t *g, int k)
+{
+    for (int i = 0; i < BR_NX; i++) {
+        f->x[i] = (float)br_trace_get(&g->u, k, g->c_x[i]);
+        for (int j = 0; j < BR_NX; j++) {
+            f->P[i][j] = (float)br_trace_get(&g->u, k, g->c_P[i][j]);
+        }
+    }
+    f->origin_counts = (int32_t)br_trace_get(&g->u, k, g->c_org);
+    f->n_outliers = (uint32_t)br_trace_get(&g->u, k, g->c_nout);
+    const br_meas_t y = meas(g, k);
+    f->prev_counts = y.counts;
+    f->prev_frac = y.frac;
+    f->primed = 1;
+}
+
+typedef struct {
+    br_errstat_t x[BR_NX], P[BR_NX][BR_NX], F, nu, S;
+    long bad_status, bad_exact;
+} ukf_err_t;
+
+static void err_init(ukf_err_t *e)
+{
+    static const char *xn[BR_NX] = {"theta", "omega", "z", "gp"};
+    static const char *xu[BR_NX] = {"rad", "rad/s", "m", "N"};
+    static char pn[BR_NX][BR_NX][8];
+    for (int i = 0; i < BR_NX; i++) {
+        br_errstat_init(&e->x[i], xn[i], xu[i]);
+        for (int j = 0; j < BR_NX; j++) {
+            snprintf(pn[i][j], sizeof pn[i][j], "P%d%d", i, j);
+            br_errstat_init(&e->P[i][j], pn[i][j], "");
+        }
+    }
+    br_errstat_init(&e->F, "F_hat", "N");
+    br_errstat_init(&e->nu, "innov", "rad");
+    br_errstat_init(&e->S, "innov_var", "rad^2");
+    e->bad_status = e->bad_exact = 0;
+}
+
+/* Compares the filter after step k with the reference row k. */
+static void compare_step(const br_ukf_t *f, const ukf_golden_t *g, int k, br_status_t st, ukf_err_t *e,
+                         const double tol_x[BR_NX], double tol_P[BR_NX][BR_NX], double tol_F, double tol_nu,
+                         double tol_S)
+{
+    const br_trace_t *t = &g->u;
+    const int st_exp = (int)br_trace_get(t, k, g->c_st);
+    if ((int)st != st_exp) {
+        if (e->bad_status++ < 5) {
+            print_error("%s:%d: br_ukf_step returned %d, expected %d\n", t->path, t->line[k], (int)st, st_exp);
+        }
+        return;
+    }
+    if ((double)f->origin_counts != br_trace_get(t, k, g->c_org) || f->est.origin_counts != f->origin_counts ||
+        (double)f->n_outliers != br_trace_get(t, k, g->c_nout)) {
+        if (e->bad_exact++ < 5) {
+            print_error("%s:%d: origin %d, n_outliers %u, expected %.0f, %.0f\n", t->path, t->line[k],
+                        (int)f->origin_counts, (unsigned)f->n_outliers, br_trace_get(t, k, g->c_org),
+                        br_trace_get(t, k, g->c_nout));
+        }
+    }
+    for (int i = 0; i < BR_NX; i++) {
+        br_errstat_add(&e->x[i], t, k, (double)f->est.mean[i], br_trace_get(t, k, g->c_x[i]), tol_x[i]);
+        for (int j = i; j < BR_NX; j++) {
+            br_errstat_add(&e->P[i][j], t, k, (double)f->P[i][j], br_trace_get(t, k, g->c_P[i][j]), tol_P[i][j]);
+        }
+    }
+    br_errstat_add(&e->F, t, k, (double)f->est.F_hat_N, br_trace_get(t, k, g->c_F), tol_F);
+    if (k > 0) {
+        br_errstat_add(&e->nu, t, k, (double)f->est.innov_rad, br_trace_get(t, k, g->c_nu), tol_nu);
+        br_errstat_add(&e->S, t, k, (double)f->est.innov_var_rad2, br_trace_get(t, k, g->c_S), tol_S);
+    }
+}
+
+static long err_print(const ukf_err_t *e, const ukf_golden_t *g, const char *what)
+{
+    long fails = 0;
+    for (int i = 0; i < BR_NX; i++) {
+        br_errstat_print(&e->x[i], &g->u, what);
+        fails += e->x[i].n_fail;
+    }
+    for (int i = 0; i < BR_NX; i++) {
+        for (int j = i; j < BR_NX; j++) {
+            br_errstat_print(&e->P[i][j], &g->u, what);
+            fails += e->P[i][j].n_fail;
+        }
+    }
+    br_errstat_print(&e->F, &g->u, what);
+    br_errstat_print(&e->nu, &g->u, what);
+    br_errstat_print(&e->S, &g->u, what);
+    return fails + e->F.n_fail + e->nu.n_fail + e->S.n_fail;
+}
+
+/* Scales of one UKF step (docs/golden.md), from the reference's row k: the
+ * posterior x and P, the prior's diagonal Pm, the innovation, and the input.
+ * sp_i = c sqrt(Pm_ii) is the prior's sigma-point spread; r = |nu| / sqrt(S)
+ * the normalised innovation (the update moves x_i by at most sqrt(Pm_ii) r).
+ * tol = C u scale, C the rounding-chain factor. */
+typedef struct {
+    double h, L, Jeff, s0, s1, s2, c, R;
+} ukf_consts_t;
+
+static void tolerances(const ukf_golden_t *g, const ukf_consts_t *uc, int k, double C, double tol_x[BR_NX],
+                       double tol_P[BR_NX][BR_NX], double *tol_F, double *tol_nu, double *tol_S)
+{
+    const br_trace_t *t = &g->u;
+    const int st = (int)br_trace_get(t, k, g->c_st);
+    static const char *pm[BR_NX] = {"Pm00", "Pm11", "Pm22", "Pm33"};
+    double x[BR_NX], sp[BR_NX], spp[BR_NX], S[BR_NX];
+    const double nu = br_trace_get(t, k, g->c_nu), Sv = br_trace_get(t, k, g->c_S);
+    const double r = (st == BR_OK && k > 0) ? fabs(nu) / sqrt(Sv) : 0.0;
+    for (int i = 0; i < BR_NX; i++) {
+        x[i] = fabs(br_trace_get(t, k, g->c_x[i]));
+        sp[i] = uc->c * sqrt(fabs(br_trace_get(t, k, br_trace_col(t, pm[i]))));
+        spp[i] = uc->c * sqrt(fabs(br_trace_get(t, k, g->c_P[i][i])));
+    }
+    const double u = fabs(br_trace_get(&g->in, k, g->c_uprev));
+    const double Th = x[0] + sp[0] * (1.0 + r), Om = x[1] + sp[1] * (1.0 + r);
+    const double Z = x[2] + sp[2] * (1.0 + r), G = x[3] + sp[3] * (1.0 + r);
+    S[0] = Th + uc->h * Om;
+    S[1] = Om + uc->h / uc->Jeff * (u + uc->L * (uc->s0 * Z + G + (2.0 * uc->s1 + uc->s2) * uc->L * Om));
+    S[2] = fmax(Z, G / uc->s0) + uc->h * uc->L * Om;
+    S[3] = G;
+    for (int i = 0; i < BR_NX; i++) {
+        tol_x[i] = C * U32 * S[i];
+        for (int j = 0; j < BR_NX; j++) {
+            tol_P[i][j] = C * U32 * (sp[i] * S[j] + S[i] * sp[j] + sp[i] * sp[j]);
+        }
+    }
+    /* F_hat over the posterior sigma points: f_nl's scale there, plus the
+     * state errors times the partial derivatives of f_nl */
+    const double Zp = x[2] + spp[2], Op = x[1] + spp[1];
+    const double Gp = fmax(x[3] - spp[3], (double)g->cfg.gp_min_N);
+    const double a = uc->s0 * uc->L * Op / Gp;
+    const double S_f = uc->s0 * Zp + uc->s1 * uc->L * Op * (1.0 + uc->s0 * Zp / Gp);
+    *tol_F = C * U32 * S_f + (uc->s0 + uc->s1 * a) * tol_x[2] + uc->s1 * uc->L * (1.0 + uc->s0 * Zp / Gp) * tol_x[1] +
+             uc->s1 * a * Zp / Gp * tol_x[3];
+    *tol_nu = C * U32 * (fabs(nu) + S[0]);
+    *tol_S = C * U32 * (2.0 * sp[0] * S[0] + sp[0] * sp[0] + uc->R);
+}
+
+static ukf_consts_t consts(const ukf_golden_t *g)
+{
+    ukf_consts_t uc;
+    const br_trace_t *t = &g->u;
+    uc.h = g->cfg.model.dt_s;
+    uc.L = br_trace_meta_num(t, "L_mprad");
+    uc.Jeff = br_trace_meta_num(t, "J_kgm2") + uc.L * uc.L * br_trace_meta_num(t, "M_kg");
+    uc.s0 = br_trace_meta_num(t, "sigma0_Npm");
+    uc.s1 = br_trace_meta_num(t, "sigma1_Nspm");
+    uc.s2 = br_trace_meta_num(t, "sigma2_Nspm");
+    const double n = BR_NX, al = g->cfg.alpha, ka = g->cfg.kappa;
+    uc.c = sqrt(n + al * al * (n + ka) - n);
+    uc.R = g->cfg.r_var_rad2;
+    return uc;
+}
+
+static void test_ukf_one_step(void **state)
+{
+    (void)state;
+    ukf_golden_t g;
+    load_all(&g);
+    br_ukf_t f;
+    assert_int_equal(br_ukf_init(&f, &g.cfg), BR_OK);
+    ukf_err_t e;
+    err_init(&e);
+    double tx[BR_NX], tP[BR_NX][BR_NX], tF, tnu, tS;
+    const ukf_consts_t uc = consts(&g);
+    for (int k = 0; k < g.nsteps; k++) {
+        if (k > 0) {
+            seed(&f, &g, k - 1);
+        }
+        const br_meas_t y = meas(&g, k);
+        const br_status_t st = br_ukf_step(&f, &y, (float)br_trace_get(&g.in, k, g.c_uprev));
+        tolerances(&g, &uc, k, C_ONE_STEP, tx, tP, &tF, &tnu, &tS);
+        compare_step(&f, &g, k, st, &e, tx, tP, tF, tnu, tS);
+    }
+    const long fails = err_print(&e, &g, "ukf1");
+    free_all(&g);
+    assert_int_equal(e.bad_status, 0);
+    assert_int_equal(e.bad_exact, 0);
+    if (fails != 0) {
+        fail_msg("ukf one-step: %ld comparisons outside tolerance", fails);
+    }
+}
+
+static void test_ukf_free_run(void **state)
+{
+    (void)state;
+    ukf_golden_t g;
+    load_all(&g);
+    br_ukf_t f;
+    assert_int_equal(br_ukf_init(&f, &g.cfg), BR_OK);
+    ukf_err_t e;
+    err_init(&e);
+    double tx[BR_NX], tP[BR_NX][BR_NX], tF, tnu, tS;
+    const ukf_consts_t uc = consts(&g);
+    for (int k = 0; k < g.nsteps; k++) {
+        const br_meas_t y = meas(&g, k);
+        const br_status_t st = br_ukf_step(&f, &y, (float)br_trace_get(&g.in, k, g.c_uprev));
+        tolerances(&g, &uc, k, C_FREE_RUN, tx, tP, &tF, &tnu, &tS);
+        compare_step(&f, &g, k, st, &e, tx, tP, tF, tnu, tS);
+    }
+    long n_out = 0, n_ra = 0;
+    for (int k = 0; k < g.nsteps; k++) {
+        n_out += (int)br_trace_get(&g.u, k, g.c_st) == BR_E_OUTLIER;
+        n_ra += (int)br_trace_get(&g.u, k, g.c_ra);
+    }
+    print_message("golden ukf        %d steps (%ld outlier, %ld re-anchoring), statuses %s, origin and outlier "
+                  "counts %s\n", g.nsteps, n_out, n_ra, e.bad_status ? "DIFFER" : "identical",
+                  e.bad_exact ? "DIFFER" : "identical");
+    const long fails = err_print(&e, &g, "ukf");
+    free_all(&g);
+    assert_int_equal(e.bad_status, 0);
+    assert_int_equal(e.bad_exact, 0);
+    if (fails != 0) {
+        fail_msg("ukf free run: %ld comparisons outside tolerance", fails);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ukf_one_step),
+        cmocka_unit_test(test_ukf_free_run),
+    };
+    return cmocka_run_group_tests_name("golden_ukf", tests, NULL, NULL);
+}
