@@ -12,7 +12,7 @@
 #define BR_PF_W_ONE (1u << BR_PF_W_BITS)
 
 static int finite_nonneg(float v) { return isfinite(v) && v >= 0.0f; }
-static int finite_pos(float v) { return isfinite(v) && v > 0.0f; }
+
 
 br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
 {
@@ -30,19 +30,16 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
         return BR_E_PARAM;
     }
     for (int i = 0; i < BR_NX; i++) {
-        if (!finite_nonneg(cfg->q_var[i]) || !finite_nonneg(cfg->x0_std[i])) {
+        if (!finite_nonneg(cfg->x0_std[i])) {
             return BR_E_PARAM;
         }
     }
-    if (!finite_pos(cfg->r_var_rad2) || !finite_pos(cfg->outlier_sigma) || !finite_pos(cfg->rad_per_count) ||
-        cfg->reanchor_after < 1u) {
-        return BR_E_PARAM;
+    br_status_t st = br_est_check_common(cfg->q_var, cfg->r_var_rad2, cfg->gp0_N, cfg->gp_min_N, cfg->gp_max_N,
+                                         cfg->outlier_sigma, cfg->reanchor_after, cfg->rad_per_count);
+    if (st != BR_OK) {
+        return st;
     }
-    if (!finite_pos(cfg->gp_min_N) || !isfinite(cfg->gp_max_N) || !(cfg->gp_max_N > cfg->gp_min_N) ||
-        !(cfg->gp0_N >= cfg->gp_min_N && cfg->gp0_N <= cfg->gp_max_N)) {
-        return BR_E_PARAM;
-    }
-    br_status_t st = br_model_init(&pf->model, &cfg->model);
+    st = br_model_init(&pf->model, &cfg->model);
     if (st != BR_OK) {
         return st;
     }

@@ -28,16 +28,12 @@ static int mat_finite(const float A[BR_NX][BR_NX])
 static br_status_t check_cfg(const br_ukf_cfg_t *cfg)
 {
     for (int i = 0; i < BR_NX; i++) {
-        if (!finite_nonneg(cfg->q_var[i]) || !finite_pos(cfg->p0_var[i])) {
+        if (!finite_pos(cfg->p0_var[i])) {
             return BR_E_PARAM;
         }
     }
-    if (!finite_pos(cfg->r_var_rad2) || !finite_pos(cfg->outlier_sigma) || !finite_pos(cfg->rad_per_count) ||
-        cfg->reanchor_after < 1u) {
-        return BR_E_PARAM;
-    }
-    if (!finite_pos(cfg->gp_min_N) || !isfinite(cfg->gp_max_N) || !(cfg->gp_max_N > cfg->gp_min_N) ||
-        !(cfg->gp0_N >= cfg->gp_min_N && cfg->gp0_N <= cfg->gp_max_N)) {
+    if (br_est_check_common(cfg->q_var, cfg->r_var_rad2, cfg->gp0_N, cfg->gp_min_N, cfg->gp_max_N,
+                            cfg->outlier_sigma, cfg->reanchor_after, cfg->rad_per_count) != BR_OK) {
         return BR_E_PARAM;
     }
     /* scaled UT: alpha in (0, 1], beta >= 0, n + lambda = alpha^2 (n + kappa) > 0 */

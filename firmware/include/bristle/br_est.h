@@ -24,4 +24,11 @@ typedef struct {
     br_est_step_fn step;
 } br_est_t;
 
+/* The checks the PF and the UKF share: process-noise variances finite and
+ * >= 0, R > 0, 0 < gp_min < gp_max with gp0 inside, an outlier gate > 0, at
+ * least one outlier before re-anchoring, an encoder resolution > 0.
+ * BR_OK or BR_E_PARAM. */
+br_status_t br_est_check_common(const float q_var[4], float r_var_rad2, float gp0_N, float gp_min_N, float gp_max_N,
+                                float outlier_sigma, uint32_t reanchor_after, float rad_per_count);
+
 #endif
