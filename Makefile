@@ -22,8 +22,10 @@ IMAGE      := build/cm7-release/hal/stm32h7/br_image_stm32h7.elf
 FLASH_KIB  := 2048
 RAM_KIB    := 128
 DEMO_OUT   := out/demo
+HIDDEN_OUT := out/diagnose-hidden
 TUNE_OUT   := out/tune
 BENCH_OUT  := out/bench
+TARGET_BENCH_OUT := out/target-bench
 BENCH      := build/host-release/sim/bench/br_bench
 
 # $(call configure,<preset>): cmake --preset, output shown only on failure.
@@ -51,7 +53,7 @@ define print_size
 	  END { exit ok ? 0 : 1 }'
 endef
 
-.PHONY: help deps build test demo bench firmware regen clean distclean
+.PHONY: help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control firmware regen clean distclean
 
 help:
 	@echo "bristle targets:"
@@ -60,9 +62,15 @@ help:
 	@echo "  make test      host-debug build + ctest, then the firmware image and its size"
 	@echo "  make demo      host-release build, run the circle demo into $(DEMO_OUT), plot it"
 	@echo "  make bench     host-release build, time the PF (C and numpy) and the UKF, memory -> $(BENCH_OUT)/bench.json"
+	@echo "  make diagnose LOG=<csv> OUT=<dir> [MACHINE=<json>]  what the model gets wrong in a measured log (docs/diagnose.md)"
+	@echo "  make validate MODEL=<model.json> LOG=<csv>          a saved model's relerr on another log"
+	@echo "  make diagnose-hidden  the hidden-cause suite -> docs/diagnose-hidden.md"
+	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
 	@echo "  make firmware  cross build (cm7-release) and print flash / RAM use"
+	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
 	@echo "  make regen     regenerate the generated headers and the golden traces"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates sim/circle/gen/)"
+	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
 	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
 	@echo "  V=1 shows the commands; JOBS=n sets the ctest parallelism (default 2)"
 
@@ -75,15 +83,17 @@ build: deps
 
 # The release tools (the estimator tuner) are built first: the regen test of the
 # tuned configurations runs them unsanitised, at full speed.
+# The cm7-release images are built before ctest: target_qemu_replay runs the
+# mps2-an500 replay image under qemu-system-arm (docs/target.md).
 test: deps
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(call configure,host-debug)
 	$(call build,host-debug)
-	$(Q)echo "== test host-debug"
-	$(Q)ctest --preset host-debug --output-on-failure -j$(JOBS)
 	$(call configure,cm7-release)
 	$(call build,cm7-release)
+	$(Q)echo "== test host-debug"
+	$(Q)ctest --preset host-debug --output-on-failure -j$(JOBS)
 	$(print_size)
 
 demo: deps
@@ -105,6 +115,13 @@ tune: deps
 	$(Q)build/host-release/sim/br_tune_est --est pf --out sim/circle/gen/br_pf_tuned.h --log $(TUNE_OUT)/pf.csv
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_tuning.py $(TUNE_OUT)/fig1_tuning.png $(TUNE_OUT)/pf.csv:"H-inf + PF" $(TUNE_OUT)/ukf.csv:"H-inf + UKF"
 
+# Thesis Figs. 1-8 into docs/figures/ and docs/results.md (about 12 min: the
+# tunings, the sampling-time study, the demo; progress is printed).
+figures: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)MPLBACKEND=Agg $(PYTHON) sim/studies/make_figures.py build/host-release out/figures
+
 # C bench (records the input, times PF and UKF, memory), then the numpy PF on
 # the same recording; the script prints the summary table and merges both into
 # bench.json. docs/bench.md.
@@ -115,6 +132,45 @@ bench: deps
 	$(Q)mkdir -p $(BENCH_OUT)
 	$(Q)$(BENCH) --json $(BENCH_OUT)/c.json --record $(BENCH_OUT)/pf_input.csv
 	$(Q)$(PYTHON) sim/bench/pf_numpy.py $(BENCH_OUT)/pf_input.csv --c-json $(BENCH_OUT)/c.json --out $(BENCH_OUT)/bench.json
+
+# Instructions per PF particle-step and per control period on QEMU's emulated
+# Cortex-M7 (-icount), flash / RAM from the map file. docs/target.md.
+target-bench: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(call configure,cm7-release)
+	$(call build,cm7-release)
+	$(Q)echo "== target-bench -> $(TARGET_BENCH_OUT)"
+	$(Q)hal/mps2/target_bench.sh build/host-release build/cm7-release $(TARGET_BENCH_OUT)
+
+# Measured logs (docs/diagnose.md): diagnose one, validate a saved model on
+# another, and the hidden-cause suite that writes docs/diagnose-hidden.md.
+diagnose: deps
+	$(Q)test -n "$(LOG)" -a -n "$(OUT)" || { echo "usage: make diagnose LOG=<csv> OUT=<dir> [MACHINE=<json>]" >&2; exit 2; }
+	$(Q)PYTHONPATH=sim MPLBACKEND=Agg $(PYTHON) -m diagnose diagnose --log "$(LOG)" --out "$(OUT)" $(if $(MACHINE),--machine "$(MACHINE)")
+
+validate: deps
+	$(Q)test -n "$(MODEL)" -a -n "$(LOG)" || { echo "usage: make validate MODEL=<model.json> LOG=<csv>" >&2; exit 2; }
+	$(Q)PYTHONPATH=sim $(PYTHON) -m diagnose validate --model "$(MODEL)" --log "$(LOG)"
+
+diagnose-control: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== diagnosis in control terms -> out/diagnose-control, docs/diagnose-control.md"
+	$(Q)PYTHONPATH=sim $(PYTHON) sim/studies/diagnose_control.py --bin build/host-release/sim --work out/diagnose-control \
+	  --est ukf,pf --md docs/diagnose-control.md
+
+diagnose-hidden: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== hidden-cause suite -> $(HIDDEN_OUT), docs/diagnose-hidden.md"
+	$(Q)mkdir -p $(HIDDEN_OUT)
+	$(Q)pids=""; for k in 0 1; do \
+	  $(PYTHON) tests/diagnose/hidden_cause.py --simlog build/host-release/sim/br_simlog --work $(HIDDEN_OUT) \
+	    --shard $$k/2 --json $(HIDDEN_OUT)/shard$$k.json & pids="$$pids $$!"; done; \
+	  rc=0; for p in $$pids; do wait $$p || rc=1; done; \
+	  BR_HIDDEN_COMMAND="make diagnose-hidden" $(PYTHON) tests/diagnose/hidden_cause.py \
+	    --merge $(HIDDEN_OUT)/shard0.json $(HIDDEN_OUT)/shard1.json --md docs/diagnose-hidden.md || rc=1; exit $$rc
 
 firmware: deps
 	$(call configure,cm7-release)

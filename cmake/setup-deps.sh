@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what building and testing bristle needs, idempotently:
 #   Debian packages: host compiler, CMake, Ninja, cmocka, the Arm cross
-#   toolchain with newlib, Python's venv module;
+#   toolchain with newlib, qemu-system-arm (the emulated Cortex-M7 of the
+#   target tests and make target-bench, docs/target.md), Python's venv module;
 #   .venv in the project root with the pinned cmake/python-requirements.txt.
 # Quick when everything is in place: dpkg status checks, and a stamp in .venv
 # keyed by the hash of the requirements file (and of the interpreter).
@@ -21,6 +22,7 @@ pkgs=(
   gcc libc6-dev make cmake ninja-build
   libcmocka-dev
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
+  qemu-system-arm
   python3 python3-venv
 )
 installed() {
@@ -48,7 +50,7 @@ if ((${#missing[@]})); then
     installed "$p" || die "package $p is still not installed"
   done
 fi
-for t in cmake ninja arm-none-eabi-gcc arm-none-eabi-size; do
+for t in cmake ninja arm-none-eabi-gcc arm-none-eabi-size qemu-system-arm; do
   command -v "$t" >/dev/null || die "$t not on PATH after installation"
 done
 

@@ -62,10 +62,11 @@ void br_model_deriv(const br_model_t *m, const float x[BR_NX], float u_Nm, float
     dx[BR_X_GP] = 0.0f;
 }
 
-/* a h = sigma0 L |omega| h / g_p: the bristle rate times the step */
-static float bristle_ah(const br_model_t *m, float omega, float g_p)
+/* a h = sigma0 L |omega| h / g_p <= BR_MODEL_RK4_AH_MAX, without a division:
+ * sigma0 L |omega| h <= BR_MODEL_RK4_AH_MAX g_p (g_p > 0) */
+static int rk4_stable(const br_model_t *m, float omega, float g_p)
 {
-    return m->cfg.lugre.sigma0_Npm * m->cfg.lead_mprad * fabsf(omega) * m->cfg.dt_s / g_p;
+    return m->cfg.lugre.sigma0_Npm * m->cfg.lead_mprad * fabsf(omega) * m->cfg.dt_s <= BR_MODEL_RK4_AH_MAX * g_p;
 }
 
 static void rk4_step(const br_model_t *m, const float x[BR_NX], float u, float out[BR_NX])
@@ -158,8 +159,7 @@ br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm,
     }
     rk4_step(m, x, u_Nm, tmp);
     /* RK4 only where both ends of the step are inside its stability region. */
-    if (!(bristle_ah(m, x[BR_X_OMEGA], x[BR_X_GP]) <= BR_MODEL_RK4_AH_MAX &&
-          bristle_ah(m, tmp[BR_X_OMEGA], x[BR_X_GP]) <= BR_MODEL_RK4_AH_MAX)) {
+    if (!(rk4_stable(m, x[BR_X_OMEGA], x[BR_X_GP]) && rk4_stable(m, tmp[BR_X_OMEGA], x[BR_X_GP]))) {
         bounded_step(m, x, u_Nm, tmp);
     }
     if (!all_finite(tmp)) {

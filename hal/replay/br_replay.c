@@ -1,0 +1,163 @@
+/* Replay core (br_replay.h): portable C99, no libc I/O, no globals. */
+#include "br_replay.h"
+
+#include <string.h>
+
+#include "br_noise_table.h"
+
+static uint32_t f2w(float f)
+{
+    uint32_t w;
+    memcpy(&w, &f, sizeof w);
+    return w;
+}
+
+static float w2f(uint32_t w)
+{
+    float f;
+    memcpy(&f, &w, sizeof f);
+    return f;
+}
+
+void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WORDS])
+{
+    uint32_t i = 0u;
+    const br_model_cfg_t *m = &c->pf.model;
+    w[i++] = BR_REPLAY_MAGIC;
+    w[i++] = BR_REPLAY_VERSION;
+    w[i++] = c->n_steps;
+    for (uint32_t j = 0u; j < 3u; ++j) w[i++] = f2w(c->ctrl.K[j]);
+    w[i++] = f2w(c->ctrl.dt_s);
+    w[i++] = f2w(c->ctrl.tau_max_Nm);
+    w[i++] = f2w(c->ctrl.tau_per_duty_Nm);
+    w[i++] = f2w(c->ctrl.rad_per_count);
+    w[i++] = f2w(c->ctrl.lead_mprad);
+    w[i++] = f2w(m->J_kgm2);
+    w[i++] = f2w(m->M_kg);
+    w[i++] = f2w(m->lead_mprad);
+    w[i++] = f2w(m->sigma2_Nspm);
+    w[i++] = f2w(m->lugre.sigma0_Npm);
+    w[i++] = f2w(m->lugre.sigma1_Nspm);
+    w[i++] = f2w(m->lugre.Fc_N);
+    w[i++] = f2w(m->lugre.Fs_N);
+    w[i++] = f2w(m->lugre.vs_mps);
+    w[i++] = f2w(m->dt_s);
+    w[i++] = c->pf.n_particles;
+    for (uint32_t j = 0u; j < BR_NX; ++j) w[i++] = f2w(c->pf.q_var[j]);
+    w[i++] = f2w(c->pf.r_var_rad2);
+    w[i++] = f2w(c->pf.gp0_N);
+    for (uint32_t j = 0u; j < BR_NX; ++j) w[i++] = f2w(c->pf.x0_std[j]);
+    w[i++] = f2w(c->pf.gp_min_N);
+    w[i++] = f2w(c->pf.gp_max_N);
+    w[i++] = f2w(c->pf.outlier_sigma);
+    w[i++] = c->pf.reanchor_after;
+    w[i++] = f2w(c->pf.rad_per_count);
+    w[i++] = c->pf.noise_len;
+    w[i++] = c->pf.noise_skip;
+    while (i < BR_REPLAY_HDR_WORDS) w[i++] = 0u;
+}
+
+br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_replay_cfg_t *c)
+{
+    uint32_t i = 0u;
+    br_model_cfg_t *m = &c->pf.model;
+    if (w[i++] != BR_REPLAY_MAGIC || w[i++] != BR_REPLAY_VERSION) return BR_E_PARAM;
+    c->n_steps = w[i++];
+    for (uint32_t j = 0u; j < 3u; ++j) c->ctrl.K[j] = w2f(w[i++]);
+    c->ctrl.dt_s = w2f(w[i++]);
+    c->ctrl.tau_max_Nm = w2f(w[i++]);
+    c->ctrl.tau_per_duty_Nm = w2f(w[i++]);
+    c->ctrl.rad_per_count = w2f(w[i++]);
+    c->ctrl.lead_mprad = w2f(w[i++]);
+    m->J_kgm2 = w2f(w[i++]);
+    m->M_kg = w2f(w[i++]);
+    m->lead_mprad = w2f(w[i++]);
+    m->sigma2_Nspm = w2f(w[i++]);
+    m->lugre.sigma0_Npm = w2f(w[i++]);
+    m->lugre.sigma1_Nspm = w2f(w[i++]);
+    m->lugre.Fc_N = w2f(w[i++]);
+    m->lugre.Fs_N = w2f(w[i++]);
+    m->lugre.vs_mps = w2f(w[i++]);
+    m->dt_s = w2f(w[i++]);
+    c->pf.n_particles = w[i++];
+    for (uint32_t j = 0u; j < BR_NX; ++j) c->pf.q_var[j] = w2f(w[i++]);
+    c->pf.r_var_rad2 = w2f(w[i++]);
+    c->pf.gp0_N = w2f(w[i++]);
+    for (uint32_t j = 0u; j < BR_NX; ++j) c->pf.x0_std[j] = w2f(w[i++]);
+    c->pf.gp_min_N = w2f(w[i++]);
+    c->pf.gp_max_N = w2f(w[i++]);
+    c->pf.outlier_sigma = w2f(w[i++]);
+    c->pf.reanchor_after = w[i++];
+    c->pf.rad_per_count = w2f(w[i++]);
+    c->pf.noise_len = w[i++];
+    c->pf.noise_skip = w[i++];
+    if (c->pf.noise_len != BR_NOISE_LEN) return BR_E_PARAM;
+    c->pf.noise = br_noise_table;
+    return BR_OK;
+}
+
+uint32_t br_replay_idx_hash(const uint16_t *idx, uint32_t m)
+{
+    uint32_t h = BR_REPLAY_FNV_OFFSET;
+    for (uint32_t i = 0u; i < m; ++i) {
+        h = (h ^ (uint32_t)(idx[i] & 0xFFu)) * BR_REPLAY_FNV_PRIME;
+        h = (h ^ (uint32_t)(idx[i] >> 8)) * BR_REPLAY_FNV_PRIME;
+    }
+    return h;
+}
+
+static br_status_t enc_read(void *ctx, int32_t *counts)
+{
+    *counts = ((const br_replay_t *)ctx)->enc_counts;
+    return BR_OK;
+}
+
+static br_status_t pwm_write(void *ctx, float duty)
+{
+    ((br_replay_t *)ctx)->duty = duty;
+    return BR_OK;
+}
+
+static br_status_t tick_wait(void *ctx, uint32_t *tick)
+{
+    (void)ctx;
+    *tick = 0u;
+    return BR_OK;
+}
+
+int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles_override)
+{
+    uint32_t hdr[BR_REPLAY_HDR_WORDS];
+    if (io->read(io->ctx, hdr, (uint32_t)sizeof hdr) != 0) return -1;
+    if (br_replay_hdr_decode(hdr, &r->cfg) != BR_OK) return -2;
+    if (n_particles_override != 0u) r->cfg.pf.n_particles = n_particles_override;
+    r->hal.ctx = r;
+    r->hal.encoder_read = enc_read;
+    r->hal.pwm_write = pwm_write;
+    r->hal.tick_wait = tick_wait;
+    r->duty = 0.0f;
+    const br_est_t est = {&r->pf, br_pf_est_step};
+    if (br_pf_init(&r->pf, &r->cfg.pf) != BR_OK ||
+        br_axis_init(&r->axis, &r->hal, &r->cfg.ctrl, &est) != BR_OK) {
+        return -3;
+    }
+    for (uint32_t k = 0u; k < r->cfg.n_steps; ++k) {
+        uint32_t in[BR_REPLAY_STEP_WORDS];
+        uint32_t out[BR_REPLAY_OUT_WORDS];
+        if (io->read(io->ctx, in, (uint32_t)sizeof in) != 0) return -1;
+        r->enc_counts = (int32_t)in[0];
+        const br_ref_t ref = {(int32_t)in[1], w2f(in[2]), w2f(in[3])};
+        const uint32_t t0 = io->stamp ? io->stamp(io->ctx) : 0u;
+        const br_status_t st = br_axis_step(&r->axis, &ref);
+        const uint32_t t1 = io->stamp ? io->stamp(io->ctx) : 0u;
+        out[0] = k;
+        out[1] = (uint32_t)(int32_t)st;
+        out[2] = br_replay_idx_hash(r->pf.idx, r->cfg.pf.n_particles);
+        out[3] = f2w(r->axis.F_hat_N);
+        out[4] = f2w(r->duty);
+        out[5] = t1 - t0;
+        if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;
+        if (st != BR_OK && st != BR_E_OUTLIER) return -4;
+    }
+    return 0;
+}
