@@ -5,8 +5,12 @@
  * Usage: br_simlog --out FILE [--traj ident|circle] [--cycles N] [--duration S]
  *                  [--seed N] [--force-noise N] [--model MODEL.json]
  *                  [--offset F] [--asym DFC,DFV] [--ripple A,P[,PHASE]]
- *                  [--gradient S] [--delay D] [--controller-out FILE]
+ *                  [--gradient S] [--delay D] [--machine-out FILE]
  *                  [--truth]
+ *
+ * --machine-out (identification run) writes the position loop as a machine
+ * file for the diagnosis (its closed-loop re-simulation); named
+ * <log>.machine.json beside the log, the diagnosis finds it by itself.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -16,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "br_cause_args.h"
 #include "br_circle.h"
 #include "br_ident.h"
 #include "plant/br_plant_json.h"
@@ -68,7 +73,12 @@ static void write_row(out_t *o, double t, double ref, double pos, double force, 
 {
     const double f = o->noise_N > 0.0 ? force + o->noise_N * rng_gauss(&o->rng) : force;
     fprintf(o->f, "%.6f,%.10e,%.10e,%.8e", t, ref, pos, f);
-    if (o->truth) fprintf(o->f, ",%.10e,%.8e,%.8e", pos_true, vel_true, fnl);
+    if (o->truth) {
+        /* the circle's sample has no velocity: an empty cell */
+        fprintf(o->f, ",%.10e,", pos_true);
+        if (!isnan(vel_true)) fprintf(o->f, "%.8e", vel_true);
+        fprintf(o->f, ",%.8e", fnl);
+    }
     fputc('\n', o->f);
 }
 
@@ -95,30 +105,13 @@ static int usage(const char *argv0)
     fprintf(stderr,
             "usage: %s --out FILE [--traj ident|circle] [--cycles N] [--duration S] [--seed N]\n"
             "          [--force-noise N] [--model MODEL.json] [--offset F] [--asym DFC,DFV]\n"
-            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--controller-out FILE] [--truth]\n",
+            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--machine-out FILE] [--truth]\n",
             argv0);
     return 2;
 }
 
-/* parses "a[,b[,c]]" into up to n numbers; returns how many, or -1 */
-static int parse_list(const char *s, double *v, int n)
-{
-    int k = 0;
-    const char *p = s;
-    while (k < n) {
-        char *end;
-        errno = 0;
-        v[k] = strtod(p, &end);
-        if (end == p || errno == ERANGE || !isfinite(v[k])) return -1;
-        k++;
-        if (*end == '\0') return k;
-        if (*end != ',') return -1;
-        p = end + 1;
-    }
-    return -1;
-}
-
-static int write_controller(const char *path, const br_ident_cfg_t *c)
+/* the machine file of docs/diagnose.md: the position loop of the log */
+static int write_machine(const char *path, const br_ident_cfg_t *c)
 {
     FILE *f = fopen(path, "w");
     if (!f) {
@@ -126,18 +119,19 @@ static int write_controller(const char *path, const br_ident_cfg_t *c)
         return -1;
     }
     fprintf(f,
-            "{\n  \"banner\": \"written by br_simlog (sim/apps/br_simlog.c); the position loop of the log\",\n"
-            "  \"type\": \"emps_pd\",\n  \"dt_s\": %.9g,\n  \"kp_1ps\": %.9g,\n  \"kv\": %.9g,\n"
-            "  \"gain_N\": %.9g,\n  \"u_max\": %.9g\n}\n",
+            "{\n  \"generator\": \"br_simlog (sim/apps/br_simlog.c); generated, do not edit\",\n"
+            "  \"name\": \"br_simlog identification run\",\n"
+            "  \"controller\": {\"type\": \"emps_pd\", \"dt_s\": %.9g, \"kp_1ps\": %.9g, \"kv\": %.9g, "
+            "\"gain_N\": %.9g, \"u_max\": %.9g}\n}\n",
             c->dt_s, c->pd.kp_1ps, c->pd.kv, c->pd.gain_N, c->pd.u_max);
     return fclose(f) == 0 ? 0 : -1;
 }
 
 int main(int argc, char **argv)
 {
-    const char *out = NULL, *traj = "ident", *model = NULL, *ctrl_out = NULL;
+    const char *out = NULL, *traj = "ident", *model = NULL, *machine_out = NULL;
     int cycles = 0, truth = 0;
-    double duration = 8.0, noise = 0.0, v[3];
+    double duration = 8.0, noise = 0.0;
     unsigned long long seed = 1;
     br_plant_cfg_t causes = br_plant_cfg_reference();
     int bad = 0;
@@ -153,37 +147,30 @@ int main(int argc, char **argv)
         }
         i++;
         char *end = NULL;
-        if (strcmp(a, "--out") == 0) out = val;
+        const int ca = br_cause_arg(a, val, &causes);
+        if (ca != 0) bad = ca < 0;
+        else if (strcmp(a, "--out") == 0) out = val;
         else if (strcmp(a, "--traj") == 0) traj = val;
         else if (strcmp(a, "--model") == 0) model = val;
-        else if (strcmp(a, "--controller-out") == 0) ctrl_out = val;
+        else if (strcmp(a, "--machine-out") == 0) machine_out = val;
         else if (strcmp(a, "--cycles") == 0) bad = !((cycles = atoi(val)) >= 1 && cycles <= 1000);
         else if (strcmp(a, "--seed") == 0) {
             seed = strtoull(val, &end, 10);
             bad = (end == val || *end != '\0');
-        } else if (strcmp(a, "--duration") == 0) bad = !(parse_list(val, &duration, 1) == 1 && duration > 0.0);
-        else if (strcmp(a, "--force-noise") == 0) bad = !(parse_list(val, &noise, 1) == 1 && noise >= 0.0);
-        else if (strcmp(a, "--offset") == 0) bad = parse_list(val, &causes.offset_N, 1) != 1;
-        else if (strcmp(a, "--gradient") == 0) bad = parse_list(val, &causes.grad_per_m, 1) != 1;
-        else if (strcmp(a, "--delay") == 0) bad = parse_list(val, &causes.delay_s, 1) != 1;
-        else if (strcmp(a, "--asym") == 0) {
-            bad = parse_list(val, v, 2) != 2;
-            causes.dFc_neg_N = v[0];
-            causes.dsigma2_neg_Nspm = v[1];
-        } else if (strcmp(a, "--ripple") == 0) {
-            const int k = parse_list(val, v, 3);
-            bad = k < 2;
-            causes.ripple_amp_N = v[0];
-            causes.ripple_period_m = v[1];
-            causes.ripple_phase_rad = k == 3 ? v[2] : 0.0;
-        } else bad = 1;
+        } else if (strcmp(a, "--duration") == 0) bad = !(br_parse_numbers(val, &duration, 1) == 1 && duration > 0.0);
+        else if (strcmp(a, "--force-noise") == 0) bad = !(br_parse_numbers(val, &noise, 1) == 1 && noise >= 0.0);
+        else bad = 1;
         if (bad) fprintf(stderr, "br_simlog: bad option or value: %s %s\n", a, val);
     }
     if (bad || !out || (strcmp(traj, "ident") != 0 && strcmp(traj, "circle") != 0)) return usage(argv[0]);
 
     /* the plant: the reference machine or a saved model, then the cause flags on top */
     br_plant_cfg_t plant = br_plant_cfg_reference();
-    if (model && br_plant_cfg_from_model_json(model, &plant, &plant) != 0) return 1;
+    char msg[512];
+    if (model && br_plant_cfg_from_model_json(model, &plant, &plant, msg, sizeof msg) != 0) {
+        fprintf(stderr, "br_simlog: %s\n", msg);
+        return 1;
+    }
     const br_plant_cfg_t ref = br_plant_cfg_reference();
     if (causes.offset_N != 0.0) plant.offset_N = causes.offset_N;
     if (causes.dFc_neg_N != ref.dFc_neg_N || causes.dsigma2_neg_Nspm != ref.dsigma2_neg_Nspm) {
@@ -210,7 +197,7 @@ int main(int argc, char **argv)
         br_ident_cfg_t c = br_ident_cfg_default(&plant);
         if (cycles > 0) c.cycles = cycles;
         rc = br_ident_run(&c, &plant, ident_sink, &o);
-        if (rc == 0 && ctrl_out) rc = write_controller(ctrl_out, &c);
+        if (rc == 0 && machine_out) rc = write_machine(machine_out, &c);
     } else {
         br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
         c.plant = plant;
@@ -219,7 +206,7 @@ int main(int argc, char **argv)
         circle_sink_t cs = {&o, plant.lead_mprad * 2.0 * BR_PI / plant.counts_per_rev,
                             plant.tau_per_duty_Nm / plant.lead_mprad};
         rc = br_circle_run(&c, circle_sink, &cs, &res);
-        if (rc == 0 && ctrl_out) fprintf(stderr, "br_simlog: --controller-out applies to --traj ident only\n");
+        if (rc == 0 && machine_out) fprintf(stderr, "br_simlog: --machine-out applies to --traj ident only\n");
     }
     if (fclose(o.f) != 0) rc = -1;
     if (rc != 0) {

@@ -37,6 +37,8 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     for (int i = 0; i < 3; i++) c.K[i] = K[i];
     c.pf = br_circle_pf_cfg_tuned((float)c.dt_s);
     c.ukf = br_circle_ukf_cfg_tuned((float)c.dt_s);
+    c.est_wrap = NULL;
+    c.est_wrap_user = NULL;
     return c;
 }
 
@@ -75,7 +77,7 @@ static br_ref_t axis_ref(const br_circle_cfg_t *c, double phase, double t, doubl
     return r;
 }
 
-static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
+static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, int axis, double phase)
 {
     a->phase = phase;
     a->pf = NULL;
@@ -125,6 +127,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
         fprintf(stderr, "br_circle: estimator init failed (status %d)\n", (int)st);
         return -1;
     }
+    if (c->est_wrap != NULL && est.step != NULL) est = c->est_wrap(c->est_wrap_user, axis, est);
     st = br_axis_init(&a->axis, &a->hal, &cc, est.step ? &est : NULL);
     if (st != BR_OK) {
         fprintf(stderr, "br_circle: controller init failed (status %d)\n", (int)st);
@@ -162,7 +165,7 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     ax[0].pf = ax[1].pf = NULL;
     ax[0].ukf = ax[1].ukf = NULL;
     int rc = -1;
-    if (axis_init(&ax[0], c, 0.0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI) != 0) goto done;
+    if (axis_init(&ax[0], c, 0, 0.0) != 0 || axis_init(&ax[1], c, 1, 0.5 * BR_PI) != 0) goto done;
     const long n = lround(c->duration_s / c->dt_s);
     double sum2 = 0.0, emax = 0.0, fe2 = 0.0;
     int nsat = 0, nout = 0;

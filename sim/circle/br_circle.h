@@ -33,6 +33,10 @@ typedef struct {
     float K[3];          /* state-feedback gains */
     br_pf_cfg_t pf;      /* BR_CTRL_HINF_PF: the filter (its model.dt_s must equal dt_s) */
     br_ukf_cfg_t ukf;    /* BR_CTRL_HINF_UKF: likewise */
+    /* Optional (NULL: none): replaces each axis's estimator by a wrapper around
+     * it, e.g. one that adds an extended model's causes (sim/extmodel/). */
+    br_est_t (*est_wrap)(void *user, int axis, br_est_t inner);
+    void *est_wrap_user;
 } br_circle_cfg_t;
 
 typedef struct {

@@ -29,10 +29,25 @@ br_plant_cfg_t br_plant_cfg_reference(void)
     c.counts_per_rev = BR_REF_COUNTS_PER_REV;
     c.tau_per_duty_Nm = BR_REF_TAU_PER_DUTY_NM;
     c.n_sub = 20;
+    /* causes off */
+    c.offset_N = 0.0;
+    c.dFc_neg_N = 0.0;
+    c.dsigma2_neg_Nspm = 0.0;
+    c.ripple_amp_N = 0.0;
+    c.ripple_period_m = 0.0;
+    c.ripple_phase_rad = 0.0;
+    c.grad_per_m = 0.0;
+    c.delay_s = 0.0;
     return c;
 }
 
 static double lugre_force(const br_plant_t *p);
+
+int br_plant_causes_on(const br_plant_cfg_t *c)
+{
+    return c->offset_N != 0.0 || c->dFc_neg_N != 0.0 || c->dsigma2_neg_Nspm != 0.0 || c->ripple_amp_N != 0.0 ||
+           c->grad_per_m != 0.0 || c->delay_s != 0.0;
+}
 
 static int bad(const char *what)
 {
@@ -59,31 +74,98 @@ int br_plant_init(br_plant_t *p, const br_plant_cfg_t *cfg, const br_plant_state
     if (!POS(cfg->tau_per_duty_Nm)) return bad("tau_per_duty_Nm (must be > 0)");
     if (cfg->n_sub < 1 || cfg->n_sub > 100000) return bad("n_sub (must be in 1..100000)");
     if (!isfinite(x0->theta_rad) || !isfinite(x0->omega_radps) || !isfinite(x0->z_m)) return bad("initial state");
+    /* causes */
+    if (!isfinite(cfg->offset_N)) return bad("offset_N (must be finite)");
+    if (!(isfinite(cfg->dFc_neg_N) && cfg->Fc_N + cfg->dFc_neg_N > 0.0)) return bad("dFc_neg_N (Fc_N + dFc_neg_N must be > 0)");
+    if (!(isfinite(cfg->dsigma2_neg_Nspm) && cfg->sigma2_Nspm + cfg->dsigma2_neg_Nspm >= 0.0))
+        return bad("dsigma2_neg_Nspm (sigma2_Nspm + dsigma2_neg_Nspm must be >= 0)");
+    if (!isfinite(cfg->ripple_amp_N)) return bad("ripple_amp_N (must be finite)");
+    if (!isfinite(cfg->ripple_phase_rad)) return bad("ripple_phase_rad (must be finite)");
+    if (!(isfinite(cfg->ripple_period_m) && (cfg->ripple_amp_N == 0.0 || cfg->ripple_period_m > 0.0)))
+        return bad("ripple_period_m (must be > 0 with a ripple)");
+    if (!isfinite(cfg->grad_per_m)) return bad("grad_per_m (must be finite)");
+    if (!(isfinite(cfg->delay_s) && cfg->delay_s >= 0.0 && cfg->delay_s <= BR_PLANT_DELAY_MAX_S))
+        return bad("delay_s (must be in 0..BR_PLANT_DELAY_MAX_S)");
     p->cfg = *cfg;
     p->x = *x0;
     /* eq. 1: effective inertia seen by the motor */
     p->Jeff_kgm2 = cfg->J_kgm2 + cfg->lead_mprad * cfg->lead_mprad * cfg->M_kg;
     p->tau_Nm = 0.0;
+    p->fdist_N = 0.0;
+    p->t_s = 0.0;
+    p->cmd_head = 0;
+    p->cmd_n = 0;
+    p->cmd_pushed = 0;
+    p->delay_overruns = 0;
     p->fnl_N = lugre_force(p);
     return 0;
 }
 
-/* eq. 5: Stribeck level */
+/* eq. 5: Stribeck level; in -x the whole curve is scaled by
+ * (Fc_N + dFc_neg_N) / Fc_N (dFc_neg_N = 0, symmetric friction, leaves the
+ * expression as it was) */
 static double stribeck_g(const br_plant_cfg_t *c, double v)
 {
-    return c->Fc_N + (c->Fs_N - c->Fc_N) * exp(-fabs(v) / c->vs_mps);
+    const double g = c->Fc_N + (c->Fs_N - c->Fc_N) * exp(-fabs(v) / c->vs_mps);
+    if (v < 0.0 && c->dFc_neg_N != 0.0) return g * ((c->Fc_N + c->dFc_neg_N) / c->Fc_N);
+    return g;
 }
 
-/* eq. 3 at the current state */
+/* position factor of the friction, k(x) = max(0, 1 + grad_per_m x) */
+static double grad_k(const br_plant_cfg_t *c, double x)
+{
+    return fmax(0.0, 1.0 + c->grad_per_m * x);
+}
+
+/* offset + ripple at load position x */
+static double dist_force(const br_plant_cfg_t *c, double x)
+{
+    double f = c->offset_N;
+    if (c->ripple_amp_N != 0.0) f += c->ripple_amp_N * sin(2.0 * BR_PI * x / c->ripple_period_m + c->ripple_phase_rad);
+    return f;
+}
+
+/* eq. 3 at the current state (times k(x) with a gradient) */
 static double lugre_force(const br_plant_t *p)
 {
     const br_plant_cfg_t *c = &p->cfg;
     const double v = c->lead_mprad * p->x.omega_radps;
     const double g = stribeck_g(c, v);
-    return c->sigma0_Npm * p->x.z_m + c->sigma1_Nspm * (v - c->sigma0_Npm * fabs(v) * p->x.z_m / g);
+    const double f = c->sigma0_Npm * p->x.z_m + c->sigma1_Nspm * (v - c->sigma0_Npm * fabs(v) * p->x.z_m / g);
+    if (c->grad_per_m != 0.0) return grad_k(c, c->lead_mprad * p->x.theta_rad) * f;
+    return f;
 }
 
-static void substep(br_plant_t *p, double tau, double h)
+/* Integral of the commanded torque over [a, b] (a < b), from the ring: each
+ * command holds from its t_s to the next one's (the newest: onwards). Before
+ * the first command the torque is 0; before the oldest kept one (history
+ * overrun) the oldest is used and the overrun is counted. */
+static double cmd_integral(br_plant_t *p, double a, double b)
+{
+    double s = 0.0, t_next = INFINITY;
+    int idx = p->cmd_head;
+    for (int i = 0; i < p->cmd_n; i++) {
+        const br_plant_cmd_t *e = &p->cmd[idx];
+        const double lo = fmax(a, e->t_s), hi = fmin(b, t_next);
+        if (hi > lo) s += e->tau_Nm * (hi - lo);
+        if (e->t_s <= a) return s;
+        t_next = e->t_s;
+        idx = (idx + BR_PLANT_DELAY_RING - 1) % BR_PLANT_DELAY_RING;
+    }
+    /* [a, oldest command) is left */
+    if (p->cmd_pushed > p->cmd_n && p->cmd_n > 0) {
+        const int oldest = (p->cmd_head + BR_PLANT_DELAY_RING - (p->cmd_n - 1)) % BR_PLANT_DELAY_RING;
+        s += p->cmd[oldest].tau_Nm * (fmin(b, t_next) - a);
+        p->delay_overruns++;
+    }
+    return s;
+}
+
+/* One substep of h with the mean torque tau over it. With the causes on
+ * (causes != 0): the viscous coefficient and g by the direction of the mean
+ * velocity, the friction impulse times k(x) and offset + ripple, both at the
+ * substep's mean position (midpoint rule, second order like the rest). */
+static void substep(br_plant_t *p, double tau, double h, int causes)
 {
     const br_plant_cfg_t *c = &p->cfg;
     const double L = c->lead_mprad;
@@ -106,8 +188,15 @@ static void substep(br_plant_t *p, double tau, double h)
             z1 = z0;
             zint = z0 * h;
         }
-        /* eq. 1 integrated over h: Jeff dw = tau h - L^2 sigma2 dtheta - L (sigma0 int z + sigma1 dz) (eq. 3) */
-        w1 = w0 + (tau * h - L * L * c->sigma2_Nspm * dth - L * (c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0))) / p->Jeff_kgm2;
+        if (causes) {
+            const double xm = L * (p->x.theta_rad + 0.5 * dth);
+            const double s2 = dth < 0.0 ? c->sigma2_Nspm + c->dsigma2_neg_Nspm : c->sigma2_Nspm;
+            const double fric = grad_k(c, xm) * (L * s2 * dth + c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0));
+            w1 = w0 + (tau * h - L * (fric + dist_force(c, xm) * h)) / p->Jeff_kgm2;
+        } else {
+            /* eq. 1 integrated over h: Jeff dw = tau h - L^2 sigma2 dtheta - L (sigma0 int z + sigma1 dz) (eq. 3) */
+            w1 = w0 + (tau * h - L * L * c->sigma2_Nspm * dth - L * (c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0))) / p->Jeff_kgm2;
+        }
         /* trapezoidal rule: mean velocity of the substep */
         wm = 0.5 * (w0 + w1);
     }
@@ -123,11 +212,34 @@ void br_plant_step(br_plant_t *p, double duty, double dt_s)
     double d = isfinite(duty) ? fmin(fmax(duty, -1.0), 1.0) : 0.0;
     double tau = d * c->tau_per_duty_Nm;
     double h = dt_s / c->n_sub;
-    for (int i = 0; i < c->n_sub; i++) {
-        substep(p, tau, h);
+    const int causes = br_plant_causes_on(c);
+    if (c->delay_s > 0.0) {
+        /* keep the command; each substep gets the mean of the delayed command over it */
+        p->cmd_head = (p->cmd_head + 1) % BR_PLANT_DELAY_RING;
+        p->cmd[p->cmd_head].t_s = p->t_s;
+        p->cmd[p->cmd_head].tau_Nm = tau;
+        if (p->cmd_n < BR_PLANT_DELAY_RING) p->cmd_n++;
+        p->cmd_pushed++;
+        const long over0 = p->delay_overruns;
+        double sum = 0.0;
+        for (int i = 0; i < c->n_sub; i++) {
+            const double ta = p->t_s + (double)i * h - c->delay_s;
+            const double ti = cmd_integral(p, ta, ta + h) / h;
+            sum += ti;
+            substep(p, ti, h, causes);
+        }
+        /* one overrun per step at most */
+        if (p->delay_overruns > over0) p->delay_overruns = over0 + 1;
+        tau = sum / c->n_sub;
+    } else {
+        for (int i = 0; i < c->n_sub; i++) {
+            substep(p, tau, h, causes);
+        }
     }
+    p->t_s += dt_s;
     p->tau_Nm = tau;
     p->fnl_N = lugre_force(p); /* eq. 3 at the end of the step */
+    if (causes) p->fdist_N = dist_force(c, br_plant_pos_m(p));
 }
 
 int32_t br_plant_encoder(const br_plant_t *p)

@@ -10,7 +10,18 @@
  * the displacement (bounded at any speed), the friction impulse is integrated
  * in closed form (sigma0 * integral of z, sigma1 * change of z), and the rigid
  * body uses the trapezoidal rule, solved by a fixed number of fixed-point
- * iterations on the mean velocity. */
+ * iterations on the mean velocity.
+ *
+ * Causes (../shared/spec/measured-log.md, docs/simlog.md): fields at the end
+ * of br_plant_cfg_t switch on what a measured log may show beyond the thesis
+ * model. All zero is the thesis model, bit for bit. With x = L theta the load
+ * position and k(x) = max(0, 1 + grad_per_m x):
+ *
+ *   (J + L^2 M) domega/dt = tau(t - delay_s)
+ *        - L [ k(x) (sigma2_d L omega + F_nl) + offset_N + ripple_amp_N sin(2 pi x / ripple_period_m + ripple_phase_rad) ]
+ *
+ * where, while the axis moves in -x, sigma2_d = sigma2_Nspm + dsigma2_neg_Nspm
+ * and the Stribeck curve g is scaled by (Fc_N + dFc_neg_N) / Fc_N. */
 #ifndef BR_SIM_PLANT_H
 #define BR_SIM_PLANT_H
 
@@ -22,7 +33,28 @@ typedef struct {
     double counts_per_rev;    /* encoder on the motor */
     double tau_per_duty_Nm;   /* amplifier gain */
     int n_sub;                /* substeps per step, >= 1 */
+    /* Causes (all 0 = off; the reference machine has them off). */
+    double offset_N;          /* constant load force, + opposes motion in +x (gravity on a tilted axis, cable drag) */
+    double dFc_neg_N;         /* asymmetric friction: Coulomb level in -x is Fc_N + dFc_neg_N (Fs scaled alike) */
+    double dsigma2_neg_Nspm;  /* asymmetric friction: viscous friction in -x is sigma2_Nspm + dsigma2_neg_Nspm */
+    double ripple_amp_N;      /* position ripple amplitude (screw lead error, recirculation, cogging) */
+    double ripple_period_m;   /* its period in load position, > 0 when ripple_amp_N != 0 */
+    double ripple_phase_rad;  /* its phase at x = 0 */
+    double grad_per_m;        /* friction (viscous + LuGre) scaled by max(0, 1 + grad_per_m x) along the travel */
+    double delay_s;           /* actuator dead time, 0 .. BR_PLANT_DELAY_MAX_S */
 } br_plant_cfg_t;
+
+/* Actuator delay: the commanded torques of the last BR_PLANT_DELAY_RING
+ * steps are kept; a delay longer than that history (delay_s beyond
+ * (BR_PLANT_DELAY_RING - 1) steps of dt) applies the oldest kept command and
+ * counts the step in br_plant_t.delay_overruns. */
+#define BR_PLANT_DELAY_MAX_S 0.1
+#define BR_PLANT_DELAY_RING 1024
+
+typedef struct {
+    double t_s;     /* start of the step the command was held over */
+    double tau_Nm;  /* commanded torque */
+} br_plant_cmd_t;
 
 typedef struct {
     double theta_rad, omega_radps, z_m;
@@ -32,8 +64,16 @@ typedef struct {
     br_plant_cfg_t cfg;
     br_plant_state_t x;
     double Jeff_kgm2;
-    double tau_Nm;     /* torque applied during the last step */
-    double fnl_N;      /* LuGre force at the end of the last step */
+    double tau_Nm;     /* torque applied during the last step (its mean with a delay) */
+    double fnl_N;      /* LuGre force at the end of the last step (direction level and k(x) included) */
+    /* Causes: bookkeeping (zero and unused while the causes are off). */
+    double fdist_N;    /* offset + ripple force at the end of the last step */
+    double t_s;        /* plant time: the sum of the steps taken */
+    br_plant_cmd_t cmd[BR_PLANT_DELAY_RING]; /* command history, a ring (delay_s > 0 only) */
+    int cmd_head;      /* index of the newest command */
+    int cmd_n;         /* commands kept, <= BR_PLANT_DELAY_RING */
+    long cmd_pushed;   /* commands ever pushed */
+    long delay_overruns; /* steps whose delayed command was older than the history */
 } br_plant_t;
 
 /* Reference machine of ../shared/spec/reference-machine.md. */
@@ -42,7 +82,9 @@ br_plant_cfg_t br_plant_cfg_reference(void);
 /* 0 on success, -1 on an invalid configuration (message on stderr). */
 int br_plant_init(br_plant_t *p, const br_plant_cfg_t *cfg, const br_plant_state_t *x0);
 
-/* Advances by dt_s with the duty held (zero-order hold). */
+/* Advances by dt_s with the duty held (zero-order hold); with delay_s > 0
+ * the torque reaching the axis is the command of delay_s earlier (zero before
+ * the first command). */
 void br_plant_step(br_plant_t *p, double duty, double dt_s);
 
 /* Encoder reading: floor(theta / rad_per_count), wrapped modulo 2^32. */
@@ -51,5 +93,8 @@ int32_t br_plant_encoder(const br_plant_t *p);
 /* Load-side position and velocity. */
 double br_plant_pos_m(const br_plant_t *p);
 double br_plant_vel_mps(const br_plant_t *p);
+
+/* 1 when any cause of the configuration is switched on. */
+int br_plant_causes_on(const br_plant_cfg_t *cfg);
 
 #endif

@@ -1,0 +1,179 @@
+"""Closed-loop re-simulation of a log: the fitted model as the plant, the
+log's position controller (when it is known), the log's reference as input.
+
+Controller file (JSON), type "emps_pd" (the EMPS loop, and br_simlog's
+identification loop, which writes it with --controller-out):
+
+  qf(k) = (q(k) + q(k-1)) / 2,  qdot(k) = (qf(k) - qf(k-1)) / dt
+  u = kp kv (ref - q) - kv qdot,  |u| <= u_max,  F = gain u
+
+keys: dt_s, kp_1ps, kv, gain_N, u_max.
+
+Plant, load side (model.py's force model as dynamics):
+
+  M dv/dt = F(t - d) - k(x) [Fv_d v + sigma0 z + sigma1 dz/dt] - offset - A sin(2 pi x / P + phase)
+
+integrated like the C plant (docs/modules/plant.md): N_SUB substeps per
+period; in each, z follows the exact displacement-domain solution with g
+held (bounded at any speed), the friction impulse is integrated in closed
+form, the rigid body by the trapezoidal rule with fixed-point passes on the
+mean velocity. The measured position q is the simulated one quantised to the
+log's resolution (the smallest position step found in the log), rounded
+down like an encoder count.
+"""
+import json
+import math
+
+import numpy as np
+
+N_SUB = 10
+PASSES = 3
+CONTROLLER_TYPES = ("emps_pd",)
+
+
+class ControllerError(ValueError):
+    pass
+
+
+def check_controller(c, where):
+    """Validates a controller description (a dict); where names it in messages."""
+    if not isinstance(c, dict) or c.get("type") not in CONTROLLER_TYPES:
+        raise ControllerError(f"{where}: \"type\" must be one of {', '.join(CONTROLLER_TYPES)}")
+    for k in ("dt_s", "kp_1ps", "kv", "gain_N", "u_max"):
+        v = c.get(k)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or (k != "kp_1ps" and v <= 0):
+            raise ControllerError(f"{where}: \"{k}\" must be a finite number" + ("" if k == "kp_1ps" else " > 0"))
+    return c
+
+
+def load_controller(path):
+    try:
+        with open(path, encoding="utf-8-sig") as f:
+            c = json.load(f)
+    except (OSError, json.JSONDecodeError) as e:
+        raise ControllerError(f"{path}: {e}") from None
+    return check_controller(c, path)
+
+
+def position_quantum(pos):
+    """The log's position resolution: the smallest nonzero step, if the
+    steps are whole multiples of it (an encoder), else 0 (no quantising)."""
+    d = np.abs(np.diff(pos))
+    d = d[d > 0]
+    if len(d) == 0:
+        return 0.0
+    q = float(d.min())
+    r = d / q
+    return q if np.mean(np.abs(r - np.round(r)) < 0.02) > 0.95 else 0.0
+
+
+def simulate(params, ctrl, ref, pos0, vel0):
+    """Runs the loop over len(ref) periods. Returns (q, force, x_true)."""
+    p = params
+    dt = float(ctrl["dt_s"])
+    kp, kv, gain, umax = (float(ctrl[k]) for k in ("kp_1ps", "kv", "gain_N", "u_max"))
+    M = p["M_kg"]
+    Fc = p["Fc_N"]
+    beta = p["Fs_N"] / Fc
+    vs = p["vs_mps"]
+    s0 = p["sigma0_Npm"]
+    s1 = p.get("sigma1_Nspm", 0.0)
+    Fv_p = p["Fv_Nspm"]
+    Fv_n = p.get("Fv_neg_Nspm", Fv_p)
+    c_neg = p.get("Fc_neg_N", Fc) / Fc
+    off = p.get("offset_N", 0.0)
+    ra, rp, rph = p.get("ripple_amp_N", 0.0), p.get("ripple_period_m", 1.0), p.get("ripple_phase_rad", 0.0)
+    grad = p.get("grad_per_m", 0.0)
+    delay = p.get("delay_s", 0.0)
+    quantum = ctrl.get("_quantum", 0.0)
+    h = dt / N_SUB
+    exp, expm1, fabs, sin, copysign = math.exp, math.expm1, math.fabs, math.sin, math.copysign
+    two_pi = 2.0 * math.pi
+
+    n = len(ref)
+    q_out = np.empty(n)
+    f_out = np.empty(n)
+    x_out = np.empty(n)
+    x, v = float(pos0), float(vel0)
+    z = copysign(Fc / s0, v) if v != 0.0 else 0.0
+    cmd = np.zeros(n)
+    dm = int(math.floor(delay / dt))
+    dfrac = delay / dt - dm
+
+    def quant(xx):  # an incremental encoder: whole counts below the position
+        return math.floor(xx / quantum + 1e-9) * quantum if quantum > 0 else xx
+
+    q_prev = qf_prev = quant(x)
+    for k in range(n):
+        q = quant(x)
+        qf = 0.5 * (q + q_prev)
+        qdot = (qf - qf_prev) / dt
+        q_prev, qf_prev = q, qf
+        u = kp * kv * (ref[k] - q) - kv * qdot
+        u = umax if u > umax else (-umax if u < -umax else u)
+        F = gain * u
+        cmd[k] = F
+        q_out[k], f_out[k], x_out[k] = q, F, x
+        for i in range(N_SUB):
+            # force reaching the axis over this substep: the command of delay earlier (ZOH)
+            if delay > 0.0:
+                ts = (i + 0.5) * h - dfrac * dt  # substep mid time minus the fractional part
+                j = k - dm + (-1 if ts < 0 else 0)
+                Fa = cmd[j] if j >= 0 else 0.0
+            else:
+                Fa = F
+            vm = v
+            for _ in range(PASSES):
+                dx = vm * h
+                gn = 1.0 + (beta - 1.0) * exp(-fabs(vm) / vs)
+                if dx < 0.0:
+                    gn *= c_neg
+                g = Fc * gn
+                if dx != 0.0:
+                    zss = copysign(g / s0, dx)
+                    r = s0 * fabs(dx) / g
+                    qq = -expm1(-r)
+                    z1 = z + (zss - z) * qq
+                    zint = h * (zss + (z - zss) * (qq / r if r > 1e-12 else 1.0 - 0.5 * r))
+                else:
+                    z1, zint = z, z * h
+                xm = x + 0.5 * dx
+                kx = max(0.0, 1.0 + grad * xm) if grad != 0.0 else 1.0
+                fv = Fv_n if dx < 0.0 else Fv_p
+                imp = kx * (fv * dx + s0 * zint + s1 * (z1 - z)) + off * h
+                if ra != 0.0:
+                    imp += ra * sin(two_pi * xm / rp + rph) * h
+                v1 = v + (Fa * h - imp) / M
+                vm = 0.5 * (v + v1)
+            x += dx
+            v, z = v1, z1
+    return q_out, f_out, x_out
+
+
+def resimulate(prep, params, ctrl):
+    """Re-simulates the whole log; relative errors (percent) of position,
+    velocity, acceleration and force against the measured ones; velocity,
+    acceleration (central differences of the low-passed positions) and force
+    compared after the diagnosis's low-pass (like the fit)."""
+    ctrl = dict(ctrl)
+    if abs(ctrl["dt_s"] - prep.dt) > 1e-6 * prep.dt:
+        raise ControllerError(f"controller period {ctrl['dt_s']} s differs from the log's {prep.dt:.6g} s")
+    ctrl["_quantum"] = position_quantum(prep.pos)
+    vel0 = (prep.pos[1] - prep.pos[0]) / prep.dt
+    q, f, _ = simulate(params, ctrl, prep.ref, prep.pos[0], vel0)
+    w = prep.whole
+    v_meas = np.gradient(prep.xf, prep.dt)
+    v_sim = np.gradient(prep.lp(q), prep.dt)
+    a_meas, a_sim = np.gradient(v_meas, prep.dt), np.gradient(v_sim, prep.dt)
+    f_meas, f_sim = prep.lp(prep.force), prep.lp(f)
+
+    def rel(a, b):
+        return 100.0 * float(np.linalg.norm((a - b)[w]) / np.linalg.norm(a[w]))
+
+    return {
+        "q": q, "force": f,
+        "relerr_position_percent": rel(prep.pos, q),
+        "relerr_velocity_percent": rel(v_meas, v_sim),
+        "relerr_acceleration_percent": rel(a_meas, a_sim),
+        "relerr_force_percent": rel(f_meas, f_sim),
+    }

@@ -1,0 +1,95 @@
+"""From a log to the quantities the force model is fitted on.
+
+Filter: a 4th-order Butterworth low-pass at FC_HZ (FC_MAX_FRAC of Nyquist at
+most), run forward and backward (zero phase), applied to the measured
+position and, identically, to the measured force ("parallel filtering": both
+sides of the fit see the same filter; relerr is computed on the filtered force).
+
+Each sample interval k (t_k .. t_k+1) is one equation: the force logged at
+t_k is held over it (zero-order hold, what a digital controller does), so
+
+  y_k  = filtered force at t_k
+  v_k  = (xf_k+1 - xf_k) / dt                 mean velocity over the interval
+  a_k  = (w_k+1 - w_k) / dt,  w_k = (xf_k+1 - xf_k-1) / (2 dt)
+                                              mean acceleration over the interval
+  xm_k = (xf_k + xf_k+1) / 2                  position of the interval
+
+with xf the filtered position. The first and last EDGE_S seconds (at least
+EDGE_MIN samples) are left out of every fit and error (filter transients).
+
+Held-out split: the fit uses the first TRAIN_FRAC of the remaining
+intervals; every relerr the report gives is measured on the rest, the last
+(1 - TRAIN_FRAC) of the log in time.
+"""
+import numpy as np
+from scipy import signal
+
+FC_HZ = 50.0
+FC_MAX_FRAC = 0.4
+ORDER = 4
+EDGE_S = 0.15
+EDGE_MIN = 50
+TRAIN_FRAC = 0.7
+
+
+class Prepared:
+    """Interval quantities of one log, the filter, and the train/held-out split."""
+
+    def __init__(self, log, fc_hz=FC_HZ, train_frac=TRAIN_FRAC):
+        self.path = log.path
+        self.dt = log.dt
+        self.fc_hz = min(fc_hz, FC_MAX_FRAC * 0.5 / log.dt)
+        self._b, self._a = signal.butter(ORDER, self.fc_hz / (0.5 / log.dt))
+        self.t = log.t
+        self.ref = log.ref
+        self.pos = log.pos
+        self.force = log.force
+        self.xf = self.lp(log.pos)
+        dt = log.dt
+        w = np.gradient(self.xf, dt)
+        self.v = np.diff(self.xf) / dt
+        self.a = np.diff(w) / dt
+        self.xm = 0.5 * (self.xf[1:] + self.xf[:-1])
+        self.dx = np.diff(log.pos)  # the measured path: the bristle state depends on it
+        self.y = self.lp(log.force)[:-1]
+        self.n = len(self.v)  # intervals
+        edge = max(EDGE_MIN, int(round(EDGE_S / dt)))
+        if self.n < 4 * edge + 100:
+            raise ValueError(f"{log.path}: {log.n} samples are too few for the diagnosis "
+                             f"(at least {4 * edge + 101} needed)")
+        self.lo, self.hi = edge, self.n - edge
+        self.split = self.lo + int(train_frac * (self.hi - self.lo))
+        self.train = slice(self.lo, self.split)
+        self.test = slice(self.split, self.hi)
+        self.whole = slice(self.lo, self.hi)
+        self.train_frac = train_frac
+
+    def lp(self, x):
+        """The zero-phase low-pass applied to every signal."""
+        return signal.filtfilt(self._b, self._a, x)
+
+    def y_delayed(self, delay_s):
+        """The filtered force that reaches the axis over each interval when the
+        logged (commanded) force is applied delay_s later: with zero-order
+        hold, the mean over interval k of the command delayed by
+        d = (m + f) dt is (1 - f) F[k-m] + f F[k-m-1]."""
+        if delay_s <= 0.0:
+            return self.y
+        m = int(np.floor(delay_s / self.dt))
+        f = delay_s / self.dt - m
+        F = self.force
+        prev = np.concatenate([np.full(m, F[0]), F])[: len(F)]
+        prev2 = np.concatenate([np.full(m + 1, F[0]), F])[: len(F)]
+        return self.lp((1.0 - f) * prev + f * prev2)[:-1]
+
+    def held_out_description(self):
+        t0, t1 = self.t[self.split], self.t[self.hi]
+        return (f"the last {100 * (1 - self.train_frac):.0f} % of the log in time, "
+                f"t = {t0:.3f} .. {t1:.3f} s ({self.hi - self.split} samples); the fit used "
+                f"t = {self.t[self.lo]:.3f} .. {t0:.3f} s")
+
+
+def relerr(y, e):
+    """100 ||e|| / ||y|| in percent."""
+    ny = float(np.linalg.norm(y))
+    return 100.0 * float(np.linalg.norm(e)) / ny if ny > 0 else float("inf")

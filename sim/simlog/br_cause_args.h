@@ -1,0 +1,21 @@
+/* The cause options of the simulator's command lines (br_simlog,
+ * br_circle_ext): docs/simlog.md.
+ *
+ *   --offset F           constant load force, N
+ *   --asym DFC,DFV       friction in -x: Coulomb (and stiction) + DFC N, viscous + DFV N s/m
+ *   --ripple A,P[,PH]    A sin(2 pi x / P + PH), N, m, rad
+ *   --gradient S         friction times (1 + S x), 1/m
+ *   --delay D            actuator dead time, s */
+#ifndef BR_CAUSE_ARGS_H
+#define BR_CAUSE_ARGS_H
+
+#include "plant/br_sim_plant.h"
+
+/* Parses "a[,b[,c]]" into up to n numbers: how many, or -1. */
+int br_parse_numbers(const char *s, double *v, int n);
+
+/* 1 when opt is a cause option and val was applied to c; 0 when opt is not a
+ * cause option; -1 (message on stderr) when val is malformed. */
+int br_cause_arg(const char *opt, const char *val, br_plant_cfg_t *c);
+
+#endif

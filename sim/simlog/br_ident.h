@@ -1,0 +1,68 @@
+/* Identification run on the simulator (docs/simlog.md): a repeated cycle of
+ * bang-bang-acceleration moves (trapezoidal velocity) over about 0.1 m at up
+ * to 0.05 m/s with dwells, like the EMPS benchmark's excitation, tracked by an
+ * EMPS-form position loop at the control period:
+ *
+ *   qf(k) = (q(k) + q(k-1)) / 2,  qdot(k) = (qf(k) - qf(k-1)) / dt
+ *   u = kp kv (ref - q) - kv qdot,  |u| <= u_max,  F = gain u   (force at the load)
+ *
+ * q is the encoder position at the load (quantised), F the commanded force,
+ * applied as duty F L / tau_per_duty over the next period. */
+#ifndef BR_IDENT_H
+#define BR_IDENT_H
+
+#include "plant/br_sim_plant.h"
+
+typedef struct {
+    double kp_1ps;   /* position gain, 1/s */
+    double kv;       /* velocity gain (controller units per m/s) */
+    double gain_N;   /* force per controller unit */
+    double u_max;    /* controller output limit (controller units) */
+} br_pd_cfg_t;
+
+typedef struct {
+    double x_to_m;    /* target of the move */
+    double v_max_mps; /* cruise speed */
+    double dwell_s;   /* rest after the move */
+} br_move_t;
+
+#define BR_IDENT_MAX_MOVES 16
+
+typedef struct {
+    double dt_s;       /* control period */
+    double acc_mps2;   /* acceleration of every move */
+    double dwell0_s;   /* rest before the first move */
+    int cycles;        /* repetitions of the move list */
+    int n_moves;
+    br_move_t moves[BR_IDENT_MAX_MOVES]; /* from x = 0 */
+    br_pd_cfg_t pd;
+} br_ident_cfg_t;
+
+/* One logged period: what a measured log holds, plus the plant's truth. */
+typedef struct {
+    double t_s, ref_m;
+    double pos_m;      /* encoder position at the load */
+    double force_N;    /* commanded force at the load (after the limit) */
+    double pos_true_m, vel_true_mps;
+    double fnl_N;      /* the plant's LuGre force */
+} br_log_row_t;
+
+typedef void (*br_log_sink_t)(void *user, const br_log_row_t *row);
+
+/* The default run for a plant: 1 ms, 0.5 m/s^2, 3 cycles of four moves
+ * (0 -> 0.1 m at 0.05 m/s, -> 0.04 at 0.03, -> 0.07 at 0.015, -> 0 at 0.04,
+ * 0.3 s dwells), and the EMPS loop scaled to the plant's moving mass (same
+ * kp and velocity-loop rate kv gain / m as EMPS: 160.18 1/s, 90 1/s). */
+br_ident_cfg_t br_ident_cfg_default(const br_plant_cfg_t *plant);
+
+/* Duration of the reference (all cycles), s. */
+double br_ident_duration_s(const br_ident_cfg_t *c);
+
+/* Reference position at t (before 0: 0; after the end: the last target). */
+double br_ident_ref_m(const br_ident_cfg_t *c, double t_s);
+
+/* Runs the loop on a plant starting at rest at x = 0; calls sink once per
+ * period (samples 0 .. duration/dt). 0, or -1 with a message on stderr. */
+int br_ident_run(const br_ident_cfg_t *c, const br_plant_cfg_t *plant, br_log_sink_t sink, void *user);
+
+#endif
