@@ -6,7 +6,7 @@
 #include "gen/br_ukf_tuned.h"
 #include "br_reference_machine.h"
 
-static br_model_cfg_t model_cfg(float dt_s)
+br_model_cfg_t br_ref_model_cfg(float dt_s)
 {
     br_model_cfg_t m;
     m.J_kgm2 = BR_REF_J_KGM2_F;
@@ -26,7 +26,7 @@ br_pf_cfg_t br_circle_pf_cfg_default(float dt_s)
 {
     const float rpc = BR_REF_RAD_PER_COUNT_F;
     br_pf_cfg_t c;
-    c.model = model_cfg(dt_s);
+    c.model = br_ref_model_cfg(dt_s);
     c.n_particles = 1500u;
     /* hand-tuned on the circle by a grid (docs/modules/pf.md) */
     c.q_var[BR_X_THETA] = 0.01f * rpc * rpc;
@@ -54,7 +54,7 @@ br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s)
 {
     const float rpc = BR_REF_RAD_PER_COUNT_F;
     br_ukf_cfg_t c;
-    c.model = model_cfg(dt_s);
+    c.model = br_ref_model_cfg(dt_s);
     /* the values of docs/modules/ukf.md (lightly hand-tuned) */
     c.q_var[BR_X_THETA] = 1.0e-14f;
     c.q_var[BR_X_OMEGA] = 1.0e-6f;

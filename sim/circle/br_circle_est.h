@@ -5,6 +5,9 @@
 #include "bristle/br_pf.h"
 #include "bristle/br_ukf.h"
 
+/* The eq. 6 estimation model of the reference machine at period dt_s. */
+br_model_cfg_t br_ref_model_cfg(float dt_s);
+
 /* The PF of thesis section 5 (1500 particles) at period dt_s, with the
  * hand-tuned noise variances: the start of the Nelder-Mead tuning. */
 br_pf_cfg_t br_circle_pf_cfg_default(float dt_s);

@@ -3,20 +3,10 @@
 #include "br_test.h"
 
 #include "br_reference_machine.h"
+#include "br_circle_est.h"
 #include "bristle/br_model.h"
 
-static br_model_cfg_t ref_cfg(float dt)
-{
-    br_model_cfg_t c;
-    c.J_kgm2 = BR_REF_J_KGM2_F;
-    c.M_kg = BR_REF_M_KG_F;
-    c.lead_mprad = BR_REF_LEAD_MPRAD_F;
-    c.sigma2_Nspm = BR_REF_SIGMA2_NSPM_F;
-    c.lugre = (br_lugre_cfg_t){BR_REF_SIGMA0_NPM_F, BR_REF_SIGMA1_NSPM_F, BR_REF_FC_N_F, BR_REF_FS_N_F,
-                               BR_REF_VS_MPS_F};
-    c.dt_s = dt;
-    return c;
-}
+static br_model_cfg_t ref_cfg(float dt) { return br_ref_model_cfg(dt); }
 
 static void test_init_guards(void **st)
 {

@@ -6,6 +6,7 @@
 
 #include "br_noise_table.h"
 #include "br_reference_machine.h"
+#include "br_circle_est.h"
 #include "bristle/br_pf.h"
 #include "plant/br_sim_plant.h"
 
@@ -14,13 +15,7 @@
 static br_pf_cfg_t cfg(uint32_t m)
 {
     br_pf_cfg_t c;
-    c.model.J_kgm2 = BR_REF_J_KGM2_F;
-    c.model.M_kg = BR_REF_M_KG_F;
-    c.model.lead_mprad = BR_REF_LEAD_MPRAD_F;
-    c.model.sigma2_Nspm = BR_REF_SIGMA2_NSPM_F;
-    c.model.lugre = (br_lugre_cfg_t){BR_REF_SIGMA0_NPM_F, BR_REF_SIGMA1_NSPM_F, BR_REF_FC_N_F, BR_REF_FS_N_F,
-                                     BR_REF_VS_MPS_F};
-    c.model.dt_s = 1.0e-3f;
+    c.model = br_ref_model_cfg(1.0e-3f);
     c.n_particles = m;
     c.q_var[0] = 0.01f * RPC * RPC;
     c.q_var[1] = 1.0e-5f;

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "br_hinf_gains.h"
+#include "br_circle_est.h"
 #include "br_reference_machine.h"
 #include "bristle/br_encoder.h"
 #include "bristle/br_ukf.h"
@@ -20,13 +21,7 @@
 static br_ukf_cfg_t ref_cfg(void)
 {
     br_ukf_cfg_t c;
-    c.model.J_kgm2 = BR_REF_J_KGM2_F;
-    c.model.M_kg = BR_REF_M_KG_F;
-    c.model.lead_mprad = BR_REF_LEAD_MPRAD_F;
-    c.model.sigma2_Nspm = BR_REF_SIGMA2_NSPM_F;
-    c.model.lugre = (br_lugre_cfg_t){BR_REF_SIGMA0_NPM_F, BR_REF_SIGMA1_NSPM_F, BR_REF_FC_N_F, BR_REF_FS_N_F,
-                                     BR_REF_VS_MPS_F};
-    c.model.dt_s = 1.0e-3f;
+    c.model = br_ref_model_cfg(1.0e-3f);
     c.q_var[BR_X_THETA] = 1.0e-14f;
     c.q_var[BR_X_OMEGA] = 1.0e-6f;
     c.q_var[BR_X_Z] = 1.0e-15f;
