@@ -305,3 +305,35 @@ void br_errstat_print(const br_errstat_t *s, const br_trace_t *t, const char *tr
                   "n = %ld, fails = %ld\n",
                   trace, s->name, s->max_err, s->unit, ml, s->max_ratio, rl, s->n, s->n_fail);
 }
+
+br_model_cfg_t br_trace_model_cfg(const br_trace_t *t)
+{
+    br_model_cfg_t m;
+    m.J_kgm2 = (float)br_trace_meta_num(t, "J_kgm2");
+    m.M_kg = (float)br_trace_meta_num(t, "M_kg");
+    m.lead_mprad = (float)br_trace_meta_num(t, "L_mprad");
+    m.sigma2_Nspm = (float)br_trace_meta_num(t, "sigma2_Nspm");
+    m.lugre.sigma0_Npm = (float)br_trace_meta_num(t, "sigma0_Npm");
+    m.lugre.sigma1_Nspm = (float)br_trace_meta_num(t, "sigma1_Nspm");
+    m.lugre.Fc_N = (float)br_trace_meta_num(t, "Fc_N");
+    m.lugre.Fs_N = (float)br_trace_meta_num(t, "Fs_N");
+    m.lugre.vs_mps = (float)br_trace_meta_num(t, "vs_mps");
+    m.dt_s = (float)br_trace_meta_num(t, "dt_s");
+    return m;
+}
+
+br_trace_est_common_t br_trace_est_common(const br_trace_t *t)
+{
+    br_trace_est_common_t e;
+    double q[4];
+    br_trace_meta_nums(t, "q_var", q, 4);
+    for (int i = 0; i < 4; i++) e.q_var[i] = (float)q[i];
+    e.r_var_rad2 = (float)br_trace_meta_num(t, "r_var_rad2");
+    e.gp0_N = (float)br_trace_meta_num(t, "gp0_N");
+    e.gp_min_N = (float)br_trace_meta_num(t, "gp_min_N");
+    e.gp_max_N = (float)br_trace_meta_num(t, "gp_max_N");
+    e.outlier_sigma = (float)br_trace_meta_num(t, "outlier_sigma");
+    e.reanchor_after = (uint32_t)br_trace_meta_num(t, "reanchor_after");
+    e.rad_per_count = (float)br_trace_meta_num(t, "rad_per_count");
+    return e;
+}

@@ -11,6 +11,9 @@
 #define BR_TRACE_READER_H
 
 #include <stddef.h>
+#include <stdint.h>
+
+#include "bristle/br_model.h"
 
 #define BR_TRACE_MAX_COLS 32
 #define BR_TRACE_MAX_META 64
@@ -64,5 +67,16 @@ int br_errstat_add(br_errstat_t *s, const br_trace_t *t, int row, double actual,
                    double expected, double tol);
 /* Prints "golden <trace>: <name> max |err| = ... (row, line), max err/tol = ...". */
 void br_errstat_print(const br_errstat_t *s, const br_trace_t *t, const char *trace);
+
+/* The eq. 6 model configuration recorded in a trace's metadata (J_kgm2, M_kg,
+ * L_mprad, sigma2_Nspm, sigma0_Npm, sigma1_Nspm, Fc_N, Fs_N, vs_mps, dt_s). */
+br_model_cfg_t br_trace_model_cfg(const br_trace_t *t);
+
+/* The configuration fields the PF and the UKF share, from a trace's metadata. */
+typedef struct {
+    float q_var[4], r_var_rad2, gp0_N, gp_min_N, gp_max_N, outlier_sigma, rad_per_count;
+    uint32_t reanchor_after;
+} br_trace_est_common_t;
+br_trace_est_common_t br_trace_est_common(const br_trace_t *t);
 
 #endif

@@ -18,30 +18,8 @@
 #define PI_D 3.14159265358979323846
 
 /* The defaults of docs/modules/ukf.md for the reference machine at 1 ms. */
-static br_ukf_cfg_t ref_cfg(void)
-{
-    br_ukf_cfg_t c;
-    c.model = br_ref_model_cfg(1.0e-3f);
-    c.q_var[BR_X_THETA] = 1.0e-14f;
-    c.q_var[BR_X_OMEGA] = 1.0e-6f;
-    c.q_var[BR_X_Z] = 1.0e-15f;
-    c.q_var[BR_X_GP] = 0.05f;
-    c.r_var_rad2 = 4.0f * RPC_F * RPC_F / 12.0f; /* 4 x the quantisation variance */
-    c.gp0_N = 12.0f;
-    c.p0_var[BR_X_THETA] = RPC_F * RPC_F;
-    c.p0_var[BR_X_OMEGA] = 1.0e-4f;
-    c.p0_var[BR_X_Z] = 1.0e-12f;
-    c.p0_var[BR_X_GP] = 25.0f;
-    c.gp_min_N = 1.0f;
-    c.gp_max_N = 40.0f;
-    c.outlier_sigma = 50.0f;
-    c.reanchor_after = 3u;
-    c.rad_per_count = RPC_F;
-    c.alpha = 1.0f;
-    c.beta = 2.0f;
-    c.kappa = 0.0f;
-    return c;
-}
+/* the hand-tuned UKF of the circle experiment (docs/modules/ukf.md) at 1 ms */
+static br_ukf_cfg_t ref_cfg(void) { return br_circle_ukf_cfg_default(1.0e-3f); }
 
 static int init_with(br_ukf_cfg_t c)
 {
