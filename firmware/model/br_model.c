@@ -1,6 +1,7 @@
 /* Four-state estimation model (thesis eq. 6) and its discretisation, float32.
  * See br_model.h and docs/modules/model.md. */
 #include "bristle/br_model.h"
+#include "bristle/br_model_kernel.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -36,66 +37,27 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
     return BR_OK;
 }
 
-/* eq. 4 with g = g_p: load-side bristle rate */
-static float model_zdot(const br_model_t *m, const float x[BR_NX])
-{
-    const br_lugre_cfg_t *c = &m->cfg.lugre;
-    float v = m->cfg.lead_mprad * x[BR_X_OMEGA];
-    return br_lugre_zdot_mps(c, x[BR_X_Z], v, x[BR_X_GP]);
-}
-
 float br_model_fnl_N(const br_model_t *m, const float x[BR_NX])
 {
-    /* eq. 6: f_nl = sigma0 z + sigma1 dz/dt */
-    return br_lugre_force_N(&m->cfg.lugre, x[BR_X_Z], model_zdot(m, x));
+    const br_model_k_t k = br_model_k(m);
+    /* eq. 6: f_nl = sigma0 z + sigma1 dz/dt, dz/dt from eq. 4 with g = g_p */
+    return br_model_k_fnl(&k, x[BR_X_Z], br_model_k_zdot(&k, x[BR_X_OMEGA], x[BR_X_Z], x[BR_X_GP]));
 }
 
 void br_model_deriv(const br_model_t *m, const float x[BR_NX], float u_Nm, float dx[BR_NX])
 {
-    float L = m->cfg.lead_mprad;
-    float zdot = model_zdot(m, x);
-    float fnl = br_lugre_force_N(&m->cfg.lugre, x[BR_X_Z], zdot);
+    const br_model_k_t k = br_model_k(m);
+    const float zdot = br_model_k_zdot(&k, x[BR_X_OMEGA], x[BR_X_Z], x[BR_X_GP]);
     /* eq. 6: theta' = omega; omega' = (u - L (sigma2 L omega + f_nl)) / Jeff; z' = eq. 4; g_p' = 0 */
     dx[BR_X_THETA] = x[BR_X_OMEGA];
-    dx[BR_X_OMEGA] = (u_Nm - m->visc_Nmsprad * x[BR_X_OMEGA] - L * fnl) * m->inv_Jeff;
+    dx[BR_X_OMEGA] = br_model_k_omega_dot(&k, x[BR_X_OMEGA], br_model_k_fnl(&k, x[BR_X_Z], zdot), u_Nm);
     dx[BR_X_Z] = zdot;
     dx[BR_X_GP] = 0.0f;
 }
 
-/* a h = sigma0 L |omega| h / g_p <= BR_MODEL_RK4_AH_MAX, without a division:
- * sigma0 L |omega| h <= BR_MODEL_RK4_AH_MAX g_p (g_p > 0) */
-static int rk4_stable(const br_model_t *m, float omega, float g_p)
-{
-    return m->cfg.lugre.sigma0_Npm * m->cfg.lead_mprad * fabsf(omega) * m->cfg.dt_s <= BR_MODEL_RK4_AH_MAX * g_p;
-}
-
-static void rk4_step(const br_model_t *m, const float x[BR_NX], float u, float out[BR_NX])
-{
-    float h = m->cfg.dt_s;
-    float k1[BR_NX], k2[BR_NX], k3[BR_NX], k4[BR_NX], xs[BR_NX];
-    int i;
-    /* classic RK4 on eq. 6 */
-    br_model_deriv(m, x, u, k1);
-    for (i = 0; i < BR_NX; i++) {
-        xs[i] = x[i] + 0.5f * h * k1[i];
-    }
-    br_model_deriv(m, xs, u, k2);
-    for (i = 0; i < BR_NX; i++) {
-        xs[i] = x[i] + 0.5f * h * k2[i];
-    }
-    br_model_deriv(m, xs, u, k3);
-    for (i = 0; i < BR_NX; i++) {
-        xs[i] = x[i] + h * k3[i];
-    }
-    br_model_deriv(m, xs, u, k4);
-    for (i = 0; i < BR_NX; i++) {
-        out[i] = x[i] + (h / 6.0f) * (k1[i] + 2.0f * k2[i] + 2.0f * k3[i] + k4[i]);
-    }
-}
-
 /* Bounded scheme: z exact over the displacement (eq. 4 with g_p held), friction
  * impulse in closed form, trapezoidal rigid body solved by fixed-point passes. */
-static void bounded_step(const br_model_t *m, const float x[BR_NX], float u, float out[BR_NX])
+void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u, float out[BR_NX])
 {
     const br_lugre_cfg_t *c = &m->cfg.lugre;
     float h = m->cfg.dt_s;
@@ -157,10 +119,10 @@ br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm,
         copy_state(x, x_next);
         return BR_E_INPUT;
     }
-    rk4_step(m, x, u_Nm, tmp);
+    const br_model_k_t k = br_model_k(m);
     /* RK4 only where both ends of the step are inside its stability region. */
-    if (!(rk4_stable(m, x[BR_X_OMEGA], x[BR_X_GP]) && rk4_stable(m, tmp[BR_X_OMEGA], x[BR_X_GP]))) {
-        bounded_step(m, x, u_Nm, tmp);
+    if (!br_model_k_rk4(&k, x, u_Nm, tmp)) {
+        br_model_bounded_step(m, x, u_Nm, tmp);
     }
     if (!all_finite(tmp)) {
         copy_state(x, x_next);

@@ -7,6 +7,7 @@
 
 #include "bristle/br_encoder.h"
 #include "bristle/br_math.h"
+#include "bristle/br_model_kernel.h"
 
 /* W of a particle of weight 1 (the best one after the max-shift) */
 #define BR_PF_W_ONE (1u << BR_PF_W_BITS)
@@ -81,7 +82,7 @@ static void estimate_current(br_pf_t *pf, float ess)
     for (uint32_t j = 0; j < m; j++) {
         float xj[BR_NX];
         for (int i = 0; i < BR_NX; i++) {
-            xj[i] = pf->x[i][j];
+            xj[i] = pf->x[j][i];
             s[i] += xj[i];
         }
         /* thesis estimate: the mean of f_nl (eq. 6) over the particles */
@@ -103,9 +104,9 @@ static void prime(br_pf_t *pf, const br_meas_t *y)
     const float mean[BR_NX] = {y->frac * pf->cfg.rad_per_count, 0.0f, 0.0f, pf->cfg.gp0_N};
     for (uint32_t j = 0; j < m; j++) {
         for (uint32_t i = 0; i < BR_NX; i++) {
-            pf->x[i][j] = mean[i] + pf->cfg.x0_std[i] * noise_at(pf, j, i);
+            pf->x[j][i] = mean[i] + pf->cfg.x0_std[i] * noise_at(pf, j, i);
         }
-        pf->x[BR_X_GP][j] = clampf(pf->x[BR_X_GP][j], pf->cfg.gp_min_N, pf->cfg.gp_max_N);
+        pf->x[j][BR_X_GP] = clampf(pf->x[j][BR_X_GP], pf->cfg.gp_min_N, pf->cfg.gp_max_N);
     }
     noise_advance(pf);
     pf->origin_counts = y->counts;
@@ -114,46 +115,194 @@ static void prime(br_pf_t *pf, const br_meas_t *y)
     estimate_current(pf, (float)m);
 }
 
-br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
+/* Systematic resampling on integer weights with a known total, 0 < total and
+ * 2 total < 2^32 (W_j <= 2^16 and m <= BR_PF_MAX_PARTICLES < 2^15).
+ * xi_i = (i + 1/2)/m on the integer scale: t_i = floor((2 i + 1) C_m / (2 m));
+ * particle j is picked while C_{j-1} <= t_i < C_j (C inclusive running sums).
+ * t_i is stepped exactly as quotient and remainder of (2 i + 1) C_m by 2 m:
+ * two divisions in all instead of one per particle. */
+static void resample(const uint32_t *W, uint32_t m, uint32_t total, uint16_t *idx)
 {
-    if (W == NULL || idx == NULL) {
-        return BR_E_NULL;
-    }
-    if (m < 1u || m > 65535u) {
-        return BR_E_PARAM;
-    }
-    uint64_t total = 0u;
-    for (uint32_t j = 0; j < m; j++) {
-        total += W[j];
-    }
-    if (total == 0u) {
-        return BR_E_INPUT;
-    }
-    /* xi_i = (i + 1/2)/m on the integer scale: t_i = floor((2 i + 1) C_m / (2 m));
-     * particle j is picked while C_{j-1} <= t_i < C_j (C inclusive running sums).
-     * t_i is stepped exactly as quotient and remainder of (2 i + 1) C_m by 2 m:
-     * two divisions in all instead of one per particle. */
-    const uint64_t den = 2u * (uint64_t)m;
-    const uint64_t dq = (2u * total) / den, dr = (2u * total) % den;
-    uint64_t t = total / den, r = total % den;
-    uint32_t j = 0u;
-    uint64_t c = W[0];
+    const uint32_t den = 2u * m;
+    const uint32_t dq = (2u * total) / den, dr = (2u * total) % den;
+    uint32_t t = total / den, r = total % den;
+    uint32_t j = 0u, c = W[0];
     for (uint32_t i = 0; i < m; i++) {
-        if (i > 0u) {
-            t += dq;
-            r += dr;
-            if (r >= den) {
-                t++;
-                r -= den;
-            }
-        }
         while (c <= t && j + 1u < m) {
             j++;
             c += W[j];
         }
         idx[i] = (uint16_t)j;
+        /* t_{i+1} = t_i + dq, plus 1 when the remainder carries */
+        t += dq;
+        r += dr;
+        if (r >= den) {
+            t++;
+            r -= den;
+        }
     }
+}
+
+br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
+{
+    if (W == NULL || idx == NULL) {
+        return BR_E_NULL;
+    }
+    if (m < 1u || m > BR_PF_MAX_PARTICLES) {
+        return BR_E_PARAM;
+    }
+    uint32_t total = 0u;
+    for (uint32_t j = 0; j < m; j++) {
+        if (W[j] > BR_PF_W_ONE) {
+            return BR_E_PARAM;
+        }
+        total += W[j];
+    }
+    if (total == 0u) {
+        return BR_E_INPUT;
+    }
+    resample(W, m, total, idx);
     return BR_OK;
+}
+
+/* Steps 1 and 2 for every particle: prediction into xp, f_nl, log-weight.
+ * Returns the number of valid (finite) predicted particles and their largest
+ * log-weight in *lmax. */
+static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, float *lmax)
+{
+    /* the model's constants and the loop's invariants, held in registers */
+    const br_model_k_t mk = br_model_k(&pf->model);
+    const float q0 = pf->q_std[0], q1 = pf->q_std[1], q2 = pf->q_std[2], q3 = pf->q_std[3];
+    const float gp_min = pf->cfg.gp_min_N, gp_max = pf->cfg.gp_max_N, inv_2r = pf->inv_2r;
+    const float *const noise = pf->cfg.noise;
+    const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
+    uint32_t pos = pf->noise_pos, n_valid = 0u;
+    float lm = -INFINITY;
+
+    for (uint32_t j = 0; j < m; j++, pos += BR_NX) {
+        const float *const xj = pf->x[j];
+        float *const xo = pf->xp[j];
+        /* 1. predict: eq. 6 discretised as br_model_step (RK4, or the bounded scheme
+         * beyond its a h limit); the particles are finite with g_p >= gp_min > 0.
+         * xn stays in registers; only the rare bounded step goes through memory. */
+        float xn[BR_NX];
+        if (!br_model_k_rk4(&mk, xj, u_prev_Nm, xn)) {
+            float xb[BR_NX];
+            br_model_bounded_step(&pf->model, xj, u_prev_Nm, xb);
+            for (int i = 0; i < BR_NX; i++) {
+                xn[i] = xb[i];
+            }
+        }
+        /* process noise: the next BR_NX standard-normal samples of the ROM table,
+         * read in one block unless they wrap round its end */
+        float n0, n1, n2, n3;
+        const uint32_t p0 = pos & mask;
+        if (p0 + (BR_NX - 1u) <= mask) {
+            n0 = noise[p0];
+            n1 = noise[p0 + 1u];
+            n2 = noise[p0 + 2u];
+            n3 = noise[p0 + 3u];
+        } else {
+            n0 = noise[p0];
+            n1 = noise[(pos + 1u) & mask];
+            n2 = noise[(pos + 2u) & mask];
+            n3 = noise[(pos + 3u) & mask];
+        }
+        const float th = xn[BR_X_THETA] + q0 * n0 - shift;
+        const float om = xn[BR_X_OMEGA] + q1 * n1;
+        const float z = xn[BR_X_Z] + q2 * n2;
+        const float gp = clampf(xn[BR_X_GP] + q3 * n3, gp_min, gp_max);
+        /* eq. 6: f_nl of the predicted particle */
+        const float fnl = br_model_k_fnl(&mk, z, br_model_k_zdot(&mk, om, z, gp));
+        /* Validity: x - x is 0 for finite x and NaN otherwise. g_p is finite after
+         * the clamp; a non-finite omega or z makes f_nl non-finite (inf - inf,
+         * 0 * inf or inf in eqs. 3-4), so theta and f_nl tell all four states. */
+        if ((th - th) + (fnl - fnl) == 0.0f) {
+            xo[BR_X_THETA] = th;
+            xo[BR_X_OMEGA] = om;
+            xo[BR_X_Z] = z;
+            xo[BR_X_GP] = gp;
+            pf->fnl[j] = fnl;
+            /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R) */
+            const float e = th - y_rel;
+            const float l = -(e * e) * inv_2r;
+            pf->l[j] = l;
+            lm = fmaxf(lm, l);
+            n_valid++;
+        } else {
+            /* unusable: the particle keeps its state and gets weight 0 */
+            for (int i = 0; i < BR_NX; i++) {
+                xo[i] = xj[i];
+            }
+            pf->fnl[j] = 0.0f;
+            pf->l[j] = -INFINITY;
+        }
+    }
+    *lmax = lm;
+    return n_valid;
+}
+
+/* Step 3: max-shifted weights w_j = e^(l_j - lmax), quantised to W_j (an invalid
+ * particle has l_j = -inf and gets e^-inf = 0); on an outlier every valid particle
+ * gets w = 1. Returns the total of W; *sw and *sw2 get the sums of w and w^2
+ * (for the ESS). */
+static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw, float *sw2)
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const float *const l = pf->l;
+    uint32_t *const W = pf->W;
+    uint32_t total = 0u;
+    float s1 = 0.0f, s2 = 0.0f;
+    if (outlier) {
+        for (uint32_t j = 0; j < m; j++) {
+            const float w = (l[j] > -INFINITY) ? 1.0f : 0.0f;
+            W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
+            total += W[j];
+            s1 += w;
+            s2 += w * w;
+        }
+    } else {
+        for (uint32_t j = 0; j < m; j++) {
+            const float w = br_exp_neg(l[j] - lmax);
+            W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
+            total += W[j];
+            s1 += w;
+            s2 += w * w;
+        }
+    }
+    *sw = s1;
+    *sw2 = s2;
+    return total;
+}
+
+/* Step 4's copy and step 5's sums: x_i <- xp_{idx_i}; s gets the sums of the
+ * states, the return value the sum of f_nl over the resampled set. */
+static float copy_resampled(br_pf_t *pf, float s[BR_NX])
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const uint16_t *const idx = pf->idx;
+    float(*const xp)[BR_NX] = pf->xp; /* read only */
+    const float *const fnl = pf->fnl;
+    float(*const x)[BR_NX] = pf->x;
+    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
+    for (uint32_t j = 0; j < m; j++) {
+        const uint32_t k = idx[j];
+        const float a = xp[k][0], b = xp[k][1], c = xp[k][2], d = xp[k][3];
+        x[j][0] = a;
+        x[j][1] = b;
+        x[j][2] = c;
+        x[j][3] = d;
+        s0 += a;
+        s1 += b;
+        s2 += c;
+        s3 += d;
+        sf += fnl[k];
+    }
+    s[0] = s0;
+    s[1] = s1;
+    s[2] = s2;
+    s[3] = s3;
+    return sf;
 }
 
 br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
@@ -176,37 +325,8 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     /* new integer origin: theta_j is re-expressed relative to y.counts */
     const float shift = (float)br_counts_delta(y->counts, pf->origin_counts) * rpc;
     const float y_rel = y->frac * rpc;
-    float lmax = -INFINITY;
-    uint32_t n_valid = 0u;
-
-    for (uint32_t j = 0; j < m; j++) {
-        float xj[BR_NX], xn[BR_NX];
-        for (int i = 0; i < BR_NX; i++) {
-            xj[i] = pf->x[i][j];
-        }
-        /* 1. predict: eq. 6 discretised (br_model_step), then process noise from the ROM table */
-        br_status_t st = br_model_step(&pf->model, xj, u_prev_Nm, xn);
-        for (uint32_t i = 0; i < BR_NX; i++) {
-            xn[i] += pf->q_std[i] * noise_at(pf, j, i);
-        }
-        xn[BR_X_GP] = clampf(xn[BR_X_GP], pf->cfg.gp_min_N, pf->cfg.gp_max_N);
-        xn[BR_X_THETA] -= shift;
-        int valid = (st == BR_OK) && isfinite(xn[0]) && isfinite(xn[1]) && isfinite(xn[2]) && isfinite(xn[3]);
-        float fnl = valid ? br_model_fnl_N(&pf->model, xn) : 0.0f;
-        valid = valid && isfinite(fnl);
-        for (int i = 0; i < BR_NX; i++) {
-            pf->xp[i][j] = valid ? xn[i] : xj[i];
-        }
-        pf->fnl[j] = fnl;
-        /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R) */
-        const float e = xn[BR_X_THETA] - y_rel;
-        const float l = valid ? -(e * e) * pf->inv_2r : -INFINITY;
-        pf->l[j] = l;
-        if (valid) {
-            n_valid++;
-            lmax = fmaxf(lmax, l);
-        }
-    }
+    float lmax;
+    const uint32_t n_valid = predict_and_weigh(pf, u_prev_Nm, shift, y_rel, &lmax);
     noise_advance(pf);
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
@@ -214,32 +334,14 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     const br_status_t verdict = (lmax < pf->outlier_l) ? BR_E_OUTLIER : BR_OK;
 
     /* 3. max-shifted weights, quantised; an outlier gives every valid particle weight 1 */
-    float sw = 0.0f, sw2 = 0.0f;
-    for (uint32_t j = 0; j < m; j++) {
-        float w;
-        if (!(pf->l[j] > -INFINITY)) {
-            w = 0.0f;
-        } else if (verdict == BR_E_OUTLIER) {
-            w = 1.0f;
-        } else {
-            w = br_exp_neg(pf->l[j] - lmax);
-        }
-        pf->W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
-        sw += w;
-        sw2 += w * w;
-    }
-    /* 4. deterministic systematic resampling on the integer weights */
-    (void)br_pf_resample_idx(pf->W, m, pf->idx);
+    float sw, sw2;
+    const uint32_t total = quantise_weights(pf, lmax, verdict == BR_E_OUTLIER, &sw, &sw2);
+    /* 4. deterministic systematic resampling on the integer weights (total >= 2^16:
+     * the best valid particle has W = 2^16) */
+    resample(pf->W, m, total, pf->idx);
     /* 5. estimate over the resampled set: particle mean and the mean of f_nl (eq. 6) */
-    float s[BR_NX] = {0.0f, 0.0f, 0.0f, 0.0f}, sf = 0.0f;
-    for (uint32_t j = 0; j < m; j++) {
-        const uint32_t k = pf->idx[j];
-        for (int i = 0; i < BR_NX; i++) {
-            pf->x[i][j] = pf->xp[i][k];
-            s[i] += pf->x[i][j];
-        }
-        sf += pf->fnl[k];
-    }
+    float s[BR_NX];
+    float sf = copy_resampled(pf, s);
     const float inv_m = 1.0f / (float)m;
     pf->n_outliers = (verdict == BR_E_OUTLIER) ? pf->n_outliers + 1u : 0u;
     if (pf->n_outliers >= pf->cfg.reanchor_after) {
@@ -250,10 +352,10 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
             float xj[BR_NX];
-            pf->x[BR_X_THETA][j] += d_th;
-            pf->x[BR_X_OMEGA][j] += d_om;
+            pf->x[j][BR_X_THETA] += d_th;
+            pf->x[j][BR_X_OMEGA] += d_om;
             for (int i = 0; i < BR_NX; i++) {
-                xj[i] = pf->x[i][j];
+                xj[i] = pf->x[j][i];
             }
             /* f_nl depends on omega: the estimate is that of the moved cloud */
             sf += br_model_fnl_N(&pf->model, xj);

@@ -8,7 +8,9 @@
 # time advances by exactly 1 ns per executed instruction and 1 tick = 40
 # instructions, which a calibration loop of 2e6 known instructions checks on
 # every run. Two particle counts separate the per-particle slope from the
-# fixed per-period cost.
+# fixed per-period cost. A third, short run (20 periods, m_hi) with QEMU's
+# translation-block log gives the profile: instructions per particle-step by
+# function and by block (hal/mps2/tb_profile.py).
 set -euo pipefail
 host=$1 cm7=$2 out=$3
 qemu=${BR_QEMU:-qemu-system-arm}
@@ -51,6 +53,16 @@ BEGIN {
   printf "  budget: half of 480 MHz x 1.5 ms = 360000 cycles / 1500 particles = 240 per particle-step, fixed part included\n"
   printf "  operation-count lower bound per particle-step: about 190 instructions (docs/target.md)\n"
 }'
+
+# Profile: a 0.03 s stream (20 periods), one execution trace, then the log is deleted.
+"$host/tests/target/br_replay_record" --out "$out/stream_prof.bin" --duration 0.03 >/dev/null
+"$qemu" -M mps2-an500 -nographic -monitor none -serial none -icount shift=0 \
+  -semihosting-config "enable=on,target=native,arg=replay,arg=$out/stream_prof.bin,arg=$out/target_prof.bin,arg=$m_hi" \
+  -kernel "$image" -d in_asm,exec,nochain -D "$out/qemu_prof.log" >/dev/null 2>&1
+read -r n_prof _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_prof.bin")
+"${BR_PYTHON:-python3}" "$(dirname "$0")/tb_profile.py" "$out/qemu_prof.log" "$image" \
+  --particle-steps $(( (n_prof - 1) * m_hi )) --skip main  # main: the calibration loop
+rm -f "$out/qemu_prof.log"
 
 # Memory from the map file: output sections in CODE (0x0...) and RAM (0x2...).
 awk -v szr="$sz_replay" -v szp="$sz_pf" '

@@ -45,7 +45,7 @@ static void demo_sink(void *user, const br_circle_sample_t *s)
         const br_pf_t *pf = s->pf[a];
         int h[BR_HIST_BINS] = {0};
         for (uint32_t j = 0; j < pf->cfg.n_particles; j++) {
-            int b = (int)((double)pf->x[BR_X_GP][j] / BR_HIST_W_N);
+            int b = (int)((double)pf->x[j][BR_X_GP] / BR_HIST_W_N);
             if (b >= 0 && b < BR_HIST_BINS) h[b]++;
         }
         fprintf(k->hist, "%.6f,%d", s->t_s, a);

@@ -222,8 +222,8 @@ static void resample_forced(br_pf_t *pf, const uint16_t *idx)
     float s[BR_NX] = {0.0f, 0.0f, 0.0f, 0.0f}, sf = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
         for (int i = 0; i < BR_NX; i++) {
-            pf->x[i][j] = pf->xp[i][idx[j]];
-            s[i] += pf->x[i][j];
+            pf->x[j][i] = pf->xp[idx[j]][i];
+            s[i] += pf->x[j][i];
         }
         sf += pf->fnl[idx[j]];
         pf->idx[j] = idx[j];
@@ -478,8 +478,8 @@ static void test_pf_forced_run(void **state)
         for (uint32_t j = 0; j < m; j++) {
             float xj[BR_NX];
             for (int i = 0; i < BR_NX; i++) {
-                xj[i] = (k > 0) ? pf->xp[i][pf->idx[j]] : pf->x[i][j];
-                xmax[i] = fmax(xmax[i], fabs((double)pf->x[i][j]));
+                xj[i] = (k > 0) ? pf->xp[pf->idx[j]][i] : pf->x[j][i];
+                xmax[i] = fmax(xmax[i], fabs((double)pf->x[j][i]));
             }
             const double f = (k > 0) ? pf->fnl[pf->idx[j]] : br_model_fnl_N(&pf->model, xj);
             fmax_ = fmax(fmax_, fabs(f));
@@ -514,8 +514,8 @@ static void test_pf_forced_run(void **state)
                 assert_int_equal((int)br_trace_get(&g.x, xrow, cx_j), (int)j);
                 for (int i = 0; i < BR_NX; i++) {
                     const double ref = br_trace_get(&g.x, xrow, cx[i]);
-                    br_errstat_add(&e_x[i], &g.x, xrow, (double)pf->x[i][j], ref, dr.d[i]);
-                    pf->x[i][j] = (float)ref;
+                    br_errstat_add(&e_x[i], &g.x, xrow, (double)pf->x[j][i], ref, dr.d[i]);
+                    pf->x[j][i] = (float)ref;
                 }
             }
             step_scales(&c, xm, xm, 0.0, 0.0, S);

@@ -1,8 +1,10 @@
 /* Particle filter: configuration guards, integer resampling, bad input,
- * outliers, all-invalid steps, underflow-proof weights, tracking. */
+ * outliers, all-invalid and single invalid particles, underflow-proof weights,
+ * the inline prediction against br_model_step, tracking. */
 #include "br_test.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 #include "br_noise_table.h"
 #include "br_reference_machine.h"
@@ -51,7 +53,7 @@ static int all_finite(const br_pf_t *pf)
 {
     for (uint32_t j = 0; j < pf->cfg.n_particles; j++)
         for (int i = 0; i < BR_NX; i++)
-            if (!isfinite(pf->x[i][j])) return 0;
+            if (!isfinite(pf->x[j][i])) return 0;
     return 1;
 }
 
@@ -108,12 +110,22 @@ static void test_resample_idx(void **st)
     assert_int_equal(idx[1], 1);
     assert_int_equal(idx[2], 3);
     assert_int_equal(idx[3], 3);
-    /* the largest totals do not overflow: 65535 particles of 2^16 need 64 bits for (2i+1) C */
-    const uint32_t big[2] = {65536, 65536};
-    assert_int_equal(br_pf_resample_idx(big, 2, idx), BR_OK);
-    assert_int_equal(idx[0], 0);
-    assert_int_equal(idx[1], 1);
-    /* guards */
+    /* the largest total, BR_PF_MAX_PARTICLES weights of 2^16: 2 C_m = 2^17 m must
+     * not wrap in 32 bits (equal weights: each particle exactly once) */
+    uint32_t *big = malloc((BR_PF_MAX_PARTICLES + 1u) * sizeof *big);
+    uint16_t *bidx = malloc((BR_PF_MAX_PARTICLES + 1u) * sizeof *bidx);
+    assert_non_null(big);
+    assert_non_null(bidx);
+    for (uint32_t j = 0; j <= BR_PF_MAX_PARTICLES; j++) big[j] = 1u << BR_PF_W_BITS;
+    assert_int_equal(br_pf_resample_idx(big, BR_PF_MAX_PARTICLES, bidx), BR_OK);
+    for (uint32_t j = 0; j < BR_PF_MAX_PARTICLES; j++) assert_int_equal(bidx[j], j);
+    /* guards: the filter's contract, m <= BR_PF_MAX_PARTICLES and W_j <= 2^16,
+     * keeps every sum inside 32 bits */
+    assert_int_equal(br_pf_resample_idx(big, BR_PF_MAX_PARTICLES + 1u, bidx), BR_E_PARAM);
+    big[7] = (1u << BR_PF_W_BITS) + 1u;
+    assert_int_equal(br_pf_resample_idx(big, BR_PF_MAX_PARTICLES, bidx), BR_E_PARAM);
+    free(big);
+    free(bidx);
     const uint32_t zero[4] = {0, 0, 0, 0};
     assert_int_equal(br_pf_resample_idx(zero, 4, idx), BR_E_INPUT);
     assert_int_equal(br_pf_resample_idx(w, 0, idx), BR_E_PARAM);
@@ -127,7 +139,7 @@ static void test_bad_input_keeps_state(void **st)
     br_meas_t y = {1000, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK); /* primes */
     assert_int_equal(br_pf_step(pf, &y, 0.001f), BR_OK);
-    float th0 = pf->x[0][7], gp0 = pf->x[3][7];
+    float th0 = pf->x[7][0], gp0 = pf->x[7][3];
     uint32_t pos = pf->noise_pos;
     const float bad[] = {NAN, INFINITY, -INFINITY};
     for (int k = 0; k < 3; k++) {
@@ -139,7 +151,7 @@ static void test_bad_input_keeps_state(void **st)
     assert_int_equal(br_pf_step(pf, &yr, 0.0f), BR_E_INPUT);
     yr.frac = -0.1f;
     assert_int_equal(br_pf_step(pf, &yr, 0.0f), BR_E_INPUT);
-    assert_true(pf->x[0][7] == th0 && pf->x[3][7] == gp0 && pf->noise_pos == pos);
+    assert_true(pf->x[7][0] == th0 && pf->x[7][3] == gp0 && pf->noise_pos == pos);
     assert_int_equal(br_pf_step(pf, NULL, 0.0f), BR_E_NULL);
     free(pf);
 }
@@ -178,13 +190,13 @@ static void test_all_invalid_keeps_previous(void **st)
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    float th = pf->x[0][3];
+    float th = pf->x[3][0];
     int32_t origin = pf->origin_counts;
     /* a torque that overflows every particle's velocity: no particle is usable */
     y.counts = 5;
     assert_int_equal(br_pf_step(pf, &y, 3.0e38f), BR_E_NUMERIC);
     assert_true(all_finite(pf));
-    assert_true(pf->x[0][3] == th && pf->origin_counts == origin);
+    assert_true(pf->x[3][0] == th && pf->origin_counts == origin);
     free(pf);
 }
 
@@ -262,6 +274,110 @@ static void test_tracks_plant_friction(void **st)
     free(pf);
 }
 
+/* The PF's inline prediction (RK4 kernel, bounded fallback) is br_model_step bit
+ * for bit: without process noise, every predicted particle equals br_model_step
+ * of its parent shifted to the new origin, at circle speeds and beyond the RK4
+ * a h limit (the bounded scheme). */
+static void test_predict_is_model_step(void **st)
+{
+    (void)st;
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t c = cfg(64);
+    for (int i = 0; i < BR_NX; i++) c.q_var[i] = 0.0f;
+    c.outlier_sigma = 1e6f;
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    /* speeds from 2 um/s to 2 m/s, both signs */
+    float parent[64][BR_NX];
+    int n_bounded = 0;
+    for (uint32_t j = 0; j < 64; j++) {
+        const float v = (j % 2 ? 1.0f : -1.0f) * 2.0f * powf(10.0f, -6.0f + 6.0f * (float)j / 63.0f);
+        pf->x[j][BR_X_OMEGA] = v / c.model.lead_mprad;
+        pf->x[j][BR_X_Z] = (j % 3 == 0) ? 0.0f : 1e-6f;
+        for (int i = 0; i < BR_NX; i++) parent[j][i] = pf->x[j][i];
+        const float ah = c.model.lugre.sigma0_Npm * fabsf(v) * c.model.dt_s / parent[j][BR_X_GP];
+        n_bounded += ah > BR_MODEL_RK4_AH_MAX;
+    }
+    assert_true(n_bounded >= 10 && n_bounded <= 54); /* both schemes are exercised */
+    const float u = 0.05f;
+    y.counts = 3;
+    assert_int_equal(br_pf_step(pf, &y, u), BR_OK);
+    for (uint32_t j = 0; j < 64; j++) {
+        float xn[BR_NX];
+        assert_int_equal(br_model_step(&pf->model, parent[j], u, xn), BR_OK);
+        xn[BR_X_THETA] -= 3.0f * RPC;
+        for (int i = 0; i < BR_NX; i++) {
+            if (memcmp(&xn[i], &pf->xp[j][i], sizeof(float)) != 0) {
+                fail_msg("particle %u state %d: PF %.9g, br_model_step %.9g", (unsigned)j, i,
+                         (double)pf->xp[j][i], (double)xn[i]);
+            }
+        }
+        assert_true(pf->l[j] > -INFINITY);
+    }
+    free(pf);
+}
+
+/* A particle whose prediction is not finite is kept as it was, with weight 0,
+ * while the others go on. */
+static void test_one_invalid_particle(void **st)
+{
+    (void)st;
+    br_pf_t *pf = new_pf(100);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    const int bad[3] = {5, 6, 7};
+    pf->x[5][BR_X_Z] = 3.0e38f;     /* f_nl overflows */
+    pf->x[6][BR_X_OMEGA] = 3.0e38f; /* the velocity overflows */
+    pf->x[7][BR_X_OMEGA] = -3.0e38f;
+    float keep[3][BR_NX];
+    for (int b = 0; b < 3; b++)
+        for (int i = 0; i < BR_NX; i++) keep[b][i] = pf->x[bad[b]][i];
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    for (int b = 0; b < 3; b++) {
+        const int j = bad[b];
+        assert_true(pf->l[j] == -INFINITY);
+        assert_int_equal(pf->W[j], 0u);
+        assert_true(pf->fnl[j] == 0.0f);
+        for (int i = 0; i < BR_NX; i++) assert_true(pf->xp[j][i] == keep[b][i]);
+    }
+    for (uint32_t j = 0; j < 100; j++) {
+        assert_true(pf->idx[j] < 5 || pf->idx[j] > 7); /* never resampled */
+    }
+    assert_true(all_finite(pf));
+    assert_true(isfinite(br_pf_estimate(pf)->F_hat_N));
+    free(pf);
+}
+
+/* theta finite, f_nl not: process noise of ~1e19 on omega and z makes the
+ * bristle rate overflow (sigma0 |v| z / g_p) while theta stays finite. Such
+ * particles must get weight 0; the estimate must stay finite. */
+static void test_fnl_overflow_is_invalid(void **st)
+{
+    (void)st;
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t c = cfg(100);
+    c.q_var[1] = 3e38f;
+    c.q_var[2] = 3e38f;
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    const br_status_t s = br_pf_step(pf, &y, 0.0f);
+    assert_true(s == BR_OK || s == BR_E_NUMERIC);
+    int n_invalid = 0;
+    for (uint32_t j = 0; j < 100; j++) {
+        n_invalid += pf->l[j] == -INFINITY;
+        if (pf->l[j] > -INFINITY) assert_true(isfinite(pf->fnl[j]));
+    }
+    assert_true(n_invalid > 0);
+    assert_true(all_finite(pf));
+    assert_true(isfinite(br_pf_estimate(pf)->F_hat_N));
+    free(pf);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -269,6 +385,8 @@ int main(void)
         cmocka_unit_test(test_bad_input_keeps_state), cmocka_unit_test(test_outlier_100_sigma),
         cmocka_unit_test(test_all_invalid_keeps_previous), cmocka_unit_test(test_weights_survive_underflow),
         cmocka_unit_test(test_ess_reported),         cmocka_unit_test(test_tracks_plant_friction),
+        cmocka_unit_test(test_predict_is_model_step), cmocka_unit_test(test_one_invalid_particle),
+        cmocka_unit_test(test_fnl_overflow_is_invalid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -23,10 +23,11 @@
 #ifndef BR_PF_MAX_PARTICLES
 #define BR_PF_MAX_PARTICLES 2048u
 #endif
-/* weight quantisation: W in [0, 2^16]; C_m <= 2^16 m fits uint32 */
+/* weight quantisation: W in [0, 2^16]; the resampling works on 2 C_m <= 2^17 m,
+ * which fits uint32 for m < 2^15 (and the indices fit uint16) */
 #define BR_PF_W_BITS 16u
-#if BR_PF_MAX_PARTICLES > 65535u
-#error "BR_PF_MAX_PARTICLES must fit the uint16 resampling indices"
+#if BR_PF_MAX_PARTICLES > 32767u
+#error "BR_PF_MAX_PARTICLES must keep 2^17 m inside uint32 (m < 2^15)"
 #endif
 
 typedef struct {
@@ -64,9 +65,9 @@ typedef struct {
     float prev_frac;              /* the last measurement's fraction */
     uint32_t n_outliers;          /* consecutive outlier steps */
     int primed;                   /* particles drawn around the first measurement */
-    /* particles (structure of arrays): current set, and the predicted set */
-    float x[BR_NX][BR_PF_MAX_PARTICLES];
-    float xp[BR_NX][BR_PF_MAX_PARTICLES];
+    /* particles, one state vector each: current set, and the predicted set */
+    float x[BR_PF_MAX_PARTICLES][BR_NX];
+    float xp[BR_PF_MAX_PARTICLES][BR_NX];
     float fnl[BR_PF_MAX_PARTICLES];   /* f_nl of the predicted particles */
     float l[BR_PF_MAX_PARTICLES];     /* log-weights */
     uint32_t W[BR_PF_MAX_PARTICLES];  /* quantised weights */
@@ -89,7 +90,9 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm);
 
 /* Deterministic systematic resampling in integer arithmetic: for the weights
  * W[0..m-1] (not all zero) writes idx[i] = the j with C_{j-1} <= t_i < C_j,
- * t_i = floor((2 i + 1) C_m / (2 m)). Identical on every target. */
+ * t_i = floor((2 i + 1) C_m / (2 m)). Identical on every target. The filter's
+ * own weights: m in 1..BR_PF_MAX_PARTICLES and every W_j <= 2^16, else
+ * BR_E_PARAM; all zero gives BR_E_INPUT. */
 br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx);
 
 /* The last step's estimate. */
