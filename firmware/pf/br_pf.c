@@ -80,13 +80,11 @@ static void estimate_current(br_pf_t *pf, float ess)
     const uint32_t m = pf->cfg.n_particles;
     float s[BR_NX] = {0.0f, 0.0f, 0.0f, 0.0f}, sf = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
-        float xj[BR_NX];
         for (int i = 0; i < BR_NX; i++) {
-            xj[i] = pf->x[j][i];
-            s[i] += xj[i];
+            s[i] += pf->x[j][i];
         }
         /* thesis estimate: the mean of f_nl (eq. 6) over the particles */
-        sf += br_model_fnl_N(&pf->model, xj);
+        sf += br_model_fnl_N(&pf->model, pf->x[j]);
     }
     const float inv_m = 1.0f / (float)m;
     for (int i = 0; i < BR_NX; i++) {
@@ -253,6 +251,8 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
     uint32_t *const W = pf->W;
     uint32_t total = 0u;
     float s1 = 0.0f, s2 = 0.0f;
+    /* two loops, so that the common one has no per-particle branch on the verdict
+     * (one loop with the branch costs 5 more instructions per particle on the M7) */
     if (outlier) {
         for (uint32_t j = 0; j < m; j++) {
             const float w = (l[j] > -INFINITY) ? 1.0f : 0.0f;
@@ -351,14 +351,10 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         const float d_th = y_rel - s[BR_X_THETA] * inv_m, d_om = omega_meas - s[BR_X_OMEGA] * inv_m;
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
-            float xj[BR_NX];
             pf->x[j][BR_X_THETA] += d_th;
             pf->x[j][BR_X_OMEGA] += d_om;
-            for (int i = 0; i < BR_NX; i++) {
-                xj[i] = pf->x[j][i];
-            }
             /* f_nl depends on omega: the estimate is that of the moved cloud */
-            sf += br_model_fnl_N(&pf->model, xj);
+            sf += br_model_fnl_N(&pf->model, pf->x[j]);
         }
         s[BR_X_THETA] += d_th * (float)m;
         s[BR_X_OMEGA] += d_om * (float)m;

@@ -12,7 +12,7 @@
 
 /* e^x for x <= 0: 2^n * p(f), n = round(x log2 e), |f| <= 1/2, p the degree-6
  * Taylor polynomial of e^(f ln 2); relative error < 5e-6 over [-87, 0], set by
- * the rounding of x log2 e (measured in tests/golden/test_golden_pf.c); 0 below x = -87
+ * the rounding of x log2 e (measured in tests/unit/test_math.c); 0 below x = -87
  * (and for NaN). */
 static inline float br_exp_neg(float x)
 {
