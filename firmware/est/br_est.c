@@ -1,4 +1,4 @@
-/* Configuration checks shared by the friction estimators. See br_est.h. */
+/* Configuration and step-input checks shared by the friction estimators. See br_est.h. */
 #include "bristle/br_est.h"
 
 #include <math.h>
@@ -19,6 +19,14 @@ br_status_t br_est_check_common(const float q_var[4], float r_var_rad2, float gp
     if (!finite_pos(gp_min_N) || !isfinite(gp_max_N) || !(gp_max_N > gp_min_N) ||
         !(gp0_N >= gp_min_N && gp0_N <= gp_max_N)) {
         return BR_E_PARAM;
+    }
+    return BR_OK;
+}
+
+br_status_t br_est_check_step(const br_meas_t *y, float u_prev_Nm)
+{
+    if (!isfinite(u_prev_Nm) || !isfinite(y->frac) || y->frac < 0.0f || y->frac > 1.0f) {
+        return BR_E_INPUT;
     }
     return BR_OK;
 }

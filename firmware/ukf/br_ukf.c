@@ -246,8 +246,9 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     if (!ukf->ready) {
         return BR_E_STATE;
     }
-    if (!isfinite(u_prev_Nm) || !isfinite(y->frac) || y->frac < 0.0f || y->frac > 1.0f) {
-        return BR_E_INPUT;
+    const br_status_t in = br_est_check_step(y, u_prev_Nm);
+    if (in != BR_OK) {
+        return in;
     }
     if (!ukf->primed) {
         return prime(ukf, y);

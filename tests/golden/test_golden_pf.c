@@ -90,14 +90,7 @@ static void load_all(pf_golden_t *g)
     c.n_particles = (uint32_t)br_trace_meta_num(t, "n_particles");
     for (int i = 0; i < BR_NX; i++) c.x0_std[i] = (float)s0[i];
     const br_trace_est_common_t e = br_trace_est_common(t);
-    for (int i = 0; i < BR_NX; i++) c.q_var[i] = e.q_var[i];
-    c.r_var_rad2 = e.r_var_rad2;
-    c.gp0_N = e.gp0_N;
-    c.gp_min_N = e.gp_min_N;
-    c.gp_max_N = e.gp_max_N;
-    c.outlier_sigma = e.outlier_sigma;
-    c.reanchor_after = e.reanchor_after;
-    c.rad_per_count = e.rad_per_count;
+    BR_TRACE_SET_EST_COMMON(c, e);
     c.noise = br_noise_table;
     c.noise_len = BR_NOISE_LEN;
     c.noise_skip = (uint32_t)br_trace_meta_num(t, "noise_skip");

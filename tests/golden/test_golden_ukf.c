@@ -51,14 +51,7 @@ static void load_all(ukf_golden_t *g)
     c.model = br_trace_model_cfg(t);
     for (int i = 0; i < BR_NX; i++) c.p0_var[i] = (float)p0[i];
     const br_trace_est_common_t e = br_trace_est_common(t);
-    for (int i = 0; i < BR_NX; i++) c.q_var[i] = e.q_var[i];
-    c.r_var_rad2 = e.r_var_rad2;
-    c.gp0_N = e.gp0_N;
-    c.gp_min_N = e.gp_min_N;
-    c.gp_max_N = e.gp_max_N;
-    c.outlier_sigma = e.outlier_sigma;
-    c.reanchor_after = e.reanchor_after;
-    c.rad_per_count = e.rad_per_count;
+    BR_TRACE_SET_EST_COMMON(c, e);
     c.alpha = (float)br_trace_meta_num(t, "alpha");
     c.beta = (float)br_trace_meta_num(t, "beta");
     c.kappa = (float)br_trace_meta_num(t, "kappa");

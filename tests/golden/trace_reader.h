@@ -78,5 +78,19 @@ typedef struct {
     uint32_t reanchor_after;
 } br_trace_est_common_t;
 br_trace_est_common_t br_trace_est_common(const br_trace_t *t);
+/* Copies those fields into a br_pf_cfg_t or br_ukf_cfg_t (same field names). */
+#define BR_TRACE_SET_EST_COMMON(cfg, e)                  \
+    do {                                                 \
+        for (int br_i_ = 0; br_i_ < 4; br_i_++) {        \
+            (cfg).q_var[br_i_] = (e).q_var[br_i_];       \
+        }                                                \
+        (cfg).r_var_rad2 = (e).r_var_rad2;               \
+        (cfg).gp0_N = (e).gp0_N;                         \
+        (cfg).gp_min_N = (e).gp_min_N;                   \
+        (cfg).gp_max_N = (e).gp_max_N;                   \
+        (cfg).outlier_sigma = (e).outlier_sigma;         \
+        (cfg).reanchor_after = (e).reanchor_after;       \
+        (cfg).rad_per_count = (e).rad_per_count;         \
+    } while (0)
 
 #endif

@@ -31,4 +31,8 @@ typedef struct {
 br_status_t br_est_check_common(const float q_var[4], float r_var_rad2, float gp0_N, float gp_min_N, float gp_max_N,
                                 float outlier_sigma, uint32_t reanchor_after, float rad_per_count);
 
+/* The step inputs both estimators accept: u finite, frac finite and in [0, 1];
+ * BR_OK, else BR_E_INPUT. */
+br_status_t br_est_check_step(const br_meas_t *y, float u_prev_Nm);
+
 #endif
