@@ -170,7 +170,7 @@ def record(m, gt):
             counts, fault = rctrl.to_int32(counts + SLIP_COUNTS), 2
         # the estimator sees the count's centre and the torque of the last period
         st = pf.step(counts, 0.5, u_prev)
-        assert st in (rpf.BR_OK, rpf.BR_E_OUTLIER), (k, st)
+        assert st in (rpf.BR_OK, rpf.BR_W_OUTLIER), (k, st)
         comp = f32(pf.F_hat)
         pos = COUNTS0 + 0.5 + CIRCLE_A_M * math.sin(w * t) / L / rpc
         fl = math.floor(pos)
@@ -226,7 +226,7 @@ def run_ukf(cfg, rows_in):
     for r in rows_in:
         k, counts, frac, u_prev = r[0], r[2], r[3], r[4]
         st = u.step(counts, frac, u_prev)
-        assert st in (rukf.BR_OK, rukf.BR_E_OUTLIER), (k, st)
+        assert st in (rukf.BR_OK, rukf.BR_W_OUTLIER), (k, st)
         P = [u.P[i][j] for i in range(4) for j in range(i, 4)]
         rows.append([k, st, u.origin, u.n_outliers, int(u.reanchored), *u.x, *P, u.F_hat, u.nu, u.S,
                      *u.Pm_diag])

@@ -44,9 +44,9 @@ br_status_t br_axis_step(br_axis_t *a, const br_ref_t *ref)
         /* the estimator sees the count's centre and the torque of the last period */
         const br_meas_t y = {counts, 0.5f};
         st = a->est.step(a->est.ctx, &y, a->last.tau_Nm, &a->F_hat_N);
-        /* an outlier measurement is skipped by the estimator, whose prediction
-         * stays usable: control goes on and the status is passed up */
-        if (st != BR_OK && st != BR_E_OUTLIER) {
+        /* a warning (an outlier measurement skipped by the estimator, whose
+         * prediction stays usable): control goes on and the status is passed up */
+        if (BR_FAILED(st)) {
             (void)a->hal->pwm_write(a->hal->ctx, 0.0f);
             a->last.tau_Nm = 0.0f;
             return st;

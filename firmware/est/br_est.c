@@ -2,22 +2,31 @@
 #include "bristle/br_est.h"
 
 #include <math.h>
+#include <stddef.h>
 
-static int finite_pos(float v) { return isfinite(v) && v > 0.0f; }
+#include "br_check.h"
 
-br_status_t br_est_check_common(const float q_var[4], float r_var_rad2, float gp0_N, float gp_min_N, float gp_max_N,
-                                float outlier_sigma, uint32_t reanchor_after, float rad_per_count)
+br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
 {
-    for (int i = 0; i < 4; i++) {
-        if (!isfinite(q_var[i]) || q_var[i] < 0.0f) {
+    if (cfg == NULL) {
+        return BR_E_NULL;
+    }
+    br_model_t model;
+    const br_status_t st = br_model_init(&model, &cfg->model);
+    if (st != BR_OK) {
+        return st;
+    }
+    for (int i = 0; i < BR_NX; i++) {
+        if (!br_finite_nonneg(cfg->q_var[i])) {
             return BR_E_PARAM;
         }
     }
-    if (!finite_pos(r_var_rad2) || !finite_pos(outlier_sigma) || !finite_pos(rad_per_count) || reanchor_after < 1u) {
+    if (!br_finite_pos(cfg->r_var_rad2) || !br_finite_pos(cfg->outlier_sigma) || !br_finite_pos(cfg->rad_per_count) ||
+        cfg->reanchor_after < 1u) {
         return BR_E_PARAM;
     }
-    if (!finite_pos(gp_min_N) || !isfinite(gp_max_N) || !(gp_max_N > gp_min_N) ||
-        !(gp0_N >= gp_min_N && gp0_N <= gp_max_N)) {
+    if (!br_finite_pos(cfg->gp_min_N) || !isfinite(cfg->gp_max_N) || !(cfg->gp_max_N > cfg->gp_min_N) ||
+        !(cfg->gp0_N >= cfg->gp_min_N && cfg->gp0_N <= cfg->gp_max_N)) {
         return BR_E_PARAM;
     }
     return BR_OK;

@@ -4,17 +4,18 @@
 #include <math.h>
 #include <stddef.h>
 
-static int is_pos(float v) { return isfinite(v) && v > 0.0f; }
+#include "br_check.h"
+#include "br_lugre_kernel.h"
 
 br_status_t br_lugre_cfg_check(const br_lugre_cfg_t *cfg)
 {
     if (cfg == NULL) {
         return BR_E_NULL;
     }
-    if (!is_pos(cfg->sigma0_Npm) || !is_pos(cfg->Fc_N) || !is_pos(cfg->vs_mps)) {
+    if (!br_finite_pos(cfg->sigma0_Npm) || !br_finite_pos(cfg->Fc_N) || !br_finite_pos(cfg->vs_mps)) {
         return BR_E_PARAM;
     }
-    if (!isfinite(cfg->sigma1_Nspm) || cfg->sigma1_Nspm < 0.0f) {
+    if (!br_finite_nonneg(cfg->sigma1_Nspm)) {
         return BR_E_PARAM;
     }
     if (!isfinite(cfg->Fs_N) || cfg->Fs_N < cfg->Fc_N) {
@@ -25,20 +26,20 @@ br_status_t br_lugre_cfg_check(const br_lugre_cfg_t *cfg)
 
 float br_lugre_g_N(const br_lugre_cfg_t *cfg, float v_mps)
 {
-    /* eq. 5: g(v) = Fc + (Fs - Fc) exp(-|v| / vs) */
-    return cfg->Fc_N + (cfg->Fs_N - cfg->Fc_N) * expf(-fabsf(v_mps) / cfg->vs_mps);
+    /* eq. 5 */
+    return br_lk_g_N(cfg->Fc_N, cfg->Fs_N, cfg->vs_mps, v_mps);
 }
 
 float br_lugre_zdot_mps(const br_lugre_cfg_t *cfg, float z_m, float v_mps, float g_N)
 {
-    /* eq. 4: dz/dt = v - sigma0 |v| z / g */
-    return v_mps - cfg->sigma0_Npm * fabsf(v_mps) * z_m / g_N;
+    /* eq. 4 */
+    return br_lk_zdot_mps(cfg->sigma0_Npm, v_mps, z_m, g_N);
 }
 
 float br_lugre_force_N(const br_lugre_cfg_t *cfg, float z_m, float zdot_mps)
 {
-    /* eq. 3: F = sigma0 z + sigma1 dz/dt */
-    return cfg->sigma0_Npm * z_m + cfg->sigma1_Nspm * zdot_mps;
+    /* eq. 3 */
+    return br_lk_force_N(cfg->sigma0_Npm, cfg->sigma1_Nspm, z_m, zdot_mps);
 }
 
 float br_lugre_z_advance_m(const br_lugre_cfg_t *cfg, float z_m, float dx_m, float g_N)
@@ -46,10 +47,8 @@ float br_lugre_z_advance_m(const br_lugre_cfg_t *cfg, float z_m, float dx_m, flo
     if (dx_m == 0.0f) {
         return z_m;
     }
-    /* eq. 4 over displacement: z1 = zss + (z0 - zss) exp(-sigma0 |dx| / g), zss = sgn(dx) g / sigma0,
-     * written as z0 + (zss - z0)(1 - exp(-r)) so that small moves keep full float precision */
-    float zss = copysignf(g_N / cfg->sigma0_Npm, dx_m);
-    return z_m + (zss - z_m) * -expm1f(-cfg->sigma0_Npm * fabsf(dx_m) / g_N);
+    /* eq. 4 over the displacement, exact and bounded */
+    return br_lk_move(cfg->sigma0_Npm, z_m, dx_m, g_N).z1_m;
 }
 
 br_status_t br_lugre_init(br_lugre_t *s, const br_lugre_cfg_t *cfg)
@@ -76,7 +75,7 @@ br_status_t br_lugre_step(br_lugre_t *s, float v_mps, float dt_s, float *F_N)
     if (!s->ready) {
         return BR_E_STATE;
     }
-    if (!isfinite(v_mps) || !is_pos(dt_s)) {
+    if (!isfinite(v_mps) || !br_finite_pos(dt_s)) {
         return BR_E_INPUT;
     }
     const br_lugre_cfg_t *c = &s->cfg;

@@ -1,16 +1,17 @@
 /* Four-state estimation model (thesis eq. 6) and its discretisation, float32.
  * See br_model.h and docs/modules/model.md. */
 #include "bristle/br_model.h"
-#include "bristle/br_model_kernel.h"
 
 #include <math.h>
 #include <stddef.h>
 
+#include "br_check.h"
+#include "br_lugre_kernel.h"
+#include "br_model_kernel.h"
+
 /* Fixed-point passes of the bounded scheme (contraction factor ~1e-2 per pass
  * at the reference machine's parameters, docs/modules/model.md). */
 #define BR_MODEL_BOUNDED_PASSES 3
-
-static int finite_pos(float v) { return isfinite(v) && v > 0.0f; }
 
 br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
 {
@@ -18,10 +19,10 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
         return BR_E_NULL;
     }
     m->ready = 0;
-    if (!finite_pos(cfg->J_kgm2) || !finite_pos(cfg->lead_mprad) || !finite_pos(cfg->dt_s)) {
+    if (!br_finite_pos(cfg->J_kgm2) || !br_finite_pos(cfg->lead_mprad) || !br_finite_pos(cfg->dt_s)) {
         return BR_E_PARAM;
     }
-    if (!isfinite(cfg->M_kg) || cfg->M_kg < 0.0f || !isfinite(cfg->sigma2_Nspm) || cfg->sigma2_Nspm < 0.0f) {
+    if (!br_finite_nonneg(cfg->M_kg) || !br_finite_nonneg(cfg->sigma2_Nspm)) {
         return BR_E_PARAM;
     }
     br_status_t st = br_lugre_cfg_check(&cfg->lugre);
@@ -70,15 +71,13 @@ void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u, f
         float dx = L * dth;
         float zint;
         if (dx != 0.0f) {
-            /* eq. 4 over displacement: z1 = zss + (z0 - zss) e^{-r}, r = sigma0 |dx| / g_p */
-            float zss = copysignf(gp / c->sigma0_Npm, dx);
-            float r = c->sigma0_Npm * fabsf(dx) / gp;
-            float one_minus_e = -expm1f(-r);
-            z1 = z0 + (zss - z0) * one_minus_e; /* same, without cancellation for small r */
+            /* eq. 4 over the displacement with g = g_p: exact, bounded */
+            const br_lk_move_t mv = br_lk_move(c->sigma0_Npm, z0, dx, gp);
+            z1 = mv.z1_m;
             /* integral of z over the step: h (zss + (z0 - zss) (1 - e^{-r}) / r);
              * (1 - e^{-r}) / r by its series where r would underflow the division */
-            float q = (r > 1e-6f) ? one_minus_e / r : 1.0f - 0.5f * r;
-            zint = h * (zss + (z0 - zss) * q);
+            float q = (mv.r > 1e-6f) ? mv.one_minus_e / mv.r : 1.0f - 0.5f * mv.r;
+            zint = h * (mv.zss_m + (z0 - mv.zss_m) * q);
         } else {
             z1 = z0;
             zint = z0 * h;

@@ -6,13 +6,12 @@
 #include <stddef.h>
 
 #include "bristle/br_encoder.h"
-#include "bristle/br_math.h"
-#include "bristle/br_model_kernel.h"
+#include "br_check.h"
+#include "br_math.h"
+#include "br_model_kernel.h"
 
 /* W of a particle of weight 1 (the best one after the max-shift) */
 #define BR_PF_W_ONE (1u << BR_PF_W_BITS)
-
-static int finite_nonneg(float v) { return isfinite(v) && v >= 0.0f; }
 
 
 br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
@@ -31,35 +30,32 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
         return BR_E_PARAM;
     }
     for (int i = 0; i < BR_NX; i++) {
-        if (!finite_nonneg(cfg->x0_std[i])) {
+        if (!br_finite_nonneg(cfg->x0_std[i])) {
             return BR_E_PARAM;
         }
     }
-    br_status_t st = br_est_check_common(cfg->q_var, cfg->r_var_rad2, cfg->gp0_N, cfg->gp_min_N, cfg->gp_max_N,
-                                         cfg->outlier_sigma, cfg->reanchor_after, cfg->rad_per_count);
+    br_status_t st = br_est_cfg_check(&cfg->est);
     if (st != BR_OK) {
         return st;
     }
-    st = br_model_init(&pf->model, &cfg->model);
+    st = br_model_init(&pf->model, &cfg->est.model);
     if (st != BR_OK) {
         return st;
     }
     pf->cfg = *cfg;
     for (int i = 0; i < BR_NX; i++) {
-        pf->q_std[i] = sqrtf(cfg->q_var[i]);
+        pf->q_std[i] = sqrtf(cfg->est.q_var[i]);
     }
-    pf->inv_2r = 0.5f / cfg->r_var_rad2;
-    pf->outlier_l = -0.5f * cfg->outlier_sigma * cfg->outlier_sigma;
+    pf->inv_2r = 0.5f / cfg->est.r_var_rad2;
+    pf->outlier_l = -0.5f * cfg->est.outlier_sigma * cfg->est.outlier_sigma;
     pf->noise_pos = 0u;
     pf->origin_counts = 0;
     pf->primed = 0;
     pf->n_outliers = 0u;
-    pf->est = (br_pf_est_t){{0.0f, 0.0f, 0.0f, cfg->gp0_N}, 0, 0.0f, (float)cfg->n_particles};
+    pf->est = (br_pf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N}, 0, 0.0f, (float)cfg->n_particles};
     pf->ready = 1;
     return BR_OK;
 }
-
-static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
 
 /* Next standard-normal sample of the ROM table for (particle j, state i). */
 static float noise_at(const br_pf_t *pf, uint32_t j, uint32_t i)
@@ -99,12 +95,12 @@ static void estimate_current(br_pf_t *pf, float ess)
 static void prime(br_pf_t *pf, const br_meas_t *y)
 {
     const uint32_t m = pf->cfg.n_particles;
-    const float mean[BR_NX] = {y->frac * pf->cfg.rad_per_count, 0.0f, 0.0f, pf->cfg.gp0_N};
+    const float mean[BR_NX] = {y->frac * pf->cfg.est.rad_per_count, 0.0f, 0.0f, pf->cfg.est.gp0_N};
     for (uint32_t j = 0; j < m; j++) {
         for (uint32_t i = 0; i < BR_NX; i++) {
             pf->x[j][i] = mean[i] + pf->cfg.x0_std[i] * noise_at(pf, j, i);
         }
-        pf->x[j][BR_X_GP] = clampf(pf->x[j][BR_X_GP], pf->cfg.gp_min_N, pf->cfg.gp_max_N);
+        pf->x[j][BR_X_GP] = br_clampf(pf->x[j][BR_X_GP], pf->cfg.est.gp_min_N, pf->cfg.est.gp_max_N);
     }
     noise_advance(pf);
     pf->origin_counts = y->counts;
@@ -171,7 +167,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     /* the model's constants and the loop's invariants, held in registers */
     const br_model_k_t mk = br_model_k(&pf->model);
     const float q0 = pf->q_std[0], q1 = pf->q_std[1], q2 = pf->q_std[2], q3 = pf->q_std[3];
-    const float gp_min = pf->cfg.gp_min_N, gp_max = pf->cfg.gp_max_N, inv_2r = pf->inv_2r;
+    const float gp_min = pf->cfg.est.gp_min_N, gp_max = pf->cfg.est.gp_max_N, inv_2r = pf->inv_2r;
     const float *const noise = pf->cfg.noise;
     const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
     uint32_t pos = pf->noise_pos, n_valid = 0u;
@@ -209,7 +205,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
         const float th = xn[BR_X_THETA] + q0 * n0 - shift;
         const float om = xn[BR_X_OMEGA] + q1 * n1;
         const float z = xn[BR_X_Z] + q2 * n2;
-        const float gp = clampf(xn[BR_X_GP] + q3 * n3, gp_min, gp_max);
+        const float gp = br_clampf(xn[BR_X_GP] + q3 * n3, gp_min, gp_max);
         /* eq. 6: f_nl of the predicted particle */
         const float fnl = br_model_k_fnl(&mk, z, br_model_k_zdot(&mk, om, z, gp));
         /* Validity: x - x is 0 for finite x and NaN otherwise. g_p is finite after
@@ -322,7 +318,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         return BR_OK;
     }
     const uint32_t m = pf->cfg.n_particles;
-    const float rpc = pf->cfg.rad_per_count;
+    const float rpc = pf->cfg.est.rad_per_count;
     /* new integer origin: theta_j is re-expressed relative to y.counts */
     const float shift = (float)br_counts_delta(y->counts, pf->origin_counts) * rpc;
     const float y_rel = y->frac * rpc;
@@ -332,11 +328,11 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
     }
-    const br_status_t verdict = (lmax < pf->outlier_l) ? BR_E_OUTLIER : BR_OK;
+    const br_status_t verdict = (lmax < pf->outlier_l) ? BR_W_OUTLIER : BR_OK;
 
     /* 3. max-shifted weights, quantised; an outlier gives every valid particle weight 1 */
     float sw, sw2;
-    const uint32_t total = quantise_weights(pf, lmax, verdict == BR_E_OUTLIER, &sw, &sw2);
+    const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER, &sw, &sw2);
     /* 4. deterministic systematic resampling on the integer weights (total >= 2^16:
      * the best valid particle has W = 2^16) */
     resample(pf->W, m, total, pf->idx);
@@ -344,11 +340,11 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     float s[BR_NX];
     float sf = copy_resampled(pf, s);
     const float inv_m = 1.0f / (float)m;
-    pf->n_outliers = (verdict == BR_E_OUTLIER) ? pf->n_outliers + 1u : 0u;
-    if (pf->n_outliers >= pf->cfg.reanchor_after) {
+    pf->n_outliers = (verdict == BR_W_OUTLIER) ? pf->n_outliers + 1u : 0u;
+    if (pf->n_outliers >= pf->cfg.est.reanchor_after) {
         /* lost lock: re-anchor the cloud on the measurement, keeping its spread:
          * theta's mean moves to y, omega's mean to the measured velocity */
-        const float omega_meas = (shift + (y->frac - pf->prev_frac) * rpc) / pf->cfg.model.dt_s;
+        const float omega_meas = (shift + (y->frac - pf->prev_frac) * rpc) / pf->cfg.est.model.dt_s;
         const float d_th = y_rel - s[BR_X_THETA] * inv_m, d_om = omega_meas - s[BR_X_OMEGA] * inv_m;
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
@@ -381,7 +377,7 @@ br_status_t br_pf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float
         return BR_E_NULL;
     }
     br_status_t st = br_pf_step(pf, y, u_prev_Nm);
-    if (st == BR_OK || st == BR_E_OUTLIER) { /* an outlier step still predicts */
+    if (!BR_FAILED(st)) { /* an outlier step still predicts */
         *F_hat_N = pf->est.F_hat_N;
     }
     return st;

@@ -6,10 +6,7 @@
 #include <stddef.h>
 
 #include "bristle/br_encoder.h"
-
-static int finite_nonneg(float v) { return isfinite(v) && v >= 0.0f; }
-static int finite_pos(float v) { return isfinite(v) && v > 0.0f; }
-static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
+#include "br_check.h"
 
 static int vec_finite(const float v[BR_NX])
 {
@@ -28,16 +25,16 @@ static int mat_finite(const float A[BR_NX][BR_NX])
 static br_status_t check_cfg(const br_ukf_cfg_t *cfg)
 {
     for (int i = 0; i < BR_NX; i++) {
-        if (!finite_pos(cfg->p0_var[i])) {
+        if (!br_finite_pos(cfg->p0_var[i])) {
             return BR_E_PARAM;
         }
     }
-    if (br_est_check_common(cfg->q_var, cfg->r_var_rad2, cfg->gp0_N, cfg->gp_min_N, cfg->gp_max_N,
-                            cfg->outlier_sigma, cfg->reanchor_after, cfg->rad_per_count) != BR_OK) {
-        return BR_E_PARAM;
+    const br_status_t st = br_est_cfg_check(&cfg->est);
+    if (st != BR_OK) {
+        return st;
     }
     /* scaled UT: alpha in (0, 1], beta >= 0, n + lambda = alpha^2 (n + kappa) > 0 */
-    if (!finite_pos(cfg->alpha) || cfg->alpha > 1.0f || !finite_nonneg(cfg->beta) || !isfinite(cfg->kappa) ||
+    if (!br_finite_pos(cfg->alpha) || cfg->alpha > 1.0f || !br_finite_nonneg(cfg->beta) || !isfinite(cfg->kappa) ||
         !((float)BR_NX + cfg->kappa > 0.0f)) {
         return BR_E_PARAM;
     }
@@ -54,7 +51,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
-    st = br_model_init(&ukf->model, &cfg->model);
+    st = br_model_init(&ukf->model, &cfg->est.model);
     if (st != BR_OK) {
         return st;
     }
@@ -66,7 +63,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     const float wm0 = lambda / n_lam;
     const float wc0 = wm0 + 1.0f - cfg->alpha * cfg->alpha + cfg->beta;
     const float wi = 0.5f / n_lam;
-    if (!finite_pos(n_lam) || !isfinite(wm0) || !isfinite(wc0) || !finite_pos(wi)) {
+    if (!br_finite_pos(n_lam) || !isfinite(wm0) || !isfinite(wc0) || !br_finite_pos(wi)) {
         return BR_E_PARAM;
     }
     ukf->cfg = *cfg;
@@ -75,7 +72,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->wc0 = wc0;
     ukf->wi = wi;
     ukf->cmm = cfg->beta - cfg->alpha * cfg->alpha;
-    ukf->out_s2 = cfg->outlier_sigma * cfg->outlier_sigma;
+    ukf->out_s2 = cfg->est.outlier_sigma * cfg->est.outlier_sigma;
     for (int i = 0; i < BR_NX; i++) {
         ukf->x[i] = 0.0f;
         for (int j = 0; j < BR_NX; j++) {
@@ -83,7 +80,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
             ukf->S[i][j] = 0.0f;
         }
     }
-    ukf->x[BR_X_GP] = cfg->gp0_N;
+    ukf->x[BR_X_GP] = cfg->est.gp0_N;
     for (int s = 0; s < BR_UKF_NSIG; s++) {
         for (int i = 0; i < BR_NX; i++) {
             ukf->X[s][i] = ukf->x[i];
@@ -96,7 +93,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->n_outliers = 0u;
     ukf->n_recover = 0u;
     ukf->primed = 0;
-    ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->gp0_N},
+    ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N},
                               {cfg->p0_var[0], cfg->p0_var[1], cfg->p0_var[2], cfg->p0_var[3]},
                               0, 0.0f, 0.0f, 0.0f};
     ukf->ready = 1;
@@ -178,7 +175,7 @@ static br_status_t sigma_points(br_ukf_t *ukf, const float x[BR_NX], float P[BR_
     }
     /* the model needs g_p > 0: every sigma point's g_p in [gp_min, gp_max] */
     for (int s = 0; s < BR_UKF_NSIG; s++) {
-        ukf->X[s][BR_X_GP] = clampf(ukf->X[s][BR_X_GP], ukf->cfg.gp_min_N, ukf->cfg.gp_max_N);
+        ukf->X[s][BR_X_GP] = br_clampf(ukf->X[s][BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
     }
     return st;
 }
@@ -215,10 +212,10 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
     ukf->origin_counts = y->counts;
     ukf->prev_counts = y->counts;
     ukf->prev_frac = y->frac;
-    ukf->x[BR_X_THETA] = y->frac * ukf->cfg.rad_per_count;
+    ukf->x[BR_X_THETA] = y->frac * ukf->cfg.est.rad_per_count;
     ukf->x[BR_X_OMEGA] = 0.0f;
     ukf->x[BR_X_Z] = 0.0f;
-    ukf->x[BR_X_GP] = ukf->cfg.gp0_N;
+    ukf->x[BR_X_GP] = ukf->cfg.est.gp0_N;
     reset_cov(&ukf->cfg, ukf->P);
     (void)sigma_points(ukf, ukf->x, ukf->P); /* diagonal with p0_var > 0: cannot fail */
     set_estimate(ukf, fnl_unscented(ukf), 0.0f, 0.0f);
@@ -253,7 +250,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     if (!ukf->primed) {
         return prime(ukf, y);
     }
-    const float rpc = ukf->cfg.rad_per_count;
+    const float rpc = ukf->cfg.est.rad_per_count;
 
     /* 1. sigma points of the posterior (x, P) of the last step; a failed
      *    Cholesky resets P (kept in ukf->P: the recovery outlives a later failure) */
@@ -297,7 +294,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
         }
     }
     for (int i = 0; i < BR_NX; i++) {
-        Pm[i][i] += ukf->cfg.q_var[i];
+        Pm[i][i] += ukf->cfg.est.q_var[i];
         for (int j = 0; j < i; j++) {
             Pm[j][i] = Pm[i][j];
         }
@@ -312,23 +309,23 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     const float theta_new = xm[BR_X_THETA] - shift;
     const float nu = y->frac * rpc - theta_new;
     /* innovation variance S = H P- H^T + R = P-_00 + R (h(x) = theta) */
-    const float S = Pm[0][0] + ukf->cfg.r_var_rad2;
-    if (!isfinite(nu) || !finite_pos(S)) {
+    const float S = Pm[0][0] + ukf->cfg.est.r_var_rad2;
+    if (!isfinite(nu) || !br_finite_pos(S)) {
         return BR_E_NUMERIC;
     }
     br_status_t verdict = BR_OK;
     int32_t origin_new = y->counts;
     if (nu * nu > ukf->out_s2 * S) {
         /* outlier: keep the prediction in the old origin's frame, no update */
-        verdict = BR_E_OUTLIER;
+        verdict = BR_W_OUTLIER;
         origin_new = ukf->origin_counts;
-        if (ukf->n_outliers + 1u >= ukf->cfg.reanchor_after) {
+        if (ukf->n_outliers + 1u >= ukf->cfg.est.reanchor_after) {
             /* lost lock: re-anchor on the measurement, theta = frac rpc relative
              * to y.counts, omega = the measured velocity over the last period
              * (wrap-safe count difference), z and g_p means kept, P = diag(p0_var) */
             const float dcounts = (float)br_counts_delta(y->counts, ukf->prev_counts);
             xm[BR_X_THETA] = y->frac * rpc;
-            xm[BR_X_OMEGA] = (dcounts + (y->frac - ukf->prev_frac)) * rpc / ukf->cfg.model.dt_s;
+            xm[BR_X_OMEGA] = (dcounts + (y->frac - ukf->prev_frac)) * rpc / ukf->cfg.est.model.dt_s;
             reset_cov(&ukf->cfg, Pm);
             origin_new = y->counts;
             if (!vec_finite(xm)) {
@@ -353,7 +350,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
                 AP[i][j] = Pm[i][j] - K[i] * Pm[0][j];
             }
         }
-        const float r = ukf->cfg.r_var_rad2;
+        const float r = ukf->cfg.est.r_var_rad2;
         for (int i = 0; i < BR_NX; i++) {
             for (int j = 0; j < BR_NX; j++) {
                 Pm[i][j] = AP[i][j] - AP[i][0] * K[j] + r * K[i] * K[j];
@@ -362,7 +359,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
         /* P+ <- (P+ + P+^T) / 2 */
         symmetrise(Pm);
         /* g_p of the mean kept in [gp_min, gp_max], as the sigma points' are */
-        xm[BR_X_GP] = clampf(xm[BR_X_GP], ukf->cfg.gp_min_N, ukf->cfg.gp_max_N);
+        xm[BR_X_GP] = br_clampf(xm[BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
         if (!vec_finite(xm) || !mat_finite((const float(*)[BR_NX])Pm)) {
             return BR_E_NUMERIC;
         }
@@ -387,7 +384,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     ukf->prev_counts = y->counts;
     ukf->prev_frac = y->frac;
     /* as in the PF, every further outlier in the run re-anchors again */
-    if (verdict != BR_E_OUTLIER) {
+    if (verdict != BR_W_OUTLIER) {
         ukf->n_outliers = 0u;
     } else if (ukf->n_outliers < UINT32_MAX) {
         ukf->n_outliers++;
@@ -408,7 +405,7 @@ br_status_t br_ukf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, floa
         return BR_E_NULL;
     }
     const br_status_t st = br_ukf_step(ukf, y, u_prev_Nm);
-    if (st == BR_OK || st == BR_E_OUTLIER) { /* an outlier step still predicts */
+    if (!BR_FAILED(st)) { /* an outlier step still predicts */
         *F_hat_N = ukf->est.F_hat_N;
     }
     return st;

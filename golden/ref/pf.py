@@ -45,7 +45,7 @@ from . import model as rmodel
 BR_OK = 0
 BR_E_INPUT = -3
 BR_E_NUMERIC = -4
-BR_E_OUTLIER = -6
+BR_W_OUTLIER = 1  # a warning (positive): the step predicted only
 
 W_BITS = 16
 NX = 4
@@ -200,4 +200,4 @@ class Pf:
         self.prev_frac = frac
         self._estimate()
         self.ess = sum(w) ** 2 / sum(wj * wj for wj in w)
-        return BR_E_OUTLIER if outlier else BR_OK
+        return BR_W_OUTLIER if outlier else BR_OK

@@ -40,7 +40,7 @@ from . import model as rmodel
 BR_OK = 0
 BR_E_INPUT = -3
 BR_E_NUMERIC = -4
-BR_E_OUTLIER = -6
+BR_W_OUTLIER = 1  # a warning (positive): the step predicted only
 
 NX = 4
 NSIG = 2 * NX + 1
@@ -171,7 +171,7 @@ class Ukf:
         S = Pm[0][0] + c.r_var
         if nu * nu > c.outlier_sigma ** 2 * S:
             # 4. outlier: the prediction, old frame; re-anchoring after a run
-            status_o = BR_E_OUTLIER
+            status_o = BR_W_OUTLIER
             x_new, P_new, origin_new = xm, Pm, self.origin
             n_out = self.n_outliers + 1
             if n_out >= c.reanchor_after:

@@ -22,7 +22,7 @@ static float w2f(uint32_t w)
 void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WORDS])
 {
     uint32_t i = 0u;
-    const br_model_cfg_t *m = &c->pf.model;
+    const br_model_cfg_t *m = &c->pf.est.model;
     w[i++] = BR_REPLAY_MAGIC;
     w[i++] = BR_REPLAY_VERSION;
     w[i++] = c->n_steps;
@@ -43,15 +43,15 @@ void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WOR
     w[i++] = f2w(m->lugre.vs_mps);
     w[i++] = f2w(m->dt_s);
     w[i++] = c->pf.n_particles;
-    for (uint32_t j = 0u; j < BR_NX; ++j) w[i++] = f2w(c->pf.q_var[j]);
-    w[i++] = f2w(c->pf.r_var_rad2);
-    w[i++] = f2w(c->pf.gp0_N);
+    for (uint32_t j = 0u; j < BR_NX; ++j) w[i++] = f2w(c->pf.est.q_var[j]);
+    w[i++] = f2w(c->pf.est.r_var_rad2);
+    w[i++] = f2w(c->pf.est.gp0_N);
     for (uint32_t j = 0u; j < BR_NX; ++j) w[i++] = f2w(c->pf.x0_std[j]);
-    w[i++] = f2w(c->pf.gp_min_N);
-    w[i++] = f2w(c->pf.gp_max_N);
-    w[i++] = f2w(c->pf.outlier_sigma);
-    w[i++] = c->pf.reanchor_after;
-    w[i++] = f2w(c->pf.rad_per_count);
+    w[i++] = f2w(c->pf.est.gp_min_N);
+    w[i++] = f2w(c->pf.est.gp_max_N);
+    w[i++] = f2w(c->pf.est.outlier_sigma);
+    w[i++] = c->pf.est.reanchor_after;
+    w[i++] = f2w(c->pf.est.rad_per_count);
     w[i++] = c->pf.noise_len;
     w[i++] = c->pf.noise_skip;
     while (i < BR_REPLAY_HDR_WORDS) w[i++] = 0u;
@@ -60,7 +60,7 @@ void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WOR
 br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_replay_cfg_t *c)
 {
     uint32_t i = 0u;
-    br_model_cfg_t *m = &c->pf.model;
+    br_model_cfg_t *m = &c->pf.est.model;
     if (w[i++] != BR_REPLAY_MAGIC || w[i++] != BR_REPLAY_VERSION) return BR_E_PARAM;
     c->n_steps = w[i++];
     for (uint32_t j = 0u; j < 3u; ++j) c->ctrl.K[j] = w2f(w[i++]);
@@ -80,15 +80,15 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
     m->lugre.vs_mps = w2f(w[i++]);
     m->dt_s = w2f(w[i++]);
     c->pf.n_particles = w[i++];
-    for (uint32_t j = 0u; j < BR_NX; ++j) c->pf.q_var[j] = w2f(w[i++]);
-    c->pf.r_var_rad2 = w2f(w[i++]);
-    c->pf.gp0_N = w2f(w[i++]);
+    for (uint32_t j = 0u; j < BR_NX; ++j) c->pf.est.q_var[j] = w2f(w[i++]);
+    c->pf.est.r_var_rad2 = w2f(w[i++]);
+    c->pf.est.gp0_N = w2f(w[i++]);
     for (uint32_t j = 0u; j < BR_NX; ++j) c->pf.x0_std[j] = w2f(w[i++]);
-    c->pf.gp_min_N = w2f(w[i++]);
-    c->pf.gp_max_N = w2f(w[i++]);
-    c->pf.outlier_sigma = w2f(w[i++]);
-    c->pf.reanchor_after = w[i++];
-    c->pf.rad_per_count = w2f(w[i++]);
+    c->pf.est.gp_min_N = w2f(w[i++]);
+    c->pf.est.gp_max_N = w2f(w[i++]);
+    c->pf.est.outlier_sigma = w2f(w[i++]);
+    c->pf.est.reanchor_after = w[i++];
+    c->pf.est.rad_per_count = w2f(w[i++]);
     c->pf.noise_len = w[i++];
     c->pf.noise_skip = w[i++];
     if (c->pf.noise_len != BR_NOISE_LEN) return BR_E_PARAM;
@@ -157,7 +157,7 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
         out[4] = f2w(r->duty);
         out[5] = t1 - t0;
         if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;
-        if (st != BR_OK && st != BR_E_OUTLIER) return -4;
+        if (BR_FAILED(st)) return -4;
     }
     return 0;
 }

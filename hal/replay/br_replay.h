@@ -66,7 +66,7 @@ uint32_t br_replay_idx_hash(const uint16_t *idx, uint32_t m);
 /* Reads the header and every step from io, runs br_axis_step per step and
  * writes the output records. n_particles_override != 0 replaces the stream's m.
  * Returns 0, or a negative code: -1 I/O, -2 bad header, -3 init failed,
- * -4 a step failed with a status other than BR_OK / BR_E_OUTLIER (its record
+ * -4 a step failed with a status other than BR_OK / a warning (its record
  * is written first). */
 int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles_override);
 

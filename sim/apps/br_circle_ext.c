@@ -29,7 +29,7 @@ static br_est_t wrap(void *user, int axis, br_est_t inner)
     br_est_ext_t *e = &w->ext[axis];
     const br_ukf_t *ukf = w->use_pf ? NULL : (const br_ukf_t *)inner.ctx;
     const br_pf_t *pf = w->use_pf ? (const br_pf_t *)inner.ctx : NULL;
-    const double dt = w->use_pf ? (double)pf->cfg.model.dt_s : (double)ukf->cfg.model.dt_s;
+    const double dt = w->use_pf ? (double)pf->cfg.est.model.dt_s : (double)ukf->cfg.est.model.dt_s;
     if (br_est_ext_init(e, inner, ukf, pf, &w->model, dt) != 0) {
         w->failed = 1;
         return inner;

@@ -119,8 +119,8 @@ int main(int argc, char **argv)
         if (have_gains) memcpy(cfg.K, K, sizeof K);
         if (dt > 0.0) {
             cfg.dt_s = dt;
-            cfg.pf.model.dt_s = (float)dt;
-            cfg.ukf.model.dt_s = (float)dt;
+            cfg.pf.est.model.dt_s = (float)dt;
+            cfg.ukf.est.model.dt_s = (float)dt;
         }
         if (nsub > 0) cfg.plant.n_sub = nsub;
         char fname[256];

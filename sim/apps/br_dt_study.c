@@ -99,14 +99,14 @@ int main(int argc, char **argv)
             for (int s = 0; s < seeds; s++) {
                 br_pf_cfg_t pc = br_circle_pf_cfg_tuned((float)dt);
                 pc.n_particles = m;
-                for (int i = 0; i < BR_NX; i++) pc.q_var[i] *= (float)(dt / 1.5e-3);
+                for (int i = 0; i < BR_NX; i++) pc.est.q_var[i] *= (float)(dt / 1.5e-3);
                 if (br_pf_init(pf, &pc) != BR_OK) return 1;
                 pf->noise_pos = ((uint32_t)s * 1031u) & (pc.noise_len - 1u); /* realisation s */
                 double u = 0.0;
                 for (long k = 0; k <= K; k++) {
                     const br_meas_t y = {g.counts[a][k * N], 0.5f};
                     br_status_t st = br_pf_step(pf, &y, (float)u);
-                    if (st == BR_E_OUTLIER) outliers++;
+                    if (st == BR_W_OUTLIER) outliers++;
                     else if (st != BR_OK) return 1;
                     fhat[(size_t)s * (size_t)g.cap + (size_t)k] = (double)br_pf_estimate(pf)->F_hat_N;
                     u = 0.0; /* mean torque over the next N sub-periods */

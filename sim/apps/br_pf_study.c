@@ -40,7 +40,7 @@ static float *load_table(const char *path, uint32_t *len)
 int main(int argc, char **argv)
 {
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
-    const float rpc = c.pf.rad_per_count;
+    const float rpc = c.pf.est.rad_per_count;
     float *table = NULL;
     for (int i = 1; i < argc; i++) {
         const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
@@ -55,16 +55,16 @@ int main(int argc, char **argv)
             ok = sscanf(v, "%u", &c.pf.n_particles) == 1;
         } else if (ok && strcmp(argv[i], "--dt") == 0) {
             ok = sscanf(v, "%lf", &c.dt_s) == 1;
-            c.pf.model.dt_s = (float)c.dt_s;
+            c.pf.est.model.dt_s = (float)c.dt_s;
         } else if (ok && strcmp(argv[i], "--duration") == 0) {
             ok = sscanf(v, "%lf", &c.duration_s) == 1;
         } else if (ok && strcmp(argv[i], "--q") == 0) {
-            float *q = c.pf.q_var;
+            float *q = c.pf.est.q_var;
             ok = sscanf(v, "%f,%f,%f,%f", &q[0], &q[1], &q[2], &q[3]) == 4;
             q[0] *= rpc * rpc;
         } else if (ok && strcmp(argv[i], "--r") == 0) {
-            ok = sscanf(v, "%f", &c.pf.r_var_rad2) == 1;
-            c.pf.r_var_rad2 *= rpc * rpc;
+            ok = sscanf(v, "%f", &c.pf.est.r_var_rad2) == 1;
+            c.pf.est.r_var_rad2 *= rpc * rpc;
         } else {
             ok = 0;
         }

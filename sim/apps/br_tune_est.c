@@ -33,9 +33,9 @@ static int n_params(const tune_t *t) { return t->pf ? 4 : 5; }
 static float *param_ptr(br_circle_cfg_t *c, int pf, int i)
 {
     if (pf) {
-        return i < 3 ? &c->pf.q_var[i + 1] : &c->pf.r_var_rad2;
+        return i < 3 ? &c->pf.est.q_var[i + 1] : &c->pf.est.r_var_rad2;
     }
-    return i < 4 ? &c->ukf.q_var[i] : &c->ukf.r_var_rad2;
+    return i < 4 ? &c->ukf.est.q_var[i] : &c->ukf.est.r_var_rad2;
 }
 
 static const char *param_name(int pf, int i)

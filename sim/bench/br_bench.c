@@ -154,7 +154,7 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
             fprintf(stderr, "br_bench: out of memory while recording\n");
             return -1;
         }
-        if (st != BR_OK && st != BR_E_OUTLIER) {
+        if (BR_FAILED(st)) {
             fprintf(stderr, "br_bench: axis step failed at t = %.4f s (status %d)\n", t, (int)st);
             return -1;
         }
@@ -233,7 +233,7 @@ static br_status_t pf_step_w(void *s, const br_meas_t *y, float u, float *F)
 {
     br_pf_t *pf = s;
     br_status_t st = br_pf_step(pf, y, u);
-    if (st == BR_OK || st == BR_E_OUTLIER) *F = pf->est.F_hat_N;
+    if (!BR_FAILED(st)) *F = pf->est.F_hat_N;
     return st;
 }
 static br_status_t ukf_init_w(void *s, const void *c) { return br_ukf_init(s, c); }
@@ -241,7 +241,7 @@ static br_status_t ukf_step_w(void *s, const br_meas_t *y, float u, float *F)
 {
     br_ukf_t *ukf = s;
     br_status_t st = br_ukf_step(ukf, y, u);
-    if (st == BR_OK || st == BR_E_OUTLIER) *F = ukf->est.F_hat_N;
+    if (!BR_FAILED(st)) *F = ukf->est.F_hat_N;
     return st;
 }
 
@@ -275,8 +275,8 @@ static int replay(void *state, const void *cfg, init_fn init, step_fn step, cons
         } else {
             st = step(state, &y, rec->u_prev[k], &F);
         }
-        nout += (st == BR_E_OUTLIER);
-        nerr += (st != BR_OK && st != BR_E_OUTLIER);
+        nout += (st == BR_W_OUTLIER);
+        nerr += (BR_FAILED(st));
         mism += (F != rec->fhat[k]);
         fhat_out[k] = F;
     }
@@ -403,7 +403,7 @@ static void json_f4(FILE *f, const float *v)
 /* The PF configuration, every float exact (%.9g round-trips float32). */
 static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
 {
-    const br_model_cfg_t *m = &c->model;
+    const br_model_cfg_t *m = &c->est.model;
     fprintf(f,
             "{\"dt_s\": %.9g, \"J_kgm2\": %.9g, \"M_kg\": %.9g, \"lead_mprad\": %.9g, \"sigma2_Nspm\": %.9g, "
             "\"sigma0_Npm\": %.9g, \"sigma1_Nspm\": %.9g, \"Fc_N\": %.9g, \"Fs_N\": %.9g, \"vs_mps\": %.9g, "
@@ -411,14 +411,14 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
             (double)m->dt_s, (double)m->J_kgm2, (double)m->M_kg, (double)m->lead_mprad, (double)m->sigma2_Nspm,
             (double)m->lugre.sigma0_Npm, (double)m->lugre.sigma1_Nspm, (double)m->lugre.Fc_N,
             (double)m->lugre.Fs_N, (double)m->lugre.vs_mps, (unsigned)c->n_particles);
-    json_f4(f, c->q_var);
-    fprintf(f, ", \"r_var_rad2\": %.9g, \"gp0_N\": %.9g, \"x0_std\": ", (double)c->r_var_rad2, (double)c->gp0_N);
+    json_f4(f, c->est.q_var);
+    fprintf(f, ", \"r_var_rad2\": %.9g, \"gp0_N\": %.9g, \"x0_std\": ", (double)c->est.r_var_rad2, (double)c->est.gp0_N);
     json_f4(f, c->x0_std);
     fprintf(f,
             ", \"gp_min_N\": %.9g, \"gp_max_N\": %.9g, \"outlier_sigma\": %.9g, \"reanchor_after\": %u, "
             "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"noise_fnv1a64\": \"%016llx\"}",
-            (double)c->gp_min_N, (double)c->gp_max_N, (double)c->outlier_sigma, (unsigned)c->reanchor_after,
-            (double)c->rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip,
+            (double)c->est.gp_min_N, (double)c->est.gp_max_N, (double)c->est.outlier_sigma, (unsigned)c->est.reanchor_after,
+            (double)c->est.rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip,
             (unsigned long long)fnv1a(c->noise, (size_t)c->noise_len * sizeof *c->noise));
 }
 

@@ -54,7 +54,7 @@ F = np.float32
 RK4_AH_MAX = F(2.0)          # BR_MODEL_RK4_AH_MAX, br_model.h
 BOUNDED_PASSES = 3           # BR_MODEL_BOUNDED_PASSES, br_model.c
 W_ONE = F(1 << 16)           # 2^BR_PF_W_BITS, br_pf.h
-BR_OK, BR_E_NUMERIC, BR_E_OUTLIER = 0, -4, -6
+BR_OK, BR_E_NUMERIC, BR_W_OUTLIER = 0, -4, 1
 
 
 def fnv1a64(b):
@@ -256,7 +256,7 @@ class NumpyPf:
         self.mean = s * self.inv_m
         self.F_hat = sf * self.inv_m
         self.ess = sw * sw / sw2
-        return BR_E_OUTLIER if outlier else BR_OK
+        return BR_W_OUTLIER if outlier else BR_OK
 
 
 def load_recording(path):
@@ -296,7 +296,7 @@ def replay(cfg, noise, rec, n_steps=None):
         s = pf.step(counts[k], frac[k], u[k])
         ns[k - 1] = clock() - t0
         st[k] = s
-        if s == BR_OK or s == BR_E_OUTLIER:
+        if s == BR_OK or s == BR_W_OUTLIER:
             fhat[k] = pf.F_hat
         else:
             fhat[k] = fhat[k - 1]
@@ -398,8 +398,8 @@ def main():
         "fhat_vs_c_max_N": float(np.max(np.abs(diff))),
         "fhat_identical_to_c_steps": same,
         "steps": n,
-        "outlier_steps": int(np.count_nonzero(st == BR_E_OUTLIER)),
-        "error_steps": int(np.count_nonzero((st != BR_OK) & (st != BR_E_OUTLIER))),
+        "outlier_steps": int(np.count_nonzero(st == BR_W_OUTLIER)),
+        "error_steps": int(np.count_nonzero((st != BR_OK) & (st != BR_W_OUTLIER))),
     }
     print("PF  numpy (float32, vectorised over particles, numpy %s): %.1f ns per particle-step "
           "(median of %d replays of %d steps; min %.1f, max %.1f)"

@@ -101,9 +101,9 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, int axis, double p
         est = (br_est_t){&a->plant, oracle_step};
         break;
     case BR_CTRL_HINF_UKF:
-        if (fabs((double)c->ukf.model.dt_s - c->dt_s) > 1e-9) {
+        if (fabs((double)c->ukf.est.model.dt_s - c->dt_s) > 1e-9) {
             fprintf(stderr, "br_circle: the UKF's period %g s differs from the control period %g s\n",
-                    (double)c->ukf.model.dt_s, c->dt_s);
+                    (double)c->ukf.est.model.dt_s, c->dt_s);
             return -1;
         }
         a->ukf = calloc(1, sizeof *a->ukf);
@@ -112,9 +112,9 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, int axis, double p
         est = (br_est_t){a->ukf, br_ukf_est_step};
         break;
     case BR_CTRL_HINF_PF:
-        if (fabs((double)c->pf.model.dt_s - c->dt_s) > 1e-9) {
+        if (fabs((double)c->pf.est.model.dt_s - c->dt_s) > 1e-9) {
             fprintf(stderr, "br_circle: the PF's period %g s differs from the control period %g s\n",
-                    (double)c->pf.model.dt_s, c->dt_s);
+                    (double)c->pf.est.model.dt_s, c->dt_s);
             return -1;
         }
         a->pf = calloc(1, sizeof *a->pf);
@@ -182,7 +182,7 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
             br_status_t st = br_axis_step(&ax[i].axis, &r);
-            if (st == BR_E_OUTLIER) {
+            if (st == BR_W_OUTLIER) {
                 nout++; /* the estimator skipped the update; control went on */
             } else if (st != BR_OK) {
                 fprintf(stderr, "br_circle: axis %d step failed at t=%.4f s (status %d)\n", i, t, (int)st);

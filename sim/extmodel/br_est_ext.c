@@ -66,7 +66,7 @@ br_status_t br_est_ext_step(void *ctx, const br_meas_t *y, float u_prev_Nm, floa
     const double L = e->m.lead_mprad;
     float f_in = 0.0f;
     const br_status_t st = e->inner.step(e->inner.ctx, y, (float)(u_applied - L * e->F_cause_N), &f_in);
-    if (st != BR_OK && st != BR_E_OUTLIER) return st;
+    if (BR_FAILED(st)) return st;
     const float *x;
     int32_t origin;
     if (e->ukf) {

@@ -111,7 +111,7 @@ static void test_rejects_bad_experiment(void **st)
     c.dt_s = 1e-3;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
     c = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
-    c.ukf.r_var_rad2 = -1.0f;
+    c.ukf.est.r_var_rad2 = -1.0f;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
 }
 

@@ -86,11 +86,9 @@ static void load_all(pf_golden_t *g)
     br_trace_meta_nums(t, "x0_std", s0, BR_NX);
     br_pf_cfg_t c;
     memset(&c, 0, sizeof c);
-    c.model = br_trace_model_cfg(t);
+    c.est = br_trace_est_cfg(t);
     c.n_particles = (uint32_t)br_trace_meta_num(t, "n_particles");
     for (int i = 0; i < BR_NX; i++) c.x0_std[i] = (float)s0[i];
-    const br_trace_est_common_t e = br_trace_est_common(t);
-    BR_TRACE_SET_EST_COMMON(c, e);
     c.noise = br_noise_table;
     c.noise_len = BR_NOISE_LEN;
     c.noise_skip = (uint32_t)br_trace_meta_num(t, "noise_skip");
@@ -311,17 +309,17 @@ static void test_pf_forced_run(void **state)
     br_pf_t *pf = &g_pf;
     assert_int_equal(br_pf_init(pf, &g.cfg), BR_OK);
     const uint32_t m = g.m;
-    const double rpc = g.cfg.rad_per_count;
+    const double rpc = g.cfg.est.rad_per_count;
     pf_consts_t c;
-    c.h = g.cfg.model.dt_s;
+    c.h = g.cfg.est.model.dt_s;
     c.L = br_trace_meta_num(&g.pf, "L_mprad");
     c.Jeff = br_trace_meta_num(&g.pf, "J_kgm2") + c.L * c.L * br_trace_meta_num(&g.pf, "M_kg");
     c.s0 = br_trace_meta_num(&g.pf, "sigma0_Npm");
     c.s1 = br_trace_meta_num(&g.pf, "sigma1_Nspm");
     c.s2 = br_trace_meta_num(&g.pf, "sigma2_Nspm");
-    c.R = g.cfg.r_var_rad2;
+    c.R = g.cfg.est.r_var_rad2;
     c.sig_R = sqrt(c.R);
-    c.gp_max = g.cfg.gp_max_N;
+    c.gp_max = g.cfg.est.gp_max_N;
     c.m = m;
 
     const int c_counts = br_trace_col(&g.in, "counts"), c_frac = br_trace_col(&g.in, "frac");
@@ -393,7 +391,7 @@ static void test_pf_forced_run(void **state)
                             st_exp);
             }
         }
-        n_outlier += st_exp == BR_E_OUTLIER;
+        n_outlier += st_exp == BR_W_OUTLIER;
         const int reanchored = (int)br_trace_get(&g.pf, k, c_ra);
         n_reanchor += reanchored;
         /* integer state: exact */
@@ -409,7 +407,7 @@ static void test_pf_forced_run(void **state)
         if (k > 0) {
             step_w(&g, k, W_t, idx_t);
             n_res_steps++;
-            const int outlier = st_exp == BR_E_OUTLIER;
+            const int outlier = st_exp == BR_W_OUTLIER;
             /* max log-weight over the valid particles */
             float lmax = -INFINITY;
             for (uint32_t j = 0; j < m; j++) {

@@ -48,10 +48,8 @@ static void load_all(ukf_golden_t *g)
     br_trace_meta_nums(t, "p0_var", p0, BR_NX);
     br_ukf_cfg_t c;
     memset(&c, 0, sizeof c);
-    c.model = br_trace_model_cfg(t);
+    c.est = br_trace_est_cfg(t);
     for (int i = 0; i < BR_NX; i++) c.p0_var[i] = (float)p0[i];
-    const br_trace_est_common_t e = br_trace_est_common(t);
-    BR_TRACE_SET_EST_COMMON(c, e);
     c.alpha = (float)br_trace_meta_num(t, "alpha");
     c.beta = (float)br_trace_meta_num(t, "beta");
     c.kappa = (float)br_trace_meta_num(t, "kappa");
@@ -227,7 +225,7 @@ static void tolerances(const ukf_golden_t *g, const ukf_consts_t *uc, int k, dou
     /* F_hat over the posterior sigma points: f_nl's scale there, plus the
      * state errors times the partial derivatives of f_nl */
     const double Zp = x[2] + spp[2], Op = x[1] + spp[1];
-    const double Gp = fmax(x[3] - spp[3], (double)g->cfg.gp_min_N);
+    const double Gp = fmax(x[3] - spp[3], (double)g->cfg.est.gp_min_N);
     const double a = uc->s0 * uc->L * Op / Gp;
     const double S_f = uc->s0 * Zp + uc->s1 * uc->L * Op * (1.0 + uc->s0 * Zp / Gp);
     *tol_F = C * U32 * S_f + (uc->s0 + uc->s1 * a) * tol_x[2] + uc->s1 * uc->L * (1.0 + uc->s0 * Zp / Gp) * tol_x[1] +
@@ -240,7 +238,7 @@ static ukf_consts_t consts(const ukf_golden_t *g)
 {
     ukf_consts_t uc;
     const br_trace_t *t = &g->u;
-    uc.h = g->cfg.model.dt_s;
+    uc.h = g->cfg.est.model.dt_s;
     uc.L = br_trace_meta_num(t, "L_mprad");
     uc.Jeff = br_trace_meta_num(t, "J_kgm2") + uc.L * uc.L * br_trace_meta_num(t, "M_kg");
     uc.s0 = br_trace_meta_num(t, "sigma0_Npm");
@@ -248,7 +246,7 @@ static ukf_consts_t consts(const ukf_golden_t *g)
     uc.s2 = br_trace_meta_num(t, "sigma2_Nspm");
     const double n = BR_NX, al = g->cfg.alpha, ka = g->cfg.kappa;
     uc.c = sqrt(n + al * al * (n + ka) - n);
-    uc.R = g->cfg.r_var_rad2;
+    uc.R = g->cfg.est.r_var_rad2;
     return uc;
 }
 
@@ -300,7 +298,7 @@ static void test_ukf_free_run(void **state)
     }
     long n_out = 0, n_ra = 0;
     for (int k = 0; k < g.nsteps; k++) {
-        n_out += (int)br_trace_get(&g.u, k, g.c_st) == BR_E_OUTLIER;
+        n_out += (int)br_trace_get(&g.u, k, g.c_st) == BR_W_OUTLIER;
         n_ra += (int)br_trace_get(&g.u, k, g.c_ra);
     }
     print_message("golden ukf        %d steps (%ld outlier, %ld re-anchoring), statuses %s, origin and outlier "

@@ -322,10 +322,11 @@ br_model_cfg_t br_trace_model_cfg(const br_trace_t *t)
     return m;
 }
 
-br_trace_est_common_t br_trace_est_common(const br_trace_t *t)
+br_est_cfg_t br_trace_est_cfg(const br_trace_t *t)
 {
-    br_trace_est_common_t e;
+    br_est_cfg_t e;
     double q[4];
+    e.model = br_trace_model_cfg(t);
     br_trace_meta_nums(t, "q_var", q, 4);
     for (int i = 0; i < 4; i++) e.q_var[i] = (float)q[i];
     e.r_var_rad2 = (float)br_trace_meta_num(t, "r_var_rad2");

@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bristle/br_est.h"
 #include "bristle/br_model.h"
 
 #define BR_TRACE_MAX_COLS 32
@@ -72,25 +73,8 @@ void br_errstat_print(const br_errstat_t *s, const br_trace_t *t, const char *tr
  * L_mprad, sigma2_Nspm, sigma0_Npm, sigma1_Nspm, Fc_N, Fs_N, vs_mps, dt_s). */
 br_model_cfg_t br_trace_model_cfg(const br_trace_t *t);
 
-/* The configuration fields the PF and the UKF share, from a trace's metadata. */
-typedef struct {
-    float q_var[4], r_var_rad2, gp0_N, gp_min_N, gp_max_N, outlier_sigma, rad_per_count;
-    uint32_t reanchor_after;
-} br_trace_est_common_t;
-br_trace_est_common_t br_trace_est_common(const br_trace_t *t);
-/* Copies those fields into a br_pf_cfg_t or br_ukf_cfg_t (same field names). */
-#define BR_TRACE_SET_EST_COMMON(cfg, e)                  \
-    do {                                                 \
-        for (int br_i_ = 0; br_i_ < 4; br_i_++) {        \
-            (cfg).q_var[br_i_] = (e).q_var[br_i_];       \
-        }                                                \
-        (cfg).r_var_rad2 = (e).r_var_rad2;               \
-        (cfg).gp0_N = (e).gp0_N;                         \
-        (cfg).gp_min_N = (e).gp_min_N;                   \
-        (cfg).gp_max_N = (e).gp_max_N;                   \
-        (cfg).outlier_sigma = (e).outlier_sigma;         \
-        (cfg).reanchor_after = (e).reanchor_after;       \
-        (cfg).rad_per_count = (e).rad_per_count;         \
-    } while (0)
+/* The configuration the PF and the UKF share (br_est_cfg_t: the model above
+ * and the noise, g_p range and gates), from a trace's metadata. */
+br_est_cfg_t br_trace_est_cfg(const br_trace_t *t);
 
 #endif

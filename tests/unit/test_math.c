@@ -2,7 +2,7 @@
  * edges (underflow, NaN, -inf, positive input), monotonicity. */
 #include "br_test.h"
 
-#include "bristle/br_math.h"
+#include "br_math.h"
 
 /* every float in (-87, 0] would be 1.1e9 points; a dense geometric-plus-linear
  * sweep of 2e6 points covers each binade and every exponent n */

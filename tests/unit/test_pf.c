@@ -17,23 +17,23 @@
 static br_pf_cfg_t cfg(uint32_t m)
 {
     br_pf_cfg_t c;
-    c.model = br_ref_model_cfg(1.0e-3f);
+    c.est.model = br_ref_model_cfg(1.0e-3f);
     c.n_particles = m;
-    c.q_var[0] = 0.01f * RPC * RPC;
-    c.q_var[1] = 1.0e-5f;
-    c.q_var[2] = 1.0e-14f;
-    c.q_var[3] = 0.09f;
-    c.r_var_rad2 = 0.3f * RPC * RPC;
-    c.gp0_N = 18.0f;
+    c.est.q_var[0] = 0.01f * RPC * RPC;
+    c.est.q_var[1] = 1.0e-5f;
+    c.est.q_var[2] = 1.0e-14f;
+    c.est.q_var[3] = 0.09f;
+    c.est.r_var_rad2 = 0.3f * RPC * RPC;
+    c.est.gp0_N = 18.0f;
     c.x0_std[0] = 0.3f * RPC;
     c.x0_std[1] = 1e-3f;
     c.x0_std[2] = 1e-7f;
     c.x0_std[3] = 2.0f;
-    c.gp_min_N = 3.5f;
-    c.gp_max_N = 27.0f;
-    c.outlier_sigma = 30.0f;
-    c.reanchor_after = 3u;
-    c.rad_per_count = RPC;
+    c.est.gp_min_N = 3.5f;
+    c.est.gp_max_N = 27.0f;
+    c.est.outlier_sigma = 30.0f;
+    c.est.reanchor_after = 3u;
+    c.est.rad_per_count = RPC;
     c.noise = br_noise_table;
     c.noise_len = BR_NOISE_LEN;
     c.noise_skip = 1u;
@@ -71,21 +71,21 @@ static void test_init_guards(void **st)
     c = cfg(100); c.noise_len = 1000u;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* not 2^k */
     c = cfg(100); c.noise_len = 1u;               assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     for (int i = 0; i < BR_NX; i++) {
-        c = cfg(100); c.q_var[i] = -1e-20f;       assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-        c = cfg(100); c.q_var[i] = NAN;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+        c = cfg(100); c.est.q_var[i] = -1e-20f;       assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+        c = cfg(100); c.est.q_var[i] = NAN;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
         c = cfg(100); c.x0_std[i] = -1.0f;        assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     }
-    c = cfg(100); c.r_var_rad2 = 0.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.r_var_rad2 = -1.0f;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.r_var_rad2 = INFINITY;        assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.outlier_sigma = 0.0f;         assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.reanchor_after = 0u;          assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.rad_per_count = 0.0f;         assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.gp_min_N = 0.0f;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.gp_max_N = 3.0f;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* < min */
-    c = cfg(100); c.gp0_N = 30.0f;                assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* > max */
-    c = cfg(100); c.model.dt_s = 0.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.model.lugre.sigma0_Npm = -1.0f; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.r_var_rad2 = 0.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.r_var_rad2 = -1.0f;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.r_var_rad2 = INFINITY;        assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.outlier_sigma = 0.0f;         assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.reanchor_after = 0u;          assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.rad_per_count = 0.0f;         assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.gp_min_N = 0.0f;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.gp_max_N = 3.0f;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* < min */
+    c = cfg(100); c.est.gp0_N = 30.0f;                assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* > max */
+    c = cfg(100); c.est.model.dt_s = 0.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.est.model.lugre.sigma0_Npm = -1.0f; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_STATE); /* last init failed */
     free(pf);
@@ -165,7 +165,7 @@ static void test_outlier_100_sigma(void **st)
     for (int k = 0; k < 5; k++) assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     /* 100 sigma (R = 1 count^2): every particle is an outlier */
     y.counts = 100;
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_OUTLIER);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
     assert_true(all_finite(pf));
     assert_true(isfinite(br_pf_estimate(pf)->F_hat_N));
     /* a single glitch: the measurement returns and tracking resumes */
@@ -174,9 +174,9 @@ static void test_outlier_100_sigma(void **st)
     BR_ASSERT_NEAR(br_pf_estimate(pf)->mean[0] / RPC, 0.5, 1.0);
     /* a lasting jump (the filter lost lock): re-anchored after 3 outliers */
     y.counts = 100;
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_OUTLIER);
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_OUTLIER);
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_OUTLIER);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
     assert_true(all_finite(pf));
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     BR_ASSERT_NEAR(br_pf_estimate(pf)->mean[0] / RPC, 0.5, 1.0);
@@ -207,7 +207,7 @@ static void test_weights_survive_underflow(void **st)
      * every particle; the max-shift keeps the best at weight 1 */
     br_pf_t *pf = calloc(1, sizeof *pf);
     br_pf_cfg_t c = cfg(100);
-    c.outlier_sigma = 1e6f; /* not an outlier by configuration */
+    c.est.outlier_sigma = 1e6f; /* not an outlier by configuration */
     assert_int_equal(br_pf_init(pf, &c), BR_OK);
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
@@ -253,8 +253,8 @@ static void test_tracks_plant_friction(void **st)
         br_status_t s = br_pf_step(pf, &y, (float)u);
         /* breakaway drops the friction from Fs to Fc within a few ms, faster than
          * the g_p random walk: the filter may reject a few measurements there */
-        assert_true(s == BR_OK || s == BR_E_OUTLIER);
-        n_out += (s == BR_E_OUTLIER);
+        assert_true(s == BR_OK || s == BR_W_OUTLIER);
+        n_out += (s == BR_W_OUTLIER);
         if (k >= 1000) { /* after the first breakaway */
             double e = (double)br_pf_estimate(pf)->F_hat_N - p.fnl_N;
             se += e * e;
@@ -284,8 +284,8 @@ static void test_predict_is_model_step(void **st)
     br_pf_t *pf = calloc(1, sizeof *pf);
     assert_non_null(pf);
     br_pf_cfg_t c = cfg(64);
-    for (int i = 0; i < BR_NX; i++) c.q_var[i] = 0.0f;
-    c.outlier_sigma = 1e6f;
+    for (int i = 0; i < BR_NX; i++) c.est.q_var[i] = 0.0f;
+    c.est.outlier_sigma = 1e6f;
     assert_int_equal(br_pf_init(pf, &c), BR_OK);
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
@@ -294,10 +294,10 @@ static void test_predict_is_model_step(void **st)
     int n_bounded = 0;
     for (uint32_t j = 0; j < 64; j++) {
         const float v = (j % 2 ? 1.0f : -1.0f) * 2.0f * powf(10.0f, -6.0f + 6.0f * (float)j / 63.0f);
-        pf->x[j][BR_X_OMEGA] = v / c.model.lead_mprad;
+        pf->x[j][BR_X_OMEGA] = v / c.est.model.lead_mprad;
         pf->x[j][BR_X_Z] = (j % 3 == 0) ? 0.0f : 1e-6f;
         for (int i = 0; i < BR_NX; i++) parent[j][i] = pf->x[j][i];
-        const float ah = c.model.lugre.sigma0_Npm * fabsf(v) * c.model.dt_s / parent[j][BR_X_GP];
+        const float ah = c.est.model.lugre.sigma0_Npm * fabsf(v) * c.est.model.dt_s / parent[j][BR_X_GP];
         n_bounded += ah > BR_MODEL_RK4_AH_MAX;
     }
     assert_true(n_bounded >= 10 && n_bounded <= 54); /* both schemes are exercised */
@@ -360,8 +360,8 @@ static void test_fnl_overflow_is_invalid(void **st)
     br_pf_t *pf = calloc(1, sizeof *pf);
     assert_non_null(pf);
     br_pf_cfg_t c = cfg(100);
-    c.q_var[1] = 3e38f;
-    c.q_var[2] = 3e38f;
+    c.est.q_var[1] = 3e38f;
+    c.est.q_var[2] = 3e38f;
     assert_int_equal(br_pf_init(pf, &c), BR_OK);
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);

@@ -43,40 +43,40 @@ static void test_init_guards(void **st)
     assert_int_equal(init_with(ref_cfg()), BR_OK);
     for (int i = 0; i < BR_NX; i++) {
         for (unsigned b = 0; b < 3; b++) {
-            c = ref_cfg(); c.q_var[i] = bad[b];  assert_int_equal(init_with(c), BR_E_PARAM);
+            c = ref_cfg(); c.est.q_var[i] = bad[b];  assert_int_equal(init_with(c), BR_E_PARAM);
             c = ref_cfg(); c.p0_var[i] = bad[b]; assert_int_equal(init_with(c), BR_E_PARAM);
         }
-        c = ref_cfg(); c.q_var[i] = -1e-20f; assert_int_equal(init_with(c), BR_E_PARAM);
-        c = ref_cfg(); c.q_var[i] = 0.0f;    assert_int_equal(init_with(c), BR_OK);
+        c = ref_cfg(); c.est.q_var[i] = -1e-20f; assert_int_equal(init_with(c), BR_E_PARAM);
+        c = ref_cfg(); c.est.q_var[i] = 0.0f;    assert_int_equal(init_with(c), BR_OK);
         c = ref_cfg(); c.p0_var[i] = 0.0f;   assert_int_equal(init_with(c), BR_E_PARAM);
         c = ref_cfg(); c.p0_var[i] = -1.0f;  assert_int_equal(init_with(c), BR_E_PARAM);
     }
     for (unsigned b = 0; b < 3; b++) {
-        c = ref_cfg(); c.r_var_rad2 = bad[b];    assert_int_equal(init_with(c), BR_E_PARAM);
-        c = ref_cfg(); c.gp0_N = bad[b];         assert_int_equal(init_with(c), BR_E_PARAM);
-        c = ref_cfg(); c.gp_min_N = bad[b];      assert_int_equal(init_with(c), BR_E_PARAM);
-        c = ref_cfg(); c.gp_max_N = bad[b];      assert_int_equal(init_with(c), BR_E_PARAM);
-        c = ref_cfg(); c.outlier_sigma = bad[b]; assert_int_equal(init_with(c), BR_E_PARAM);
-        c = ref_cfg(); c.rad_per_count = bad[b]; assert_int_equal(init_with(c), BR_E_PARAM);
+        c = ref_cfg(); c.est.r_var_rad2 = bad[b];    assert_int_equal(init_with(c), BR_E_PARAM);
+        c = ref_cfg(); c.est.gp0_N = bad[b];         assert_int_equal(init_with(c), BR_E_PARAM);
+        c = ref_cfg(); c.est.gp_min_N = bad[b];      assert_int_equal(init_with(c), BR_E_PARAM);
+        c = ref_cfg(); c.est.gp_max_N = bad[b];      assert_int_equal(init_with(c), BR_E_PARAM);
+        c = ref_cfg(); c.est.outlier_sigma = bad[b]; assert_int_equal(init_with(c), BR_E_PARAM);
+        c = ref_cfg(); c.est.rad_per_count = bad[b]; assert_int_equal(init_with(c), BR_E_PARAM);
         c = ref_cfg(); c.alpha = bad[b];         assert_int_equal(init_with(c), BR_E_PARAM);
         c = ref_cfg(); c.beta = bad[b];          assert_int_equal(init_with(c), BR_E_PARAM);
         c = ref_cfg(); c.kappa = bad[b];         assert_int_equal(init_with(c), BR_E_PARAM);
     }
-    c = ref_cfg(); c.r_var_rad2 = 0.0f;      assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.r_var_rad2 = -1e-12f;   assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.r_var_rad2 = 0.0f;      assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.r_var_rad2 = -1e-12f;   assert_int_equal(init_with(c), BR_E_PARAM);
     /* g_p range: 0 < min < max, gp0 inside */
-    c = ref_cfg(); c.gp_min_N = 0.0f;        assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.gp_min_N = -1.0f;       assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.gp_max_N = c.gp_min_N;  assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.gp_max_N = 0.5f;        assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.gp0_N = 0.5f;           assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.gp0_N = 41.0f;          assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.gp0_N = c.gp_max_N;     assert_int_equal(init_with(c), BR_OK);
-    c = ref_cfg(); c.outlier_sigma = 0.0f;   assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.reanchor_after = 0u;    assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.reanchor_after = 1u;    assert_int_equal(init_with(c), BR_OK);
-    c = ref_cfg(); c.rad_per_count = 0.0f;   assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.rad_per_count = -RPC_F; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.gp_min_N = 0.0f;        assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.gp_min_N = -1.0f;       assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.gp_max_N = c.est.gp_min_N;  assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.gp_max_N = 0.5f;        assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.gp0_N = 0.5f;           assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.gp0_N = 41.0f;          assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.gp0_N = c.est.gp_max_N;     assert_int_equal(init_with(c), BR_OK);
+    c = ref_cfg(); c.est.outlier_sigma = 0.0f;   assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.reanchor_after = 0u;    assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.reanchor_after = 1u;    assert_int_equal(init_with(c), BR_OK);
+    c = ref_cfg(); c.est.rad_per_count = 0.0f;   assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.rad_per_count = -RPC_F; assert_int_equal(init_with(c), BR_E_PARAM);
     /* scaled UT: alpha in (0, 1], beta >= 0, n + kappa > 0 */
     c = ref_cfg(); c.alpha = 0.0f;           assert_int_equal(init_with(c), BR_E_PARAM);
     c = ref_cfg(); c.alpha = -0.5f;          assert_int_equal(init_with(c), BR_E_PARAM);
@@ -88,9 +88,9 @@ static void test_init_guards(void **st)
     c = ref_cfg(); c.kappa = -5.0f;          assert_int_equal(init_with(c), BR_E_PARAM);
     c = ref_cfg(); c.kappa = -3.5f;          assert_int_equal(init_with(c), BR_OK);
     /* the model's own checks */
-    c = ref_cfg(); c.model.J_kgm2 = 0.0f;    assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.model.dt_s = NAN;       assert_int_equal(init_with(c), BR_E_PARAM);
-    c = ref_cfg(); c.model.lugre.Fs_N = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.model.J_kgm2 = 0.0f;    assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.model.dt_s = NAN;       assert_int_equal(init_with(c), BR_E_PARAM);
+    c = ref_cfg(); c.est.model.lugre.Fs_N = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
 }
 
 static void test_weights(void **st)
@@ -245,7 +245,7 @@ static void test_outlier(void **st)
     const int32_t jump = (int32_t)ceil(100.0 * sqrt((double)innov_var(&u, &rest)) / (double)RPC_F);
     const br_meas_t y = {1000 + jump, 0.5f};
     float F = 77.0f;
-    assert_int_equal(br_ukf_est_step(&u, &y, 0.0f, &F), BR_E_OUTLIER);
+    assert_int_equal(br_ukf_est_step(&u, &y, 0.0f, &F), BR_W_OUTLIER);
     assert_true(state_finite(&u));
     assert_true(F == u.est.F_hat_N); /* the prediction's estimate is still reported */
     BR_ASSERT_NEAR(u.est.innov_rad / sqrt((double)u.est.innov_var_rad2), 100.0, 1.0);
@@ -275,12 +275,12 @@ static void test_reanchor_after_lost_lock(void **st)
      * would never reopen; the third outlier in a row re-anchors */
     const int32_t jump = 100000;
     const br_meas_t y = {jump, 0.25f};
-    for (unsigned k = 1; k < c.reanchor_after; k++) {
-        assert_int_equal(br_ukf_step(&u, &y, 0.0f), BR_E_OUTLIER);
+    for (unsigned k = 1; k < c.est.reanchor_after; k++) {
+        assert_int_equal(br_ukf_step(&u, &y, 0.0f), BR_W_OUTLIER);
         assert_int_equal(u.origin_counts, 0);
         assert_int_equal(u.n_outliers, k);
     }
-    assert_int_equal(br_ukf_step(&u, &y, 0.0f), BR_E_OUTLIER);
+    assert_int_equal(br_ukf_step(&u, &y, 0.0f), BR_W_OUTLIER);
     assert_int_equal(u.origin_counts, jump);
     assert_true(u.x[BR_X_THETA] == 0.25f * RPC_F);
     assert_true(u.x[BR_X_OMEGA] == 0.0f); /* same count as the last measurement: at rest */
@@ -301,16 +301,16 @@ static void test_reanchor_after_lost_lock(void **st)
     for (int k = 0; k < 300; k++, cnt += 200) {
         const br_meas_t ym = {cnt, 0.5f};
         const br_status_t s = br_ukf_step(&u, &ym, 0.0f);
-        assert_true(s == BR_OK || (s == BR_E_OUTLIER && k < 10)); /* the start from rest may be rejected */
-        n_out += s == BR_E_OUTLIER;
+        assert_true(s == BR_OK || (s == BR_W_OUTLIER && k < 10)); /* the start from rest may be rejected */
+        n_out += s == BR_W_OUTLIER;
     }
     print_message("  start at 200 counts/period from rest: %d outliers\n", n_out);
     cnt += 50000;
     br_status_t last = BR_OK;
-    for (unsigned k = 0; k < c.reanchor_after; k++, cnt += 200) {
+    for (unsigned k = 0; k < c.est.reanchor_after; k++, cnt += 200) {
         const br_meas_t ym = {cnt, 0.5f};
         last = br_ukf_step(&u, &ym, 0.0f);
-        assert_int_equal(last, BR_E_OUTLIER);
+        assert_int_equal(last, BR_W_OUTLIER);
     }
     BR_ASSERT_NEAR(u.x[BR_X_OMEGA], 200.0 * RPC_F / 1e-3, 1e-6);
     for (int k = 0; k < 20; k++, cnt += 200) {
@@ -370,7 +370,7 @@ static void test_cholesky_failure_recovers(void **st)
     assert_true(state_finite(&u));
     /* the step ran from P0 = diag(p0_var) with the mean kept: g_p's variance is
      * back near p0_var + q_var (theta's measurement barely informs g_p in one step) */
-    BR_ASSERT_NEAR(u.P[BR_X_GP][BR_X_GP], c.p0_var[BR_X_GP] + c.q_var[BR_X_GP], 0.05 * c.p0_var[BR_X_GP]);
+    BR_ASSERT_NEAR(u.P[BR_X_GP][BR_X_GP], c.p0_var[BR_X_GP] + c.est.q_var[BR_X_GP], 0.05 * c.p0_var[BR_X_GP]);
     BR_ASSERT_NEAR(u.x[BR_X_GP], gp_before, 1.0);
     float L[BR_NX][BR_NX];
     assert_int_equal(br_ukf_chol4((const float(*)[BR_NX])u.P, L), BR_OK);
@@ -410,13 +410,13 @@ static void test_gp_clamped(void **st)
     br_ukf_t u;
     br_ukf_cfg_t c = ref_cfg();
     c.p0_var[BR_X_GP] = 1.0e4f; /* sigma points at 12 +- 200 N: clamped into [1, 40] */
-    c.gp0_N = 1.5f;
+    c.est.gp0_N = 1.5f;
     assert_int_equal(br_ukf_init(&u, &c), BR_OK);
     run_at_rest(&u, 0, 5);
     for (int s = 0; s < BR_UKF_NSIG; s++) {
-        assert_true(u.X[s][BR_X_GP] >= c.gp_min_N && u.X[s][BR_X_GP] <= c.gp_max_N);
+        assert_true(u.X[s][BR_X_GP] >= c.est.gp_min_N && u.X[s][BR_X_GP] <= c.est.gp_max_N);
     }
-    assert_true(u.x[BR_X_GP] >= c.gp_min_N && u.x[BR_X_GP] <= c.gp_max_N);
+    assert_true(u.x[BR_X_GP] >= c.est.gp_min_N && u.x[BR_X_GP] <= c.est.gp_max_N);
     assert_true(state_finite(&u));
 }
 
@@ -610,7 +610,7 @@ static void test_tuning_sensitivity(void **st)
             }
         }
         br_ukf_cfg_t c = ref_cfg();
-        c.r_var_rad2 = RPC_F * RPC_F / 12.0f;
+        c.est.r_var_rad2 = RPC_F * RPC_F / 12.0f;
         print_message("%s R = rpc^2/12 (quantisation only):\n", s ? "H-inf loop" : "open loop");
         (void)run_filter_cfg(&t[s], v_sl[s], &c);
     }

@@ -1,10 +1,33 @@
-/* What every friction estimator (PF, UKF) shares: the measurement it takes
- * and the interface through which the axis loop drives it. */
+/* What every friction estimator (PF, UKF) shares: the configuration common
+ * to both, the measurement it takes and the interface through which the axis
+ * loop drives it. */
 #ifndef BR_EST_H
 #define BR_EST_H
 
 #include <stdint.h>
+
+#include "bristle/br_model.h"
 #include "bristle/br_status.h"
+
+/* The configuration the PF and the UKF share (each embeds it as `est`). */
+typedef struct {
+    br_model_cfg_t model;    /* eq. 6 model; model.dt_s is the estimator's period */
+    float q_var[BR_NX];      /* process noise variance per step: rad^2, (rad/s)^2, m^2, N^2; >= 0 */
+    float r_var_rad2;        /* measurement noise variance, > 0 */
+    float gp0_N;             /* initial g_p, in [gp_min_N, gp_max_N] */
+    float gp_min_N;          /* g_p is kept in [gp_min_N, gp_max_N], 0 < min < max */
+    float gp_max_N;
+    float outlier_sigma;     /* a measurement further than outlier_sigma standard deviations from the
+                                whole estimate is an outlier, > 0 (each filter says which deviation) */
+    uint32_t reanchor_after; /* consecutive outliers before the filter is re-anchored on y, >= 1 */
+    float rad_per_count;     /* encoder resolution, > 0 */
+} br_est_cfg_t;
+
+/* Checks the shared configuration: the model (br_model_init's checks),
+ * process-noise variances finite and >= 0, R > 0, 0 < gp_min < gp_max with
+ * gp0 inside, an outlier gate > 0, at least one outlier before re-anchoring,
+ * an encoder resolution > 0. BR_OK, BR_E_NULL or BR_E_PARAM. */
+br_status_t br_est_cfg_check(const br_est_cfg_t *cfg);
 
 /* Encoder measurement: position = (counts + frac) counts. For a plain
  * quadrature encoder (floor quantisation) pass frac = 0.5, the centre of the
@@ -15,21 +38,15 @@ typedef struct {
 } br_meas_t;
 
 /* One estimator step: y is the measurement at t_k, u_prev_Nm the torque that
- * was applied over [t_{k-1}, t_k]; on BR_OK *F_hat_N is the friction
- * estimate f_nl at t_k (load side, N). */
+ * was applied over [t_{k-1}, t_k]. Unless the status is an error (negative),
+ * *F_hat_N is the friction estimate f_nl at t_k (load side, N); BR_W_OUTLIER
+ * means the measurement was skipped and the estimate is the prediction's. */
 typedef br_status_t (*br_est_step_fn)(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
 
 typedef struct {
     void *ctx;
     br_est_step_fn step;
 } br_est_t;
-
-/* The checks the PF and the UKF share: process-noise variances finite and
- * >= 0, R > 0, 0 < gp_min < gp_max with gp0 inside, an outlier gate > 0, at
- * least one outlier before re-anchoring, an encoder resolution > 0.
- * BR_OK or BR_E_PARAM. */
-br_status_t br_est_check_common(const float q_var[4], float r_var_rad2, float gp0_N, float gp_min_N, float gp_max_N,
-                                float outlier_sigma, uint32_t reanchor_after, float rad_per_count);
 
 /* The step inputs both estimators accept: u finite, frac finite and in [0, 1];
  * BR_OK, else BR_E_INPUT. */

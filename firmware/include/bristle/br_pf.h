@@ -31,17 +31,11 @@
 #endif
 
 typedef struct {
-    br_model_cfg_t model;    /* eq. 6 model; model.dt_s is the PF's period */
+    br_est_cfg_t est;        /* what the PF shares with the UKF: model (est.model.dt_s is the PF's
+                                period), noise, g_p range, gates; outlier: |y - theta_j| >
+                                est.outlier_sigma sqrt(R) for every particle j */
     uint32_t n_particles;    /* m, 1..BR_PF_MAX_PARTICLES */
-    float q_var[BR_NX];      /* process noise variance per step: rad^2, (rad/s)^2, m^2, N^2; >= 0 */
-    float r_var_rad2;        /* measurement noise variance, > 0 */
-    float gp0_N;             /* initial g_p, in [gp_min_N, gp_max_N] */
     float x0_std[BR_NX];     /* initial spread around [y_0, 0, 0, gp0]; >= 0 */
-    float gp_min_N;          /* g_p is kept in [gp_min_N, gp_max_N], 0 < min < max */
-    float gp_max_N;
-    float outlier_sigma;     /* |y - theta_j| > outlier_sigma sqrt(R) for every j: outlier, > 0 */
-    uint32_t reanchor_after; /* consecutive outliers before the cloud is re-anchored on y, >= 1 */
-    float rad_per_count;     /* encoder resolution, > 0 */
     const float *noise;      /* standard-normal ROM table (e.g. br_noise_table) */
     uint32_t noise_len;      /* its length, a power of two >= 2 */
     uint32_t noise_skip;     /* extra table advance per step (indexing scheme, docs/modules/pf.md) */
@@ -79,7 +73,7 @@ typedef struct {
 br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg);
 
 /* One filter step (see above). Statuses: BR_E_INPUT for a non-finite u or
- * frac outside [0, 1] (state untouched); BR_E_OUTLIER when y is further than
+ * frac outside [0, 1] (state untouched); BR_W_OUTLIER when y is further than
  * outlier_sigma from every particle (no weighting: the valid predicted
  * particles are kept with equal weights; after reanchor_after consecutive
  * outliers the cloud is re-anchored, its mean theta moved to y and its mean

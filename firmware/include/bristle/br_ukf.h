@@ -33,16 +33,10 @@
 #define BR_UKF_NSIG (2 * BR_NX + 1)
 
 typedef struct {
-    br_model_cfg_t model;    /* eq. 6 model; model.dt_s is the UKF's period */
-    float q_var[BR_NX];      /* process noise variance per step: rad^2, (rad/s)^2, m^2, N^2; >= 0 */
-    float r_var_rad2;        /* measurement noise variance, > 0 */
-    float gp0_N;             /* initial g_p, in [gp_min_N, gp_max_N] */
+    br_est_cfg_t est;        /* what the UKF shares with the PF: model (est.model.dt_s is the UKF's
+                                period), noise, g_p range (every sigma point and the mean are kept
+                                in it), gates; outlier: |y - theta-| > est.outlier_sigma sqrt(S) */
     float p0_var[BR_NX];     /* initial (and recovery) variances P0 = diag(p0_var), > 0 */
-    float gp_min_N;          /* g_p of every sigma point and of the mean kept in */
-    float gp_max_N;          /*   [gp_min_N, gp_max_N], 0 < min < max */
-    float outlier_sigma;     /* |y - theta-| > outlier_sigma sqrt(S): outlier, > 0 */
-    uint32_t reanchor_after; /* consecutive outliers before x is re-anchored on y, >= 1 */
-    float rad_per_count;     /* encoder resolution, > 0 */
     float alpha;             /* sigma-point spread, in (0, 1]; use >= 0.1 in float32 (1 recommended) */
     float beta;              /* prior-distribution weight, >= 0 (2 for a Gaussian) */
     float kappa;             /* secondary scaling, n + kappa > 0 (so n + lambda > 0) */
@@ -86,7 +80,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg);
  * Statuses:
  *   BR_E_NULL / BR_E_STATE  NULL argument / not initialised;
  *   BR_E_INPUT    non-finite u, or frac non-finite or outside [0, 1]: state untouched;
- *   BR_E_OUTLIER  |y - theta-| > outlier_sigma sqrt(S): the prediction is kept
+ *   BR_W_OUTLIER  |y - theta-| > outlier_sigma sqrt(S): the prediction is kept
  *                 (origin unchanged), no update; on the reanchor_after-th
  *                 consecutive outlier the filter has lost lock and is
  *                 re-anchored: origin = y.counts, x = [frac rpc, measured
@@ -104,7 +98,7 @@ br_status_t br_ukf_chol4(const float A[BR_NX][BR_NX], float L[BR_NX][BR_NX]);
 const br_ukf_est_t *br_ukf_estimate(const br_ukf_t *ukf);
 
 /* br_est_t binding: ctx is a br_ukf_t *. *F_hat_N is written on BR_OK and on
- * BR_E_OUTLIER (the prediction's estimate), as for the PF. */
+ * BR_W_OUTLIER (the prediction's estimate), as for the PF. */
 br_status_t br_ukf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
 
 #endif

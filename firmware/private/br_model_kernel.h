@@ -1,4 +1,4 @@
-/* Inline kernel of the eq. 6 model's RK4 step (internal to the firmware).
+/* Inline kernel of the eq. 6 model's RK4 step (private to the firmware).
  *
  * br_model_step and the particle filter's prediction loop both step through
  * these functions. The model's constants are copied once into a local
@@ -14,6 +14,7 @@
 #include <math.h>
 
 #include "bristle/br_model.h"
+#include "br_lugre_kernel.h"
 
 typedef struct {
     float L;        /* lead, m/rad */
@@ -44,14 +45,13 @@ static inline br_model_k_t br_model_k(const br_model_t *m)
 /* eq. 4 with g = g_p: dz/dt = v - sigma0 |v| z / g_p, v = L omega */
 static inline float br_model_k_zdot(const br_model_k_t *k, float omega, float z, float gp)
 {
-    const float v = k->L * omega;
-    return v - k->s0 * fabsf(v) * z / gp;
+    return br_lk_zdot_mps(k->s0, k->L * omega, z, gp);
 }
 
 /* eq. 3: f_nl = sigma0 z + sigma1 dz/dt */
 static inline float br_model_k_fnl(const br_model_k_t *k, float z, float zdot)
 {
-    return k->s0 * z + k->s1 * zdot;
+    return br_lk_force_N(k->s0, k->s1, z, zdot);
 }
 
 /* eq. 6: domega/dt = (u - L^2 sigma2 omega - L f_nl) / Jeff */
