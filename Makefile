@@ -69,7 +69,7 @@ help:
 	@echo "  make firmware  cross build (cm7-release) and print flash / RAM use"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
 	@echo "  make regen     regenerate the generated headers and the golden traces"
-	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates sim/circle/gen/)"
+	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
 	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
 	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
 	@echo "  V=1 shows the commands; JOBS=n sets the ctest parallelism (default 2)"
@@ -105,14 +105,14 @@ demo: deps
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_demo.py $(DEMO_OUT)
 
 # Nelder-Mead tuning of the PF's and the UKF's noise variances on the circle
-# (thesis section 3.2): regenerates sim/circle/gen/br_{pf,ukf}_tuned.h, with the
+# (thesis section 3.2): regenerates firmware/gen/bristle_gen/est/br_{pf,ukf}_tuned.h, with the
 # progress logs and thesis Fig. 1 in $(TUNE_OUT). docs/tuning.md.
 tune: deps
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)mkdir -p $(TUNE_OUT)
-	$(Q)build/host-release/sim/br_tune_est --est ukf --out sim/circle/gen/br_ukf_tuned.h --log $(TUNE_OUT)/ukf.csv
-	$(Q)build/host-release/sim/br_tune_est --est pf --out sim/circle/gen/br_pf_tuned.h --log $(TUNE_OUT)/pf.csv
+	$(Q)build/host-release/sim/br_tune_est --est ukf --out firmware/gen/bristle_gen/est/br_ukf_tuned.h --log $(TUNE_OUT)/ukf.csv
+	$(Q)build/host-release/sim/br_tune_est --est pf --out firmware/gen/bristle_gen/est/br_pf_tuned.h --log $(TUNE_OUT)/pf.csv
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_tuning.py $(TUNE_OUT)/fig1_tuning.png $(TUNE_OUT)/pf.csv:"H-inf + PF" $(TUNE_OUT)/ukf.csv:"H-inf + UKF"
 
 # Thesis Figs. 1-8 into docs/figures/ and docs/results.md (about 12 min: the

@@ -32,7 +32,7 @@ from ref import plant as rplant
 from ref import ukf as rukf
 
 DESIGN_DIR = os.path.join(REPO_ROOT, "firmware", "design")
-NOISE_HEADER = os.path.join(REPO_ROOT, "firmware", "gen", "br_noise_table.h")
+NOISE_HEADER = os.path.join(REPO_ROOT, "firmware", "gen", "bristle_gen", "est", "br_noise_table.h")
 
 # the closed-loop recording: x axis of the thesis circle (A = 1e-4 m, T = 8 s)
 # at the PF's 1.5 ms, from rest; 1600 steps = 2.4 s (reversal at 2.0 s)
@@ -66,7 +66,7 @@ def fmt_f32(v):
 
 def noise_table():
     """The PF's ROM table exactly as firmware/design/gen_noise.py writes it,
-    of the length in firmware/gen/br_noise_table.h (BR_NOISE_LEN)."""
+    of the length in firmware/gen/bristle_gen/est/br_noise_table.h (BR_NOISE_LEN)."""
     sys.path.insert(0, DESIGN_DIR)
     try:
         import gen_noise

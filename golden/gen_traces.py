@@ -40,7 +40,7 @@ SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
 DT = 1.0e-3
 INT32_MAX = 2**31 - 1
 K_FALLBACK = (-0.60, -0.0094, -13.6)
-GAINS_HEADER = os.path.join(REPO_ROOT, "firmware", "gen", "br_hinf_gains.h")
+GAINS_HEADER = os.path.join(REPO_ROOT, "firmware", "gen", "bristle_gen", "ctrl", "br_hinf_gains.h")
 
 # Rows whose RK4/bounded choice (a h vs 2) or saturation flag (|u| vs tau_max)
 # lies closer to the threshold than this relative margin are not emitted: a
@@ -240,7 +240,7 @@ def gen_model(out_dir, m):
 # (c) controller sequence
 # --------------------------------------------------------------------------
 def read_gains():
-    """K from firmware/gen/br_hinf_gains.h (#define BR_HINF_K { a, b, c }) if it
+    """K from firmware/gen/bristle_gen/ctrl/br_hinf_gains.h (#define BR_HINF_K { a, b, c }) if it
     exists, else the fallback; rounded to float32 (what the C config holds)."""
     try:
         with open(GAINS_HEADER, "r", encoding="utf-8") as f:
@@ -248,7 +248,7 @@ def read_gains():
         mm = re.search(r"#define\s+BR_HINF_K\s*\{([^}]*)\}", text)
         vals = [float(s.strip().rstrip("fF")) for s in mm.group(1).split(",")]
         assert len(vals) == 3
-        return tuple(f32(v) for v in vals), "firmware/gen/br_hinf_gains.h"
+        return tuple(f32(v) for v in vals), "firmware/gen/bristle_gen/ctrl/br_hinf_gains.h"
     except (OSError, AttributeError, ValueError, AssertionError):
         return tuple(f32(v) for v in K_FALLBACK), "fallback"
 

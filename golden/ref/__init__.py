@@ -14,11 +14,11 @@ import os
 __all__ = ["REPO_ROOT", "MACHINE_JSON", "load_machine"]
 
 REPO_ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-MACHINE_JSON = os.path.join(REPO_ROOT, "firmware", "design", "reference_machine.json")
+MACHINE_JSON = os.path.join(REPO_ROOT, "machines", "reference.json")
 
 
 def load_machine(path=MACHINE_JSON):
-    """Reference machine parameters (firmware/design/reference_machine.json)
+    """Reference machine parameters (machines/reference.json)
     plus the derived quantities every reference needs:
       L = lead / (2 pi)                  (m/rad)
       Jeff = J + L^2 M                   (kg m^2)

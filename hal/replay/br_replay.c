@@ -3,7 +3,7 @@
 
 #include <string.h>
 
-#include "br_noise_table.h"
+#include "bristle_gen/est/br_noise_table.h"
 
 static uint32_t f2w(float f)
 {

@@ -24,7 +24,7 @@
 
 #include "br_circle.h"
 #include "br_circle_est.h"
-#include "br_reference_machine.h"
+#include "bristle_gen/machine/br_machine.h"
 
 #define DT0_S 0.5e-3
 #define N_DT 6
@@ -43,7 +43,7 @@ static void log_sink(void *user, const br_circle_sample_t *s)
     if (g->n >= g->cap) return;
     for (int a = 0; a < 2; a++) {
         g->counts[a][g->n] = s->counts[a];
-        g->tau[a][g->n] = s->duty[a] * BR_REF_TAU_PER_DUTY_NM;
+        g->tau[a][g->n] = s->duty[a] * BR_MACHINE_TAU_PER_DUTY_NM;
         g->fnl[a][g->n] = s->fnl_N[a];
     }
     g->n++;

@@ -34,7 +34,7 @@
 #include "br_circle.h"
 #include "br_circle_est.h"
 #include "br_hal_sim.h"
-#include "br_noise_table.h"
+#include "bristle_gen/est/br_noise_table.h"
 #include "bristle/br_axis.h"
 
 #define BR_PI 3.14159265358979323846

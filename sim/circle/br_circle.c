@@ -6,8 +6,8 @@
 
 #include "br_circle_est.h"
 #include "br_hal_sim.h"
-#include "br_hinf_gains.h"
-#include "br_reference_machine.h"
+#include "bristle_gen/ctrl/br_hinf_gains.h"
+#include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_axis.h"
 
 #define BR_PI 3.14159265358979323846

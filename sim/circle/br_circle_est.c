@@ -1,30 +1,30 @@
 /* Estimator configurations for the circle experiment (docs/modules/pf.md). */
 #include "br_circle_est.h"
 
-#include "br_noise_table.h"
-#include "gen/br_pf_tuned.h"
-#include "gen/br_ukf_tuned.h"
-#include "br_reference_machine.h"
+#include "bristle_gen/est/br_noise_table.h"
+#include "bristle_gen/est/br_pf_tuned.h"
+#include "bristle_gen/est/br_ukf_tuned.h"
+#include "bristle_gen/machine/br_machine.h"
 
 br_model_cfg_t br_ref_model_cfg(float dt_s)
 {
     br_model_cfg_t m;
-    m.J_kgm2 = BR_REF_J_KGM2_F;
-    m.M_kg = BR_REF_M_KG_F;
-    m.lead_mprad = BR_REF_LEAD_MPRAD_F;
-    m.sigma2_Nspm = BR_REF_SIGMA2_NSPM_F;
-    m.lugre.sigma0_Npm = BR_REF_SIGMA0_NPM_F;
-    m.lugre.sigma1_Nspm = BR_REF_SIGMA1_NSPM_F;
-    m.lugre.Fc_N = BR_REF_FC_N_F;
-    m.lugre.Fs_N = BR_REF_FS_N_F;
-    m.lugre.vs_mps = BR_REF_VS_MPS_F;
+    m.J_kgm2 = BR_MACHINE_J_KGM2_F;
+    m.M_kg = BR_MACHINE_M_KG_F;
+    m.lead_mprad = BR_MACHINE_LEAD_MPRAD_F;
+    m.sigma2_Nspm = BR_MACHINE_SIGMA2_NSPM_F;
+    m.lugre.sigma0_Npm = BR_MACHINE_SIGMA0_NPM_F;
+    m.lugre.sigma1_Nspm = BR_MACHINE_SIGMA1_NSPM_F;
+    m.lugre.Fc_N = BR_MACHINE_FC_N_F;
+    m.lugre.Fs_N = BR_MACHINE_FS_N_F;
+    m.lugre.vs_mps = BR_MACHINE_VS_MPS_F;
     m.dt_s = dt_s;
     return m;
 }
 
 br_pf_cfg_t br_circle_pf_cfg_default(float dt_s)
 {
-    const float rpc = BR_REF_RAD_PER_COUNT_F;
+    const float rpc = BR_MACHINE_RAD_PER_COUNT_F;
     br_pf_cfg_t c;
     c.est.model = br_ref_model_cfg(dt_s);
     c.n_particles = 1500u;
@@ -34,13 +34,13 @@ br_pf_cfg_t br_circle_pf_cfg_default(float dt_s)
     c.est.q_var[BR_X_Z] = 1.0e-14f;
     c.est.q_var[BR_X_GP] = 0.1f;
     c.est.r_var_rad2 = 0.3f * rpc * rpc;
-    c.est.gp0_N = BR_REF_FS_N_F;
+    c.est.gp0_N = BR_MACHINE_FS_N_F;
     c.x0_std[BR_X_THETA] = 0.3f * rpc;
     c.x0_std[BR_X_OMEGA] = 1.0e-3f;
     c.x0_std[BR_X_Z] = 1.0e-7f;
     c.x0_std[BR_X_GP] = 2.0f;
-    c.est.gp_min_N = 0.5f * BR_REF_FC_N_F;
-    c.est.gp_max_N = 1.5f * BR_REF_FS_N_F;
+    c.est.gp_min_N = 0.5f * BR_MACHINE_FC_N_F;
+    c.est.gp_max_N = 1.5f * BR_MACHINE_FS_N_F;
     c.est.outlier_sigma = 30.0f;
     c.est.reanchor_after = 3u;
     c.est.rad_per_count = rpc;
@@ -52,7 +52,7 @@ br_pf_cfg_t br_circle_pf_cfg_default(float dt_s)
 
 br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s)
 {
-    const float rpc = BR_REF_RAD_PER_COUNT_F;
+    const float rpc = BR_MACHINE_RAD_PER_COUNT_F;
     br_ukf_cfg_t c;
     c.est.model = br_ref_model_cfg(dt_s);
     /* the values of docs/modules/ukf.md (lightly hand-tuned) */

@@ -15,7 +15,7 @@ br_pf_cfg_t br_circle_pf_cfg_default(float dt_s);
 /* The UKF of thesis section 5 at period dt_s, hand-tuned (the tuning's start). */
 br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s);
 
-/* The same with the variances found by Nelder-Mead (sim/circle/gen/, make tune):
+/* The same with the variances found by Nelder-Mead (firmware/gen/bristle_gen/est/, make tune):
  * what the demo runs. */
 br_pf_cfg_t br_circle_pf_cfg_tuned(float dt_s);
 br_ukf_cfg_t br_circle_ukf_cfg_tuned(float dt_s);

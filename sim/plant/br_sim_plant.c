@@ -5,7 +5,7 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "br_reference_machine.h"
+#include "bristle_gen/machine/br_machine.h"
 
 /* Fixed-point passes on the mean velocity of a substep. The map contracts by
  * about 2 sigma1 L^2 h / Jeff (6e-3 at h = 50 us), so 4 passes leave an error
@@ -17,17 +17,17 @@
 br_plant_cfg_t br_plant_cfg_reference(void)
 {
     br_plant_cfg_t c;
-    c.J_kgm2 = BR_REF_J_KGM2;
-    c.M_kg = BR_REF_M_KG;
-    c.lead_mprad = BR_REF_LEAD_MPRAD;
-    c.sigma2_Nspm = BR_REF_SIGMA2_NSPM;
-    c.sigma0_Npm = BR_REF_SIGMA0_NPM;
-    c.sigma1_Nspm = BR_REF_SIGMA1_NSPM;
-    c.Fc_N = BR_REF_FC_N;
-    c.Fs_N = BR_REF_FS_N;
-    c.vs_mps = BR_REF_VS_MPS;
-    c.counts_per_rev = BR_REF_COUNTS_PER_REV;
-    c.tau_per_duty_Nm = BR_REF_TAU_PER_DUTY_NM;
+    c.J_kgm2 = BR_MACHINE_J_KGM2;
+    c.M_kg = BR_MACHINE_M_KG;
+    c.lead_mprad = BR_MACHINE_LEAD_MPRAD;
+    c.sigma2_Nspm = BR_MACHINE_SIGMA2_NSPM;
+    c.sigma0_Npm = BR_MACHINE_SIGMA0_NPM;
+    c.sigma1_Nspm = BR_MACHINE_SIGMA1_NSPM;
+    c.Fc_N = BR_MACHINE_FC_N;
+    c.Fs_N = BR_MACHINE_FS_N;
+    c.vs_mps = BR_MACHINE_VS_MPS;
+    c.counts_per_rev = BR_MACHINE_COUNTS_PER_REV;
+    c.tau_per_duty_Nm = BR_MACHINE_TAU_PER_DUTY_NM;
     c.n_sub = 20;
     /* causes off */
     c.offset_N = 0.0;

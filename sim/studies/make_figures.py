@@ -35,7 +35,7 @@ def tune(build, work):
         hdr = os.path.join(work, "br_%s_tuned.h" % est)
         run([os.path.join(build, "sim", "br_tune_est"), "--est", est, "--out", hdr, "--log",
              os.path.join(work, "%s_tune.csv" % est)])
-        same[est] = filecmp.cmp(hdr, os.path.join(ROOT, "sim", "circle", "gen", "br_%s_tuned.h" % est), shallow=False)
+        same[est] = filecmp.cmp(hdr, os.path.join(ROOT, "firmware", "gen", "bristle_gen", "est", "br_%s_tuned.h" % est), shallow=False)
     run([PY, os.path.join(ROOT, "sim", "plots", "plot_tuning.py"), os.path.join(FIGS, "fig1_tuning.png"),
          os.path.join(work, "pf_tune.csv") + ":H-inf + PF", os.path.join(work, "ukf_tune.csv") + ":H-inf + UKF"])
     logs = {}
@@ -138,7 +138,7 @@ def results_only(work):
         rows = [r.split(",") for r in open(os.path.join(work, "%s_tune.csv" % est)).read().split("\n")[1:] if r]
         logs[est] = (float(rows[0][2]), float(rows[-1][2]), int(rows[-1][1]))
     same = {e: filecmp.cmp(os.path.join(work, "br_%s_tuned.h" % e),
-                           os.path.join(ROOT, "sim", "circle", "gen", "br_%s_tuned.h" % e), shallow=False)
+                           os.path.join(ROOT, "firmware", "gen", "bristle_gen", "est", "br_%s_tuned.h" % e), shallow=False)
             for e in ("ukf", "pf")}
     demo = os.path.join(work, "demo")
     write_results(json.load(open(os.path.join(demo, "summary.json"))),

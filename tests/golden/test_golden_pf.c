@@ -32,7 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_noise_table.h"
+#include "bristle_gen/est/br_noise_table.h"
 #include "bristle/br_encoder.h"
 #include "bristle/br_model.h"
 #include "bristle/br_pf.h"

@@ -1,12 +1,12 @@
 /* LuGre module: configuration guards, eqs. 3-5, bounded bristle update. */
 #include "br_test.h"
 
-#include "br_reference_machine.h"
+#include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_lugre.h"
 
 static br_lugre_cfg_t ref_cfg(void)
 {
-    br_lugre_cfg_t c = {BR_REF_SIGMA0_NPM_F, BR_REF_SIGMA1_NSPM_F, BR_REF_FC_N_F, BR_REF_FS_N_F, BR_REF_VS_MPS_F};
+    br_lugre_cfg_t c = {BR_MACHINE_SIGMA0_NPM_F, BR_MACHINE_SIGMA1_NSPM_F, BR_MACHINE_FC_N_F, BR_MACHINE_FS_N_F, BR_MACHINE_VS_MPS_F};
     return c;
 }
 
@@ -107,7 +107,7 @@ static void test_bounded_at_any_speed(void **st)
         for (int k = 0; k < 50; k++) {
             assert_int_equal(br_lugre_step(&s, speeds[i], 1e-3f, &F), BR_OK);
             assert_true(isfinite(F));
-            assert_true(fabsf(s.z_m) <= BR_REF_FS_N_F / BR_REF_SIGMA0_NPM_F * 1.0001f);
+            assert_true(fabsf(s.z_m) <= BR_MACHINE_FS_N_F / BR_MACHINE_SIGMA0_NPM_F * 1.0001f);
         }
         BR_ASSERT_NEAR(F, copysign(7.0, speeds[i]), 1e-3 * 7.0 + 0.0);
     }

@@ -2,7 +2,7 @@
  * against a fine double-precision integration, boundedness at speed. */
 #include "br_test.h"
 
-#include "br_reference_machine.h"
+#include "bristle_gen/machine/br_machine.h"
 #include "br_circle_est.h"
 #include "bristle/br_model.h"
 
@@ -36,7 +36,7 @@ static void test_deriv_eq6(void **st)
     br_model_t m;
     br_model_cfg_t c = ref_cfg(1e-3f);
     assert_int_equal(br_model_init(&m, &c), BR_OK);
-    const double L = BR_REF_LEAD_MPRAD, J = BR_REF_J_KGM2 + L * L * BR_REF_M_KG;
+    const double L = BR_MACHINE_LEAD_MPRAD, J = BR_MACHINE_J_KGM2 + L * L * BR_MACHINE_M_KG;
     float x[BR_NX] = {0.1f, 2.0f, 1e-6f, 12.0f}, dx[BR_NX];
     br_model_deriv(&m, x, 0.05f, dx);
     double v = L * 2.0, zd = v - 4e6 * fabs(v) * 1e-6 / 12.0, fnl = 4e6 * 1e-6 + 2e3 * zd;
@@ -50,7 +50,7 @@ static void test_deriv_eq6(void **st)
 /* Double-precision RK4 of eq. 6 with n substeps: the accuracy reference. */
 static void fine_step(const double p[4], double u, double dt, int n, double out[4])
 {
-    const double L = BR_REF_LEAD_MPRAD, J = BR_REF_J_KGM2 + L * L * BR_REF_M_KG;
+    const double L = BR_MACHINE_LEAD_MPRAD, J = BR_MACHINE_J_KGM2 + L * L * BR_MACHINE_M_KG;
     double x[4] = {p[0], p[1], p[2], p[3]}, h = dt / n;
     for (int s = 0; s < n; s++) {
         double k[4][4], xs[4];
@@ -103,8 +103,8 @@ static void test_bounded_at_speed(void **st)
     for (unsigned i = 0; i < 4; i++) {
         float x[BR_NX] = {0.0f, omegas[i], -1.0e-6f, 7.0f}, xn[BR_NX];
         /* torque that holds the speed: viscous + Coulomb */
-        float u = BR_REF_LEAD_MPRAD_F * BR_REF_LEAD_MPRAD_F * 50.0f * omegas[i] +
-                  copysignf(BR_REF_LEAD_MPRAD_F * 7.0f, omegas[i]);
+        float u = BR_MACHINE_LEAD_MPRAD_F * BR_MACHINE_LEAD_MPRAD_F * 50.0f * omegas[i] +
+                  copysignf(BR_MACHINE_LEAD_MPRAD_F * 7.0f, omegas[i]);
         for (int k = 0; k < 1000; k++) {
             assert_int_equal(br_model_step(&m, x, u, xn), BR_OK);
             for (int j = 0; j < BR_NX; j++) x[j] = xn[j];
@@ -123,7 +123,7 @@ static void test_switch_is_continuous(void **st)
     br_model_cfg_t c = ref_cfg(1e-3f);
     assert_int_equal(br_model_init(&m, &c), BR_OK);
     /* just below and just above the RK4 limit a h = 2 the two schemes agree */
-    const double L = BR_REF_LEAD_MPRAD;
+    const double L = BR_MACHINE_LEAD_MPRAD;
     float w_lim = (float)(2.0 * 7.0 / (4e6 * L * 1e-3));
     float xa[BR_NX] = {0.0f, 0.999f * w_lim, 7.0f / 4.0e6f, 7.0f}, xb[BR_NX] = {0.0f, 1.001f * w_lim, 7.0f / 4.0e6f, 7.0f};
     float na[BR_NX], nb[BR_NX];

@@ -6,13 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_noise_table.h"
-#include "br_reference_machine.h"
+#include "bristle_gen/est/br_noise_table.h"
+#include "bristle_gen/machine/br_machine.h"
 #include "br_circle_est.h"
 #include "bristle/br_pf.h"
 #include "plant/br_sim_plant.h"
 
-#define RPC BR_REF_RAD_PER_COUNT_F
+#define RPC BR_MACHINE_RAD_PER_COUNT_F
 
 static br_pf_cfg_t cfg(uint32_t m)
 {

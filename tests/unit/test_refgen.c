@@ -9,7 +9,7 @@
 
 #define TWO_PI 6.283185307179586476925
 
-/* Reference machine (firmware/design/reference_machine.json): 8 mm lead,
+/* Reference machine (machines/reference.json): 8 mm lead,
  * 2^20 counts per motor revolution. */
 static br_refgen_cfg_t cfg_default(void)
 {

@@ -7,14 +7,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_hinf_gains.h"
+#include "bristle_gen/ctrl/br_hinf_gains.h"
 #include "br_circle_est.h"
-#include "br_reference_machine.h"
+#include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_encoder.h"
 #include "bristle/br_ukf.h"
 #include "plant/br_sim_plant.h"
 
-#define RPC_F BR_REF_RAD_PER_COUNT_F
+#define RPC_F BR_MACHINE_RAD_PER_COUNT_F
 #define PI_D 3.14159265358979323846
 
 /* The defaults of docs/modules/ukf.md for the reference machine at 1 ms. */
@@ -446,7 +446,7 @@ static trace_t simulate(scen_t scen, int n)
     const br_plant_state_t x0 = {0.0, 0.0, 0.0};
     br_plant_t p;
     assert_int_equal(br_plant_init(&p, &pc, &x0), 0);
-    const double L = BR_REF_LEAD_MPRAD, rpc = BR_REF_RAD_PER_COUNT, dt = 1.0e-3;
+    const double L = BR_MACHINE_LEAD_MPRAD, rpc = BR_MACHINE_RAD_PER_COUNT, dt = 1.0e-3;
     const float K[3] = BR_HINF_K;
     double integ = 0.0;
     for (int k = 0; k < n; k++) {
@@ -519,7 +519,7 @@ static conv_t run_filter_cfg(const trace_t *t, double v_sliding, const br_ukf_cf
             n_half++;
             if (fabs(t->v[k]) > v_sliding) {
                 /* eq. 5: the plant's Stribeck level at its velocity */
-                const double g = BR_REF_FC_N + (BR_REF_FS_N - BR_REF_FC_N) * exp(-fabs(t->v[k]) / BR_REF_VS_MPS);
+                const double g = BR_MACHINE_FC_N + (BR_MACHINE_FS_N - BR_MACHINE_FC_N) * exp(-fabs(t->v[k]) / BR_MACHINE_VS_MPS);
                 r.gp_err_N += fabs(u.x[BR_X_GP] - g);
                 r.n_sliding++;
             }

@@ -6,7 +6,7 @@
  *   u      = K [e_theta, e_omega, eps]^T + L F_comp
  *   tau    = sat(u, tau_max)               (anti-windup: conditional integration)
  *   duty   = tau / tau_per_duty
- * K comes from tools/hinf/synth_hinf.py (firmware/gen/br_hinf_gains.h).
+ * K comes from firmware/design/synth_hinf.py (firmware/gen/bristle_gen/ctrl/br_hinf_gains.h).
  * See docs/modules/ctrl.md. */
 #ifndef BR_CTRL_H
 #define BR_CTRL_H

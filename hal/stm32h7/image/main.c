@@ -1,6 +1,6 @@
 /* The bristle firmware image for the STM32H743: one axis tracking a
  * sinusoidal (circle-test) reference with the H-infinity gains of
- * firmware/gen/br_hinf_gains.h, without friction compensation (comp 0 N).
+ * firmware/gen/bristle_gen/ctrl/br_hinf_gains.h, without friction compensation (comp 0 N).
  *
  * Peripherals (RM0433): TIM2 encoder on PA0 (CH1) / PA1 (CH2), TIM1 PWM on
  * PA8 (CH1), PA9 (CH2), PB13 (CH1N), PB14 (CH2N), all AF1; SysTick tick.
@@ -13,10 +13,10 @@
 #include <stddef.h>
 
 #include "bristle/br_axis.h"
-#include "br_hinf_gains.h"
+#include "bristle_gen/ctrl/br_hinf_gains.h"
 #include "bristle/br_refgen.h"
 #include "bristle/br_stm32h7.h"
-#include "br_reference_machine.h"
+#include "bristle_gen/machine/br_machine.h"
 
 #define BR_IMAGE_CPU_HZ       64000000u  /* HSI after reset */
 #define BR_IMAGE_TIM_HZ       64000000u  /* APB timer kernel clock */
@@ -35,7 +35,7 @@
 #define BR_IMAGE_REF_PERIOD_S    2.0f
 #define BR_IMAGE_REF_PHASE_RAD   0.0f
 
-#define BR_IMAGE_TAU_MAX_NM      (0.9f * BR_REF_TAU_PER_DUTY_NM_F)
+#define BR_IMAGE_TAU_MAX_NM      (0.9f * BR_MACHINE_TAU_PER_DUTY_NM_F)
 
 /* Motor stopped and outputs off; waits for a reset or a debugger. */
 static void br_image_halt(br_stm32h7_t *port)
@@ -71,17 +71,17 @@ int main(void)
         .K = BR_IMAGE_K,
         .dt_s = BR_IMAGE_DT_S,
         .tau_max_Nm = BR_IMAGE_TAU_MAX_NM,
-        .tau_per_duty_Nm = BR_REF_TAU_PER_DUTY_NM_F,
-        .rad_per_count = BR_REF_RAD_PER_COUNT_F,
-        .lead_mprad = BR_REF_LEAD_MPRAD_F,
+        .tau_per_duty_Nm = BR_MACHINE_TAU_PER_DUTY_NM_F,
+        .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,
+        .lead_mprad = BR_MACHINE_LEAD_MPRAD_F,
     };
     const br_refgen_cfg_t ref_cfg = {
         .amplitude_m = BR_IMAGE_REF_AMPLITUDE_M,
         .period_s = BR_IMAGE_REF_PERIOD_S,
         .phase_rad = BR_IMAGE_REF_PHASE_RAD,
         .dt_s = BR_IMAGE_DT_S,
-        .lead_mprad = BR_REF_LEAD_MPRAD_F,
-        .rad_per_count = BR_REF_RAD_PER_COUNT_F,
+        .lead_mprad = BR_MACHINE_LEAD_MPRAD_F,
+        .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,
     };
     br_stm32h7_gpio_t *gpioa = (br_stm32h7_gpio_t *)BR_STM32H7_GPIOA_BASE;
     br_stm32h7_gpio_t *gpiob = (br_stm32h7_gpio_t *)BR_STM32H7_GPIOB_BASE;
