@@ -1,10 +1,19 @@
 /* Configuration and step-input checks shared by the friction estimators. See br_est.h. */
 #include "bristle/br_est.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
 #include "br_check.h"
+
+int br_est_var_ok(float v, int zero_ok)
+{
+    if (v == 0.0f) {
+        return zero_ok;
+    }
+    return isfinite(v) && v >= FLT_MIN && v <= BR_EST_VAR_MAX;
+}
 
 br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
 {
@@ -16,13 +25,16 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
+    if (!br_finite_pos(cfg->rad_per_count) || !br_finite_pos(cfg->outlier_sigma) || cfg->reanchor_after < 1u) {
+        return BR_E_PARAM;
+    }
     for (int i = 0; i < BR_NX; i++) {
-        if (!br_finite_nonneg(cfg->q_var[i])) {
+        if (!br_est_var_ok(cfg->q_var[i], 1)) {
             return BR_E_PARAM;
         }
     }
-    if (!br_finite_pos(cfg->r_var_rad2) || !br_finite_pos(cfg->outlier_sigma) || !br_finite_pos(cfg->rad_per_count) ||
-        cfg->reanchor_after < 1u) {
+    const float rpc2 = cfg->rad_per_count * cfg->rad_per_count;
+    if (!br_est_var_ok(cfg->r_var_rad2, 0) || !(cfg->r_var_rad2 >= BR_EST_R_MIN_COUNTS2 * rpc2)) {
         return BR_E_PARAM;
     }
     if (!br_finite_pos(cfg->gp_min_N) || !isfinite(cfg->gp_max_N) || !(cfg->gp_max_N > cfg->gp_min_N) ||

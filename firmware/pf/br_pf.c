@@ -30,13 +30,18 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
         return BR_E_PARAM;
     }
     for (int i = 0; i < BR_NX; i++) {
-        if (!br_finite_nonneg(cfg->x0_std[i])) {
+        if (!br_est_var_ok(cfg->x0_std[i] * cfg->x0_std[i], 1) || !br_finite_nonneg(cfg->x0_std[i])) {
             return BR_E_PARAM;
         }
     }
     br_status_t st = br_est_cfg_check(&cfg->est);
     if (st != BR_OK) {
         return st;
+    }
+    /* g_p is static in the model: its process noise is the only thing that keeps
+     * the resampled particles apart in g_p; without it the cloud collapses */
+    if (!(cfg->est.q_var[BR_X_GP] > 0.0f)) {
+        return BR_E_PARAM;
     }
     st = br_model_init(&pf->model, &cfg->est.model);
     if (st != BR_OK) {
@@ -52,6 +57,7 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     pf->origin_counts = 0;
     pf->primed = 0;
     pf->n_outliers = 0u;
+    pf->n_predicted = 0u;
     pf->est = (br_pf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N}, 0, 0.0f, (float)cfg->n_particles};
     pf->ready = 1;
     return BR_OK;
@@ -219,17 +225,20 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             pf->fnl[j] = fnl;
             /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R) */
             const float e = th - y_rel;
+            /* may be -inf for a particle far from y: still valid (NaN marks invalid) */
             const float l = -(e * e) * inv_2r;
             pf->l[j] = l;
             lm = fmaxf(lm, l);
             n_valid++;
         } else {
-            /* unusable: the particle keeps its state and gets weight 0 */
+            /* unusable: the particle keeps its state and gets weight 0; its
+             * log-weight is NaN, which no valid particle's can be (fmaxf and
+             * the max-shifted exponential both skip it) */
             for (int i = 0; i < BR_NX; i++) {
                 xo[i] = xj[i];
             }
             pf->fnl[j] = 0.0f;
-            pf->l[j] = -INFINITY;
+            pf->l[j] = NAN;
         }
     }
     *lmax = lm;
@@ -237,8 +246,8 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
 }
 
 /* Step 3: max-shifted weights w_j = e^(l_j - lmax), quantised to W_j (an invalid
- * particle has l_j = -inf and gets e^-inf = 0); on an outlier every valid particle
- * gets w = 1. Returns the total of W; *sw and *sw2 get the sums of w and w^2
+ * particle has l_j = NaN and br_exp_neg gives 0 for it); on an outlier every
+ * valid particle (l_j not NaN, even -inf when its residual overflowed) gets w = 1. Returns the total of W; *sw and *sw2 get the sums of w and w^2
  * (for the ESS). */
 static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw, float *sw2)
 {
@@ -251,7 +260,7 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
      * (one loop with the branch costs 5 more instructions per particle on the M7) */
     if (outlier) {
         for (uint32_t j = 0; j < m; j++) {
-            const float w = (l[j] > -INFINITY) ? 1.0f : 0.0f;
+            const float w = (l[j] == l[j]) ? 1.0f : 0.0f; /* valid: not NaN */
             W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
             total += W[j];
             s1 += w;
@@ -344,7 +353,8 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     if (pf->n_outliers >= pf->cfg.est.reanchor_after) {
         /* lost lock: re-anchor the cloud on the measurement, keeping its spread:
          * theta's mean moves to y, omega's mean to the measured velocity */
-        const float omega_meas = (shift + (y->frac - pf->prev_frac) * rpc) / pf->cfg.est.model.dt_s;
+        const float periods = (float)pf->n_predicted + 1.0f;
+        const float omega_meas = (shift + (y->frac - pf->prev_frac) * rpc) / (periods * pf->cfg.est.model.dt_s);
         const float d_th = y_rel - s[BR_X_THETA] * inv_m, d_om = omega_meas - s[BR_X_OMEGA] * inv_m;
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
@@ -358,6 +368,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     }
     pf->origin_counts = y->counts;
     pf->prev_frac = y->frac;
+    pf->n_predicted = 0u;
     for (int i = 0; i < BR_NX; i++) {
         pf->est.mean[i] = s[i] * inv_m;
     }
@@ -366,6 +377,43 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     /* effective sample size of the weights, (sum w)^2 / sum w^2 */
     pf->est.ess = sw * sw / sw2;
     return verdict;
+}
+
+br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
+{
+    if (pf == NULL) {
+        return BR_E_NULL;
+    }
+    if (!pf->ready || !pf->primed) {
+        return BR_E_STATE; /* nothing to predict from before the first measurement */
+    }
+    if (!isfinite(u_prev_Nm)) {
+        return BR_E_INPUT;
+    }
+    const uint32_t m = pf->cfg.n_particles;
+    /* step 1 only: the log-weights against a dummy measurement are not used */
+    float lmax;
+    const uint32_t n_valid = predict_and_weigh(pf, u_prev_Nm, 0.0f, 0.0f, &lmax);
+    noise_advance(pf);
+    if (n_valid == 0u) {
+        return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
+    }
+    /* every particle moves on unweighted (an invalid one kept its state in xp) */
+    for (uint32_t j = 0; j < m; j++) {
+        pf->idx[j] = (uint16_t)j;
+    }
+    float s[BR_NX];
+    const float sf = copy_resampled(pf, s);
+    const float inv_m = 1.0f / (float)m;
+    for (int i = 0; i < BR_NX; i++) {
+        pf->est.mean[i] = s[i] * inv_m;
+    }
+    pf->est.F_hat_N = sf * inv_m;
+    pf->est.ess = (float)m;
+    if (pf->n_predicted < UINT32_MAX) {
+        pf->n_predicted++;
+    }
+    return BR_OK;
 }
 
 const br_pf_est_t *br_pf_estimate(const br_pf_t *pf) { return (pf != NULL) ? &pf->est : NULL; }

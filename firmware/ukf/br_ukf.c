@@ -25,7 +25,7 @@ static int mat_finite(const float A[BR_NX][BR_NX])
 static br_status_t check_cfg(const br_ukf_cfg_t *cfg)
 {
     for (int i = 0; i < BR_NX; i++) {
-        if (!br_finite_pos(cfg->p0_var[i])) {
+        if (!br_est_var_ok(cfg->p0_var[i], 0)) {
             return BR_E_PARAM;
         }
     }
@@ -92,6 +92,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->prev_frac = 0.0f;
     ukf->n_outliers = 0u;
     ukf->n_recover = 0u;
+    ukf->n_predicted = 0u;
     ukf->primed = 0;
     ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N},
                               {cfg->p0_var[0], cfg->p0_var[1], cfg->p0_var[2], cfg->p0_var[3]},
@@ -223,6 +224,90 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
     return BR_OK;
 }
 
+/* Steps 1-2: sigma points of the posterior (x, P) of the last step and their
+ * prediction through eq. 6 discretised, Y_j = f_d(X_j, u_{k-1}), into the
+ * predicted mean xm and covariance Pm. *chol_reset is set when a failed
+ * Cholesky reset P (kept in ukf->P: the recovery outlives a later failure).
+ * Returns 0 when the prediction is not finite. */
+static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[BR_NX], float Pm[BR_NX][BR_NX], int *chol_reset)
+{
+    *chol_reset = sigma_points(ukf, ukf->x, ukf->P) != BR_OK;
+    for (int s = 0; s < BR_UKF_NSIG; s++) {
+        if (br_model_step(&ukf->model, ukf->X[s], u_prev_Nm, ukf->Y[s]) != BR_OK) {
+            return 0;
+        }
+    }
+    /* predicted mean x- = sum_j Wm_j Y_j = Y_0 + m, m = sum_{j>=1} W (Y_j - Y_0) (sum Wm = 1) */
+    float mdev[BR_NX];
+    for (int i = 0; i < BR_NX; i++) {
+        float d = 0.0f;
+        for (int s = 1; s < BR_UKF_NSIG; s++) {
+            d += ukf->Y[s][i] - ukf->Y[0][i];
+        }
+        mdev[i] = ukf->wi * d;
+        xm[i] = ukf->Y[0][i] + mdev[i];
+    }
+    /* predicted covariance P- = sum_j Wc_j (Y_j - x-)(Y_j - x-)^T + Q, evaluated about
+     * the central point (d_j = Y_j - Y_0) as the algebraically equal
+     *   P- = sum_{j>=1} W d_j d_j^T + (beta - alpha^2) m m^T + Q,
+     * which has no large |Wc_0| to cancel in float32 and is PSD for beta >= alpha^2 */
+    for (int i = 0; i < BR_NX; i++) {
+        for (int j = 0; j <= i; j++) {
+            Pm[i][j] = ukf->cmm * mdev[i] * mdev[j];
+        }
+    }
+    for (int s = 1; s < BR_UKF_NSIG; s++) {
+        float d[BR_NX];
+        for (int i = 0; i < BR_NX; i++) {
+            d[i] = ukf->Y[s][i] - ukf->Y[0][i];
+        }
+        for (int i = 0; i < BR_NX; i++) {
+            for (int j = 0; j <= i; j++) {
+                Pm[i][j] += ukf->wi * d[i] * d[j];
+            }
+        }
+    }
+    for (int i = 0; i < BR_NX; i++) {
+        Pm[i][i] += ukf->cfg.est.q_var[i];
+        for (int j = 0; j < i; j++) {
+            Pm[j][i] = Pm[i][j];
+        }
+    }
+    return vec_finite(xm) && mat_finite((const float(*)[BR_NX])Pm);
+}
+
+/* A step whose prediction or update is not finite: the mean and origin are
+ * kept, P is reset to diag(p0_var) and the reset counted, so the next step
+ * starts again from a usable covariance instead of failing forever. */
+static br_status_t fail_reset(br_ukf_t *ukf)
+{
+    reset_cov(&ukf->cfg, ukf->P);
+    ukf->n_recover++;
+    return BR_E_NUMERIC;
+}
+
+/* Step 4 and the commit: sigma points of (xm, Pm) (a failed Cholesky resets Pm
+ * as in step 1 and sets *chol_reset), the unscented mean of f_nl over them
+ * into *F_hat, then x = xm, P = Pm. Returns 0, committing nothing, when
+ * *F_hat is not finite. */
+static int posterior(br_ukf_t *ukf, const float xm[BR_NX], float Pm[BR_NX][BR_NX], float *F_hat, int *chol_reset)
+{
+    if (sigma_points(ukf, xm, Pm) != BR_OK) {
+        *chol_reset = 1;
+    }
+    *F_hat = fnl_unscented(ukf);
+    if (!isfinite(*F_hat)) {
+        return 0;
+    }
+    for (int i = 0; i < BR_NX; i++) {
+        ukf->x[i] = xm[i];
+        for (int j = 0; j < BR_NX; j++) {
+            ukf->P[i][j] = Pm[i][j];
+        }
+    }
+    return 1;
+}
+
 /* P <- (P + P^T) / 2 */
 static void symmetrise(float P[BR_NX][BR_NX])
 {
@@ -252,55 +337,11 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     }
     const float rpc = ukf->cfg.est.rad_per_count;
 
-    /* 1. sigma points of the posterior (x, P) of the last step; a failed
-     *    Cholesky resets P (kept in ukf->P: the recovery outlives a later failure) */
-    const br_status_t st_chol = sigma_points(ukf, ukf->x, ukf->P);
-
-    /* 2. predict every sigma point through eq. 6 discretised: Y_j = f_d(X_j, u_{k-1}) */
-    for (int s = 0; s < BR_UKF_NSIG; s++) {
-        if (br_model_step(&ukf->model, ukf->X[s], u_prev_Nm, ukf->Y[s]) != BR_OK) {
-            return BR_E_NUMERIC; /* x, P (possibly reset) and origin kept */
-        }
-    }
-    /* predicted mean x- = sum_j Wm_j Y_j = Y_0 + m, m = sum_{j>=1} W (Y_j - Y_0) (sum Wm = 1) */
-    float xm[BR_NX], mdev[BR_NX];
-    for (int i = 0; i < BR_NX; i++) {
-        float d = 0.0f;
-        for (int s = 1; s < BR_UKF_NSIG; s++) {
-            d += ukf->Y[s][i] - ukf->Y[0][i];
-        }
-        mdev[i] = ukf->wi * d;
-        xm[i] = ukf->Y[0][i] + mdev[i];
-    }
-    /* predicted covariance P- = sum_j Wc_j (Y_j - x-)(Y_j - x-)^T + Q, evaluated about
-     * the central point (d_j = Y_j - Y_0) as the algebraically equal
-     *   P- = sum_{j>=1} W d_j d_j^T + (beta - alpha^2) m m^T + Q,
-     * which has no large |Wc_0| to cancel in float32 and is PSD for beta >= alpha^2 */
-    float Pm[BR_NX][BR_NX];
-    for (int i = 0; i < BR_NX; i++) {
-        for (int j = 0; j <= i; j++) {
-            Pm[i][j] = ukf->cmm * mdev[i] * mdev[j];
-        }
-    }
-    for (int s = 1; s < BR_UKF_NSIG; s++) {
-        float d[BR_NX];
-        for (int i = 0; i < BR_NX; i++) {
-            d[i] = ukf->Y[s][i] - ukf->Y[0][i];
-        }
-        for (int i = 0; i < BR_NX; i++) {
-            for (int j = 0; j <= i; j++) {
-                Pm[i][j] += ukf->wi * d[i] * d[j];
-            }
-        }
-    }
-    for (int i = 0; i < BR_NX; i++) {
-        Pm[i][i] += ukf->cfg.est.q_var[i];
-        for (int j = 0; j < i; j++) {
-            Pm[j][i] = Pm[i][j];
-        }
-    }
-    if (!vec_finite(xm) || !mat_finite((const float(*)[BR_NX])Pm)) {
-        return BR_E_NUMERIC;
+    /* 1.-2. sigma points of the last posterior, predicted mean and covariance */
+    float xm[BR_NX], Pm[BR_NX][BR_NX];
+    int chol_reset;
+    if (!predict(ukf, u_prev_Nm, xm, Pm, &chol_reset)) {
+        return fail_reset(ukf);
     }
 
     /* 3. measurement: theta re-expressed relative to the new origin y.counts
@@ -311,7 +352,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     /* innovation variance S = H P- H^T + R = P-_00 + R (h(x) = theta) */
     const float S = Pm[0][0] + ukf->cfg.est.r_var_rad2;
     if (!isfinite(nu) || !br_finite_pos(S)) {
-        return BR_E_NUMERIC;
+        return fail_reset(ukf);
     }
     br_status_t verdict = BR_OK;
     int32_t origin_new = y->counts;
@@ -325,11 +366,12 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
              * (wrap-safe count difference), z and g_p means kept, P = diag(p0_var) */
             const float dcounts = (float)br_counts_delta(y->counts, ukf->prev_counts);
             xm[BR_X_THETA] = y->frac * rpc;
-            xm[BR_X_OMEGA] = (dcounts + (y->frac - ukf->prev_frac)) * rpc / ukf->cfg.est.model.dt_s;
+            const float periods = (float)ukf->n_predicted + 1.0f;
+            xm[BR_X_OMEGA] = (dcounts + (y->frac - ukf->prev_frac)) * rpc / (periods * ukf->cfg.est.model.dt_s);
             reset_cov(&ukf->cfg, Pm);
             origin_new = y->counts;
             if (!vec_finite(xm)) {
-                return BR_E_NUMERIC;
+                return fail_reset(ukf);
             }
         }
     } else {
@@ -361,28 +403,19 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
         /* g_p of the mean kept in [gp_min, gp_max], as the sigma points' are */
         xm[BR_X_GP] = br_clampf(xm[BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
         if (!vec_finite(xm) || !mat_finite((const float(*)[BR_NX])Pm)) {
-            return BR_E_NUMERIC;
+            return fail_reset(ukf);
         }
     }
 
-    /* 4. posterior sigma points and the unscented mean of f_nl (eq. 6);
-     *    a failed Cholesky of P+ resets Pm as in step 1 */
-    const br_status_t st_post = sigma_points(ukf, xm, Pm);
-    const float F_hat = fnl_unscented(ukf);
-    if (!isfinite(F_hat)) {
-        return BR_E_NUMERIC;
-    }
-
-    /* commit */
-    for (int i = 0; i < BR_NX; i++) {
-        ukf->x[i] = xm[i];
-        for (int j = 0; j < BR_NX; j++) {
-            ukf->P[i][j] = Pm[i][j];
-        }
+    /* 4. posterior sigma points, the unscented mean of f_nl, commit x and P */
+    float F_hat;
+    if (!posterior(ukf, xm, Pm, &F_hat, &chol_reset)) {
+        return fail_reset(ukf);
     }
     ukf->origin_counts = origin_new;
     ukf->prev_counts = y->counts;
     ukf->prev_frac = y->frac;
+    ukf->n_predicted = 0u;
     /* as in the PF, every further outlier in the run re-anchors again */
     if (verdict != BR_W_OUTLIER) {
         ukf->n_outliers = 0u;
@@ -390,10 +423,39 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
         ukf->n_outliers++;
     }
     set_estimate(ukf, F_hat, nu, S);
-    if (st_chol != BR_OK || st_post != BR_OK) {
-        return BR_E_NUMERIC;
+    return chol_reset ? BR_E_NUMERIC : verdict;
+}
+
+br_status_t br_ukf_predict(br_ukf_t *ukf, float u_prev_Nm)
+{
+    if (ukf == NULL) {
+        return BR_E_NULL;
     }
-    return verdict;
+    if (!ukf->ready) {
+        return BR_E_STATE;
+    }
+    if (!isfinite(u_prev_Nm)) {
+        return BR_E_INPUT;
+    }
+    if (!ukf->primed) {
+        return BR_E_STATE; /* nothing to predict from before the first measurement */
+    }
+    float xm[BR_NX], Pm[BR_NX][BR_NX];
+    int chol_reset;
+    if (!predict(ukf, u_prev_Nm, xm, Pm, &chol_reset)) {
+        return fail_reset(ukf);
+    }
+    xm[BR_X_GP] = br_clampf(xm[BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
+    /* the predicted set's sigma points give the estimate, as after an update */
+    float F_hat;
+    if (!posterior(ukf, xm, Pm, &F_hat, &chol_reset)) {
+        return fail_reset(ukf);
+    }
+    if (ukf->n_predicted < UINT32_MAX) {
+        ukf->n_predicted++;
+    }
+    set_estimate(ukf, F_hat, 0.0f, 0.0f);
+    return chol_reset ? BR_E_NUMERIC : BR_OK;
 }
 
 const br_ukf_est_t *br_ukf_estimate(const br_ukf_t *ukf) { return (ukf != NULL) ? &ukf->est : NULL; }

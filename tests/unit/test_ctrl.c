@@ -94,11 +94,12 @@ static void test_saturation_and_antiwindup(void **st)
     /* integrating would push deeper into saturation: eps held at zero */
     BR_ASSERT_NEAR(c.eps_rads, 0.0, 0.0);
     /* saturated but the error now reduces the command: the integral runs */
-    c.eps_rads = -1.0f;           /* u = -10 * -1 = 10 N m, saturated high */
+    c.eps_rads = -0.06f;          /* K2 eps = 0.6 N m, inside the clamp tau_max / |K2| = 0.064 */
     in = in_at(1000, 0);          /* e > 0: K2 e < 0, opposite to u */
+    in.comp_N = 100.0f;           /* L F_comp = 0.127 N m: u = 0.724 N m, saturated high */
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
     assert_int_equal(out.saturated, 1);
-    BR_ASSERT_NEAR(c.eps_rads, -1.0 + 1000 * 6.0e-6 * 1e-3, 1e-7);
+    BR_ASSERT_NEAR(c.eps_rads, -0.06 + 1000 * 6.0e-6 * 1e-3, 1e-7);
     /* negative side */
     br_ctrl_t c2;
     assert_int_equal(br_ctrl_init(&c2, &k), BR_OK);
@@ -153,9 +154,82 @@ static void test_step_rejects_bad_input(void **st)
     assert_int_equal(br_ctrl_step(&c, &in, NULL), BR_E_NULL);
 }
 
+/* Out-of-range inputs and unusable states give zero duty and an error: the
+ * axis loop latches them (docs/reliability.md). */
+static void test_out_of_range_gives_zero_duty(void **st)
+{
+    (void)st;
+    br_ctrl_t c;
+    br_ctrl_cfg_t k = cfg();
+    br_ctrl_out_t out;
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    br_ctrl_in_t in = in_at(0, 5);
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    const float eps = c.eps_rads;
+    /* a reference fraction of 1e30 once gave duty +1 */
+    const float bad_frac[] = {1e30f, -0.01f, 1.0001f, -INFINITY};
+    for (unsigned i = 0; i < sizeof bad_frac / sizeof bad_frac[0]; i++) {
+        in = in_at(0, 5); in.ref_frac_counts = bad_frac[i];
+        assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_INPUT);
+        assert_true(out.duty == 0.0f && out.tau_Nm == 0.0f);
+    }
+    in = in_at(0, 5); in.ref_frac_counts = 1.0f;
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    /* a compensation beyond what the actuator can exert (tau_max / L = 504 N) */
+    in = in_at(0, 5); in.comp_N = 510.0f;
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_INPUT);
+    assert_true(out.duty == 0.0f);
+    in = in_at(0, 5); in.comp_N = -500.0f;
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    /* a velocity reference that makes the law overflow */
+    in = in_at(0, 5); in.ref_omega_radps = 3e38f;
+    c.eps_rads = eps;
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK); /* K1 e_omega = 3e36: saturates, finite */
+    k.K[1] = -1e10f;
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_NUMERIC); /* K1 e_omega overflows */
+    assert_true(out.duty == 0.0f);
+    /* a NaN or infinite integrator once gave duty -1 with BR_OK */
+    k = cfg();
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    const float bad_eps[] = {NAN, INFINITY, -INFINITY, 1.0f};
+    for (unsigned i = 0; i < sizeof bad_eps / sizeof bad_eps[0]; i++) {
+        c.eps_rads = bad_eps[i];
+        in = in_at(0, 5);
+        assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_NUMERIC);
+        assert_true(out.duty == 0.0f && out.tau_Nm == 0.0f);
+    }
+}
+
+/* The integral is clamped both ways where its term alone saturates the
+ * torque: a compensation that holds the command at the opposite limit lets it
+ * integrate (the anti-windup sees the error reducing the command), and
+ * without the clamp it would run on to twice that. */
+static void test_integrator_clamped_both_ways(void **st)
+{
+    (void)st;
+    const br_ctrl_cfg_t k = cfg();
+    const double eps_max = k.tau_max_Nm / fabs(k.K[2]);
+    for (int sign = -1; sign <= 1; sign += 2) {
+        br_ctrl_t c;
+        br_ctrl_out_t out;
+        assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+        BR_ASSERT_NEAR(c.eps_max_rads, eps_max, 1e-6 * eps_max);
+        for (int i = 0; i < 30000; i++) {
+            br_ctrl_in_t in = in_at(sign * 1000, 0);
+            in.comp_N = (float)sign * 450.0f; /* L F_comp = 0.57 N m against the integral */
+            assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+            assert_true(fabs(c.eps_rads) <= eps_max * (1.0 + 1e-6));
+        }
+        BR_ASSERT_NEAR(c.eps_rads, sign * eps_max, 1e-6 * eps_max);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_out_of_range_gives_zero_duty),
+        cmocka_unit_test(test_integrator_clamped_both_ways),
         cmocka_unit_test(test_init_guards),           cmocka_unit_test(test_control_law),
         cmocka_unit_test(test_compensation_adds_torque), cmocka_unit_test(test_saturation_and_antiwindup),
         cmocka_unit_test(test_velocity_across_wrap),  cmocka_unit_test(test_step_rejects_bad_input),

@@ -2,7 +2,7 @@
  *
  *   e_theta = theta - theta_ref            (from integer counts, wrap-safe)
  *   e_omega = omega - omega_ref            (omega from the encoder difference)
- *   eps    <- eps + e_theta dt             (integral state)
+ *   eps    <- eps + e_theta dt             (integral state, |eps| <= tau_max / |K2|)
  *   u      = K [e_theta, e_omega, eps]^T + L F_comp
  *   tau    = sat(u, tau_max)               (anti-windup: conditional integration)
  *   duty   = tau / tau_per_duty
@@ -41,7 +41,9 @@ typedef struct {
 
 typedef struct {
     br_ctrl_cfg_t cfg;
-    float eps_rads;        /* integral of the position error */
+    float eps_rads;        /* integral of the position error, |eps| <= eps_max_rads */
+    float eps_max_rads;    /* tau_max / |K2|: the integral term alone saturates the torque */
+    float comp_max_N;      /* tau_max / L: the largest compensation the actuator can exert */
     int32_t prev_counts;
     int primed;            /* prev_counts valid */
     int ready;
@@ -49,8 +51,14 @@ typedef struct {
 
 br_status_t br_ctrl_init(br_ctrl_t *c, const br_ctrl_cfg_t *cfg);
 
-/* One control period. A non-finite input gives BR_E_INPUT, a zero-torque
- * output, and leaves the integral state unchanged. */
+/* One control period. Zero torque and duty, the integral state unchanged, and
+ *   BR_E_INPUT   for a reference fraction outside [0, 1] or non-finite, a
+ *                non-finite reference velocity, or a compensation that is
+ *                non-finite or larger than tau_max / L;
+ *   BR_E_NUMERIC for an integral state that is non-finite or beyond its clamp,
+ *                or a control law that is not finite (an error or reference
+ *                velocity beyond float range).
+ * The caller (the axis loop) latches these as faults. */
 br_status_t br_ctrl_step(br_ctrl_t *c, const br_ctrl_in_t *in, br_ctrl_out_t *out);
 
 #endif

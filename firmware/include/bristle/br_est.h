@@ -9,6 +9,16 @@
 #include "bristle/br_model.h"
 #include "bristle/br_status.h"
 
+/* Largest variance an estimator accepts, in any of its units (rad^2,
+ * (rad/s)^2, m^2, N^2): a standard deviation of 1e6 rad, rad/s, m or N is no
+ * physical setting, and beyond it the float32 sigma points, squared residuals
+ * and the eq. 6 prediction of a spread-out state lose the range they need. */
+#define BR_EST_VAR_MAX 1.0e12f
+/* Smallest measurement variance, in encoder counts^2: a millionth of a count^2
+ * is far below any quantised encoder's noise (1/12 count^2), and it keeps
+ * 1 / (2 R) and the log-weights finite. */
+#define BR_EST_R_MIN_COUNTS2 1.0e-6f
+
 /* The configuration the PF and the UKF share (each embeds it as `est`). */
 typedef struct {
     br_model_cfg_t model;    /* eq. 6 model; model.dt_s is the estimator's period */
@@ -23,11 +33,16 @@ typedef struct {
     float rad_per_count;     /* encoder resolution, > 0 */
 } br_est_cfg_t;
 
-/* Checks the shared configuration: the model (br_model_init's checks),
- * process-noise variances finite and >= 0, R > 0, 0 < gp_min < gp_max with
- * gp0 inside, an outlier gate > 0, at least one outlier before re-anchoring,
- * an encoder resolution > 0. BR_OK, BR_E_NULL or BR_E_PARAM. */
+/* Checks the shared configuration: the model (br_model_init's checks), an
+ * encoder resolution > 0, process-noise variances 0 or normal floats up to
+ * BR_EST_VAR_MAX (no subnormals), R from BR_EST_R_MIN_COUNTS2 counts^2 up to
+ * BR_EST_VAR_MAX, 0 < gp_min < gp_max with gp0 inside, an outlier gate > 0, at
+ * least one outlier before re-anchoring. BR_OK, BR_E_NULL or BR_E_PARAM. */
 br_status_t br_est_cfg_check(const br_est_cfg_t *cfg);
+
+/* 1 when v is a usable variance: a normal float in [FLT_MIN, BR_EST_VAR_MAX],
+ * or exactly 0 where zero_ok. */
+int br_est_var_ok(float v, int zero_ok);
 
 /* Encoder measurement: position = (counts + frac) counts. For a plain
  * quadrature encoder (floor quantisation) pass frac = 0.5, the centre of the

@@ -58,12 +58,13 @@ typedef struct {
     int32_t origin_counts;
     float prev_frac;              /* the last measurement's fraction */
     uint32_t n_outliers;          /* consecutive outlier steps */
+    uint32_t n_predicted;         /* predict-only steps since the last measurement */
     int primed;                   /* particles drawn around the first measurement */
     /* particles, one state vector each: current set, and the predicted set */
     float x[BR_PF_MAX_PARTICLES][BR_NX];
     float xp[BR_PF_MAX_PARTICLES][BR_NX];
     float fnl[BR_PF_MAX_PARTICLES];   /* f_nl of the predicted particles */
-    float l[BR_PF_MAX_PARTICLES];     /* log-weights */
+    float l[BR_PF_MAX_PARTICLES];     /* log-weights; NaN marks an invalid particle */
     uint32_t W[BR_PF_MAX_PARTICLES];  /* quantised weights */
     uint16_t idx[BR_PF_MAX_PARTICLES];/* resampling indices of the last step */
     br_pf_est_t est;
@@ -81,6 +82,16 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg);
  * BR_E_NUMERIC when every predicted particle is non-finite (the previous set is
  * kept). In every case the particles stay finite. */
 br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm);
+
+/* Predict-only step for a period without a measurement (a failed or missing
+ * encoder read): step 1 for every particle with u_{k-1}, no weighting or
+ * resampling, so the cloud spreads by the process noise each period; origin
+ * unchanged; the estimate is the predicted set's mean and mean f_nl. The next
+ * br_pf_step weighs and resamples as usual; a re-anchoring after a gap takes
+ * the measured velocity over all the periods since the last measurement.
+ * BR_E_STATE before the first measurement, BR_E_INPUT for a non-finite u,
+ * BR_E_NUMERIC when every predicted particle is non-finite (set kept). */
+br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm);
 
 /* Deterministic systematic resampling in integer arithmetic: for the weights
  * W[0..m-1] (not all zero) writes idx[i] = the j with C_{j-1} <= t_i < C_j,

@@ -67,7 +67,9 @@ typedef struct {
     int32_t prev_counts;             /* last measurement (accepted or not): the measured */
     float prev_frac;                 /*   velocity for a re-anchoring */
     uint32_t n_outliers;             /* consecutive outlier steps */
-    uint32_t n_recover;              /* Cholesky recoveries since init */
+    uint32_t n_recover;              /* covariance resets since init (failed Cholesky, or a
+                                        non-finite prediction or update) */
+    uint32_t n_predicted;            /* predict-only steps since the last measurement */
     int primed;                      /* x, P set from the first measurement */
     br_ukf_est_t est;
     int ready;
@@ -85,10 +87,20 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg);
  *                 consecutive outlier the filter has lost lock and is
  *                 re-anchored: origin = y.counts, x = [frac rpc, measured
  *                 velocity, z, g_p] (z, g_p means kept), P = diag(p0_var);
- *   BR_E_NUMERIC  a non-finite prediction or update: the previous x, P and
- *                 origin are kept; or a Cholesky failure: P was reset to
- *                 diag(p0_var) with the mean kept (the step otherwise completed). */
+ *   BR_E_NUMERIC  a non-finite prediction or update: x and origin are kept
+ *                 and P is reset to diag(p0_var) (counted in n_recover), so
+ *                 the filter cannot stay stuck; or a Cholesky failure: P was
+ *                 reset the same way (the step otherwise completed). */
 br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm);
+
+/* Predict-only step for a period without a measurement (a failed or missing
+ * encoder read): steps 1-2 with u_{k-1}, x = x-, P = P- (the spread grows by
+ * Q each period), origin unchanged; the estimate is the unscented mean of
+ * f_nl over the predicted sigma points. The next br_ukf_step updates as
+ * usual; a re-anchoring after a gap takes the measured velocity over all the
+ * periods since the last measurement. BR_E_STATE before the first
+ * measurement, BR_E_INPUT for a non-finite u, BR_E_NUMERIC as for a step. */
+br_status_t br_ukf_predict(br_ukf_t *ukf, float u_prev_Nm);
 
 /* Fixed-size 4 x 4 Cholesky factorisation A = L L^T (L lower, upper part
  * zeroed). BR_E_NUMERIC on a pivot <= 0 or a non-finite value (L then undefined). */
