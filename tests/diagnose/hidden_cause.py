@@ -4,7 +4,7 @@ generator the diagnosis never sees, diagnosed from the log alone.
 Each case: the generator draws a cause (balanced over none + the five
 causes, in a seeded order) and its parameters; br_simlog writes an
 identification log of the reference machine with that cause (and seeded
-force noise); the diagnosis's command line (`python -m diagnose diagnose`,
+force noise); the diagnosis's command line (`python -m bristle.diagnose diagnose`,
 called in this process) gets only the log path, in a directory holding
 nothing else. The case passes when
   - the verdict is the hidden cause ("none" for a nominal log),
@@ -32,8 +32,8 @@ import time
 import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(REPO, "sim"))
-from diagnose import __main__ as diagnose_cli  # noqa: E402
+sys.path.insert(0, os.path.join(REPO, "python"))
+from bristle.diagnose import __main__ as diagnose_cli  # noqa: E402
 
 CAUSES = ("none", "offset", "asymmetric_friction", "position_ripple", "position_gradient", "actuator_delay")
 MASTER_SEED = 20261121

@@ -1,5 +1,5 @@
 """End to end through the command lines: br_simlog writes a log with a
-hidden offset; `python -m diagnose diagnose` writes every output; `validate`
+hidden offset; `python -m bristle.diagnose diagnose` writes every output; `validate`
 applies the saved model to another log of the same machine; br_simlog loads
 the saved model and its log is explained by it; the Python closed loop
 agrees with the C plant; bad inputs give "file:line: problem".
@@ -21,8 +21,8 @@ ARGS = None
 
 
 def py(*a):
-    env = dict(os.environ, PYTHONPATH=os.path.join(REPO, "sim"), MPLBACKEND="Agg")
-    return subprocess.run([sys.executable, "-m", "diagnose", *a], env=env, capture_output=True, text=True)
+    env = dict(os.environ, PYTHONPATH=os.path.join(REPO, "python"), MPLBACKEND="Agg")
+    return subprocess.run([sys.executable, "-m", "bristle.diagnose", *a], env=env, capture_output=True, text=True)
 
 
 def simlog(*a):
@@ -62,7 +62,7 @@ class CliTest(unittest.TestCase):
         self.assertLess(cl["extended"]["relerr_position_percent"], 0.01)
         with open(os.path.join(self.out, "report.md")) as f:
             md = f.read()
-        self.assertTrue(md.startswith("<!-- sim/diagnose"))
+        self.assertTrue(md.startswith("<!-- python/bristle/diagnose"))
         self.assertIn("**Verdict: offset**", md)
         self.assertNotRegex(md, r"20\d\d-\d\d-\d\d")  # no timestamp
         # a rerun writes the same report (deterministic, no timestamp)
@@ -102,8 +102,8 @@ class CliTest(unittest.TestCase):
     def test_python_closed_loop_agrees_with_the_c_plant(self):
         """The diagnosis's closed-loop simulator with the true parameters
         against br_simlog's true position (same controller, same reference)."""
-        sys.path.insert(0, os.path.join(REPO, "sim"))
-        from diagnose import closedloop
+        sys.path.insert(0, os.path.join(REPO, "python"))
+        from bristle.diagnose import closedloop
 
         d = np.loadtxt(self.log_a, delimiter=",", skiprows=1)
         t, ref, pos, pos_true = d[:, 0], d[:, 1], d[:, 2], d[:, 4]

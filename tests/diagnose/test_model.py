@@ -1,4 +1,4 @@
-"""Numerics and guards of the diagnosis (sim/diagnose): the parallel scan,
+"""Numerics and guards of the diagnosis (python/bristle/diagnose): the parallel scan,
 the bounded bristle update, the force model's exactness, the block test, the
 controller and model-file guards."""
 import math
@@ -8,8 +8,8 @@ import unittest
 
 import numpy as np
 
-from diagnose import __main__ as cli
-from diagnose import causes, closedloop, logreader, lugre, model, signals
+from bristle.diagnose import __main__ as cli
+from bristle.diagnose import causes, closedloop, logreader, lugre, model, signals
 
 
 def loop_bristle(dx, dt, rho, beta, vs, neg_ratio=1.0):

@@ -10,7 +10,7 @@ import numpy as np
 
 from . import causes, model, signals
 
-GENERATOR = "sim/diagnose (python -m diagnose); generated, do not edit"
+GENERATOR = "python/bristle/diagnose (python -m bristle.diagnose); generated, do not edit"
 MODEL_FORMAT = "bristle-model/1"
 
 

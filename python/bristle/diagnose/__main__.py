@@ -1,9 +1,9 @@
 """Command line (docs/diagnose.md):
 
-  python -m diagnose diagnose --log LOG.csv --out DIR [--machine M.json] [--fc HZ] [--no-plots] [--quiet]
-  python -m diagnose validate --model DIR/model.json --log OTHER.csv
+  python -m bristle.diagnose diagnose --log LOG.csv --out DIR [--machine M.json] [--fc HZ] [--no-plots] [--quiet]
+  python -m bristle.diagnose validate --model DIR/model.json --log OTHER.csv
 
-(run with sim/ on PYTHONPATH; `make diagnose` and `make validate` do that).
+(run with python/ on PYTHONPATH; `make diagnose` and `make validate` do that).
 diagnose writes DIR/report.json, DIR/model.json, DIR/report.md and the figures;
 validate prints the saved model's relerr on another log of the same machine.
 Exit status: 0, 1 when the log, model or machine file cannot be used (a
@@ -29,7 +29,7 @@ MACHINES_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "machine
 
 
 def _known_machine(log):
-    """A machine file of sim/diagnose/machines/ that lists the log's file name."""
+    """A machine file of python/bristle/diagnose/machines/ that lists the log's file name."""
     name = os.path.basename(log)
     for f in sorted(os.listdir(MACHINES_DIR)):
         p = os.path.join(MACHINES_DIR, f)
@@ -44,7 +44,7 @@ def _known_machine(log):
 
 def _machine(args):
     """The machine file: --machine, else <log>.machine.json beside the log,
-    else one of sim/diagnose/machines/ listing the log's name."""
+    else one of python/bristle/diagnose/machines/ listing the log's name."""
     path = args.machine
     if path is None:
         side = os.path.splitext(args.log)[0] + ".machine.json"
@@ -166,13 +166,13 @@ def cmd_validate(args):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m diagnose", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m bristle.diagnose", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     d = sub.add_parser("diagnose", help="fit, test the causes, report")
     d.add_argument("--log", required=True)
     d.add_argument("--out", required=True)
     d.add_argument("--machine", help="JSON with the controller (and published results); default: "
-                                     "<log>.machine.json beside the log, else a file of sim/diagnose/machines/ "
+                                     "<log>.machine.json beside the log, else a file of python/bristle/diagnose/machines/ "
                                      "listing the log's name")
     d.add_argument("--fc", type=float, default=signals.FC_HZ, help="low-pass cutoff, Hz")
     d.add_argument("--no-plots", action="store_true")
