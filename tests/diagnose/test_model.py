@@ -65,6 +65,20 @@ class ScanTest(unittest.TestCase):
             self.assertTrue(np.all(np.isfinite(ze)))
             self.assertLessEqual(np.max(np.abs(ze)), 2.5 * max(1.0, ratio) / 5e5 * (1 + 1e-12))
 
+    def test_scalar_step_is_the_vectorised_update(self):
+        """The closed loop's per-substep update (floats) and the fit's (arrays)
+        are one implementation: the same numbers, interval by interval."""
+        rng = np.random.default_rng(4)
+        dx = np.concatenate([rng.normal(0, 2e-7, 200), np.full(20, 5e-3), np.zeros(5), np.full(20, -5e-3)])
+        dt, rho, beta, vs = 1e-3, 5e5, 2.5, 1e-4
+        for ratio in (1.0, 0.8):
+            zm, ze = lugre.bristle(dx, dt, rho, beta, vs, neg_ratio=ratio)
+            z = 0.0
+            for k, d in enumerate(dx):
+                z, zbar = lugre.step(z, float(d), lugre.stribeck(float(d) / dt, beta, vs, ratio, lugre.SCALAR), rho)
+                self.assertAlmostEqual(z, ze[k], delta=1e-12 * 2.5 / rho)
+                self.assertAlmostEqual(zbar, zm[k], delta=1e-12 * 2.5 / rho)
+
 
 class ModelTest(unittest.TestCase):
     def prepared(self, force_of):

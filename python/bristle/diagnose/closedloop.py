@@ -15,7 +15,7 @@ Plant, load side (model.py's force model as dynamics):
 
 integrated like the C plant (docs/modules/plant.md): N_SUB substeps per
 period; in each, z follows the exact displacement-domain solution with g
-held (bounded at any speed), the friction impulse is integrated in closed
+held (lugre.step, the fit's bristle update), the friction impulse is integrated in closed
 form, the rigid body by the trapezoidal rule with fixed-point passes on the
 mean velocity. The measured position q is the simulated one quantised to the
 log's resolution (the smallest position step found in the log), rounded
@@ -25,6 +25,8 @@ import json
 import math
 
 import numpy as np
+
+from . import lugre
 
 N_SUB = 10
 PASSES = 3
@@ -87,7 +89,9 @@ def simulate(params, ctrl, ref, pos0, vel0):
     delay = p.get("delay_s", 0.0)
     quantum = ctrl.get("_quantum", 0.0)
     h = dt / N_SUB
-    exp, expm1, fabs, sin, copysign = math.exp, math.expm1, math.fabs, math.sin, math.copysign
+    rho = s0 / Fc
+    stribeck, bristle_step, SCALAR = lugre.stribeck, lugre.step, lugre.SCALAR
+    sin, copysign = math.sin, math.copysign
     two_pi = 2.0 * math.pi
 
     n = len(ref)
@@ -125,18 +129,8 @@ def simulate(params, ctrl, ref, pos0, vel0):
             vm = v
             for _ in range(PASSES):
                 dx = vm * h
-                gn = 1.0 + (beta - 1.0) * exp(-fabs(vm) / vs)
-                if dx < 0.0:
-                    gn *= c_neg
-                g = Fc * gn
-                if dx != 0.0:
-                    zss = copysign(g / s0, dx)
-                    r = s0 * fabs(dx) / g
-                    qq = -expm1(-r)
-                    z1 = z + (zss - z) * qq
-                    zint = h * (zss + (z - zss) * (qq / r if r > 1e-12 else 1.0 - 0.5 * r))
-                else:
-                    z1, zint = z, z * h
+                z1, zbar = bristle_step(z, dx, stribeck(vm, beta, vs, c_neg, SCALAR), rho)
+                zint = h * zbar
                 xm = x + 0.5 * dx
                 kx = max(0.0, 1.0 + grad * xm) if grad != 0.0 else 1.0
                 fv = Fv_n if dx < 0.0 else Fv_p
