@@ -1,42 +1,37 @@
 """The force model fitted to a log: the nominal (thesis) model and its
-extensions by the causes of ../shared/spec/measured-log.md.
+extensions by the causes (causes/, one module each).
 
-Force needed over interval k (load side), with k(x) = max(0, 1 + s x):
+Force needed over interval k (load side):
 
-  F = M a + k(x) [ Fv_d v + Fc_d (rho z) + sigma1 dz/dt ]            nominal: k = 1, one Fv, one Fc
-      + offset + A sin(2 pi x / P + phase)                            offset, position_ripple
-  compared with the logged force delayed by the dead time d           actuator_delay
+  F = Meff a + sigma2 v + Fc (rho z) + sigma1 dz/dt                  nominal
 
-Fv_d, Fc_d: one value each (nominal) or one per direction
-(asymmetric_friction: Fv by the sign of v; the whole Stribeck curve in -x is
-c = Fc_neg / Fc times that in +x, inside the bristle dynamics too, exactly as
-the plant simulator does). z follows lugre.bristle with the shape
-(rho = sigma0/Fc, beta = Fs/Fc, vs) and c. Columns that
-are nonlinear in the motion (the LuGre ones, the ripple) are computed from the
-filtered position and filtered once more (signals.Prepared.lp), like the force
-they are compared with; a and v are linear in the position and are not.
+with z from lugre.bristle along the measured path and the shape
+(rho = sigma0/Fc, beta = Fs/Fc, vs). A cause extends it through the hooks of
+its module (causes/__init__.py): columns added to the force, a factor on the
+friction, the Stribeck curve in -x, the friction columns split by
+direction, the force it is compared with. Columns that are nonlinear in the
+motion (the LuGre ones, a ripple) are computed from the filtered position
+and filtered once more (signals.Prepared.lp), like the force they are
+compared with; a and v are linear in the position and are not.
 
-Given the shape and the causes' nonlinear parameters (P, s, d) the force is
-linear in the rest, which is solved by least squares on the training part
-(variable projection); the shape and (P, s, d) are searched around that.
+Given the shape and the causes' nonlinear parameters (`nl`) the force is
+linear in the rest (`coef`), which is solved by least squares on the
+training part (variable projection); the shape and `nl` are searched
+around that.
 """
 import math
 
 import numpy as np
 from scipy import optimize
 
+from . import causes as causes_
 from . import lugre
 from .signals import relerr
 
-CAUSES = ("offset", "asymmetric_friction", "position_ripple", "position_gradient", "actuator_delay")
-
-# bounds of the searches
+# bounds of the shape search
 RHO_BOUNDS = (1e3, 1e9)      # sigma0 / Fc, 1/m: presliding lengths from 1 nm to 1 mm
 BETA_BOUNDS = (1.0, 10.0)    # Fs / Fc
 VS_BOUNDS = (1e-7, 0.1)      # Stribeck velocity, m/s
-DELAY_MAX_S = 0.02           # actuator dead time searched over 0 .. 20 ms
-PERIODOGRAM_DECIMATE = 4     # the residual is low-passed far below the sampling rate
-FC_RATIO_BOUNDS = (0.2, 5.0)  # Fc_neg / Fc
 SHAPE_STARTS = ((2e5, 1.5, 1e-3), (2e6, 2.0, 3e-5))
 
 
@@ -45,16 +40,13 @@ class Fit:
     coefficients; predicts the force over the intervals of a Prepared log."""
 
     def __init__(self, causes, shape, nl, coef):
-        self.causes = tuple(c for c in CAUSES if c in causes)
+        self.causes = tuple(m.NAME for m in causes_.of(causes))
         self.shape = tuple(shape)
         self.nl = dict(nl)
         self.coef = dict(coef)
 
-    def has(self, cause):
-        return cause in self.causes
-
     def target(self, prep):
-        return _target(prep, self.causes, self.nl)
+        return target(prep, self.causes, self.nl)
 
     def predict(self, prep):
         cols = columns(prep, self.shape, self.causes, self.nl)
@@ -68,151 +60,98 @@ class Fit:
         return relerr(y[sl], (y - self.predict(prep))[sl])
 
     def params(self):
-        """Physical parameters, load side (the names of model.json)."""
+        """Physical parameters, load side: model.json's "params" (params.py)."""
         c, (rho, beta, vs) = self.coef, self.shape
-        asym = self.has("asymmetric_friction")
         Fc = c["Fc"]
-        Fv = c["Fv_pos"] if asym else c["Fv"]
         p = {
-            "M_kg": c["M"],
-            "Fv_Nspm": Fv,
+            "Meff_kg": c["Meff"],
+            "sigma2_Nspm": c["sigma2"],
             "Fc_N": Fc,
             "Fs_N": beta * Fc,
             "vs_mps": vs,
             "sigma0_Npm": rho * Fc,
             "sigma1_Nspm": c.get("sigma1", 0.0),
         }
-        if asym:
-            p["Fc_neg_N"] = self.nl["fc_ratio"] * Fc
-            p["Fv_neg_Nspm"] = c["Fv_neg"]
-        if self.has("offset"):
-            p["offset_N"] = c["offset"]
-        if self.has("position_ripple"):
-            a_s, a_c = c["ripple_sin"], c["ripple_cos"]
-            p["ripple_amp_N"] = math.hypot(a_s, a_c)
-            p["ripple_period_m"] = self.nl["period_m"]
-            p["ripple_phase_rad"] = math.atan2(a_c, a_s)
-        if self.has("position_gradient"):
-            p["grad_per_m"] = self.nl["grad_per_m"]
-        if self.has("actuator_delay"):
-            p["delay_s"] = self.nl["delay_s"]
+        for m in causes_.of(self.causes):
+            p.update(m.params(c, self.nl, p))
         return {k: float(v) for k, v in p.items()}
 
     def cause_params(self, cause):
-        """The parameters the spec asks a finding to report."""
-        p = self.params()
-        if cause == "offset":
-            return {"force_N": p["offset_N"]}
-        if cause == "asymmetric_friction":
-            return {"Fc_pos_N": p["Fc_N"], "Fc_neg_N": p["Fc_neg_N"],
-                    "Fv_pos_Nspm": p["Fv_Nspm"], "Fv_neg_Nspm": p["Fv_neg_Nspm"]}
-        if cause == "position_ripple":
-            return {"period_m": p["ripple_period_m"], "amplitude_N": p["ripple_amp_N"],
-                    "phase_rad": p["ripple_phase_rad"]}
-        if cause == "position_gradient":
-            return {"relative_slope_per_m": p["grad_per_m"]}
-        if cause == "actuator_delay":
-            return {"delay_s": p["delay_s"]}
-        raise ValueError(cause)
+        """The parameters the spec asks a finding of this cause to report."""
+        return causes_.get(cause).report_params(self.params())
 
 
 def from_params(p, causes):
     """A Fit from physical parameters (a saved model)."""
     Fc = p["Fc_N"]
     shape = (p["sigma0_Npm"] / Fc, p["Fs_N"] / Fc, p["vs_mps"])
-    coef = {"M": p["M_kg"], "sigma1": p.get("sigma1_Nspm", 0.0), "Fc": Fc}
+    coef = {"Meff": p["Meff_kg"], "sigma2": p["sigma2_Nspm"], "Fc": Fc, "sigma1": p["sigma1_Nspm"]}
     nl = {}
-    if "asymmetric_friction" in causes:
-        coef.update(Fv_pos=p["Fv_Nspm"], Fv_neg=p["Fv_neg_Nspm"])
-        nl["fc_ratio"] = p["Fc_neg_N"] / Fc
-    else:
-        coef.update(Fv=p["Fv_Nspm"])
-    if "offset" in causes:
-        coef["offset"] = p["offset_N"]
-    if "position_ripple" in causes:
-        A, ph = p["ripple_amp_N"], p["ripple_phase_rad"]
-        coef.update(ripple_sin=A * math.cos(ph), ripple_cos=A * math.sin(ph))
-        nl["period_m"] = p["ripple_period_m"]
-    if "position_gradient" in causes:
-        nl["grad_per_m"] = p["grad_per_m"]
-    if "actuator_delay" in causes:
-        nl["delay_s"] = p["delay_s"]
+    for m in causes_.of(causes):
+        c, n = m.from_params(p)
+        coef.update(c)
+        nl.update(n)
     return Fit(causes, shape, nl, coef)
 
 
-def _cached(prep, key, make):
-    """Per-log memo of column blocks (the searches reuse them many times)."""
-    cache = prep.__dict__.setdefault("_model_cache", {})
-    if key not in cache:
-        if len(cache) > 64:
-            cache.clear()
-        cache[key] = make()
-    return cache[key]
+def _neg_ratio(mods, nl):
+    """The Stribeck curve's scale in -x inside the bristle dynamics."""
+    ratio = 1.0
+    for hook in causes_.hooks(mods, "stribeck_neg_ratio"):
+        ratio *= hook(nl)
+    return ratio
 
 
-def _friction_columns(prep, shape, causes, nl):
-    """The friction columns (viscous, LuGre level, sigma1), with the gradient
-    and the direction split applied."""
-    grad = nl["grad_per_m"] if "position_gradient" in causes else None
-    asym = "asymmetric_friction" in causes
-    split = nl.get("fc_split", False)  # asymmetric: Fc per sign of z, z symmetric (first estimate of c)
-    ratio = nl["fc_ratio"] if asym and not split else 1.0
+FRICTION_HOOKS = ("stribeck_neg_ratio", "friction_scale", "friction_columns")
+
+
+def _friction_columns(prep, shape, mods, nl):
+    """The friction columns (viscous, LuGre level, sigma1) with what the
+    causes do to the friction."""
+    fmods = [m for m in mods if any(hasattr(m, h) for h in FRICTION_HOOKS)]
 
     def make():
         rho, beta, vs = shape
-        phi, zd = _cached(prep, ("bristle", shape, ratio),
-                          lambda: lugre.bristle_columns(prep.dx, prep.dt, rho, beta, vs, neg_ratio=ratio))
+        ratio = _neg_ratio(fmods, nl)
+        phi, zd = prep.memo(("bristle", shape, ratio),
+                            lambda: lugre.bristle_columns(prep.dx, prep.dt, rho, beta, vs, neg_ratio=ratio))
         v = prep.v
-        if grad is not None:
-            k = np.maximum(0.0, 1.0 + grad * prep.xm)
+        for scale in causes_.hooks(fmods, "friction_scale"):
+            k = scale(prep, nl)
             phi, zd, v = k * phi, k * zd, k * v
-        cols = {}
-        if asym:
-            cols["Fv_pos"] = np.maximum(v, 0.0)
-            cols["Fv_neg"] = np.minimum(v, 0.0)
-        else:
-            cols["Fv"] = v
-        if split:
-            cols["Fc"] = prep.lp(np.maximum(phi, 0.0))
-            cols["Fc_neg_split"] = prep.lp(np.minimum(phi, 0.0))
-        else:
-            cols["Fc"] = prep.lp(phi)
+        split = causes_.hooks(fmods, "friction_columns")
+        cols = split[0](prep, nl, v, phi) if split else {"sigma2": v, "Fc": prep.lp(phi)}
         cols["sigma1"] = prep.lp(zd)
         return cols
 
-    return _cached(prep, ("friction", shape, grad, asym, ratio, split), make)
+    key = ("friction", shape) + tuple((m.NAME,) + tuple(nl.get(k) for k in m.NL) for m in fmods)
+    return prep.memo(key, make)
 
 
 def columns(prep, shape, causes, nl):
     """Design columns over all intervals, by coefficient name."""
-    cols = {"M": prep.a}
-    cols.update(_friction_columns(prep, shape, causes, nl))
-    if "offset" in causes:
-        cols["offset"] = _cached(prep, ("ones",), lambda: np.ones(prep.n))
-    if "position_ripple" in causes:
-        P = nl["period_m"]
-
-        def make():
-            th = 2.0 * np.pi * prep.xm / P
-            return prep.lp(np.sin(th)), prep.lp(np.cos(th))
-
-        cols["ripple_sin"], cols["ripple_cos"] = _cached(prep, ("ripple", P), make)
+    mods = causes_.of(causes)
+    cols = {"Meff": prep.a}
+    cols.update(_friction_columns(prep, shape, mods, nl))
+    for load in causes_.hooks(mods, "load_columns"):
+        cols.update(load(prep, nl))
     return cols
 
 
-def _target(prep, causes, nl):
-    if "actuator_delay" not in causes:
-        return prep.y
-    d = nl.get("delay_s", 0.0)
-    return _cached(prep, ("target", d), lambda: prep.y_delayed(d))
+def target(prep, causes, nl):
+    """The force the model is compared with: the filtered log's, or what a
+    cause makes of it (a dead time)."""
+    for hook in causes_.hooks(causes_.of(causes), "target"):
+        return hook(prep, nl)
+    return prep.y
 
 
 def solve(prep, shape, causes, nl):
     """Linear least squares of the coefficients on the training part; sigma1
     is kept >= 0 (dropped when the free solution is negative). The fit keeps
-    its training sum of squares (train_sse)."""
+    its training residual and sum of squares (train_sse)."""
     cols = columns(prep, shape, causes, nl)
-    y = _target(prep, causes, nl)
+    y = target(prep, causes, nl)
     names = list(cols)
     tr = prep.train
     yt = y[tr]
@@ -230,15 +169,12 @@ def solve(prep, shape, causes, nl):
     return fit
 
 
-def train_sse(fit, prep):
-    return fit.train_sse
-
-
 def fit_shape(prep, causes, nl, starts=SHAPE_STARTS, max_nfev=40):
     """Searches the LuGre shape (log rho, beta, log vs) by bounded least
     squares on the training residual, the coefficients solved inside."""
     lo = np.array([math.log(RHO_BOUNDS[0]), BETA_BOUNDS[0], math.log(VS_BOUNDS[0])])
     hi = np.array([math.log(RHO_BOUNDS[1]), BETA_BOUNDS[1], math.log(VS_BOUNDS[1])])
+    ratio = _neg_ratio(causes_.of(causes), nl)
 
     def unpack(u):
         return (math.exp(u[0]), u[1], math.exp(u[2]))
@@ -246,7 +182,7 @@ def fit_shape(prep, causes, nl, starts=SHAPE_STARTS, max_nfev=40):
     def resid(u):
         shape = unpack(u)
         r = solve(prep, shape, causes, nl).train_resid
-        prep.__dict__.get("_model_cache", {}).pop(("bristle", shape, nl.get("fc_ratio", 1.0)), None)
+        prep.forget(("bristle", shape, ratio))  # a shape is seldom seen twice
         return r
 
     best = None
@@ -259,152 +195,38 @@ def fit_shape(prep, causes, nl, starts=SHAPE_STARTS, max_nfev=40):
     return solve(prep, unpack(best.x), causes, nl)
 
 
-def position_periodogram(e, x, periods):
-    """Amplitude of the best sin/cos fit of e at each period over position x."""
-    amps = np.empty(len(periods))
-    for i in range(0, len(periods), 64):
-        P = np.asarray(periods[i:i + 64])[:, None]
-        th = 2.0 * np.pi * x[None, :] / P
-        s, c = np.sin(th), np.cos(th)
-        ss, cc, sc = (s * s).sum(1), (c * c).sum(1), (s * c).sum(1)
-        es, ec = s @ e, c @ e
-        det = ss * cc - sc * sc
-        a = (cc * es - sc * ec) / det
-        b = (ss * ec - sc * es) / det
-        amps[i:i + 64] = np.hypot(a, b)
-    return amps
+def search_cause(prep, base, cause, causes, nl):
+    """The nonlinear parameters of `cause` in the model base.shape + causes
+    ({} when it has none, None when the log cannot show it)."""
+    def fit_with(extra):
+        return solve(prep, base.shape, causes, dict(nl, **extra))
 
-
-def ripple_period_range(prep):
-    """Periods the ripple test searches: at least the distance the axis
-    covers in one filter-cutoff period at its 95th-percentile speed (shorter
-    ones are filtered away), at most a third of the travel."""
-    sl = prep.whole
-    v95 = float(np.percentile(np.abs(prep.v[sl]), 95))
-    travel = float(np.ptp(prep.xm[sl]))
-    pmin = max(v95 / prep.fc_hz, 1e-5)
-    pmax = travel / 3.0
-    return pmin, pmax
-
-
-def fit_ripple_period(prep, base, causes, nl):
-    """Period of a position ripple: the highest peak of the training
-    residual's periodogram over position, refined by a bounded search."""
-    pmin, pmax = ripple_period_range(prep)
-    if not pmax > 1.5 * pmin:
-        return None
-    periods = np.geomspace(pmin, pmax, 400)
-    tr = slice(prep.train.start, prep.train.stop, PERIODOGRAM_DECIMATE)
-    amps = position_periodogram(base.residual(prep)[tr], prep.xm[tr], periods)
-    best = None
-    for i in np.argsort(amps)[::-1][:3]:
-        P0 = periods[i]
-        g = periods[1] / periods[0]
-
-        def sse(lp):
-            return train_sse(solve(prep, base.shape, causes, dict(nl, period_m=math.exp(lp))), prep)
-
-        r = optimize.minimize_scalar(sse, bounds=(math.log(P0 / g ** 2), math.log(P0 * g ** 2)), method="bounded",
-                                     options={"xatol": 1e-5})
-        if best is None or r.fun < best[1]:
-            best = (math.exp(r.x), r.fun)
-    return best[0]
-
-
-def fit_gradient(prep, base, causes, nl):
-    """Relative slope s of k(x) = 1 + s x: bounded scalar search of the
-    training error, within |s| < 0.95 / max|x| (k stays positive on the log)."""
-    xmax = float(np.max(np.abs(prep.xm[prep.whole])))
-    smax = 0.95 / max(xmax, 1e-6)
-
-    def sse(s):
-        return train_sse(solve(prep, base.shape, causes, dict(nl, grad_per_m=s)), prep)
-
-    grid = np.linspace(-smax, smax, 21)
-    vals = [sse(s) for s in grid]
-    i = int(np.argmin(vals))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    r = optimize.minimize_scalar(sse, bounds=(a, b), method="bounded", options={"xatol": 1e-4 * smax})
-    return float(r.x)
-
-
-def fit_delay(prep, base, causes, nl):
-    """Dead time d in 0 .. DELAY_MAX_S: a grid of half a period, then a
-    bounded scalar search around its best point."""
-    dt = prep.dt
-
-    def sse(d):
-        return train_sse(solve(prep, base.shape, causes, dict(nl, delay_s=max(d, 0.0))), prep)
-
-    grid = np.arange(0.0, DELAY_MAX_S + 1e-12, 0.5 * dt)
-    vals = [sse(d) for d in grid]
-    i = int(np.argmin(vals))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    if b <= a:
-        return float(grid[i])
-    r = optimize.minimize_scalar(sse, bounds=(a, b), method="bounded", options={"xatol": 1e-3 * dt})
-    return float(max(r.x, 0.0))
-
-
-def fit_fc_ratio(prep, base, causes, nl):
-    """c = Fc_neg / Fc of asymmetric friction: first from a linear fit with
-    the LuGre level split by the sign of z (symmetric bristle dynamics), then
-    a bounded scalar search with c inside the bristle dynamics."""
-    split = solve(prep, base.shape, causes, dict(nl, fc_split=True, fc_ratio=1.0))
-    c0 = split.coef["Fc_neg_split"] / split.coef["Fc"] if split.coef["Fc"] > 0 else 1.0
-    c0 = min(max(c0, FC_RATIO_BOUNDS[0]), FC_RATIO_BOUNDS[1])
-
-    def sse(lc):
-        return train_sse(solve(prep, base.shape, causes, dict(nl, fc_ratio=math.exp(lc))), prep)
-
-    lo = max(math.log(c0) - 0.2, math.log(FC_RATIO_BOUNDS[0]))
-    hi = min(math.log(c0) + 0.2, math.log(FC_RATIO_BOUNDS[1]))
-    r = optimize.minimize_scalar(sse, bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
-    return float(math.exp(r.x))
-
-
-def fit_cause_nl(prep, base, cause, causes, nl):
-    """The nonlinear parameter a cause brings (None when it has none, or
-    when it cannot be searched on this log)."""
-    if cause == "position_ripple":
-        P = fit_ripple_period(prep, base, causes, nl)
-        return None if P is None else {"period_m": P}
-    if cause == "position_gradient":
-        return {"grad_per_m": fit_gradient(prep, base, causes, nl)}
-    if cause == "actuator_delay":
-        return {"delay_s": fit_delay(prep, base, causes, nl)}
-    if cause == "asymmetric_friction":
-        return {"fc_ratio": fit_fc_ratio(prep, base, causes, nl)}
-    return {}
+    return causes_.get(cause).search(prep, base, fit_with)
 
 
 def add_cause(prep, base, cause):
-    """base + cause with base's shape held: the cause's nonlinear parameter is
+    """base + cause with base's shape held: the cause's nonlinear parameters
     searched, the coefficients solved. None if the cause cannot be fitted."""
     causes = base.causes + (cause,)
-    extra = fit_cause_nl(prep, base, cause, causes, base.nl)
+    extra = search_cause(prep, base, cause, causes, base.nl)
     if extra is None:
         return None
     return solve(prep, base.shape, causes, dict(base.nl, **extra))
 
 
 def refine(prep, fit, rounds=2, max_nfev=40):
-    """Alternates the shape search (from the current shape) and the causes'
-    nonlinear searches."""
+    """Alternates the shape search (from the current shape) and each cause's
+    nonlinear search (the others held)."""
     for _ in range(rounds):
         fit = fit_shape(prep, fit.causes, fit.nl, starts=(fit.shape,), max_nfev=max_nfev)
         nl = dict(fit.nl)
         for c in fit.causes:
-            others = Fit(tuple(x for x in fit.causes if x != c), fit.shape, nl, fit.coef)
-            extra = fit_cause_nl(prep, _refit_without(prep, others), c, fit.causes, nl)
+            others = solve(prep, fit.shape, tuple(x for x in fit.causes if x != c), nl)
+            extra = search_cause(prep, others, c, fit.causes, nl)
             if extra:
                 nl.update(extra)
         fit = solve(prep, fit.shape, fit.causes, nl)
     return fit
-
-
-def _refit_without(prep, fit):
-    return solve(prep, fit.shape, fit.causes, {k: v for k, v in fit.nl.items()})
 
 
 def fit_nominal(prep):
