@@ -42,7 +42,7 @@ MASTER_SEED = 20261121
 DEFAULT_CASES = 36
 PARAM_TOL = 0.20
 # the reference machine's friction, which br_simlog's plant has
-with open(os.path.join(REPO, "firmware", "design", "reference_machine.json")) as _f:
+with open(os.path.join(REPO, "machines", "reference.json")) as _f:
     _REF = json.load(_f)
 FC_N, SIGMA2_NSPM = _REF["Fc_N"], _REF["sigma2_Nspm"]
 

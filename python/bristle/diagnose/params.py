@@ -16,7 +16,7 @@ class Param(NamedTuple):
 
 NOMINAL = (
     Param("Meff_kg", "kg", "moving mass at the load, J/L² + M (a log cannot tell the screw's inertia from the "
-          "table's mass; firmware/design/reference_machine.json's M_kg is the table alone)", True),
+          "table's mass; machines/reference.json's M_kg is the table alone)", True),
     Param("sigma2_Nspm", "N s/m", "viscous friction σ2 (moving in +x when the friction is asymmetric)"),
     Param("Fc_N", "N", "Coulomb friction level (moving in +x when the friction is asymmetric)", True),
     Param("Fs_N", "N", "stiction level (the Stribeck curve at rest)", True),
