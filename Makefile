@@ -147,17 +147,17 @@ target-bench: deps
 # another, and the hidden-cause suite that writes docs/diagnose-hidden.md.
 diagnose: deps
 	$(Q)test -n "$(LOG)" -a -n "$(OUT)" || { echo "usage: make diagnose LOG=<csv> OUT=<dir> [MACHINE=<json>]" >&2; exit 2; }
-	$(Q)PYTHONPATH=sim MPLBACKEND=Agg $(PYTHON) -m diagnose diagnose --log "$(LOG)" --out "$(OUT)" $(if $(MACHINE),--machine "$(MACHINE)")
+	$(Q)PYTHONPATH=python MPLBACKEND=Agg $(PYTHON) -m bristle.diagnose diagnose --log "$(LOG)" --out "$(OUT)" $(if $(MACHINE),--machine "$(MACHINE)")
 
 validate: deps
 	$(Q)test -n "$(MODEL)" -a -n "$(LOG)" || { echo "usage: make validate MODEL=<model.json> LOG=<csv>" >&2; exit 2; }
-	$(Q)PYTHONPATH=sim $(PYTHON) -m diagnose validate --model "$(MODEL)" --log "$(LOG)"
+	$(Q)PYTHONPATH=python $(PYTHON) -m bristle.diagnose validate --model "$(MODEL)" --log "$(LOG)"
 
 diagnose-control: deps
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)echo "== diagnosis in control terms -> out/diagnose-control, docs/diagnose-control.md"
-	$(Q)PYTHONPATH=sim $(PYTHON) sim/studies/diagnose_control.py --bin build/host-release/sim --work out/diagnose-control \
+	$(Q)PYTHONPATH=python $(PYTHON) sim/studies/diagnose_control.py --bin build/host-release/sim --work out/diagnose-control \
 	  --est ukf,pf --md docs/diagnose-control.md
 
 diagnose-hidden: deps

@@ -35,7 +35,8 @@ typedef struct {
     br_est_t inner;
     const br_ukf_t *ukf;        /* exactly one of ukf / pf: the inner estimator, */
     const br_pf_t *pf;          /* read for its mean state */
-    br_plant_cfg_t m;           /* the extended model (plant-configuration form) */
+    br_plant_cfg_t m;           /* the extended model (plant-configuration form: the fields model.json's
+                                 * names set, sim/plant/br_model_params.h) */
     double dt_s, rad_per_count;
     double u_hist[BR_EST_EXT_HIST]; /* commanded torques, newest at u_head */
     int u_head;

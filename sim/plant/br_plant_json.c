@@ -1,5 +1,6 @@
 /* model.json -> br_plant_cfg_t (br_plant_json.h): a small recursive-descent
- * JSON reader that keeps only the numbers under the top-level "params". */
+ * JSON reader that keeps only the numbers under the top-level "params", by
+ * the table of br_model_params.h. */
 #include "br_plant_json.h"
 
 #include <errno.h>
@@ -7,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "br_model_params.h"
 
 #define MAX_DEPTH 32
 #define MAX_FILE_BYTES (1L << 20)
@@ -21,18 +24,22 @@ typedef struct {
     size_t msg_len;
 } json_t;
 
-/* the parameters a model may hold; `required` ones must be present */
-enum {
-    P_M, P_FV, P_FC, P_FS, P_VS, P_S0, P_S1, /* required */
-    P_OFF, P_FCN, P_FVN, P_RA, P_RP, P_RPH, P_GRAD, P_DELAY,
-    P_COUNT
-};
-static const char *const param_names[P_COUNT] = {
-    "M_kg", "Fv_Nspm", "Fc_N", "Fs_N", "vs_mps", "sigma0_Npm", "sigma1_Nspm",
-    "offset_N", "Fc_neg_N", "Fv_neg_Nspm", "ripple_amp_N", "ripple_period_m", "ripple_phase_rad", "grad_per_m",
-    "delay_s",
-};
-#define N_REQUIRED 7
+/* the parameters a model may hold (br_model_params.h): the moving mass and
+ * the nominal ones are required, the causes' optional */
+#define ENUM_ROW(json, token, ...) P_##token,
+enum { BR_MEFF_PARAM(ENUM_ROW) BR_NOMINAL_PARAMS(ENUM_ROW) N_REQUIRED };
+enum { P_CAUSES = N_REQUIRED - 1, BR_CAUSE_PARAMS(ENUM_ROW) P_COUNT };
+#undef ENUM_ROW
+
+typedef struct {
+    const char *name;
+    double lo, hi;
+} param_t;
+#define ROW(json, token, unit, lo, hi) {json, lo, hi},
+#define CAUSE_ROW(json, field, unit, lo, hi, cause, option, required) {json, lo, hi},
+static const param_t params[P_COUNT] = {BR_MEFF_PARAM(ROW) BR_NOMINAL_PARAMS(ROW) BR_CAUSE_PARAMS(CAUSE_ROW)};
+#undef ROW
+#undef CAUSE_ROW
 
 static int fail(const json_t *j, const char *what)
 {
@@ -173,7 +180,7 @@ static int skip_value(json_t *j, int depth)
 /* the "params" object: numbers only, known keys only, each once */
 static int parse_params(json_t *j, double val[P_COUNT], int have[P_COUNT])
 {
-    char key[KEY_LEN], msg[160];
+    char key[KEY_LEN], msg[200], bounds[64];
     if (j->s[j->i] != '{') return fail(j, "\"params\" must be an object");
     j->i++;
     skip_ws(j);
@@ -185,7 +192,7 @@ static int parse_params(json_t *j, double val[P_COUNT], int have[P_COUNT])
         skip_ws(j);
         if (parse_string(j, key, sizeof key) != 0) return -1;
         int k = 0;
-        while (k < P_COUNT && strcmp(key, param_names[k]) != 0) k++;
+        while (k < P_COUNT && strcmp(key, params[k].name) != 0) k++;
         if (k == P_COUNT) {
             snprintf(msg, sizeof msg, "unknown parameter \"%s\" in \"params\"", key);
             return fail(j, msg);
@@ -204,6 +211,11 @@ static int parse_params(json_t *j, double val[P_COUNT], int have[P_COUNT])
             return fail(j, msg);
         }
         if (parse_number(j, &val[k]) != 0) return -1;
+        if (!br_param_in_bounds(val[k], params[k].lo, params[k].hi)) {
+            br_param_bounds_text(params[k].lo, params[k].hi, bounds, sizeof bounds);
+            snprintf(msg, sizeof msg, "parameter \"%s\" = %g %s", key, val[k], bounds);
+            return fail(j, msg);
+        }
         have[k] = 1;
         skip_ws(j);
         if (j->s[j->i] == ',') {
@@ -260,7 +272,7 @@ int br_plant_cfg_from_model_text(const char *text, const char *name, const br_pl
     if (!seen_params) return fail(&j, "no \"params\" object");
     for (int k = 0; k < N_REQUIRED; k++) {
         if (!have[k]) {
-            snprintf(what, sizeof what, "\"params\" lacks \"%s\"", param_names[k]);
+            snprintf(what, sizeof what, "\"params\" lacks \"%s\"", params[k].name);
             j.line = params_line; /* the line where "params" opens */
             return fail(&j, what);
         }
@@ -268,23 +280,14 @@ int br_plant_cfg_from_model_text(const char *text, const char *name, const br_pl
     *out = *base;
     /* the moving mass at the load, split between J and M like the base machine */
     const double L = base->lead_mprad;
-    const double scale = val[P_M] * L * L / (base->J_kgm2 + L * L * base->M_kg);
+    const double scale = val[P_Meff_kg] * L * L / (base->J_kgm2 + L * L * base->M_kg);
     out->J_kgm2 = base->J_kgm2 * scale;
     out->M_kg = base->M_kg * scale;
-    out->sigma2_Nspm = val[P_FV];
-    out->Fc_N = val[P_FC];
-    out->Fs_N = val[P_FS];
-    out->vs_mps = val[P_VS];
-    out->sigma0_Npm = val[P_S0];
-    out->sigma1_Nspm = val[P_S1];
-    out->offset_N = val[P_OFF];
-    out->dFc_neg_N = have[P_FCN] ? val[P_FCN] - val[P_FC] : 0.0;
-    out->dsigma2_neg_Nspm = have[P_FVN] ? val[P_FVN] - val[P_FV] : 0.0;
-    out->ripple_amp_N = val[P_RA];
-    out->ripple_period_m = val[P_RP];
-    out->ripple_phase_rad = val[P_RPH];
-    out->grad_per_m = val[P_GRAD];
-    out->delay_s = val[P_DELAY];
+    /* the other parameters set the fields of their names (absent causes: 0, off) */
+#define SET_ROW(json, field, ...) out->field = val[P_##field];
+    BR_NOMINAL_PARAMS(SET_ROW)
+    BR_CAUSE_PARAMS(SET_ROW)
+#undef SET_ROW
     return 0;
 }
 

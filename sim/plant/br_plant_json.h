@@ -2,15 +2,16 @@
  * turned into a plant configuration, so the simulator can run an identified,
  * extended model.
  *
- * The file holds load-side parameters under "params":
- *   M_kg (the whole moving mass seen at the load, J/L^2 + M), Fv_Nspm,
- *   Fc_N, Fs_N, vs_mps, sigma0_Npm, sigma1_Nspm  (required)
- *   offset_N, Fc_neg_N, Fv_neg_Nspm, ripple_amp_N, ripple_period_m,
- *   ripple_phase_rad, grad_per_m, delay_s        (optional; absent = cause off)
- * Everything outside "params" is ignored; an unknown key inside it is an error.
+ * The file holds load-side parameters under "params", named by the table of
+ * br_model_params.h: Meff_kg (the moving mass at the load, J/L^2 + M) and the
+ * nominal ones are required, the causes' optional (absent = cause off); each
+ * sets the br_plant_cfg_t field of its name. Everything outside "params" is
+ * ignored; an unknown key inside it is an error, and so is a value outside
+ * its bounds. (Models written before the names were unified, format
+ * "bristle-model/1", are refused: they hold M_kg, Fv_Nspm, Fc_neg_N.)
  *
  * The lead, encoder, amplifier and substeps come from a base configuration;
- * M_kg is split between J and M in the base configuration's proportion. */
+ * Meff_kg is split between J and M in the base configuration's proportion. */
 #ifndef BR_PLANT_JSON_H
 #define BR_PLANT_JSON_H
 

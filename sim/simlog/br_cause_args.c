@@ -1,4 +1,4 @@
-/* Cause options (br_cause_args.h). */
+/* Cause options (br_cause_args.h), by the table of br_model_params.h. */
 #include "br_cause_args.h"
 
 #include <errno.h>
@@ -6,6 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "plant/br_model_params.h"
 
 int br_parse_numbers(const char *s, double *v, int n)
 {
@@ -24,39 +26,47 @@ int br_parse_numbers(const char *s, double *v, int n)
     return -1;
 }
 
+/* one row of the table that the option sets */
+typedef struct {
+    const char *name;
+    double *field;
+    double lo, hi;
+} row_t;
+
+#define COUNT_ROW(...) +1
+enum { N_CAUSE_PARAMS = 0 BR_CAUSE_PARAMS(COUNT_ROW) };
+#undef COUNT_ROW
+
 int br_cause_arg(const char *opt, const char *val, br_plant_cfg_t *c)
 {
-    double v[3];
-    int ok;
-    if (strcmp(opt, "--offset") == 0) {
-        ok = br_parse_numbers(val, v, 1) == 1;
-        if (ok) c->offset_N = v[0];
-    } else if (strcmp(opt, "--gradient") == 0) {
-        ok = br_parse_numbers(val, v, 1) == 1;
-        if (ok) c->grad_per_m = v[0];
-    } else if (strcmp(opt, "--delay") == 0) {
-        ok = br_parse_numbers(val, v, 1) == 1;
-        if (ok) c->delay_s = v[0];
-    } else if (strcmp(opt, "--asym") == 0) {
-        ok = br_parse_numbers(val, v, 2) == 2;
-        if (ok) {
-            c->dFc_neg_N = v[0];
-            c->dsigma2_neg_Nspm = v[1];
-        }
-    } else if (strcmp(opt, "--ripple") == 0) {
-        const int k = br_parse_numbers(val, v, 3);
-        ok = k >= 2;
-        if (ok) {
-            c->ripple_amp_N = v[0];
-            c->ripple_period_m = v[1];
-            c->ripple_phase_rad = k == 3 ? v[2] : 0.0;
-        }
-    } else {
-        return 0;
+    row_t rows[N_CAUSE_PARAMS];
+    int n = 0, required = 0;
+#define MATCH_ROW(json, fld, unit, lo_, hi_, cause, option, req) \
+    if (strcmp(opt, option) == 0) {                              \
+        rows[n] = (row_t){json, &c->fld, lo_, hi_};              \
+        n++;                                                     \
+        required += req;                                         \
     }
-    if (!ok) {
-        fprintf(stderr, "bad value for %s: %s\n", opt, val);
+    BR_CAUSE_PARAMS(MATCH_ROW)
+#undef MATCH_ROW
+    if (n == 0) return 0;
+    double v[N_CAUSE_PARAMS];
+    const int k = br_parse_numbers(val, v, n);
+    if (k < required) {
+        fprintf(stderr, "bad value for %s: %s (%d to %d numbers: ", opt, val, required, n);
+        for (int i = 0; i < n; i++) fprintf(stderr, "%s%s", i ? "," : "", rows[i].name);
+        fprintf(stderr, ")\n");
         return -1;
     }
+    for (int i = k; i < n; i++) v[i] = 0.0; /* optional values left out */
+    for (int i = 0; i < n; i++) {
+        if (!br_param_in_bounds(v[i], rows[i].lo, rows[i].hi)) {
+            char bounds[64];
+            br_param_bounds_text(rows[i].lo, rows[i].hi, bounds, sizeof bounds);
+            fprintf(stderr, "bad value for %s: %s (%s %s)\n", opt, val, rows[i].name, bounds);
+            return -1;
+        }
+    }
+    for (int i = 0; i < n; i++) *rows[i].field = v[i];
     return 1;
 }

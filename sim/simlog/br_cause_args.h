@@ -1,11 +1,13 @@
 /* The cause options of the simulator's command lines (br_simlog,
- * br_circle_ext): docs/simlog.md.
+ * br_circle_ext): docs/simlog.md. Each sets the br_plant_cfg_t fields of its
+ * rows in sim/plant/br_model_params.h, its values in their order:
  *
- *   --offset F           constant load force, N
- *   --asym DFC,DFV       friction in -x: Coulomb (and stiction) + DFC N, viscous + DFV N s/m
- *   --ripple A,P[,PH]    A sin(2 pi x / P + PH), N, m, rad
- *   --gradient S         friction times (1 + S x), 1/m
- *   --delay D            actuator dead time, s */
+ *   --offset F           offset_N: constant load force, N
+ *   --asym DFC,DFV       dFc_neg_N, dsigma2_neg_Nspm: friction in -x, Coulomb (and stiction) + DFC N,
+ *                        viscous + DFV N s/m
+ *   --ripple A,P[,PH]    ripple_amp_N, ripple_period_m, ripple_phase_rad: A sin(2 pi x / P + PH), N, m, rad
+ *   --gradient S         grad_per_m: friction times max(0, 1 + S x), 1/m
+ *   --delay D            delay_s: actuator dead time, s */
 #ifndef BR_CAUSE_ARGS_H
 #define BR_CAUSE_ARGS_H
 
@@ -15,7 +17,8 @@
 int br_parse_numbers(const char *s, double *v, int n);
 
 /* 1 when opt is a cause option and val was applied to c; 0 when opt is not a
- * cause option; -1 (message on stderr) when val is malformed. */
+ * cause option; -1 (message on stderr, c unchanged) when val is malformed or
+ * a value is outside its parameter's bounds. */
 int br_cause_arg(const char *opt, const char *val, br_plant_cfg_t *c);
 
 #endif

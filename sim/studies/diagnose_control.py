@@ -47,7 +47,7 @@ def main():
     ap.add_argument("--only")
     ap.add_argument("--check", action="store_true")
     a = ap.parse_args()
-    env = dict(os.environ, PYTHONPATH=os.path.join(REPO, "sim"), MPLBACKEND="Agg")
+    env = dict(os.environ, PYTHONPATH=os.path.join(REPO, "python"), MPLBACKEND="Agg")
     os.makedirs(a.work, exist_ok=True)
     ests = [e for e in a.est.split(",") if e]
     if not ests or any(e not in ("ukf", "pf") for e in ests):
@@ -61,7 +61,7 @@ def main():
         log = os.path.join(d, "ident.csv")
         run([os.path.join(a.bin, "br_simlog"), "--out", log, "--force-noise", "0.1", "--seed", "5"] + flags)
         out = os.path.join(d, "diagnosis")
-        run([sys.executable, "-m", "diagnose", "diagnose", "--log", log, "--out", out, "--no-plots", "--quiet"],
+        run([sys.executable, "-m", "bristle.diagnose", "diagnose", "--log", log, "--out", out, "--no-plots", "--quiet"],
             env=env)
         with open(os.path.join(out, "report.json")) as f:
             rep = json.load(f)

@@ -4,12 +4,13 @@ generator the diagnosis never sees, diagnosed from the log alone.
 Each case: the generator draws a cause (balanced over none + the five
 causes, in a seeded order) and its parameters; br_simlog writes an
 identification log of the reference machine with that cause (and seeded
-force noise); the diagnosis's command line (`python -m diagnose diagnose`,
+force noise); the diagnosis's command line (`python -m bristle.diagnose diagnose`,
 called in this process) gets only the log path, in a directory holding
 nothing else. The case passes when
   - the verdict is the hidden cause ("none" for a nominal log),
-  - every parameter the spec names for the cause is within PARAM_TOL (20 %)
-    of the hidden value (checked for the verdict's finding),
+  - every parameter the spec names for the cause (the spec's names: a
+    finding's "params") is within PARAM_TOL (20 %) of the hidden value
+    (checked for the verdict's finding),
   - the extended model's held-out relerr is below the nominal's (a cause),
     or no finding at all (none).
 
@@ -32,15 +33,18 @@ import time
 import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(REPO, "sim"))
-from diagnose import __main__ as diagnose_cli  # noqa: E402
+sys.path.insert(0, os.path.join(REPO, "python"))
+from bristle.diagnose import __main__ as diagnose_cli  # noqa: E402
+from bristle.diagnose import causes  # noqa: E402
 
-CAUSES = ("none", "offset", "asymmetric_friction", "position_ripple", "position_gradient", "actuator_delay")
+CAUSES = ("none",) + causes.NAMES
 MASTER_SEED = 20261121
 DEFAULT_CASES = 36
 PARAM_TOL = 0.20
-# the reference machine's friction (firmware/design/reference_machine.json)
-FC_N, FV_NSPM = 7.0, 50.0
+# the reference machine's friction, which br_simlog's plant has
+with open(os.path.join(REPO, "machines", "reference.json")) as _f:
+    _REF = json.load(_f)
+FC_N, SIGMA2_NSPM = _REF["Fc_N"], _REF["sigma2_Nspm"]
 
 
 def draw(i, n_cases, master=MASTER_SEED):
@@ -58,8 +62,8 @@ def draw(i, n_cases, master=MASTER_SEED):
     elif cause == "asymmetric_friction":
         r = 1.0 + sign() * rng.uniform(0.10, 0.30)
         fv = 1.0 + sign() * rng.uniform(0.20, 0.60)
-        truth = {"Fc_pos_N": FC_N, "Fc_neg_N": FC_N * r, "Fv_pos_Nspm": FV_NSPM, "Fv_neg_Nspm": FV_NSPM * fv}
-        flags = ["--asym", f"{FC_N * (r - 1):.6g},{FV_NSPM * (fv - 1):.6g}"]
+        truth = {"Fc_pos_N": FC_N, "Fc_neg_N": FC_N * r, "Fv_pos_Nspm": SIGMA2_NSPM, "Fv_neg_Nspm": SIGMA2_NSPM * fv}
+        flags = ["--asym", f"{FC_N * (r - 1):.6g},{SIGMA2_NSPM * (fv - 1):.6g}"]
     elif cause == "position_ripple":
         a = rng.uniform(0.3, 1.5)
         p = math.exp(rng.uniform(math.log(3e-3), math.log(20e-3)))
@@ -74,6 +78,8 @@ def draw(i, n_cases, master=MASTER_SEED):
         d = rng.uniform(1e-3, 5e-3)
         truth = {"delay_s": d}
         flags = ["--delay", f"{d:.6g}"]
+    elif cause != "none":
+        raise ValueError(f"no generator for the cause {cause}: add one here")
     return {"case": i, "cause": cause, "truth": truth, "flags": flags, "noise_N": noise,
             "sim_seed": int(rng.integers(1, 2 ** 31))}
 

@@ -1,5 +1,5 @@
 """End to end through the command lines: br_simlog writes a log with a
-hidden offset; `python -m diagnose diagnose` writes every output; `validate`
+hidden offset; `python -m bristle.diagnose diagnose` writes every output; `validate`
 applies the saved model to another log of the same machine; br_simlog loads
 the saved model and its log is explained by it; the Python closed loop
 agrees with the C plant; bad inputs give "file:line: problem".
@@ -21,8 +21,8 @@ ARGS = None
 
 
 def py(*a):
-    env = dict(os.environ, PYTHONPATH=os.path.join(REPO, "sim"), MPLBACKEND="Agg")
-    return subprocess.run([sys.executable, "-m", "diagnose", *a], env=env, capture_output=True, text=True)
+    env = dict(os.environ, PYTHONPATH=os.path.join(REPO, "python"), MPLBACKEND="Agg")
+    return subprocess.run([sys.executable, "-m", "bristle.diagnose", *a], env=env, capture_output=True, text=True)
 
 
 def simlog(*a):
@@ -62,7 +62,7 @@ class CliTest(unittest.TestCase):
         self.assertLess(cl["extended"]["relerr_position_percent"], 0.01)
         with open(os.path.join(self.out, "report.md")) as f:
             md = f.read()
-        self.assertTrue(md.startswith("<!-- sim/diagnose"))
+        self.assertTrue(md.startswith("<!-- python/bristle/diagnose"))
         self.assertIn("**Verdict: offset**", md)
         self.assertNotRegex(md, r"20\d\d-\d\d-\d\d")  # no timestamp
         # a rerun writes the same report (deterministic, no timestamp)
@@ -102,8 +102,8 @@ class CliTest(unittest.TestCase):
     def test_python_closed_loop_agrees_with_the_c_plant(self):
         """The diagnosis's closed-loop simulator with the true parameters
         against br_simlog's true position (same controller, same reference)."""
-        sys.path.insert(0, os.path.join(REPO, "sim"))
-        from diagnose import closedloop
+        sys.path.insert(0, os.path.join(REPO, "python"))
+        from bristle.diagnose import closedloop
 
         d = np.loadtxt(self.log_a, delimiter=",", skiprows=1)
         t, ref, pos, pos_true = d[:, 0], d[:, 1], d[:, 2], d[:, 4]
@@ -111,7 +111,7 @@ class CliTest(unittest.TestCase):
             ctrl = dict(json.load(f)["controller"])
         ctrl["_quantum"] = closedloop.position_quantum(pos)
         L = 0.008 / (2 * np.pi)
-        truth = {"M_kg": (4.0e-5 + L * L * 10.0) / (L * L), "Fv_Nspm": 50.0, "Fc_N": 7.0, "Fs_N": 18.0,
+        truth = {"Meff_kg": (4.0e-5 + L * L * 10.0) / (L * L), "sigma2_Nspm": 50.0, "Fc_N": 7.0, "Fs_N": 18.0,
                  "vs_mps": 2e-5, "sigma0_Npm": 4e6, "sigma1_Nspm": 2000.0, "offset_N": 1.2}
         n = 6000
         q, _, x = closedloop.simulate(truth, ctrl, ref[:n], 0.0, 0.0)
@@ -129,18 +129,27 @@ class CliTest(unittest.TestCase):
         self.assertIn(f"{bad}:1501: column 'pos' is NaN", r.stderr)
         model = os.path.join(self.w, "bad_model.json")
         with open(model, "w") as f:
-            f.write('{"format": "bristle-model/1",\n "params": {"M_kg": 1}}\n')
+            f.write('{"format": "bristle-model/2",\n "params": {"Meff_kg": 1}}\n')
         r = py("validate", "--model", model, "--log", self.log_a)
         self.assertEqual(r.returncode, 1)
-        self.assertIn(f"{model}:2: \"params\" lacks Fv_Nspm", r.stderr)
+        self.assertIn(f"{model}:2: \"params\" lacks sigma2_Nspm", r.stderr)
         r = simlog("--out", os.path.join(self.w, "x.csv"), "--model", model)
         self.assertEqual(r.returncode, 1)
-        self.assertIn(f"{model}:2: \"params\" lacks \"Fv_Nspm\"", r.stderr)
+        self.assertIn(f"{model}:2: \"params\" lacks \"sigma2_Nspm\"", r.stderr)
         r = simlog("--out", os.path.join(self.w, "x.csv"), "--delay", "-1")
         self.assertNotEqual(r.returncode, 0)
         self.assertIn("delay_s", r.stderr)
         r = simlog("--out", os.path.join(self.w, "x.csv"), "--ripple", "1")
         self.assertEqual(r.returncode, 2)
+        # the options set the parameters of sim/plant/br_model_params.h, by their names and bounds
+        r = simlog("--out", os.path.join(self.w, "x.csv"), "--asym", "1")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("dFc_neg_N,dsigma2_neg_Nspm", r.stderr)
+        r = simlog("--out", os.path.join(self.w, "x.csv"), "--delay", "0.5")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("delay_s must be in 0 .. 0.1", r.stderr)
+        r = simlog("--out", os.path.join(self.w, "x.csv"), "--ripple", "1,0")
+        self.assertIn("ripple_period_m must be > 0", r.stderr)
 
 
 def main():

@@ -25,9 +25,9 @@ def main():
               "(the public EMPS benchmark, DATA_EMPS.mat, converted; docs/diagnose.md says where to get it).",
               file=sys.stderr)
         return 1
-    env = dict(os.environ, PYTHONPATH=os.path.join(REPO, "sim"), MPLBACKEND="Agg")
-    r = subprocess.run([sys.executable, "-m", "diagnose", "diagnose", "--log", a.log, "--out", a.out,
-                        "--machine", os.path.join(REPO, "sim", "diagnose", "machines", "emps.json")], env=env)
+    env = dict(os.environ, PYTHONPATH=os.path.join(REPO, "python"), MPLBACKEND="Agg")
+    r = subprocess.run([sys.executable, "-m", "bristle.diagnose", "diagnose", "--log", a.log, "--out", a.out,
+                        "--machine", os.path.join(REPO, "python", "bristle", "diagnose", "machines", "emps.json")], env=env)
     if r.returncode != 0:
         print("FAIL: the diagnosis failed", file=sys.stderr)
         return 1

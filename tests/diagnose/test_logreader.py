@@ -1,4 +1,4 @@
-"""Log reader (sim/diagnose/logreader.py): what real files contain is
+"""Log reader (python/bristle/diagnose/logreader.py): what real files contain is
 accepted, every problem is rejected with "file:line: problem", and a large
 file streams in bounded memory. One test per guard."""
 import os
@@ -8,8 +8,8 @@ import unittest
 
 import numpy as np
 
-from diagnose import logreader
-from diagnose.logreader import LogError
+from bristle.diagnose import logreader
+from bristle.diagnose.logreader import LogError
 
 N = logreader.MIN_SAMPLES + 20
 

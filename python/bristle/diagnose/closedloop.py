@@ -1,34 +1,39 @@
 """Closed-loop re-simulation of a log: the fitted model as the plant, the
 log's position controller (when it is known), the log's reference as input.
 
-Controller file (JSON), type "emps_pd" (the EMPS loop, and br_simlog's
-identification loop, which writes it with --controller-out):
+Controller (a machine file's "controller"), type "emps_pd" (the EMPS loop,
+and br_simlog's identification loop, which writes it with --machine-out):
 
   qf(k) = (q(k) + q(k-1)) / 2,  qdot(k) = (qf(k) - qf(k-1)) / dt
   u = kp kv (ref - q) - kv qdot,  |u| <= u_max,  F = gain u
 
 keys: dt_s, kp_1ps, kv, gain_N, u_max.
 
-Plant, load side (model.py's force model as dynamics):
+Plant, load side (model.py's force model as dynamics, model.json's names):
 
-  M dv/dt = F(t - d) - k(x) [Fv_d v + sigma0 z + sigma1 dz/dt] - offset - A sin(2 pi x / P + phase)
+  Meff dv/dt = F(t - d) - k(x, t) [sigma2_d v + sigma0 z + sigma1 dz/dt] - load(x)
 
-integrated like the C plant (docs/modules/plant.md): N_SUB substeps per
-period; in each, z follows the exact displacement-domain solution with g
-held (bounded at any speed), the friction impulse is integrated in closed
-form, the rigid body by the trapezoidal rule with fixed-point passes on the
-mean velocity. The measured position q is the simulated one quantised to the
-log's resolution (the smallest position step found in the log), rounded
-down like an encoder count.
+nominal: k = 1, sigma2_d = sigma2_Nspm, load = 0, d = 0, the Stribeck curve
+the same in both directions; each cause whose parameters the model holds
+sets its terms (its module's closed_loop(p, plant): causes/). Integrated
+like the C plant (docs/modules/plant.md): N_SUB substeps per period; in
+each, z follows the exact displacement-domain solution with g held
+(lugre.step, the fit's bristle update), the friction impulse is integrated
+in closed form, the rigid body by the trapezoidal rule with fixed-point
+passes on the mean velocity. The measured position q is the simulated one
+quantised to the log's resolution (the smallest position step found in the
+log), rounded down like an encoder count.
 """
-import json
 import math
 
 import numpy as np
 
+from . import causes, checks, lugre
+
 N_SUB = 10
 PASSES = 3
 CONTROLLER_TYPES = ("emps_pd",)
+CONTROLLER_KEYS = ("dt_s", "kp_1ps", "kv", "gain_N", "u_max")
 
 
 class ControllerError(ValueError):
@@ -39,20 +44,29 @@ def check_controller(c, where):
     """Validates a controller description (a dict); where names it in messages."""
     if not isinstance(c, dict) or c.get("type") not in CONTROLLER_TYPES:
         raise ControllerError(f"{where}: \"type\" must be one of {', '.join(CONTROLLER_TYPES)}")
-    for k in ("dt_s", "kp_1ps", "kv", "gain_N", "u_max"):
-        v = c.get(k)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or (k != "kp_1ps" and v <= 0):
-            raise ControllerError(f"{where}: \"{k}\" must be a finite number" + ("" if k == "kp_1ps" else " > 0"))
+    for k in CONTROLLER_KEYS:
+        positive = k != "kp_1ps"
+        if not checks.finite(c.get(k), positive):
+            raise ControllerError(f"{where}: \"{k}\" must be a finite number" + (" > 0" if positive else ""))
     return c
 
 
-def load_controller(path):
-    try:
-        with open(path, encoding="utf-8-sig") as f:
-            c = json.load(f)
-    except (OSError, json.JSONDecodeError) as e:
-        raise ControllerError(f"{path}: {e}") from None
-    return check_controller(c, path)
+class Plant:
+    """The cause terms of the re-simulated plant (what causes/*.closed_loop set)."""
+
+    def __init__(self, p):
+        self.stribeck_neg_ratio = 1.0         # the Stribeck curve in -x over the one in +x
+        self.sigma2_neg_Nspm = p["sigma2_Nspm"]  # viscous friction in -x
+        self.friction_scales = []             # k(x, t) = product of these
+        self.loads = []                       # load(x) = sum of these, N
+        self.delay_s = 0.0                    # actuator dead time
+
+
+def plant(p):
+    pl = Plant(p)
+    for m in causes.present(p):
+        m.closed_loop(p, pl)
+    return pl
 
 
 def position_quantum(pos):
@@ -68,27 +82,26 @@ def position_quantum(pos):
 
 
 def simulate(params, ctrl, ref, pos0, vel0):
-    """Runs the loop over len(ref) periods. Returns (q, force, x_true)."""
+    """Runs the loop over len(ref) periods (params: model.json's). Returns
+    (q, force, x_true)."""
     p = params
     dt = float(ctrl["dt_s"])
     kp, kv, gain, umax = (float(ctrl[k]) for k in ("kp_1ps", "kv", "gain_N", "u_max"))
-    M = p["M_kg"]
+    M = p["Meff_kg"]
     Fc = p["Fc_N"]
     beta = p["Fs_N"] / Fc
     vs = p["vs_mps"]
     s0 = p["sigma0_Npm"]
-    s1 = p.get("sigma1_Nspm", 0.0)
-    Fv_p = p["Fv_Nspm"]
-    Fv_n = p.get("Fv_neg_Nspm", Fv_p)
-    c_neg = p.get("Fc_neg_N", Fc) / Fc
-    off = p.get("offset_N", 0.0)
-    ra, rp, rph = p.get("ripple_amp_N", 0.0), p.get("ripple_period_m", 1.0), p.get("ripple_phase_rad", 0.0)
-    grad = p.get("grad_per_m", 0.0)
-    delay = p.get("delay_s", 0.0)
+    s1 = p["sigma1_Nspm"]
+    Fv_p = p["sigma2_Nspm"]
+    pl = plant(p)
+    Fv_n, c_neg, scales, loads, delay = (pl.sigma2_neg_Nspm, pl.stribeck_neg_ratio, pl.friction_scales, pl.loads,
+                                         pl.delay_s)
     quantum = ctrl.get("_quantum", 0.0)
     h = dt / N_SUB
-    exp, expm1, fabs, sin, copysign = math.exp, math.expm1, math.fabs, math.sin, math.copysign
-    two_pi = 2.0 * math.pi
+    rho = s0 / Fc
+    stribeck, bristle_step, SCALAR = lugre.stribeck, lugre.step, lugre.SCALAR
+    copysign = math.copysign
 
     n = len(ref)
     q_out = np.empty(n)
@@ -123,26 +136,19 @@ def simulate(params, ctrl, ref, pos0, vel0):
             else:
                 Fa = F
             vm = v
+            tm = (k * N_SUB + i + 0.5) * h  # the substep's mid time from the log's start
             for _ in range(PASSES):
                 dx = vm * h
-                gn = 1.0 + (beta - 1.0) * exp(-fabs(vm) / vs)
-                if dx < 0.0:
-                    gn *= c_neg
-                g = Fc * gn
-                if dx != 0.0:
-                    zss = copysign(g / s0, dx)
-                    r = s0 * fabs(dx) / g
-                    qq = -expm1(-r)
-                    z1 = z + (zss - z) * qq
-                    zint = h * (zss + (z - zss) * (qq / r if r > 1e-12 else 1.0 - 0.5 * r))
-                else:
-                    z1, zint = z, z * h
+                z1, zbar = bristle_step(z, dx, stribeck(vm, beta, vs, c_neg, SCALAR), rho)
+                zint = h * zbar
                 xm = x + 0.5 * dx
-                kx = max(0.0, 1.0 + grad * xm) if grad != 0.0 else 1.0
+                kx = 1.0
+                for scale in scales:
+                    kx *= scale(xm, tm)
                 fv = Fv_n if dx < 0.0 else Fv_p
-                imp = kx * (fv * dx + s0 * zint + s1 * (z1 - z)) + off * h
-                if ra != 0.0:
-                    imp += ra * sin(two_pi * xm / rp + rph) * h
+                imp = kx * (fv * dx + s0 * zint + s1 * (z1 - z))
+                for load in loads:
+                    imp += load(xm) * h
                 v1 = v + (Fa * h - imp) / M
                 vm = 0.5 * (v + v1)
             x += dx

@@ -1,4 +1,4 @@
-"""Testing the causes, keeping the significant ones, ranking them.
+"""Testing the causes (causes/), keeping the significant ones, ranking them.
 
 A cause is tested by fitting base + cause on the training part (the shape of
 the base held, the cause's own parameters searched) and measuring both models
@@ -23,6 +23,7 @@ the ones before it.
 import numpy as np
 from scipy import stats
 
+from . import causes as causes_
 from . import model
 
 MIN_REL_GAIN = 0.05
@@ -91,7 +92,7 @@ def diagnose(prep, progress=None):
     nominal = model.fit_nominal(prep)
     say(f"nominal: held-out relerr {nominal.relerr(prep, prep.test):.3f} %")
     base = nominal
-    remaining = list(model.CAUSES)
+    remaining = list(causes_.NAMES)
     findings, rounds = [], []
     while remaining:
         cands = [c for c in (test(prep, base, cause) for cause in remaining) if c is not None]

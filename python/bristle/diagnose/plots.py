@@ -1,11 +1,17 @@
-"""Figures of a diagnosis (matplotlib, Agg): what report.md lists."""
+"""Figures of a diagnosis (matplotlib, Agg): what report.md lists. A cause's
+own figures are in its module (causes/, FIGURES) and use `plt` and `save`
+from here."""
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 
-from . import model  # noqa: E402
+
+
+def save(fig, path):
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def _shade_held_out(ax, prep):
@@ -33,9 +39,7 @@ def force_fit(path, prep, diag):
     ax.set_ylabel("residual [N]")
     ax.set_xlabel("t [s]")
     ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
 
 
 def residuals(path, prep, diag):
@@ -53,29 +57,7 @@ def residuals(path, prep, diag):
         ax.set_ylabel("residual [N]")
         ax.legend(loc="upper right", fontsize=8, markerscale=8)
     axs[0].set_title("Force residual (measured - predicted) against time, velocity and position")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def residual_spectrum(path, prep, diag):
-    pmin, pmax = model.ripple_period_range(prep)
-    pmin = max(pmin / 2, 1e-6)
-    w = slice(prep.lo, prep.hi, model.PERIODOGRAM_DECIMATE)
-    periods = np.geomspace(pmin, max(pmax, 2 * pmin), 500)
-    fig, ax = plt.subplots(figsize=(10, 4.5))
-    ax.semilogx(1e3 * periods, model.position_periodogram(diag.nominal.residual(prep)[w], prep.xm[w], periods),
-                color="tab:red", lw=0.8, label="nominal residual")
-    if diag.extended.causes:
-        ax.semilogx(1e3 * periods, model.position_periodogram(diag.extended.residual(prep)[w], prep.xm[w], periods),
-                    color="tab:blue", lw=0.8, label="extended residual")
-    ax.set_xlabel("period in position [mm]")
-    ax.set_ylabel("amplitude [N]")
-    ax.set_title("Residual spectrum over position (least-squares sine fit at each period)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
 
 
 def closed_loop(path, prep, sims):
@@ -95,6 +77,4 @@ def closed_loop(path, prep, sims):
     for ax in axs:
         ax.legend(loc="upper right", fontsize=8)
     axs[0].set_title("Closed-loop re-simulation: the log's reference, its controller, the fitted model")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)

@@ -30,6 +30,7 @@ ORDER = 4
 EDGE_S = 0.15
 EDGE_MIN = 50
 TRAIN_FRAC = 0.7
+MEMO_MAX = 64
 
 
 class Prepared:
@@ -63,24 +64,23 @@ class Prepared:
         self.test = slice(self.split, self.hi)
         self.whole = slice(self.lo, self.hi)
         self.train_frac = train_frac
+        self._memo = {}
 
     def lp(self, x):
         """The zero-phase low-pass applied to every signal."""
         return signal.filtfilt(self._b, self._a, x)
 
-    def y_delayed(self, delay_s):
-        """The filtered force that reaches the axis over each interval when the
-        logged (commanded) force is applied delay_s later: with zero-order
-        hold, the mean over interval k of the command delayed by
-        d = (m + f) dt is (1 - f) F[k-m] + f F[k-m-1]."""
-        if delay_s <= 0.0:
-            return self.y
-        m = int(np.floor(delay_s / self.dt))
-        f = delay_s / self.dt - m
-        F = self.force
-        prev = np.concatenate([np.full(m, F[0]), F])[: len(F)]
-        prev2 = np.concatenate([np.full(m + 1, F[0]), F])[: len(F)]
-        return self.lp((1.0 - f) * prev + f * prev2)[:-1]
+    def memo(self, key, make):
+        """Per-log memo of column blocks (the searches reuse them many times):
+        make() once per key; a bounded store, cleared when full."""
+        if key not in self._memo:
+            if len(self._memo) > MEMO_MAX:
+                self._memo.clear()
+            self._memo[key] = make()
+        return self._memo[key]
+
+    def forget(self, key):
+        self._memo.pop(key, None)
 
     def held_out_description(self):
         t0, t1 = self.t[self.split], self.t[self.hi]

@@ -1,0 +1,72 @@
+"""The causes a diagnosis can name (../shared/spec/measured-log.md), one
+module each, and their registry: REGISTRY is the ordered list the rest of
+the package iterates (the order of the columns, of model.json's keys and of
+the selection's tests). Adding a cause: a module here and a line in
+REGISTRY (docs/diagnose.md, "Adding a cause").
+
+What a cause module holds:
+
+  NAME, MEANING        the spec's name; what it is physically (report.md)
+  OPTION               br_simlog's / br_circle_ext's option that switches it on
+                       (the C table sim/plant/br_model_params.h)
+  PARAMS               its model.json parameters (params.Param), in the
+                       option's order; the same names as br_plant_cfg_t's fields
+  NL                   the names of its nonlinear parameters in a fit's `nl`
+  search(prep, base, fit_with) -> dict | None
+                       its nonlinear parameters for base + it; fit_with(nl)
+                       solves the linear ones with those (model.Fit, train_sse);
+                       {} when it has none, None when the log cannot show it
+  params(coef, nl, p), from_params(p) -> (coef, nl)
+                       fit <-> model.json parameters (p: the nominal ones)
+  report_params(p)     the parameters the spec names for a finding
+  evidence(r, p)       one sentence from the nominal residual (evidence.Residual)
+                       and the report parameters
+  closed_loop(p, plant)
+                       its terms in the closed-loop re-simulation's plant
+                       (closedloop.Plant)
+
+and, for the force model (model.py), the hooks it needs of:
+
+  load_columns(prep, nl) -> dict      columns added to the force (linear coefficients)
+  friction_scale(prep, nl) -> array   a factor on the friction (viscous + LuGre) over the intervals
+  stribeck_neg_ratio(nl) -> float     the Stribeck curve's scale in -x, inside the bristle dynamics
+  friction_columns(prep, nl, v, phi) -> dict
+                                      the viscous and LuGre-level columns, replacing the nominal ones
+  target(prep, nl) -> array           the force the model is compared with, replacing the filtered log's
+
+and FIGURES, ((file, what, function(path, prep, diag)), ...), if it draws any.
+"""
+from .. import params
+from . import actuator_delay, asymmetric_friction, offset, position_gradient, position_ripple
+
+REGISTRY = (
+    offset,
+    asymmetric_friction,
+    position_ripple,
+    position_gradient,
+    actuator_delay,
+)
+
+NAMES = tuple(m.NAME for m in REGISTRY)
+# every model.json parameter: the nominal ones, then each cause's
+MODEL_PARAMS = params.NOMINAL + tuple(q for m in REGISTRY for q in m.PARAMS)
+_BY_NAME = {m.NAME: m for m in REGISTRY}
+
+
+def get(name):
+    return _BY_NAME[name]
+
+
+def of(names):
+    """The modules of the named causes, in registry order."""
+    return tuple(m for m in REGISTRY if m.NAME in names)
+
+
+def present(p):
+    """The modules whose every parameter p (model.json "params") holds."""
+    return tuple(m for m in REGISTRY if all(q.name in p for q in m.PARAMS))
+
+
+def hooks(mods, name):
+    """The hook `name` of each module that has it, in order."""
+    return [getattr(m, name) for m in mods if hasattr(m, name)]

@@ -1,0 +1,49 @@
+"""offset: a constant force on the axis (gravity on a tilted axis, cable
+drag, an amplifier offset).
+
+Force model: + offset_N (a column of ones, linear: nothing to search).
+Plant (br_sim_plant.c) and closed loop: a load force offset_N, + opposing
+motion in +x. Estimator (br_est_ext.c): added to the friction estimate."""
+import numpy as np
+
+from ..params import Param
+
+NAME = "offset"
+MEANING = "a constant force: gravity on a tilted axis, cable drag, an amplifier offset"
+OPTION = "--offset"
+PARAMS = (Param("offset_N", "N", "constant load force, + opposes motion in +x"),)
+NL = ()
+
+
+def load_columns(prep, nl):
+    return {"offset": prep.memo(("ones",), lambda: np.ones(prep.n))}
+
+
+def search(prep, base, fit_with):
+    return {}
+
+
+def params(coef, nl, p):
+    return {"offset_N": coef["offset"]}
+
+
+def from_params(p):
+    return {"offset": p["offset_N"]}, {}
+
+
+def report_params(p):
+    return {"force_N": p["offset_N"]}
+
+
+def evidence(r, p):
+    rest = np.abs(r.v) < 0.02 * r.v95
+    mp, mn = r.e[r.moving & (r.v > 0)].mean(), r.e[r.moving & (r.v < 0)].mean()
+    at_rest = f", {r.e[rest].mean():+.2f} N at rest" if rest.any() else ""
+    return (f"The nominal model's residual has the same sign in both directions: {mp:+.2f} N moving in +x, "
+            f"{mn:+.2f} N moving in -x{at_rest} (residual vs velocity); fitted constant force "
+            f"{p['force_N']:+.3g} N.")
+
+
+def closed_loop(p, plant):
+    off = p["offset_N"]
+    plant.loads.append(lambda x: off)

@@ -1,0 +1,234 @@
+"""The force model fitted to a log: the nominal (thesis) model and its
+extensions by the causes (causes/, one module each).
+
+Force needed over interval k (load side):
+
+  F = Meff a + sigma2 v + Fc (rho z) + sigma1 dz/dt                  nominal
+
+with z from lugre.bristle along the measured path and the shape
+(rho = sigma0/Fc, beta = Fs/Fc, vs). A cause extends it through the hooks of
+its module (causes/__init__.py): columns added to the force, a factor on the
+friction, the Stribeck curve in -x, the friction columns split by
+direction, the force it is compared with. Columns that are nonlinear in the
+motion (the LuGre ones, a ripple) are computed from the filtered position
+and filtered once more (signals.Prepared.lp), like the force they are
+compared with; a and v are linear in the position and are not.
+
+Given the shape and the causes' nonlinear parameters (`nl`) the force is
+linear in the rest (`coef`), which is solved by least squares on the
+training part (variable projection); the shape and `nl` are searched
+around that.
+"""
+import math
+
+import numpy as np
+from scipy import optimize
+
+from . import causes as causes_
+from . import lugre
+from .signals import relerr
+
+# bounds of the shape search
+RHO_BOUNDS = (1e3, 1e9)      # sigma0 / Fc, 1/m: presliding lengths from 1 nm to 1 mm
+BETA_BOUNDS = (1.0, 10.0)    # Fs / Fc
+VS_BOUNDS = (1e-7, 0.1)      # Stribeck velocity, m/s
+SHAPE_STARTS = ((2e5, 1.5, 1e-3), (2e6, 2.0, 3e-5))
+
+
+class Fit:
+    """One fitted model: causes, shape, nonlinear cause parameters, linear
+    coefficients; predicts the force over the intervals of a Prepared log."""
+
+    def __init__(self, causes, shape, nl, coef):
+        self.causes = tuple(m.NAME for m in causes_.of(causes))
+        self.shape = tuple(shape)
+        self.nl = dict(nl)
+        self.coef = dict(coef)
+
+    def target(self, prep):
+        return target(prep, self.causes, self.nl)
+
+    def predict(self, prep):
+        cols = columns(prep, self.shape, self.causes, self.nl)
+        return sum(self.coef.get(k, 0.0) * c for k, c in cols.items())
+
+    def residual(self, prep):
+        return self.target(prep) - self.predict(prep)
+
+    def relerr(self, prep, sl):
+        y = self.target(prep)
+        return relerr(y[sl], (y - self.predict(prep))[sl])
+
+    def params(self):
+        """Physical parameters, load side: model.json's "params" (params.py)."""
+        c, (rho, beta, vs) = self.coef, self.shape
+        Fc = c["Fc"]
+        p = {
+            "Meff_kg": c["Meff"],
+            "sigma2_Nspm": c["sigma2"],
+            "Fc_N": Fc,
+            "Fs_N": beta * Fc,
+            "vs_mps": vs,
+            "sigma0_Npm": rho * Fc,
+            "sigma1_Nspm": c.get("sigma1", 0.0),
+        }
+        for m in causes_.of(self.causes):
+            p.update(m.params(c, self.nl, p))
+        return {k: float(v) for k, v in p.items()}
+
+    def cause_params(self, cause):
+        """The parameters the spec asks a finding of this cause to report."""
+        return causes_.get(cause).report_params(self.params())
+
+
+def from_params(p, causes):
+    """A Fit from physical parameters (a saved model)."""
+    Fc = p["Fc_N"]
+    shape = (p["sigma0_Npm"] / Fc, p["Fs_N"] / Fc, p["vs_mps"])
+    coef = {"Meff": p["Meff_kg"], "sigma2": p["sigma2_Nspm"], "Fc": Fc, "sigma1": p["sigma1_Nspm"]}
+    nl = {}
+    for m in causes_.of(causes):
+        c, n = m.from_params(p)
+        coef.update(c)
+        nl.update(n)
+    return Fit(causes, shape, nl, coef)
+
+
+def _neg_ratio(mods, nl):
+    """The Stribeck curve's scale in -x inside the bristle dynamics."""
+    ratio = 1.0
+    for hook in causes_.hooks(mods, "stribeck_neg_ratio"):
+        ratio *= hook(nl)
+    return ratio
+
+
+FRICTION_HOOKS = ("stribeck_neg_ratio", "friction_scale", "friction_columns")
+
+
+def _friction_columns(prep, shape, mods, nl):
+    """The friction columns (viscous, LuGre level, sigma1) with what the
+    causes do to the friction."""
+    fmods = [m for m in mods if any(hasattr(m, h) for h in FRICTION_HOOKS)]
+
+    def make():
+        rho, beta, vs = shape
+        ratio = _neg_ratio(fmods, nl)
+        phi, zd = prep.memo(("bristle", shape, ratio),
+                            lambda: lugre.bristle_columns(prep.dx, prep.dt, rho, beta, vs, neg_ratio=ratio))
+        v = prep.v
+        for scale in causes_.hooks(fmods, "friction_scale"):
+            k = scale(prep, nl)
+            phi, zd, v = k * phi, k * zd, k * v
+        split = causes_.hooks(fmods, "friction_columns")
+        cols = split[0](prep, nl, v, phi) if split else {"sigma2": v, "Fc": prep.lp(phi)}
+        cols["sigma1"] = prep.lp(zd)
+        return cols
+
+    key = ("friction", shape) + tuple((m.NAME,) + tuple(nl.get(k) for k in m.NL) for m in fmods)
+    return prep.memo(key, make)
+
+
+def columns(prep, shape, causes, nl):
+    """Design columns over all intervals, by coefficient name."""
+    mods = causes_.of(causes)
+    cols = {"Meff": prep.a}
+    cols.update(_friction_columns(prep, shape, mods, nl))
+    for load in causes_.hooks(mods, "load_columns"):
+        cols.update(load(prep, nl))
+    return cols
+
+
+def target(prep, causes, nl):
+    """The force the model is compared with: the filtered log's, or what a
+    cause makes of it (a dead time)."""
+    for hook in causes_.hooks(causes_.of(causes), "target"):
+        return hook(prep, nl)
+    return prep.y
+
+
+def solve(prep, shape, causes, nl):
+    """Linear least squares of the coefficients on the training part; sigma1
+    is kept >= 0 (dropped when the free solution is negative). The fit keeps
+    its training residual and sum of squares (train_sse)."""
+    cols = columns(prep, shape, causes, nl)
+    y = target(prep, causes, nl)
+    names = list(cols)
+    tr = prep.train
+    yt = y[tr]
+    for _ in range(2):
+        X = np.column_stack([cols[k][tr] for k in names])
+        sol, *_ = np.linalg.lstsq(X, yt, rcond=None)
+        coef = dict(zip(names, sol))
+        if coef.get("sigma1", 0.0) >= 0.0:
+            break
+        names.remove("sigma1")
+    coef.setdefault("sigma1", 0.0)
+    fit = Fit(causes, shape, nl, coef)
+    fit.train_resid = yt - X @ sol
+    fit.train_sse = float(fit.train_resid @ fit.train_resid)
+    return fit
+
+
+def fit_shape(prep, causes, nl, starts=SHAPE_STARTS, max_nfev=40):
+    """Searches the LuGre shape (log rho, beta, log vs) by bounded least
+    squares on the training residual, the coefficients solved inside."""
+    lo = np.array([math.log(RHO_BOUNDS[0]), BETA_BOUNDS[0], math.log(VS_BOUNDS[0])])
+    hi = np.array([math.log(RHO_BOUNDS[1]), BETA_BOUNDS[1], math.log(VS_BOUNDS[1])])
+    ratio = _neg_ratio(causes_.of(causes), nl)
+
+    def unpack(u):
+        return (math.exp(u[0]), u[1], math.exp(u[2]))
+
+    def resid(u):
+        shape = unpack(u)
+        r = solve(prep, shape, causes, nl).train_resid
+        prep.forget(("bristle", shape, ratio))  # a shape is seldom seen twice
+        return r
+
+    best = None
+    for s in starts:
+        u0 = np.clip([math.log(s[0]), s[1], math.log(s[2])], lo + 1e-9, hi - 1e-9)
+        r = optimize.least_squares(resid, u0, bounds=(lo, hi), diff_step=1e-4, x_scale=[1.0, 0.5, 1.0],
+                                   max_nfev=max_nfev, xtol=1e-5, ftol=1e-7)
+        if best is None or r.cost < best.cost:
+            best = r
+    return solve(prep, unpack(best.x), causes, nl)
+
+
+def search_cause(prep, base, cause, causes, nl):
+    """The nonlinear parameters of `cause` in the model base.shape + causes
+    ({} when it has none, None when the log cannot show it)."""
+    def fit_with(extra):
+        return solve(prep, base.shape, causes, dict(nl, **extra))
+
+    return causes_.get(cause).search(prep, base, fit_with)
+
+
+def add_cause(prep, base, cause):
+    """base + cause with base's shape held: the cause's nonlinear parameters
+    searched, the coefficients solved. None if the cause cannot be fitted."""
+    causes = base.causes + (cause,)
+    extra = search_cause(prep, base, cause, causes, base.nl)
+    if extra is None:
+        return None
+    return solve(prep, base.shape, causes, dict(base.nl, **extra))
+
+
+def refine(prep, fit, rounds=2, max_nfev=40):
+    """Alternates the shape search (from the current shape) and each cause's
+    nonlinear search (the others held)."""
+    for _ in range(rounds):
+        fit = fit_shape(prep, fit.causes, fit.nl, starts=(fit.shape,), max_nfev=max_nfev)
+        nl = dict(fit.nl)
+        for c in fit.causes:
+            others = solve(prep, fit.shape, tuple(x for x in fit.causes if x != c), nl)
+            extra = search_cause(prep, others, c, fit.causes, nl)
+            if extra:
+                nl.update(extra)
+        fit = solve(prep, fit.shape, fit.causes, nl)
+    return fit
+
+
+def fit_nominal(prep):
+    """The thesis model: rigid body + viscous + symmetric LuGre with Stribeck."""
+    return fit_shape(prep, (), {})
