@@ -28,6 +28,9 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
     if (!br_finite_pos(cfg->rad_per_count) || !br_finite_pos(cfg->outlier_sigma) || cfg->reanchor_after < 1u) {
         return BR_E_PARAM;
     }
+    if (!(cfg->model.causes.delay_s <= (float)(BR_EST_DELAY_HIST - 2u) * cfg->model.dt_s)) {
+        return BR_E_PARAM;
+    }
     for (int i = 0; i < BR_NX; i++) {
         if (!br_est_var_ok(cfg->q_var[i], 1)) {
             return BR_E_PARAM;
@@ -50,4 +53,37 @@ br_status_t br_est_check_step(const br_meas_t *y, float u_prev_Nm)
         return BR_E_INPUT;
     }
     return BR_OK;
+}
+
+void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg)
+{
+    const float q = cfg->model.causes.delay_s / cfg->model.dt_s;
+    d->m = (uint32_t)q;
+    d->f = q - (float)d->m;
+    d->on = cfg->model.causes.delay_s > 0.0f;
+    d->head = 0u;
+    d->n = 0u;
+    for (uint32_t i = 0; i < BR_EST_DELAY_HIST; i++) {
+        d->u[i] = 0.0f;
+    }
+}
+
+/* the command j periods before the newest (j = 0: the newest), 0 before the first */
+static float cmd_ago(const br_est_delay_t *d, uint32_t j)
+{
+    return (j < d->n) ? d->u[(d->head + BR_EST_DELAY_HIST - j) % BR_EST_DELAY_HIST] : 0.0f;
+}
+
+float br_est_delay_apply(br_est_delay_t *d, float u_prev_Nm)
+{
+    if (!d->on) {
+        return u_prev_Nm;
+    }
+    d->head = (d->head + 1u) % BR_EST_DELAY_HIST;
+    d->u[d->head] = u_prev_Nm;
+    if (d->n < BR_EST_DELAY_HIST) {
+        d->n++;
+    }
+    /* u_a = (1 - f) u[k-1-m] + f u[k-2-m] */
+    return (1.0f - d->f) * cmd_ago(d, d->m) + d->f * cmd_ago(d, d->m + 1u);
 }

@@ -29,11 +29,28 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
+    const br_causes_t *c = &cfg->causes;
+    if (!isfinite(c->offset_N) || !isfinite(c->dFc_neg_N) || !isfinite(c->dsigma2_neg_Nspm) ||
+        !isfinite(c->ripple_amp_N) || !isfinite(c->ripple_phase_rad) || !isfinite(c->grad_per_m) ||
+        !br_finite_nonneg(c->delay_s)) {
+        return BR_E_PARAM;
+    }
+    /* the level in -x stays positive, the viscous friction in -x not negative,
+     * and a ripple has a period */
+    if (!(cfg->lugre.Fc_N + c->dFc_neg_N > 0.0f) || !(cfg->sigma2_Nspm + c->dsigma2_neg_Nspm >= 0.0f) ||
+        (c->ripple_amp_N != 0.0f && !br_finite_pos(c->ripple_period_m))) {
+        return BR_E_PARAM;
+    }
     m->cfg = *cfg;
     float L = cfg->lead_mprad;
     /* eq. 1: effective inertia on the motor side, J + L^2 M */
     m->inv_Jeff = 1.0f / (cfg->J_kgm2 + L * L * cfg->M_kg);
     m->visc_Nmsprad = L * L * cfg->sigma2_Nspm;
+    m->extended = c->offset_N != 0.0f || c->dFc_neg_N != 0.0f || c->dsigma2_neg_Nspm != 0.0f ||
+                  c->ripple_amp_N != 0.0f || c->grad_per_m != 0.0f;
+    m->c_neg = (cfg->lugre.Fc_N + c->dFc_neg_N) / cfg->lugre.Fc_N;
+    m->sigma2_neg_Nspm = cfg->sigma2_Nspm + c->dsigma2_neg_Nspm;
+    m->ripple_k_radpm = (c->ripple_amp_N != 0.0f) ? 6.28318531f / c->ripple_period_m : 0.0f;
     m->ready = 1;
     return BR_OK;
 }
@@ -41,19 +58,36 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
 float br_model_fnl_N(const br_model_t *m, const float x[BR_NX])
 {
     const br_model_k_t k = br_model_k(m);
-    /* eq. 6: f_nl = sigma0 z + sigma1 dz/dt, dz/dt from eq. 4 with g = g_p */
-    return br_model_k_fnl(&k, x[BR_X_Z], br_model_k_zdot(&k, x[BR_X_OMEGA], x[BR_X_Z], x[BR_X_GP]));
+    /* eq. 3 with dz/dt from eq. 4, g = g_p (c g_p in -x) */
+    const float gp = (m->cfg.lead_mprad * x[BR_X_OMEGA] < 0.0f) ? m->c_neg * x[BR_X_GP] : x[BR_X_GP];
+    return br_model_k_fnl(&k, x[BR_X_Z], br_model_k_zdot(&k, x[BR_X_OMEGA], x[BR_X_Z], gp));
+}
+
+float br_model_fcomp_N(const br_model_t *m, const float x[BR_NX], float p0_m)
+{
+    if (!m->extended) {
+        return br_model_fnl_N(m, x);
+    }
+    const br_model_kx_t k = br_model_kx(m, p0_m);
+    return br_model_kx_fcomp_N(&k, x);
 }
 
 void br_model_deriv(const br_model_t *m, const float x[BR_NX], float u_Nm, float dx[BR_NX])
 {
+    dx[BR_X_THETA] = x[BR_X_OMEGA];
+    dx[BR_X_GP] = 0.0f;
+    if (m->extended) {
+        /* the load force at the absolute position L theta (the expansion at its origin) */
+        const br_model_kx_t k = br_model_kx(m, m->cfg.lead_mprad * x[BR_X_THETA]);
+        const float F = br_model_kx_load_N(&k, 0.0f, x[BR_X_OMEGA], x[BR_X_Z], x[BR_X_GP], &dx[BR_X_Z]);
+        dx[BR_X_OMEGA] = (u_Nm - k.n.L * F) * k.n.inv_Jeff;
+        return;
+    }
     const br_model_k_t k = br_model_k(m);
     const float zdot = br_model_k_zdot(&k, x[BR_X_OMEGA], x[BR_X_Z], x[BR_X_GP]);
-    /* eq. 6: theta' = omega; omega' = (u - L (sigma2 L omega + f_nl)) / Jeff; z' = eq. 4; g_p' = 0 */
-    dx[BR_X_THETA] = x[BR_X_OMEGA];
+    /* eq. 6: omega' = (u - L (sigma2 L omega + f_nl)) / Jeff; z' = eq. 4 */
     dx[BR_X_OMEGA] = br_model_k_omega_dot(&k, x[BR_X_OMEGA], br_model_k_fnl(&k, x[BR_X_Z], zdot), u_Nm);
     dx[BR_X_Z] = zdot;
-    dx[BR_X_GP] = 0.0f;
 }
 
 /* Bounded scheme: z exact over the displacement (eq. 4 with g_p held), friction
@@ -92,6 +126,45 @@ void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u, f
     out[BR_X_GP] = gp;
 }
 
+/* The bounded scheme of the extended model: as above with the level c g_p
+ * and sigma2_d by the direction of the move, the friction impulse scaled by
+ * k(p) and the offset and ripple impulses added, k and the ripple taken at
+ * the middle of the move. */
+void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float u, float out[BR_NX])
+{
+    const float h = k->n.h, L = k->n.L, s0 = k->n.s0;
+    const float t0 = x[BR_X_THETA], w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z], gp = x[BR_X_GP];
+    float wm = w0, dth = 0.0f, z1 = z0, w1 = w0;
+    int pass;
+    for (pass = 0; pass < BR_MODEL_BOUNDED_PASSES; pass++) {
+        dth = wm * h;
+        const float dx = L * dth;
+        const int neg = dx < 0.0f;
+        float zint;
+        if (dx != 0.0f) {
+            /* eq. 4 over the displacement with the direction's level, exact and bounded */
+            const br_lk_move_t mv = br_lk_move(s0, z0, dx, neg ? k->c_neg * gp : gp);
+            z1 = mv.z1_m;
+            float q = (mv.r > 1e-6f) ? mv.one_minus_e / mv.r : 1.0f - 0.5f * mv.r;
+            zint = h * (mv.zss_m + (z0 - mv.zss_m) * q);
+        } else {
+            z1 = z0;
+            zint = z0 * h;
+        }
+        const float tm = t0 + 0.5f * dth;
+        const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + L * tm));
+        /* the load impulse: k (sigma2_d dx + sigma0 int z + sigma1 dz) + (offset + ripple) h */
+        const float imp = kp * ((neg ? k->s2_neg : k->s2) * dx + s0 * zint + k->n.s1 * (z1 - z0)) +
+                          (k->off + br_model_kx_ripple_N(k, tm)) * h;
+        w1 = w0 + (u * h - L * imp) * k->n.inv_Jeff;
+        wm = 0.5f * (w0 + w1);
+    }
+    out[BR_X_THETA] = t0 + dth;
+    out[BR_X_OMEGA] = w1;
+    out[BR_X_Z] = z1;
+    out[BR_X_GP] = gp;
+}
+
 static int all_finite(const float x[BR_NX])
 {
     return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(x[3]);
@@ -105,7 +178,8 @@ static void copy_state(const float src[BR_NX], float dst[BR_NX])
     }
 }
 
-br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm, float x_next[BR_NX])
+br_status_t br_model_step_at(const br_model_t *m, const float x[BR_NX], float p0_m, float u_Nm,
+                             float x_next[BR_NX])
 {
     if (m == NULL || x == NULL || x_next == NULL) {
         return BR_E_NULL;
@@ -114,19 +188,46 @@ br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm,
         return BR_E_STATE;
     }
     float tmp[BR_NX];
-    if (!all_finite(x) || !isfinite(u_Nm) || !(x[BR_X_GP] > 0.0f)) {
+    if (!all_finite(x) || !isfinite(u_Nm) || !isfinite(p0_m) || !(x[BR_X_GP] > 0.0f)) {
         copy_state(x, x_next);
         return BR_E_INPUT;
     }
-    const br_model_k_t k = br_model_k(m);
-    /* RK4 only where both ends of the step are inside its stability region. */
-    if (!br_model_k_rk4(&k, x, u_Nm, tmp)) {
-        br_model_bounded_step(m, x, u_Nm, tmp);
+    if (m->extended) {
+        const br_model_kx_t k = br_model_kx(m, p0_m);
+        if (!br_model_kx_rk4(&k, x, u_Nm, tmp)) {
+            br_model_bounded_step_x(&k, x, u_Nm, tmp);
+        }
+    } else {
+        const br_model_k_t k = br_model_k(m);
+        /* RK4 only where both ends of the step are inside its stability region. */
+        if (!br_model_k_rk4(&k, x, u_Nm, tmp)) {
+            br_model_bounded_step(m, x, u_Nm, tmp);
+        }
     }
     if (!all_finite(tmp)) {
         copy_state(x, x_next);
         return BR_E_NUMERIC;
     }
     copy_state(tmp, x_next);
+    return BR_OK;
+}
+
+br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm, float x_next[BR_NX])
+{
+    if (m == NULL || x == NULL || x_next == NULL || !m->ready || !m->extended) {
+        return br_model_step_at(m, x, 0.0f, u_Nm, x_next);
+    }
+    /* extended: step about the state's own position (theta = 0 at p0 = L theta);
+     * x may be x_next */
+    const float th0 = x[BR_X_THETA];
+    const float rel[BR_NX] = {0.0f, x[BR_X_OMEGA], x[BR_X_Z], x[BR_X_GP]};
+    float out[BR_NX];
+    const br_status_t st = br_model_step_at(m, rel, m->cfg.lead_mprad * th0, u_Nm, out);
+    if (st != BR_OK) {
+        copy_state(x, x_next); /* x_next = x, as for every failed step */
+        return st;
+    }
+    out[BR_X_THETA] += th0;
+    copy_state(out, x_next);
     return BR_OK;
 }

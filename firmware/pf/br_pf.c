@@ -7,6 +7,7 @@
 
 #include "bristle/br_encoder.h"
 #include "br_check.h"
+#include "br_inline.h"
 #include "br_math.h"
 #include "br_model_kernel.h"
 
@@ -52,6 +53,8 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
         pf->q_std[i] = sqrtf(cfg->est.q_var[i]);
     }
     pf->inv_2r = 0.5f / cfg->est.r_var_rad2;
+    pf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
+    br_est_delay_init(&pf->delay, &cfg->est);
     pf->outlier_l = -0.5f * cfg->est.outlier_sigma * cfg->est.outlier_sigma;
     pf->noise_pos = 0u;
     pf->origin_counts = 0;
@@ -76,6 +79,10 @@ static void noise_advance(br_pf_t *pf)
     pf->noise_pos = (pf->noise_pos + BR_NX * pf->cfg.n_particles + pf->cfg.noise_skip) & (pf->cfg.noise_len - 1u);
 }
 
+/* Load position of the integer origin, p0 = L rpc origin (float: exact to
+ * one count up to 2^24 counts, to 2^(n-24) counts at 2^n) */
+static float origin_pos_m(const br_pf_t *pf) { return (float)pf->origin_counts * pf->m_per_count; }
+
 /* Estimate of the freshly drawn set: means and the mean of f_nl (eq. 6). */
 static void estimate_current(br_pf_t *pf, float ess)
 {
@@ -86,7 +93,7 @@ static void estimate_current(br_pf_t *pf, float ess)
             s[i] += pf->x[j][i];
         }
         /* thesis estimate: the mean of f_nl (eq. 6) over the particles */
-        sf += br_model_fnl_N(&pf->model, pf->x[j]);
+        sf += br_model_fcomp_N(&pf->model, pf->x[j], origin_pos_m(pf));
     }
     const float inv_m = 1.0f / (float)m;
     for (int i = 0; i < BR_NX; i++) {
@@ -165,10 +172,14 @@ br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
     return BR_OK;
 }
 
-/* Steps 1 and 2 for every particle: prediction into xp, f_nl, log-weight.
- * Returns the number of valid (finite) predicted particles and their largest
- * log-weight in *lmax. */
-static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, float *lmax)
+/* Steps 1 and 2 for every particle: prediction into xp, the force to
+ * compensate (f_nl for the thesis model), log-weight. ext: the extended
+ * model's kernel mx (theta relative to the origin at its p0) instead of the
+ * thesis model's; a constant at each call site, so that each case is its own
+ * loop. Returns the number of valid (finite) predicted particles and their
+ * largest log-weight in *lmax. */
+BR_INLINE uint32_t predict_and_weigh_with(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, float *lmax,
+                                          const int ext, const br_model_kx_t *mx)
 {
     /* the model's constants and the loop's invariants, held in registers */
     const br_model_k_t mk = br_model_k(&pf->model);
@@ -186,9 +197,13 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
          * beyond its a h limit); the particles are finite with g_p >= gp_min > 0.
          * xn stays in registers; only the rare bounded step goes through memory. */
         float xn[BR_NX];
-        if (!br_model_k_rk4(&mk, xj, u_prev_Nm, xn)) {
+        if (ext ? !br_model_kx_rk4(mx, xj, u_prev_Nm, xn) : !br_model_k_rk4(&mk, xj, u_prev_Nm, xn)) {
             float xb[BR_NX];
-            br_model_bounded_step(&pf->model, xj, u_prev_Nm, xb);
+            if (ext) {
+                br_model_bounded_step_x(mx, xj, u_prev_Nm, xb);
+            } else {
+                br_model_bounded_step(&pf->model, xj, u_prev_Nm, xb);
+            }
             for (int i = 0; i < BR_NX; i++) {
                 xn[i] = xb[i];
             }
@@ -208,12 +223,20 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             n2 = noise[(pos + 2u) & mask];
             n3 = noise[(pos + 3u) & mask];
         }
-        const float th = xn[BR_X_THETA] + q0 * n0 - shift;
+        const float th_old = xn[BR_X_THETA] + q0 * n0; /* relative to the last origin */
+        const float th = th_old - shift;
         const float om = xn[BR_X_OMEGA] + q1 * n1;
         const float z = xn[BR_X_Z] + q2 * n2;
         const float gp = br_clampf(xn[BR_X_GP] + q3 * n3, gp_min, gp_max);
-        /* eq. 6: f_nl of the predicted particle */
-        const float fnl = br_model_k_fnl(&mk, z, br_model_k_zdot(&mk, om, z, gp));
+        /* the force to compensate of the predicted particle: eq. 6's f_nl, or
+         * the extended model's (at its position relative to the last origin) */
+        float fnl;
+        if (ext) {
+            const float xe[BR_NX] = {th_old, om, z, gp};
+            fnl = br_model_kx_fcomp_N(mx, xe);
+        } else {
+            fnl = br_model_k_fnl(&mk, z, br_model_k_zdot(&mk, om, z, gp));
+        }
         /* Validity: x - x is 0 for finite x and NaN otherwise. g_p is finite after
          * the clamp; a non-finite omega or z makes f_nl non-finite (inf - inf,
          * 0 * inf or inf in eqs. 3-4), so theta and f_nl tell all four states. */
@@ -243,6 +266,17 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     }
     *lmax = lm;
     return n_valid;
+}
+
+/* Steps 1 and 2 with the configured model; theta of the particles relative
+ * to pf->origin_counts */
+static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, float *lmax)
+{
+    if (pf->model.extended) {
+        const br_model_kx_t mx = br_model_kx(&pf->model, origin_pos_m(pf));
+        return predict_and_weigh_with(pf, u_prev_Nm, shift, y_rel, lmax, 1, &mx);
+    }
+    return predict_and_weigh_with(pf, u_prev_Nm, shift, y_rel, lmax, 0, NULL);
 }
 
 /* Step 3: max-shifted weights w_j = e^(l_j - lmax), quantised to W_j (an invalid
@@ -322,6 +356,8 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     if (in != BR_OK) {
         return in;
     }
+    /* the torque that reached the axis over the last period (the command itself without a delay) */
+    const float u_a = br_est_delay_apply(&pf->delay, u_prev_Nm);
     if (!pf->primed) {
         prime(pf, y);
         return BR_OK;
@@ -332,7 +368,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     const float shift = (float)br_counts_delta(y->counts, pf->origin_counts) * rpc;
     const float y_rel = y->frac * rpc;
     float lmax;
-    const uint32_t n_valid = predict_and_weigh(pf, u_prev_Nm, shift, y_rel, &lmax);
+    const uint32_t n_valid = predict_and_weigh(pf, u_a, shift, y_rel, &lmax);
     noise_advance(pf);
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
@@ -361,7 +397,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
             pf->x[j][BR_X_THETA] += d_th;
             pf->x[j][BR_X_OMEGA] += d_om;
             /* f_nl depends on omega: the estimate is that of the moved cloud */
-            sf += br_model_fnl_N(&pf->model, pf->x[j]);
+            sf += br_model_fcomp_N(&pf->model, pf->x[j], (float)y->counts * pf->m_per_count);
         }
         s[BR_X_THETA] += d_th * (float)m;
         s[BR_X_OMEGA] += d_om * (float)m;
@@ -393,7 +429,7 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     const uint32_t m = pf->cfg.n_particles;
     /* step 1 only: the log-weights against a dummy measurement are not used */
     float lmax;
-    const uint32_t n_valid = predict_and_weigh(pf, u_prev_Nm, 0.0f, 0.0f, &lmax);
+    const uint32_t n_valid = predict_and_weigh(pf, br_est_delay_apply(&pf->delay, u_prev_Nm), 0.0f, 0.0f, &lmax);
     noise_advance(pf);
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */

@@ -98,7 +98,116 @@ static inline int br_model_k_rk4(const br_model_k_t *k, const float x[BR_NX], fl
     return br_model_k_rk4_ok(k, w0, gp) && br_model_k_rk4_ok(k, out[BR_X_OMEGA], gp);
 }
 
-/* The bounded scheme of br_model_step (out of line: not reached at circle speeds). */
+/* ---- The extended model (causes on; docs/modules/model.md, "Extended model") ----
+ * Its own constants and stages, so that the thesis model's kernel above keeps
+ * its operations (and its results, bit for bit) when no cause is on. theta is
+ * relative to an origin at load position p0 (the estimators' integer count
+ * origin); the ripple's sine is taken once per step at p0 and expanded to
+ * third order in the phase advance d = 2 pi L theta / P of each stage
+ * (|error| <= d^4 / 24 of A: 4e-4 A for a move of 5 % of the period from the
+ * origin, far more than a particle moves between two measurements). */
+typedef struct {
+    br_model_k_t n;  /* the thesis model's constants */
+    float p0;        /* load position of theta = 0, m */
+    float c_neg;     /* Stribeck level factor in -x, (Fc + dFc_neg) / Fc */
+    float c_min;     /* min(c_neg, 1): the a h test's smallest level per g_p */
+    float s2;        /* sigma2 */
+    float s2_neg;    /* sigma2 + dsigma2_neg */
+    float off;       /* offset, N */
+    float grad;      /* gradient, 1/m */
+    float kL;        /* 2 pi L / P: ripple phase per radian of theta (0 without ripple) */
+    float rs, rc;    /* A sin(phi0), A cos(phi0), phi0 = 2 pi p0 / P + phase */
+} br_model_kx_t;
+
+static inline br_model_kx_t br_model_kx(const br_model_t *m, float p0_m)
+{
+    const br_causes_t *c = &m->cfg.causes;
+    br_model_kx_t k;
+    k.n = br_model_k(m);
+    k.p0 = p0_m;
+    k.c_neg = m->c_neg;
+    k.c_min = fminf(m->c_neg, 1.0f);
+    k.s2 = m->cfg.sigma2_Nspm;
+    k.s2_neg = m->sigma2_neg_Nspm;
+    k.off = c->offset_N;
+    k.grad = c->grad_per_m;
+    k.kL = m->ripple_k_radpm * m->cfg.lead_mprad;
+    k.rs = 0.0f;
+    k.rc = 0.0f;
+    if (c->ripple_amp_N != 0.0f) {
+        /* the phase at p0, reduced to one period first (fmodf is exact) */
+        const float phi0 = m->ripple_k_radpm * fmodf(p0_m, c->ripple_period_m) + c->ripple_phase_rad;
+        k.rs = c->ripple_amp_N * sinf(phi0);
+        k.rc = c->ripple_amp_N * cosf(phi0);
+    }
+    return k;
+}
+
+/* ripple A sin(phi0 + d), d = 2 pi L theta / P: sin(phi0) (1 - d^2/2) + cos(phi0) d (1 - d^2/6) */
+static inline float br_model_kx_ripple_N(const br_model_kx_t *k, float th)
+{
+    const float d = k->kL * th;
+    const float d2 = d * d;
+    return k->rs * (1.0f - 0.5f * d2) + k->rc * d * (1.0f - 0.166666672f * d2);
+}
+
+/* The load force of the extended model at (theta, omega, z, g_p), N, and the
+ * bristle rate in *zd: eq. 4 with the level c g_p in -x, eq. 3, then
+ * k(p) (sigma2_d v + f_nl) + offset + ripple, k(p) = max(0, 1 + grad p). */
+static inline float br_model_kx_load_N(const br_model_kx_t *k, float th, float w, float z, float gp, float *zd)
+{
+    const float v = k->n.L * w;
+    const int neg = v < 0.0f;
+    *zd = br_lk_zdot_mps(k->n.s0, v, z, neg ? k->c_neg * gp : gp);
+    const float f = br_lk_force_N(k->n.s0, k->n.s1, z, *zd);
+    const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + k->n.L * th));
+    return kp * ((neg ? k->s2_neg : k->s2) * v + f) + k->off + br_model_kx_ripple_N(k, th);
+}
+
+/* The force to compensate: the load force without the nominal viscous term */
+static inline float br_model_kx_fcomp_N(const br_model_kx_t *k, const float x[BR_NX])
+{
+    float zd;
+    const float F = br_model_kx_load_N(k, x[BR_X_THETA], x[BR_X_OMEGA], x[BR_X_Z], x[BR_X_GP], &zd);
+    return F - k->s2 * (k->n.L * x[BR_X_OMEGA]);
+}
+
+/* a h <= BR_MODEL_RK4_AH_MAX with the smaller of the two direction levels */
+static inline int br_model_kx_rk4_ok(const br_model_kx_t *k, float omega, float gp)
+{
+    return k->n.s0Lh * fabsf(omega) <= BR_MODEL_RK4_AH_MAX * (k->c_min * gp);
+}
+
+/* Classic RK4 of the extended model over h with u held; theta enters the
+ * right-hand side (ripple, gradient), so the stages carry it. Returns 1 when
+ * a h is inside the RK4 limit at both ends (as br_model_k_rk4). */
+static inline int br_model_kx_rk4(const br_model_kx_t *k, const float x[BR_NX], float u, float out[BR_NX])
+{
+    const float L = k->n.L, ij = k->n.inv_Jeff, hh = k->n.h_half;
+    const float t0 = x[BR_X_THETA], w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z], gp = x[BR_X_GP];
+    float zd1, zd2, zd3, zd4;
+    /* stage 1 at x */
+    const float wd1 = (u - L * br_model_kx_load_N(k, t0, w0, z0, gp, &zd1)) * ij;
+    /* stage 2 at x + h/2 k1 */
+    const float t2 = t0 + hh * w0, w2 = w0 + hh * wd1, z2 = z0 + hh * zd1;
+    const float wd2 = (u - L * br_model_kx_load_N(k, t2, w2, z2, gp, &zd2)) * ij;
+    /* stage 3 at x + h/2 k2 */
+    const float t3 = t0 + hh * w2, w3 = w0 + hh * wd2, z3 = z0 + hh * zd2;
+    const float wd3 = (u - L * br_model_kx_load_N(k, t3, w3, z3, gp, &zd3)) * ij;
+    /* stage 4 at x + h k3 */
+    const float t4 = t0 + k->n.h * w3, w4 = w0 + k->n.h * wd3, z4 = z0 + k->n.h * zd3;
+    const float wd4 = (u - L * br_model_kx_load_N(k, t4, w4, z4, gp, &zd4)) * ij;
+    /* x + h/6 (k1 + 2 k2 + 2 k3 + k4) */
+    out[BR_X_THETA] = t0 + k->n.h_6 * (w0 + 2.0f * w2 + 2.0f * w3 + w4);
+    out[BR_X_OMEGA] = w0 + k->n.h_6 * (wd1 + 2.0f * wd2 + 2.0f * wd3 + wd4);
+    out[BR_X_Z] = z0 + k->n.h_6 * (zd1 + 2.0f * zd2 + 2.0f * zd3 + zd4);
+    out[BR_X_GP] = gp;
+    return br_model_kx_rk4_ok(k, w0, gp) && br_model_kx_rk4_ok(k, out[BR_X_OMEGA], gp);
+}
+
+/* The bounded schemes of br_model_step (out of line: not reached at circle
+ * speeds), for the thesis model and for the extended one. */
 void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u_Nm, float out[BR_NX]);
+void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float u_Nm, float out[BR_NX]);
 
 #endif

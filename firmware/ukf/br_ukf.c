@@ -73,6 +73,8 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->wi = wi;
     ukf->cmm = cfg->beta - cfg->alpha * cfg->alpha;
     ukf->out_s2 = cfg->est.outlier_sigma * cfg->est.outlier_sigma;
+    ukf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
+    br_est_delay_init(&ukf->delay, &cfg->est);
     for (int i = 0; i < BR_NX; i++) {
         ukf->x[i] = 0.0f;
         for (int j = 0; j < BR_NX; j++) {
@@ -184,12 +186,14 @@ static br_status_t sigma_points(br_ukf_t *ukf, const float x[BR_NX], float P[BR_
 /* Unscented mean of f_nl (eq. 6) over the sigma points in ukf->X:
  * F_hat = sum_j Wm_j f_nl(X_j), written as f_0 + sum_{j>=1} W_j (f_j - f_0)
  * (sum Wm = 1) so that a large |Wm_0| (small alpha) does not cancel in float32. */
-static float fnl_unscented(const br_ukf_t *ukf)
+static float fnl_unscented(const br_ukf_t *ukf, int32_t origin_counts)
 {
-    const float f0 = br_model_fnl_N(&ukf->model, ukf->X[0]);
+    /* the force to compensate: f_nl for the thesis model (eq. 6), the extended model's otherwise */
+    const float p0 = (float)origin_counts * ukf->m_per_count;
+    const float f0 = br_model_fcomp_N(&ukf->model, ukf->X[0], p0);
     float df = 0.0f;
     for (int s = 1; s < BR_UKF_NSIG; s++) {
-        df += br_model_fnl_N(&ukf->model, ukf->X[s]) - f0;
+        df += br_model_fcomp_N(&ukf->model, ukf->X[s], p0) - f0;
     }
     return f0 + ukf->wi * df;
 }
@@ -219,7 +223,7 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
     ukf->x[BR_X_GP] = ukf->cfg.est.gp0_N;
     reset_cov(&ukf->cfg, ukf->P);
     (void)sigma_points(ukf, ukf->x, ukf->P); /* diagonal with p0_var > 0: cannot fail */
-    set_estimate(ukf, fnl_unscented(ukf), 0.0f, 0.0f);
+    set_estimate(ukf, fnl_unscented(ukf, ukf->origin_counts), 0.0f, 0.0f);
     ukf->primed = 1;
     return BR_OK;
 }
@@ -231,9 +235,10 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
  * Returns 0 when the prediction is not finite. */
 static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[BR_NX], float Pm[BR_NX][BR_NX], int *chol_reset)
 {
+    const float p0 = (float)ukf->origin_counts * ukf->m_per_count; /* theta's origin */
     *chol_reset = sigma_points(ukf, ukf->x, ukf->P) != BR_OK;
     for (int s = 0; s < BR_UKF_NSIG; s++) {
-        if (br_model_step(&ukf->model, ukf->X[s], u_prev_Nm, ukf->Y[s]) != BR_OK) {
+        if (br_model_step_at(&ukf->model, ukf->X[s], p0, u_prev_Nm, ukf->Y[s]) != BR_OK) {
             return 0;
         }
     }
@@ -290,12 +295,13 @@ static br_status_t fail_reset(br_ukf_t *ukf)
  * as in step 1 and sets *chol_reset), the unscented mean of f_nl over them
  * into *F_hat, then x = xm, P = Pm. Returns 0, committing nothing, when
  * *F_hat is not finite. */
-static int posterior(br_ukf_t *ukf, const float xm[BR_NX], float Pm[BR_NX][BR_NX], float *F_hat, int *chol_reset)
+static int posterior(br_ukf_t *ukf, const float xm[BR_NX], float Pm[BR_NX][BR_NX], int32_t origin_counts,
+                     float *F_hat, int *chol_reset)
 {
     if (sigma_points(ukf, xm, Pm) != BR_OK) {
         *chol_reset = 1;
     }
-    *F_hat = fnl_unscented(ukf);
+    *F_hat = fnl_unscented(ukf, origin_counts);
     if (!isfinite(*F_hat)) {
         return 0;
     }
@@ -332,6 +338,8 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     if (in != BR_OK) {
         return in;
     }
+    /* the torque that reached the axis over the last period (the command itself without a delay) */
+    const float u_a = br_est_delay_apply(&ukf->delay, u_prev_Nm);
     if (!ukf->primed) {
         return prime(ukf, y);
     }
@@ -340,7 +348,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     /* 1.-2. sigma points of the last posterior, predicted mean and covariance */
     float xm[BR_NX], Pm[BR_NX][BR_NX];
     int chol_reset;
-    if (!predict(ukf, u_prev_Nm, xm, Pm, &chol_reset)) {
+    if (!predict(ukf, u_a, xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }
 
@@ -409,7 +417,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
 
     /* 4. posterior sigma points, the unscented mean of f_nl, commit x and P */
     float F_hat;
-    if (!posterior(ukf, xm, Pm, &F_hat, &chol_reset)) {
+    if (!posterior(ukf, xm, Pm, origin_new, &F_hat, &chol_reset)) {
         return fail_reset(ukf);
     }
     ukf->origin_counts = origin_new;
@@ -442,13 +450,13 @@ br_status_t br_ukf_predict(br_ukf_t *ukf, float u_prev_Nm)
     }
     float xm[BR_NX], Pm[BR_NX][BR_NX];
     int chol_reset;
-    if (!predict(ukf, u_prev_Nm, xm, Pm, &chol_reset)) {
+    if (!predict(ukf, br_est_delay_apply(&ukf->delay, u_prev_Nm), xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }
     xm[BR_X_GP] = br_clampf(xm[BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
     /* the predicted set's sigma points give the estimate, as after an update */
     float F_hat;
-    if (!posterior(ukf, xm, Pm, &F_hat, &chol_reset)) {
+    if (!posterior(ukf, xm, Pm, ukf->origin_counts, &F_hat, &chol_reset)) {
         return fail_reset(ukf);
     }
     if (ukf->n_predicted < UINT32_MAX) {

@@ -79,6 +79,7 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
     m->lugre.Fs_N = w2f(w[i++]);
     m->lugre.vs_mps = w2f(w[i++]);
     m->dt_s = w2f(w[i++]);
+    m->causes = (br_causes_t){0}; /* the stream's model is the thesis model */
     c->pf.n_particles = w[i++];
     for (uint32_t j = 0u; j < BR_NX; ++j) c->pf.est.q_var[j] = w2f(w[i++]);
     c->pf.est.r_var_rad2 = w2f(w[i++]);

@@ -8,7 +8,7 @@
 
 br_model_cfg_t br_ref_model_cfg(float dt_s)
 {
-    br_model_cfg_t m;
+    br_model_cfg_t m = {0}; /* no causes: the thesis model */
     m.J_kgm2 = BR_MACHINE_J_KGM2_F;
     m.M_kg = BR_MACHINE_M_KG_F;
     m.lead_mprad = BR_MACHINE_LEAD_MPRAD_F;

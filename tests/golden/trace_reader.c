@@ -308,7 +308,7 @@ void br_errstat_print(const br_errstat_t *s, const br_trace_t *t, const char *tr
 
 br_model_cfg_t br_trace_model_cfg(const br_trace_t *t)
 {
-    br_model_cfg_t m;
+    br_model_cfg_t m = {0}; /* no causes: the thesis model */
     m.J_kgm2 = (float)br_trace_meta_num(t, "J_kgm2");
     m.M_kg = (float)br_trace_meta_num(t, "M_kg");
     m.lead_mprad = (float)br_trace_meta_num(t, "L_mprad");

@@ -33,7 +33,8 @@ typedef struct {
     float rad_per_count;     /* encoder resolution, > 0 */
 } br_est_cfg_t;
 
-/* Checks the shared configuration: the model (br_model_init's checks), an
+/* Checks the shared configuration: the model (br_model_init's checks, the
+ * causes' included; the delay at most BR_EST_DELAY_HIST - 2 periods), an
  * encoder resolution > 0, process-noise variances 0 or normal floats up to
  * BR_EST_VAR_MAX (no subnormals), R from BR_EST_R_MIN_COUNTS2 counts^2 up to
  * BR_EST_VAR_MAX, 0 < gp_min < gp_max with gp0 inside, an outlier gate > 0, at
@@ -43,6 +44,30 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg);
 /* 1 when v is a usable variance: a normal float in [FLT_MIN, BR_EST_VAR_MAX],
  * or exactly 0 where zero_ok. */
 int br_est_var_ok(float v, int zero_ok);
+
+/* Commands the estimators keep for an actuator delay (model.causes.delay_s):
+ * delays up to BR_EST_DELAY_HIST - 2 periods. */
+#define BR_EST_DELAY_HIST 64u
+
+/* The torque that reached the axis over the last period, from the commands:
+ * with the delay d = (m + f) dt (m whole periods, 0 <= f < 1) and each command
+ * held over its period, u_a = (1 - f) u[k-1-m] + f u[k-2-m] (0 before the
+ * first command). No delay: u_a is the last command itself. */
+typedef struct {
+    float u[BR_EST_DELAY_HIST]; /* commanded torques, newest at head */
+    uint32_t head;
+    uint32_t n;                 /* commands kept, <= BR_EST_DELAY_HIST */
+    uint32_t m;                 /* whole periods of the delay */
+    float f;                    /* its fraction of a period */
+    int on;                     /* delay_s > 0 */
+} br_est_delay_t;
+
+/* Empties the history for the configuration's delay (checked by br_est_cfg_check). */
+void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg);
+
+/* Keeps u_prev_Nm, the command held over the last period, and returns the
+ * torque that reached the axis over it. */
+float br_est_delay_apply(br_est_delay_t *d, float u_prev_Nm);
 
 /* Encoder measurement: position = (counts + frac) counts. For a plain
  * quadrature encoder (floor quantisation) pass frac = 0.5, the centre of the

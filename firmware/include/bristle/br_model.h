@@ -21,6 +21,25 @@ enum { BR_X_THETA = 0, BR_X_OMEGA = 1, BR_X_Z = 2, BR_X_GP = 3, BR_NX = 4 };
  * beyond it the step switches to the bounded displacement-exact scheme. */
 #define BR_MODEL_RK4_AH_MAX 2.0f
 
+/* What a diagnosis found beyond the thesis model (docs/modules/model.md,
+ * "Extended model"; the causes of a measured log, docs/diagnose.md): all 0 is
+ * eq. 6 exactly, bit for bit. The names are those of model.json and of the
+ * machine file. With p = L theta_abs the load position and v = L omega:
+ *   J_eff omega' = u(t - delay) - L [ k(p) (sigma2_d v + f_nl) + offset + A sin(2 pi p / P + phi) ]
+ *   k(p) = max(0, 1 + grad p);  in -x (v < 0): sigma2_d = sigma2 + dsigma2_neg and the
+ *   Stribeck level is c g_p, c = (Fc + dFc_neg) / Fc (eq. 4 with that level). */
+typedef struct {
+    float offset_N;          /* constant load force, + opposes motion in +x (gravity, cable drag) */
+    float dFc_neg_N;         /* Coulomb level in -x minus that in +x (Stribeck curve scaled alike) */
+    float dsigma2_neg_Nspm;  /* viscous friction in -x minus that in +x */
+    float ripple_amp_N;      /* position ripple amplitude A (lead error, recirculation, cogging) */
+    float ripple_period_m;   /* its period P in load position, > 0 when A != 0 */
+    float ripple_phase_rad;  /* its phase phi at p = 0 */
+    float grad_per_m;        /* friction scaled by max(0, 1 + grad p) along the travel */
+    float delay_s;           /* actuator dead time; the estimators delay the torque they predict
+                                with through a command history (br_est.h), the model step not */
+} br_causes_t;
+
 typedef struct {
     float J_kgm2;       /* motor + screw inertia, > 0 */
     float M_kg;         /* table mass, >= 0 */
@@ -28,26 +47,45 @@ typedef struct {
     float sigma2_Nspm;  /* viscous friction, >= 0 */
     br_lugre_cfg_t lugre;
     float dt_s;         /* discretisation step, > 0 */
+    br_causes_t causes; /* all 0: the thesis model */
 } br_model_cfg_t;
 
 typedef struct {
     br_model_cfg_t cfg;
     float inv_Jeff;     /* 1 / (J + L^2 M) */
     float visc_Nmsprad; /* L^2 sigma2 */
+    int extended;       /* a cause other than the delay is on: the extended right-hand side */
+    float c_neg;        /* (Fc + dFc_neg) / Fc, the Stribeck level's factor in -x */
+    float sigma2_neg_Nspm; /* sigma2 + dsigma2_neg */
+    float ripple_k_radpm;  /* 2 pi / P (0 without ripple) */
     int ready;
 } br_model_t;
 
 br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg);
 
-/* Eq. 6 right-hand side f(x, u). */
+/* Eq. 6 right-hand side f(x, u), extended by the causes; theta absolute
+ * (the load position is p = L theta). */
 void br_model_deriv(const br_model_t *m, const float x[BR_NX], float u_Nm, float dx[BR_NX]);
 
-/* Lumped friction f_nl(x) in N (load side). */
+/* Lumped friction f_nl(x) in N (load side): eqs. 3-4 with the level g_p (c g_p
+ * in -x with an asymmetry). */
 float br_model_fnl_N(const br_model_t *m, const float x[BR_NX]);
 
-/* One discretisation step of dt_s with the torque u_Nm held:
+/* The force a compensation must cancel (load side, N) for a state whose theta
+ * is relative to an origin at load position p0_m (p = p0_m + L theta): f_nl
+ * for the thesis model; with causes k(p) (sigma2_d v + f_nl) - sigma2 v +
+ * offset + ripple, everything but the nominal viscous friction (which the
+ * controller sees as part of the plant, as in the thesis). */
+float br_model_fcomp_N(const br_model_t *m, const float x[BR_NX], float p0_m);
+
+/* One discretisation step of dt_s with the torque u_Nm held, theta absolute:
  * RK4 where a h <= BR_MODEL_RK4_AH_MAX, otherwise the bounded scheme.
  * Non-finite input or g_p <= 0 gives BR_E_INPUT and x_next = x. */
 br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm, float x_next[BR_NX]);
+
+/* The same for a state whose theta is relative to an origin at load position
+ * p0_m (the estimators keep theta relative to an integer count origin). */
+br_status_t br_model_step_at(const br_model_t *m, const float x[BR_NX], float p0_m, float u_Nm,
+                             float x_next[BR_NX]);
 
 #endif

@@ -53,6 +53,8 @@ typedef struct {
     br_model_t model;
     float q_std[BR_NX];
     float inv_2r;                 /* 1 / (2 R) */
+    float m_per_count;            /* L rpc: load position per encoder count */
+    br_est_delay_t delay;         /* commands for the actuator delay (model.causes.delay_s) */
     float outlier_l;              /* -outlier_sigma^2 / 2: log-weight threshold */
     uint32_t noise_pos;           /* table position, advances every step */
     int32_t origin_counts;

@@ -58,6 +58,8 @@ typedef struct {
     float wm0, wc0, wi;              /* weights: Wm_0, Wc_0, and Wm_i = Wc_i = W for i >= 1 */
     float cmm;                       /* beta - alpha^2: the m m^T term of P- about the central point */
     float out_s2;                    /* outlier_sigma^2 */
+    float m_per_count;               /* L rpc: load position per encoder count */
+    br_est_delay_t delay;            /* commands for the actuator delay (model.causes.delay_s) */
     float x[BR_NX];                  /* mean; theta relative to origin_counts */
     float P[BR_NX][BR_NX];           /* covariance, symmetric positive definite */
     float S[BR_NX][BR_NX];           /* scratch: Cholesky factor of the last factorised P (lower) */
