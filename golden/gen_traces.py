@@ -31,11 +31,14 @@ from ref import lugre as rlugre  # noqa: E402
 from ref import model as rmodel  # noqa: E402
 from ref import plant as rplant  # noqa: E402
 import gen_est_traces  # noqa: E402
+import gen_ext_traces  # noqa: E402
 
 SEED = 20240611  # base seed; trace i uses SEED + i (recorded in each header)
 SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                # estimator traces (gen_est_traces.py): one recorded input, one seed
-               "est_input": 6, "pf": 6, "pf_w": 6, "pf_x": 6, "ukf": 6}
+               "est_input": 6, "pf": 6, "pf_w": 6, "pf_x": 6, "ukf": 6,
+               # the extended model (gen_ext_traces.py)
+               "model_ext": 7}
 
 DT = 1.0e-3
 INT32_MAX = 2**31 - 1
@@ -428,6 +431,7 @@ def main(argv=None):
     paths = [gen_lugre(args.out, m), gen_model(args.out, m), gen_ctrl(args.out, m)]
     paths += gen_plant(args.out, m)
     paths += gen_est_traces.generate(args.out, m, sys.modules[__name__])
+    paths.append(gen_ext_traces.generate(args.out, m, sys.modules[__name__]))
     for pth in paths:
         print("wrote", os.path.relpath(pth))
     return 0

@@ -129,3 +129,115 @@ def step(p, x, u, h):
     if ah(p, x[1], x[3], h) <= RK4_AH_MAX and ah(p, x1[1], x[3], h) <= RK4_AH_MAX:
         return BR_OK, x1, BRANCH_RK4
     return BR_OK, bounded(p, x, u, h), BRANCH_BOUNDED
+
+
+# --------------------------------------------------------------------------
+# Extended model: the causes of a diagnosis (docs/modules/model.md, "Extended
+# model"), written from the equations, not from the C kernel. theta is
+# relative to an origin at load position p0, so the load position is
+# pos = p0 + L theta and the load velocity v = L omega:
+#
+#   Jeff omega' = u - L F,   F = k(pos) (sigma2_d v + f_nl) + offset + A sin(2 pi pos / P + phi)
+#   k(pos) = max(0, 1 + grad pos)
+#   z' = v - sigma0 |v| z / g,  g = g_p for v >= 0, c g_p for v < 0,  c = (Fc + dFc_neg) / Fc
+#   f_nl = sigma0 z + sigma1 z',  sigma2_d = sigma2 (+ dsigma2_neg for v < 0)
+#
+# The force to compensate is F - sigma2 v. The ripple is evaluated exactly
+# here (the C kernel expands it about p0; docs/golden.md bounds the
+# difference).
+# --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Causes:
+    offset: float = 0.0       # N
+    dFc_neg: float = 0.0      # N
+    dsigma2_neg: float = 0.0  # N s/m
+    ripple_amp: float = 0.0   # N
+    ripple_period: float = 1.0  # m
+    ripple_phase: float = 0.0   # rad
+    grad: float = 0.0         # 1/m
+
+    def level_factor(self, p, v):
+        """The Stribeck level's factor: 1 in +x, (Fc + dFc_neg) / Fc in -x."""
+        return (p.lugre.Fc + self.dFc_neg) / p.lugre.Fc if v < 0.0 else 1.0
+
+
+def load_force_ext(p, c, pos, w, z, gp):
+    """(F, z') of the extended model at load position pos."""
+    s0, s1, L = p.lugre.sigma0, p.lugre.sigma1, p.L
+    v = L * w
+    g = c.level_factor(p, v) * gp
+    zd = v - s0 * abs(v) * z / g
+    f = s0 * z + s1 * zd
+    k = max(0.0, 1.0 + c.grad * pos)
+    s2 = p.sigma2 + (c.dsigma2_neg if v < 0.0 else 0.0)
+    ripple = c.ripple_amp * math.sin(2.0 * math.pi * pos / c.ripple_period + c.ripple_phase)
+    return k * (s2 * v + f) + c.offset + ripple, zd
+
+
+def fcomp_ext(p, c, p0, x):
+    """The force a compensation must cancel: F - sigma2 v."""
+    th, w, z, gp = (float(v) for v in x)
+    F, _ = load_force_ext(p, c, p0 + p.L * th, w, z, gp)
+    return F - p.sigma2 * p.L * w
+
+
+def deriv_ext(p, c, p0, x, u):
+    th, w, z, gp = (float(v) for v in x)
+    F, zd = load_force_ext(p, c, p0 + p.L * th, w, z, gp)
+    return np.array([w, (u - p.L * F) / p.Jeff, zd, 0.0], dtype=np.float64)
+
+
+def rk4_ext(p, c, p0, x, u, h):
+    x = np.asarray(x, dtype=np.float64)
+    k1 = deriv_ext(p, c, p0, x, u)
+    k2 = deriv_ext(p, c, p0, x + (h / 2.0) * k1, u)
+    k3 = deriv_ext(p, c, p0, x + (h / 2.0) * k2, u)
+    k4 = deriv_ext(p, c, p0, x + h * k3, u)
+    return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+
+def bounded_ext(p, c, p0, x, u, h):
+    """B2 with the causes: the level and sigma2_d by the direction of the move,
+    the friction impulse scaled by k, the offset and ripple impulses added; k
+    and the ripple at the middle of the move."""
+    theta, w, z, gp = (float(v) for v in x)
+    s0, s1, L = p.lugre.sigma0, p.lugre.sigma1, p.L
+    wm = w
+    for _ in range(BOUNDED_PASSES):
+        dth = wm * h
+        dx = L * dth
+        g = c.level_factor(p, dx) * gp
+        if dx != 0.0:
+            r = s0 * abs(dx) / g
+            zss = (1.0 if dx > 0.0 else -1.0) * g / s0
+            e = math.exp(-r)
+            z1 = zss + (z - zss) * e
+            zint = h * (zss + (z - zss) * (1.0 - e) / r)
+        else:
+            z1 = z
+            zint = z * h
+        pos = p0 + L * (theta + 0.5 * dth)
+        k = max(0.0, 1.0 + c.grad * pos)
+        s2 = p.sigma2 + (c.dsigma2_neg if dx < 0.0 else 0.0)
+        ripple = c.ripple_amp * math.sin(2.0 * math.pi * pos / c.ripple_period + c.ripple_phase)
+        imp = k * (s2 * dx + s0 * zint + s1 * (z1 - z)) + (c.offset + ripple) * h
+        w1 = w + (u * h - L * imp) / p.Jeff
+        wm = (w + w1) / 2.0
+    return np.array([theta + dth, w1, z1, gp], dtype=np.float64)
+
+
+def ah_ext(p, c, w, gp, h):
+    """a h with the smaller of the two direction levels."""
+    cmin = min(1.0, (p.lugre.Fc + c.dFc_neg) / p.lugre.Fc)
+    return p.lugre.sigma0 * p.L * abs(w) * h / (cmin * gp)
+
+
+def step_ext(p, c, p0, x, u, h):
+    """br_model_step_at of the extended model: (status, x_next, branch)."""
+    x = np.asarray(x, dtype=np.float64)
+    if not (np.all(np.isfinite(x)) and math.isfinite(u) and math.isfinite(p0)) or not x[3] > 0.0:
+        return BR_E_INPUT, x.copy(), BRANCH_INVALID
+    x1 = rk4_ext(p, c, p0, x, u, h)
+    if ah_ext(p, c, x[1], x[3], h) <= RK4_AH_MAX and ah_ext(p, c, x1[1], x[3], h) <= RK4_AH_MAX:
+        return BR_OK, x1, BRANCH_RK4
+    return BR_OK, bounded_ext(p, c, p0, x, u, h), BRANCH_BOUNDED

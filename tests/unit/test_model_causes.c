@@ -1,0 +1,165 @@
+/* The extended estimation model's guards and the estimators' actuator-delay
+ * history (docs/modules/model.md, "Extended model"); the equations themselves
+ * are held to the float64 reference by tests/golden/test_golden_model_ext.c. */
+#include "br_test.h"
+
+#include "br_circle_est.h"
+#include "bristle/br_est.h"
+#include "bristle/br_model.h"
+
+#define DT_S 1.0e-3f
+
+static void test_causes_guards(void **st)
+{
+    (void)st;
+    br_model_t m;
+    const br_model_cfg_t ok = br_ref_model_cfg(DT_S);
+    br_model_cfg_t c = ok;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    assert_false(m.extended); /* no cause: the thesis model's kernel */
+    c = ok; c.causes.offset_N = NAN;                  assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ok; c.causes.grad_per_m = INFINITY;           assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    /* the level in -x must stay positive */
+    c = ok; c.causes.dFc_neg_N = -ok.lugre.Fc_N;      assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ok; c.causes.dFc_neg_N = -0.5f * ok.lugre.Fc_N; assert_int_equal(br_model_init(&m, &c), BR_OK);
+    assert_true(m.extended);
+    BR_ASSERT_NEAR(m.c_neg, 0.5, 1e-7);
+    /* the viscous friction in -x must not be negative */
+    c = ok; c.causes.dsigma2_neg_Nspm = -2.0f * ok.sigma2_Nspm; assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    /* a ripple needs a period */
+    c = ok; c.causes.ripple_amp_N = 1.0f; c.causes.ripple_period_m = 0.0f;
+    assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c.causes.ripple_period_m = 2e-3f;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    /* a delay alone is the estimators' business: the model stays the thesis model */
+    c = ok; c.causes.delay_s = 3e-3f;  assert_int_equal(br_model_init(&m, &c), BR_OK);
+    assert_false(m.extended);
+    c = ok; c.causes.delay_s = -1e-3f; assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+}
+
+/* An offset on a particle at rest: the model decelerates it by L offset / Jeff,
+ * and the force to compensate is the offset (with no friction at rest). */
+static void test_offset_at_rest(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = br_ref_model_cfg(DT_S);
+    c.causes.offset_N = 0.5f * c.lugre.Fc_N;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    const float x[BR_NX] = {0.0f, 0.0f, 0.0f, c.lugre.Fs_N};
+    float dx[BR_NX];
+    br_model_deriv(&m, x, 0.0f, dx);
+    const double Jeff = c.J_kgm2 + (double)c.lead_mprad * c.lead_mprad * c.M_kg;
+    BR_ASSERT_NEAR(dx[BR_X_OMEGA], -c.lead_mprad * c.causes.offset_N / Jeff, 1e-5 * c.lead_mprad * c.causes.offset_N / Jeff);
+    BR_ASSERT_NEAR(br_model_fcomp_N(&m, x, 0.0f), c.causes.offset_N, 1e-6);
+}
+
+/* Sliding in -x with an asymmetry: the steady friction is the level c Fc and
+ * the viscous term sigma2 + dsigma2 (the force to compensate leaves out the
+ * nominal sigma2 v). */
+static void test_asymmetry_in_minus_x(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = br_ref_model_cfg(DT_S);
+    c.causes.dFc_neg_N = 0.3f * c.lugre.Fc_N;
+    c.causes.dsigma2_neg_Nspm = 0.5f * c.sigma2_Nspm;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    const float v = -0.01f, w = v / c.lead_mprad, g = c.lugre.Fc_N; /* sliding, g_p = Fc */
+    const float cn = (c.lugre.Fc_N + c.causes.dFc_neg_N) / c.lugre.Fc_N;
+    const float x[BR_NX] = {0.0f, w, -cn * g / c.lugre.sigma0_Npm, g}; /* steady deflection */
+    BR_ASSERT_NEAR(br_model_fnl_N(&m, x), -cn * g, 1e-4 * g);
+    BR_ASSERT_NEAR(br_model_fcomp_N(&m, x, 0.0f), -cn * g + c.causes.dsigma2_neg_Nspm * v, 1e-4 * g);
+    /* the same sliding in +x sees the nominal level */
+    const float xp[BR_NX] = {0.0f, -w, g / c.lugre.sigma0_Npm, g};
+    BR_ASSERT_NEAR(br_model_fcomp_N(&m, xp, 0.0f), g, 1e-4 * g);
+}
+
+/* The ripple and the gradient follow the load position p0 + L theta. */
+static void test_ripple_and_gradient_follow_position(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = br_ref_model_cfg(DT_S);
+    c.causes.ripple_amp_N = 0.1f * c.lugre.Fc_N;
+    c.causes.ripple_period_m = 2.0e-3f;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    const float x[BR_NX] = {0.0f, 0.0f, 0.0f, c.lugre.Fs_N};
+    /* a quarter period on: the ripple at its crest */
+    BR_ASSERT_NEAR(br_model_fcomp_N(&m, x, 0.25f * c.causes.ripple_period_m), c.causes.ripple_amp_N, 1e-5);
+    /* the same point as theta relative to an origin 5 % of a period back: the
+     * kernel's expansion about the origin is within its bound A d^4 / 24 */
+    const float xr[BR_NX] = {0.05f * c.causes.ripple_period_m / c.lead_mprad, 0.0f, 0.0f, c.lugre.Fs_N};
+    const double d = 2.0 * 3.14159265358979 * 0.05;
+    BR_ASSERT_NEAR(br_model_fcomp_N(&m, xr, 0.20f * c.causes.ripple_period_m), c.causes.ripple_amp_N,
+                   c.causes.ripple_amp_N * (d * d * d * d / 24.0 + 1e-5));
+    c = br_ref_model_cfg(DT_S);
+    c.causes.grad_per_m = 2.0f;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    const float g = c.lugre.Fc_N;
+    const float xs[BR_NX] = {0.0f, 0.01f / c.lead_mprad, g / c.lugre.sigma0_Npm, g};
+    /* friction (LuGre and viscous) scaled by 1 + grad p at p = 0.1 m */
+    const double F0 = br_model_fcomp_N(&m, xs, 0.0f);
+    BR_ASSERT_NEAR(br_model_fcomp_N(&m, xs, 0.1f), 1.2 * F0 + 0.2 * c.sigma2_Nspm * 0.01, 1e-4 * F0);
+}
+
+/* br_model_step on an absolute theta equals br_model_step_at about the
+ * state's own position, for the extended model. */
+static void test_step_absolute_equals_relative(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = br_ref_model_cfg(DT_S);
+    c.causes.ripple_amp_N = 0.1f * c.lugre.Fc_N;
+    c.causes.ripple_period_m = 2.0e-3f;
+    c.causes.offset_N = 1.0f;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    const float th = 0.7f / c.lead_mprad * 1e-3f; /* 0.7 mm */
+    float x[BR_NX] = {th, 0.02f, 0.0f, c.lugre.Fs_N}, a[BR_NX], b[BR_NX];
+    const float xr[BR_NX] = {0.0f, x[1], x[2], x[3]};
+    assert_int_equal(br_model_step(&m, x, 0.01f, a), BR_OK);
+    assert_int_equal(br_model_step_at(&m, xr, c.lead_mprad * th, 0.01f, b), BR_OK);
+    assert_true(a[BR_X_OMEGA] == b[BR_X_OMEGA] && a[BR_X_Z] == b[BR_X_Z]);
+    assert_true(a[BR_X_THETA] == th + b[BR_X_THETA]);
+    /* in place */
+    assert_int_equal(br_model_step(&m, x, 0.01f, x), BR_OK);
+    assert_memory_equal(x, a, sizeof a);
+}
+
+/* The torque that reached the axis, from the commands: a delay of 2.25
+ * periods gives 0.75 u[k-3] + 0.25 u[k-4]; none gives the command itself. */
+static void test_delay_history(void **st)
+{
+    (void)st;
+    br_est_cfg_t c = br_circle_ukf_cfg_tuned(DT_S).est;
+    br_est_delay_t d;
+    br_est_delay_init(&d, &c);
+    assert_true(br_est_delay_apply(&d, 0.125f) == 0.125f); /* no delay: the command itself */
+    c.model.causes.delay_s = 2.25f * DT_S;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    br_est_delay_init(&d, &c);
+    const float u[] = {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f};
+    for (int k = 0; k < 6; k++) {
+        const float ua = br_est_delay_apply(&d, u[k]);
+        const double expect = 0.75 * (k >= 2 ? u[k - 2] : 0.0) + 0.25 * (k >= 3 ? u[k - 3] : 0.0);
+        BR_ASSERT_NEAR(ua, expect, 1e-5 * (fabs(expect) + 1.0));
+    }
+    /* the history's length bounds the delay */
+    c.model.causes.delay_s = (float)(BR_EST_DELAY_HIST - 2u) * DT_S;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    c.model.causes.delay_s = (float)(BR_EST_DELAY_HIST - 1u) * DT_S;
+    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_causes_guards),
+        cmocka_unit_test(test_offset_at_rest),
+        cmocka_unit_test(test_asymmetry_in_minus_x),
+        cmocka_unit_test(test_ripple_and_gradient_follow_position),
+        cmocka_unit_test(test_step_absolute_equals_relative),
+        cmocka_unit_test(test_delay_history),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
