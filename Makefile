@@ -141,7 +141,7 @@ target-bench: deps
 	$(call configure,cm7-release)
 	$(call build,cm7-release)
 	$(Q)echo "== target-bench -> $(TARGET_BENCH_OUT)"
-	$(Q)hal/mps2/target_bench.sh build/host-release build/cm7-release $(TARGET_BENCH_OUT)
+	$(Q)target/mps2/target_bench.sh build/host-release build/cm7-release $(TARGET_BENCH_OUT)
 
 # Measured logs (docs/diagnose.md): diagnose one, validate a saved model on
 # another, and the hidden-cause suite that writes docs/diagnose-hidden.md.
