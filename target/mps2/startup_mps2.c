@@ -36,7 +36,7 @@ typedef union {
 
 void br_mps2_fault(void)
 {
-    br_sh_puts("br_replay_mps2: unexpected exception (fault)\n");
+    br_sh_puts("mps2: unexpected exception (fault)\n");
     br_sh_exit(BR_MPS2_FAULT_STATUS);
 }
 
