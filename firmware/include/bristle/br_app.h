@@ -13,7 +13,7 @@
  * (br_app_mem_t), not in a union inside br_app_t. A union would make every
  * br_app_t as large as br_pf_t (~94 KB at BR_PF_MAX_PARTICLES): the
  * H-infinity-only image, whose whole state sits in a 16 KiB stack, would
- * carry 94 KB it never uses, and a UKF application (~1 KB of filter) too.
+ * carry 94 KB it never uses, and a UKF application (696 B of filter) too.
  * With caller storage each program sizes and places exactly its estimator:
  * on the MCU a static br_pf_t in a RAM section (.bss in the DTCM, never the
  * stack), on the host the heap. br_app_t itself is small (the axis loop). */
