@@ -18,9 +18,11 @@ endif
 
 JOBS       ?= 2
 PYTHON     := .venv/bin/python
-IMAGE      := build/cm7-release/hal/stm32h7/br_image_stm32h7.elf
-FLASH_KIB  := 2048
-RAM_KIB    := 128
+# The board whose firmware image `make firmware` / `make test` build and size:
+# its CMakeLists (hal/<board>/) writes into BOARD_INFO the image's path, its
+# part's flash and RAM sizes (KiB) and the RAM's name.
+BOARD      ?= stm32h7
+BOARD_INFO  = build/cm7-release/board-$(BOARD).txt
 DEMO_OUT   := out/demo
 HIDDEN_OUT := out/diagnose-hidden
 TUNE_OUT   := out/tune
@@ -44,12 +46,14 @@ endef
 # Flash = text + data (the .data image is stored in flash), RAM = data + bss
 # (bss includes the reserved stack), from arm-none-eabi-size (Berkeley format).
 define print_size
-	$(Q)test -f $(IMAGE) || { echo "no firmware image at $(IMAGE)" >&2; exit 1; }
-	$(Q)arm-none-eabi-size $(IMAGE) | awk -v fk=$(FLASH_KIB) -v rk=$(RAM_KIB) -v img=$(IMAGE) ' \
+	$(Q)test -f $(BOARD_INFO) || { echo "no board $(BOARD) in the cm7-release build ($(BOARD_INFO))" >&2; exit 1; }
+	$(Q)read -r img fk rk rn < $(BOARD_INFO); img=$$(realpath --relative-to=. "$$img"); \
+	test -f "$$img" || { echo "no firmware image at $$img" >&2; exit 1; }; \
+	arm-none-eabi-size "$$img" | awk -v fk="$$fk" -v rk="$$rk" -v rn="$$rn" -v img="$$img" ' \
 	  NR == 2 { f = $$1 + $$2; r = $$2 + $$3; ok = 1; \
 	    printf "firmware %s\n", img; \
 	    printf "  flash: %7d bytes (text %d + data %d)  %5.2f%% of %d KiB\n", f, $$1, $$2, 100 * f / (fk * 1024), fk; \
-	    printf "  RAM:   %7d bytes (data %d + bss %d)   %5.2f%% of %d KiB DTCM\n", r, $$2, $$3, 100 * r / (rk * 1024), rk } \
+	    printf "  RAM:   %7d bytes (data %d + bss %d)   %5.2f%% of %d KiB %s\n", r, $$2, $$3, 100 * r / (rk * 1024), rk, rn } \
 	  END { exit ok ? 0 : 1 }'
 endef
 
@@ -66,7 +70,7 @@ help:
 	@echo "  make validate MODEL=<model.json> LOG=<csv>          a saved model's relerr on another log"
 	@echo "  make diagnose-hidden  the hidden-cause suite -> docs/diagnose-hidden.md"
 	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
-	@echo "  make firmware  cross build (cm7-release) and print flash / RAM use"
+	@echo "  make firmware  cross build (cm7-release), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
 	@echo "  make regen     regenerate the generated headers and the golden traces"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
@@ -81,10 +85,10 @@ build: deps
 	$(call configure,host-debug)
 	$(call build,host-debug)
 
-# The release tools (the estimator tuner) are built first: the regen test of the
-# tuned configurations runs them unsanitised, at full speed.
-# The cm7-release images are built before ctest: target_qemu_replay runs the
-# mps2-an500 replay image under qemu-system-arm (docs/target.md).
+# Every preset is built before ctest: the tests that run another preset's
+# binary (regen_{pf,ukf}_tuned: the release tuner; target_qemu_replay: the
+# mps2-an500 replay image, docs/target.md) build it through a ctest fixture,
+# which then finds it up to date; the firmware image is sized at the end.
 test: deps
 	$(call configure,host-release)
 	$(call build,host-release)
@@ -141,7 +145,7 @@ target-bench: deps
 	$(call configure,cm7-release)
 	$(call build,cm7-release)
 	$(Q)echo "== target-bench -> $(TARGET_BENCH_OUT)"
-	$(Q)hal/mps2/target_bench.sh build/host-release build/cm7-release $(TARGET_BENCH_OUT)
+	$(Q)target/mps2/target_bench.sh build/host-release build/cm7-release $(TARGET_BENCH_OUT)
 
 # Measured logs (docs/diagnose.md): diagnose one, validate a saved model on
 # another, and the hidden-cause suite that writes docs/diagnose-hidden.md.

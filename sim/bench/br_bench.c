@@ -35,7 +35,7 @@
 #include "br_circle_est.h"
 #include "br_hal_sim.h"
 #include "bristle_gen/est/br_noise_table.h"
-#include "bristle/br_axis.h"
+#include "bristle/br_app.h"
 
 #define BR_PI 3.14159265358979323846
 
@@ -121,7 +121,7 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
     br_plant_t plant;
     br_hal_sim_t port;
     br_hal_t hal;
-    br_axis_t axis;
+    br_app_t app;
     const br_plant_state_t x0 = {0.0, 0.0, 0.0};
     if (br_plant_init(&plant, &c->plant, &x0) != 0) return -1;
     if (br_hal_sim_init(&port, &plant, c->dt_s, &hal) != BR_OK) return -1;
@@ -135,8 +135,9 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
     cc.lead_mprad = (float)c->plant.lead_mprad;
     rec_est_t wrap = {est, &plant, rec, 0};
     const br_est_t e = {&wrap, rec_est_step};
-    if (br_axis_init(&axis, &hal, &cc, &e) != BR_OK) {
-        fprintf(stderr, "br_bench: axis init failed\n");
+    const br_app_cfg_t ac = {&cc, BR_APP_EST_EXTERN, NULL, NULL, &e};
+    if (br_app_init(&app, &ac, &hal, NULL) != BR_OK) {
+        fprintf(stderr, "br_bench: application init failed\n");
         return -1;
     }
     const double L = c->plant.lead_mprad, rpc = 2.0 * BR_PI / c->plant.counts_per_rev;
@@ -149,7 +150,7 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
         /* reference in counts + fraction and its velocity, as in sim/circle */
         const double counts = c->radius_m * sin(w * t) / L / rpc, whole = floor(counts);
         const br_ref_t r = {(int32_t)whole, (float)(counts - whole), (float)(c->radius_m * w * cos(w * t) / L)};
-        const br_status_t st = br_axis_step(&axis, &r);
+        const br_status_t st = br_app_step(&app, &r);
         if (wrap.failed) {
             fprintf(stderr, "br_bench: out of memory while recording\n");
             return -1;

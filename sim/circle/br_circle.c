@@ -8,7 +8,7 @@
 #include "br_hal_sim.h"
 #include "bristle_gen/ctrl/br_hinf_gains.h"
 #include "bristle_gen/machine/br_machine.h"
-#include "bristle/br_axis.h"
+#include "bristle/br_app.h"
 
 #define BR_PI 3.14159265358979323846
 
@@ -55,9 +55,8 @@ typedef struct {
     br_plant_t plant;
     br_hal_sim_t port;
     br_hal_t hal;
-    br_axis_t axis;
-    br_pf_t *pf;   /* owned, BR_CTRL_HINF_PF only */
-    br_ukf_t *ukf; /* owned, BR_CTRL_HINF_UKF only */
+    br_app_t app;
+    br_app_mem_t mem; /* the filter's state, owned: PF or UKF only */
     double phase;
 } axis_sim_t;
 
@@ -80,8 +79,7 @@ static br_ref_t axis_ref(const br_circle_cfg_t *c, double phase, double t, doubl
 static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, int axis, double phase)
 {
     a->phase = phase;
-    a->pf = NULL;
-    a->ukf = NULL;
+    a->mem = (br_app_mem_t){NULL, NULL};
     br_plant_state_t x0 = {c->radius_m * sin(phase) / c->plant.lead_mprad, 0.0, 0.0};
     if (br_plant_init(&a->plant, &c->plant, &x0) != 0) return -1;
     if (br_hal_sim_init(&a->port, &a->plant, c->dt_s, &a->hal) != BR_OK) return -1;
@@ -92,45 +90,40 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, int axis, double p
     cc.tau_per_duty_Nm = (float)c->plant.tau_per_duty_Nm;
     cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
     cc.lead_mprad = (float)c->plant.lead_mprad;
-    br_est_t est = {NULL, NULL};
-    br_status_t st = BR_OK;
+    br_est_t ext = {NULL, NULL};
+    br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext};
     switch (c->controller) {
     case BR_CTRL_HINF_ONLY:
         break;
     case BR_CTRL_HINF_TRUE:
-        est = (br_est_t){&a->plant, oracle_step};
+        ext = (br_est_t){&a->plant, oracle_step};
+        ac.est = BR_APP_EST_EXTERN;
         break;
     case BR_CTRL_HINF_UKF:
-        if (fabs((double)c->ukf.est.model.dt_s - c->dt_s) > 1e-9) {
-            fprintf(stderr, "br_circle: the UKF's period %g s differs from the control period %g s\n",
-                    (double)c->ukf.est.model.dt_s, c->dt_s);
-            return -1;
-        }
-        a->ukf = calloc(1, sizeof *a->ukf);
-        if (a->ukf == NULL) return -1;
-        st = br_ukf_init(a->ukf, &c->ukf);
-        est = (br_est_t){a->ukf, br_ukf_est_step};
+        if ((a->mem.ukf = calloc(1, sizeof *a->mem.ukf)) == NULL) return -1;
+        ac.est = BR_APP_EST_UKF;
         break;
     case BR_CTRL_HINF_PF:
-        if (fabs((double)c->pf.est.model.dt_s - c->dt_s) > 1e-9) {
-            fprintf(stderr, "br_circle: the PF's period %g s differs from the control period %g s\n",
-                    (double)c->pf.est.model.dt_s, c->dt_s);
-            return -1;
-        }
-        a->pf = calloc(1, sizeof *a->pf);
-        if (a->pf == NULL) return -1;
-        st = br_pf_init(a->pf, &c->pf);
-        est = (br_est_t){a->pf, br_pf_est_step};
+        if ((a->mem.pf = calloc(1, sizeof *a->mem.pf)) == NULL) return -1;
+        ac.est = BR_APP_EST_PF;
         break;
     }
-    if (st != BR_OK) {
-        fprintf(stderr, "br_circle: estimator init failed (status %d)\n", (int)st);
-        return -1;
+    br_status_t st;
+    if (c->est_wrap != NULL && (ac.est == BR_APP_EST_PF || ac.est == BR_APP_EST_UKF)) {
+        /* the filter goes in front of the loop behind the caller's wrapper */
+        br_est_t inner;
+        st = br_app_est_init(&ac, &a->mem, &inner);
+        if (st != BR_OK) {
+            fprintf(stderr, "br_circle: estimator init failed (status %d)\n", (int)st);
+            return -1;
+        }
+        ext = c->est_wrap(c->est_wrap_user, axis, inner);
+        ac.est = BR_APP_EST_EXTERN;
     }
-    if (c->est_wrap != NULL && est.step != NULL) est = c->est_wrap(c->est_wrap_user, axis, est);
-    st = br_axis_init(&a->axis, &a->hal, &cc, est.step ? &est : NULL);
+    /* BR_E_PARAM also when an estimator's period is not the control period */
+    st = br_app_init(&a->app, &ac, &a->hal, &a->mem);
     if (st != BR_OK) {
-        fprintf(stderr, "br_circle: controller init failed (status %d)\n", (int)st);
+        fprintf(stderr, "br_circle: application init failed (status %d)\n", (int)st);
         return -1;
     }
     return 0;
@@ -162,8 +155,7 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
         return -1;
     }
     axis_sim_t ax[2];
-    ax[0].pf = ax[1].pf = NULL;
-    ax[0].ukf = ax[1].ukf = NULL;
+    ax[0].mem = ax[1].mem = (br_app_mem_t){NULL, NULL};
     int rc = -1;
     if (axis_init(&ax[0], c, 0, 0.0) != 0 || axis_init(&ax[1], c, 1, 0.5 * BR_PI) != 0) goto done;
     const long n = lround(c->duration_s / c->dt_s);
@@ -181,19 +173,19 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             s.counts[i] = br_plant_encoder(&ax[i].plant);
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
-            br_status_t st = br_axis_step(&ax[i].axis, &r);
+            br_status_t st = br_app_step(&ax[i].app, &r);
             if (st == BR_W_OUTLIER) {
                 nout++; /* the estimator skipped the update; control went on */
             } else if (st != BR_OK) {
                 fprintf(stderr, "br_circle: axis %d step failed at t=%.4f s (status %d)\n", i, t, (int)st);
                 goto done;
             }
-            sat |= ax[i].axis.last.saturated;
-            s.duty[i] = (double)ax[i].axis.last.duty;
-            s.F_hat_N[i] = (double)ax[i].axis.F_hat_N;
+            sat |= ax[i].app.axis.last.saturated;
+            s.duty[i] = (double)ax[i].app.axis.last.duty;
+            s.F_hat_N[i] = (double)ax[i].app.axis.F_hat_N;
             fe2 += (s.F_hat_N[i] - s.fnl_N[i]) * (s.F_hat_N[i] - s.fnl_N[i]);
-            s.pf[i] = ax[i].pf;
-            s.ukf[i] = ax[i].ukf;
+            s.pf[i] = ax[i].mem.pf;
+            s.ukf[i] = ax[i].mem.ukf;
         }
         /* contour error of a circle: radial deviation from the radius */
         const double er = hypot(s.pos_m[0], s.pos_m[1]) - c->radius_m;
@@ -211,9 +203,9 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     res->fhat_rms_err_N = sqrt(fe2 / (2.0 * (double)(n + 1)));
     rc = 0;
 done:
-    free(ax[0].pf);
-    free(ax[1].pf);
-    free(ax[0].ukf);
-    free(ax[1].ukf);
+    for (int i = 0; i < 2; i++) {
+        free(ax[i].mem.pf);
+        free(ax[i].mem.ukf);
+    }
     return rc;
 }

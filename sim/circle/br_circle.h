@@ -1,6 +1,7 @@
 /* The thesis's X-Y circle experiment (section 5) on the simulator: two
- * identical axes, each a plant + host HAL + firmware control loop, tracking
- * x_ref = A sin(2 pi t / T), y_ref = A cos(2 pi t / T). */
+ * identical axes, each a plant, the simulator's HAL (sim/hal) and the
+ * firmware application (br_app_step), tracking x_ref = A sin(2 pi t / T),
+ * y_ref = A cos(2 pi t / T). */
 #ifndef BR_CIRCLE_H
 #define BR_CIRCLE_H
 

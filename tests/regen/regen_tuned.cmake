@@ -1,7 +1,7 @@
 # Reruns the estimator tuning and fails on any difference from the committed
 # header. Variables: TUNER, EST, COMMITTED, OUT.
 if(NOT EXISTS ${TUNER})
-  message(FATAL_ERROR "${TUNER} is missing: `make test` builds the host-release tools first")
+  message(FATAL_ERROR "${TUNER} is missing (the release_tuner fixture builds it)")
 endif()
 execute_process(COMMAND ${TUNER} --est ${EST} --out ${OUT} RESULT_VARIABLE rc OUTPUT_VARIABLE log)
 if(NOT rc EQUAL 0)

@@ -1,4 +1,4 @@
-/* Compares replay outputs (hal/replay/br_replay.h), and summarises their cost.
+/* Compares replay outputs (target/replay/br_replay.h), and summarises their cost.
  *
  *   br_replay_cmp HOST.bin TARGET.bin [--expect EXPECT.bin]
  *     every record: same k and status, identical resampling-index hash,

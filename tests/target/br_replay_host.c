@@ -1,4 +1,4 @@
-/* Host build of the replay (hal/replay/br_replay.h) with a stdio shim: the
+/* Host build of the replay (target/replay/br_replay.h) with a stdio shim: the
  * same core the mps2-an500 image runs under QEMU.  br_replay_host IN OUT [M] */
 #include <stdio.h>
 #include <stdlib.h>

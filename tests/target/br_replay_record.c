@@ -1,4 +1,4 @@
-/* Records the replay stream (hal/replay/br_replay.h) from the simulator:
+/* Records the replay stream (target/replay/br_replay.h) from the simulator:
  * the x axis of the thesis circle, H-inf + PF at 1.5 ms, m = 1500, for
  * --duration seconds. Per period: the encoder counts the axis read and the
  * reference it was given. --expect also writes the closed loop's own

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # ctest target_qemu_replay (docs/target.md): record a 1 s stream of the
-# H-inf + PF circle on the host simulator, replay it through the axis loop
-# with the PF (m = 1500) on the host and on the Cortex-M7 image under
+# H-inf + PF circle on the host simulator, replay it through the application
+# (br_app_step with the PF, m = 1500) on the host and on the Cortex-M7 image under
 # qemu-system-arm (mps2-an500, semihosting), and compare the outputs.
 # Fails (never skips) when QEMU or the image is missing.
 #   qemu_replay.sh RECORD HOST_REPLAY CMP IMAGE WORKDIR

@@ -3,19 +3,19 @@
 # control period of the firmware on QEMU's emulated Cortex-M7 (mps2-an500),
 # and flash / RAM from the replay image's map file.
 #   target_bench.sh HOST_BUILD_DIR CM7_BUILD_DIR OUT_DIR
-# Method: the replay image times every br_axis_step with SysTick (CPU clock
+# Method: the replay image times every br_app_step with SysTick (CPU clock
 # source, 25 MHz in QEMU's model); QEMU runs with -icount shift=0, so virtual
 # time advances by exactly 1 ns per executed instruction and 1 tick = 40
 # instructions, which a calibration loop of 2e6 known instructions checks on
 # every run. Two particle counts separate the per-particle slope from the
 # fixed per-period cost. A third, short run (20 periods, m_hi) with QEMU's
 # translation-block log gives the profile: instructions per particle-step by
-# function and by block (hal/mps2/tb_profile.py).
+# function and by block (target/mps2/tb_profile.py).
 set -euo pipefail
 host=$1 cm7=$2 out=$3
 qemu=${BR_QEMU:-qemu-system-arm}
-image=$cm7/hal/mps2/br_replay_mps2.elf
-map=$cm7/hal/mps2/br_replay_mps2.map
+image=$cm7/target/mps2/br_replay_mps2.elf
+map=$cm7/target/mps2/br_replay_mps2.map
 m_hi=${BR_BENCH_M_HI:-1500}
 m_lo=${BR_BENCH_M_LO:-100}
 command -v "$qemu" >/dev/null || { echo "target-bench: $qemu not found (make deps)" >&2; exit 1; }
@@ -43,7 +43,7 @@ awk -v mh="$m_hi" -v ml="$m_lo" -v n="$n" \
 BEGIN {
   printf "target-bench: QEMU mps2-an500 (Cortex-M7, FPU), -icount shift=0, %d control periods of 1.5 ms (k >= 1)\n", n - 1
   printf "  calibration: %.3f instructions per SysTick tick (expected 40)\n", ih
-  printf "  instructions per control period (br_axis_step: encoder, PF, controller, PWM)\n"
+  printf "  instructions per control period (br_app_step: encoder, PF, controller, PWM)\n"
   printf "    m = %4d: mean %9.0f  median %9.0f  p99 %9.0f  max %9.0f\n", mh, ah * ih, dh * ih, ph * ih, xh * ih
   printf "    m = %4d: mean %9.0f  median %9.0f\n", ml, al * il, dl * il
   slope = (ah * ih - al * il) / (mh - ml); fixed = al * il - ml * slope

@@ -137,11 +137,9 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
     r->hal.pwm_write = pwm_write;
     r->hal.tick_wait = tick_wait;
     r->duty = 0.0f;
-    const br_est_t est = {&r->pf, br_pf_est_step};
-    if (br_pf_init(&r->pf, &r->cfg.pf) != BR_OK ||
-        br_axis_init(&r->axis, &r->hal, &r->cfg.ctrl, &est) != BR_OK) {
-        return -3;
-    }
+    const br_app_cfg_t app_cfg = {&r->cfg.ctrl, BR_APP_EST_PF, &r->cfg.pf, NULL, NULL};
+    const br_app_mem_t mem = {&r->pf, NULL};
+    if (br_app_init(&r->app, &app_cfg, &r->hal, &mem) != BR_OK) return -3;
     for (uint32_t k = 0u; k < r->cfg.n_steps; ++k) {
         uint32_t in[BR_REPLAY_STEP_WORDS];
         uint32_t out[BR_REPLAY_OUT_WORDS];
@@ -149,12 +147,12 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
         r->enc_counts = (int32_t)in[0];
         const br_ref_t ref = {(int32_t)in[1], w2f(in[2]), w2f(in[3])};
         const uint32_t t0 = io->stamp ? io->stamp(io->ctx) : 0u;
-        const br_status_t st = br_axis_step(&r->axis, &ref);
+        const br_status_t st = br_app_step(&r->app, &ref);
         const uint32_t t1 = io->stamp ? io->stamp(io->ctx) : 0u;
         out[0] = k;
         out[1] = (uint32_t)(int32_t)st;
         out[2] = br_replay_idx_hash(r->pf.idx, r->cfg.pf.n_particles);
-        out[3] = f2w(r->axis.F_hat_N);
+        out[3] = f2w(r->app.axis.F_hat_N);
         out[4] = f2w(r->duty);
         out[5] = t1 - t0;
         if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;

@@ -1,5 +1,6 @@
-/* Replay of a recorded stream through the axis loop with the PF, identical
- * on the host and on the Cortex-M7 (hal/mps2 image under QEMU). docs/target.md.
+/* Replay of a recorded stream through the application (br_app_step with the
+ * PF), identical on the host and on the Cortex-M7 (target/mps2 image under
+ * QEMU). docs/target.md.
  *
  * Stream (little-endian 32-bit words, both hosts and the M7 are LE):
  *   header  BR_REPLAY_HDR_WORDS words: magic, version, n_steps, then the
@@ -12,15 +13,14 @@
  * Output: one record of BR_REPLAY_OUT_WORDS words per step: k, status,
  *   FNV-1a hash of the PF's m uint16 resampling indices (little-endian bytes),
  *   F_hat (float bits), duty (float bits), cost (stamp difference around
- *   br_axis_step; 0 when the I/O has no stamp; not compared).
+ *   br_app_step; 0 when the I/O has no stamp; not compared).
  * The PF's noise table is the firmware's br_noise_table; noise_len must match. */
 #ifndef BR_REPLAY_H
 #define BR_REPLAY_H
 
 #include <stdint.h>
 
-#include "bristle/br_axis.h"
-#include "bristle/br_pf.h"
+#include "bristle/br_app.h"
 
 #define BR_REPLAY_MAGIC 0x53525242u /* "BRRS" */
 #define BR_REPLAY_VERSION 1u
@@ -49,11 +49,11 @@ typedef struct {
  * target: main's stack). */
 typedef struct {
     br_replay_cfg_t cfg;
-    br_pf_t pf;
-    br_axis_t axis;
+    br_pf_t pf;   /* the application's estimator storage */
+    br_app_t app;
     br_hal_t hal;
     int32_t enc_counts; /* this step's recorded encoder reading */
-    float duty;         /* last duty written by the axis */
+    float duty;         /* last duty written by the application */
 } br_replay_t;
 
 /* Header encode/decode (the recorder uses the encoder). */
@@ -63,7 +63,7 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
 /* FNV-1a over the m indices as little-endian uint16. */
 uint32_t br_replay_idx_hash(const uint16_t *idx, uint32_t m);
 
-/* Reads the header and every step from io, runs br_axis_step per step and
+/* Reads the header and every step from io, runs br_app_step per step and
  * writes the output records. n_particles_override != 0 replaces the stream's m.
  * Returns 0, or a negative code: -1 I/O, -2 bad header, -3 init failed,
  * -4 a step failed with a status other than BR_OK / a warning (its record

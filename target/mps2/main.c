@@ -1,13 +1,13 @@
 /* Replay image for QEMU's mps2-an500 (Cortex-M7, FPU): reads a recorded
- * stream through semihosting, runs it through br_axis_step with the PF
- * (hal/replay/br_replay.h) and writes one output record per step.
+ * stream through semihosting, runs it through br_app_step with the PF
+ * (target/replay/br_replay.h) and writes one output record per step.
  *
  *   qemu-system-arm -M mps2-an500 -nographic -kernel br_replay_mps2.elf \
  *     -semihosting-config enable=on,target=native,arg=replay,arg=IN,arg=OUT,arg=M
  *
  * M = 0 keeps the stream's particle count. Exit status 0 on success.
  * The cost field of each record is the SysTick (25 MHz in QEMU's model, CPU
- * clock source) difference around br_axis_step, extended to 32 bits; with
+ * clock source) difference around br_app_step, extended to 32 bits; with
  * `-icount shift=0` it counts executed instructions / 40. Before the replay,
  * a calibration loop of 2 x BR_CAL_ITER instructions is timed the same way
  * and printed ("calib insns=... ticks=..."), so the conversion is measured,

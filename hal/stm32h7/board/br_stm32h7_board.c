@@ -1,0 +1,43 @@
+/* The board's wiring and clocks (br_stm32h7_board.h). */
+#include "br_stm32h7_board.h"
+
+br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_hz)
+{
+    const br_stm32h7_cfg_t cfg = {
+        .pwm_tim = (br_stm32h7_tim_t *)BR_STM32H7_TIM1_BASE,
+        .enc_tim = (br_stm32h7_tim_t *)BR_STM32H7_TIM2_BASE,
+        .systick = (br_stm32h7_systick_t *)BR_STM32H7_SYSTICK_BASE,
+        .cpu_clock_hz = BR_BOARD_CPU_HZ,
+        .tim_clock_hz = BR_BOARD_TIM_HZ,
+        .pwm_hz = BR_BOARD_PWM_HZ,
+        .control_hz = control_hz,
+        .enc_counter_bits = 32u,
+        .enc_filter = BR_BOARD_ENC_FILTER,
+        .deadtime_ticks = BR_BOARD_DEADTIME,
+    };
+    return cfg;
+}
+
+br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_hz, br_hal_t *hal)
+{
+    br_stm32h7_gpio_t *gpioa = (br_stm32h7_gpio_t *)BR_STM32H7_GPIOA_BASE;
+    br_stm32h7_gpio_t *gpiob = (br_stm32h7_gpio_t *)BR_STM32H7_GPIOB_BASE;
+    (void)br_stm32h7_rcc_enable((br_stm32h7_rcc_t *)BR_STM32H7_RCC_BASE);
+    (void)br_stm32h7_gpio_af(gpioa, 0u, 1u);  /* TIM2_CH1 */
+    (void)br_stm32h7_gpio_af(gpioa, 1u, 1u);  /* TIM2_CH2 */
+    (void)br_stm32h7_gpio_af(gpioa, 8u, 1u);  /* TIM1_CH1 */
+    (void)br_stm32h7_gpio_af(gpioa, 9u, 1u);  /* TIM1_CH2 */
+    (void)br_stm32h7_gpio_af(gpiob, 13u, 1u); /* TIM1_CH1N */
+    (void)br_stm32h7_gpio_af(gpiob, 14u, 1u); /* TIM1_CH2N */
+    const br_stm32h7_cfg_t cfg = br_stm32h7_board_cfg(control_hz);
+    const br_status_t st = br_stm32h7_init(port, &cfg);
+    return (st != BR_OK) ? st : br_stm32h7_hal(port, hal);
+}
+
+void br_stm32h7_board_halt(br_stm32h7_t *port)
+{
+    (void)br_stm32h7_pwm_disable(port);
+    for (;;) {
+        __asm__ volatile("nop");
+    }
+}
