@@ -58,8 +58,8 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
 float br_model_fnl_N(const br_model_t *m, const float x[BR_NX])
 {
     const br_model_k_t k = br_model_k(m);
-    /* eq. 3 with dz/dt from eq. 4, g = g_p (c g_p in -x) */
-    const float gp = (m->cfg.lead_mprad * x[BR_X_OMEGA] < 0.0f) ? m->c_neg * x[BR_X_GP] : x[BR_X_GP];
+    /* eq. 3 with dz/dt from eq. 4, g = g_p (c g_p for bristles deflected towards -x) */
+    const float gp = (x[BR_X_Z] < 0.0f) ? m->c_neg * x[BR_X_GP] : x[BR_X_GP];
     return br_model_k_fnl(&k, x[BR_X_Z], br_model_k_zdot(&k, x[BR_X_OMEGA], x[BR_X_Z], gp));
 }
 

@@ -152,13 +152,17 @@ static inline float br_model_kx_ripple_N(const br_model_kx_t *k, float th)
 }
 
 /* The load force of the extended model at (theta, omega, z, g_p), N, and the
- * bristle rate in *zd: eq. 4 with the level c g_p in -x, eq. 3, then
+ * bristle rate in *zd: eq. 4 with the level c g_p for bristles deflected
+ * towards -x (z < 0), eq. 3, then
  * k(p) (sigma2_d v + f_nl) + offset + ripple, k(p) = max(0, 1 + grad p). */
 static inline float br_model_kx_load_N(const br_model_kx_t *k, float th, float w, float z, float gp, float *zd)
 {
     const float v = k->n.L * w;
     const int neg = v < 0.0f;
-    *zd = br_lk_zdot_mps(k->n.s0, v, z, neg ? k->c_neg * gp : gp);
+    /* the level by the direction the bristles are deflected (the sliding
+     * direction once they are loaded): continuous through a reversal, where
+     * z crosses 0 and the level's term sigma0 |v| z / g vanishes */
+    *zd = br_lk_zdot_mps(k->n.s0, v, z, (z < 0.0f) ? k->c_neg * gp : gp);
     const float f = br_lk_force_N(k->n.s0, k->n.s1, z, *zd);
     const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + k->n.L * th));
     return kp * ((neg ? k->s2_neg : k->s2) * v + f) + k->off + br_model_kx_ripple_N(k, th);

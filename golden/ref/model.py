@@ -139,7 +139,9 @@ def step(p, x, u, h):
 #
 #   Jeff omega' = u - L F,   F = k(pos) (sigma2_d v + f_nl) + offset + A sin(2 pi pos / P + phi)
 #   k(pos) = max(0, 1 + grad pos)
-#   z' = v - sigma0 |v| z / g,  g = g_p for v >= 0, c g_p for v < 0,  c = (Fc + dFc_neg) / Fc
+#   z' = v - sigma0 |v| z / g,  g = g_p for z >= 0, c g_p for z < 0,  c = (Fc + dFc_neg) / Fc
+#        (the level by the direction the bristles are deflected; in a bounded
+#        step, by the direction of the move)
 #   f_nl = sigma0 z + sigma1 z',  sigma2_d = sigma2 (+ dsigma2_neg for v < 0)
 #
 # The force to compensate is F - sigma2 v. The ripple is evaluated exactly
@@ -156,16 +158,17 @@ class Causes:
     ripple_phase: float = 0.0   # rad
     grad: float = 0.0         # 1/m
 
-    def level_factor(self, p, v):
-        """The Stribeck level's factor: 1 in +x, (Fc + dFc_neg) / Fc in -x."""
-        return (p.lugre.Fc + self.dFc_neg) / p.lugre.Fc if v < 0.0 else 1.0
+    def level_factor(self, p, d):
+        """The Stribeck level's factor for a deflection or move d: 1 towards
+        +x, (Fc + dFc_neg) / Fc towards -x."""
+        return (p.lugre.Fc + self.dFc_neg) / p.lugre.Fc if d < 0.0 else 1.0
 
 
 def load_force_ext(p, c, pos, w, z, gp):
     """(F, z') of the extended model at load position pos."""
     s0, s1, L = p.lugre.sigma0, p.lugre.sigma1, p.L
     v = L * w
-    g = c.level_factor(p, v) * gp
+    g = c.level_factor(p, z) * gp
     zd = v - s0 * abs(v) * z / g
     f = s0 * z + s1 * zd
     k = max(0.0, 1.0 + c.grad * pos)

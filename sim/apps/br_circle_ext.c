@@ -2,7 +2,8 @@
  * on the reference machine with causes switched on (the "hidden" ones), with
  * H-inf only, with H-inf + an estimator on the nominal model (the firmware's
  * as configured), and with H-inf + the same estimator on the extended model a
- * diagnosis saved (model.json, sim/extmodel/br_est_ext.h). docs/diagnose.md.
+ * diagnosis saved (model.json): the firmware's own extended model, its
+ * br_model_cfg_t.causes set from the model's. docs/diagnose.md.
  *
  * Usage: br_circle_ext [--model MODEL.json] [--est ukf|pf] [--json OUT] [cause options]
  * Prints one line per run and, with --json, writes them. */
@@ -13,29 +14,8 @@
 
 #include "br_cause_args.h"
 #include "br_circle.h"
-#include "br_est_ext.h"
+#include "plant/br_model_params.h"
 #include "plant/br_plant_json.h"
-
-typedef struct {
-    br_plant_cfg_t model;
-    int use_pf;
-    br_est_ext_t ext[2];
-    int failed;
-} wrap_t;
-
-static br_est_t wrap(void *user, int axis, br_est_t inner)
-{
-    wrap_t *w = user;
-    br_est_ext_t *e = &w->ext[axis];
-    const br_ukf_t *ukf = w->use_pf ? NULL : (const br_ukf_t *)inner.ctx;
-    const br_pf_t *pf = w->use_pf ? (const br_pf_t *)inner.ctx : NULL;
-    const double dt = w->use_pf ? (double)pf->cfg.est.model.dt_s : (double)ukf->cfg.est.model.dt_s;
-    if (br_est_ext_init(e, inner, ukf, pf, &w->model, dt) != 0) {
-        w->failed = 1;
-        return inner;
-    }
-    return (br_est_t){e, br_est_ext_step};
-}
 
 int main(int argc, char **argv)
 {
@@ -60,14 +40,14 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    static wrap_t w; /* holds two estimators' wrappers */
-    w.use_pf = strcmp(est, "pf") == 0;
+    const int use_pf = strcmp(est, "pf") == 0;
+    br_plant_cfg_t saved;
     char msg[512];
-    if (model && br_plant_cfg_from_model_json(model, &plant, &w.model, msg, sizeof msg) != 0) {
+    if (model && br_plant_cfg_from_model_json(model, &plant, &saved, msg, sizeof msg) != 0) {
         fprintf(stderr, "br_circle_ext: %s\n", msg);
         return 1;
     }
-    const br_circle_ctrl_t ctrl = w.use_pf ? BR_CTRL_HINF_PF : BR_CTRL_HINF_UKF;
+    const br_circle_ctrl_t ctrl = use_pf ? BR_CTRL_HINF_PF : BR_CTRL_HINF_UKF;
     struct {
         const char *name;
         br_circle_ctrl_t ctrl;
@@ -86,19 +66,28 @@ int main(int argc, char **argv)
         br_circle_cfg_t c = br_circle_cfg_thesis(runs[r].ctrl);
         c.plant = plant;
         if (runs[r].extended) {
-            c.est_wrap = wrap;
-            c.est_wrap_user = &w;
+            /* the estimator predicts and compensates with the diagnosed causes */
+            const br_causes_t causes = br_causes_from_model(&saved);
+            c.pf.est.model.causes = causes;
+            c.ukf.est.model.causes = causes;
         }
         br_circle_result_t res;
-        if (br_circle_run(&c, NULL, NULL, &res) != 0 || w.failed) {
+        const int rc = br_circle_run(&c, NULL, NULL, &res);
+        if (rc < 0) {
             fprintf(stderr, "br_circle_ext: run %s failed\n", runs[r].name);
             return 1;
         }
-        printf("%-14s contour RMS %.4e m, max %.4e m, outlier steps %d\n", runs[r].name, res.contour_rms_m,
+        /* rc 1: the firmware stopped the axis safe (a fault), part of the result */
+        printf("%-14s contour RMS %.4e m, max %.4e m, outlier steps %d", runs[r].name, res.contour_rms_m,
                res.max_err_m, res.outlier_steps);
+        if (res.fault_status != 0) printf(", fault (status %d) at %.4f s", res.fault_status, res.fault_t_s);
+        printf("\n");
         if (js)
-            fprintf(js, ",\n  \"%s\": {\"contour_rms_m\": %.6e, \"max_err_m\": %.6e, \"outlier_steps\": %d}",
-                    runs[r].name, res.contour_rms_m, res.max_err_m, res.outlier_steps);
+            fprintf(js,
+                    ",\n  \"%s\": {\"contour_rms_m\": %.6e, \"max_err_m\": %.6e, \"outlier_steps\": %d, "
+                    "\"fault_status\": %d, \"fault_t_s\": %.6g}",
+                    runs[r].name, res.contour_rms_m, res.max_err_m, res.outlier_steps, res.fault_status,
+                    res.fault_t_s);
     }
     if (js) {
         fprintf(js, "\n}\n");

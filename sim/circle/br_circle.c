@@ -37,8 +37,6 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     for (int i = 0; i < 3; i++) c.K[i] = K[i];
     c.pf = br_circle_pf_cfg_tuned((float)c.dt_s);
     c.ukf = br_circle_ukf_cfg_tuned((float)c.dt_s);
-    c.est_wrap = NULL;
-    c.est_wrap_user = NULL;
     return c;
 }
 
@@ -76,7 +74,7 @@ static br_ref_t axis_ref(const br_circle_cfg_t *c, double phase, double t, doubl
     return r;
 }
 
-static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, int axis, double phase)
+static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
 {
     a->phase = phase;
     a->mem = (br_app_mem_t){NULL, NULL};
@@ -109,17 +107,6 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, int axis, double p
         break;
     }
     br_status_t st;
-    if (c->est_wrap != NULL && (ac.est == BR_APP_EST_PF || ac.est == BR_APP_EST_UKF)) {
-        /* the filter goes in front of the loop behind the caller's wrapper */
-        br_est_t inner;
-        st = br_app_est_init(&ac, &a->mem, &inner);
-        if (st != BR_OK) {
-            fprintf(stderr, "br_circle: estimator init failed (status %d)\n", (int)st);
-            return -1;
-        }
-        ext = c->est_wrap(c->est_wrap_user, axis, inner);
-        ac.est = BR_APP_EST_EXTERN;
-    }
     /* BR_E_PARAM also when an estimator's period is not the control period */
     st = br_app_init(&a->app, &ac, &a->hal, &a->mem);
     if (st != BR_OK) {
@@ -157,11 +144,14 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     axis_sim_t ax[2];
     ax[0].mem = ax[1].mem = (br_app_mem_t){NULL, NULL};
     int rc = -1;
-    if (axis_init(&ax[0], c, 0, 0.0) != 0 || axis_init(&ax[1], c, 1, 0.5 * BR_PI) != 0) goto done;
+    if (axis_init(&ax[0], c, 0.0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI) != 0) goto done;
     const long n = lround(c->duration_s / c->dt_s);
     double sum2 = 0.0, emax = 0.0, fe2 = 0.0;
     int nsat = 0, nout = 0;
-    for (long k = 0; k <= n; k++) {
+    long k_end = n; /* the last period run */
+    res->fault_status = 0;
+    res->fault_t_s = 0.0;
+    for (long k = 0; k <= n && res->fault_status == 0; k++) {
         const double t = (double)k * c->dt_s;
         br_circle_sample_t s;
         s.t_s = t;
@@ -177,8 +167,11 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             if (st == BR_W_OUTLIER) {
                 nout++; /* the estimator skipped the update; control went on */
             } else if (st != BR_OK) {
-                fprintf(stderr, "br_circle: axis %d step failed at t=%.4f s (status %d)\n", i, t, (int)st);
-                goto done;
+                /* the firmware zeroed the drive: the axis stops safe; so does the run */
+                res->fault_status = (int)st;
+                res->fault_t_s = t;
+                k_end = k;
+                break;
             }
             sat |= ax[i].app.axis.last.saturated;
             s.duty[i] = (double)ax[i].app.axis.last.duty;
@@ -186,6 +179,9 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             fe2 += (s.F_hat_N[i] - s.fnl_N[i]) * (s.F_hat_N[i] - s.fnl_N[i]);
             s.pf[i] = ax[i].mem.pf;
             s.ukf[i] = ax[i].mem.ukf;
+        }
+        if (res->fault_status != 0) {
+            break;
         }
         /* contour error of a circle: radial deviation from the radius */
         const double er = hypot(s.pos_m[0], s.pos_m[1]) - c->radius_m;
@@ -195,13 +191,15 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
         nsat += sat;
         if (sink) sink(user, &s);
     }
-    res->n_samples = n + 1;
-    res->contour_rms_m = sqrt(sum2 / (double)(n + 1));
+    /* over the periods run (all of them unless a fault stopped the axis) */
+    const long ns = (res->fault_status != 0) ? k_end : n + 1;
+    res->n_samples = ns;
+    res->contour_rms_m = ns > 0 ? sqrt(sum2 / (double)ns) : 0.0;
     res->max_err_m = emax;
     res->saturated_steps = nsat;
     res->outlier_steps = nout;
-    res->fhat_rms_err_N = sqrt(fe2 / (2.0 * (double)(n + 1)));
-    rc = 0;
+    res->fhat_rms_err_N = ns > 0 ? sqrt(fe2 / (2.0 * (double)ns)) : 0.0;
+    rc = (res->fault_status != 0) ? 1 : 0;
 done:
     for (int i = 0; i < 2; i++) {
         free(ax[i].mem.pf);

@@ -33,11 +33,7 @@ typedef struct {
     br_plant_cfg_t plant; /* both axes alike */
     float K[3];          /* state-feedback gains */
     br_pf_cfg_t pf;      /* BR_CTRL_HINF_PF: the filter (its model.dt_s must equal dt_s) */
-    br_ukf_cfg_t ukf;    /* BR_CTRL_HINF_UKF: likewise */
-    /* Optional (NULL: none): replaces each axis's estimator by a wrapper around
-     * it, e.g. one that adds an extended model's causes (sim/extmodel/). */
-    br_est_t (*est_wrap)(void *user, int axis, br_est_t inner);
-    void *est_wrap_user;
+    br_ukf_cfg_t ukf;    /* BR_CTRL_HINF_UKF: likewise (an extended model: est.model.causes) */
 } br_circle_cfg_t;
 
 typedef struct {
@@ -47,6 +43,8 @@ typedef struct {
     int saturated_steps;    /* periods where either axis saturated */
     int outlier_steps;      /* axis-periods whose measurement the estimator rejected */
     double fhat_rms_err_N;  /* RMS of (compensation - true friction) over both axes */
+    int fault_status;       /* 0, or the negative status with which the firmware stopped an axis */
+    double fault_t_s;       /* when it did */
 } br_circle_result_t;
 
 /* The thesis experiment with the reference machine, the H-inf gains and the
@@ -70,8 +68,10 @@ typedef struct {
 
 typedef void (*br_circle_sink_t)(void *user, const br_circle_sample_t *s);
 
-/* Runs the experiment, calling sink (if not NULL) once per period. Returns 0,
- * or -1 with a message on stderr on an invalid configuration or a firmware error. */
+/* Runs the experiment, calling sink (if not NULL) once per period. Returns 0;
+ * 1 when the firmware stopped an axis (a fault: zero duty, the status and time
+ * in res->fault_status, fault_t_s; the results cover the periods before it);
+ * -1 with a message on stderr on an invalid configuration. */
 int br_circle_run(const br_circle_cfg_t *cfg, br_circle_sink_t sink, void *user, br_circle_result_t *res);
 
 /* A sink writing CSV rows t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y,

@@ -1,9 +1,9 @@
 /* The parameters of a saved model, model.json's "params" (docs/diagnose.md,
  * "Parameters"): the one table of their names in C. The model loader
  * (br_plant_json.c) reads them by it, the simulators' cause options
- * (sim/simlog/br_cause_args.c) set them by it, and the estimator on the
- * extended model (sim/extmodel/br_est_ext.c) reads the br_plant_cfg_t
- * fields they fill. The diagnosis (python/bristle/diagnose: params.py, one
+ * (sim/simlog/br_cause_args.c) set them by it, and br_causes_from_model
+ * copies the causes' rows into the firmware's extended estimation model
+ * (br_causes_t, the same field names). The diagnosis (python/bristle/diagnose: params.py, one
  * module per cause in causes/) uses the same names, units and causes;
  * tests/diagnose/test_model.py holds the two tables together.
  *
@@ -24,6 +24,7 @@
 #include <stdio.h>
 
 #include "br_sim_plant.h"
+#include "bristle/br_model.h"
 
 #define BR_GT0 DBL_MIN
 
@@ -54,6 +55,18 @@
     X("ripple_phase_rad", ripple_phase_rad, "rad", -HUGE_VAL, HUGE_VAL, "position_ripple", "--ripple", 0)  \
     X("grad_per_m", grad_per_m, "1/m", -HUGE_VAL, HUGE_VAL, "position_gradient", "--gradient", 1)          \
     X("delay_s", delay_s, "s", 0.0, BR_PLANT_DELAY_MAX_S, "actuator_delay", "--delay", 1)
+
+/* The causes of a model (a diagnosis's model.json, loaded into a plant
+ * configuration) for the firmware's extended estimation model: br_causes_t
+ * has the same fields, one per row of BR_CAUSE_PARAMS. */
+static inline br_causes_t br_causes_from_model(const br_plant_cfg_t *p)
+{
+    br_causes_t c = {0};
+#define BR_CAUSE_COPY(json, field, unit, lo, hi, cause, option, req) c.field = (float)p->field;
+    BR_CAUSE_PARAMS(BR_CAUSE_COPY)
+#undef BR_CAUSE_COPY
+    return c;
+}
 
 /* 1 when v is within [lo, hi] (NaN is not) */
 static inline int br_param_in_bounds(double v, double lo, double hi)

@@ -115,9 +115,31 @@ static void test_rejects_bad_experiment(void **st)
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
 }
 
+/* A fault stops the run safe: the UKF on the nominal model of a plant with a
+ * 3 ms actuator dead time diverges, its estimate leaves what the actuator can
+ * exert, and the firmware zeroes the drive instead of compensating with it
+ * (it once ran on with an 11064-outlier, 0.17 mm contour error). */
+static void test_diverged_estimate_stops_safe(void **st)
+{
+    (void)st;
+    br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
+    c.plant.delay_s = 3.0e-3;
+    br_circle_result_t r;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 1);
+    assert_true(r.fault_status < 0);
+    assert_true(r.fault_t_s > 0.0 && r.fault_t_s < c.duration_s);
+    print_message("UKF on the nominal model, 3 ms plant delay: fault %d at %.3f s, contour RMS before it %.3g m\n",
+                  r.fault_status, r.fault_t_s, r.contour_rms_m);
+    /* with the delay in its own model the same estimator runs the whole circle */
+    c.ukf.est.model.causes.delay_s = 3.0e-3f;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 0);
+    assert_int_equal(r.fault_status, 0);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_hinf_only_reproduces_thesis),
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_diverged_estimate_stops_safe),cmocka_unit_test(test_hinf_only_reproduces_thesis),
                                        cmocka_unit_test(test_same_gains_at_pf_period),
                                        cmocka_unit_test(test_ukf_beats_thesis_ratio),
                                        cmocka_unit_test(test_pf_beats_thesis_ratio),

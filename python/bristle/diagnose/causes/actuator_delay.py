@@ -6,8 +6,8 @@ zero-order hold, the mean over interval k of the command delayed by
 d = (m + f) dt is (1 - f) F[k-m] + f F[k-m-1], filtered like the force. d is
 searched on a half-period grid over 0 .. DELAY_MAX_S, then by a bounded
 search around the best point. Plant (br_sim_plant.c), closed loop and
-estimator (br_est_ext.c): the torque reaching the axis is the command of d
-earlier."""
+estimator (the firmware's extended model: model.causes.delay_s, a command
+history in br_est): the torque reaching the axis is the command of d earlier."""
 import numpy as np
 from scipy import optimize
 

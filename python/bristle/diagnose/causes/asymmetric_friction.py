@@ -10,8 +10,9 @@ one nonlinear parameter: first from a linear fit with the LuGre level split
 by the sign of z (symmetric bristle dynamics), then a bounded scalar search
 with c inside the bristle dynamics.
 
-Estimator (br_est_ext.c): the viscous term by the direction of motion, the
-LuGre level by the sign of the estimated friction."""
+Estimator (the firmware's extended model, br_model_cfg_t.causes): the
+viscous term and the Stribeck level inside the bristle dynamics by the
+direction of motion, as here."""
 import math
 
 import numpy as np

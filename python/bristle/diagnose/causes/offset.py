@@ -3,7 +3,8 @@ drag, an amplifier offset).
 
 Force model: + offset_N (a column of ones, linear: nothing to search).
 Plant (br_sim_plant.c) and closed loop: a load force offset_N, + opposing
-motion in +x. Estimator (br_est_ext.c): added to the friction estimate."""
+motion in +x. Estimator (the firmware's extended
+model, br_model_cfg_t.causes): in its force balance and its compensation."""
 import numpy as np
 
 from ..params import Param

@@ -2,7 +2,7 @@
 (misalignment of screw and guides, a preload that varies).
 
 Force model, plant (br_sim_plant.c), closed loop and estimator
-(br_est_ext.c): the friction (viscous + LuGre) times k(x) = max(0, 1 + s x),
+(the firmware's extended model): the friction (viscous + LuGre) times k(x) = max(0, 1 + s x),
 s = grad_per_m. s is searched on a GRID-point grid over |s| < 0.95 / max|x|
 (k stays positive on the log), then by a bounded search around the best
 point."""

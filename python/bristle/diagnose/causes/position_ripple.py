@@ -7,7 +7,7 @@ training residual's periodogram over position (PERIODS periods, from the
 distance the axis covers in one filter-cutoff period at its 95th-percentile
 speed, shorter ones being filtered away, to a third of the travel), each
 refined by a bounded search. Plant, closed loop and estimator
-(br_est_ext.c): the same load force."""
+(the firmware's extended model): the same load force."""
 import math
 
 import numpy as np
