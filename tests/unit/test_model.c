@@ -6,7 +6,7 @@
 #include "br_circle_est.h"
 #include "bristle/br_model.h"
 
-static br_model_cfg_t ref_cfg(float dt) { return br_ref_model_cfg(dt); }
+static br_model_cfg_t ref_cfg(float dt) { return br_machine_model_cfg(dt); }
 
 static void test_init_guards(void **st)
 {

@@ -17,7 +17,7 @@
 static br_pf_cfg_t cfg(uint32_t m)
 {
     br_pf_cfg_t c;
-    c.est.model = br_ref_model_cfg(1.0e-3f);
+    c.est.model = br_machine_model_cfg(1.0e-3f);
     c.n_particles = m;
     c.est.q_var[0] = 0.01f * RPC * RPC;
     c.est.q_var[1] = 1.0e-5f;
