@@ -9,7 +9,6 @@
 #define FS BR_MACHINE_FS_N
 #define SIGMA0 BR_MACHINE_SIGMA0_NPM
 #define SIGMA1 BR_MACHINE_SIGMA1_NSPM
-#define VS BR_MACHINE_VS_MPS
 
 static br_lugre_cfg_t ref_cfg(void)
 {
