@@ -8,6 +8,7 @@
 
 #include "br_circle.h"
 #include "bristle_gen/est/br_est_machine.h"
+#include "bristle_gen/machine/br_machine.h"
 
 #ifdef BR_TEST_THESIS_MACHINE
 /* thesis section 5: H-inf only, contour RMS */
@@ -43,6 +44,9 @@ static void test_hinf_only_quadrant_glitches(void **st)
     glitch_t g = {{0}, {0}};
     assert_int_equal(br_circle_run(&c, glitch_sink, &g, &r), 0);
     print_message("H-inf only: contour RMS %.3e m, max %.3e m\n", r.contour_rms_m, r.max_err_m);
+    /* the experiment fits the machine: its diameter in the travel, its speed under the top speed */
+    assert_true(2.0 * c.radius_m <= BR_MACHINE_TRAVEL_M);
+    assert_true(2.0 * 3.14159265358979323846 * c.radius_m / c.period_s <= BR_MACHINE_MAX_SPEED_MPS);
     assert_int_equal(r.n_samples, (long)floor(c.duration_s / c.dt_s + 0.5) + 1);
     assert_int_equal(r.saturated_steps, 0);
 #ifdef BR_TEST_THESIS_MACHINE

@@ -39,7 +39,8 @@ static void test_init_guards(void **st)
     k = cfg(); k.dt_s = NAN;             assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.tau_max_Nm = 0.0f;      assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.tau_max_Nm = -1.0f;     assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
-    k = cfg(); k.tau_max_Nm = 1.1f * k.tau_per_duty_Nm; assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM); /* > full duty */
+    /* beyond full duty */
+    k = cfg(); k.tau_max_Nm = 1.1f * k.tau_per_duty_Nm; assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.tau_per_duty_Nm = 0.0f; assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.rad_per_count = 0.0f;   assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.lead_mprad = -1e-3f;    assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
