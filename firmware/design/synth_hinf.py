@@ -19,7 +19,7 @@ The closed-loop H-infinity norm from w to z is then computed independently
 (ZOH plant, rectangular integral, backward-difference velocity) is checked
 at the control period and at the PF's period.
 A machine for which this fails (no stabilising design, a sampled loop that is
-unstable) ends the script with "FILE: control.hinf: problem", exit status 1.
+unstable) ends the script with "FILE: field control.hinf: problem", exit status 1.
 
 Usage: synth_hinf.py [--machine FILE] [--out FILE]"""
 import argparse
