@@ -186,7 +186,7 @@ regen: deps
 	$(Q)$(PYTHON) firmware/design/gen_noise.py
 	$(call configure,host-release)
 	$(call build,host-release)
-	$(Q)echo "== regen: tuned estimator variances (about 4 min)"
+	$(Q)echo "== regen: tuned estimator variances (about 3 min)"
 	$(Q)build/host-release/sim/br_tune_est --est ukf --out firmware/gen/bristle_gen/est/br_ukf_tuned.h > /dev/null
 	$(Q)build/host-release/sim/br_tune_est --est pf --out firmware/gen/bristle_gen/est/br_pf_tuned.h > /dev/null
 	$(Q)echo "== regen: golden traces"
