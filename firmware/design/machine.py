@@ -137,7 +137,7 @@ SCHEMA = {
         "duty_limit": Num(0.0, 1.0, "largest |duty| the amplifier accepts", lo_open=True),
     },
     "friction": {
-        "viscous_Nspm": Num(0.0, 1.0e6, "sigma2, viscous friction"),
+        "sigma2_Nspm": Num(0.0, 1.0e6, "sigma2, viscous friction"),
         "sigma0_Npm": Num(0.0, 1.0e10, "LuGre bristle stiffness", lo_open=True),
         "sigma1_Nspm": Num(0.0, 1.0e8, "LuGre bristle damping"),
         "Fc_N": Num(0.0, 1.0e5, "Coulomb friction", lo_open=True),
@@ -145,22 +145,23 @@ SCHEMA = {
         "vs_mps": Num(0.0, 1.0, "Stribeck velocity", lo_open=True),
     },
     # what a diagnosis of a measured log found beyond the nominal model (docs/diagnose.md);
-    # names as the diagnosis names them, each absent = off
+    # grouped by cause, each parameter under its model.json name (the names of
+    # br_causes_t and of br_plant_cfg_t too), each cause absent = off
     "causes": {
         "offset": Optional({
             "offset_N": Num(-1.0e5, 1.0e5, "constant load force, + opposes motion in +x"),
         }),
         "asymmetric_friction": Optional({
             "dFc_neg_N": Num(-1.0e5, 1.0e5, "Coulomb level in -x is Fc_N + dFc_neg_N (Fs scaled alike)"),
-            "dviscous_neg_Nspm": Num(-1.0e6, 1.0e6, "viscous friction in -x is viscous_Nspm + this"),
+            "dsigma2_neg_Nspm": Num(-1.0e6, 1.0e6, "viscous friction in -x is sigma2_Nspm + this"),
         }),
         "position_ripple": Optional({
-            "amp_N": Num(0.0, 1.0e5, "ripple force amplitude"),
-            "period_m": Num(0.0, 10.0, "ripple period in load position", lo_open=True),
-            "phase_rad": Num(-2.0 * math.pi, 2.0 * math.pi, "phase at x = 0"),
+            "ripple_amp_N": Num(0.0, 1.0e5, "ripple force amplitude"),
+            "ripple_period_m": Num(0.0, 10.0, "ripple period in load position", lo_open=True),
+            "ripple_phase_rad": Num(-2.0 * math.pi, 2.0 * math.pi, "phase at x = 0"),
         }),
         "position_gradient": Optional({
-            "per_m": Num(-1.0e3, 1.0e3, "friction scaled by max(0, 1 + per_m x) along the travel"),
+            "grad_per_m": Num(-1.0e3, 1.0e3, "friction scaled by max(0, 1 + grad_per_m x) along the travel"),
         }),
         "actuator_delay": Optional({
             "delay_s": Num(0.0, 0.1, "actuator dead time"),
@@ -325,7 +326,7 @@ def params(m):
         "lead_m_per_rev": mech["lead_m_per_rev"],
         "M_kg": mech["table_mass_kg"],
         "J_kgm2": mech["inertia_kgm2"],
-        "sigma2_Nspm": fr["viscous_Nspm"],
+        "sigma2_Nspm": fr["sigma2_Nspm"],
         "sigma0_Npm": fr["sigma0_Npm"],
         "sigma1_Nspm": fr["sigma1_Nspm"],
         "Fc_N": fr["Fc_N"],
