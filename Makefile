@@ -72,7 +72,7 @@ help:
 	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
 	@echo "  make firmware  cross build (cm7-release), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
-	@echo "  make regen     regenerate the generated headers and the golden traces"
+	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
 	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
 	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
@@ -181,11 +181,18 @@ firmware: deps
 	$(call build,cm7-release)
 	$(print_size)
 
+# Everything generated from machines/reference.json (docs/machine-file.md):
+# after editing it, `make regen` then `make test` needs no hand edits.
 regen: deps
-	$(Q)echo "== regen: machine parameters, gains"
+	$(Q)echo "== regen: machine parameters, estimator settings, gains, noise table"
 	$(Q)$(PYTHON) firmware/design/gen_machine.py
 	$(Q)$(PYTHON) firmware/design/synth_hinf.py
 	$(Q)$(PYTHON) firmware/design/gen_noise.py
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== regen: tuned estimator variances (about 3 min)"
+	$(Q)build/host-release/sim/br_tune_est --est ukf --out firmware/gen/bristle_gen/est/br_ukf_tuned.h > /dev/null
+	$(Q)build/host-release/sim/br_tune_est --est pf --out firmware/gen/bristle_gen/est/br_pf_tuned.h > /dev/null
 	$(Q)echo "== regen: golden traces"
 	$(Q)$(PYTHON) golden/gen_traces.py
 

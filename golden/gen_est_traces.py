@@ -23,7 +23,7 @@ import sys
 
 import numpy as np
 
-from ref import REPO_ROOT
+from ref import MACHINE_JSON, REPO_ROOT, machine_module
 from ref import ctrl as rctrl
 from ref import lugre as rlugre
 from ref import model as rmodel
@@ -105,22 +105,29 @@ def model_meta(mp):
             ("Fc_N", mp.lugre.Fc), ("Fs_N", mp.lugre.Fs), ("vs_mps", mp.lugre.vs)]
 
 
+def est_section(name):
+    """The machine file's estimator settings (estimator.pf or .ukf)."""
+    return machine_module().load_or_exit(MACHINE_JSON)["estimator"][name]
+
+
 def pf_cfg(m, f32):
-    """The traced PF, modelled on the circle demo's (x0 spread, g_p range,
-    outlier gate, noise_skip) with m = 128 particles and a tuning that mostly
-    holds lock with so few (R = 10 rpc^2, q_theta = rpc^2, q_gp = 1 N^2; the
-    1500-particle tuning loses lock every few steps at m = 128). Fixed here,
+    """The traced PF: the machine file's (x0 spread, g_p range, outlier gate,
+    noise_skip) with m = 128 particles and a tuning that mostly holds lock
+    with so few (R = 10 rpc^2, q_theta = rpc^2, q_gp = 1 N^2; the
+    1500-particle tuning loses lock every few steps at m = 128), fixed here,
     independent of later tuning of the demo. All values float32-exact."""
     rpc = m["rad_per_count"]
+    e = est_section("pf")
+    x0 = e["x0_std"]
     table, crc = noise_table()
     cfg = rpf.PfCfg(
         model=model_params_f32(m, f32), dt=f32(EST_DT), m=PF_M,
         q_var=(f32(rpc * rpc), f32(5.0e-6), f32(1.0e-14), f32(1.0)),
-        r_var=f32(10.0 * rpc * rpc), gp0=f32(m["Fs_N"]),
-        x0_std=(f32(0.3 * rpc), f32(1.0e-3), f32(1.0e-7), f32(2.0)),
-        gp_min=f32(0.5 * m["Fc_N"]), gp_max=f32(1.5 * m["Fs_N"]),
-        outlier_sigma=f32(30.0), reanchor_after=3, rad_per_count=f32(rpc),
-        noise=table, noise_skip=1)
+        r_var=f32(10.0 * rpc * rpc), gp0=f32(e["gp0_N"]),
+        x0_std=(f32(x0["theta_counts"] * rpc), f32(x0["omega_rad_per_s"]), f32(x0["z_m"]), f32(x0["gp_N"])),
+        gp_min=f32(e["gp_min_N"]), gp_max=f32(e["gp_max_N"]),
+        outlier_sigma=f32(e["outlier_gate_sigma"]), reanchor_after=e["reanchor_after"],
+        rad_per_count=f32(rpc), noise=table, noise_skip=e["noise_skip"])
     return cfg, crc
 
 
@@ -203,16 +210,21 @@ def record(m, gt):
 
 
 def ukf_cfg(m, f32):
-    """The traced UKF: the defaults of docs/modules/ukf.md (fixed here) at the
-    input's 1.5 ms. All values float32-exact."""
+    """The traced UKF: the machine file's (estimator.ukf, the hand-tuned
+    defaults of docs/modules/ukf.md) at the input's 1.5 ms. All values
+    float32-exact."""
     rpc = f32(m["rad_per_count"])
+    e = est_section("ukf")
+    q, p0 = e["q_var"], e["p0_var"]
     return rukf.UkfCfg(
         model=model_params_f32(m, f32), dt=f32(EST_DT),
-        q_var=(f32(1.0e-14), f32(1.0e-6), f32(1.0e-15), f32(0.05)),
-        r_var=f32(4.0 * rpc * rpc / 12.0), gp0=f32(12.0),
-        p0_var=(f32(rpc * rpc), f32(1.0e-4), f32(1.0e-12), f32(25.0)),
-        gp_min=f32(1.0), gp_max=f32(40.0), outlier_sigma=f32(50.0), reanchor_after=3,
-        rad_per_count=rpc, alpha=f32(1.0), beta=f32(2.0), kappa=f32(0.0))
+        q_var=(f32(q["theta_rad2"]), f32(q["omega_rad2_per_s2"]), f32(q["z_m2"]), f32(q["gp_N2"])),
+        r_var=f32(e["r_var_counts2"] * rpc * rpc), gp0=f32(e["gp0_N"]),
+        p0_var=(f32(p0["theta_counts2"] * rpc * rpc), f32(p0["omega_rad2_per_s2"]), f32(p0["z_m2"]),
+                f32(p0["gp_N2"])),
+        gp_min=f32(e["gp_min_N"]), gp_max=f32(e["gp_max_N"]), outlier_sigma=f32(e["outlier_gate_sigma"]),
+        reanchor_after=e["reanchor_after"], rad_per_count=rpc, alpha=f32(e["alpha"]), beta=f32(e["beta"]),
+        kappa=f32(e["kappa"]))
 
 
 UKF_P_COLUMNS = ["P%d%d" % (i, j) for i in range(4) for j in range(i, 4)]

@@ -189,7 +189,8 @@ def gen_model(out_dir, m):
     gp = m["Fc_N"]
     x = np.array([0.0, w0, gp / s0, gp])
     u_cruise = L * (m["sigma2_Nspm"] * 0.05 + m["Fc_N"])
-    plan = [(u_cruise, 100), (-0.64, 8), (-u_cruise, 100), (0.64, 5), (0.0, 140)]
+    u_full = m["tau_per_duty_Nm"]
+    plan = [(u_cruise, 100), (-u_full, 8), (-u_cruise, 100), (u_full, 5), (0.0, 140)]
     k = 0
     for u0, n in plan:
         for _ in range(n):
@@ -204,21 +205,21 @@ def gen_model(out_dir, m):
         w = (1.0 if rng.random() < 0.5 else -1.0) * 10.0 ** rng.uniform(-4.0, 1.8)
         z = rng.uniform(-1.2, 1.2) * gp / s0
         th = rng.uniform(-50.0, 50.0)
-        u = rng.uniform(-0.64, 0.64)
+        u = rng.uniform(-u_full, u_full)
         emit(3, 0.0, [th, w, z, gp], u)
 
     # seg 4: edge cases: rest, start from rest under full torque (bounded, first
     # pass wm = 0), reversal inside one bounded step, invalid inputs.
-    gs = m["Fs_N"]
+    gs, gc = m["Fs_N"], m["Fc_N"]
     for x, u in [([0.0, 0.0, 0.0, gs], 0.0),
                  ([1.0, 0.0, 2e-6, gs], 0.0),
                  ([0.0, 0.0, 0.0, gs], 0.3),
-                 ([0.0, 0.0, -gs / s0, gs], 0.64),
-                 ([0.0, -0.0, 0.0, gs], -0.64),
-                 ([0.0, -5.7, -7.0 / s0, 7.0], 0.64),
-                 ([0.0, 5.0, 7.0 / s0, 7.0], -0.64),
+                 ([0.0, 0.0, -gs / s0, gs], u_full),
+                 ([0.0, -0.0, 0.0, gs], -u_full),
+                 ([0.0, -5.7, -gc / s0, gc], u_full),
+                 ([0.0, 5.0, gc / s0, gc], -u_full),
                  ([0.0, 1e-3, 0.0, gs], 0.0),
-                 ([0.0, -40.0, -7.0 / s0, 7.0], 0.0),
+                 ([0.0, -40.0, -gc / s0, gc], 0.0),
                  ([float("nan"), 0.0, 0.0, gs], 0.0),
                  ([0.0, float("inf"), 0.0, gs], 0.0),
                  ([0.0, 0.0, float("-inf"), gs], 0.0),
@@ -304,7 +305,7 @@ def gen_ctrl(out_dir, m):
         pr = base + 0.25 + 3.0e4 * math.sin(2.0 * math.pi * 2.0 * t)
         vr = 3.0e4 * 2.0 * math.pi * 2.0 * math.cos(2.0 * math.pi * 2.0 * t)
         e = 0.97 * e + 8.0 * rng.standard_normal()
-        comp = 7.0 * math.copysign(1.0, vr) if k >= 300 else 0.0
+        comp = m["Fc_N"] * math.copysign(1.0, vr) if k >= 300 else 0.0
         one(pr + e, pr - 3.0 * math.sin(2.0 * math.pi * 5.0 * t), vr, comp)
 
     # phase B (0.6 s): fast motion across the int32 wrap and back (peak
@@ -316,7 +317,7 @@ def gen_ctrl(out_dir, m):
         vr = 4.0e5 * 2.0 * math.pi / 0.6 * math.cos(2.0 * math.pi * t / 0.6)
         e = 0.9 * e + 20.0 * rng.standard_normal()
         one(pr - 150.0 * math.sin(2.0 * math.pi * t / 0.6) + e, pr, vr,
-            7.0 * math.copysign(1.0, vr))
+            m["Fc_N"] * math.copysign(1.0, vr))
 
     # phase C (1 s): reference steps that saturate the torque; the axis answers
     # with a slow damped oscillation so the error changes sign while the
@@ -330,13 +331,13 @@ def gen_ctrl(out_dir, m):
             one(pos + err + 3.0 * rng.standard_normal(), pos, 0.0, 0.0)
 
     # phase D (0.6 s): seeded random walk of reference and encoder, random
-    # fractions and compensation forces in [-18, 18] N.
+    # fractions and compensation forces in [-Fs, Fs].
     pr = pos
     for k in range(600):
         vr = 2.0e5 * math.sin(2.0 * math.pi * 3.0 * k * DT)
         pr += vr * DT
         e = 0.95 * e + 40.0 * rng.standard_normal()
-        one(pr + e, pr + rng.random(), vr, rng.uniform(-18.0, 18.0))
+        one(pr + e, pr + rng.random(), vr, rng.uniform(-m["Fs_N"], m["Fs_N"]))
 
     # phase E (0.3 s): a fast 30 Hz oscillation around a still reference: the
     # velocity term saturates the command while the position error has either

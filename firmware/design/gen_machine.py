@@ -1,57 +1,177 @@
 #!/usr/bin/env python3
-"""Writes the machine-parameter header bristle_gen/machine/br_machine.h from a
-machine description (default machines/reference.json, into firmware/gen/).
+"""Writes a machine description's headers below a generated-header root
+(default firmware/gen/, machine machines/reference.json):
 
-Usage: gen_machine.py [--machine FILE] [--out FILE]"""
+  bristle_gen/machine/br_machine.h    BR_MACHINE_*: mechanics, encoder, amplifier,
+                                      nominal friction, control period and torque
+                                      limit, axis limits
+  bristle_gen/est/br_est_machine.h    BR_EST_PF_*, BR_EST_UKF_*: the estimator
+                                      section (the PF's period, particles, noise
+                                      variances, spreads, g_p range, gates)
+
+With --tuned also bristle_gen/est/br_pf_tuned.h and br_ukf_tuned.h, the
+variances the circle runs with, taken from the estimator section as they are
+(for a machine without a Nelder-Mead tuning; the reference machine's come from
+`make tune`, sim/apps/br_tune_est.c).
+
+Usage: gen_machine.py [--machine FILE] [--gen-root DIR] [--tuned]
+A bad machine file: "FILE: field a.b.c: problem" lines, exit status 1."""
 import argparse
 import os
 
+import numpy as np
+
 import machine
 
-FIELDS = [
-    # (C name, key, unit/comment)
-    ("BR_MACHINE_LEAD_MPRAD", "L_mprad", "L = lead / (2 pi), m/rad"),
-    ("BR_MACHINE_M_KG", "M_kg", "table mass"),
-    ("BR_MACHINE_J_KGM2", "J_kgm2", "motor + screw inertia"),
-    ("BR_MACHINE_SIGMA2_NSPM", "sigma2_Nspm", "viscous friction"),
-    ("BR_MACHINE_SIGMA0_NPM", "sigma0_Npm", "bristle stiffness"),
-    ("BR_MACHINE_SIGMA1_NSPM", "sigma1_Nspm", "bristle damping"),
-    ("BR_MACHINE_FC_N", "Fc_N", "Coulomb friction"),
-    ("BR_MACHINE_FS_N", "Fs_N", "maximum stiction"),
-    ("BR_MACHINE_VS_MPS", "vs_mps", "Stribeck velocity"),
-    ("BR_MACHINE_COUNTS_PER_REV", "counts_per_rev", "encoder counts per motor revolution"),
-    ("BR_MACHINE_RAD_PER_COUNT", "rad_per_count", "2 pi / counts_per_rev"),
-    ("BR_MACHINE_TAU_PER_DUTY_NM", "tau_per_duty_Nm", "amplifier torque at duty 1"),
-]
+# (C name, value in the file or derived, comment); floats get a double and an _F float literal
+def machine_fields(m, p):
+    ctl, lim = m["control"], m["limits"]
+    return [
+        ("BR_MACHINE_LEAD_MPRAD", p["L_mprad"], "L = lead / (2 pi), m/rad"),
+        ("BR_MACHINE_M_KG", p["M_kg"], "table mass"),
+        ("BR_MACHINE_J_KGM2", p["J_kgm2"], "motor + screw inertia"),
+        ("BR_MACHINE_SIGMA2_NSPM", p["sigma2_Nspm"], "viscous friction"),
+        ("BR_MACHINE_SIGMA0_NPM", p["sigma0_Npm"], "bristle stiffness"),
+        ("BR_MACHINE_SIGMA1_NSPM", p["sigma1_Nspm"], "bristle damping"),
+        ("BR_MACHINE_FC_N", p["Fc_N"], "Coulomb friction"),
+        ("BR_MACHINE_FS_N", p["Fs_N"], "maximum stiction"),
+        ("BR_MACHINE_VS_MPS", p["vs_mps"], "Stribeck velocity"),
+        ("BR_MACHINE_COUNTS_PER_REV", p["counts_per_rev"], "encoder counts per motor revolution"),
+        ("BR_MACHINE_RAD_PER_COUNT", p["rad_per_count"], "2 pi / counts_per_rev"),
+        ("BR_MACHINE_TAU_PER_DUTY_NM", p["tau_per_duty_Nm"], "amplifier torque at duty 1"),
+        ("BR_MACHINE_DUTY_LIMIT", m["amplifier"]["duty_limit"], "largest |duty| the amplifier accepts"),
+        ("BR_MACHINE_COUNTER_BITS", m["encoder"]["counter_bits"], "width of the encoder's hardware counter"),
+        ("BR_MACHINE_CTRL_PERIOD_S", ctl["period_s"], "control period (H-inf only, H-inf + UKF)"),
+        ("BR_MACHINE_TORQUE_LIMIT_NM", ctl["torque_limit_Nm"], "controller torque saturation"),
+        ("BR_MACHINE_MAX_SPEED_MPS", lim["max_speed_mps"], "largest table speed the axis is used at"),
+        ("BR_MACHINE_TRAVEL_M", lim["travel_m"], "stroke of the table"),
+    ]
 
 
-def render(p):
+def est_fields(m):
+    pf, ukf = m["estimator"]["pf"], m["estimator"]["ukf"]
+    out = [("BR_EST_PF_PERIOD_S", pf["period_s"], "the PF's period (its loop runs at it)"),
+           ("BR_EST_PF_N_PARTICLES", pf["n_particles"], "particle count")]
+    for k, c in (("theta_counts2", "Q_THETA_COUNTS2"), ("omega_rad2_per_s2", "Q_OMEGA_RAD2PS2"),
+                 ("z_m2", "Q_Z_M2"), ("gp_N2", "Q_GP_N2")):
+        out.append(("BR_EST_PF_" + c, pf["q_var"][k], "process noise variance per step"))
+    out.append(("BR_EST_PF_R_COUNTS2", pf["r_var_counts2"], "measurement noise variance"))
+    for k, c in (("theta_counts", "X0_STD_THETA_COUNTS"), ("omega_rad_per_s", "X0_STD_OMEGA_RADPS"),
+                 ("z_m", "X0_STD_Z_M"), ("gp_N", "X0_STD_GP_N")):
+        out.append(("BR_EST_PF_" + c, pf["x0_std"][k], "initial spread"))
+    out += gate_fields("PF", pf)
+    out.append(("BR_EST_PF_NOISE_SKIP", pf["noise_skip"], "extra noise-table advance per step"))
+    for k, c in (("theta_rad2", "Q_THETA_RAD2"), ("omega_rad2_per_s2", "Q_OMEGA_RAD2PS2"),
+                 ("z_m2", "Q_Z_M2"), ("gp_N2", "Q_GP_N2")):
+        out.append(("BR_EST_UKF_" + c, ukf["q_var"][k], "process noise variance per step"))
+    out.append(("BR_EST_UKF_R_COUNTS2", ukf["r_var_counts2"], "measurement noise variance"))
+    for k, c in (("theta_counts2", "P0_THETA_COUNTS2"), ("omega_rad2_per_s2", "P0_OMEGA_RAD2PS2"),
+                 ("z_m2", "P0_Z_M2"), ("gp_N2", "P0_GP_N2")):
+        out.append(("BR_EST_UKF_" + c, ukf["p0_var"][k], "initial (and recovery) variance"))
+    out += gate_fields("UKF", ukf)
+    out += [("BR_EST_UKF_ALPHA", ukf["alpha"], "sigma-point spread"),
+            ("BR_EST_UKF_BETA", ukf["beta"], "prior-distribution weight"),
+            ("BR_EST_UKF_KAPPA", ukf["kappa"], "secondary scaling")]
+    return out
+
+
+def gate_fields(E, e):
+    return [("BR_EST_%s_GP0_N" % E, e["gp0_N"], "initial g_p"),
+            ("BR_EST_%s_GP_MIN_N" % E, e["gp_min_N"], "g_p range"),
+            ("BR_EST_%s_GP_MAX_N" % E, e["gp_max_N"], ""),
+            ("BR_EST_%s_OUTLIER_SIGMA" % E, e["outlier_gate_sigma"], "outlier gate, standard deviations"),
+            ("BR_EST_%s_REANCHOR_AFTER" % E, e["reanchor_after"], "consecutive outliers before re-anchoring")]
+
+
+def render_defines(fields):
+    out = []
+    for name, v, doc in fields:
+        if doc:
+            out.append("/* %s */" % doc)
+        if isinstance(v, int):
+            out.append("#define %s %du" % (name, v))
+        else:
+            out.append("#define %s (%s)" % (name, repr(float(v))))
+            out.append("#define %s_F (%s)" % (name, machine.c_float(v)))
+    return out
+
+
+def render_machine(m):
     out = [
-        "/* generated by firmware/design/gen_machine.py from %s -- do not edit */" % p["file"],
+        "/* generated by firmware/design/gen_machine.py from %s -- do not edit */" % m["file"],
         "/* The machine's parameters. Each value is given as a double literal (for the",
         " * double-precision simulator) and as a float literal that rounds exactly",
         " * (suffix _F, for the firmware). */",
         "#ifndef BR_GEN_MACHINE_H",
         "#define BR_GEN_MACHINE_H",
         "",
+        "/* the machine description these values come from */",
+        "#define BR_MACHINE_FILE \"%s\"" % m["file"],
     ]
-    for name, key, doc in FIELDS:
-        v = float(p[key])
-        out.append("/* %s */" % doc)
-        out.append("#define %s (%s)" % (name, repr(v)))
-        out.append("#define %s_F (%s)" % (name, machine.c_float(v)))
+    out += render_defines(machine_fields(m, machine.params(m)))
     out += ["", "#endif", ""]
     return "\n".join(out)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--machine", default=machine.REFERENCE_MACHINE, help="machine description (JSON)")
-    ap.add_argument("--out", default=os.path.join(machine.GEN_DIR, "bristle_gen", "machine", "br_machine.h"))
-    a = ap.parse_args()
-    text = render(machine.load(a.machine))
-    with open(a.out, "w") as f:
+def render_est(m):
+    out = [
+        "/* generated by firmware/design/gen_machine.py from %s -- do not edit */" % m["file"],
+        "/* The estimators' settings of the machine description (its \"estimator\" section):",
+        " * double and exact float (_F) literals, counts as unsigned integers. Variances",
+        " * in counts^2 and spreads in counts are multiplied by BR_MACHINE_RAD_PER_COUNT_F",
+        " * (squared) where the configuration is built (sim/circle/br_circle_est.c). */",
+        "#ifndef BR_GEN_EST_MACHINE_H",
+        "#define BR_GEN_EST_MACHINE_H",
+        "",
+    ]
+    out += render_defines(est_fields(m))
+    out += ["", "#endif", ""]
+    return "\n".join(out)
+
+
+def render_tuned(m, est):
+    """The br_<est>_tuned.h of a machine without a tuning: the estimator section's
+    variances, in the units and float32 arithmetic of the configuration."""
+    f32 = np.float32
+    rpc = f32(machine.params(m)["rad_per_count"])
+    e = m["estimator"][est]
+    r = f32(e["r_var_counts2"]) * rpc * rpc
+    q = e["q_var"]
+    if est == "pf":
+        vals = [("q_omega", q["omega_rad2_per_s2"]), ("q_z", q["z_m2"]), ("q_gp", q["gp_N2"]), ("r", r)]
+    else:
+        vals = [("q_theta", q["theta_rad2"]), ("q_omega", q["omega_rad2_per_s2"]), ("q_z", q["z_m2"]),
+                ("q_gp", q["gp_N2"]), ("r", r)]
+    E = est.upper()
+    out = ["/* generated by firmware/design/gen_machine.py from %s -- do not edit */" % m["file"],
+           "/* not a tuning result: the variances of the machine file's estimator section, as they are */",
+           "#ifndef BR_%s_TUNED_H" % E, "#define BR_%s_TUNED_H" % E, ""]
+    for name, v in vals:
+        out.append("#define BR_%s_TUNED_%s (%s)" % (E, name, machine.c_float(v)))
+    out += ["", "#endif", ""]
+    return "\n".join(out)
+
+
+def write(path, text):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
         f.write(text)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--machine", default=machine.REFERENCE_MACHINE, help="machine description (JSON)")
+    ap.add_argument("--gen-root", default=machine.GEN_DIR, help="root of bristle_gen/ (default firmware/gen)")
+    ap.add_argument("--tuned", action="store_true",
+                    help="also write bristle_gen/est/br_{pf,ukf}_tuned.h from the estimator section")
+    a = ap.parse_args()
+    m = machine.load_or_exit(a.machine)
+    root = os.path.join(a.gen_root, "bristle_gen")
+    write(os.path.join(root, "machine", "br_machine.h"), render_machine(m))
+    write(os.path.join(root, "est", "br_est_machine.h"), render_est(m))
+    if a.tuned:
+        for est in ("pf", "ukf"):
+            write(os.path.join(root, "est", "br_%s_tuned.h" % est), render_tuned(m, est))
 
 
 if __name__ == "__main__":

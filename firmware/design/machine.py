@@ -1,10 +1,19 @@
-"""Machine parameters (a machine description, machines/*.json) and derived values.
+"""Machine description (machines/*.json, format version 1): loader, validator
+and the values derived from it. Documented field by field in
+docs/machine-file.md; the reference machine is machines/reference.json.
 
-Shared by the design scripts. The reference machine (machines/reference.json)
-is the default; its numbers' source is ../shared/spec/reference-machine.md."""
+    m = machine.load(path)        # validated, nested like the file; raises MachineError
+    m = machine.load_or_exit(path)  # the same; on an error prints
+                                    # "FILE: field a.b.c: problem" lines, exit status 1
+    p = machine.params(m)         # the plant / eq. 6 parameters by their symbols
+                                  # (L_mprad, Jeff_kgm2, rad_per_count, Fc_N, ...)
+
+Run as a script it validates files: machine.py FILE... (exit 1 on any error)."""
 import json
 import math
 import os
+import re
+import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO_ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -12,12 +21,320 @@ REFERENCE_MACHINE = os.path.join(REPO_ROOT, "machines", "reference.json")
 # generated headers: one root on the include path, one folder per kind below bristle_gen/
 GEN_DIR = os.path.join(REPO_ROOT, "firmware", "gen")
 
+FORMAT_VERSION = 1
+# BR_PF_MAX_PARTICLES of firmware/include/bristle/br_pf.h
+PF_MAX_PARTICLES = 2048
+
+
+class MachineError(Exception):
+    """Every problem found in one file, one "FILE: field a.b.c: problem" line each."""
+
+    def __init__(self, lines):
+        super().__init__("\n".join(lines))
+        self.lines = lines
+
+
+# --- schema -----------------------------------------------------------------
+# A leaf is Num / Int / Str; a section is a dict of name -> leaf or section.
+# Bounds: lo / hi inclusive unless lo_open / hi_open.
+
+class Num:
+    def __init__(self, lo, hi, doc, lo_open=False, hi_open=False):
+        self.lo, self.hi, self.doc, self.lo_open, self.hi_open = lo, hi, doc, lo_open, hi_open
+
+    def range_text(self):
+        return "%s%s, %s%s" % ("(" if self.lo_open else "[", _g(self.lo), _g(self.hi), ")" if self.hi_open else "]")
+
+    def check(self, v):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            return None, "expected a number, got %s" % _kind(v)
+        v = float(v)
+        if not math.isfinite(v):
+            return None, "not finite"
+        below = v <= self.lo if self.lo_open else v < self.lo
+        above = v >= self.hi if self.hi_open else v > self.hi
+        if below or above:
+            return None, "%s is outside %s" % (_g(v), self.range_text())
+        return v, None
+
+
+class Int(Num):
+    def check(self, v):
+        if isinstance(v, bool) or not isinstance(v, int):
+            return None, "expected an integer, got %s" % _kind(v)
+        if v < self.lo or v > self.hi:
+            return None, "%d is outside %s" % (v, self.range_text())
+        return v, None
+
+
+class Str:
+    def __init__(self, pattern, doc):
+        self.pattern, self.doc = pattern, doc
+
+    def range_text(self):
+        return "text matching %s" % self.pattern
+
+    def check(self, v):
+        if not isinstance(v, str):
+            return None, "expected a string, got %s" % _kind(v)
+        if not re.fullmatch(self.pattern, v):
+            return None, "%r does not match %s" % (v, self.pattern)
+        return v, None
+
+
+class Optional:
+    """A section that may be left out (the causes: absent = the cause is off)."""
+
+    def __init__(self, section):
+        self.section = section
+
+
+def _g(v):
+    return "%g" % v if isinstance(v, float) else str(v)
+
+
+def _kind(v):
+    return {dict: "an object", list: "a list", str: "a string", bool: "a boolean",
+            type(None): "null"}.get(type(v), type(v).__name__)
+
+
+def _variances(doc_theta, theta_name, theta_rng):
+    """Process-noise variances per step of x = [theta, omega, z, g_p]."""
+    return {
+        theta_name: Num(theta_rng[0], theta_rng[1], doc_theta),
+        "omega_rad2_per_s2": Num(0.0, 1.0e3, "omega, per step"),
+        "z_m2": Num(0.0, 1.0e-6, "bristle deflection z, per step"),
+        "gp_N2": Num(0.0, 1.0e6, "g_p, per step"),
+    }
+
+
+def _gates():
+    return {
+        "gp0_N": Num(0.0, 1.0e5, "initial g_p (friction level the filter starts from)", lo_open=True),
+        "gp_min_N": Num(0.0, 1.0e5, "g_p is kept >= this", lo_open=True),
+        "gp_max_N": Num(0.0, 1.0e5, "g_p is kept <= this", lo_open=True),
+        "outlier_gate_sigma": Num(0.0, 1.0e4, "a measurement further than this many standard deviations "
+                                  "is an outlier", lo_open=True),
+        "reanchor_after": Int(1, 1000, "consecutive outliers before the filter is re-anchored on the measurement"),
+    }
+
+
+SCHEMA = {
+    "format_version": Int(FORMAT_VERSION, FORMAT_VERSION, "format of this file"),
+    "name": Str(r"[a-z0-9][a-z0-9_-]*", "short name (file banners, build folders)"),
+    "source": Str(r"(?s).*", "where the values come from"),
+    "mechanics": {
+        "table_mass_kg": Num(0.0, 1.0e4, "M, moving mass at the load", lo_open=True),
+        "inertia_kgm2": Num(0.0, 1.0, "J, motor + screw inertia", lo_open=True),
+        "lead_m_per_rev": Num(1.0e-4, 0.1, "ball-screw lead"),
+    },
+    "encoder": {
+        "counts_per_rev": Int(4, 2**31, "counts per motor revolution"),
+        "counter_bits": Int(16, 32, "width of the hardware counter (extended to 32 bits in software)"),
+    },
+    "amplifier": {
+        "torque_per_duty_Nm": Num(0.0, 1.0e3, "motor torque at duty 1 (current mode)", lo_open=True),
+        "duty_limit": Num(0.0, 1.0, "largest |duty| the amplifier accepts", lo_open=True),
+    },
+    "friction": {
+        "sigma2_Nspm": Num(0.0, 1.0e6, "sigma2, viscous friction"),
+        "sigma0_Npm": Num(0.0, 1.0e10, "LuGre bristle stiffness", lo_open=True),
+        "sigma1_Nspm": Num(0.0, 1.0e8, "LuGre bristle damping"),
+        "Fc_N": Num(0.0, 1.0e5, "Coulomb friction", lo_open=True),
+        "Fs_N": Num(0.0, 1.0e5, "maximum stiction, >= Fc_N", lo_open=True),
+        "vs_mps": Num(0.0, 1.0, "Stribeck velocity", lo_open=True),
+    },
+    # what a diagnosis of a measured log found beyond the nominal model (docs/diagnose.md);
+    # grouped by cause, each parameter under its model.json name (the names of
+    # br_causes_t and of br_plant_cfg_t too), each cause absent = off
+    "causes": {
+        "offset": Optional({
+            "offset_N": Num(-1.0e5, 1.0e5, "constant load force, + opposes motion in +x"),
+        }),
+        "asymmetric_friction": Optional({
+            "dFc_neg_N": Num(-1.0e5, 1.0e5, "Coulomb level in -x is Fc_N + dFc_neg_N (Fs scaled alike)"),
+            "dsigma2_neg_Nspm": Num(-1.0e6, 1.0e6, "viscous friction in -x is sigma2_Nspm + this"),
+        }),
+        "position_ripple": Optional({
+            "ripple_amp_N": Num(0.0, 1.0e5, "ripple force amplitude"),
+            "ripple_period_m": Num(0.0, 10.0, "ripple period in load position", lo_open=True),
+            "ripple_phase_rad": Num(-2.0 * math.pi, 2.0 * math.pi, "phase at x = 0"),
+        }),
+        "position_gradient": Optional({
+            "grad_per_m": Num(-1.0e3, 1.0e3, "friction scaled by max(0, 1 + grad_per_m x) along the travel"),
+        }),
+        "actuator_delay": Optional({
+            "delay_s": Num(0.0, 0.1, "actuator dead time"),
+        }),
+    },
+    "control": {
+        "period_s": Num(1.0e-5, 0.1, "control period (H-inf only, UKF)"),
+        "torque_limit_Nm": Num(0.0, 1.0e3, "controller torque saturation, <= duty_limit * torque_per_duty_Nm; "
+                               "also the H-inf design's torque scale (Dz = 1/torque_limit_Nm)", lo_open=True),
+        "hinf": {
+            "weight_theta_per_rad": Num(0.0, 1.0e6, "Cz weight on e_theta", lo_open=True),
+            "weight_omega_s_per_rad": Num(0.0, 1.0e6, "Cz weight on e_omega"),
+            "weight_eps_per_rad_s": Num(0.0, 1.0e6, "Cz weight on the integral eps", lo_open=True),
+            "gamma_margin": Num(1.0, 100.0, "design gamma = gamma_margin * gamma_min", lo_open=True),
+        },
+    },
+    "estimator": {
+        "pf": dict({
+            "period_s": Num(1.0e-5, 0.1, "the PF's (and its loop's) period"),
+            "n_particles": Int(1, PF_MAX_PARTICLES, "particle count m"),
+            "q_var": _variances("theta, per step, in counts^2 (times rad_per_count^2)",
+                                "theta_counts2", (0.0, 1.0e6)),
+            "r_var_counts2": Num(0.0, 1.0e6, "measurement noise variance R", lo_open=True),
+            "x0_std": {
+                "theta_counts": Num(0.0, 1.0e6, "initial spread of theta around the first measurement"),
+                "omega_rad_per_s": Num(0.0, 1.0e3, "of omega around 0"),
+                "z_m": Num(0.0, 1.0e-3, "of z around 0"),
+                "gp_N": Num(0.0, 1.0e5, "of g_p around gp0_N"),
+            },
+            "noise_skip": Int(0, 1024, "extra ROM noise-table advance per step (docs/modules/pf.md)"),
+        }, **_gates()),
+        "ukf": dict({
+            "q_var": _variances("theta, per step", "theta_rad2", (0.0, 1.0)),
+            "r_var_counts2": Num(0.0, 1.0e6, "measurement noise variance R", lo_open=True),
+            "p0_var": {
+                "theta_counts2": Num(0.0, 1.0e6, "initial (and recovery) variance of theta", lo_open=True),
+                "omega_rad2_per_s2": Num(0.0, 1.0e6, "of omega", lo_open=True),
+                "z_m2": Num(0.0, 1.0, "of z", lo_open=True),
+                "gp_N2": Num(0.0, 1.0e8, "of g_p", lo_open=True),
+            },
+            "alpha": Num(0.1, 1.0, "sigma-point spread"),
+            "beta": Num(0.0, 10.0, "prior-distribution weight (2 for a Gaussian)"),
+            "kappa": Num(-3.0, 100.0, "secondary scaling (n + kappa > 0, n = 4)", lo_open=True),
+        }, **_gates()),
+    },
+    "limits": {
+        "max_speed_mps": Num(0.0, 100.0, "largest table speed the axis is used at", lo_open=True),
+        "travel_m": Num(0.0, 100.0, "stroke of the table", lo_open=True),
+    },
+}
+
+
+def _walk(schema, value, path, errors):
+    """Checks value against schema; returns the cleaned value (numbers as float / int)."""
+    if isinstance(schema, Optional):
+        schema = schema.section
+    if isinstance(schema, dict):
+        if not isinstance(value, dict):
+            errors.append((path, "expected an object, got %s" % _kind(value)))
+            return None
+        out = {}
+        for k in value:
+            if k not in schema:
+                errors.append((_join(path, k), "unknown field (expected one of: %s)" % ", ".join(schema)))
+        for k, sub in schema.items():
+            if k not in value:
+                if not isinstance(sub, Optional):
+                    errors.append((_join(path, k), "missing"))
+                continue
+            out[k] = _walk(sub, value[k], _join(path, k), errors)
+        return out
+    v, problem = schema.check(value)
+    if problem:
+        errors.append((path, problem))
+    return v
+
+
+def _join(path, k):
+    return k if not path else path + "." + k
+
+
+def _cross_checks(m, errors):
+    """Relations between fields (only when the fields themselves are valid)."""
+    def get(dotted):
+        v = m
+        for k in dotted.split("."):
+            if not isinstance(v, dict) or v.get(k) is None:
+                return None
+            v = v[k]
+        return v
+
+    def need(cond_fields, ok, field, problem):
+        if all(get(f) is not None for f in cond_fields) and not ok():
+            errors.append((field, problem))
+
+    need(["friction.Fc_N", "friction.Fs_N"], lambda: get("friction.Fs_N") >= get("friction.Fc_N"),
+         "friction.Fs_N", "must be >= friction.Fc_N (%s N)" % _g(get("friction.Fc_N") or 0.0))
+    need(["control.torque_limit_Nm", "amplifier.duty_limit", "amplifier.torque_per_duty_Nm"],
+         lambda: get("control.torque_limit_Nm") <= get("amplifier.duty_limit") * get("amplifier.torque_per_duty_Nm"),
+         "control.torque_limit_Nm", "must be <= amplifier.duty_limit * amplifier.torque_per_duty_Nm")
+    for est in ("pf", "ukf"):
+        e = "estimator.%s." % est
+        need([e + "gp_min_N", e + "gp_max_N"], lambda: get(e + "gp_min_N") < get(e + "gp_max_N"),
+             e + "gp_max_N", "must be > %sgp_min_N" % e)
+        need([e + "gp_min_N", e + "gp_max_N", e + "gp0_N"],
+             lambda: get(e + "gp_min_N") <= get(e + "gp0_N") <= get(e + "gp_max_N"),
+             e + "gp0_N", "must lie in [%sgp_min_N, %sgp_max_N]" % (e, e))
+    need(["encoder.counts_per_rev", "encoder.counter_bits"],
+         lambda: get("encoder.counts_per_rev") <= 2 ** get("encoder.counter_bits"),
+         "encoder.counts_per_rev", "more counts per revolution than the counter holds (2^counter_bits)")
+
+
+def display_name(path):
+    """The file as messages and banners name it: relative to the repository
+    when it is inside, else as given."""
+    a = os.path.abspath(path)
+    return os.path.relpath(a, REPO_ROOT) if a.startswith(REPO_ROOT + os.sep) else path
+
 
 def load(path=REFERENCE_MACHINE):
-    with open(path) as f:
-        p = {k: v for k, v in json.load(f).items() if not k.startswith("_")}
-    p["file"] = os.path.relpath(os.path.abspath(path), REPO_ROOT) if os.path.abspath(path).startswith(REPO_ROOT + os.sep) \
-        else os.path.basename(path)
+    """The validated machine description, nested like the file, plus "file"
+    (its display name). Raises MachineError listing every problem."""
+    name = display_name(path)
+    try:
+        with open(path, "r", encoding="utf-8") as f:
+            text = f.read()
+    except OSError as e:
+        raise MachineError(["%s: cannot read: %s" % (name, e.strerror or e)])
+    try:
+        raw = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise MachineError(["%s: not valid JSON: line %d column %d: %s" % (name, e.lineno, e.colno, e.msg)])
+    errors = []
+    if isinstance(raw, dict) and "format_version" in raw and raw["format_version"] != FORMAT_VERSION:
+        raise MachineError(["%s: field format_version: %r is not a version this loader reads (%d)"
+                            % (name, raw["format_version"], FORMAT_VERSION)])
+    m = _walk(SCHEMA, raw, "", errors)
+    if not errors:
+        _cross_checks(m, errors)
+    if errors:
+        raise MachineError(["%s: field %s: %s" % (name, p or "(top level)", problem) for p, problem in errors])
+    m["file"] = name
+    return m
+
+
+def load_or_exit(path=REFERENCE_MACHINE):
+    """load(), for scripts: a bad file ends the program with its messages and exit status 1."""
+    try:
+        return load(path)
+    except MachineError as e:
+        for line in e.lines:
+            sys.stderr.write(line + "\n")
+        sys.exit(1)
+
+
+def params(m):
+    """The plant / estimation-model parameters by their symbols (thesis eqs.
+    1-6), with the derived ones:
+      L_mprad = lead / (2 pi),  Jeff_kgm2 = J + L^2 M,  rad_per_count = 2 pi / counts_per_rev."""
+    mech, fr = m["mechanics"], m["friction"]
+    p = {
+        "lead_m_per_rev": mech["lead_m_per_rev"],
+        "M_kg": mech["table_mass_kg"],
+        "J_kgm2": mech["inertia_kgm2"],
+        "sigma2_Nspm": fr["sigma2_Nspm"],
+        "sigma0_Npm": fr["sigma0_Npm"],
+        "sigma1_Nspm": fr["sigma1_Nspm"],
+        "Fc_N": fr["Fc_N"],
+        "Fs_N": fr["Fs_N"],
+        "vs_mps": fr["vs_mps"],
+        "counts_per_rev": float(m["encoder"]["counts_per_rev"]),
+        "tau_per_duty_Nm": m["amplifier"]["torque_per_duty_Nm"],
+    }
     p["L_mprad"] = p["lead_m_per_rev"] / (2.0 * math.pi)
     p["Jeff_kgm2"] = p["J_kgm2"] + p["L_mprad"] ** 2 * p["M_kg"]
     p["rad_per_count"] = 2.0 * math.pi / p["counts_per_rev"]
@@ -31,3 +348,23 @@ def c_float(x):
     s = "%.9e" % float(f)
     assert np.float32(float(s)) == f
     return s + "f"
+
+
+def main(argv):
+    if not argv:
+        sys.stderr.write("usage: machine.py FILE...  (validates machine descriptions)\n")
+        return 2
+    rc = 0
+    for path in argv:
+        try:
+            load(path)
+            print("%s: ok" % display_name(path))
+        except MachineError as e:
+            for line in e.lines:
+                sys.stderr.write(line + "\n")
+            rc = 1
+    return rc
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -24,6 +24,7 @@
 
 #include "br_circle.h"
 #include "br_circle_est.h"
+#include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 
 #define DT0_S 0.5e-3
@@ -99,7 +100,8 @@ int main(int argc, char **argv)
             for (int s = 0; s < seeds; s++) {
                 br_pf_cfg_t pc = br_circle_pf_cfg_tuned((float)dt);
                 pc.n_particles = m;
-                for (int i = 0; i < BR_NX; i++) pc.est.q_var[i] *= (float)(dt / 1.5e-3);
+                /* the variances are per step of the PF's period */
+                for (int i = 0; i < BR_NX; i++) pc.est.q_var[i] *= (float)(dt / BR_EST_PF_PERIOD_S);
                 if (br_pf_init(pf, &pc) != BR_OK) return 1;
                 pf->noise_pos = ((uint32_t)s * 1031u) & (pc.noise_len - 1u); /* realisation s */
                 double u = 0.0;

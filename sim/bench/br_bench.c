@@ -35,6 +35,7 @@
 #include "br_circle_est.h"
 #include "br_hal_sim.h"
 #include "bristle_gen/est/br_noise_table.h"
+#include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_app.h"
 
 #define BR_PI 3.14159265358979323846
@@ -129,7 +130,7 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
     memset(&cc, 0, sizeof cc);
     for (int i = 0; i < 3; i++) cc.K[i] = c->K[i];
     cc.dt_s = (float)c->dt_s;
-    cc.tau_max_Nm = (float)c->plant.tau_per_duty_Nm;
+    cc.tau_max_Nm = BR_MACHINE_TORQUE_LIMIT_NM_F;
     cc.tau_per_duty_Nm = (float)c->plant.tau_per_duty_Nm;
     cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
     cc.lead_mprad = (float)c->plant.lead_mprad;

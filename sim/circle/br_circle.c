@@ -7,6 +7,7 @@
 #include "br_circle_est.h"
 #include "br_hal_sim.h"
 #include "bristle_gen/ctrl/br_hinf_gains.h"
+#include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_app.h"
 
@@ -30,8 +31,8 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     c.radius_m = 1.0e-4;
     c.period_s = 8.0;
     c.duration_s = 8.0;
-    /* thesis section 5: 1.5 ms for the PF, 1 ms for the others */
-    c.dt_s = (controller == BR_CTRL_HINF_PF) ? 1.5e-3 : 1.0e-3;
+    /* the machine's periods (thesis section 5: 1.5 ms for the PF, 1 ms for the others) */
+    c.dt_s = (controller == BR_CTRL_HINF_PF) ? BR_EST_PF_PERIOD_S : BR_MACHINE_CTRL_PERIOD_S;
     c.controller = controller;
     c.plant = br_plant_cfg_reference();
     for (int i = 0; i < 3; i++) c.K[i] = K[i];
@@ -84,7 +85,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     br_ctrl_cfg_t cc;
     for (int i = 0; i < 3; i++) cc.K[i] = c->K[i];
     cc.dt_s = (float)c->dt_s;
-    cc.tau_max_Nm = (float)c->plant.tau_per_duty_Nm;
+    cc.tau_max_Nm = BR_MACHINE_TORQUE_LIMIT_NM_F;
     cc.tau_per_duty_Nm = (float)c->plant.tau_per_duty_Nm;
     cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
     cc.lead_mprad = (float)c->plant.lead_mprad;

@@ -1,12 +1,14 @@
-/* Estimator configurations for the circle experiment (docs/modules/pf.md). */
+/* Estimator configurations for the circle experiment, from the machine
+ * description (bristle_gen/est/, docs/machine-file.md; docs/modules/pf.md). */
 #include "br_circle_est.h"
 
+#include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/est/br_noise_table.h"
 #include "bristle_gen/est/br_pf_tuned.h"
 #include "bristle_gen/est/br_ukf_tuned.h"
 #include "bristle_gen/machine/br_machine.h"
 
-br_model_cfg_t br_ref_model_cfg(float dt_s)
+br_model_cfg_t br_machine_model_cfg(float dt_s)
 {
     br_model_cfg_t m = {0}; /* no causes: the thesis model */
     m.J_kgm2 = BR_MACHINE_J_KGM2_F;
@@ -26,27 +28,28 @@ br_pf_cfg_t br_circle_pf_cfg_default(float dt_s)
 {
     const float rpc = BR_MACHINE_RAD_PER_COUNT_F;
     br_pf_cfg_t c;
-    c.est.model = br_ref_model_cfg(dt_s);
-    c.n_particles = 1500u;
-    /* hand-tuned on the circle by a grid (docs/modules/pf.md) */
-    c.est.q_var[BR_X_THETA] = 0.01f * rpc * rpc;
-    c.est.q_var[BR_X_OMEGA] = 5.0e-6f;
-    c.est.q_var[BR_X_Z] = 1.0e-14f;
-    c.est.q_var[BR_X_GP] = 0.1f;
-    c.est.r_var_rad2 = 0.3f * rpc * rpc;
-    c.est.gp0_N = BR_MACHINE_FS_N_F;
-    c.x0_std[BR_X_THETA] = 0.3f * rpc;
-    c.x0_std[BR_X_OMEGA] = 1.0e-3f;
-    c.x0_std[BR_X_Z] = 1.0e-7f;
-    c.x0_std[BR_X_GP] = 2.0f;
-    c.est.gp_min_N = 0.5f * BR_MACHINE_FC_N_F;
-    c.est.gp_max_N = 1.5f * BR_MACHINE_FS_N_F;
-    c.est.outlier_sigma = 30.0f;
-    c.est.reanchor_after = 3u;
+    c.est.model = br_machine_model_cfg(dt_s);
+    c.n_particles = BR_EST_PF_N_PARTICLES;
+    /* the machine file's estimator section (hand-tuned on the reference circle by a grid,
+     * docs/modules/pf.md); theta in counts */
+    c.est.q_var[BR_X_THETA] = BR_EST_PF_Q_THETA_COUNTS2_F * rpc * rpc;
+    c.est.q_var[BR_X_OMEGA] = BR_EST_PF_Q_OMEGA_RAD2PS2_F;
+    c.est.q_var[BR_X_Z] = BR_EST_PF_Q_Z_M2_F;
+    c.est.q_var[BR_X_GP] = BR_EST_PF_Q_GP_N2_F;
+    c.est.r_var_rad2 = BR_EST_PF_R_COUNTS2_F * rpc * rpc;
+    c.est.gp0_N = BR_EST_PF_GP0_N_F;
+    c.x0_std[BR_X_THETA] = BR_EST_PF_X0_STD_THETA_COUNTS_F * rpc;
+    c.x0_std[BR_X_OMEGA] = BR_EST_PF_X0_STD_OMEGA_RADPS_F;
+    c.x0_std[BR_X_Z] = BR_EST_PF_X0_STD_Z_M_F;
+    c.x0_std[BR_X_GP] = BR_EST_PF_X0_STD_GP_N_F;
+    c.est.gp_min_N = BR_EST_PF_GP_MIN_N_F;
+    c.est.gp_max_N = BR_EST_PF_GP_MAX_N_F;
+    c.est.outlier_sigma = BR_EST_PF_OUTLIER_SIGMA_F;
+    c.est.reanchor_after = BR_EST_PF_REANCHOR_AFTER;
     c.est.rad_per_count = rpc;
     c.noise = br_noise_table;
     c.noise_len = BR_NOISE_LEN;
-    c.noise_skip = 1u;
+    c.noise_skip = BR_EST_PF_NOISE_SKIP;
     return c;
 }
 
@@ -54,26 +57,26 @@ br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s)
 {
     const float rpc = BR_MACHINE_RAD_PER_COUNT_F;
     br_ukf_cfg_t c;
-    c.est.model = br_ref_model_cfg(dt_s);
-    /* the values of docs/modules/ukf.md (lightly hand-tuned) */
-    c.est.q_var[BR_X_THETA] = 1.0e-14f;
-    c.est.q_var[BR_X_OMEGA] = 1.0e-6f;
-    c.est.q_var[BR_X_Z] = 1.0e-15f;
-    c.est.q_var[BR_X_GP] = 0.05f;
-    c.est.r_var_rad2 = 4.0f * rpc * rpc / 12.0f;
-    c.est.gp0_N = 12.0f;
-    c.p0_var[BR_X_THETA] = rpc * rpc;
-    c.p0_var[BR_X_OMEGA] = 1.0e-4f;
-    c.p0_var[BR_X_Z] = 1.0e-12f;
-    c.p0_var[BR_X_GP] = 25.0f;
-    c.est.gp_min_N = 1.0f;
-    c.est.gp_max_N = 40.0f;
-    c.est.outlier_sigma = 50.0f;
-    c.est.reanchor_after = 3u;
+    c.est.model = br_machine_model_cfg(dt_s);
+    /* the machine file's estimator section (docs/modules/ukf.md, lightly hand-tuned) */
+    c.est.q_var[BR_X_THETA] = BR_EST_UKF_Q_THETA_RAD2_F;
+    c.est.q_var[BR_X_OMEGA] = BR_EST_UKF_Q_OMEGA_RAD2PS2_F;
+    c.est.q_var[BR_X_Z] = BR_EST_UKF_Q_Z_M2_F;
+    c.est.q_var[BR_X_GP] = BR_EST_UKF_Q_GP_N2_F;
+    c.est.r_var_rad2 = BR_EST_UKF_R_COUNTS2_F * rpc * rpc;
+    c.est.gp0_N = BR_EST_UKF_GP0_N_F;
+    c.p0_var[BR_X_THETA] = BR_EST_UKF_P0_THETA_COUNTS2_F * rpc * rpc;
+    c.p0_var[BR_X_OMEGA] = BR_EST_UKF_P0_OMEGA_RAD2PS2_F;
+    c.p0_var[BR_X_Z] = BR_EST_UKF_P0_Z_M2_F;
+    c.p0_var[BR_X_GP] = BR_EST_UKF_P0_GP_N2_F;
+    c.est.gp_min_N = BR_EST_UKF_GP_MIN_N_F;
+    c.est.gp_max_N = BR_EST_UKF_GP_MAX_N_F;
+    c.est.outlier_sigma = BR_EST_UKF_OUTLIER_SIGMA_F;
+    c.est.reanchor_after = BR_EST_UKF_REANCHOR_AFTER;
     c.est.rad_per_count = rpc;
-    c.alpha = 1.0f;
-    c.beta = 2.0f;
-    c.kappa = 0.0f;
+    c.alpha = BR_EST_UKF_ALPHA_F;
+    c.beta = BR_EST_UKF_BETA_F;
+    c.kappa = BR_EST_UKF_KAPPA_F;
     return c;
 }
 

@@ -1,18 +1,21 @@
-/* Estimator configurations for the circle experiment on the reference machine. */
+/* Estimator configurations for the circle experiment on the configured
+ * machine (BR_MACHINE; the reference machine by default). */
 #ifndef BR_CIRCLE_EST_H
 #define BR_CIRCLE_EST_H
 
 #include "bristle/br_pf.h"
 #include "bristle/br_ukf.h"
 
-/* The eq. 6 estimation model of the reference machine at period dt_s. */
-br_model_cfg_t br_ref_model_cfg(float dt_s);
+/* The eq. 6 estimation model of the machine at period dt_s. */
+br_model_cfg_t br_machine_model_cfg(float dt_s);
 
-/* The PF of thesis section 5 (1500 particles) at period dt_s, with the
- * hand-tuned noise variances: the start of the Nelder-Mead tuning. */
+/* The PF of thesis section 5 at period dt_s with the machine file's settings
+ * (particles, hand-tuned noise variances, gates): the start of the
+ * Nelder-Mead tuning. */
 br_pf_cfg_t br_circle_pf_cfg_default(float dt_s);
 
-/* The UKF of thesis section 5 at period dt_s, hand-tuned (the tuning's start). */
+/* The UKF of thesis section 5 at period dt_s with the machine file's settings
+ * (hand-tuned; the tuning's start). */
 br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s);
 
 /* The same with the variances found by Nelder-Mead (firmware/gen/bristle_gen/est/, make tune):

@@ -1,11 +1,19 @@
 /* The thesis circle on the simulator with the H-inf-only controller
- * (section 5): contour RMS near the published figure, outward quadrant
- * glitches after the reversals, no saturation; and the same gains at 1.5 ms. */
+ * (section 5): outward quadrant glitches after the reversals, no saturation,
+ * the same gains at the PF's period; the compensated loops against H-inf only.
+ * Machine-generic: every bound is a ratio to the H-inf-only run or comes from
+ * the machine's headers. On the thesis's machine (BR_TEST_THESIS_MACHINE,
+ * set by CMake for machines/reference.json) also the published figures. */
 #include "br_test.h"
 
 #include "br_circle.h"
+#include "bristle_gen/est/br_est_machine.h"
+#include "bristle_gen/machine/br_machine.h"
 
+#ifdef BR_TEST_THESIS_MACHINE
+/* thesis section 5: H-inf only, contour RMS */
 #define THESIS_HINF_ONLY_RMS_M 2.4e-6
+#endif
 
 /* Reversals of the circle x = A sin(2 pi t / 8), y = A cos(2 pi t / 8):
  * y at t = 4 s, x at t = 2 and 6 s (t = 0 is the start, excluded). */
@@ -28,37 +36,50 @@ static void glitch_sink(void *user, const br_circle_sample_t *s)
     }
 }
 
-static void test_hinf_only_reproduces_thesis(void **st)
+static void test_hinf_only_quadrant_glitches(void **st)
 {
     (void)st;
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     br_circle_result_t r;
     glitch_t g = {{0}, {0}};
     assert_int_equal(br_circle_run(&c, glitch_sink, &g, &r), 0);
-    print_message("H-inf only: contour RMS %.3e m (thesis %.1e), max %.3e m\n", r.contour_rms_m,
-                  THESIS_HINF_ONLY_RMS_M, r.max_err_m);
-    assert_int_equal(r.n_samples, 8001);
-    assert_true(fabs(r.contour_rms_m / THESIS_HINF_ONLY_RMS_M - 1.0) <= 0.30);
+    print_message("H-inf only: contour RMS %.3e m, max %.3e m\n", r.contour_rms_m, r.max_err_m);
+    /* the experiment fits the machine: its diameter in the travel, its speed under the top speed */
+    assert_true(2.0 * c.radius_m <= BR_MACHINE_TRAVEL_M);
+    assert_true(2.0 * 3.14159265358979323846 * c.radius_m / c.period_s <= BR_MACHINE_MAX_SPEED_MPS);
+    assert_int_equal(r.n_samples, (long)floor(c.duration_s / c.dt_s + 0.5) + 1);
     assert_int_equal(r.saturated_steps, 0);
+#ifdef BR_TEST_THESIS_MACHINE
+    /* the weights were chosen to give the published figure (docs/modules/hinf.md) */
+    print_message("thesis: %.1e m\n", THESIS_HINF_ONLY_RMS_M);
+    assert_true(fabs(r.contour_rms_m / THESIS_HINF_ONLY_RMS_M - 1.0) <= 0.30);
+#endif
     for (int i = 0; i < N_REV; i++) {
         print_message("reversal at %.0f s: outward %.2f um, inward %.2f um\n", reversal_s[i], g.max_out[i] * 1e6,
                       g.max_in[i] * 1e6);
-        /* an outward glitch of a few um after each reversal, larger than any inward excursion */
-        assert_true(g.max_out[i] > 2e-6);
+        /* an outward glitch after each reversal, larger than the run's RMS and
+         * than any inward excursion there */
+        assert_true(g.max_out[i] > r.contour_rms_m);
         assert_true(g.max_out[i] > 1.5 * g.max_in[i]);
+#ifdef BR_TEST_THESIS_MACHINE
+        assert_true(g.max_out[i] > 2e-6); /* "a few um", as the thesis shows */
+#endif
     }
 }
 
 static void test_same_gains_at_pf_period(void **st)
 {
     (void)st;
-    /* the PF runs at 1.5 ms: the H-inf loop must stay stable and comparable there */
-    br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
-    c.dt_s = 1.5e-3;
-    br_circle_result_t r;
+    /* the PF runs at its own period (1.5 ms on the reference): the H-inf loop must
+     * stay stable there and within twice its RMS at the control period */
+    br_circle_cfg_t c0 = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY), c = c0;
+    c.dt_s = BR_EST_PF_PERIOD_S;
+    br_circle_result_t r0, r;
+    assert_int_equal(br_circle_run(&c0, NULL, NULL, &r0), 0);
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 0);
-    print_message("H-inf only at 1.5 ms: contour RMS %.3e m\n", r.contour_rms_m);
-    assert_true(r.contour_rms_m < 2.0 * THESIS_HINF_ONLY_RMS_M);
+    print_message("H-inf only at %.2g ms: contour RMS %.3e m (%.3e m at %.2g ms)\n", c.dt_s * 1e3, r.contour_rms_m,
+                  r0.contour_rms_m, c0.dt_s * 1e3);
+    assert_true(r.contour_rms_m < 2.0 * r0.contour_rms_m);
     assert_int_equal(r.saturated_steps, 0);
 }
 
@@ -108,7 +129,7 @@ static void test_rejects_bad_experiment(void **st)
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
     /* an estimator whose period is not the loop's */
     c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
-    c.dt_s = 1e-3;
+    c.dt_s = 2.0 * c.dt_s;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
     c = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
     c.ukf.est.r_var_rad2 = -1.0f;
@@ -125,11 +146,14 @@ static void test_diverged_estimate_stops_safe(void **st)
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
     c.plant.delay_s = 3.0e-3;
     br_circle_result_t r;
+#ifdef BR_TEST_THESIS_MACHINE
+    /* measured on the thesis's machine (docs/diagnose-control.md) */
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 1);
     assert_true(r.fault_status < 0);
     assert_true(r.fault_t_s > 0.0 && r.fault_t_s < c.duration_s);
     print_message("UKF on the nominal model, 3 ms plant delay: fault %d at %.3f s, contour RMS before it %.3g m\n",
                   r.fault_status, r.fault_t_s, r.contour_rms_m);
+#endif
     /* with the delay in its own model the same estimator runs the whole circle */
     c.ukf.est.model.causes.delay_s = 3.0e-3f;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 0);
@@ -138,8 +162,8 @@ static void test_diverged_estimate_stops_safe(void **st)
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_diverged_estimate_stops_safe),cmocka_unit_test(test_hinf_only_reproduces_thesis),
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_diverged_estimate_stops_safe),
+                                       cmocka_unit_test(test_hinf_only_quadrant_glitches),
                                        cmocka_unit_test(test_same_gains_at_pf_period),
                                        cmocka_unit_test(test_ukf_beats_thesis_ratio),
                                        cmocka_unit_test(test_pf_beats_thesis_ratio),

@@ -41,9 +41,11 @@ CAUSES = ("none",) + causes.NAMES
 MASTER_SEED = 20261121
 DEFAULT_CASES = 36
 PARAM_TOL = 0.20
-# the reference machine's friction, which br_simlog's plant has
-with open(os.path.join(REPO, "machines", "reference.json")) as _f:
-    _REF = json.load(_f)
+# the reference machine's friction, which br_simlog's plant has (through the
+# machine file's loader, firmware/design/machine.py)
+sys.path.insert(0, os.path.join(REPO, "firmware", "design"))
+import machine  # noqa: E402
+_REF = machine.params(machine.load(os.path.join(REPO, "machines", "reference.json")))
 FC_N, SIGMA2_NSPM = _REF["Fc_N"], _REF["sigma2_Nspm"]
 
 

@@ -1,8 +1,12 @@
 # Regenerates one generated file into the build tree and fails on any difference
 # from the committed copy. Variables: PYTHON, SCRIPT, COMMITTED, OUT, OUT_FLAG
 # (--out: OUT is the file; --out-dir: OUT is a directory that receives files
-# named like the committed ones).
-if(OUT_FLAG STREQUAL "--out-dir")
+# named like the committed ones; --gen-root: OUT is a generated-header root,
+# the file is at COMMITTED's path below GEN_ROOT).
+if(OUT_FLAG STREQUAL "--gen-root")
+  file(RELATIVE_PATH rel ${GEN_ROOT} ${COMMITTED})
+  set(generated ${OUT}/${rel})
+elseif(OUT_FLAG STREQUAL "--out-dir")
   file(MAKE_DIRECTORY ${OUT})
   get_filename_component(name ${COMMITTED} NAME)
   set(generated ${OUT}/${name})

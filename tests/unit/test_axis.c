@@ -2,6 +2,7 @@
 #include "br_test.h"
 
 #include "bristle/br_axis.h"
+#include "bristle_gen/machine/br_machine.h"
 
 typedef struct {
     int32_t counts;
@@ -30,9 +31,17 @@ static br_status_t fake_tick(void *ctx, uint32_t *t)
     return BR_OK;
 }
 
+/* the machine's period, torque limit, amplifier, encoder and lead */
+#define DT BR_MACHINE_CTRL_PERIOD_S_F
+#define TAU_MAX BR_MACHINE_TORQUE_LIMIT_NM_F
+#define TAU_DUTY BR_MACHINE_TAU_PER_DUTY_NM_F
+#define RPC BR_MACHINE_RAD_PER_COUNT_F
+#define LEAD BR_MACHINE_LEAD_MPRAD_F
+
+/* the test's gains (round numbers, not the H-inf design) on the machine */
 static br_ctrl_cfg_t cfg(void)
 {
-    br_ctrl_cfg_t c = {{-0.5f, -0.01f, -10.0f}, 1e-3f, 0.64f, 0.64f, 6.0e-6f, 1.27e-3f};
+    br_ctrl_cfg_t c = {{-0.5f, -0.01f, -10.0f}, DT, TAU_MAX, TAU_DUTY, RPC, LEAD};
     return c;
 }
 
@@ -65,7 +74,7 @@ static void test_step_writes_duty(void **st)
     br_ref_t r = {0, 0.0f, 0.0f};
     assert_int_equal(br_axis_step(&a, &r), BR_OK);
     assert_int_equal(f.writes, 1);
-    BR_ASSERT_NEAR(f.duty, -0.5 * 1000 * 6.0e-6 / 0.64, 1e-7);
+    BR_ASSERT_NEAR(f.duty, -0.5 * 1000 * RPC / TAU_DUTY, 1e-7);
 }
 
 static void test_encoder_fault_zeroes_pwm(void **st)
@@ -117,13 +126,13 @@ static void test_estimator_drives_compensation(void **st)
     br_ref_t r = {0, 0.0f, 0.0f};
     assert_int_equal(br_axis_step(&a, &r), BR_OK);
     /* zero error: the duty is the compensation alone, L F / tau_per_duty */
-    BR_ASSERT_NEAR(f.duty, 1.27e-3 * 10.0 / 0.64, 1e-7);
+    BR_ASSERT_NEAR(f.duty, LEAD * 10.0 / TAU_DUTY, 1e-7);
     assert_int_equal(e.y.counts, 0);
     BR_ASSERT_NEAR(e.y.frac, 0.5, 0.0);
     BR_ASSERT_NEAR(e.u_prev, 0.0, 0.0);
     /* the next call sees the torque applied over the last period */
     assert_int_equal(br_axis_step(&a, &r), BR_OK);
-    BR_ASSERT_NEAR(e.u_prev, 1.27e-3 * 10.0, 1e-9);
+    BR_ASSERT_NEAR(e.u_prev, LEAD * 10.0, 1e-9);
     /* an estimator failure: zero duty, status passed up, and the torque it will
      * see next time is the zero that was really applied */
     e.st = BR_E_NUMERIC;

@@ -3,10 +3,19 @@
 #include "br_test.h"
 
 #include "bristle/br_ctrl.h"
+#include "bristle_gen/machine/br_machine.h"
 
+/* the machine's period, torque limit, amplifier, encoder and lead */
+#define DT BR_MACHINE_CTRL_PERIOD_S_F
+#define TAU_MAX BR_MACHINE_TORQUE_LIMIT_NM_F
+#define TAU_DUTY BR_MACHINE_TAU_PER_DUTY_NM_F
+#define RPC BR_MACHINE_RAD_PER_COUNT_F
+#define LEAD BR_MACHINE_LEAD_MPRAD_F
+
+/* the test's gains (round numbers, not the H-inf design) on the machine */
 static br_ctrl_cfg_t cfg(void)
 {
-    br_ctrl_cfg_t c = {{-0.5f, -0.01f, -10.0f}, 1e-3f, 0.64f, 0.64f, 6.0e-6f, 1.27e-3f};
+    br_ctrl_cfg_t c = {{-0.5f, -0.01f, -10.0f}, DT, TAU_MAX, TAU_DUTY, RPC, LEAD};
     return c;
 }
 
@@ -30,7 +39,8 @@ static void test_init_guards(void **st)
     k = cfg(); k.dt_s = NAN;             assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.tau_max_Nm = 0.0f;      assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.tau_max_Nm = -1.0f;     assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
-    k = cfg(); k.tau_max_Nm = 0.7f;      assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM); /* > full duty */
+    /* beyond full duty */
+    k = cfg(); k.tau_max_Nm = 1.1f * k.tau_per_duty_Nm; assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.tau_per_duty_Nm = 0.0f; assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.rad_per_count = 0.0f;   assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
     k = cfg(); k.lead_mprad = -1e-3f;    assert_int_equal(br_ctrl_init(&c, &k), BR_E_PARAM);
@@ -49,18 +59,18 @@ static void test_control_law(void **st)
     /* first call primes the velocity: omega = 0; e = (100 - 50 - 0.25) counts */
     br_ctrl_in_t in = {100, 50, 0.25f, 0.0f, 0.0f};
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
-    double e = 49.75 * 6.0e-6;
+    double e = 49.75 * RPC;
     BR_ASSERT_NEAR(out.e_theta_rad, e, 1e-6 * e);
     BR_ASSERT_NEAR(out.tau_Nm, -0.5 * e, 1e-6 * 0.5 * e);
-    BR_ASSERT_NEAR(out.duty, -0.5 * e / 0.64, 1e-6 * 0.5 * e / 0.64);
-    BR_ASSERT_NEAR(c.eps_rads, e * 1e-3, 1e-6 * e * 1e-3);
-    /* second call: 10 counts moved in 1 ms, reference velocity 0.02 rad/s */
+    BR_ASSERT_NEAR(out.duty, -0.5 * e / TAU_DUTY, 1e-6 * 0.5 * e / TAU_DUTY);
+    BR_ASSERT_NEAR(c.eps_rads, e * DT, 1e-6 * e * DT);
+    /* second call: 10 counts moved in one period, reference velocity 0.02 rad/s */
     in.enc_counts = 110;
     in.ref_omega_radps = 0.02f;
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
-    double e2 = 59.75 * 6.0e-6, w = 10 * 6.0e-6 / 1e-3;
+    double e2 = 59.75 * RPC, w = 10 * RPC / DT;
     BR_ASSERT_NEAR(out.omega_radps, w, 1e-6 * w);
-    BR_ASSERT_NEAR(out.tau_Nm, -0.5 * e2 - 0.01 * (w - 0.02) - 10.0 * e * 1e-3, 1e-6 * 0.5 * e2);
+    BR_ASSERT_NEAR(out.tau_Nm, -0.5 * e2 - 0.01 * (w - 0.02) - 10.0 * e * DT, 1e-6 * 0.5 * e2);
     assert_int_equal(out.saturated, 0);
 }
 
@@ -71,9 +81,9 @@ static void test_compensation_adds_torque(void **st)
     br_ctrl_cfg_t k = cfg();
     br_ctrl_out_t out;
     assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
-    br_ctrl_in_t in = {0, 0, 0.0f, 0.0f, 18.0f};
+    br_ctrl_in_t in = {0, 0, 0.0f, 0.0f, BR_MACHINE_FS_N_F};
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
-    BR_ASSERT_NEAR(out.tau_Nm, 1.27e-3 * 18.0, 1e-6 * 1.27e-3 * 18.0); /* tau = L F_comp */
+    BR_ASSERT_NEAR(out.tau_Nm, LEAD * BR_MACHINE_FS_N, 1e-6 * LEAD * BR_MACHINE_FS_N); /* tau = L F_comp */
 }
 
 static void test_saturation_and_antiwindup(void **st)
@@ -83,29 +93,32 @@ static void test_saturation_and_antiwindup(void **st)
     br_ctrl_cfg_t k = cfg();
     br_ctrl_out_t out;
     assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
-    /* a huge error: u = -0.5 * (-2e6 * 6e-6) = 6 N m > 0.64 */
+    /* a huge error: u = -0.5 * (-2e6 rpc), 6 N m on the reference, beyond the limit */
     br_ctrl_in_t in = in_at(0, 2000000);
+    assert_true(0.5 * 2e6 * RPC > 2.0 * TAU_MAX);
     for (int i = 0; i < 100; i++) {
         assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
         assert_int_equal(out.saturated, 1);
-        BR_ASSERT_NEAR(out.tau_Nm, 0.64f, 0.0);
-        BR_ASSERT_NEAR(out.duty, 1.0, 0.0);
+        BR_ASSERT_NEAR(out.tau_Nm, TAU_MAX, 0.0);
+        BR_ASSERT_NEAR(out.duty, TAU_MAX / TAU_DUTY, 0.0);
     }
     /* integrating would push deeper into saturation: eps held at zero */
     BR_ASSERT_NEAR(c.eps_rads, 0.0, 0.0);
     /* saturated but the error now reduces the command: the integral runs */
-    c.eps_rads = -0.06f;          /* K2 eps = 0.6 N m, inside the clamp tau_max / |K2| = 0.064 */
+    /* K2 eps = 0.9 tau_max, inside the clamp tau_max / |K2| */
+    c.eps_rads = -0.09f * TAU_MAX;
     in = in_at(1000, 0);          /* e > 0: K2 e < 0, opposite to u */
-    in.comp_N = 100.0f;           /* L F_comp = 0.127 N m: u = 0.724 N m, saturated high */
+    in.comp_N = 0.3f * TAU_MAX / LEAD; /* L F_comp = 0.3 tau_max: u > 1.1 tau_max, saturated high */
+    assert_true(0.5 * 1000 * RPC < 0.1 * TAU_MAX);
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
     assert_int_equal(out.saturated, 1);
-    BR_ASSERT_NEAR(c.eps_rads, -0.06 + 1000 * 6.0e-6 * 1e-3, 1e-7);
+    BR_ASSERT_NEAR(c.eps_rads, -0.09 * TAU_MAX + 1000 * RPC * DT, 1e-7);
     /* negative side */
     br_ctrl_t c2;
     assert_int_equal(br_ctrl_init(&c2, &k), BR_OK);
     in = in_at(2000000, 0);
     assert_int_equal(br_ctrl_step(&c2, &in, &out), BR_OK);
-    BR_ASSERT_NEAR(out.duty, -1.0, 0.0);
+    BR_ASSERT_NEAR(out.duty, -TAU_MAX / TAU_DUTY, 0.0);
     BR_ASSERT_NEAR(c2.eps_rads, 0.0, 0.0);
 }
 
@@ -121,12 +134,12 @@ static void test_velocity_across_wrap(void **st)
     /* the counter wraps: +10 counts, and the reference wraps with it */
     in = in_at(INT32_MIN + 5, INT32_MIN + 5);
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
-    BR_ASSERT_NEAR(out.omega_radps, 10 * 6.0e-6 / 1e-3, 1e-6 * 0.06);
+    BR_ASSERT_NEAR(out.omega_radps, 10 * RPC / DT, 1e-6 * 10 * RPC / DT);
     BR_ASSERT_NEAR(out.e_theta_rad, 0.0, 0.0);
     /* reference on the other side of the wrap: error of 3 counts */
     in = in_at(INT32_MIN + 1, INT32_MAX - 1);
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
-    BR_ASSERT_NEAR(out.e_theta_rad, 3 * 6.0e-6, 1e-6 * 18e-6);
+    BR_ASSERT_NEAR(out.e_theta_rad, 3 * RPC, 1e-6 * 3 * RPC);
 }
 
 static void test_step_rejects_bad_input(void **st)
@@ -175,11 +188,11 @@ static void test_out_of_range_gives_zero_duty(void **st)
     }
     in = in_at(0, 5); in.ref_frac_counts = 1.0f;
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
-    /* a compensation beyond what the actuator can exert (tau_max / L = 504 N) */
-    in = in_at(0, 5); in.comp_N = 510.0f;
+    /* a compensation beyond what the actuator can exert (tau_max / L) */
+    in = in_at(0, 5); in.comp_N = 1.01f * TAU_MAX / LEAD;
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_E_INPUT);
     assert_true(out.duty == 0.0f);
-    in = in_at(0, 5); in.comp_N = -500.0f;
+    in = in_at(0, 5); in.comp_N = -0.99f * TAU_MAX / LEAD;
     assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
     /* a velocity reference that makes the law overflow */
     in = in_at(0, 5); in.ref_omega_radps = 3e38f;
@@ -210,14 +223,17 @@ static void test_integrator_clamped_both_ways(void **st)
     (void)st;
     const br_ctrl_cfg_t k = cfg();
     const double eps_max = k.tau_max_Nm / fabs(k.K[2]);
+    /* steps to integrate 1000 counts of error up to twice the clamp */
+    const long n = (long)(2.0 * eps_max / (1000.0 * RPC * DT)) + 1;
+    assert_true(0.5 * 1000 * RPC < 0.05 * TAU_MAX);
     for (int sign = -1; sign <= 1; sign += 2) {
         br_ctrl_t c;
         br_ctrl_out_t out;
         assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
         BR_ASSERT_NEAR(c.eps_max_rads, eps_max, 1e-6 * eps_max);
-        for (int i = 0; i < 30000; i++) {
+        for (long i = 0; i < n; i++) {
             br_ctrl_in_t in = in_at(sign * 1000, 0);
-            in.comp_N = (float)sign * 450.0f; /* L F_comp = 0.57 N m against the integral */
+            in.comp_N = (float)sign * 0.9f * TAU_MAX / LEAD; /* L F_comp = 0.9 tau_max against the integral */
             assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
             assert_true(fabs(c.eps_rads) <= eps_max * (1.0 + 1e-6));
         }

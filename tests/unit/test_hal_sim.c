@@ -26,7 +26,7 @@ static void test_port(void **st)
     /* the next tick applies the duty over one period */
     assert_int_equal(hal.tick_wait(hal.ctx, &tick), BR_OK);
     assert_int_equal((int)tick, 1);
-    BR_ASSERT_NEAR(p.tau_Nm, 0.32, 1e-12);
+    BR_ASSERT_NEAR(p.tau_Nm, 0.5 * c.tau_per_duty_Nm, 1e-12);
     assert_int_equal(hal.encoder_read(hal.ctx, &counts), BR_OK);
     assert_true(counts > 0);
     /* clamp and reject */

@@ -4,13 +4,19 @@
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_lugre.h"
 
+/* the machine's friction (bristle_gen/machine/br_machine.h) */
+#define FC BR_MACHINE_FC_N
+#define FS BR_MACHINE_FS_N
+#define SIGMA0 BR_MACHINE_SIGMA0_NPM
+#define SIGMA1 BR_MACHINE_SIGMA1_NSPM
+
 static br_lugre_cfg_t ref_cfg(void)
 {
     br_lugre_cfg_t c = {BR_MACHINE_SIGMA0_NPM_F, BR_MACHINE_SIGMA1_NSPM_F, BR_MACHINE_FC_N_F, BR_MACHINE_FS_N_F, BR_MACHINE_VS_MPS_F};
     return c;
 }
 
-static void test_init_accepts_reference(void **st)
+static void test_init_accepts_machine(void **st)
 {
     (void)st;
     br_lugre_t s;
@@ -34,7 +40,7 @@ static void test_init_guards(void **st)
     c = ref_cfg(); c.sigma1_Nspm = INFINITY;  assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
     c = ref_cfg(); c.Fc_N = 0.0f;             assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
     c = ref_cfg(); c.Fc_N = NAN;              assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
-    c = ref_cfg(); c.Fs_N = 6.0f;             assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM); /* < Fc */
+    c = ref_cfg(); c.Fs_N = 0.9f * c.Fc_N;    assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM); /* < Fc */
     c = ref_cfg(); c.Fs_N = INFINITY;         assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
     c = ref_cfg(); c.vs_mps = 0.0f;           assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
     c = ref_cfg(); c.vs_mps = NAN;            assert_int_equal(br_lugre_init(&s, &c), BR_E_PARAM);
@@ -46,11 +52,11 @@ static void test_stribeck_curve(void **st)
 {
     (void)st;
     br_lugre_cfg_t c = ref_cfg();
-    /* eq. 5: g(0) = Fs, g(vs) = Fc + (Fs - Fc)/e, g(large) = Fc, even in v */
-    BR_ASSERT_NEAR(br_lugre_g_N(&c, 0.0f), 18.0, 1e-5);
-    BR_ASSERT_NEAR(br_lugre_g_N(&c, 2e-5f), 7.0 + 11.0 * exp(-1.0), 1e-5);
-    BR_ASSERT_NEAR(br_lugre_g_N(&c, -2e-5f), 7.0 + 11.0 * exp(-1.0), 1e-5);
-    BR_ASSERT_NEAR(br_lugre_g_N(&c, 0.05f), 7.0, 1e-5);
+    /* eq. 5: g(0) = Fs, g(vs) = Fc + (Fs - Fc)/e, g(large: 1000 vs) = Fc, even in v */
+    BR_ASSERT_NEAR(br_lugre_g_N(&c, 0.0f), FS, 1e-5);
+    BR_ASSERT_NEAR(br_lugre_g_N(&c, BR_MACHINE_VS_MPS_F), FC + (FS - FC) * exp(-1.0), 1e-5);
+    BR_ASSERT_NEAR(br_lugre_g_N(&c, -BR_MACHINE_VS_MPS_F), FC + (FS - FC) * exp(-1.0), 1e-5);
+    BR_ASSERT_NEAR(br_lugre_g_N(&c, 1000.0f * BR_MACHINE_VS_MPS_F), FC, 1e-5);
 }
 
 static void test_rate_and_force(void **st)
@@ -58,12 +64,12 @@ static void test_rate_and_force(void **st)
     (void)st;
     br_lugre_cfg_t c = ref_cfg();
     /* eq. 4 at the steady deflection g/sigma0 is zero; eq. 3 then gives g */
-    float zss = 7.0f / 4.0e6f;
-    BR_ASSERT_NEAR(br_lugre_zdot_mps(&c, zss, 0.01f, 7.0f), 0.0, 1e-9);
-    BR_ASSERT_NEAR(br_lugre_force_N(&c, zss, 0.0f), 7.0, 1e-5);
+    float zss = BR_MACHINE_FC_N_F / BR_MACHINE_SIGMA0_NPM_F;
+    BR_ASSERT_NEAR(br_lugre_zdot_mps(&c, zss, 0.01f, BR_MACHINE_FC_N_F), 0.0, 1e-9);
+    BR_ASSERT_NEAR(br_lugre_force_N(&c, zss, 0.0f), FC, 1e-5);
     /* at z = 0 the rate is v and the force is sigma1 v */
-    BR_ASSERT_NEAR(br_lugre_zdot_mps(&c, 0.0f, 1e-4f, 18.0f), 1e-4, 1e-4 * 1e-7);
-    BR_ASSERT_NEAR(br_lugre_force_N(&c, 0.0f, 1e-4f), 0.2, 1e-6);
+    BR_ASSERT_NEAR(br_lugre_zdot_mps(&c, 0.0f, 1e-4f, BR_MACHINE_FS_N_F), 1e-4, 1e-4 * 1e-7);
+    BR_ASSERT_NEAR(br_lugre_force_N(&c, 0.0f, 1e-4f), SIGMA1 * 1e-4, 1e-6);
 }
 
 static void test_steady_sliding_reaches_g(void **st)
@@ -73,7 +79,8 @@ static void test_steady_sliding_reaches_g(void **st)
     br_lugre_cfg_t c = ref_cfg();
     assert_int_equal(br_lugre_init(&s, &c), BR_OK);
     float F = 0.0f;
-    /* 30 ms at 1e-3 m/s: 30 um of travel, 17 bristle lengths (g/sigma0 = 1.75 um) */
+    /* 30 ms at 1e-3 m/s: 30 um of travel, many bristle lengths g/sigma0 (1.75 um on the reference) */
+    assert_true(30e-6 > 10.0 * FC / SIGMA0);
     for (int k = 0; k < 300; k++) assert_int_equal(br_lugre_step(&s, 1e-3f, 1e-4f, &F), BR_OK);
     BR_ASSERT_NEAR(F, br_lugre_g_N(&c, 1e-3f), 1e-3);
     for (int k = 0; k < 300; k++) assert_int_equal(br_lugre_step(&s, -1e-3f, 1e-4f, &F), BR_OK);
@@ -88,10 +95,11 @@ static void test_presliding_is_a_spring(void **st)
     assert_int_equal(br_lugre_init(&s, &c), BR_OK);
     float F = 0.0f;
     /* 10 nm of displacement at rest-like speed: z = (Fs/sigma0)(1 - exp(-sigma0 dx / Fs)),
-     * F ~ sigma0 dx (0.04 N), far below Fs */
+     * F ~ sigma0 dx (0.04 N on the reference), far below Fs */
     assert_int_equal(br_lugre_step(&s, 1e-8f, 1.0f, &F), BR_OK);
-    BR_ASSERT_NEAR(s.z_m, 18.0 / 4e6 * (1.0 - exp(-4e6 * 1e-8 / 18.0)), 1e-8 * 1e-6);
-    BR_ASSERT_NEAR(br_lugre_force_N(&c, s.z_m, 0.0f), 0.04, 1e-4);
+    BR_ASSERT_NEAR(s.z_m, FS / SIGMA0 * (1.0 - exp(-SIGMA0 * 1e-8 / FS)), 1e-8 * 1e-6);
+    BR_ASSERT_NEAR(br_lugre_force_N(&c, s.z_m, 0.0f), SIGMA0 * 1e-8, 1e-4);
+    assert_true(SIGMA0 * 1e-8 < 0.01 * FS);
 }
 
 static void test_bounded_at_any_speed(void **st)
@@ -109,7 +117,7 @@ static void test_bounded_at_any_speed(void **st)
             assert_true(isfinite(F));
             assert_true(fabsf(s.z_m) <= BR_MACHINE_FS_N_F / BR_MACHINE_SIGMA0_NPM_F * 1.0001f);
         }
-        BR_ASSERT_NEAR(F, copysign(7.0, speeds[i]), 1e-3 * 7.0 + 0.0);
+        BR_ASSERT_NEAR(F, copysign(FC, speeds[i]), 1e-3 * FC);
     }
 }
 
@@ -135,7 +143,7 @@ static void test_step_rejects_bad_input(void **st)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_init_accepts_reference), cmocka_unit_test(test_init_guards),
+        cmocka_unit_test(test_init_accepts_machine), cmocka_unit_test(test_init_guards),
         cmocka_unit_test(test_stribeck_curve),         cmocka_unit_test(test_rate_and_force),
         cmocka_unit_test(test_steady_sliding_reaches_g), cmocka_unit_test(test_presliding_is_a_spring),
         cmocka_unit_test(test_bounded_at_any_speed),   cmocka_unit_test(test_step_rejects_bad_input),

@@ -2,11 +2,20 @@
  * against a fine double-precision integration, boundedness at speed. */
 #include "br_test.h"
 
+#include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "br_circle_est.h"
 #include "bristle/br_model.h"
 
-static br_model_cfg_t ref_cfg(float dt) { return br_ref_model_cfg(dt); }
+static br_model_cfg_t ref_cfg(float dt) { return br_machine_model_cfg(dt); }
+
+/* the machine (bristle_gen/machine/br_machine.h) */
+#define L_MPRAD BR_MACHINE_LEAD_MPRAD
+#define JEFF (BR_MACHINE_J_KGM2 + BR_MACHINE_LEAD_MPRAD * BR_MACHINE_LEAD_MPRAD * BR_MACHINE_M_KG)
+#define SIGMA0 BR_MACHINE_SIGMA0_NPM
+#define SIGMA1 BR_MACHINE_SIGMA1_NSPM
+#define SIGMA2 BR_MACHINE_SIGMA2_NSPM
+#define FC BR_MACHINE_FC_N
 
 static void test_init_guards(void **st)
 {
@@ -36,12 +45,12 @@ static void test_deriv_eq6(void **st)
     br_model_t m;
     br_model_cfg_t c = ref_cfg(1e-3f);
     assert_int_equal(br_model_init(&m, &c), BR_OK);
-    const double L = BR_MACHINE_LEAD_MPRAD, J = BR_MACHINE_J_KGM2 + L * L * BR_MACHINE_M_KG;
+    const double L = L_MPRAD, J = JEFF;
     float x[BR_NX] = {0.1f, 2.0f, 1e-6f, 12.0f}, dx[BR_NX];
     br_model_deriv(&m, x, 0.05f, dx);
-    double v = L * 2.0, zd = v - 4e6 * fabs(v) * 1e-6 / 12.0, fnl = 4e6 * 1e-6 + 2e3 * zd;
+    double v = L * 2.0, zd = v - SIGMA0 * fabs(v) * 1e-6 / 12.0, fnl = SIGMA0 * 1e-6 + SIGMA1 * zd;
     BR_ASSERT_NEAR(dx[0], 2.0, 1e-6);
-    BR_ASSERT_NEAR(dx[1], (0.05 - L * (50.0 * L * 2.0 + fnl)) / J, 1e-4 * fabs(dx[1]));
+    BR_ASSERT_NEAR(dx[1], (0.05 - L * (SIGMA2 * L * 2.0 + fnl)) / J, 1e-4 * fabs(dx[1]));
     BR_ASSERT_NEAR(dx[2], zd, 1e-6 * fabs(zd));
     BR_ASSERT_NEAR(dx[3], 0.0, 0.0);
     BR_ASSERT_NEAR(br_model_fnl_N(&m, x), fnl, 1e-5 * fabs(fnl));
@@ -50,16 +59,16 @@ static void test_deriv_eq6(void **st)
 /* Double-precision RK4 of eq. 6 with n substeps: the accuracy reference. */
 static void fine_step(const double p[4], double u, double dt, int n, double out[4])
 {
-    const double L = BR_MACHINE_LEAD_MPRAD, J = BR_MACHINE_J_KGM2 + L * L * BR_MACHINE_M_KG;
+    const double L = L_MPRAD, J = JEFF;
     double x[4] = {p[0], p[1], p[2], p[3]}, h = dt / n;
     for (int s = 0; s < n; s++) {
         double k[4][4], xs[4];
         for (int st = 0; st < 4; st++) {
             const double a = st == 0 ? 0.0 : (st == 3 ? 1.0 : 0.5);
             for (int i = 0; i < 4; i++) xs[i] = x[i] + (st ? a * h * k[st - 1][i] : 0.0);
-            double v = L * xs[1], zd = v - 4e6 * fabs(v) * xs[2] / xs[3];
+            double v = L * xs[1], zd = v - SIGMA0 * fabs(v) * xs[2] / xs[3];
             k[st][0] = xs[1];
-            k[st][1] = (u - L * (50.0 * L * xs[1] + 4e6 * xs[2] + 2e3 * zd)) / J;
+            k[st][1] = (u - L * (SIGMA2 * L * xs[1] + SIGMA0 * xs[2] + SIGMA1 * zd)) / J;
             k[st][2] = zd;
             k[st][3] = 0.0;
         }
@@ -75,7 +84,7 @@ static void test_rk4_accuracy_slow(void **st)
     br_model_cfg_t c = ref_cfg(1e-3f);
     assert_int_equal(br_model_init(&m, &c), BR_OK);
     /* circle speeds (|v| <= 8e-5 m/s): one 1 ms step vs 1000 fine substeps */
-    const float cases[][5] = {{0.0f, 0.0f, 0.0f, 18.0f, 0.01f},
+    const float cases[][5] = {{0.0f, 0.0f, 0.0f, BR_MACHINE_FS_N_F, 0.01f},
                               {0.5f, 0.06f, 1.0e-6f, 9.0f, 0.0055f},
                               {0.5f, -0.06f, 1.5e-6f, 7.5f, -0.02f}};
     for (unsigned i = 0; i < 3; i++) {
@@ -96,23 +105,26 @@ static void test_bounded_at_speed(void **st)
 {
     (void)st;
     br_model_t m;
-    br_model_cfg_t c = ref_cfg(1.5e-3f);
+    br_model_cfg_t c = ref_cfg(BR_EST_PF_PERIOD_S_F);
     assert_int_equal(br_model_init(&m, &c), BR_OK);
-    /* 0.05 m/s and beyond: a h = 43 at 0.05 m/s, far outside RK4's region */
-    const float omegas[] = {39.27f, -39.27f, 400.0f, -4000.0f};
+    /* the machine's top speed and beyond (a h = 86 at 0.1 m/s on the reference,
+     * far outside RK4's region) */
+    const float w_max = BR_MACHINE_MAX_SPEED_MPS_F / BR_MACHINE_LEAD_MPRAD_F;
+    const float omegas[] = {w_max, -w_max, 10.0f * w_max, -100.0f * w_max};
+    const float fc = BR_MACHINE_FC_N_F;
     for (unsigned i = 0; i < 4; i++) {
-        float x[BR_NX] = {0.0f, omegas[i], -1.0e-6f, 7.0f}, xn[BR_NX];
+        float x[BR_NX] = {0.0f, omegas[i], -1.0e-6f, fc}, xn[BR_NX];
         /* torque that holds the speed: viscous + Coulomb */
-        float u = BR_MACHINE_LEAD_MPRAD_F * BR_MACHINE_LEAD_MPRAD_F * 50.0f * omegas[i] +
-                  copysignf(BR_MACHINE_LEAD_MPRAD_F * 7.0f, omegas[i]);
+        float u = BR_MACHINE_LEAD_MPRAD_F * BR_MACHINE_LEAD_MPRAD_F * BR_MACHINE_SIGMA2_NSPM_F * omegas[i] +
+                  copysignf(BR_MACHINE_LEAD_MPRAD_F * fc, omegas[i]);
         for (int k = 0; k < 1000; k++) {
             assert_int_equal(br_model_step(&m, x, u, xn), BR_OK);
             for (int j = 0; j < BR_NX; j++) x[j] = xn[j];
-            assert_true(fabsf(x[BR_X_Z]) <= 7.0f / 4.0e6f * 1.0001f + 1.0e-6f);
+            assert_true(fabsf(x[BR_X_Z]) <= fc / BR_MACHINE_SIGMA0_NPM_F * 1.0001f + 1.0e-6f);
         }
         /* steady sliding: the speed is held and the friction is Coulomb */
         BR_ASSERT_NEAR(x[BR_X_OMEGA], omegas[i], 1e-3 * fabs(omegas[i]));
-        BR_ASSERT_NEAR(br_model_fnl_N(&m, x), copysign(7.0, omegas[i]), 0.01);
+        BR_ASSERT_NEAR(br_model_fnl_N(&m, x), copysign(FC, omegas[i]), 0.01);
     }
 }
 
@@ -123,15 +135,16 @@ static void test_switch_is_continuous(void **st)
     br_model_cfg_t c = ref_cfg(1e-3f);
     assert_int_equal(br_model_init(&m, &c), BR_OK);
     /* just below and just above the RK4 limit a h = 2 the two schemes agree */
-    const double L = BR_MACHINE_LEAD_MPRAD;
-    float w_lim = (float)(2.0 * 7.0 / (4e6 * L * 1e-3));
-    float xa[BR_NX] = {0.0f, 0.999f * w_lim, 7.0f / 4.0e6f, 7.0f}, xb[BR_NX] = {0.0f, 1.001f * w_lim, 7.0f / 4.0e6f, 7.0f};
+    const double L = L_MPRAD;
+    const float fc = BR_MACHINE_FC_N_F, zss = BR_MACHINE_FC_N_F / BR_MACHINE_SIGMA0_NPM_F;
+    float w_lim = (float)(2.0 * FC / (SIGMA0 * L * 1e-3));
+    float xa[BR_NX] = {0.0f, 0.999f * w_lim, zss, fc}, xb[BR_NX] = {0.0f, 1.001f * w_lim, zss, fc};
     float na[BR_NX], nb[BR_NX];
-    float u = (float)(L * L * 50.0) * w_lim + (float)(L * 7.0);
+    float u = (float)(L * L * SIGMA2) * w_lim + (float)(L * FC);
     assert_int_equal(br_model_step(&m, xa, u, na), BR_OK);
     assert_int_equal(br_model_step(&m, xb, u, nb), BR_OK);
     BR_ASSERT_NEAR(na[BR_X_OMEGA] / xa[BR_X_OMEGA], nb[BR_X_OMEGA] / xb[BR_X_OMEGA], 1e-3);
-    BR_ASSERT_NEAR(na[BR_X_Z], nb[BR_X_Z], 1e-3 * 7.0 / 4.0e6);
+    BR_ASSERT_NEAR(na[BR_X_Z], nb[BR_X_Z], 1e-3 * FC / SIGMA0);
 }
 
 static void test_step_rejects_bad_input(void **st)

@@ -13,7 +13,7 @@ static void test_causes_guards(void **st)
 {
     (void)st;
     br_model_t m;
-    const br_model_cfg_t ok = br_ref_model_cfg(DT_S);
+    const br_model_cfg_t ok = br_machine_model_cfg(DT_S);
     br_model_cfg_t c = ok;
     assert_int_equal(br_model_init(&m, &c), BR_OK);
     assert_false(m.extended); /* no cause: the thesis model's kernel */
@@ -43,7 +43,7 @@ static void test_offset_at_rest(void **st)
 {
     (void)st;
     br_model_t m;
-    br_model_cfg_t c = br_ref_model_cfg(DT_S);
+    br_model_cfg_t c = br_machine_model_cfg(DT_S);
     c.causes.offset_N = 0.5f * c.lugre.Fc_N;
     assert_int_equal(br_model_init(&m, &c), BR_OK);
     const float x[BR_NX] = {0.0f, 0.0f, 0.0f, c.lugre.Fs_N};
@@ -61,7 +61,7 @@ static void test_asymmetry_in_minus_x(void **st)
 {
     (void)st;
     br_model_t m;
-    br_model_cfg_t c = br_ref_model_cfg(DT_S);
+    br_model_cfg_t c = br_machine_model_cfg(DT_S);
     c.causes.dFc_neg_N = 0.3f * c.lugre.Fc_N;
     c.causes.dsigma2_neg_Nspm = 0.5f * c.sigma2_Nspm;
     assert_int_equal(br_model_init(&m, &c), BR_OK);
@@ -80,7 +80,7 @@ static void test_ripple_and_gradient_follow_position(void **st)
 {
     (void)st;
     br_model_t m;
-    br_model_cfg_t c = br_ref_model_cfg(DT_S);
+    br_model_cfg_t c = br_machine_model_cfg(DT_S);
     c.causes.ripple_amp_N = 0.1f * c.lugre.Fc_N;
     c.causes.ripple_period_m = 2.0e-3f;
     assert_int_equal(br_model_init(&m, &c), BR_OK);
@@ -93,7 +93,7 @@ static void test_ripple_and_gradient_follow_position(void **st)
     const double d = 2.0 * 3.14159265358979 * 0.05;
     BR_ASSERT_NEAR(br_model_fcomp_N(&m, xr, 0.20f * c.causes.ripple_period_m), c.causes.ripple_amp_N,
                    c.causes.ripple_amp_N * (d * d * d * d / 24.0 + 1e-5));
-    c = br_ref_model_cfg(DT_S);
+    c = br_machine_model_cfg(DT_S);
     c.causes.grad_per_m = 2.0f;
     assert_int_equal(br_model_init(&m, &c), BR_OK);
     const float g = c.lugre.Fc_N;
@@ -109,7 +109,7 @@ static void test_step_absolute_equals_relative(void **st)
 {
     (void)st;
     br_model_t m;
-    br_model_cfg_t c = br_ref_model_cfg(DT_S);
+    br_model_cfg_t c = br_machine_model_cfg(DT_S);
     c.causes.ripple_amp_N = 0.1f * c.lugre.Fc_N;
     c.causes.ripple_period_m = 2.0e-3f;
     c.causes.offset_N = 1.0f;

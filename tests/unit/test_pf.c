@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bristle_gen/est/br_noise_table.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "br_circle_est.h"
 #include "bristle/br_pf.h"
@@ -15,29 +14,19 @@
 
 #define RPC BR_MACHINE_RAD_PER_COUNT_F
 
+/* the test's period and its process noise on omega and g_p there (the
+ * machine file's are for its own period) */
+#define TEST_DT_S 1.0e-3f
+#define TEST_Q_OMEGA 1.0e-5f
+#define TEST_Q_GP 0.09f
+
+/* The machine file's PF (br_circle_pf_cfg_default) with m particles at the test's period. */
 static br_pf_cfg_t cfg(uint32_t m)
 {
-    br_pf_cfg_t c;
-    c.est.model = br_ref_model_cfg(1.0e-3f);
+    br_pf_cfg_t c = br_circle_pf_cfg_default(TEST_DT_S);
     c.n_particles = m;
-    c.est.q_var[0] = 0.01f * RPC * RPC;
-    c.est.q_var[1] = 1.0e-5f;
-    c.est.q_var[2] = 1.0e-14f;
-    c.est.q_var[3] = 0.09f;
-    c.est.r_var_rad2 = 0.3f * RPC * RPC;
-    c.est.gp0_N = 18.0f;
-    c.x0_std[0] = 0.3f * RPC;
-    c.x0_std[1] = 1e-3f;
-    c.x0_std[2] = 1e-7f;
-    c.x0_std[3] = 2.0f;
-    c.est.gp_min_N = 3.5f;
-    c.est.gp_max_N = 27.0f;
-    c.est.outlier_sigma = 30.0f;
-    c.est.reanchor_after = 3u;
-    c.est.rad_per_count = RPC;
-    c.noise = br_noise_table;
-    c.noise_len = BR_NOISE_LEN;
-    c.noise_skip = 1u;
+    c.est.q_var[BR_X_OMEGA] = TEST_Q_OMEGA;
+    c.est.q_var[BR_X_GP] = TEST_Q_GP;
     return c;
 }
 
@@ -83,8 +72,8 @@ static void test_init_guards(void **st)
     c = cfg(100); c.est.reanchor_after = 0u;          assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg(100); c.est.rad_per_count = 0.0f;         assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg(100); c.est.gp_min_N = 0.0f;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
-    c = cfg(100); c.est.gp_max_N = 3.0f;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* < min */
-    c = cfg(100); c.est.gp0_N = 30.0f;                assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* > max */
+    c = cfg(100); c.est.gp_max_N = 0.9f * c.est.gp_min_N; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* < min */
+    c = cfg(100); c.est.gp0_N = 1.1f * c.est.gp_max_N;    assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* > max */
     c = cfg(100); c.est.model.dt_s = 0.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg(100); c.est.model.lugre.sigma0_Npm = -1.0f; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     br_meas_t y = {0, 0.5f};
@@ -262,9 +251,9 @@ static void test_tracks_plant_friction(void **st)
             sf += p.fnl_N * p.fnl_N;
             n++;
         }
-        /* 20 N peak at the load, period 1 s: sticks, breaks away, reverses,
-         * slides at up to 0.2 m/s */
-        u = 20.0 * pc.lead_mprad * sin(2.0 * 3.14159265358979 * k * 1e-3);
+        /* 2 N above stiction at the load (20 N on the reference), period 1 s:
+         * sticks, breaks away, reverses, slides (up to 0.2 m/s on the reference) */
+        u = (pc.Fs_N + 2.0) * pc.lead_mprad * sin(2.0 * 3.14159265358979 * k * 1e-3);
         br_plant_step(&p, u / pc.tau_per_duty_Nm, 1e-3);
     }
     const double rel = sqrt(se / sf);

@@ -11,6 +11,9 @@
 
 static const br_plant_state_t rest = {0.0, 0.0, 0.0};
 
+/* the sliding speed of the settling tests: a property of the test */
+#define V_SLIDE_MPS 0.05
+
 static int init_with(br_plant_cfg_t c)
 {
     br_plant_t p;
@@ -25,12 +28,12 @@ static void test_cause_guards(void **st)
     assert_int_equal(br_plant_causes_on(&c), 0);
     c = br_plant_cfg_reference(); c.offset_N = NAN;              assert_int_equal(init_with(c), -1);
     c = br_plant_cfg_reference(); c.offset_N = -3.0;             assert_int_equal(init_with(c), 0);
-    c = br_plant_cfg_reference(); c.dFc_neg_N = -7.0;            assert_int_equal(init_with(c), -1); /* Fc in -x = 0 */
+    c = br_plant_cfg_reference(); c.dFc_neg_N = -c.Fc_N;         assert_int_equal(init_with(c), -1); /* Fc in -x = 0 */
     c = br_plant_cfg_reference(); c.dFc_neg_N = INFINITY;        assert_int_equal(init_with(c), -1);
-    c = br_plant_cfg_reference(); c.dFc_neg_N = -6.0;            assert_int_equal(init_with(c), 0);
-    c = br_plant_cfg_reference(); c.dsigma2_neg_Nspm = -50.1;    assert_int_equal(init_with(c), -1);
+    c = br_plant_cfg_reference(); c.dFc_neg_N = 1.0 - c.Fc_N;    assert_int_equal(init_with(c), 0);  /* 1 N in -x */
+    c = br_plant_cfg_reference(); c.dsigma2_neg_Nspm = -c.sigma2_Nspm - 0.1; assert_int_equal(init_with(c), -1);
     c = br_plant_cfg_reference(); c.dsigma2_neg_Nspm = NAN;      assert_int_equal(init_with(c), -1);
-    c = br_plant_cfg_reference(); c.dsigma2_neg_Nspm = -50.0;    assert_int_equal(init_with(c), 0);
+    c = br_plant_cfg_reference(); c.dsigma2_neg_Nspm = -c.sigma2_Nspm; assert_int_equal(init_with(c), 0);
     c = br_plant_cfg_reference(); c.ripple_amp_N = NAN;          assert_int_equal(init_with(c), -1);
     c = br_plant_cfg_reference(); c.ripple_amp_N = 1.0;          assert_int_equal(init_with(c), -1); /* period 0 */
     c.ripple_period_m = -0.008;                                  assert_int_equal(init_with(c), -1);
@@ -103,26 +106,30 @@ static void test_offset_shifts_sliding(void **st)
     (void)st;
     br_plant_cfg_t c = br_plant_cfg_reference();
     double fnl;
-    /* 9.5 N: (9.5 - 7) / 50 = 0.05 m/s without the offset; 2 N offset leaves 0.5 N: 0.01 m/s */
-    BR_ASSERT_NEAR(settle(c, 9.5, &fnl), 0.05, 1e-4);
-    c.offset_N = 2.0;
-    BR_ASSERT_NEAR(settle(c, 9.5, &fnl), 0.01, 1e-4);
-    BR_ASSERT_NEAR(settle(c, -9.5, &fnl), -(9.5 + 2.0 - 7.0) / 50.0, 1e-4);
+    /* F = Fc + sigma2 V slides at V without the offset (9.5 N, 0.05 m/s on the
+     * reference); an offset of 0.8 sigma2 V leaves 0.2 sigma2 V: 0.2 V */
+    const double F = c.Fc_N + c.sigma2_Nspm * V_SLIDE_MPS, off = 0.8 * c.sigma2_Nspm * V_SLIDE_MPS;
+    BR_ASSERT_NEAR(settle(c, F, &fnl), V_SLIDE_MPS, 1e-4);
+    c.offset_N = off;
+    BR_ASSERT_NEAR(settle(c, F, &fnl), 0.2 * V_SLIDE_MPS, 1e-4);
+    BR_ASSERT_NEAR(settle(c, -F, &fnl), -(F + off - c.Fc_N) / c.sigma2_Nspm, 1e-4);
 }
 
 static void test_asymmetric_friction(void **st)
 {
     (void)st;
     br_plant_cfg_t c = br_plant_cfg_reference();
-    c.dFc_neg_N = 1.0;          /* 8 N in -x */
-    c.dsigma2_neg_Nspm = 30.0;  /* 80 N s/m in -x */
+    c.dFc_neg_N = 1.0;          /* Fc + 1 N in -x (8 N on the reference) */
+    c.dsigma2_neg_Nspm = 30.0;  /* sigma2 + 30 N s/m in -x (80 N s/m on the reference) */
     double fnl;
-    /* +x unchanged */
-    BR_ASSERT_NEAR(settle(c, 9.5, &fnl), 0.05, 1e-4);
-    BR_ASSERT_NEAR(fnl, 7.0, 1e-3);
-    /* -x: (12 - 8) / 80 = 0.05 m/s, LuGre at -8 N */
-    BR_ASSERT_NEAR(settle(c, -12.0, &fnl), -0.05, 1e-4);
-    BR_ASSERT_NEAR(fnl, -8.0, 1e-3);
+    /* +x unchanged: Fc + sigma2 V slides at V */
+    BR_ASSERT_NEAR(settle(c, c.Fc_N + c.sigma2_Nspm * V_SLIDE_MPS, &fnl), V_SLIDE_MPS, 1e-4);
+    BR_ASSERT_NEAR(fnl, c.Fc_N, 1e-3);
+    /* -x: the larger levels, (Fc + 1) + (sigma2 + 30) V slides at V (12 N on the
+     * reference), LuGre at -(Fc + 1) */
+    const double Fneg = (c.Fc_N + 1.0) + (c.sigma2_Nspm + 30.0) * V_SLIDE_MPS;
+    BR_ASSERT_NEAR(settle(c, -Fneg, &fnl), -V_SLIDE_MPS, 1e-4);
+    BR_ASSERT_NEAR(fnl, -(c.Fc_N + 1.0), 1e-3);
 }
 
 static void test_position_gradient(void **st)
@@ -132,13 +139,14 @@ static void test_position_gradient(void **st)
     c.grad_per_m = 2.0; /* +20 % over 0.1 m */
     br_plant_t p;
     assert_int_equal(br_plant_init(&p, &c, &rest), 0);
-    /* slide at about 0.05 m/s for 2 s: the Coulomb level follows 7 (1 + 2 x) */
-    const double duty = 10.0 * c.lead_mprad / c.tau_per_duty_Nm;
+    /* slide at V or faster over the first 0.1 m for 2 s (the force holds V at
+     * Fc (1 + 2 * 0.1)): the Coulomb level follows Fc (1 + 2 x) */
+    const double duty = (1.2 * c.Fc_N + c.sigma2_Nspm * V_SLIDE_MPS) * c.lead_mprad / c.tau_per_duty_Nm;
     for (int k = 0; k < 2000; k++) {
         br_plant_step(&p, duty, 1e-3);
         if (k > 1000) {
             const double x = br_plant_pos_m(&p);
-            BR_ASSERT_NEAR(p.fnl_N, 7.0 * (1.0 + 2.0 * x), 1e-3);
+            BR_ASSERT_NEAR(p.fnl_N, c.Fc_N * (1.0 + 2.0 * x), 1e-3);
         }
     }
     assert_true(br_plant_pos_m(&p) > 0.05);

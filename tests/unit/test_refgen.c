@@ -6,20 +6,20 @@
 #include <float.h>
 
 #include "bristle/br_refgen.h"
+#include "bristle_gen/machine/br_machine.h"
 
 #define TWO_PI 6.283185307179586476925
 
-/* Reference machine (machines/reference.json): 8 mm lead,
- * 2^20 counts per motor revolution. */
+/* A 5 mm, 2 s sine on the machine (its lead, encoder and control period). */
 static br_refgen_cfg_t cfg_default(void)
 {
     br_refgen_cfg_t c;
     c.amplitude_m = 5.0e-3f;
     c.period_s = 2.0f;
     c.phase_rad = 0.0f;
-    c.dt_s = 1.0e-3f;
-    c.lead_mprad = (float)(0.008 / TWO_PI);
-    c.rad_per_count = (float)(TWO_PI / 1048576.0);
+    c.dt_s = BR_MACHINE_CTRL_PERIOD_S_F;
+    c.lead_mprad = BR_MACHINE_LEAD_MPRAD_F;
+    c.rad_per_count = BR_MACHINE_RAD_PER_COUNT_F;
     return c;
 }
 
@@ -104,11 +104,12 @@ static void test_guards(void **st)
     c.period_s = 1.0e7f;
     assert_int_equal(br_refgen_init(&g, &c), BR_E_PARAM);
 
-    /* amplitude beyond 2^30 counts (int32 headroom) */
+    /* amplitude beyond 2^30 counts (int32 headroom; 4.1 m on the reference) */
     c = cfg_default();
-    c.amplitude_m = 2.0f; /* 2.6e8 counts: accepted */
+    const float a_max_m = 1073741824.0f * c.rad_per_count * c.lead_mprad;
+    c.amplitude_m = 0.5f * a_max_m; /* accepted */
     assert_int_equal(br_refgen_init(&g, &c), BR_OK);
-    c.amplitude_m = 10.0f; /* 1.3e9 counts */
+    c.amplitude_m = 1.25f * a_max_m;
     assert_int_equal(br_refgen_init(&g, &c), BR_E_PARAM);
     assert_int_equal(br_refgen_step(&g, &r), BR_E_STATE); /* a failed init leaves it unready */
     assert_true(br_refgen_phase_rad(&g) == 0.0f);
@@ -148,9 +149,10 @@ static void test_amplitude_and_phase(void **st)
         double phase_tol = phase0_tol(phases[p]);
         BR_ASSERT_NEAR(max_c, 0.0, float_tol(amp_counts) + amp_counts * phase_tol);
         BR_ASSERT_NEAR(max_w, 0.0, float_tol(amp_omega) + amp_omega * phase_tol);
-        /* the amplitude itself: A / (L r) = 655360 counts for 5 mm */
+        /* the amplitude itself: A / (L r) = A / lead * counts_per_rev (655360 counts
+         * for 5 mm on the reference) */
         BR_ASSERT_NEAR(peak, amp_counts, float_tol(amp_counts) + amp_counts * 1e-5);
-        BR_ASSERT_NEAR(amp_counts, 655360.0, 1.0);
+        BR_ASSERT_NEAR(amp_counts, 5.0e-3 / (TWO_PI * BR_MACHINE_LEAD_MPRAD) * BR_MACHINE_COUNTS_PER_REV, 1.0);
     }
 }
 
@@ -212,7 +214,7 @@ static void test_frac_and_velocity(void **st)
             /* omega at k-1 from the neighbours: error (w dt)^2 / 6 relative */
             double fd = (pos[2] - pos[0]) / (2.0 * (double)c.dt_s) * (double)c.rad_per_count;
             double om = exact_omega(&c, k - 1);
-            BR_ASSERT_NEAR(fd, om, amp_omega * ((w * 1e-3) * (w * 1e-3) / 6.0 + 1e-4));
+            BR_ASSERT_NEAR(fd, om, amp_omega * ((w * c.dt_s) * (w * c.dt_s) / 6.0 + 1e-4));
         }
     }
     /* negative positions: floor, not truncation, so frac stays in [0, 1) */

@@ -5,6 +5,8 @@
 #ifndef BR_GEN_MACHINE_H
 #define BR_GEN_MACHINE_H
 
+/* the machine description these values come from */
+#define BR_MACHINE_FILE "machines/reference.json"
 /* L = lead / (2 pi), m/rad */
 #define BR_MACHINE_LEAD_MPRAD (0.0012732395447351628)
 #define BR_MACHINE_LEAD_MPRAD_F (1.273239497e-03f)
@@ -41,5 +43,22 @@
 /* amplifier torque at duty 1 */
 #define BR_MACHINE_TAU_PER_DUTY_NM (0.64)
 #define BR_MACHINE_TAU_PER_DUTY_NM_F (6.399999857e-01f)
+/* largest |duty| the amplifier accepts */
+#define BR_MACHINE_DUTY_LIMIT (1.0)
+#define BR_MACHINE_DUTY_LIMIT_F (1.000000000e+00f)
+/* width of the encoder's hardware counter */
+#define BR_MACHINE_COUNTER_BITS 32u
+/* control period (H-inf only, H-inf + UKF) */
+#define BR_MACHINE_CTRL_PERIOD_S (0.001)
+#define BR_MACHINE_CTRL_PERIOD_S_F (1.000000047e-03f)
+/* controller torque saturation */
+#define BR_MACHINE_TORQUE_LIMIT_NM (0.64)
+#define BR_MACHINE_TORQUE_LIMIT_NM_F (6.399999857e-01f)
+/* largest table speed the axis is used at */
+#define BR_MACHINE_MAX_SPEED_MPS (0.1)
+#define BR_MACHINE_MAX_SPEED_MPS_F (1.000000015e-01f)
+/* stroke of the table */
+#define BR_MACHINE_TRAVEL_M (0.3)
+#define BR_MACHINE_TRAVEL_M_F (3.000000119e-01f)
 
 #endif

@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""The machine-file loader (firmware/design/machine.py, docs/machine-file.md):
+every machine of machines/ loads; a broken file fails with one
+"FILE: field a.b.c: problem" line per problem and exit status 1, without a
+traceback, from the loader and from each generator; a machine with no
+stabilising H-infinity design is refused by synth_hinf.py.
+
+Usage: test_machine_file.py --work DIR"""
+import argparse
+import copy
+import glob
+import json
+import os
+import subprocess
+import sys
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DESIGN = os.path.join(REPO, "firmware", "design")
+sys.path.insert(0, DESIGN)
+import machine  # noqa: E402
+
+FAILURES = []
+
+
+def check(cond, what):
+    print("%s: %s" % ("ok  " if cond else "FAIL", what))
+    if not cond:
+        FAILURES.append(what)
+
+
+def write(work, name, obj):
+    path = os.path.join(work, name)
+    with open(path, "w") as f:
+        f.write(obj if isinstance(obj, str) else json.dumps(obj, indent=2))
+    return path
+
+
+def run(script, *args):
+    p = subprocess.run([sys.executable, os.path.join(DESIGN, script)] + list(args), capture_output=True, text=True)
+    return p.returncode, p.stderr
+
+
+def expect_errors(work, name, obj, wanted):
+    """The loader's lines for the file, each wanted text among them, and the same
+    from the command line: exit 1, no traceback."""
+    path = write(work, name, obj)
+    try:
+        machine.load(path)
+        lines = []
+    except machine.MachineError as e:
+        lines = e.lines
+    for w in wanted:
+        found = any(l == "%s: %s" % (machine.display_name(path), w) for l in lines)
+        check(found, "%s: reports \"%s\"%s" % (name, w, "" if found else " (got %s)" % lines))
+    for script, extra in (("machine.py", [path]), ("gen_machine.py", ["--machine", path, "--gen-root", work]),
+                          ("synth_hinf.py", ["--machine", path, "--out", os.path.join(work, "g.h")])):
+        rc, err = run(script, *extra)
+        check(rc == 1 and "Traceback" not in err and all(w in err for w in wanted),
+              "%s: %s exits 1 with the messages, no traceback (rc %d)" % (name, script, rc))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--work", required=True)
+    work = ap.parse_args().work
+    os.makedirs(work, exist_ok=True)
+
+    files = sorted(glob.glob(os.path.join(REPO, "machines", "*.json")))
+    check(len(files) >= 2, "machines/ holds the reference and at least one other machine")
+    for f in files:
+        m = machine.load(f)
+        check(m["format_version"] == machine.FORMAT_VERSION, "%s loads" % os.path.relpath(f, REPO))
+    ref = machine.load(machine.REFERENCE_MACHINE)
+    p = machine.params(ref)
+    check(p["Fc_N"] == ref["friction"]["Fc_N"] and abs(p["L_mprad"] * 2 * 3.141592653589793 -
+                                                     ref["mechanics"]["lead_m_per_rev"]) < 1e-15,
+          "params(): symbols and L = lead / 2 pi")
+
+    with open(machine.REFERENCE_MACHINE) as f:
+        good = json.load(f)
+
+    bad = copy.deepcopy(good)
+    bad["mechanics"]["mass_kg"] = bad["mechanics"].pop("table_mass_kg")
+    expect_errors(work, "typo.json", bad, ["field mechanics.mass_kg: unknown field (expected one of: "
+                                           "table_mass_kg, inertia_kgm2, lead_m_per_rev)",
+                                           "field mechanics.table_mass_kg: missing"])
+    bad = copy.deepcopy(good)
+    bad["friction"]["Fc_N"] = 0.0
+    bad["encoder"]["counter_bits"] = "32"
+    bad["estimator"]["pf"]["n_particles"] = machine.PF_MAX_PARTICLES + 1
+    expect_errors(work, "range.json", bad, ["field friction.Fc_N: 0 is outside (0, 100000]",
+                                            "field encoder.counter_bits: expected an integer, got a string",
+                                            "field estimator.pf.n_particles: 2049 is outside [1, 2048]"])
+    bad = copy.deepcopy(good)
+    bad["friction"]["Fs_N"] = 0.5 * bad["friction"]["Fc_N"]
+    bad["control"]["torque_limit_Nm"] = 2.0 * bad["amplifier"]["torque_per_duty_Nm"]
+    bad["estimator"]["ukf"]["gp0_N"] = 2.0 * bad["estimator"]["ukf"]["gp_max_N"]
+    expect_errors(work, "cross.json", bad, ["field friction.Fs_N: must be >= friction.Fc_N (7 N)",
+                                            "field control.torque_limit_Nm: must be <= amplifier.duty_limit * "
+                                            "amplifier.torque_per_duty_Nm",
+                                            "field estimator.ukf.gp0_N: must lie in [estimator.ukf.gp_min_N, "
+                                            "estimator.ukf.gp_max_N]"])
+    bad = copy.deepcopy(good)
+    bad["format_version"] = 2
+    expect_errors(work, "version.json", bad, ["field format_version: 2 is not a version this loader reads (1)"])
+    path = write(work, "syntax.json", "{\n  \"name\": \"x\",\n}\n")
+    rc, err = run("machine.py", path)
+    check(rc == 1 and err.startswith("%s: not valid JSON: line 3" % machine.display_name(path))
+          and "Traceback" not in err,
+          "syntax.json: names the file and the line")
+
+    # weights that make the sampled loop unstable: no design, a clear message
+    bad = copy.deepcopy(good)
+    bad["control"]["hinf"]["weight_theta_per_rad"] = 1.0e3
+    bad["control"]["hinf"]["weight_eps_per_rad_s"] = 1.0e5
+    path = write(work, "unstable.json", bad)
+    rc, err = run("synth_hinf.py", "--machine", path, "--out", os.path.join(work, "unstable.h"))
+    check(rc == 1
+          and err.startswith("%s: field control.hinf: the sampled loop is unstable" % machine.display_name(path))
+          and "Traceback" not in err, "unstable.json: synth_hinf.py refuses it (%r)" % err.strip())
+    check(not os.path.exists(os.path.join(work, "unstable.h")), "unstable.json: no header written")
+
+    print("%d failure(s)" % len(FAILURES))
+    return 1 if FAILURES else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
