@@ -12,8 +12,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "br_cause_args.h"
-#include "br_circle.h"
+#include "simlog/br_cause_args.h"
+#include "circle/br_circle.h"
 #include "plant/br_model_params.h"
 #include "plant/br_plant_json.h"
 

@@ -12,7 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "br_circle.h"
+#include "circle/br_circle.h"
 
 /* g_p histogram of the PF's particles: bins of BR_HIST_W_N from 0 N. */
 #define BR_HIST_BINS 60

@@ -22,8 +22,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_circle.h"
-#include "br_circle_est.h"
+#include "circle/br_circle.h"
+#include "circle/br_circle_est.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 

@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_circle.h"
+#include "circle/br_circle.h"
 
 static float *load_table(const char *path, uint32_t *len)
 {

@@ -20,9 +20,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_cause_args.h"
-#include "br_circle.h"
-#include "br_ident.h"
+#include "simlog/br_cause_args.h"
+#include "circle/br_circle.h"
+#include "simlog/br_ident.h"
 #include "plant/br_plant_json.h"
 
 #define BR_PI 3.14159265358979323846

@@ -14,9 +14,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_circle.h"
-#include "br_circle_est.h"
-#include "br_nm.h"
+#include "circle/br_circle.h"
+#include "circle/br_circle_est.h"
+#include "tune/br_nm.h"
 #include "bristle_gen/machine/br_machine.h"
 
 #define MAX_P 5

@@ -31,9 +31,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "br_circle.h"
-#include "br_circle_est.h"
-#include "br_hal_sim.h"
+#include "circle/br_circle.h"
+#include "circle/br_circle_est.h"
+#include "hal/br_hal_sim.h"
 #include "bristle_gen/est/br_noise_table.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_app.h"

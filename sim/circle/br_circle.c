@@ -5,7 +5,7 @@
 #include <stdlib.h>
 
 #include "br_circle_est.h"
-#include "br_hal_sim.h"
+#include "hal/br_hal_sim.h"
 #include "bristle_gen/ctrl/br_hinf_gains.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"

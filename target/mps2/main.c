@@ -17,7 +17,7 @@
  * globals; mps2_an500.ld reserves a 512 KiB stack. */
 #include <stdint.h>
 
-#include "br_replay.h"
+#include "replay/br_replay.h"
 #include "br_semihost.h"
 
 #define BR_SYST_CSR (*(volatile uint32_t *)0xE000E010u)

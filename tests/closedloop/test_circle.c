@@ -6,7 +6,7 @@
  * set by CMake for machines/reference.json) also the published figures. */
 #include "br_test.h"
 
-#include "br_circle.h"
+#include "circle/br_circle.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 

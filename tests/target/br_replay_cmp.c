@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_replay.h"
+#include "replay/br_replay.h"
 
 #define BR_CMP_TOL_ULP 4u
 

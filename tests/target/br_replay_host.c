@@ -3,7 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "br_replay.h"
+#include "replay/br_replay.h"
 
 static int io_read(void *ctx, void *buf, uint32_t n)
 {

@@ -10,8 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_circle.h"
-#include "br_replay.h"
+#include "circle/br_circle.h"
+#include "replay/br_replay.h"
 
 #define BR_PI 3.14159265358979323846
 

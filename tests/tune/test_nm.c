@@ -3,7 +3,7 @@
 
 #include <string.h>
 
-#include "br_nm.h"
+#include "tune/br_nm.h"
 
 typedef struct {
     int outside;

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "br_circle_est.h"
+#include "circle/br_circle_est.h"
 #include "bristle/br_app.h"
 
 typedef struct {

@@ -9,7 +9,7 @@
 #include <float.h>
 #include <stdlib.h>
 
-#include "br_circle_est.h"
+#include "circle/br_circle_est.h"
 #include "bristle/br_est.h"
 #include "bristle/br_pf.h"
 #include "bristle/br_ukf.h"

@@ -4,7 +4,7 @@
 
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
-#include "br_circle_est.h"
+#include "circle/br_circle_est.h"
 #include "bristle/br_model.h"
 
 static br_model_cfg_t ref_cfg(float dt) { return br_machine_model_cfg(dt); }

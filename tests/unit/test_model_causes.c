@@ -3,7 +3,7 @@
  * are held to the float64 reference by tests/golden/test_golden_model_ext.c. */
 #include "br_test.h"
 
-#include "br_circle_est.h"
+#include "circle/br_circle_est.h"
 #include "bristle/br_est.h"
 #include "bristle/br_model.h"
 

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "bristle_gen/machine/br_machine.h"
-#include "br_circle_est.h"
+#include "circle/br_circle_est.h"
 #include "bristle/br_pf.h"
 #include "plant/br_sim_plant.h"
 

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "bristle_gen/ctrl/br_hinf_gains.h"
-#include "br_circle_est.h"
+#include "circle/br_circle_est.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_encoder.h"
 #include "bristle/br_ukf.h"
