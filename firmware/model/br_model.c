@@ -102,20 +102,10 @@ void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u, f
     int pass;
     for (pass = 0; pass < BR_MODEL_BOUNDED_PASSES; pass++) {
         dth = wm * h;
-        float dx = L * dth;
-        float zint;
-        if (dx != 0.0f) {
-            /* eq. 4 over the displacement with g = g_p: exact, bounded */
-            const br_lk_move_t mv = br_lk_move(c->sigma0_Npm, z0, dx, gp);
-            z1 = mv.z1_m;
-            /* integral of z over the step: h (zss + (z0 - zss) (1 - e^{-r}) / r);
-             * (1 - e^{-r}) / r by its series where r would underflow the division */
-            float q = (mv.r > 1e-6f) ? mv.one_minus_e / mv.r : 1.0f - 0.5f * mv.r;
-            zint = h * (mv.zss_m + (z0 - mv.zss_m) * q);
-        } else {
-            z1 = z0;
-            zint = z0 * h;
-        }
+        /* eq. 4 over the displacement with g = g_p: exact, bounded; and the integral of z */
+        const br_lk_step_t ls = br_lk_move_over(c->sigma0_Npm, z0, L * dth, gp, h);
+        const float zint = ls.zint_ms;
+        z1 = ls.z1_m;
         /* eq. 6 integrated: Jeff dw = u h - L^2 sigma2 dtheta - L (sigma0 int z + sigma1 dz) */
         w1 = w0 + (u * h - m->visc_Nmsprad * dth - L * (c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0))) * m->inv_Jeff;
         wm = 0.5f * (w0 + w1);
@@ -140,17 +130,10 @@ void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float
         dth = wm * h;
         const float dx = L * dth;
         const int neg = dx < 0.0f;
-        float zint;
-        if (dx != 0.0f) {
-            /* eq. 4 over the displacement with the direction's level, exact and bounded */
-            const br_lk_move_t mv = br_lk_move(s0, z0, dx, neg ? k->c_neg * gp : gp);
-            z1 = mv.z1_m;
-            float q = (mv.r > 1e-6f) ? mv.one_minus_e / mv.r : 1.0f - 0.5f * mv.r;
-            zint = h * (mv.zss_m + (z0 - mv.zss_m) * q);
-        } else {
-            z1 = z0;
-            zint = z0 * h;
-        }
+        /* eq. 4 over the displacement with the direction's level, exact and bounded */
+        const br_lk_step_t ls = br_lk_move_over(s0, z0, dx, neg ? k->c_neg * gp : gp, h);
+        const float zint = ls.zint_ms;
+        z1 = ls.z1_m;
         const float tm = t0 + 0.5f * dth;
         const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + L * tm));
         /* the load impulse: k (sigma2_d dx + sigma0 int z + sigma1 dz) + (offset + ripple) h */

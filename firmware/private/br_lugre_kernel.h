@@ -49,4 +49,29 @@ static inline br_lk_move_t br_lk_move(float sigma0_Npm, float z0_m, float dx_m, 
     return mv;
 }
 
+/* The same move made at constant speed over a step h, with the integral of z
+ * over the step (the bounded schemes' friction impulse needs it):
+ *   int z dt = h (zss + (z0 - zss) (1 - e^{-r}) / r),
+ * (1 - e^{-r}) / r by its series where r would underflow the division; a move
+ * of 0 leaves z and gives z0 h. */
+typedef struct {
+    float z1_m;   /* deflection after the move */
+    float zint_ms; /* integral of z over the step, m s */
+} br_lk_step_t;
+
+static inline br_lk_step_t br_lk_move_over(float sigma0_Npm, float z0_m, float dx_m, float g_N, float h_s)
+{
+    br_lk_step_t st;
+    if (dx_m != 0.0f) {
+        const br_lk_move_t mv = br_lk_move(sigma0_Npm, z0_m, dx_m, g_N);
+        const float q = (mv.r > 1e-6f) ? mv.one_minus_e / mv.r : 1.0f - 0.5f * mv.r;
+        st.z1_m = mv.z1_m;
+        st.zint_ms = h_s * (mv.zss_m + (z0_m - mv.zss_m) * q);
+    } else {
+        st.z1_m = z0_m;
+        st.zint_ms = z0_m * h_s;
+    }
+    return st;
+}
+
 #endif

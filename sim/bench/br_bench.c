@@ -126,14 +126,7 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
     const br_plant_state_t x0 = {0.0, 0.0, 0.0};
     if (br_plant_init(&plant, &c->plant, &x0) != 0) return -1;
     if (br_hal_sim_init(&port, &plant, c->dt_s, &hal) != BR_OK) return -1;
-    br_ctrl_cfg_t cc;
-    memset(&cc, 0, sizeof cc);
-    for (int i = 0; i < 3; i++) cc.K[i] = c->K[i];
-    cc.dt_s = (float)c->dt_s;
-    cc.tau_max_Nm = BR_MACHINE_TORQUE_LIMIT_NM_F;
-    cc.tau_per_duty_Nm = (float)c->plant.tau_per_duty_Nm;
-    cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
-    cc.lead_mprad = (float)c->plant.lead_mprad;
+    const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(c);
     rec_est_t wrap = {est, &plant, rec, 0};
     const br_est_t e = {&wrap, rec_est_step};
     const br_app_cfg_t ac = {&cc, BR_APP_EST_EXTERN, NULL, NULL, &e};
