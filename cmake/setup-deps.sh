@@ -23,6 +23,7 @@ pkgs=(
   libcmocka-dev
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
   qemu-system-arm
+  cppcheck
   python3 python3-venv
 )
 installed() {
@@ -50,7 +51,7 @@ if ((${#missing[@]})); then
     installed "$p" || die "package $p is still not installed"
   done
 fi
-for t in cmake ninja arm-none-eabi-gcc arm-none-eabi-size qemu-system-arm; do
+for t in cmake ninja arm-none-eabi-gcc arm-none-eabi-size qemu-system-arm cppcheck; do
   command -v "$t" >/dev/null || die "$t not on PATH after installation"
 done
 

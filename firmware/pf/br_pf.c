@@ -272,11 +272,12 @@ BR_INLINE uint32_t predict_and_weigh_with(br_pf_t *pf, float u_prev_Nm, float sh
  * to pf->origin_counts */
 static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, float *lmax)
 {
+    /* the extended kernel's constants (a few operations per step; unused by the thesis model) */
+    const br_model_kx_t mx = br_model_kx(&pf->model, origin_pos_m(pf));
     if (pf->model.extended) {
-        const br_model_kx_t mx = br_model_kx(&pf->model, origin_pos_m(pf));
         return predict_and_weigh_with(pf, u_prev_Nm, shift, y_rel, lmax, 1, &mx);
     }
-    return predict_and_weigh_with(pf, u_prev_Nm, shift, y_rel, lmax, 0, NULL);
+    return predict_and_weigh_with(pf, u_prev_Nm, shift, y_rel, lmax, 0, &mx);
 }
 
 /* Step 3: max-shifted weights w_j = e^(l_j - lmax), quantised to W_j (an invalid

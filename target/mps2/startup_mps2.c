@@ -12,13 +12,15 @@
 
 #include "br_semihost.h"
 
-/* Linker script symbols (addresses only; never read as values). */
+/* Linker script symbols (addresses only; never read as values). The region
+ * bounds are declared as arrays, so that copying through them indexes an
+ * array rather than the address of a single object. */
 extern uint32_t _estack;
-extern uint32_t _sidata;
-extern uint32_t _sdata;
-extern uint32_t _edata;
-extern uint32_t _sbss;
-extern uint32_t _ebss;
+extern uint32_t _sidata[];
+extern uint32_t _sdata[];
+extern uint32_t _edata[];
+extern uint32_t _sbss[];
+extern uint32_t _ebss[];
 
 int main(void);
 void Reset_Handler(void);
@@ -52,14 +54,14 @@ void Reset_Handler(void)
     __asm__ volatile("dsb 0xF\n\tisb 0xF" ::: "memory");
 
     /* Word loops through volatile pointers: no call to memcpy/memset here. */
-    src = &_sidata;
-    dst = &_sdata;
-    n = ((uintptr_t)&_edata - (uintptr_t)&_sdata) / sizeof(uint32_t);
+    src = _sidata;
+    dst = _sdata;
+    n = ((uintptr_t)_edata - (uintptr_t)_sdata) / sizeof(uint32_t);
     for (i = 0u; i < n; ++i) {
         dst[i] = src[i];
     }
-    dst = &_sbss;
-    n = ((uintptr_t)&_ebss - (uintptr_t)&_sbss) / sizeof(uint32_t);
+    dst = _sbss;
+    n = ((uintptr_t)_ebss - (uintptr_t)_sbss) / sizeof(uint32_t);
     for (i = 0u; i < n; ++i) {
         dst[i] = 0u;
     }
