@@ -57,7 +57,7 @@ define print_size
 	  END { exit ok ? 0 : 1 }'
 endef
 
-.PHONY: help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control firmware regen clean distclean
+.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control firmware regen clean distclean
 
 help:
 	@echo "bristle targets:"
@@ -75,6 +75,7 @@ help:
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
 	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
+	@echo "  make fuzz [FUZZ_SECONDS=600]  every libFuzzer target (clang, ASan + UBSan) for that long (ctest runs 20 s each)"
 	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
 	@echo "  V=1 shows the commands; JOBS=n sets the ctest parallelism (default 2)"
 
@@ -195,6 +196,18 @@ regen: deps
 	$(Q)build/host-release/sim/br_tune_est --est pf --out firmware/gen/bristle_gen/est/br_pf_tuned.h > /dev/null
 	$(Q)echo "== regen: golden traces"
 	$(Q)$(PYTHON) golden/gen_traces.py
+
+# The libFuzzer targets of tests/fuzz for longer than ctest's 20 s each,
+# corpora kept in out/fuzz (docs/reliability.md).
+FUZZ_SECONDS ?= 600
+fuzz: deps
+	$(call configure,fuzz)
+	$(call build,fuzz)
+	$(Q)for f in build/fuzz/tests/fuzz/fuzz_*; do \
+	  n=$$(basename $$f); mkdir -p out/fuzz/$$n; echo "== $$n for $(FUZZ_SECONDS) s"; \
+	  $$f -max_total_time=$(FUZZ_SECONDS) -max_len=1024 -rss_limit_mb=2048 -print_final_stats=1 out/fuzz/$$n \
+	    2>&1 | grep -E "^stat::number_of_executed_units|ERROR|SUMMARY"; \
+	  test $${PIPESTATUS[0]} -eq 0; done
 
 clean:
 	$(Q)rm -rf build out

@@ -2,7 +2,9 @@
 # Installs what building and testing bristle needs, idempotently:
 #   Debian packages: host compiler, CMake, Ninja, cmocka, the Arm cross
 #   toolchain with newlib, qemu-system-arm (the emulated Cortex-M7 of the
-#   target tests and make target-bench, docs/target.md), Python's venv module;
+#   target tests and make target-bench, docs/target.md), cppcheck (the
+#   static test), clang with its compiler-rt (the libFuzzer targets of the
+#   fuzz preset), Python's venv module;
 #   .venv in the project root with the pinned cmake/python-requirements.txt.
 # Quick when everything is in place: dpkg status checks, and a stamp in .venv
 # keyed by the hash of the requirements file (and of the interpreter).
@@ -24,6 +26,7 @@ pkgs=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
   qemu-system-arm
   cppcheck
+  clang libclang-rt-14-dev
   python3 python3-venv
 )
 installed() {
@@ -51,7 +54,7 @@ if ((${#missing[@]})); then
     installed "$p" || die "package $p is still not installed"
   done
 fi
-for t in cmake ninja arm-none-eabi-gcc arm-none-eabi-size qemu-system-arm cppcheck; do
+for t in cmake ninja arm-none-eabi-gcc arm-none-eabi-size qemu-system-arm cppcheck clang; do
   command -v "$t" >/dev/null || die "$t not on PATH after installation"
 done
 

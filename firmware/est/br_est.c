@@ -25,7 +25,8 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
-    if (!br_finite_pos(cfg->rad_per_count) || !br_finite_pos(cfg->outlier_sigma) || cfg->reanchor_after < 1u) {
+    if (!br_finite_pos(cfg->rad_per_count) || !br_finite_pos(cfg->outlier_sigma) ||
+        cfg->outlier_sigma > BR_EST_GATE_MAX_SIGMA || cfg->reanchor_after < 1u) {
         return BR_E_PARAM;
     }
     if (!(cfg->model.causes.delay_s <= (float)(BR_EST_DELAY_HIST - 2u) * cfg->model.dt_s)) {

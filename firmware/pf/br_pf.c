@@ -374,7 +374,9 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
     }
-    const br_status_t verdict = (lmax < pf->outlier_l) ? BR_W_OUTLIER : BR_OK;
+    /* an outlier also when every valid particle's log-weight overflowed to -inf
+     * (the max-shift needs a finite lmax) */
+    const br_status_t verdict = (lmax < pf->outlier_l || lmax == -INFINITY) ? BR_W_OUTLIER : BR_OK;
 
     /* 3. max-shifted weights, quantised; an outlier gives every valid particle weight 1 */
     float sw, sw2;

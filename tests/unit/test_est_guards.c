@@ -41,6 +41,10 @@ static void test_variance_bounds(void **st)
         c = ok; c.q_var[i] = 2.0f * BR_EST_VAR_MAX; assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
         c = ok; c.q_var[i] = -1.0f;                assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
     }
+    /* the outlier gate: its square must stay a float (found by fuzz_replay:
+     * a gate of 1e30 sigma made the PF's threshold -inf and the ESS 0/0) */
+    c = ok; c.outlier_sigma = 2.0f * BR_EST_GATE_MAX_SIGMA; assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c = ok; c.outlier_sigma = BR_EST_GATE_MAX_SIGMA;        assert_int_equal(br_est_cfg_check(&c), BR_OK);
     assert_true(br_est_var_ok(BR_EST_VAR_MAX, 0));
     assert_false(br_est_var_ok(0.0f, 0));
     assert_true(br_est_var_ok(0.0f, 1));
@@ -99,6 +103,14 @@ static void test_pf_log_weight_overflow(void **st)
     assert_true(isfinite(e->ess));
     BR_ASSERT_NEAR(e->ess, (double)c.n_particles, 1e-3);
     assert_true(isfinite(e->F_hat_N));
+    /* the same with the threshold itself at -inf (init keeps the gate's square a
+     * float; the step does not rely on it): still an outlier step, not 0/0 */
+    for (uint32_t j = 0; j < c.n_particles; j++) {
+        pf->x[j][BR_X_THETA] = 1.0e18f;
+    }
+    pf->outlier_l = -INFINITY;
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
+    assert_true(isfinite(br_pf_estimate(pf)->ess));
     free(pf);
 }
 

@@ -14,6 +14,9 @@
  * physical setting, and beyond it the float32 sigma points, squared residuals
  * and the eq. 6 prediction of a spread-out state lose the range they need. */
 #define BR_EST_VAR_MAX 1.0e12f
+/* Widest outlier gate, in standard deviations: a gate of a million is no gate,
+ * and its square must stay a float (the PF's log-weight threshold). */
+#define BR_EST_GATE_MAX_SIGMA 1.0e6f
 /* Smallest measurement variance, in encoder counts^2: a millionth of a count^2
  * is far below any quantised encoder's noise (1/12 count^2), and it keeps
  * 1 / (2 R) and the log-weights finite. */
@@ -37,7 +40,8 @@ typedef struct {
  * causes' included; the delay at most BR_EST_DELAY_HIST - 2 periods), an
  * encoder resolution > 0, process-noise variances 0 or normal floats up to
  * BR_EST_VAR_MAX (no subnormals), R from BR_EST_R_MIN_COUNTS2 counts^2 up to
- * BR_EST_VAR_MAX, 0 < gp_min < gp_max with gp0 inside, an outlier gate > 0, at
+ * BR_EST_VAR_MAX, 0 < gp_min < gp_max with gp0 inside, an outlier gate in
+ * (0, BR_EST_GATE_MAX_SIGMA], at
  * least one outlier before re-anchoring. BR_OK, BR_E_NULL or BR_E_PARAM. */
 br_status_t br_est_cfg_check(const br_est_cfg_t *cfg);
 
