@@ -241,10 +241,33 @@ static void test_integrator_clamped_both_ways(void **st)
     }
 }
 
+/* Saturated for 10 s, then the setpoint reverses: no windup, the command
+ * leaves the limit at the first period (reliability checklist). */
+static void test_no_windup_after_long_saturation(void **st)
+{
+    (void)st;
+    br_ctrl_t c;
+    const br_ctrl_cfg_t k = cfg();
+    br_ctrl_out_t out;
+    assert_int_equal(br_ctrl_init(&c, &k), BR_OK);
+    const long n = (long)(10.0 / DT);
+    br_ctrl_in_t in = in_at(0, 2000000); /* far behind: saturated high */
+    for (long i = 0; i < n; i++) {
+        assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+        assert_int_equal(out.saturated, 1);
+    }
+    BR_ASSERT_NEAR(c.eps_rads, 0.0, 0.0);
+    in = in_at(0, -1000); /* the setpoint reverses */
+    assert_int_equal(br_ctrl_step(&c, &in, &out), BR_OK);
+    assert_true(out.tau_Nm < 0.0f);
+    assert_int_equal(out.saturated, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_out_of_range_gives_zero_duty),
+        cmocka_unit_test(test_no_windup_after_long_saturation),
         cmocka_unit_test(test_integrator_clamped_both_ways),
         cmocka_unit_test(test_init_guards),           cmocka_unit_test(test_control_law),
         cmocka_unit_test(test_compensation_adds_torque), cmocka_unit_test(test_saturation_and_antiwindup),

@@ -140,9 +140,56 @@ static void test_step_rejects_bad_input(void **st)
     assert_true(s.z_m == z); /* state untouched by rejected steps */
 }
 
+/* v = 0 for 1e6 steps from a full deflection: z and F stay finite and
+ * |z| <= Fs / sigma0 (reliability checklist 1). */
+static void test_million_steps_at_rest(void **st)
+{
+    (void)st;
+    br_lugre_t s;
+    br_lugre_cfg_t c = ref_cfg();
+    assert_int_equal(br_lugre_init(&s, &c), BR_OK);
+    s.z_m = (float)(FS / SIGMA0);
+    float F = 0.0f;
+    for (long k = 0; k < 1000000L; k++) {
+        assert_int_equal(br_lugre_step(&s, 0.0f, 1e-3f, &F), BR_OK);
+    }
+    assert_true(isfinite(s.z_m) && isfinite(F));
+    assert_true(fabsf(s.z_m) <= (float)(FS / SIGMA0));
+    BR_ASSERT_NEAR(F, FS, 1e-5 * FS); /* the deflection holds: a spring at rest */
+}
+
+/* A bristle stiffness of 1e8 N/m at 1 ms (a h up to 5e5): no oscillation or
+ * NaN, and the same deflection as the exact map evaluated in double
+ * (reliability checklist 2). */
+static void test_stiff_bristle_matches_double(void **st)
+{
+    (void)st;
+    br_lugre_t s;
+    br_lugre_cfg_t c = ref_cfg();
+    c.sigma0_Npm = 1.0e8f;
+    assert_int_equal(br_lugre_init(&s, &c), BR_OK);
+    const double s0 = c.sigma0_Npm, fc = c.Fc_N, fs = c.Fs_N, vs = c.vs_mps, h = 1e-3;
+    double z = 0.0;
+    float F = 0.0f;
+    for (int k = 0; k < 4000; k++) {
+        /* 50 mm/s, reversing every 0.5 s, with slow passages through zero */
+        const float v = 0.05f * sinf(2.0f * 3.14159265f * (float)k / 1000.0f);
+        assert_int_equal(br_lugre_step(&s, v, (float)h, &F), BR_OK);
+        const double vd = (double)v, g = fc + (fs - fc) * exp(-fabs(vd) / vs), dx = vd * h;
+        if (dx != 0.0) {
+            const double zss = (dx > 0.0 ? 1.0 : -1.0) * g / s0;
+            z = zss + (z - zss) * exp(-s0 * fabs(dx) / g);
+        }
+        assert_true(isfinite(F) && fabsf(s.z_m) <= (float)(fs / s0) * (1.0f + 1e-6f));
+        BR_ASSERT_NEAR(s.z_m, z, 1e-5 * fs / s0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_million_steps_at_rest),
+        cmocka_unit_test(test_stiff_bristle_matches_double),
         cmocka_unit_test(test_init_accepts_machine), cmocka_unit_test(test_init_guards),
         cmocka_unit_test(test_stribeck_curve),         cmocka_unit_test(test_rate_and_force),
         cmocka_unit_test(test_steady_sliding_reaches_g), cmocka_unit_test(test_presliding_is_a_spring),
