@@ -221,6 +221,61 @@ static void test_ukf_predict_only(void **st)
     BR_ASSERT_NEAR(u.P[BR_X_THETA][BR_X_THETA], locked, 0.1 * locked);
 }
 
+/* The UKF's shipped gate (the machine file's) rejects a 10-sigma jump of the
+ * innovation: the prediction is kept in the old frame. (The PF's gate, on
+ * the distance to every particle, stays at 30 sigma: docs/modules/pf.md.) */
+static void test_shipped_ukf_gate_rejects_10_sigma(void **st)
+{
+    (void)st;
+    br_ukf_t u;
+    const br_ukf_cfg_t uc = br_circle_ukf_cfg_tuned(UKF_DT_S);
+    assert_true(uc.est.outlier_sigma < 10.0f);
+    assert_int_equal(br_ukf_init(&u, &uc), BR_OK);
+    const br_meas_t y = {1000, 0.5f};
+    for (int k = 0; k < 50; k++) {
+        assert_int_equal(br_ukf_step(&u, &y, 0.0f), BR_OK);
+    }
+    /* the innovation's standard deviation sqrt(S), S = P-_00 + R, in counts */
+    const double sd = sqrt((double)u.P[0][0] + uc.est.r_var_rad2) / uc.est.rad_per_count;
+    const br_meas_t jump = {1000 + (int32_t)ceil(10.0 * sd), 0.5f};
+    assert_int_equal(br_ukf_step(&u, &jump, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(br_ukf_estimate(&u)->origin_counts, 1000); /* no update: the old frame */
+}
+
+/* Many resamplings in a row at rest (3 s): the cloud keeps its spread in g_p
+ * (the process noise the init insists on), it does not collapse onto a few
+ * ancestors. */
+static void test_pf_spread_survives_resampling(void **st)
+{
+    (void)st;
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    const br_pf_cfg_t c = br_circle_pf_cfg_tuned(PF_DT_S);
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    const br_meas_t y = {0, 0.5f};
+    for (int k = 0; k < 2000; k++) {
+        assert_false(BR_FAILED(br_pf_step(pf, &y, 0.0f)));
+    }
+    const uint32_t m = c.n_particles;
+    double s = 0.0, s2 = 0.0;
+    for (uint32_t j = 0; j < m; j++) s += pf->x[j][BR_X_GP];
+    const double mean = s / m;
+    uint32_t distinct = 0;
+    for (uint32_t j = 0; j < m; j++) {
+        const double d = pf->x[j][BR_X_GP] - mean;
+        s2 += d * d;
+        int seen = 0;
+        for (uint32_t i = 0; i < j && !seen; i++) seen = pf->x[i][BR_X_GP] == pf->x[j][BR_X_GP];
+        distinct += !seen;
+    }
+    const double sd = sqrt(s2 / m), q = sqrt((double)c.est.q_var[BR_X_GP]);
+    print_message("after 2000 resamplings: g_p spread %.3g N (process noise %.3g N per step), %u of %u distinct\n",
+                  sd, q, distinct, m);
+    assert_true(sd > 0.3 * q);
+    assert_true(distinct > m / 4u);
+    free(pf);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -231,6 +286,8 @@ int main(void)
         cmocka_unit_test(test_ukf_recovers_from_huge_covariance),
         cmocka_unit_test(test_pf_predict_only),
         cmocka_unit_test(test_ukf_predict_only),
+        cmocka_unit_test(test_shipped_ukf_gate_rejects_10_sigma),
+        cmocka_unit_test(test_pf_spread_survives_resampling),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
