@@ -221,27 +221,6 @@ static void test_ukf_predict_only(void **st)
     BR_ASSERT_NEAR(u.P[BR_X_THETA][BR_X_THETA], locked, 0.1 * locked);
 }
 
-/* The UKF's shipped gate (the machine file's) rejects a 10-sigma jump of the
- * innovation: the prediction is kept in the old frame. (The PF's gate, on
- * the distance to every particle, stays at 30 sigma: docs/modules/pf.md.) */
-static void test_shipped_ukf_gate_rejects_10_sigma(void **st)
-{
-    (void)st;
-    br_ukf_t u;
-    const br_ukf_cfg_t uc = br_circle_ukf_cfg_tuned(UKF_DT_S);
-    assert_true(uc.est.outlier_sigma < 10.0f);
-    assert_int_equal(br_ukf_init(&u, &uc), BR_OK);
-    const br_meas_t y = {1000, 0.5f};
-    for (int k = 0; k < 50; k++) {
-        assert_int_equal(br_ukf_step(&u, &y, 0.0f), BR_OK);
-    }
-    /* the innovation's standard deviation sqrt(S), S = P-_00 + R, in counts */
-    const double sd = sqrt((double)u.P[0][0] + uc.est.r_var_rad2) / uc.est.rad_per_count;
-    const br_meas_t jump = {1000 + (int32_t)ceil(10.0 * sd), 0.5f};
-    assert_int_equal(br_ukf_step(&u, &jump, 0.0f), BR_W_OUTLIER);
-    assert_int_equal(br_ukf_estimate(&u)->origin_counts, 1000); /* no update: the old frame */
-}
-
 /* Many resamplings in a row at rest (3 s): the cloud keeps its spread in g_p
  * (the process noise the init insists on), it does not collapse onto a few
  * ancestors. */
@@ -286,7 +265,6 @@ int main(void)
         cmocka_unit_test(test_ukf_recovers_from_huge_covariance),
         cmocka_unit_test(test_pf_predict_only),
         cmocka_unit_test(test_ukf_predict_only),
-        cmocka_unit_test(test_shipped_ukf_gate_rejects_10_sigma),
         cmocka_unit_test(test_pf_spread_survives_resampling),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

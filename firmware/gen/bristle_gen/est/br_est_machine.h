@@ -89,8 +89,8 @@
 #define BR_EST_UKF_GP_MAX_N (40.0)
 #define BR_EST_UKF_GP_MAX_N_F (4.000000000e+01f)
 /* outlier gate, standard deviations */
-#define BR_EST_UKF_OUTLIER_SIGMA (8.0)
-#define BR_EST_UKF_OUTLIER_SIGMA_F (8.000000000e+00f)
+#define BR_EST_UKF_OUTLIER_SIGMA (50.0)
+#define BR_EST_UKF_OUTLIER_SIGMA_F (5.000000000e+01f)
 /* consecutive outliers before re-anchoring */
 #define BR_EST_UKF_REANCHOR_AFTER 3u
 /* sigma-point spread */
