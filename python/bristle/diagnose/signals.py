@@ -24,7 +24,10 @@ intervals; every relerr the report gives is measured on the rest, the last
 import numpy as np
 from scipy import signal
 
+from .params import GT0, Param
+
 FC_HZ = 50.0
+FC_PARAM = Param("fc_hz", "Hz", "the low-pass cutoff (--fc, model.json's filter)", GT0, 1e6)
 FC_MAX_FRAC = 0.4
 ORDER = 4
 EDGE_S = 0.15

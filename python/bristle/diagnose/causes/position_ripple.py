@@ -13,14 +13,14 @@ import math
 import numpy as np
 from scipy import optimize
 
-from ..params import Param
+from ..params import GT0, Param
 
 NAME = "position_ripple"
 MEANING = "a force periodic in position: screw lead error, ball recirculation, motor cogging"
 OPTION = "--ripple"
-PARAMS = (Param("ripple_amp_N", "N", "amplitude A of A sin(2πx/P + φ)"),
-          Param("ripple_period_m", "m", "its period P in load position", True),
-          Param("ripple_phase_rad", "rad", "its phase φ at x = 0"))
+PARAMS = (Param("ripple_amp_N", "N", "amplitude A of A sin(2πx/P + φ)", -1e5, 1e5),
+          Param("ripple_period_m", "m", "its period P in load position", GT0, 10.0),
+          Param("ripple_phase_rad", "rad", "its phase φ at x = 0", -1e3, 1e3))
 NL = ("ripple_period_m",)
 PERIODS = 400
 PEAKS = 3
