@@ -13,7 +13,8 @@ locale. A number's magnitude is at most MAX_ABS.
 
 Rejected, with "file:line: problem" (an echoed cell cut to SHOW_CHARS): a
 header lacking a column, a row with the wrong number of fields, malformed
-quoting, an empty or non-numeric cell, NaN or infinity, a number beyond
+quoting, a field longer than csv.field_size_limit() (131072 characters), an
+empty or non-numeric cell, NaN or infinity, a number beyond
 MAX_ABS, a time that does not increase, a time step that differs from the
 first one by more than UNIFORM_TOL of it, fewer than MIN_SAMPLES rows; and,
 in read_log, a force or position that never changes (nothing to fit).
@@ -37,7 +38,7 @@ BLOCK_ROWS = 65536
 DEFAULT_MAX_SAMPLES = 2_000_000
 MAX_ABS = 1e9               # s, m, N: beyond it a cell is not a measurement
 SHOW_CHARS = 40             # an echoed cell is cut to this many characters
-COUNT_CHUNK = 1 << 22
+COUNT_CHUNK = 1 << 20
 
 NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 DECIMAL_COMMA = re.compile(r"[+-]?[0-9]+,[0-9]+")
@@ -139,6 +140,9 @@ def _rows(path):
             except StopIteration:
                 break
             except csv.Error as e:
+                if "field limit" in str(e):
+                    raise LogError(display, start, f"a field longer than {csv.field_size_limit()} characters, "
+                                   "not a measurement") from None
                 raise LogError(display, start, f"malformed quoting ({e})") from None
             lineno, start = start, lines.n + 1
             if not cells or (len(cells) == 1 and not cells[0].strip()):
