@@ -34,7 +34,7 @@ EDGE_S = 0.15
 EDGE_MIN = 50
 TRAIN_FRAC = 0.7
 MEMO_MAX = 64
-MEMO_BYTES = 256 << 20      # the memo's arrays at most (a long log: a few entries)
+MEMO_BYTES = 128 << 20      # the memo's arrays at most (a long log: a few entries)
 
 
 class Prepared:
