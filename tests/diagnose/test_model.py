@@ -11,7 +11,7 @@ import unittest
 
 import numpy as np
 
-from bristle.diagnose import causes, closedloop, logreader, lugre, model, modelfile, selection, signals
+from bristle.diagnose import causes, closedloop, logreader, lugre, model, modelfile, params, selection, signals
 from bristle.diagnose.causes import actuator_delay
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -300,10 +300,11 @@ class OneTableTest(unittest.TestCase):
             text = f.read()
         section = text[text.index("\n## Parameters"):]
         section = section[:section.index("\n## ", 1)]
-        rows = re.findall(r"^\| `(\w+)` \| ([^|]*?) \| ([^|]*?) \|", section, re.M)
+        rows = re.findall(r"^\| `(\w+)` \| ([^|]*?) \| ([^|]*?) \| ([^|]*?) \|", section, re.M)
         self.assertEqual([r[0] for r in rows], [q.name for q in causes.MODEL_PARAMS])
-        for (name, unit, cause), q in zip(rows, causes.MODEL_PARAMS):
+        for (name, unit, cause, bounds), q in zip(rows, causes.MODEL_PARAMS):
             self.assertEqual(unit, q.unit, name)
+            self.assertEqual("must be " + bounds, params.bounds_text(q.lo, q.hi), name)
             m = self.owner(name)
             self.assertEqual(cause, m.NAME if m else "nominal", name)
 

@@ -10,7 +10,7 @@ Exit status: 0, 1 when the log, model or machine file cannot be used (a
 message "file:line: problem" on stderr), 2 on a usage error.
 """
 import argparse
-import json
+import math
 import os
 import sys
 
@@ -106,6 +106,8 @@ def cmd_validate(args):
     fit = model.from_params(m["params"], m.get("causes", []))
     w = prep.whole
     rel = fit.relerr(prep, w)
+    if not math.isfinite(rel):
+        raise ValueError(f"{args.model}: the model's prediction is not finite on this log")
     line = (f"{args.log}: relerr {rel:.4g} % over {w.stop - w.start} samples (the whole log) with "
             f"{args.model} ({' + '.join(m.get('causes', [])) or 'nominal'})")
     if "nominal_params" in m:
