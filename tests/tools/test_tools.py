@@ -81,6 +81,14 @@ class ToolsTest(unittest.TestCase):
                     '"sigma0_Npm": 1e6, "sigma1_Nspm": 100}}')
         r = run("br_simlog", "--out", out, "--machine-out", machine, "--model", model, "--cycles", "1")
         self.assert_refused(r, 1, "nothing written")
+        # a run that fails part-way, 0.3 s into the log, after rows went to the temporary file:
+        # a moving mass of 1e-300 kg (within its bounds) sends the plant state to infinity
+        with open(model, "w") as f:
+            f.write('{"params": {"Meff_kg": 1e-300, "sigma2_Nspm": 100, "Fc_N": 20, "Fs_N": 30, "vs_mps": 0.01, '
+                    '"sigma0_Npm": 1e6, "sigma1_Nspm": 100}}')
+        r = run("br_simlog", "--out", out, "--machine-out", machine, "--model", model, "--cycles", "1")
+        self.assert_refused(r, 1, "not finite")
+        self.assertIn("nothing written", r.stderr)
         os.remove(model)
         self.assert_untouched(out, machine)
 
