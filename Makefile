@@ -27,6 +27,7 @@ DEMO_OUT   := out/demo
 HIDDEN_OUT := out/diagnose-hidden
 TUNE_OUT   := out/tune
 BENCH_OUT  := out/bench
+DIAG_BENCH_OUT := out/diagnose-bench
 TARGET_BENCH_OUT := out/target-bench
 BENCH      := build/host-release/sim/bench/br_bench
 
@@ -57,7 +58,7 @@ define print_size
 	  END { exit ok ? 0 : 1 }'
 endef
 
-.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control firmware regen clean distclean
+.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench firmware regen clean distclean
 
 help:
 	@echo "bristle targets:"
@@ -70,6 +71,7 @@ help:
 	@echo "  make validate MODEL=<model.json> LOG=<csv>          a saved model's relerr on another log"
 	@echo "  make diagnose-hidden  the hidden-cause suite -> docs/diagnose-hidden.md"
 	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
+	@echo "  make diagnose-bench   peak memory of a diagnosis of a 2e6-row log written by br_simlog (docs/diagnose.md, Memory)"
 	@echo "  make firmware  cross build (cm7-release), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
@@ -164,6 +166,14 @@ diagnose-control: deps
 	$(Q)echo "== diagnosis in control terms -> out/diagnose-control, docs/diagnose-control.md"
 	$(Q)PYTHONPATH=python $(PYTHON) sim/studies/diagnose_control.py --bin build/host-release/sim --work out/diagnose-control \
 	  --est ukf,pf --md docs/diagnose-control.md
+
+# Peak RSS of a diagnosis of a 2 million-row log (br_simlog writes it, about
+# 120 MB, into $(DIAG_BENCH_OUT)); goal under 1 GB. docs/diagnose.md, "Memory".
+diagnose-bench: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== diagnosis memory benchmark -> $(DIAG_BENCH_OUT)"
+	$(Q)$(PYTHON) sim/studies/diagnose_memory.py --simlog build/host-release/sim/br_simlog --work $(DIAG_BENCH_OUT) --rows 2000000
 
 diagnose-hidden: deps
 	$(call configure,host-release)

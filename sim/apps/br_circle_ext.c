@@ -6,26 +6,42 @@
  * br_model_cfg_t.causes set from the model's. docs/diagnose.md.
  *
  * Usage: br_circle_ext [--model MODEL.json] [--est ukf|pf] [--json OUT] [cause options]
- * Prints one line per run and, with --json, writes them. */
+ * Prints one line per run and, with --json, writes them (to a temporary file
+ * renamed at the end, br_outfile.h: a failed run writes nothing). */
 #define _POSIX_C_SOURCE 200809L
-#include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "simlog/br_cause_args.h"
 #include "circle/br_circle.h"
 #include "plant/br_model_params.h"
 #include "plant/br_plant_json.h"
+#include "simlog/br_cause_args.h"
+#include "tools/br_args.h"
+#include "tools/br_outfile.h"
+
+#define TOOL "br_circle_ext"
+
+static int usage(const char *argv0, FILE *to)
+{
+    fprintf(to, "usage: %s [--model MODEL.json] [--est ukf|pf] [--json OUT] [--offset F] [--asym DFC,DFV]\n"
+                "       [--ripple A,P[,PH]] [--gradient S] [--delay D]\n", argv0);
+    return 2;
+}
 
 int main(int argc, char **argv)
 {
     const char *model = NULL, *json = NULL, *est = "ukf";
     br_plant_cfg_t plant = br_plant_cfg_reference();
+    if (br_args_want_help(argc, argv)) {
+        usage(argv[0], stdout);
+        return 0;
+    }
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
         if (!val) {
-            fprintf(stderr, "br_circle_ext: %s needs a value\n", a);
-            return 2;
+            fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
+            return usage(argv[0], stderr);
         }
         i++;
         const int ca = br_cause_arg(a, val, &plant);
@@ -35,16 +51,15 @@ int main(int argc, char **argv)
         else if (strcmp(a, "--json") == 0) json = val;
         else if (strcmp(a, "--est") == 0 && (strcmp(val, "ukf") == 0 || strcmp(val, "pf") == 0)) est = val;
         else {
-            fprintf(stderr, "usage: %s [--model MODEL.json] [--est ukf|pf] [--json OUT] [--offset F] [--asym DFC,DFV]\n"
-                            "       [--ripple A,P[,PH]] [--gradient S] [--delay D]\n", argv[0]);
-            return 2;
+            fprintf(stderr, "%s: bad option or value: %s %s\n", TOOL, a, val);
+            return usage(argv[0], stderr);
         }
     }
     const int use_pf = strcmp(est, "pf") == 0;
     br_plant_cfg_t saved;
     char msg[512];
     if (model && br_plant_cfg_from_model_json(model, &plant, &saved, msg, sizeof msg) != 0) {
-        fprintf(stderr, "br_circle_ext: %s\n", msg);
+        fprintf(stderr, "%s: %s\n", TOOL, msg);
         return 1;
     }
     const br_circle_ctrl_t ctrl = use_pf ? BR_CTRL_HINF_PF : BR_CTRL_HINF_UKF;
@@ -53,14 +68,11 @@ int main(int argc, char **argv)
         br_circle_ctrl_t ctrl;
         int extended;
     } runs[3] = {{"hinf_only", BR_CTRL_HINF_ONLY, 0}, {"est_nominal", ctrl, 0}, {"est_extended", ctrl, 1}};
-    FILE *js = NULL;
+    br_outfile_t js = {0}; /* a temporary file until every run succeeded (br_outfile.h) */
     if (json) {
-        js = fopen(json, "w");
-        if (!js) {
-            fprintf(stderr, "br_circle_ext: cannot write %s: %s\n", json, strerror(errno));
-            return 1;
-        }
-        fprintf(js, "{\n  \"generator\": \"br_circle_ext (sim/apps/br_circle_ext.c)\",\n  \"estimator\": \"%s\"", est);
+        if (br_outfile_open(&js, TOOL, json) != 0) return 1;
+        fprintf(js.f, "{\n  \"generator\": \"br_circle_ext (sim/apps/br_circle_ext.c)\",\n  \"estimator\": \"%s\"",
+                est);
     }
     for (int r = 0; r < (model ? 3 : 2); r++) {
         br_circle_cfg_t c = br_circle_cfg_thesis(runs[r].ctrl);
@@ -72,26 +84,28 @@ int main(int argc, char **argv)
             c.ukf.est.model.causes = causes;
         }
         br_circle_result_t res;
+        /* 1: the firmware stopped the axis safe (a fault), part of the result */
         const int rc = br_circle_run(&c, NULL, NULL, &res);
-        if (rc < 0) {
-            fprintf(stderr, "br_circle_ext: run %s failed\n", runs[r].name);
+        if (rc < 0 || !isfinite(res.contour_rms_m) || !isfinite(res.max_err_m)) {
+            fprintf(stderr, "%s: run %s %s; nothing written\n", TOOL, runs[r].name,
+                    rc < 0 ? "failed" : "gave a non-finite result");
+            br_outfile_discard(&js);
             return 1;
         }
-        /* rc 1: the firmware stopped the axis safe (a fault), part of the result */
         printf("%-14s contour RMS %.4e m, max %.4e m, outlier steps %d", runs[r].name, res.contour_rms_m,
                res.max_err_m, res.outlier_steps);
         if (res.fault_status != 0) printf(", fault (status %d) at %.4f s", res.fault_status, res.fault_t_s);
         printf("\n");
-        if (js)
-            fprintf(js,
+        if (js.f)
+            fprintf(js.f,
                     ",\n  \"%s\": {\"contour_rms_m\": %.6e, \"max_err_m\": %.6e, \"outlier_steps\": %d, "
                     "\"fault_status\": %d, \"fault_t_s\": %.6g}",
                     runs[r].name, res.contour_rms_m, res.max_err_m, res.outlier_steps, res.fault_status,
                     res.fault_t_s);
     }
-    if (js) {
-        fprintf(js, "\n}\n");
-        if (fclose(js) != 0) return 1;
+    if (js.f) {
+        fprintf(js.f, "\n}\n");
+        if (br_outfile_commit(&js, TOOL) != 0) return 1;
     }
     return 0;
 }

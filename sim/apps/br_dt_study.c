@@ -25,8 +25,10 @@
 #include "circle/br_circle.h"
 #include "circle/br_circle_est.h"
 #include "bristle_gen/est/br_est_machine.h"
+#include "tools/br_args.h"
 #include "bristle_gen/machine/br_machine.h"
 
+#define TOOL "br_dt_study"
 #define DT0_S 0.5e-3
 #define N_DT 6
 #define SKIP_S 0.5
@@ -50,25 +52,39 @@ static void log_sink(void *user, const br_circle_sample_t *s)
     g->n++;
 }
 
+static int usage(const char *argv0, FILE *to)
+{
+    fprintf(to, "usage: %s [--m-per-ms K | --budget F --cost-ns c] [--seeds S]\n"
+                "bounds: K 1e-3 .. 1e6, F 1e-6 .. 1, c 1e-3 .. 1e9 ns, S 2 .. %d\n", argv0, MAX_SEEDS);
+    return 2;
+}
+
 int main(int argc, char **argv)
 {
     double m_per_ms = 1000.0, budget = 0.0, cost_ns = 0.0;
-    int seeds = 4;
-    for (int i = 1; i + 1 < argc; i += 2) {
-        int ok = 1;
-        if (strcmp(argv[i], "--m-per-ms") == 0) ok = sscanf(argv[i + 1], "%lf", &m_per_ms) == 1 && m_per_ms > 0;
-        else if (strcmp(argv[i], "--budget") == 0) ok = sscanf(argv[i + 1], "%lf", &budget) == 1 && budget > 0;
-        else if (strcmp(argv[i], "--cost-ns") == 0) ok = sscanf(argv[i + 1], "%lf", &cost_ns) == 1 && cost_ns > 0;
-        else if (strcmp(argv[i], "--seeds") == 0) ok = sscanf(argv[i + 1], "%d", &seeds) == 1 && seeds >= 2 && seeds <= MAX_SEEDS;
-        else ok = 0;
-        if (!ok) {
-            fprintf(stderr, "br_dt_study: bad option %s %s (see the source's header)\n", argv[i], argv[i + 1]);
-            return 2;
-        }
+    long seeds = 4;
+    if (br_args_want_help(argc, argv)) {
+        usage(argv[0], stdout);
+        return 0;
     }
-    if ((budget > 0) != (cost_ns > 0) || argc % 2 != 1) {
-        fprintf(stderr, "usage: %s [--m-per-ms K | --budget F --cost-ns c] [--seeds S]\n", argv[0]);
-        return 2;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[++i] : NULL;
+        int bad = v == NULL;
+        if (bad) fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
+        else if (strcmp(a, "--m-per-ms") == 0) bad = br_arg_double(TOOL, a, v, 1e-3, 1e6, &m_per_ms);
+        else if (strcmp(a, "--budget") == 0) bad = br_arg_double(TOOL, a, v, 1e-6, 1.0, &budget);
+        else if (strcmp(a, "--cost-ns") == 0) bad = br_arg_double(TOOL, a, v, 1e-3, 1e9, &cost_ns);
+        else if (strcmp(a, "--seeds") == 0) bad = br_arg_long(TOOL, a, v, 2, MAX_SEEDS, &seeds);
+        else {
+            fprintf(stderr, "%s: unknown option %s\n", TOOL, a);
+            bad = 1;
+        }
+        if (bad) return usage(argv[0], stderr);
+    }
+    if ((budget > 0) != (cost_ns > 0)) {
+        fprintf(stderr, "%s: --budget and --cost-ns go together\n", TOOL);
+        return usage(argv[0], stderr);
     }
     /* 1. the log: H-inf-only circle at 0.5 ms */
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
@@ -129,9 +145,14 @@ int main(int argc, char **argv)
                 cnt++;
             }
         }
+        const double rms = sqrt(tot2 / cnt), bias = sqrt(bias2 / cnt), mc = sqrt(mc2 / cnt);
+        if (cnt == 0 || !isfinite(rms) || !isfinite(bias) || !isfinite(mc)) {
+            fprintf(stderr, "%s: dt = %g s gave a non-finite error\n", TOOL, dt);
+            return 1;
+        }
         printf("{\"dt_s\": %.6g, \"particles\": %u, \"rms_err_N\": %.6e, \"bias_N\": %.6e, \"mc_N\": %.6e, "
                "\"outliers\": %d, \"seeds\": %d}\n",
-               dt, m, sqrt(tot2 / cnt), sqrt(bias2 / cnt), sqrt(mc2 / cnt), outliers, seeds);
+               dt, m, rms, bias, mc, outliers, (int)seeds);
         fflush(stdout);
     }
     free(pf);

@@ -7,78 +7,132 @@
  *            default: the committed ROM table
  *   --q      process noise variances: theta in counts^2, omega (rad/s)^2,
  *            z m^2, g_p N^2; --r measurement variance in counts^2
- * Prints one JSON object: contour_rms_m, max_err_m, fhat_rms_err_N, outliers. */
+ * Prints one JSON object: contour_rms_m, max_err_m, fhat_rms_err_N, outliers
+ * (exit 1 when one is not finite). Bounds: br_tool_limits.h. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "circle/br_circle.h"
+#include "tools/br_args.h"
+#include "tools/br_tool_limits.h"
+
+#define TOOL "br_pf_study"
 
 static float *load_table(const char *path, uint32_t *len)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
-        fprintf(stderr, "br_pf_study: cannot open %s\n", path);
+        fprintf(stderr, "%s: cannot open %s\n", TOOL, path);
         return NULL;
     }
-    fseek(f, 0, SEEK_END);
-    long bytes = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    uint32_t n = (uint32_t)(bytes / (long)sizeof(float));
-    float *t = malloc((size_t)n * sizeof *t);
-    if (!t || n < 2 || (n & (n - 1)) || fread(t, sizeof *t, n, f) != n) {
-        fprintf(stderr, "br_pf_study: %s: need 2^k float32 samples (%ld bytes read)\n", path, bytes);
+    long bytes = -1;
+    if (fseek(f, 0, SEEK_END) == 0) bytes = ftell(f);
+    const long n = bytes / (long)sizeof(float);
+    float *t = NULL;
+    if (bytes < 0 || n < 2 || n > BR_TOOL_TABLE_MAX_SAMPLES || (n & (n - 1)) || bytes % (long)sizeof(float) ||
+        fseek(f, 0, SEEK_SET) != 0 || !(t = malloc((size_t)n * sizeof *t)) || fread(t, sizeof *t, (size_t)n, f) != (size_t)n) {
+        fprintf(stderr, "%s: %s: need 2^k float32 samples, 2 .. %ld (%ld bytes)\n", TOOL, path,
+                BR_TOOL_TABLE_MAX_SAMPLES, bytes);
         free(t);
         fclose(f);
         return NULL;
     }
     fclose(f);
-    *len = n;
+    for (long i = 0; i < n; i++) {
+        if (!isfinite(t[i])) {
+            fprintf(stderr, "%s: %s: sample %ld is not finite\n", TOOL, path, i);
+            free(t);
+            return NULL;
+        }
+    }
+    *len = (uint32_t)n;
     return t;
+}
+
+static int usage(const char *argv0, FILE *to)
+{
+    fprintf(to,
+            "usage: %s [--table FILE] [--skip N] [--particles M] [--dt S] [--q QTH,QW,QZ,QG] [--r R] [--duration S]\n"
+            "bounds: --particles 1 .. %u, --dt %g .. %g s, --duration %g .. %g s (docs/tools.md)\n",
+            argv0, BR_TOOL_PARTICLES_MAX, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_DURATION_MIN_S,
+            BR_TOOL_DURATION_MAX_S);
+    return 2;
+}
+
+/* n comma-separated finite numbers >= 0 (variances) */
+static int parse_variances(const char *val, float *q, int n)
+{
+    const char *p = val;
+    for (int k = 0; k < n; k++) {
+        char *end = NULL;
+        const float v = strtof(p, &end);
+        if (end == p || !isfinite(v) || v < 0.0f || *end != (k + 1 < n ? ',' : '\0')) return -1;
+        q[k] = v;
+        p = end + 1;
+    }
+    return 0;
 }
 
 int main(int argc, char **argv)
 {
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     const float rpc = c.pf.est.rad_per_count;
-    float *table = NULL;
+    const char *table_path = NULL;
+    if (br_args_want_help(argc, argv)) {
+        usage(argv[0], stdout);
+        return 0;
+    }
     for (int i = 1; i < argc; i++) {
-        const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
-        int ok = v != NULL;
-        if (ok && strcmp(argv[i], "--table") == 0) {
-            table = load_table(v, &c.pf.noise_len);
-            ok = table != NULL;
-            c.pf.noise = table;
-        } else if (ok && strcmp(argv[i], "--skip") == 0) {
-            ok = sscanf(v, "%u", &c.pf.noise_skip) == 1;
-        } else if (ok && strcmp(argv[i], "--particles") == 0) {
-            ok = sscanf(v, "%u", &c.pf.n_particles) == 1;
-        } else if (ok && strcmp(argv[i], "--dt") == 0) {
-            ok = sscanf(v, "%lf", &c.dt_s) == 1;
+        const char *a = argv[i];
+        const char *v = (i + 1 < argc) ? argv[++i] : NULL;
+        long n = 0;
+        int bad = v == NULL;
+        if (bad) {
+            fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
+        } else if (strcmp(a, "--table") == 0) {
+            table_path = v;
+        } else if (strcmp(a, "--skip") == 0) {
+            bad = br_arg_long(TOOL, a, v, 0, BR_TOOL_TABLE_MAX_SAMPLES, &n);
+            c.pf.noise_skip = (uint32_t)n;
+        } else if (strcmp(a, "--particles") == 0) {
+            bad = br_arg_long(TOOL, a, v, 1, BR_TOOL_PARTICLES_MAX, &n);
+            c.pf.n_particles = (uint32_t)n;
+        } else if (strcmp(a, "--dt") == 0) {
+            bad = br_arg_double(TOOL, a, v, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, &c.dt_s);
             c.pf.est.model.dt_s = (float)c.dt_s;
-        } else if (ok && strcmp(argv[i], "--duration") == 0) {
-            ok = sscanf(v, "%lf", &c.duration_s) == 1;
-        } else if (ok && strcmp(argv[i], "--q") == 0) {
+        } else if (strcmp(a, "--duration") == 0) {
+            bad = br_arg_double(TOOL, a, v, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &c.duration_s);
+        } else if (strcmp(a, "--q") == 0) {
             float *q = c.pf.est.q_var;
-            ok = sscanf(v, "%f,%f,%f,%f", &q[0], &q[1], &q[2], &q[3]) == 4;
+            bad = parse_variances(v, q, 4);
             q[0] *= rpc * rpc;
-        } else if (ok && strcmp(argv[i], "--r") == 0) {
-            ok = sscanf(v, "%f", &c.pf.est.r_var_rad2) == 1;
+            if (bad) fprintf(stderr, "%s: --q %s: four comma-separated numbers >= 0\n", TOOL, v);
+        } else if (strcmp(a, "--r") == 0) {
+            bad = parse_variances(v, &c.pf.est.r_var_rad2, 1) || c.pf.est.r_var_rad2 <= 0.0f;
             c.pf.est.r_var_rad2 *= rpc * rpc;
+            if (bad) fprintf(stderr, "%s: --r %s: a number > 0\n", TOOL, v);
         } else {
-            ok = 0;
+            fprintf(stderr, "%s: unknown option %s\n", TOOL, a);
+            bad = 1;
         }
-        if (!ok) {
-            fprintf(stderr, "br_pf_study: bad or unknown option %s (see the source's header)\n", argv[i]);
-            free(table);
-            return 2;
-        }
-        i++;
+        if (bad) return usage(argv[0], stderr);
+    }
+    float *table = NULL;
+    if (table_path) {
+        table = load_table(table_path, &c.pf.noise_len);
+        if (!table) return 1;
+        c.pf.noise = table;
     }
     br_circle_result_t r;
     int rc = br_circle_run(&c, NULL, NULL, &r);
     free(table);
     if (rc != 0) return 1;
+    if (!isfinite(r.contour_rms_m) || !isfinite(r.max_err_m) || !isfinite(r.fhat_rms_err_N)) {
+        fprintf(stderr, "%s: the run gave a non-finite result\n", TOOL);
+        return 1;
+    }
     printf("{\"contour_rms_m\": %.6e, \"max_err_m\": %.6e, \"fhat_rms_err_N\": %.6e, \"outliers\": %d}\n",
            r.contour_rms_m, r.max_err_m, r.fhat_rms_err_N, r.outlier_steps);
     return 0;

@@ -11,9 +11,13 @@
  * --machine-out (identification run) writes the position loop as a machine
  * file for the diagnosis (its closed-loop re-simulation); named
  * <log>.machine.json beside the log, the diagnosis finds it by itself.
+ *
+ * Every option is checked (bounds: br_tool_limits.h) and the model read
+ * before any output is touched; the outputs are written beside their names
+ * and renamed at the end (br_outfile.h): a failed run writes nothing.
  */
 #define _POSIX_C_SOURCE 200809L
-#include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -23,8 +27,12 @@
 #include "simlog/br_cause_args.h"
 #include "circle/br_circle.h"
 #include "simlog/br_ident.h"
+#include "tools/br_args.h"
+#include "tools/br_outfile.h"
+#include "tools/br_tool_limits.h"
 #include "plant/br_plant_json.h"
 
+#define TOOL "br_simlog"
 #define BR_PI 3.14159265358979323846
 
 /* splitmix64 and Box-Muller: seeded force noise, the same on every machine */
@@ -61,6 +69,7 @@ typedef struct {
     rng_t rng;
     double noise_N;
     int truth;
+    long nonfinite; /* rows with a non-finite value: the run fails */
 } out_t;
 
 static void write_header(const out_t *o)
@@ -72,6 +81,9 @@ static void write_row(out_t *o, double t, double ref, double pos, double force, 
                       double fnl)
 {
     const double f = o->noise_N > 0.0 ? force + o->noise_N * rng_gauss(&o->rng) : force;
+    if (!(isfinite(t) && isfinite(ref) && isfinite(pos) && isfinite(f) && isfinite(pos_true) && isfinite(fnl) &&
+          !isinf(vel_true)))
+        o->nonfinite++;
     fprintf(o->f, "%.6f,%.10e,%.10e,%.8e", t, ref, pos, f);
     if (o->truth) {
         /* the circle's sample has no velocity: an empty cell */
@@ -100,117 +112,159 @@ static void circle_sink(void *user, const br_circle_sample_t *s)
     write_row(c->o, s->t_s, s->ref_m[0], pos, s->duty[0] * c->F_per_duty, s->pos_m[0], NAN, s->fnl_N[0]);
 }
 
-static int usage(const char *argv0)
+static int usage(const char *argv0, FILE *to)
 {
-    fprintf(stderr,
+    fprintf(to,
             "usage: %s --out FILE [--traj ident|circle] [--cycles N] [--duration S] [--seed N]\n"
             "          [--force-noise N] [--model MODEL.json] [--offset F] [--asym DFC,DFV]\n"
-            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--machine-out FILE] [--truth]\n",
-            argv0);
+            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--machine-out FILE] [--truth]\n"
+            "bounds: --cycles 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N (docs/tools.md)\n",
+            argv0, BR_TOOL_CYCLES_MAX, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
     return 2;
 }
 
 /* the machine file of docs/diagnose.md: the position loop of the log */
-static int write_machine(const char *path, const br_ident_cfg_t *c)
+static void write_machine(FILE *f, const br_ident_cfg_t *c)
 {
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "br_simlog: cannot write %s: %s\n", path, strerror(errno));
-        return -1;
-    }
     fprintf(f,
             "{\n  \"generator\": \"br_simlog (sim/apps/br_simlog.c); generated, do not edit\",\n"
             "  \"name\": \"br_simlog identification run\",\n"
             "  \"controller\": {\"type\": \"emps_pd\", \"dt_s\": %.9g, \"kp_1ps\": %.9g, \"kv\": %.9g, "
             "\"gain_N\": %.9g, \"u_max\": %.9g}\n}\n",
             c->dt_s, c->pd.kp_1ps, c->pd.kv, c->pd.gain_N, c->pd.u_max);
-    return fclose(f) == 0 ? 0 : -1;
+}
+
+typedef struct {
+    const char *out, *traj, *model, *machine_out;
+    long cycles, seed;
+    int truth;
+    double duration, noise;
+    br_plant_cfg_t causes;
+} opts_t;
+
+/* every option checked: 0, 1 (--help), or 2 (usage error, message printed) */
+static int parse(int argc, char **argv, opts_t *o)
+{
+    if (br_args_want_help(argc, argv)) return 1;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "--truth") == 0) {
+            o->truth = 1;
+            continue;
+        }
+        if (!val) {
+            fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
+            return 2;
+        }
+        i++;
+        const int ca = br_cause_arg(a, val, &o->causes);
+        int bad = 0;
+        if (ca != 0) bad = ca < 0;
+        else if (strcmp(a, "--out") == 0) o->out = val;
+        else if (strcmp(a, "--traj") == 0) o->traj = val;
+        else if (strcmp(a, "--model") == 0) o->model = val;
+        else if (strcmp(a, "--machine-out") == 0) o->machine_out = val;
+        else if (strcmp(a, "--cycles") == 0) bad = br_arg_long(TOOL, a, val, 1, BR_TOOL_CYCLES_MAX, &o->cycles);
+        else if (strcmp(a, "--seed") == 0) bad = br_arg_long(TOOL, a, val, 0, LONG_MAX, &o->seed);
+        else if (strcmp(a, "--duration") == 0)
+            bad = br_arg_double(TOOL, a, val, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &o->duration);
+        else if (strcmp(a, "--force-noise") == 0) bad = br_arg_double(TOOL, a, val, 0.0, BR_TOOL_NOISE_MAX_N, &o->noise);
+        else {
+            fprintf(stderr, "%s: unknown option %s\n", TOOL, a);
+            bad = 1;
+        }
+        if (bad) return 2;
+    }
+    if (!o->out) {
+        fprintf(stderr, "%s: --out is required\n", TOOL);
+        return 2;
+    }
+    if (strcmp(o->traj, "ident") != 0 && strcmp(o->traj, "circle") != 0) {
+        fprintf(stderr, "%s: --traj %s: must be ident or circle\n", TOOL, o->traj);
+        return 2;
+    }
+    if (o->machine_out && strcmp(o->traj, "ident") != 0) {
+        fprintf(stderr, "%s: --machine-out applies to --traj ident only\n", TOOL);
+        return 2;
+    }
+    if (o->machine_out && strcmp(o->machine_out, o->out) == 0) {
+        fprintf(stderr, "%s: --machine-out and --out name the same file\n", TOOL);
+        return 2;
+    }
+    return 0;
+}
+
+/* the plant: the reference machine or a saved model, then the cause options on top */
+static void apply_causes(br_plant_cfg_t *plant, const br_plant_cfg_t *causes)
+{
+    const br_plant_cfg_t ref = br_plant_cfg_reference();
+    if (causes->offset_N != 0.0) plant->offset_N = causes->offset_N;
+    if (causes->dFc_neg_N != ref.dFc_neg_N || causes->dsigma2_neg_Nspm != ref.dsigma2_neg_Nspm) {
+        plant->dFc_neg_N = causes->dFc_neg_N;
+        plant->dsigma2_neg_Nspm = causes->dsigma2_neg_Nspm;
+    }
+    if (causes->ripple_amp_N != 0.0) {
+        plant->ripple_amp_N = causes->ripple_amp_N;
+        plant->ripple_period_m = causes->ripple_period_m;
+        plant->ripple_phase_rad = causes->ripple_phase_rad;
+    }
+    if (causes->grad_per_m != 0.0) plant->grad_per_m = causes->grad_per_m;
+    if (causes->delay_s != 0.0) plant->delay_s = causes->delay_s;
 }
 
 int main(int argc, char **argv)
 {
-    const char *out = NULL, *traj = "ident", *model = NULL, *machine_out = NULL;
-    int cycles = 0, truth = 0;
-    double duration = 8.0, noise = 0.0;
-    unsigned long long seed = 1;
-    br_plant_cfg_t causes = br_plant_cfg_reference();
-    int bad = 0;
-    for (int i = 1; i < argc && !bad; i++) {
-        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "--truth") == 0) {
-            truth = 1;
-            continue;
-        }
-        if (!val) {
-            bad = 1;
-            break;
-        }
-        i++;
-        char *end = NULL;
-        const int ca = br_cause_arg(a, val, &causes);
-        if (ca != 0) bad = ca < 0;
-        else if (strcmp(a, "--out") == 0) out = val;
-        else if (strcmp(a, "--traj") == 0) traj = val;
-        else if (strcmp(a, "--model") == 0) model = val;
-        else if (strcmp(a, "--machine-out") == 0) machine_out = val;
-        else if (strcmp(a, "--cycles") == 0) bad = !((cycles = atoi(val)) >= 1 && cycles <= 1000);
-        else if (strcmp(a, "--seed") == 0) {
-            seed = strtoull(val, &end, 10);
-            bad = (end == val || *end != '\0');
-        } else if (strcmp(a, "--duration") == 0) bad = !(br_parse_numbers(val, &duration, 1) == 1 && duration > 0.0);
-        else if (strcmp(a, "--force-noise") == 0) bad = !(br_parse_numbers(val, &noise, 1) == 1 && noise >= 0.0);
-        else bad = 1;
-        if (bad) fprintf(stderr, "br_simlog: bad option or value: %s %s\n", a, val);
+    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 8.0, 0.0, br_plant_cfg_reference()};
+    const int p = parse(argc, argv, &opt);
+    if (p == 1) {
+        usage(argv[0], stdout);
+        return 0;
     }
-    if (bad || !out || (strcmp(traj, "ident") != 0 && strcmp(traj, "circle") != 0)) return usage(argv[0]);
+    if (p != 0) return usage(argv[0], stderr);
 
-    /* the plant: the reference machine or a saved model, then the cause flags on top */
     br_plant_cfg_t plant = br_plant_cfg_reference();
     char msg[512];
-    if (model && br_plant_cfg_from_model_json(model, &plant, &plant, msg, sizeof msg) != 0) {
-        fprintf(stderr, "br_simlog: %s\n", msg);
+    if (opt.model && br_plant_cfg_from_model_json(opt.model, &plant, &plant, msg, sizeof msg) != 0) {
+        fprintf(stderr, "%s: %s\n", TOOL, msg);
         return 1;
     }
-    const br_plant_cfg_t ref = br_plant_cfg_reference();
-    if (causes.offset_N != 0.0) plant.offset_N = causes.offset_N;
-    if (causes.dFc_neg_N != ref.dFc_neg_N || causes.dsigma2_neg_Nspm != ref.dsigma2_neg_Nspm) {
-        plant.dFc_neg_N = causes.dFc_neg_N;
-        plant.dsigma2_neg_Nspm = causes.dsigma2_neg_Nspm;
-    }
-    if (causes.ripple_amp_N != 0.0) {
-        plant.ripple_amp_N = causes.ripple_amp_N;
-        plant.ripple_period_m = causes.ripple_period_m;
-        plant.ripple_phase_rad = causes.ripple_phase_rad;
-    }
-    if (causes.grad_per_m != 0.0) plant.grad_per_m = causes.grad_per_m;
-    if (causes.delay_s != 0.0) plant.delay_s = causes.delay_s;
+    apply_causes(&plant, &opt.causes);
 
-    out_t o = {NULL, {seed * 0x2545F4914F6CDD1Dull + 1u, 0, 0.0}, noise, truth};
-    o.f = fopen(out, "w");
-    if (!o.f) {
-        fprintf(stderr, "br_simlog: cannot write %s: %s\n", out, strerror(errno));
+    /* the outputs: temporary files beside their names until the run succeeded */
+    br_outfile_t log_file, machine_file = {0};
+    if (br_outfile_open(&log_file, TOOL, opt.out) != 0) return 1;
+    if (opt.machine_out && br_outfile_open(&machine_file, TOOL, opt.machine_out) != 0) {
+        br_outfile_discard(&log_file);
         return 1;
     }
+    out_t o = {log_file.f, {(unsigned long long)opt.seed * 0x2545F4914F6CDD1Dull + 1u, 0, 0.0}, opt.noise, opt.truth,
+               0};
     write_header(&o);
     int rc;
-    if (strcmp(traj, "ident") == 0) {
+    if (strcmp(opt.traj, "ident") == 0) {
         br_ident_cfg_t c = br_ident_cfg_default(&plant);
-        if (cycles > 0) c.cycles = cycles;
+        if (opt.cycles > 0) c.cycles = (int)opt.cycles;
         rc = br_ident_run(&c, &plant, ident_sink, &o);
-        if (rc == 0 && machine_out) rc = write_machine(machine_out, &c);
+        if (rc == 0 && opt.machine_out) write_machine(machine_file.f, &c);
     } else {
         br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
         c.plant = plant;
-        c.duration_s = duration;
+        c.duration_s = opt.duration;
         br_circle_result_t res;
         circle_sink_t cs = {&o, plant.lead_mprad * 2.0 * BR_PI / plant.counts_per_rev,
                             plant.tau_per_duty_Nm / plant.lead_mprad};
         rc = br_circle_run(&c, circle_sink, &cs, &res);
-        if (rc == 0 && machine_out) fprintf(stderr, "br_simlog: --machine-out applies to --traj ident only\n");
     }
-    if (fclose(o.f) != 0) rc = -1;
+    if (rc == 0 && o.nonfinite > 0) {
+        fprintf(stderr, "%s: the simulation went non-finite (%ld rows)\n", TOOL, o.nonfinite);
+        rc = -1;
+    }
+    if (rc == 0) rc = br_outfile_commit(&log_file, TOOL);
+    if (rc == 0 && opt.machine_out) rc = br_outfile_commit(&machine_file, TOOL);
+    br_outfile_discard(&log_file);
+    br_outfile_discard(&machine_file);
     if (rc != 0) {
-        fprintf(stderr, "br_simlog: failed; %s is incomplete\n", out);
+        fprintf(stderr, "%s: failed; nothing written\n", TOOL);
         return 1;
     }
     return 0;

@@ -8,7 +8,9 @@
  * progress (iteration, evaluations, best contour RMS, parameters) for Fig. 1.
  * The objective is penalised by the outlier steps (lost lock). The start is
  * the hand-tuned default of the machine file's estimator section; each log-variance may move 3 decades
- * either way (bounds by the change of variables of br_nm). See docs/tuning.md. */
+ * either way (bounds by the change of variables of br_nm). The outputs are
+ * written beside their names and renamed once the tuning succeeded
+ * (br_outfile.h): a failed tuning writes nothing. See docs/tuning.md. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,7 +20,11 @@
 #include "circle/br_circle_est.h"
 #include "tune/br_nm.h"
 #include "bristle_gen/machine/br_machine.h"
+#include "tools/br_args.h"
+#include "tools/br_outfile.h"
+#include "tools/br_tool_limits.h"
 
+#define TOOL "br_tune_est"
 #define MAX_P 5
 
 typedef struct {
@@ -74,20 +80,47 @@ static void progress(void *user, int iter, int nfev, const double *xb, double fb
     }
 }
 
+static int usage(const char *argv0, FILE *to)
+{
+    fprintf(to, "usage: %s --est pf|ukf --out HEADER [--log CSV] [--max-fev N]\n"
+                "bounds: --max-fev 1 .. %d (docs/tools.md)\n", argv0, BR_TOOL_MAX_FEV);
+    return 2;
+}
+
 int main(int argc, char **argv)
 {
     const char *est = NULL, *out = NULL, *log_path = NULL;
-    int max_fev = 0;
-    for (int i = 1; i + 1 < argc; i += 2) {
-        if (strcmp(argv[i], "--est") == 0) est = argv[i + 1];
-        else if (strcmp(argv[i], "--out") == 0) out = argv[i + 1];
-        else if (strcmp(argv[i], "--log") == 0) log_path = argv[i + 1];
-        else if (strcmp(argv[i], "--max-fev") == 0) max_fev = atoi(argv[i + 1]);
-        else est = NULL;
+    long max_fev = 0;
+    if (br_args_want_help(argc, argv)) {
+        usage(argv[0], stdout);
+        return 0;
     }
-    if (!est || !out || (strcmp(est, "pf") != 0 && strcmp(est, "ukf") != 0) || (argc % 2) != 1) {
-        fprintf(stderr, "usage: %s --est pf|ukf --out HEADER [--log CSV] [--max-fev N]\n", argv[0]);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[++i] : NULL;
+        int bad = v == NULL;
+        if (bad) fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
+        else if (strcmp(a, "--est") == 0) est = v;
+        else if (strcmp(a, "--out") == 0) out = v;
+        else if (strcmp(a, "--log") == 0) log_path = v;
+        else if (strcmp(a, "--max-fev") == 0) bad = br_arg_long(TOOL, a, v, 1, BR_TOOL_MAX_FEV, &max_fev);
+        else {
+            fprintf(stderr, "%s: unknown option %s\n", TOOL, a);
+            bad = 1;
+        }
+        if (bad) return usage(argv[0], stderr);
+    }
+    if (!est || !out || (strcmp(est, "pf") != 0 && strcmp(est, "ukf") != 0)) return usage(argv[0], stderr);
+    if (log_path && strcmp(log_path, out) == 0) {
+        fprintf(stderr, "%s: --log and --out name the same file\n", TOOL);
         return 2;
+    }
+    /* the outputs: temporary files beside their names until the tuning succeeded (br_outfile.h) */
+    br_outfile_t header_file, log_file = {0};
+    if (br_outfile_open(&header_file, TOOL, out) != 0) return 1;
+    if (log_path && br_outfile_open(&log_file, TOOL, log_path) != 0) {
+        br_outfile_discard(&header_file);
+        return 1;
     }
     tune_t t;
     t.pf = strcmp(est, "pf") == 0;
@@ -95,7 +128,7 @@ int main(int argc, char **argv)
     /* start from the hand-tuned variances, not from the last tuning's result */
     t.base.pf = br_circle_pf_cfg_default((float)t.base.dt_s);
     t.base.ukf = br_circle_ukf_cfg_default((float)t.base.dt_s);
-    t.log = NULL;
+    t.log = log_file.f;
     const int n = n_params(&t);
     double x0[MAX_P], lo[MAX_P], hi[MAX_P];
     for (int i = 0; i < n; i++) {
@@ -103,12 +136,7 @@ int main(int argc, char **argv)
         lo[i] = x0[i] - 3.0 * log(10.0);
         hi[i] = x0[i] + 3.0 * log(10.0);
     }
-    if (log_path) {
-        t.log = fopen(log_path, "w");
-        if (!t.log) {
-            fprintf(stderr, "br_tune: cannot write %s\n", log_path);
-            return 1;
-        }
+    if (t.log) {
         fprintf(t.log, "iter,nfev,contour_rms_m");
         for (int i = 0; i < n; i++) fprintf(t.log, ",%s", param_name(t.pf, i));
         fprintf(t.log, "\n");
@@ -126,20 +154,22 @@ int main(int argc, char **argv)
     cfg.init_step = 0.25; /* about 0.7 decade of each variance from the start */
     cfg.xatol = 0.01;     /* about 3 % of each variance */
     cfg.fatol = 1e-12;    /* 1 pm of contour RMS */
-    cfg.max_fev = max_fev > 0 ? max_fev : (t.pf ? 120 : 400);
+    cfg.max_fev = max_fev > 0 ? (int)max_fev : (t.pf ? 120 : 400);
     cfg.lo = lo;
     cfg.hi = hi;
     cfg.progress = progress;
     br_nm_result_t r;
-    if (br_nm_minimize(&cfg, objective, &t, x0, &r) != 0) return 1;
-    if (t.log) fclose(t.log);
-    printf("tuned %s: contour RMS %.4e m (start %.4e m, %.1f %% lower) after %d evaluations%s\n", est, r.f, f0,
-           100.0 * (1.0 - r.f / f0), r.nfev, r.converged ? "" : " (budget reached)");
-    FILE *h = fopen(out, "w");
-    if (!h) {
-        fprintf(stderr, "br_tune: cannot write %s\n", out);
+    int ok = br_nm_minimize(&cfg, objective, &t, x0, &r) == 0 && isfinite(f0) && isfinite(r.f);
+    for (int i = 0; ok && i < n; i++) ok = isfinite(r.x[i]);
+    if (!ok) {
+        fprintf(stderr, "%s: the tuning failed or gave a non-finite result; nothing written\n", TOOL);
+        br_outfile_discard(&header_file);
+        br_outfile_discard(&log_file);
         return 1;
     }
+    printf("tuned %s: contour RMS %.4e m (start %.4e m, %.1f %% lower) after %d evaluations%s\n", est, r.f, f0,
+           100.0 * (1.0 - r.f / f0), r.nfev, r.converged ? "" : " (budget reached)");
+    FILE *h = header_file.f;
     const char *E = t.pf ? "PF" : "UKF";
     fprintf(h, "/* generated by sim/apps/br_tune_est.c (make tune) -- do not edit */\n");
     fprintf(h, "/* start: the hand-tuned variances of %s (its estimator section) */\n", BR_MACHINE_FILE);
@@ -150,6 +180,9 @@ int main(int argc, char **argv)
         fprintf(h, "#define BR_%s_TUNED_%s (%.9ef)\n", E, param_name(t.pf, i), (double)(float)exp(r.x[i]));
     }
     fprintf(h, "\n#endif\n");
-    fclose(h);
-    return 0;
+    int rc = br_outfile_commit(&header_file, TOOL);
+    if (rc == 0 && log_path) rc = br_outfile_commit(&log_file, TOOL);
+    br_outfile_discard(&header_file);
+    br_outfile_discard(&log_file);
+    return rc == 0 ? 0 : 1;
 }

@@ -13,7 +13,11 @@
  * J_kgm2 and M_kg in the base machine's proportion.
  *
  * Bounds: a value outside [lower, upper] is refused where it is read (file
- * and line, or option); BR_GT0 as the lower bound means "> 0". Relations
+ * and line, or option); BR_GT0 as the lower bound means "> 0". The upper
+ * bounds are physical (a ball-screw axis at the load: 10 t, 100 kN, 10 m/s)
+ * with decades of margin; they keep every product of the simulation and the
+ * fit finite. The diagnosis's table (python/bristle/diagnose/params.py and
+ * causes/) holds the same bounds; test_model.py compares them. Relations
  * between fields (Fs_N >= Fc_N, Fc_N + dFc_neg_N > 0, ...) are
  * br_plant_init's. */
 #ifndef BR_MODEL_PARAMS_H
@@ -29,17 +33,17 @@
 #define BR_GT0 DBL_MIN
 
 /* X(json name, token, unit, lower, upper): the moving mass (required) */
-#define BR_MEFF_PARAM(X) X("Meff_kg", Meff_kg, "kg", BR_GT0, HUGE_VAL)
+#define BR_MEFF_PARAM(X) X("Meff_kg", Meff_kg, "kg", BR_GT0, 1e4)
 
 /* X(json name, br_plant_cfg_t field, unit, lower, upper): the nominal
  * (thesis) model, load side (required) */
 #define BR_NOMINAL_PARAMS(X)                                   \
-    X("sigma2_Nspm", sigma2_Nspm, "N s/m", 0.0, HUGE_VAL)     \
-    X("Fc_N", Fc_N, "N", BR_GT0, HUGE_VAL)                    \
-    X("Fs_N", Fs_N, "N", BR_GT0, HUGE_VAL)                    \
-    X("vs_mps", vs_mps, "m/s", BR_GT0, HUGE_VAL)              \
-    X("sigma0_Npm", sigma0_Npm, "N/m", BR_GT0, HUGE_VAL)      \
-    X("sigma1_Nspm", sigma1_Nspm, "N s/m", 0.0, HUGE_VAL)
+    X("sigma2_Nspm", sigma2_Nspm, "N s/m", 0.0, 1e6)          \
+    X("Fc_N", Fc_N, "N", BR_GT0, 1e5)                         \
+    X("Fs_N", Fs_N, "N", BR_GT0, 1e5)                         \
+    X("vs_mps", vs_mps, "m/s", BR_GT0, 10.0)                  \
+    X("sigma0_Npm", sigma0_Npm, "N/m", BR_GT0, 1e12)          \
+    X("sigma1_Nspm", sigma1_Nspm, "N s/m", 0.0, 1e8)
 
 /* X(json name, br_plant_cfg_t field, unit, lower, upper, cause, option,
  *   required): the causes (optional; absent = 0 = off). `option` is the
@@ -47,13 +51,13 @@
  * the rows' order; `required` 0: may be left out of the option (then 0), only
  * after the required ones. */
 #define BR_CAUSE_PARAMS(X)                                                                                 \
-    X("offset_N", offset_N, "N", -HUGE_VAL, HUGE_VAL, "offset", "--offset", 1)                             \
-    X("dFc_neg_N", dFc_neg_N, "N", -HUGE_VAL, HUGE_VAL, "asymmetric_friction", "--asym", 1)                \
-    X("dsigma2_neg_Nspm", dsigma2_neg_Nspm, "N s/m", -HUGE_VAL, HUGE_VAL, "asymmetric_friction", "--asym", 1) \
-    X("ripple_amp_N", ripple_amp_N, "N", -HUGE_VAL, HUGE_VAL, "position_ripple", "--ripple", 1)            \
-    X("ripple_period_m", ripple_period_m, "m", BR_GT0, HUGE_VAL, "position_ripple", "--ripple", 1)         \
-    X("ripple_phase_rad", ripple_phase_rad, "rad", -HUGE_VAL, HUGE_VAL, "position_ripple", "--ripple", 0)  \
-    X("grad_per_m", grad_per_m, "1/m", -HUGE_VAL, HUGE_VAL, "position_gradient", "--gradient", 1)          \
+    X("offset_N", offset_N, "N", -1e5, 1e5, "offset", "--offset", 1)                                       \
+    X("dFc_neg_N", dFc_neg_N, "N", -1e5, 1e5, "asymmetric_friction", "--asym", 1)                          \
+    X("dsigma2_neg_Nspm", dsigma2_neg_Nspm, "N s/m", -1e6, 1e6, "asymmetric_friction", "--asym", 1)        \
+    X("ripple_amp_N", ripple_amp_N, "N", -1e5, 1e5, "position_ripple", "--ripple", 1)                      \
+    X("ripple_period_m", ripple_period_m, "m", BR_GT0, 10.0, "position_ripple", "--ripple", 1)             \
+    X("ripple_phase_rad", ripple_phase_rad, "rad", -1e3, 1e3, "position_ripple", "--ripple", 0)            \
+    X("grad_per_m", grad_per_m, "1/m", -1e3, 1e3, "position_gradient", "--gradient", 1)                    \
     X("delay_s", delay_s, "s", 0.0, BR_PLANT_DELAY_MAX_S, "actuator_delay", "--delay", 1)
 
 /* The causes of a model (a diagnosis's model.json, loaded into a plant
@@ -77,14 +81,16 @@ static inline int br_param_in_bounds(double v, double lo, double hi)
 /* "must be > 0", "must be >= 0", "must be in a .. b", ... into buf */
 static inline void br_param_bounds_text(double lo, double hi, char *buf, size_t n)
 {
-    if (hi == HUGE_VAL) {
+    if (lo == BR_GT0 && hi != HUGE_VAL) {
+        snprintf(buf, n, "must be > 0 and <= %g", hi);
+    } else if (hi == HUGE_VAL) {
         if (lo == BR_GT0) snprintf(buf, n, "must be > 0");
         else if (lo == -HUGE_VAL) snprintf(buf, n, "must be finite");
         else snprintf(buf, n, "must be >= %g", lo);
     } else if (lo == -HUGE_VAL) {
         snprintf(buf, n, "must be <= %g", hi);
     } else {
-        snprintf(buf, n, "must be in %g .. %g", lo == BR_GT0 ? 0.0 : lo, hi);
+        snprintf(buf, n, "must be in %g .. %g", lo, hi);
     }
 }
 

@@ -151,6 +151,65 @@ class CliTest(unittest.TestCase):
         r = simlog("--out", os.path.join(self.w, "x.csv"), "--ripple", "1,0")
         self.assertIn("ripple_period_m must be > 0", r.stderr)
 
+    def test_unusable_inputs_fail_before_the_fit(self):
+        """Exit 1, "file:line: problem", no traceback, nothing written, and
+        before the fit (no progress line)."""
+        def refused(r, fragment):
+            self.assertEqual(r.returncode, 1, r.stderr)
+            self.assertIn(fragment, r.stderr)
+            self.assertNotIn("Traceback", r.stderr)
+            self.assertNotIn("nominal:", r.stdout)
+
+        with open(self.log_a) as f:
+            lines = f.read().splitlines()
+        a_file = os.path.join(self.w, "a_file")
+        with open(a_file, "w") as f:
+            f.write("keep\n")
+        refused(py("diagnose", "--log", self.log_a, "--out", a_file), "--out names an existing file")
+        refused(py("diagnose", "--log", self.log_a, "--out", os.path.join(a_file, "sub")), "is not a directory")
+        with open(a_file) as f:
+            self.assertEqual(f.read(), "keep\n")
+        refused(py("diagnose", "--log", self.log_a, "--out", os.path.join(self.w, "o"), "--fc", "nan"),
+                "--fc:0: parameter fc_hz = nan must be > 0")
+
+        def log_with(name, edit):
+            p = os.path.join(self.w, name)
+            with open(p, "w") as f:
+                f.write("\n".join(edit(k, x) for k, x in enumerate(lines)) + "\n")
+            return p
+
+        out = os.path.join(self.w, "out_never")
+        zero = log_with("zero.csv", lambda k, x: x if k == 0 else ",".join(x.split(",")[:3] + ["0"] + x.split(",")[4:]))
+        refused(py("diagnose", "--log", zero, "--out", out), f"{zero}:2: column 'force' is 0 on every row")
+        huge = log_with("huge.csv", lambda k, x: x if k != 700 else ",".join(x.split(",")[:3] + ["1e308"] +
+                                                                            x.split(",")[4:]))
+        refused(py("diagnose", "--log", huge, "--out", out), f"{huge}:701: column 'force': 1e308 is beyond")
+        self.assertFalse(os.path.exists(out))
+
+        machine = os.path.join(self.w, "m.json")
+        for key, value, fragment in (("gain_N", "1e308", "parameter gain_N = 1e+308 must be > 0 and <= 100000"),
+                                     ("kv", "-3", "parameter kv = -3 must be > 0"),
+                                     ("dt_s", "0.002", "controller period 0.002 s differs from the log's 0.001 s")):
+            with open(os.path.join(self.w, "a.machine.json")) as f:
+                text = re.sub(f'"{key}": [^,}}]+', f'"{key}": {value}', f.read())
+            with open(machine, "w") as f:
+                f.write(text)
+            refused(py("diagnose", "--log", self.log_a, "--out", out, "--machine", machine), f"{machine}:")
+            self.assertIn(fragment, py("diagnose", "--log", self.log_a, "--out", out, "--machine", machine).stderr)
+
+        with open(os.path.join(self.out, "model.json")) as f:
+            good = f.read()
+        model = os.path.join(self.w, "m_model.json")
+        for key, value, fragment in (("Fc_N", "0", "parameter Fc_N = 0 must be > 0"),
+                                     ("Meff_kg", "-30", "parameter Meff_kg = -30 must be > 0"),
+                                     ("sigma1_Nspm", "1e308", "parameter sigma1_Nspm = 1e+308 must be in 0 .. 1e+08")):
+            with open(model, "w") as f:
+                f.write(re.sub(f'"{key}": [^,}}\n]+', f'"{key}": {value}', good, count=1))
+            r = py("validate", "--model", model, "--log", self.log_a)
+            refused(r, f"{model}:")
+            self.assertIn(fragment, r.stderr)
+            self.assertNotIn("relerr", r.stdout)
+
 
 def main():
     global ARGS

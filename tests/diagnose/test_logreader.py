@@ -74,6 +74,27 @@ class ReaderTest(unittest.TestCase):
         text = "t,ref,pos,force\n\n" + "\n".join(r[:5]) + "\n   \n" + "\n".join(r[5:])
         self.assertEqual(logreader.read_log(self.write(text)).n, N)
 
+    def test_quoted_fields_per_rfc4180(self):
+        """Quoted numbers, and an extra column holding a comma, a doubled quote
+        and a line end: parsed; the lines after it keep their numbers."""
+        r = rows()
+        r[0] = '"0.000000","0.0e+00",' + r[0].split(",", 2)[2] + ',"a, ""quoted""\nnote"'
+        r[1:] = [x + ",plain" for x in r[1:]]
+        r[5] = r[5].replace("0.005000", "0.004000")  # an error on data row 6: line 8 (row 1 spans two lines)
+        text = "t,ref,pos,force,note\n" + "\n".join(r) + "\n"
+        with self.assertRaises(LogError) as cm:
+            logreader.read_log(self.write(text))
+        self.assertIn(":8: time 0.004 s does not increase", str(cm.exception))
+        r[5] = r[5].replace("0.004000", "0.005000")
+        log = logreader.read_log(self.write("t,ref,pos,force,note\n" + "\n".join(r) + "\n"))
+        self.assertEqual(log.n, N)
+        self.assertEqual((log.t[0], log.ref[0]), (0.0, 0.0))
+
+    def test_malformed_quoting(self):
+        r = rows()
+        r[3] = '"0.003000"x' + r[3][len("0.003000"):]
+        self.expect_error(["t,ref,pos,force"] + r, 5, "malformed quoting")
+
     def test_max_samples_keeps_the_first(self):
         p = self.write("t,ref,pos,force\n" + "\n".join(rows(N + 500)) + "\n")
         log = logreader.read_log(p, max_samples=N)
@@ -104,6 +125,42 @@ class ReaderTest(unittest.TestCase):
         r = rows()
         r[2] = r[2].rsplit(",", 1)[0] + ",1_000"
         self.expect_error(["t,ref,pos,force"] + r, 4, "'1_000' is not a number")
+
+    def test_unicode_digits_are_not_numbers(self):
+        for cell in ("١٢٫٥", "１２", "²", "0x10", "1e5j", "1_000", "0.5e"):
+            r = rows()
+            r[20] = r[20].rsplit(",", 1)[0] + "," + cell
+            self.expect_error(["t,ref,pos,force"] + r, 22, "is not a number")
+
+    def test_decimal_comma_is_refused(self):
+        r = rows()
+        r[8] = r[8].rsplit(",", 1)[0] + ',"12,5"'
+        self.expect_error(["t,ref,pos,force"] + r, 10, "'12,5' is not a number (a decimal comma")
+
+    def test_huge_cell(self):
+        r = rows()
+        r[30] = r[30].rsplit(",", 1)[0] + ",1e308"
+        self.expect_error(["t,ref,pos,force"] + r, 32, "column 'force': 1e308 is beyond ±1e+09")
+
+    def test_a_long_cell_is_echoed_short(self):
+        r = rows()
+        r[9] = r[9].rsplit(",", 1)[0] + "," + "7" * 1000 + "x" * 100_000
+        msg = self.expect_error(["t,ref,pos,force"] + r, 11, "is not a number")
+        self.assertLess(len(msg), len(self.dir.name) + 200, msg)
+        self.assertIn("7" * (logreader.SHOW_CHARS - 1) + "…'", msg)
+        r[9] = r[9].rsplit(",", 1)[0] + "," + "7" * 10_000_000  # 10 MB in one field
+        msg = self.expect_error(["t,ref,pos,force"] + r, 11, "a field longer than 131072 characters")
+        self.assertLess(len(msg), len(self.dir.name) + 200, msg)
+
+    def test_all_zero_force(self):
+        r = [x.rsplit(",", 1)[0] + ",0" for x in rows()]
+        self.expect_error(["t,ref,pos,force"] + r, 2, f"column 'force' is 0 on every row (lines 2 to {N + 1}): "
+                          "nothing to fit")
+
+    def test_constant_position(self):
+        r = [",".join(x.split(",")[:2] + ["0.25", x.split(",")[3]]) for x in rows()]
+        self.expect_error(["", "t,ref,pos,force"] + r, 3, "column 'pos' is 0.25 on every row (lines 3 to "
+                          f"{N + 2}): the axis does not move")
 
     def test_empty_cell(self):
         r = rows()
@@ -168,6 +225,24 @@ class ReaderTest(unittest.TestCase):
         self.assertIn("absent.csv:0: cannot open", str(cm.exception))
 
     # bounded memory
+    def test_read_log_keeps_four_float64_per_row(self):
+        """read_log fills preallocated arrays: its peak allocation is the
+        samples (32 bytes a row) and little more, not lists of strings or
+        copies of blocks."""
+        p = os.path.join(self.dir.name, "big.csv")
+        n = 100_000
+        k = np.arange(n)
+        with open(p, "w") as f:
+            f.write("t,ref,pos,force\n")
+            np.savetxt(f, np.column_stack([k * 1e-3, 1e-7 * k, 1e-7 * k, np.sin(k * 1e-3)]),
+                       fmt=["%.6f", "%.9e", "%.9e", "%.8e"], delimiter=",")
+        tracemalloc.start()
+        log = logreader.read_log(p)
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        self.assertEqual(log.n, n)
+        self.assertLess(peak, 1.05 * 32 * n + 1_500_000, f"peak {peak} bytes")  # the old reader: 3x the samples
+
     def test_streams_in_bounded_memory(self):
         """iter_blocks holds one block: its peak allocation does not grow with
         the file (100000 rows, 5 MB of text), while keeping the samples would

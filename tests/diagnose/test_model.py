@@ -5,12 +5,13 @@ and model-file guards."""
 import math
 import os
 import re
+import sys
 import tempfile
 import unittest
 
 import numpy as np
 
-from bristle.diagnose import causes, closedloop, logreader, lugre, model, modelfile, selection, signals
+from bristle.diagnose import causes, closedloop, logreader, lugre, model, modelfile, params, selection, signals
 from bristle.diagnose.causes import actuator_delay
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -202,8 +203,8 @@ class GuardTest(unittest.TestCase):
                                 ":2: unknown cause(s) gravity"),
                                ('{"format": "bristle-model/2"}', "no \"params\""),
                                (good.replace(', "offset_N": %s', ''), ":2: \"params\" lacks offset_N"),
-                               (good % '"2"', ":3: parameter offset_N is not a finite number"),
-                               (good.replace('"Fc_N": 1', '"Fc_N": 0') % "2", ":2: parameter Fc_N is not a finite number > 0"),
+                               (good % '"2"', ":3: parameter offset_N is not a number ('2')"),
+                               (good.replace('"Fc_N": 1', '"Fc_N": 0') % "2", ":2: parameter Fc_N = 0 must be > 0 and <= 100000"),
                                (good.replace('"sigma2_Nspm"', '"Fv_Nspm"') % "2", ":2: \"params\" lacks sigma2_Nspm"),
                                (good % '2, "Fv_Nspm": 3', ":3: unknown parameter Fv_Nspm"),
                                (good % '2, "delay_s": 0.001',
@@ -265,6 +266,18 @@ class OneTableTest(unittest.TestCase):
     C_ROW = re.compile(r'X\("(\w+)",\s*(\w+),\s*"([^"]*)",\s*([^,]+?),\s*([^,)]+?)'
                        r'(?:,\s*"(\w+)",\s*"([-\w]+)",\s*([01]))?\)')
 
+    @staticmethod
+    def c_bound(token):
+        """A bound of the C table as a number: BR_GT0 is DBL_MIN (params.GT0)."""
+        token = token.strip()
+        named = {"BR_GT0": sys.float_info.min, "HUGE_VAL": math.inf, "-HUGE_VAL": -math.inf}
+        if token in named:
+            return named[token]
+        if token == "BR_PLANT_DELAY_MAX_S":
+            with open(os.path.join(REPO, "sim", "plant", "br_sim_plant.h")) as f:
+                return float(re.search(r"#define BR_PLANT_DELAY_MAX_S ([0-9.eE+-]+)", f.read()).group(1))
+        return float(token)
+
     def owner(self, name):
         return next((m for m in causes.REGISTRY if any(q.name == name for q in m.PARAMS)), None)
 
@@ -272,9 +285,10 @@ class OneTableTest(unittest.TestCase):
         with open(os.path.join(REPO, "sim", "plant", "br_model_params.h")) as f:
             rows = self.C_ROW.findall(f.read())
         self.assertEqual([r[0] for r in rows], [q.name for q in causes.MODEL_PARAMS])
+        self.assertEqual(len(rows), len(causes.MODEL_PARAMS))
         for (name, field, unit, lo, _hi, cause, option, _req), q in zip(rows, causes.MODEL_PARAMS):
             self.assertEqual(unit, q.unit, name)
-            self.assertEqual(lo == "BR_GT0", q.positive, f"{name}: > 0 in one table only")
+            self.assertEqual((self.c_bound(lo), self.c_bound(_hi)), (q.lo, q.hi), f"{name}: bounds differ")
             if name != "Meff_kg":
                 self.assertEqual(field, name, "a json name is the br_plant_cfg_t field's")
             m = self.owner(name)
@@ -286,10 +300,11 @@ class OneTableTest(unittest.TestCase):
             text = f.read()
         section = text[text.index("\n## Parameters"):]
         section = section[:section.index("\n## ", 1)]
-        rows = re.findall(r"^\| `(\w+)` \| ([^|]*?) \| ([^|]*?) \|", section, re.M)
+        rows = re.findall(r"^\| `(\w+)` \| ([^|]*?) \| ([^|]*?) \| ([^|]*?) \|", section, re.M)
         self.assertEqual([r[0] for r in rows], [q.name for q in causes.MODEL_PARAMS])
-        for (name, unit, cause), q in zip(rows, causes.MODEL_PARAMS):
+        for (name, unit, cause, bounds), q in zip(rows, causes.MODEL_PARAMS):
             self.assertEqual(unit, q.unit, name)
+            self.assertEqual("must be " + bounds, params.bounds_text(q.lo, q.hi), name)
             m = self.owner(name)
             self.assertEqual(cause, m.NAME if m else "nominal", name)
 

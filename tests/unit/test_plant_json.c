@@ -102,7 +102,7 @@ static void test_rejects(void **st)
     /* each parameter's bounds (br_model_params.h), on the value's line */
     expect("{\"params\": {\n\"Meff_kg\": 0}}", "m.json:2: parameter \"Meff_kg\" = 0 must be > 0");
     expect("{\"params\": {\"Fc_N\": -7}}", "parameter \"Fc_N\" = -7 must be > 0");
-    expect("{\"params\": {\"sigma1_Nspm\": -1}}", "parameter \"sigma1_Nspm\" = -1 must be >= 0");
+    expect("{\"params\": {\"sigma1_Nspm\": -1}}", "parameter \"sigma1_Nspm\" = -1 must be in 0 .. 1e+08");
     expect("{\"params\": {\"ripple_period_m\": 0}}", "parameter \"ripple_period_m\" = 0 must be > 0");
     expect("{\"params\": {\n\n\"delay_s\": 0.5}}", "m.json:3: parameter \"delay_s\" = 0.5 must be in 0 .. 0.1");
     expect("{\"params\": {\"delay_s\": -0.001}}", "parameter \"delay_s\" = -0.001 must be in 0 .. 0.1");

@@ -10,11 +10,11 @@ Exit status: 0, 1 when the log, model or machine file cannot be used (a
 message "file:line: problem" on stderr), 2 on a usage error.
 """
 import argparse
-import json
+import math
 import os
 import sys
 
-from . import causes, closedloop, logreader, model, modelfile, output, report, selection, signals
+from . import causes, closedloop, logreader, machinefile, model, modelfile, output, report, selection, signals
 
 # figures: (file, what, function(path, prep, diag)); the causes' own between
 # the residuals and the closed loop
@@ -33,57 +33,45 @@ def _plots():
     return plots
 
 
-MACHINES_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "machines")
-
-
-def _known_machine(log):
-    """A machine file of python/bristle/diagnose/machines/ that lists the log's file name."""
-    name = os.path.basename(log)
-    for f in sorted(os.listdir(MACHINES_DIR)):
-        p = os.path.join(MACHINES_DIR, f)
-        try:
-            with open(p, encoding="utf-8") as fh:
-                if name in json.load(fh).get("logs", []):
-                    return p
-        except (OSError, json.JSONDecodeError, AttributeError):
-            continue
-    return None
-
-
-def _machine(args):
-    """The machine file: --machine, else <log>.machine.json beside the log,
-    else one of python/bristle/diagnose/machines/ listing the log's name."""
-    path = args.machine
-    if path is None:
-        side = os.path.splitext(args.log)[0] + ".machine.json"
-        path = side if os.path.exists(side) else _known_machine(args.log)
-    if path is None:
-        return None, None
-    try:
-        with open(path, encoding="utf-8-sig") as f:
-            m = json.load(f)
-    except (OSError, json.JSONDecodeError) as e:
-        raise closedloop.ControllerError(f"{path}: {e}") from None
-    if not isinstance(m, dict):
-        raise closedloop.ControllerError(f"{path}: a JSON object was expected")
-    return m, path
+def check_out(out):
+    """OUT before the fit: an existing directory, or a new one whose nearest
+    existing parent is a directory this process may write in."""
+    p = os.path.abspath(out)
+    if os.path.exists(p):
+        if not os.path.isdir(p):
+            raise logreader.LogError(out, 0, "--out names an existing file, not a directory")
+    else:
+        while not os.path.exists(p):
+            p = os.path.dirname(p)
+        if not os.path.isdir(p):
+            raise logreader.LogError(out, 0, f"--out cannot be created: {p} is not a directory")
+    if not os.access(p, os.W_OK | os.X_OK):
+        raise logreader.LogError(out, 0, f"--out cannot be written: no permission in {p}")
 
 
 def cmd_diagnose(args):
     say = (lambda s: None) if args.quiet else (lambda s: print(s, flush=True))
-    machine, mpath = _machine(args)
-    ctrl = None
-    if machine and "controller" in machine:
-        ctrl = closedloop.check_controller(machine["controller"], f"{mpath} (\"controller\")")
+    problem = signals.FC_PARAM.check(args.fc)
+    if problem:
+        raise logreader.LogError("--fc", 0, problem)
+    check_out(args.out)
+    mpath = machinefile.find(args.log, args.machine)
+    machine, ctrl = machinefile.load(mpath) if mpath else (None, None)
     log = logreader.read_log(args.log)
+    if ctrl is not None and abs(ctrl["dt_s"] - log.dt) > 1e-6 * log.dt:
+        raise closedloop.ControllerError(f"{mpath}: controller period {ctrl['dt_s']:g} s differs from the log's "
+                                         f"{log.dt:.6g} s")
     say(f"{args.log}: {log.n} samples at {1e3 * log.dt:.4g} ms" +
         (f" (of {log.n_total}: the first {log.n} are used)" if log.n_total > log.n else ""))
     prep = signals.Prepared(log, fc_hz=args.fc)
     diag = selection.diagnose(prep, progress=say)
     closed = None
     if ctrl is not None:
-        sims = {name: closedloop.resimulate(prep, f.params(), ctrl)
-                for name, f in (("nominal", diag.nominal), ("extended", diag.extended))}
+        try:
+            sims = {name: closedloop.resimulate(prep, f.params(), ctrl)
+                    for name, f in (("nominal", diag.nominal), ("extended", diag.extended))}
+        except closedloop.ControllerError as e:
+            raise closedloop.ControllerError(f"{mpath}: {e}") from None
         closed = {"controller": f"{mpath} ({ctrl['type']})",
                   **{name: {k: v for k, v in s.items() if k.startswith("relerr")} for name, s in sims.items()}}
     os.makedirs(args.out, exist_ok=True)
@@ -118,6 +106,8 @@ def cmd_validate(args):
     fit = model.from_params(m["params"], m.get("causes", []))
     w = prep.whole
     rel = fit.relerr(prep, w)
+    if not math.isfinite(rel):
+        raise ValueError(f"{args.model}: the model's prediction is not finite on this log")
     line = (f"{args.log}: relerr {rel:.4g} % over {w.stop - w.start} samples (the whole log) with "
             f"{args.model} ({' + '.join(m.get('causes', [])) or 'nominal'})")
     if "nominal_params" in m:
@@ -147,8 +137,14 @@ def main(argv=None):
     except (logreader.LogError, closedloop.ControllerError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
-    except ValueError as e:  # too few samples for the split, a controller period mismatch
-        print(f"error: {e}", file=sys.stderr)
+    except ValueError as e:  # too few samples for the split, a singular fit
+        print(f"error: {args.log}: {e}", file=sys.stderr)
+        return 1
+    except ArithmeticError as e:  # overflow, division by zero in degenerate data the guards let through
+        print(f"error: {args.log}: numerical failure ({e})", file=sys.stderr)
+        return 1
+    except OSError as e:  # writing the outputs
+        print(f"error: {e.filename or args.cmd}: {e.strerror}", file=sys.stderr)
         return 1
 
 

@@ -28,12 +28,20 @@ import math
 
 import numpy as np
 
-from . import causes, checks, lugre
+from . import causes, lugre
+from .params import GT0, Param
 
 N_SUB = 10
 PASSES = 3
 CONTROLLER_TYPES = ("emps_pd",)
-CONTROLLER_KEYS = ("dt_s", "kp_1ps", "kv", "gain_N", "u_max")
+# a machine file's controller keys, with their bounds (params.Param)
+CONTROLLER = (
+    Param("dt_s", "s", "control period", GT0, 1.0),
+    Param("kp_1ps", "1/s", "position gain", 0.0, 1e5),
+    Param("kv", "N s/m", "velocity gain", GT0, 1e7),
+    Param("gain_N", "N", "force per unit of u", GT0, 1e5),
+    Param("u_max", "", "limit of u", GT0, 1e7),
+)
 
 
 class ControllerError(ValueError):
@@ -41,13 +49,16 @@ class ControllerError(ValueError):
 
 
 def check_controller(c, where):
-    """Validates a controller description (a dict); where names it in messages."""
+    """Validates a controller description (a dict); where ("file:line")
+    names it in messages."""
     if not isinstance(c, dict) or c.get("type") not in CONTROLLER_TYPES:
         raise ControllerError(f"{where}: \"type\" must be one of {', '.join(CONTROLLER_TYPES)}")
-    for k in CONTROLLER_KEYS:
-        positive = k != "kp_1ps"
-        if not checks.finite(c.get(k), positive):
-            raise ControllerError(f"{where}: \"{k}\" must be a finite number" + (" > 0" if positive else ""))
+    for q in CONTROLLER:
+        if q.name not in c:
+            raise ControllerError(f"{where}: \"{q.name}\" is missing")
+        problem = q.check(c[q.name])
+        if problem:
+            raise ControllerError(f"{where}: {problem}")
     return c
 
 
@@ -166,7 +177,12 @@ def resimulate(prep, params, ctrl):
         raise ControllerError(f"controller period {ctrl['dt_s']} s differs from the log's {prep.dt:.6g} s")
     ctrl["_quantum"] = position_quantum(prep.pos)
     vel0 = (prep.pos[1] - prep.pos[0]) / prep.dt
-    q, f, _ = simulate(params, ctrl, prep.ref, prep.pos[0], vel0)
+    try:
+        q, f, _ = simulate(params, ctrl, prep.ref, prep.pos[0], vel0)
+    except (OverflowError, ZeroDivisionError):
+        q = f = np.array([np.nan])
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(f))):
+        raise ControllerError("the closed-loop re-simulation diverged (non-finite position or force)")
     w = prep.whole
     v_meas = np.gradient(prep.xf, prep.dt)
     v_sim = np.gradient(prep.lp(q), prep.dt)

@@ -2,20 +2,32 @@
 header naming at least t, ref, pos, force.
 
 Tolerated: a UTF-8 byte-order mark, CRLF line ends, extra columns (ignored),
-column names in any order and case, surrounding spaces or quotes, blank lines.
+column names in any order and case, spaces around cells, blank lines, and
+quoted fields per RFC 4180 (a quoted field may hold commas, doubled quotes
+and line ends; "1.5" is the number 1.5).
 
-Rejected, with "file:line: problem": a header lacking a column, a row with the
-wrong number of fields, an empty or non-numeric cell, NaN or infinity, a time
-that does not increase, a time step that differs from the first one by more
-than UNIFORM_TOL of it, fewer than MIN_SAMPLES rows.
+Numbers are ASCII only, in the form [+-]digits[.digits][e[+-]digits] with a
+decimal point: Unicode digits, digit separators, hexadecimal and a decimal
+comma ("1,5", which can only reach a cell quoted) are refused, whatever the
+locale. A number's magnitude is at most MAX_ABS.
 
-The file is read line by line and validated as it streams; `iter_blocks`
-yields fixed-size numpy blocks, so a caller can go through a file of any size
-in bounded memory. `read_log` keeps the samples (four float64 per row, at most
-`max_samples` of them) for the diagnosis.
+Rejected, with "file:line: problem" (an echoed cell cut to SHOW_CHARS): a
+header lacking a column, a row with the wrong number of fields, malformed
+quoting, a field longer than csv.field_size_limit() (131072 characters), an
+empty or non-numeric cell, NaN or infinity, a number beyond
+MAX_ABS, a time that does not increase, a time step that differs from the
+first one by more than UNIFORM_TOL of it, fewer than MIN_SAMPLES rows; and,
+in read_log, a force or position that never changes (nothing to fit).
+
+The file is read line by line and validated as it streams. read_log counts
+the lines first and fills four preallocated float64 arrays (t, ref, pos,
+force: 32 bytes a row, nothing else per row is kept); `iter_blocks` yields
+fixed-size numpy blocks, so a caller can go through a file of any size in
+bounded memory.
 """
-import math
+import csv
 import os
+import re
 
 import numpy as np
 
@@ -24,6 +36,14 @@ MIN_SAMPLES = 1000
 UNIFORM_TOL = 0.01          # relative deviation of a time step from the first
 BLOCK_ROWS = 65536
 DEFAULT_MAX_SAMPLES = 2_000_000
+MAX_ABS = 1e9               # s, m, N: beyond it a cell is not a measurement
+SHOW_CHARS = 40             # an echoed cell is cut to this many characters
+COUNT_CHUNK = 1 << 20
+
+NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+DECIMAL_COMMA = re.compile(r"[+-]?[0-9]+,[0-9]+")
+NAN_WORDS = {"nan", "+nan", "-nan"}
+INF_WORDS = {"inf", "+inf", "-inf", "infinity", "+infinity", "-infinity"}
 
 
 class LogError(ValueError):
@@ -32,6 +52,11 @@ class LogError(ValueError):
     def __init__(self, path, line, problem):
         super().__init__(f"{path}:{line}: {problem}")
         self.path, self.line, self.problem = path, line, problem
+
+
+def short(s, n=SHOW_CHARS):
+    """s cut to n characters with an ellipsis (an echoed cell or value)."""
+    return s if len(s) <= n else s[: n - 1] + "…"
 
 
 class Log:
@@ -45,70 +70,89 @@ class Log:
 
 
 def _cell_value(path, lineno, name, cell):
-    s = cell.strip().strip('"').strip()
+    s = cell.strip()
     if not s:
         raise LogError(path, lineno, f"column '{name}' is empty")
-    try:
-        v = float(s)
-    except ValueError:
-        raise LogError(path, lineno, f"column '{name}': '{s}' is not a number") from None
-    if "_" in s:  # float() accepts digit separators; a log does not
-        raise LogError(path, lineno, f"column '{name}': '{s}' is not a number")
-    if math.isnan(v):
-        raise LogError(path, lineno, f"column '{name}' is NaN")
-    if math.isinf(v):
-        raise LogError(path, lineno, f"column '{name}' is infinite")
+    if NUMBER.fullmatch(s) is None:
+        low = s.lower()
+        if low in NAN_WORDS:
+            raise LogError(path, lineno, f"column '{name}' is NaN")
+        if low in INF_WORDS:
+            raise LogError(path, lineno, f"column '{name}' is infinite")
+        why = " (a decimal comma; the log's decimal mark is '.')" if DECIMAL_COMMA.fullmatch(s) else ""
+        raise LogError(path, lineno, f"column '{name}': '{short(s)}' is not a number{why}")
+    v = float(s)
+    if not abs(v) <= MAX_ABS:
+        raise LogError(path, lineno, f"column '{name}': {short(s)} is beyond ±{MAX_ABS:g}")
     return v
 
 
-def _header(path, lineno, line):
-    names = [c.strip().strip('"').strip().lower() for c in line.split(",")]
+def _header(path, lineno, cells):
+    names = [c.strip().lower() for c in cells]
     missing = [c for c in COLUMNS if c not in names]
     if missing:
+        found = ", ".join(short(n) for n in names[:8] if n) + (", …" if len(names) > 8 else "")
         raise LogError(path, lineno, "header lacks column(s) " + ", ".join(missing) +
-                       f" (found: {', '.join(n for n in names if n) or 'nothing'}); "
-                       "expected t,ref,pos,force")
+                       f" (found: {found or 'nothing'}); expected t,ref,pos,force")
     dup = [c for c in COLUMNS if names.count(c) > 1]
     if dup:
         raise LogError(path, lineno, "header names column(s) twice: " + ", ".join(dup))
     return [names.index(c) for c in COLUMNS], len(names)
 
 
-def iter_blocks(path, block_rows=BLOCK_ROWS):
-    """Yields (first_line, array of shape (k, 4): t, ref, pos, force) blocks of
-    at most block_rows validated rows; raises LogError at the first problem,
-    including too few samples at the end of the file. Memory: one block."""
+class _Lines:
+    """The file's lines as text, decoded one by one (invalid UTF-8 names its
+    line); `n` is the number of lines read so far."""
+
+    def __init__(self, f, path):
+        self.f, self.path, self.n = f, path, 0
+
+    def __iter__(self):
+        for raw in self.f:
+            self.n += 1
+            try:
+                line = raw.decode("utf-8")
+            except UnicodeDecodeError as e:
+                raise LogError(self.path, self.n, f"not UTF-8 text ({e.reason} at byte {e.start})") from None
+            if self.n == 1 and line.startswith("\ufeff"):
+                line = line[1:]
+            yield line
+
+
+def _rows(path):
+    """Yields (line, t, ref, pos, force) of every validated row; raises
+    LogError at the first problem, including too few samples at the end."""
     display = os.fspath(path)
-    buf = np.empty((block_rows, 4))
-    k = 0
-    n = 0
-    idx = ncols = None
-    t_prev = dt0 = None
-    lineno = 0
-    first_line = None
     try:
         f = open(path, "rb")
     except OSError as e:
         raise LogError(display, 0, f"cannot open: {e.strerror}") from None
+    idx = ncols = None
+    t_prev = dt0 = None
+    n = 0
     with f:
-        for lineno, raw in enumerate(f, start=1):
+        lines = _Lines(f, display)
+        reader = csv.reader(lines, skipinitialspace=True, strict=True)
+        start = 1
+        while True:
             try:
-                line = raw.decode("utf-8")
-            except UnicodeDecodeError as e:
-                raise LogError(display, lineno, f"not UTF-8 text ({e.reason} at byte {e.start})") from None
-            if lineno == 1 and line.startswith("\ufeff"):
-                line = line[1:]
-            line = line.rstrip("\r\n")
-            if not line.strip():
+                cells = next(reader)
+            except StopIteration:
+                break
+            except csv.Error as e:
+                if "field limit" in str(e):
+                    raise LogError(display, start, f"a field longer than {csv.field_size_limit()} characters, "
+                                   "not a measurement") from None
+                raise LogError(display, start, f"malformed quoting ({e})") from None
+            lineno, start = start, lines.n + 1
+            if not cells or (len(cells) == 1 and not cells[0].strip()):
                 continue
             if idx is None:
-                idx, ncols = _header(display, lineno, line)
+                idx, ncols = _header(display, lineno, cells)
                 continue
-            cells = line.split(",")
             if len(cells) != ncols:
                 raise LogError(display, lineno, f"{len(cells)} fields, the header has {ncols}")
-            row = [_cell_value(display, lineno, COLUMNS[j], cells[i]) for j, i in enumerate(idx)]
-            t = row[0]
+            t, ref, pos, force = (_cell_value(display, lineno, COLUMNS[j], cells[i]) for j, i in enumerate(idx))
             if t_prev is not None:
                 step = t - t_prev
                 if not step > 0.0:
@@ -120,35 +164,69 @@ def iter_blocks(path, block_rows=BLOCK_ROWS):
                                    f"time step {step:.6g} s differs from the period {dt0:.6g} s "
                                    f"by more than {100 * UNIFORM_TOL:g} % (non-uniform sampling)")
             t_prev = t
-            if k == 0:
-                first_line = lineno
-            buf[k] = row
-            k += 1
             n += 1
-            if k == block_rows:
-                yield first_line, buf.copy()
-                k = 0
+            yield lineno, t, ref, pos, force
+        last = lines.n
     if idx is None:
-        raise LogError(display, lineno, "empty file: no header t,ref,pos,force")
+        raise LogError(display, max(last, 1), "empty file: no header t,ref,pos,force")
     if n < MIN_SAMPLES:
-        raise LogError(display, lineno,
-                       f"only {n} samples; at least {MIN_SAMPLES} are needed")
+        raise LogError(display, last, f"only {n} samples; at least {MIN_SAMPLES} are needed")
+
+
+def iter_blocks(path, block_rows=BLOCK_ROWS):
+    """Yields (first_line, array of shape (k, 4): t, ref, pos, force) blocks of
+    at most block_rows validated rows; raises LogError at the first problem,
+    including too few samples at the end of the file. Memory: one block."""
+    buf = np.empty((block_rows, 4))
+    k = 0
+    first_line = None
+    for lineno, *row in _rows(path):
+        if k == 0:
+            first_line = lineno
+        buf[k] = row
+        k += 1
+        if k == block_rows:
+            yield first_line, buf.copy()
+            k = 0
     if k:
         yield first_line, buf[:k].copy()
 
 
-def read_log(path, max_samples=DEFAULT_MAX_SAMPLES, block_rows=BLOCK_ROWS):
-    """Validates the whole file (streaming) and keeps its first max_samples rows."""
-    parts = []
-    kept = 0
-    total = 0
-    for _, blk in iter_blocks(path, block_rows):
-        total += len(blk)
-        if kept < max_samples:
-            take = blk[: max_samples - kept]
-            parts.append(take)
-            kept += len(take)
-    a = np.concatenate(parts) if len(parts) > 1 else parts[0]
-    t = a[:, 0]
-    dt = (t[-1] - t[0]) / (len(t) - 1)
-    return Log(os.fspath(path), t.copy(), a[:, 1].copy(), a[:, 2].copy(), a[:, 3].copy(), dt, total)
+def _count_lines(path):
+    n = 1  # a last line without its line end
+    try:
+        with open(path, "rb") as f:
+            while chunk := f.read(COUNT_CHUNK):
+                n += chunk.count(b"\n")
+    except OSError:
+        pass  # _rows names the problem
+    return n
+
+
+def _degenerate(path, first, last, name, a):
+    if a[0] == a[-1] and np.all(a == a[0]):
+        what = "nothing to fit" if name == "force" else "the axis does not move"
+        raise LogError(path, first, f"column '{name}' is {a[0]:g} on every row (lines {first} to {last}): {what}")
+
+
+def read_log(path, max_samples=DEFAULT_MAX_SAMPLES):
+    """Validates the whole file (streaming) and keeps its first max_samples
+    rows in four preallocated float64 arrays."""
+    display = os.fspath(path)
+    cap = max(1, min(_count_lines(path), max_samples))
+    cols = [np.empty(cap) for _ in COLUMNS]
+    t, ref, pos, force = cols
+    n = total = 0
+    first = last = 0
+    for lineno, *row in _rows(path):
+        if n < cap:
+            t[n], ref[n], pos[n], force[n] = row
+            n += 1
+            last = lineno
+        first = first or lineno
+        total += 1
+    t, ref, pos, force = (c[:n] for c in cols)
+    _degenerate(display, first, last, "force", force)
+    _degenerate(display, first, last, "pos", pos)
+    dt = (t[-1] - t[0]) / (n - 1)
+    return Log(display, t, ref, pos, force, dt, total)

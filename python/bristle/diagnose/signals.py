@@ -24,13 +24,17 @@ intervals; every relerr the report gives is measured on the rest, the last
 import numpy as np
 from scipy import signal
 
+from .params import GT0, Param
+
 FC_HZ = 50.0
+FC_PARAM = Param("fc_hz", "Hz", "the low-pass cutoff (--fc, model.json's filter)", GT0, 1e6)
 FC_MAX_FRAC = 0.4
 ORDER = 4
 EDGE_S = 0.15
 EDGE_MIN = 50
 TRAIN_FRAC = 0.7
 MEMO_MAX = 64
+MEMO_BYTES = 128 << 20      # the memo's arrays at most (a long log: a few entries)
 
 
 class Prepared:
@@ -65,6 +69,7 @@ class Prepared:
         self.whole = slice(self.lo, self.hi)
         self.train_frac = train_frac
         self._memo = {}
+        self._memo_bytes = 0
 
     def lp(self, x):
         """The zero-phase low-pass applied to every signal."""
@@ -72,21 +77,38 @@ class Prepared:
 
     def memo(self, key, make):
         """Per-log memo of column blocks (the searches reuse them many times):
-        make() once per key; a bounded store, cleared when full."""
+        make() once per key; a bounded store (MEMO_MAX entries, MEMO_BYTES of
+        arrays), cleared when full. Only a cache: the results are the same
+        whatever it holds."""
         if key not in self._memo:
-            if len(self._memo) > MEMO_MAX:
+            value = make()
+            size = _nbytes(value)
+            if len(self._memo) > MEMO_MAX or self._memo_bytes + size > MEMO_BYTES:
                 self._memo.clear()
-            self._memo[key] = make()
+                self._memo_bytes = 0
+            self._memo[key] = value
+            self._memo_bytes += size
         return self._memo[key]
 
     def forget(self, key):
-        self._memo.pop(key, None)
+        self._memo_bytes -= _nbytes(self._memo.pop(key, None))
 
     def held_out_description(self):
         t0, t1 = self.t[self.split], self.t[self.hi]
         return (f"the last {100 * (1 - self.train_frac):.0f} % of the log in time, "
                 f"t = {t0:.3f} .. {t1:.3f} s ({self.hi - self.split} samples); the fit used "
                 f"t = {self.t[self.lo]:.3f} .. {t0:.3f} s")
+
+
+def _nbytes(v):
+    """Bytes of the arrays in a memo entry (an array, or a dict or tuple of them)."""
+    if isinstance(v, np.ndarray):
+        return v.nbytes
+    if isinstance(v, dict):
+        return sum(_nbytes(x) for x in v.values())
+    if isinstance(v, (tuple, list)):
+        return sum(_nbytes(x) for x in v)
+    return 0
 
 
 def relerr(y, e):

@@ -16,7 +16,7 @@ from ..params import Param
 NAME = "actuator_delay"
 MEANING = "a dead time between the commanded and the applied force"
 OPTION = "--delay"
-PARAMS = (Param("delay_s", "s", "actuator dead time d"),)
+PARAMS = (Param("delay_s", "s", "actuator dead time d", 0.0, 0.1),)  # upper: BR_PLANT_DELAY_MAX_S
 NL = ("delay_s",)
 DELAY_MAX_S = 0.02
 

@@ -23,8 +23,9 @@ from ..params import Param
 NAME = "asymmetric_friction"
 MEANING = "Coulomb and/or viscous friction that differ by the direction of motion"
 OPTION = "--asym"
-PARAMS = (Param("dFc_neg_N", "N", "Coulomb level in −x minus that in +x (the stiction level scaled alike)"),
-          Param("dsigma2_neg_Nspm", "N s/m", "viscous friction in −x minus that in +x"))
+PARAMS = (Param("dFc_neg_N", "N", "Coulomb level in −x minus that in +x (the stiction level scaled alike)",
+                -1e5, 1e5),
+          Param("dsigma2_neg_Nspm", "N s/m", "viscous friction in −x minus that in +x", -1e6, 1e6))
 NL = ("fc_ratio", "fc_split")      # c = Fc in -x / Fc in +x; the split first estimate
 FC_RATIO_BOUNDS = (0.2, 5.0)
 

@@ -12,7 +12,7 @@ from ..params import Param
 NAME = "offset"
 MEANING = "a constant force: gravity on a tilted axis, cable drag, an amplifier offset"
 OPTION = "--offset"
-PARAMS = (Param("offset_N", "N", "constant load force, + opposes motion in +x"),)
+PARAMS = (Param("offset_N", "N", "constant load force, + opposes motion in +x", -1e5, 1e5),)
 NL = ()
 
 

@@ -14,7 +14,8 @@ from ..params import Param
 NAME = "position_gradient"
 MEANING = "friction that grows or shrinks along the travel: misalignment, preload variation"
 OPTION = "--gradient"
-PARAMS = (Param("grad_per_m", "1/m", "relative slope s of the friction along the travel: friction × max(0, 1 + s x)"),)
+PARAMS = (Param("grad_per_m", "1/m", "relative slope s of the friction along the travel: friction × max(0, 1 + s x)",
+                 -1e3, 1e3),)
 NL = ("grad_per_m",)
 GRID = 21
 

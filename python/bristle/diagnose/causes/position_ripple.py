@@ -13,18 +13,20 @@ import math
 import numpy as np
 from scipy import optimize
 
-from ..params import Param
+from ..params import GT0, Param
 
 NAME = "position_ripple"
 MEANING = "a force periodic in position: screw lead error, ball recirculation, motor cogging"
 OPTION = "--ripple"
-PARAMS = (Param("ripple_amp_N", "N", "amplitude A of A sin(2πx/P + φ)"),
-          Param("ripple_period_m", "m", "its period P in load position", True),
-          Param("ripple_phase_rad", "rad", "its phase φ at x = 0"))
+PARAMS = (Param("ripple_amp_N", "N", "amplitude A of A sin(2πx/P + φ)", -1e5, 1e5),
+          Param("ripple_period_m", "m", "its period P in load position", GT0, 10.0),
+          Param("ripple_phase_rad", "rad", "its phase φ at x = 0", -1e3, 1e3))
 NL = ("ripple_period_m",)
 PERIODS = 400
 PEAKS = 3
 PERIODOGRAM_DECIMATE = 4     # the residual is low-passed far below the sampling rate
+PERIOD_BLOCK = 64            # periods of the periodogram computed together
+BLOCK_ELEMS = 1 << 21        # at most this many (16 MB of float64) in one of its arrays
 
 
 def load_columns(prep, nl):
@@ -39,10 +41,13 @@ def load_columns(prep, nl):
 
 
 def position_periodogram(e, x, periods):
-    """Amplitude of the best sin/cos fit of e at each period over position x."""
+    """Amplitude of the best sin/cos fit of e at each period over position x,
+    PERIOD_BLOCK periods at a time, fewer for a long x: a block's arrays
+    stay under BLOCK_ELEMS elements (a log's length in memory, not 64 of them)."""
     amps = np.empty(len(periods))
-    for i in range(0, len(periods), 64):
-        P = np.asarray(periods[i:i + 64])[:, None]
+    step = max(1, min(PERIOD_BLOCK, BLOCK_ELEMS // max(len(x), 1)))
+    for i in range(0, len(periods), step):
+        P = np.asarray(periods[i:i + step])[:, None]
         th = 2.0 * np.pi * x[None, :] / P
         s, c = np.sin(th), np.cos(th)
         ss, cc, sc = (s * s).sum(1), (c * c).sum(1), (s * c).sum(1)
@@ -50,7 +55,7 @@ def position_periodogram(e, x, periods):
         det = ss * cc - sc * sc
         a = (cc * es - sc * ec) / det
         b = (ss * ec - sc * es) / det
-        amps[i:i + 64] = np.hypot(a, b)
+        amps[i:i + step] = np.hypot(a, b)
     return amps
 
 

@@ -1,0 +1,40 @@
+/* The bounds of the host tools' options (sim/apps), in one place; a value
+ * outside them is refused before any file is touched. docs/tools.md lists
+ * them with the reasons.
+ *
+ * Duration: simulated time of one run. At 1 ms a row of br_simlog is about
+ * 60 bytes, so the longest run writes about 3.6e6 rows (about 220 MB). */
+#ifndef BR_TOOL_LIMITS_H
+#define BR_TOOL_LIMITS_H
+
+#include "bristle/br_pf.h"
+
+#define BR_TOOL_DURATION_MIN_S 0.1
+#define BR_TOOL_DURATION_MAX_S 3600.0
+
+/* control period: the thesis runs 1 and 1.5 ms, the sampling-time study 0.5 to 3 ms */
+#define BR_TOOL_DT_MIN_S 1e-4
+#define BR_TOOL_DT_MAX_S 0.01
+
+/* br_simlog --cycles: identification cycles of 9.32 s (400: 3728 s, about the duration bound) */
+#define BR_TOOL_CYCLES_MAX 400
+
+/* plant substeps per control period */
+#define BR_TOOL_NSUB_MAX 1000
+
+/* particles of the PF */
+#define BR_TOOL_PARTICLES_MAX BR_PF_MAX_PARTICLES
+
+/* br_pf_study --table: float32 samples (64 MiB) */
+#define BR_TOOL_TABLE_MAX_SAMPLES (1L << 24)
+
+/* br_tune_est --max-fev: circle runs of the tuning */
+#define BR_TOOL_MAX_FEV 10000
+
+/* br_demo_circle --gains: magnitude of each H-inf gain */
+#define BR_TOOL_GAIN_MAX 1e9
+
+/* br_simlog --force-noise: standard deviation, N */
+#define BR_TOOL_NOISE_MAX_N 1e4
+
+#endif

@@ -1,0 +1,188 @@
+"""The host tools' command lines (docs/tools.md): every option checked
+against its bound (sim/tools/br_tool_limits.h) before a file is touched,
+--help never taken as an option needing a value, an output that cannot be
+written refused before the run, and a failed run leaving any existing file
+byte for byte and no temporary file behind.
+
+Usage: test_tools.py --bin DIR --work DIR"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import unittest
+
+ARGS = None
+TOOLS = ("br_simlog", "br_demo_circle", "br_circle_ext", "br_pf_study", "br_dt_study", "br_tune_est")
+VALUED = {"br_simlog": "--out", "br_demo_circle": "--out", "br_circle_ext": "--json", "br_pf_study": "--table",
+          "br_dt_study": "--seeds", "br_tune_est": "--out"}  # an option that takes a value
+OLD = b"an existing file\r\nwith two lines\n"
+
+
+def run(tool, *a, cwd=None):
+    return subprocess.run([os.path.join(ARGS.bin, tool), *a], capture_output=True, text=True, cwd=cwd, timeout=600)
+
+
+class ToolsTest(unittest.TestCase):
+    def setUp(self):
+        self.w = os.path.join(ARGS.work, self.id().rsplit(".", 1)[-1])
+        shutil.rmtree(self.w, ignore_errors=True)
+        os.makedirs(self.w)
+
+    def existing(self, name):
+        p = os.path.join(self.w, name)
+        with open(p, "wb") as f:
+            f.write(OLD)
+        return p
+
+    def assert_untouched(self, *paths):
+        for p in paths:
+            with open(p, "rb") as f:
+                self.assertEqual(f.read(), OLD, p)
+        self.assertEqual(sorted(os.listdir(self.w)), sorted(os.path.basename(p) for p in paths),
+                         "a temporary or partial file was left")
+
+    def assert_refused(self, r, rc, *words):
+        self.assertEqual(r.returncode, rc, r.stderr)
+        for w in words:
+            self.assertIn(w, r.stderr)
+
+    def test_help_everywhere(self):
+        for tool in TOOLS:
+            for h in ("--help", "-h"):
+                r = run(tool, h)
+                self.assertEqual(r.returncode, 0, f"{tool} {h}: {r.stderr}")
+                self.assertIn("usage:", r.stdout, tool)
+            # where a value is expected, --help is still help, not the value (no file named --help)
+            r = run(tool, VALUED[tool], "--help", cwd=self.w)
+            self.assertEqual(r.returncode, 0, f"{tool}: {r.stderr}")
+            self.assertIn("usage:", r.stdout, tool)
+            self.assertEqual(os.listdir(self.w), [], tool)
+
+    def test_simlog_bad_options_touch_nothing(self):
+        out = self.existing("log.csv")
+        for bad in (["--duration", "1e12"], ["--duration", "inf"], ["--duration", "nan"], ["--duration", "0"],
+                    ["--duration", "3601"], ["--cycles", "0"], ["--cycles", "401"], ["--cycles", "2x"],
+                    ["--force-noise", "-1"], ["--force-noise", "1e308"], ["--seed", "-1"], ["--traj", "square"],
+                    ["--delay", "0.5"], ["--bogus", "1"], ["--cycles"]):
+            r = run("br_simlog", "--out", out, "--traj", "circle", *bad)
+            self.assert_refused(r, 2)
+            self.assertIn("usage:", r.stderr)
+            self.assert_untouched(out)
+        r = run("br_simlog", "--out", out, "--machine-out", os.path.join(self.w, "m.json"), "--traj", "circle")
+        self.assert_refused(r, 2, "ident only")
+        self.assert_untouched(out)
+
+    def test_simlog_failed_run_writes_nothing(self):
+        out, machine = self.existing("log.csv"), self.existing("log.machine.json")
+        model = os.path.join(self.w, "model.json")
+        with open(model, "w") as f:  # every value in bounds, but stiction below Coulomb: the plant refuses it
+            f.write('{"params": {"Meff_kg": 30, "sigma2_Nspm": 100, "Fc_N": 20, "Fs_N": 10, "vs_mps": 0.01, '
+                    '"sigma0_Npm": 1e6, "sigma1_Nspm": 100}}')
+        r = run("br_simlog", "--out", out, "--machine-out", machine, "--model", model, "--cycles", "1")
+        self.assert_refused(r, 1, "nothing written")
+        # a run that fails part-way, 0.3 s into the log, after rows went to the temporary file:
+        # a moving mass of 1e-300 kg (within its bounds) sends the plant state to infinity
+        with open(model, "w") as f:
+            f.write('{"params": {"Meff_kg": 1e-300, "sigma2_Nspm": 100, "Fc_N": 20, "Fs_N": 30, "vs_mps": 0.01, '
+                    '"sigma0_Npm": 1e6, "sigma1_Nspm": 100}}')
+        r = run("br_simlog", "--out", out, "--machine-out", machine, "--model", model, "--cycles", "1")
+        self.assert_refused(r, 1, "not finite")
+        self.assertIn("nothing written", r.stderr)
+        os.remove(model)
+        self.assert_untouched(out, machine)
+
+    def test_simlog_unwritable_output_refused_before_the_run(self):
+        for out in (self.w, os.path.join(self.w, "no", "dir.csv"), "/dev/null"):
+            r = run("br_simlog", "--out", out, "--cycles", "1")
+            self.assert_refused(r, 1, "cannot write")
+        keep = self.existing("log.csv")
+        r = run("br_simlog", "--out", keep, "--machine-out", os.path.join(self.w, "no", "m.json"), "--cycles", "1")
+        self.assert_refused(r, 1, "cannot write")
+        self.assert_untouched(keep)
+
+    def test_simlog_success_replaces_whole(self):
+        out = self.existing("log.csv")
+        r = run("br_simlog", "--out", "log.csv", "--cycles", "1", "--machine-out", "log.machine.json", cwd=self.w)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(sorted(os.listdir(self.w)), ["log.csv", "log.machine.json"])
+        with open(out) as f:
+            lines = f.read().splitlines()
+        self.assertEqual(lines[0], "t,ref,pos,force")
+        self.assertGreater(len(lines), 9000)
+        self.assertEqual(os.stat(out).st_mode & 0o077, 0o066 & ~_umask())
+
+    def test_demo_bad_options_touch_nothing(self):
+        d = os.path.join(self.w, "demo")
+        os.makedirs(d)
+        summary = os.path.join(d, "summary.json")
+        with open(summary, "wb") as f:
+            f.write(OLD)
+        for bad in (["--dt", "5"], ["--dt", "0"], ["--dt", "inf"], ["--nsub", "0"], ["--nsub", "1001"],
+                    ["--gains", "1,2"], ["--gains", "1,2,inf"], ["--gains", "1,2,3x"], ["--only", "nope"],
+                    ["--bogus", "1"]):
+            r = run("br_demo_circle", "--out", d, *bad)
+            self.assert_refused(r, 2)
+            with open(summary, "rb") as f:
+                self.assertEqual(f.read(), OLD)
+            self.assertEqual(os.listdir(d), ["summary.json"])
+        r = run("br_demo_circle", "--out", os.path.join(self.w, "new"), "--only", "nope")
+        self.assert_refused(r, 2, "no controller named nope")
+        self.assertFalse(os.path.exists(os.path.join(self.w, "new")))
+
+    def test_demo_unwritable_output_refused_before_the_run(self):
+        plain = self.existing("plain")
+        r = run("br_demo_circle", "--out", plain, "--only", "hinf_only")
+        self.assert_refused(r, 1)
+        self.assertNotIn("contour", r.stdout)
+        self.assert_untouched(plain)
+
+    def test_circle_ext_output_checked_before_the_runs(self):
+        keep = self.existing("ext.json")
+        r = run("br_circle_ext", "--json", os.path.join(self.w, "no", "x.json"))
+        self.assert_refused(r, 1, "cannot write")
+        self.assertNotIn("contour RMS", r.stdout)
+        r = run("br_circle_ext", "--json", keep, "--delay", "1")
+        self.assert_refused(r, 2, "delay_s")
+        r = run("br_circle_ext", "--json", keep, "--model", os.path.join(self.w, "none.json"))
+        self.assert_refused(r, 1, "cannot open")
+        self.assert_untouched(keep)
+
+    def test_pf_study_bounds(self):
+        table = os.path.join(self.w, "t.bin")
+        with open(table, "wb") as f:
+            f.write(b"\0" * 12)  # 3 samples: not a power of two
+        for bad in (["--duration", "inf"], ["--duration", "1e12"], ["--dt", "5"], ["--particles", "0"],
+                    ["--particles", "99999"], ["--q", "1,2,3"], ["--q", "1,2,3,-4"], ["--r", "0"],
+                    ["--skip", "-1"], ["--bogus", "1"]):
+            self.assert_refused(run("br_pf_study", *bad), 2)
+        self.assert_refused(run("br_pf_study", "--table", table), 1, "2^k")
+
+    def test_dt_study_bounds(self):
+        for bad in (["--seeds", "1"], ["--seeds", "17"], ["--m-per-ms", "inf"], ["--budget", "2", "--cost-ns", "1"],
+                    ["--budget", "0.5"], ["--bogus", "1"], ["--seeds"]):
+            self.assert_refused(run("br_dt_study", *bad), 2)
+
+    def test_tune_outputs_checked_before_the_tuning(self):
+        header, log = self.existing("tuned.h"), self.existing("tune.csv")
+        r = run("br_tune_est", "--est", "pf", "--out", header, "--log", os.path.join(self.w, "no", "l.csv"))
+        self.assert_refused(r, 1, "cannot write")
+        self.assertNotIn("tuning", r.stdout)
+        for bad in (["--max-fev", "0"], ["--max-fev", "1e9"], ["--est", "kf"], ["--log", header]):
+            r = run("br_tune_est", "--est", "pf", "--out", header, *bad)
+            self.assert_refused(r, 2)
+        self.assert_untouched(header, log)
+
+
+def _umask():
+    m = os.umask(0)
+    os.umask(m)
+    return m
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--work", required=True)
+    ARGS, rest = ap.parse_known_args()
+    unittest.main(argv=[sys.argv[0], *rest])
