@@ -44,6 +44,9 @@ def machine_fields(m, p):
         ("BR_MACHINE_CTRL_PERIOD_S", ctl["period_s"], "control period (H-inf only, H-inf + UKF)"),
         ("BR_MACHINE_TORQUE_LIMIT_NM", ctl["torque_limit_Nm"], "controller torque saturation"),
         ("BR_MACHINE_MAX_SPEED_MPS", lim["max_speed_mps"], "largest table speed the axis is used at"),
+        ("BR_MACHINE_MAX_SPEED_COUNTS_PER_S", lim["max_speed_mps"] / (p["L_mprad"] * p["rad_per_count"]),
+         "that speed in encoder counts per second (max_speed / (L rad_per_count)); times the period:\n"
+         " * the largest encoder delta of one period (br_app_guard_cfg)"),
         ("BR_MACHINE_TRAVEL_M", lim["travel_m"], "stroke of the table"),
     ]
 

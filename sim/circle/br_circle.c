@@ -90,7 +90,8 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
     cc.lead_mprad = (float)c->plant.lead_mprad;
     br_est_t ext = {NULL, NULL};
-    br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext};
+    br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext,
+                       br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
     switch (c->controller) {
     case BR_CTRL_HINF_ONLY:
         break;
@@ -110,6 +111,9 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     br_status_t st;
     /* BR_E_PARAM also when an estimator's period is not the control period */
     st = br_app_init(&a->app, &ac, &a->hal, &a->mem);
+    if (st == BR_OK) {
+        st = br_app_arm(&a->app); /* the simulator arms right after init */
+    }
     if (st != BR_OK) {
         fprintf(stderr, "br_circle: application init failed (status %d)\n", (int)st);
         return -1;
