@@ -54,6 +54,7 @@ def machine_fields(m, p):
 def est_fields(m):
     pf, ukf = m["estimator"]["pf"], m["estimator"]["ukf"]
     out = [("BR_EST_PF_PERIOD_S", pf["period_s"], "the PF's period (its loop runs at it)"),
+           ("BR_EST_PF_PERIOD_NS", int(round(pf["period_s"] * 1e9)), "the same in whole nanoseconds (an MCU tick)"),
            ("BR_EST_PF_N_PARTICLES", pf["n_particles"], "particle count")]
     for k, c in (("theta_counts2", "Q_THETA_COUNTS2"), ("omega_rad2_per_s2", "Q_OMEGA_RAD2PS2"),
                  ("z_m2", "Q_Z_M2"), ("gp_N2", "Q_GP_N2")):

@@ -26,6 +26,7 @@ BR_LAYOUT_CHECK(rcc_d1cfgr, offsetof(br_stm32h7_rcc_t, D1CFGR) == 0x018u);
 BR_LAYOUT_CHECK(rcc_d3cfgr, offsetof(br_stm32h7_rcc_t, D3CFGR) == 0x020u);
 BR_LAYOUT_CHECK(rcc_pllckselr, offsetof(br_stm32h7_rcc_t, PLLCKSELR) == 0x028u);
 BR_LAYOUT_CHECK(rcc_pll1divr, offsetof(br_stm32h7_rcc_t, PLL1DIVR) == 0x030u);
+BR_LAYOUT_CHECK(rcc_rsr, offsetof(br_stm32h7_rcc_t, RSR) == 0x0D0u);
 BR_LAYOUT_CHECK(rcc_apb4enr, offsetof(br_stm32h7_rcc_t, APB4ENR) == 0x0F4u);
 BR_LAYOUT_CHECK(pwr_cr3, offsetof(br_stm32h7_pwr_t, CR3) == 0x0Cu);
 BR_LAYOUT_CHECK(pwr_d3cr, offsetof(br_stm32h7_pwr_t, D3CR) == 0x18u);

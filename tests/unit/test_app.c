@@ -8,6 +8,7 @@
 
 #include "circle/br_circle_est.h"
 #include "bristle/br_app.h"
+#include "bristle/br_machine_cfg.h"
 
 typedef struct {
     int32_t counts;
@@ -521,6 +522,37 @@ static void test_guard_config(void **st)
     assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
 }
 
+/* One home: the image's const PF configuration (compile-time initialiser, in
+ * flash) is the simulator's run-time one, value for value. */
+static const br_pf_cfg_t k_image_pf = BR_MACHINE_PF_CFG_TUNED(BR_EST_PF_PERIOD_S_F);
+
+static void test_machine_cfg_one_home(void **st)
+{
+    (void)st;
+    const br_pf_cfg_t c = br_circle_pf_cfg_tuned((float)BR_EST_PF_PERIOD_S);
+    assert_memory_equal(&c.est.model, &k_image_pf.est.model, sizeof c.est.model);
+    assert_memory_equal(c.est.q_var, k_image_pf.est.q_var, sizeof c.est.q_var);
+    assert_memory_equal(&c.est.r_var_rad2, &k_image_pf.est.r_var_rad2, sizeof(float));
+    assert_memory_equal(c.x0_std, k_image_pf.x0_std, sizeof c.x0_std);
+    assert_true(c.est.gp0_N == k_image_pf.est.gp0_N && c.est.gp_min_N == k_image_pf.est.gp_min_N &&
+                c.est.gp_max_N == k_image_pf.est.gp_max_N &&
+                c.est.outlier_sigma == k_image_pf.est.outlier_sigma &&
+                c.est.rad_per_count == k_image_pf.est.rad_per_count);
+    assert_int_equal(c.est.reanchor_after, k_image_pf.est.reanchor_after);
+    assert_int_equal(c.n_particles, k_image_pf.n_particles);
+    assert_int_equal(k_image_pf.n_particles, BR_EST_PF_N_PARTICLES);
+    assert_ptr_equal(c.noise, k_image_pf.noise);
+    assert_int_equal(c.noise_len, k_image_pf.noise_len);
+    assert_int_equal(c.noise_skip, k_image_pf.noise_skip);
+    /* and it is a configuration the PF accepts, at the image's period */
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    assert_int_equal(br_pf_init(pf, &k_image_pf), BR_OK);
+    free(pf);
+    /* the image's tick in whole ns is the period */
+    assert_true(fabs((double)BR_EST_PF_PERIOD_NS * 1e-9 - BR_EST_PF_PERIOD_S) < 0.5e-9);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -539,6 +571,7 @@ int main(void)
         cmocka_unit_test(test_encoder_frozen_latches),
         cmocka_unit_test(test_external_fault_latches),
         cmocka_unit_test(test_guard_config),
+        cmocka_unit_test(test_machine_cfg_one_home),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -109,7 +109,9 @@ typedef struct {
     volatile uint32_t PLLCFGR;   /* 0x02C PLLxRGE, PLLxVCOSEL, DIVxyEN */
     volatile uint32_t PLL1DIVR;  /* 0x030 DIVN1, DIVP1, DIVQ1, DIVR1 */
     volatile uint32_t PLL1FRACR; /* 0x034 */
-    volatile uint32_t RESERVED3[42]; /* 0x038..0x0DC */
+    volatile uint32_t RESERVED3[38]; /* 0x038..0x0CC */
+    volatile uint32_t RSR;       /* 0x0D0 reset status: the reset's cause flags, RMVF clears them */
+    volatile uint32_t RESERVED4[3]; /* 0x0D4..0x0DC */
     volatile uint32_t AHB4ENR;  /* 0x0E0 GPIOx, ... */
     volatile uint32_t APB3ENR;  /* 0x0E4 */
     volatile uint32_t APB1LENR; /* 0x0E8 TIM2..TIM7, TIM12..14, ... */
@@ -123,6 +125,9 @@ typedef struct {
 #define BR_RCC_APB1LENR_TIM2EN  (1u << 0)
 #define BR_RCC_APB2ENR_TIM1EN   (1u << 0)
 #define BR_RCC_APB4ENR_SYSCFGEN (1u << 1)
+/* RSR */
+#define BR_RCC_RSR_RMVF         (1u << 16)
+#define BR_RCC_RSR_IWDG1RSTF    (1u << 26)
 /* CR */
 #define BR_RCC_CR_HSION         (1u << 0)
 #define BR_RCC_CR_HSIRDY        (1u << 2)
