@@ -241,7 +241,10 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
             return latch(app, BR_APP_FAULT_ENC_STALE);
         }
         if (!app->have_counts) {
-            outputs_off(app); /* nothing to hold yet: duty 0 */
+            /* nothing to hold yet: duty 0 this period, outputs stay enabled
+             * (not latched: a good read next period runs the loop) */
+            (void)hal->pwm_write(hal->ctx, 0.0f);
+            a->last = (br_ctrl_out_t){0};
             return BR_OK;
         }
         counts = app->last_counts;

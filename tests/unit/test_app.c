@@ -443,9 +443,14 @@ static void test_encoder_stale_holds_then_latches(void **st)
     assert_int_equal(app.fault, BR_APP_FAULT_ENC_STALE);
     assert_false(f.on);
     assert_true(f.duty == 0.0f);
-    /* re-arm: the PF is primed again at the next measurement */
-    f.enc_st = BR_OK;
+    /* re-arm: the PF is primed again at the next measurement; a failed first
+     * read writes duty 0 without turning the outputs off (nothing latched) */
     assert_int_equal(br_app_arm(&app), BR_OK);
+    f.duty = 0.3f;
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_true(f.duty == 0.0f);
+    assert_true(f.on);
+    f.enc_st = BR_OK;
     assert_int_equal(pf->primed, 0);
     assert_int_equal(br_app_step(&app, &r), BR_OK);
     assert_int_equal(pf->primed, 1);
