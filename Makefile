@@ -20,7 +20,7 @@ JOBS       ?= 2
 PYTHON     := .venv/bin/python
 # The board whose firmware image `make firmware` / `make test` build and size:
 # its CMakeLists (hal/<board>/) writes into BOARD_INFO the image's path, its
-# part's flash and RAM sizes (KiB) and the RAM's name.
+# part's flash size (KiB) and its RAM regions (NAME:ORIGIN:KiB).
 BOARD      ?= stm32h7
 BOARD_INFO  = build/cm7-release/board-$(BOARD).txt
 DEMO_OUT   := out/demo
@@ -44,18 +44,22 @@ define build
 	$(Q)cmake --build --preset $(1) $(NINJA_QUIET)
 endef
 
-# Flash = text + data (the .data image is stored in flash), RAM = data + bss
-# (bss includes the reserved stack), from arm-none-eabi-size (Berkeley format).
+# Flash = text + data (the .data image is stored in flash); RAM per region
+# (BOARD_INFO: the image, the flash KiB, then NAME:ORIGIN:KiB per RAM region)
+# = the allocated sections whose address lies in it (.data, .bss, the reserved
+# stack, NOLOAD sections), from arm-none-eabi-size -A.
 define print_size
 	$(Q)test -f $(BOARD_INFO) || { echo "no board $(BOARD) in the cm7-release build ($(BOARD_INFO))" >&2; exit 1; }
-	$(Q)read -r img fk rk rn < $(BOARD_INFO); img=$$(realpath --relative-to=. "$$img"); \
+	$(Q)read -r img fk regions < $(BOARD_INFO); img=$$(realpath --relative-to=. "$$img"); \
 	test -f "$$img" || { echo "no firmware image at $$img" >&2; exit 1; }; \
-	arm-none-eabi-size "$$img" | awk -v fk="$$fk" -v rk="$$rk" -v rn="$$rn" -v img="$$img" ' \
-	  NR == 2 { f = $$1 + $$2; r = $$2 + $$3; ok = 1; \
-	    printf "firmware %s\n", img; \
-	    printf "  flash: %7d bytes (text %d + data %d)  %5.2f%% of %d KiB\n", f, $$1, $$2, 100 * f / (fk * 1024), fk; \
-	    printf "  RAM:   %7d bytes (data %d + bss %d)   %5.2f%% of %d KiB %s\n", r, $$2, $$3, 100 * r / (rk * 1024), rk, rn } \
-	  END { exit ok ? 0 : 1 }'
+	arm-none-eabi-size "$$img" | awk 'NR == 2 { print $$1, $$2 }' | { read -r text data; \
+	  f=$$((text + data)); echo "firmware $$img"; \
+	  awk -v f=$$f -v t=$$text -v d=$$data -v fk=$$fk 'BEGIN { printf "  flash: %7d bytes (text %d + data %d)  %5.2f%% of %d KiB\n", f, t, d, 100 * f / (fk * 1024), fk }'; }; \
+	for r in $$regions; do name=$${r%%:*}; rest=$${r#*:}; org=$${rest%%:*}; kib=$${rest#*:}; \
+	  arm-none-eabi-size -A "$$img" | awk -v name=$$name -v org=$$((org)) -v kib=$$kib ' \
+	    NF == 3 && $$3 ~ /^[0-9]+$$/ && $$3 + 0 >= org && $$3 + 0 < org + kib * 1024 && $$2 > 0 { b += $$2; s = s sprintf(" %s %d", $$1, $$2) } \
+	    END { printf "  RAM %-8s %7d bytes (%s)  %5.2f%% of %d KiB\n", name ":", b, substr(s, 2), 100 * b / (kib * 1024), kib }' || exit 1; \
+	done
 endef
 
 .PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench firmware regen clean distclean

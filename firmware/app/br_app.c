@@ -4,6 +4,9 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "bristle/br_encoder.h"
+#include "br_check.h"
+
 /* The estimator runs at the controller's period: the same float, up to a few
  * ulp of rounding in however each was formed. */
 #define BR_APP_PERIOD_RTOL 1.0e-6f
@@ -58,24 +61,232 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
     return BR_E_PARAM;
 }
 
+/* Largest values the guards accept (bounded counters, a delta that an int32
+ * difference can hold with room, a stale hold of at most a second at 1 kHz). */
+#define BR_APP_MAX_DELTA_LIMIT (1u << 30)
+#define BR_APP_STALE_LIMIT 1000u
+#define BR_APP_FROZEN_LIMIT (1u << 20)
+
+br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s)
+{
+    br_app_guard_cfg_t g = {0u, BR_APP_GUARD_STALE_PERIODS, BR_APP_GUARD_FROZEN_DUTY, 0u};
+    if (!br_finite_pos(dt_s) || !br_finite_pos(max_speed_counts_per_s)) {
+        return g; /* zero delta and frozen periods: rejected by br_app_init */
+    }
+    const float d = ceilf(max_speed_counts_per_s * dt_s);
+    const float f = ceilf(BR_APP_GUARD_FROZEN_S / dt_s);
+    g.enc_max_delta_counts = (d <= (float)BR_APP_MAX_DELTA_LIMIT) ? (uint32_t)d : BR_APP_MAX_DELTA_LIMIT + 1u;
+    g.frozen_periods = (f <= (float)BR_APP_FROZEN_LIMIT) ? (uint32_t)f : BR_APP_FROZEN_LIMIT + 1u;
+    return g;
+}
+
+static br_status_t guard_check(const br_app_guard_cfg_t *g)
+{
+    if (g->enc_max_delta_counts < 1u || g->enc_max_delta_counts > BR_APP_MAX_DELTA_LIMIT ||
+        g->enc_stale_periods > BR_APP_STALE_LIMIT || g->frozen_periods < 1u ||
+        g->frozen_periods > BR_APP_FROZEN_LIMIT) {
+        return BR_E_PARAM;
+    }
+    /* written so that a NaN fails */
+    if (!(g->frozen_duty > 0.0f && g->frozen_duty <= 1.0f)) {
+        return BR_E_PARAM;
+    }
+    return BR_OK;
+}
+
+/* Duty 0, outputs off where the port can. */
+static void outputs_off(br_app_t *app)
+{
+    const br_hal_t *hal = app->axis.hal;
+    (void)hal->pwm_write(hal->ctx, 0.0f);
+    if (hal->pwm_disable != NULL) {
+        (void)hal->pwm_disable(hal->ctx);
+    }
+    app->axis.last = (br_ctrl_out_t){0};
+}
+
+static br_status_t latch(br_app_t *app, br_app_fault_t cause)
+{
+    app->fault = cause;
+    outputs_off(app);
+    return BR_E_FAULT;
+}
+
 br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *hal, const br_app_mem_t *mem)
 {
     if (app == NULL) {
         return BR_E_NULL;
     }
     app->axis.ready = 0;
+    if (cfg == NULL) {
+        return BR_E_NULL;
+    }
     br_est_t est;
-    const br_status_t st = br_app_est_init(cfg, mem, &est);
+    br_status_t st = br_app_est_init(cfg, mem, &est);
     if (st != BR_OK) {
         return st;
     }
-    return br_axis_init(&app->axis, hal, cfg->ctrl, (est.step != NULL) ? &est : NULL);
+    st = guard_check(&cfg->guard);
+    if (st != BR_OK) {
+        return st;
+    }
+    st = br_axis_init(&app->axis, hal, cfg->ctrl, (est.step != NULL) ? &est : NULL);
+    if (st != BR_OK) {
+        return st;
+    }
+    app->guard = cfg->guard;
+    app->kind = cfg->est;
+    app->mem = (mem != NULL) ? *mem : (br_app_mem_t){NULL, NULL};
+    app->last_counts = 0;
+    app->have_counts = 0;
+    app->n_stale = 0u;
+    app->n_frozen = 0u;
+    (void)latch(app, BR_APP_FAULT_DISARMED);
+    return BR_OK;
 }
 
-br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
+br_status_t br_app_arm(br_app_t *app)
 {
     if (app == NULL) {
         return BR_E_NULL;
     }
-    return br_axis_step(&app->axis, ref);
+    if (!app->axis.ready) {
+        return BR_E_STATE;
+    }
+    /* the controller restarts: integral and previous count cleared */
+    const br_ctrl_cfg_t kc = app->axis.ctrl.cfg;
+    br_status_t st = br_ctrl_init(&app->axis.ctrl, &kc);
+    if (st == BR_OK && app->kind == BR_APP_EST_PF) {
+        const br_pf_cfg_t pc = app->mem.pf->cfg;
+        st = br_pf_init(app->mem.pf, &pc); /* primed again at the next measurement */
+    } else if (st == BR_OK && app->kind == BR_APP_EST_UKF) {
+        const br_ukf_cfg_t uc = app->mem.ukf->cfg;
+        st = br_ukf_init(app->mem.ukf, &uc);
+    }
+    if (st != BR_OK) {
+        return st; /* stays latched */
+    }
+    app->axis.F_hat_N = 0.0f;
+    app->axis.last = (br_ctrl_out_t){0};
+    app->have_counts = 0;
+    app->n_stale = 0u;
+    app->n_frozen = 0u;
+    const br_hal_t *hal = app->axis.hal;
+    st = hal->pwm_write(hal->ctx, 0.0f);
+    if (st == BR_OK && hal->pwm_enable != NULL) {
+        st = hal->pwm_enable(hal->ctx);
+    }
+    if (st != BR_OK) {
+        (void)latch(app, BR_APP_FAULT_HAL);
+        return st;
+    }
+    app->fault = BR_APP_FAULT_NONE;
+    return BR_OK;
+}
+
+br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause)
+{
+    if (app == NULL) {
+        return BR_E_NULL;
+    }
+    if (!app->axis.ready) {
+        return BR_E_STATE;
+    }
+    if (cause <= BR_APP_FAULT_NONE || cause > BR_APP_FAULT_HAL) {
+        return BR_E_PARAM;
+    }
+    return latch(app, cause);
+}
+
+/* A period without a measurement: the PF / UKF predict only; an EXTERN
+ * estimate is held. */
+static br_status_t est_predict(br_app_t *app)
+{
+    const float u = app->axis.last.tau_Nm;
+    br_status_t st = BR_OK;
+    if (app->kind == BR_APP_EST_PF) {
+        st = br_pf_predict(app->mem.pf, u);
+        if (!BR_FAILED(st)) {
+            app->axis.F_hat_N = br_pf_estimate(app->mem.pf)->F_hat_N;
+        }
+    } else if (app->kind == BR_APP_EST_UKF) {
+        st = br_ukf_predict(app->mem.ukf, u);
+        if (!BR_FAILED(st)) {
+            app->axis.F_hat_N = br_ukf_estimate(app->mem.ukf)->F_hat_N;
+        }
+    }
+    return st;
+}
+
+br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
+{
+    if (app == NULL || ref == NULL) {
+        return BR_E_NULL;
+    }
+    if (!app->axis.ready) {
+        return BR_E_STATE;
+    }
+    br_axis_t *a = &app->axis;
+    const br_hal_t *hal = a->hal;
+    if (app->fault != BR_APP_FAULT_NONE) {
+        outputs_off(app);
+        return BR_E_FAULT;
+    }
+    int32_t counts = 0;
+    br_status_t st = hal->encoder_read(hal->ctx, &counts);
+    br_status_t est_st = BR_OK;
+    if (st != BR_OK) {
+        /* no position this period: hold the last one for enc_stale_periods */
+        if (++app->n_stale > app->guard.enc_stale_periods) {
+            return latch(app, BR_APP_FAULT_ENC_STALE);
+        }
+        if (!app->have_counts) {
+            /* nothing to hold yet: duty 0 this period, outputs stay enabled
+             * (not latched: a good read next period runs the loop) */
+            (void)hal->pwm_write(hal->ctx, 0.0f);
+            a->last = (br_ctrl_out_t){0};
+            return BR_OK;
+        }
+        counts = app->last_counts;
+        est_st = est_predict(app);
+    } else {
+        app->n_stale = 0u;
+        if (app->have_counts) {
+            const int32_t d = br_counts_delta(counts, app->last_counts);
+            /* |d| as unsigned: INT32_MIN included */
+            const uint32_t mag = (d < 0) ? (uint32_t)0u - (uint32_t)d : (uint32_t)d;
+            if (mag > app->guard.enc_max_delta_counts) {
+                return latch(app, BR_APP_FAULT_ENC_JUMP);
+            }
+            if (mag == 0u && fabsf(a->last.duty) >= app->guard.frozen_duty) {
+                if (++app->n_frozen >= app->guard.frozen_periods) {
+                    return latch(app, BR_APP_FAULT_ENC_FROZEN);
+                }
+            } else {
+                app->n_frozen = 0u;
+            }
+        }
+        app->last_counts = counts;
+        app->have_counts = 1;
+        if (a->est.step != NULL) {
+            /* the estimator sees the count's centre and the torque of the last period */
+            const br_meas_t y = {counts, 0.5f};
+            est_st = a->est.step(a->est.ctx, &y, a->last.tau_Nm, &a->F_hat_N);
+        }
+    }
+    /* a warning (an outlier measurement skipped, whose prediction stays
+     * usable): control goes on and the status is passed up */
+    if (BR_FAILED(est_st)) {
+        return latch(app, BR_APP_FAULT_ESTIMATOR);
+    }
+    br_ctrl_in_t in = {counts, ref->ref_counts, ref->ref_frac_counts, ref->ref_omega_radps, a->F_hat_N};
+    st = br_ctrl_step(&a->ctrl, &in, &a->last);
+    if (st != BR_OK) {
+        return latch(app, (st == BR_E_INPUT) ? BR_APP_FAULT_CTRL_INPUT : BR_APP_FAULT_CTRL_STATE);
+    }
+    st = hal->pwm_write(hal->ctx, a->last.duty);
+    if (st != BR_OK) {
+        return latch(app, BR_APP_FAULT_HAL);
+    }
+    return est_st;
 }

@@ -44,6 +44,9 @@ def machine_fields(m, p):
         ("BR_MACHINE_CTRL_PERIOD_S", ctl["period_s"], "control period (H-inf only, H-inf + UKF)"),
         ("BR_MACHINE_TORQUE_LIMIT_NM", ctl["torque_limit_Nm"], "controller torque saturation"),
         ("BR_MACHINE_MAX_SPEED_MPS", lim["max_speed_mps"], "largest table speed the axis is used at"),
+        ("BR_MACHINE_MAX_SPEED_COUNTS_PER_S", lim["max_speed_mps"] / (p["L_mprad"] * p["rad_per_count"]),
+         "that speed in encoder counts per second (max_speed / (L rad_per_count)); times the period:\n"
+         " * the largest encoder delta of one period (br_app_guard_cfg)"),
         ("BR_MACHINE_TRAVEL_M", lim["travel_m"], "stroke of the table"),
     ]
 
@@ -51,6 +54,7 @@ def machine_fields(m, p):
 def est_fields(m):
     pf, ukf = m["estimator"]["pf"], m["estimator"]["ukf"]
     out = [("BR_EST_PF_PERIOD_S", pf["period_s"], "the PF's period (its loop runs at it)"),
+           ("BR_EST_PF_PERIOD_NS", int(round(pf["period_s"] * 1e9)), "the same in whole nanoseconds (an MCU tick)"),
            ("BR_EST_PF_N_PARTICLES", pf["n_particles"], "particle count")]
     for k, c in (("theta_counts2", "Q_THETA_COUNTS2"), ("omega_rad2_per_s2", "Q_OMEGA_RAD2PS2"),
                  ("z_m2", "Q_Z_M2"), ("gp_N2", "Q_GP_N2")):

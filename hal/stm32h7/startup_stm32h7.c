@@ -3,7 +3,7 @@
  * Reset_Handler, in order: enables the FPU (CPACR CP10/CP11 full access, with
  * DSB/ISB so no floating-point instruction can execute before it takes
  * effect), enables the instruction cache, copies .data from flash to DTCM,
- * zeroes .bss, and calls main. Every other exception and interrupt goes to
+ * zeroes .bss and .axisram (AXI SRAM: the PF's state), and calls main. Every other exception and interrupt goes to
  * br_default_handler, which parks the core (a debugger shows where).
  * Symbols come from stm32h743.ld. No interrupt is used by the image: the
  * control tick is polled. */
@@ -18,6 +18,8 @@ extern uint32_t _sdata[];
 extern uint32_t _edata[];
 extern uint32_t _sbss[];
 extern uint32_t _ebss[];
+extern uint32_t _saxisram[];
+extern uint32_t _eaxisram[];
 
 int main(void);
 void Reset_Handler(void);
@@ -79,6 +81,12 @@ void Reset_Handler(void)
     }
     dst = _sbss;
     n = ((uintptr_t)_ebss - (uintptr_t)_sbss) / sizeof(uint32_t);
+    for (i = 0u; i < n; ++i) {
+        dst[i] = 0u;
+    }
+    /* AXI SRAM (clocked from reset): the NOLOAD statics placed there */
+    dst = _saxisram;
+    n = ((uintptr_t)_eaxisram - (uintptr_t)_saxisram) / sizeof(uint32_t);
     for (i = 0u; i < n; ++i) {
         dst[i] = 0u;
     }

@@ -129,8 +129,9 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
     const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(c);
     rec_est_t wrap = {est, &plant, rec, 0};
     const br_est_t e = {&wrap, rec_est_step};
-    const br_app_cfg_t ac = {&cc, BR_APP_EST_EXTERN, NULL, NULL, &e};
-    if (br_app_init(&app, &ac, &hal, NULL) != BR_OK) {
+    const br_app_cfg_t ac = {&cc, BR_APP_EST_EXTERN, NULL, NULL, &e,
+                             br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
+    if (br_app_init(&app, &ac, &hal, NULL) != BR_OK || br_app_arm(&app) != BR_OK) {
         fprintf(stderr, "br_bench: application init failed\n");
         return -1;
     }

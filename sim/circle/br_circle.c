@@ -96,7 +96,8 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     if (br_hal_sim_init(&a->port, &a->plant, c->dt_s, &a->hal) != BR_OK) return -1;
     const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(c);
     br_est_t ext = {NULL, NULL};
-    br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext};
+    br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext,
+                       br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
     switch (c->controller) {
     case BR_CTRL_HINF_ONLY:
         break;
@@ -116,6 +117,9 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     br_status_t st;
     /* BR_E_PARAM also when an estimator's period is not the control period */
     st = br_app_init(&a->app, &ac, &a->hal, &a->mem);
+    if (st == BR_OK) {
+        st = br_app_arm(&a->app); /* the simulator arms right after init */
+    }
     if (st != BR_OK) {
         fprintf(stderr, "br_circle: application init failed (status %d)\n", (int)st);
         return -1;

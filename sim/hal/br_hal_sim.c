@@ -48,5 +48,7 @@ br_status_t br_hal_sim_init(br_hal_sim_t *port, br_plant_t *plant, double dt_s, 
     hal->encoder_read = sim_encoder_read;
     hal->pwm_write = sim_pwm_write;
     hal->tick_wait = sim_tick_wait;
+    hal->pwm_disable = NULL; /* the simulated amplifier has no enable: duty 0 is off */
+    hal->pwm_enable = NULL;
     return BR_OK;
 }

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "bristle_gen/est/br_noise_table.h"
+#include "bristle_gen/machine/br_machine.h"
 
 static uint32_t f2w(float f)
 {
@@ -136,10 +137,14 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
     r->hal.encoder_read = enc_read;
     r->hal.pwm_write = pwm_write;
     r->hal.tick_wait = tick_wait;
+    r->hal.pwm_disable = NULL;
+    r->hal.pwm_enable = NULL;
     r->duty = 0.0f;
-    const br_app_cfg_t app_cfg = {&r->cfg.ctrl, BR_APP_EST_PF, &r->cfg.pf, NULL, NULL};
+    const br_app_cfg_t app_cfg = {&r->cfg.ctrl, BR_APP_EST_PF, &r->cfg.pf, NULL, NULL,
+                                 br_app_guard_cfg(r->cfg.ctrl.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
     const br_app_mem_t mem = {&r->pf, NULL};
-    if (br_app_init(&r->app, &app_cfg, &r->hal, &mem) != BR_OK) return -3;
+    /* the replay arms right after init, as the simulator */
+    if (br_app_init(&r->app, &app_cfg, &r->hal, &mem) != BR_OK || br_app_arm(&r->app) != BR_OK) return -3;
     for (uint32_t k = 0u; k < r->cfg.n_steps; ++k) {
         uint32_t in[BR_REPLAY_STEP_WORDS];
         uint32_t out[BR_REPLAY_OUT_WORDS];

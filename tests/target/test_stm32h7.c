@@ -9,6 +9,7 @@
 
 #include <string.h>
 
+#include "bristle/br_app.h"
 #include "bristle/br_encoder.h"
 #include "bristle/br_stm32h7.h"
 
@@ -79,6 +80,12 @@ static void test_init_programs_registers(void **st)
     assert_true((f.tim1.CR1 & BR_TIM_CR1_ARPE) != 0u);
     assert_true((f.tim1.CR1 & BR_TIM_CR1_CEN) != 0u);
     assert_int_equal(f.tim1.CCMR1, 0x6868u); /* OC1M = OC2M = PWM1, preload on */
+    /* outputs off until the arm: channels and MOE cleared at init ... */
+    assert_int_equal(f.tim1.CCER, 0u);
+    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_MOE, 0u);
+    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, 48u);
+    /* ... and on, complementary pairs, at pwm_enable */
+    assert_int_equal(br_stm32h7_pwm_enable(&port), BR_OK);
     assert_int_equal(f.tim1.CCER, BR_TIM_CCER_CC1E | BR_TIM_CCER_CC1NE | BR_TIM_CCER_CC2E | BR_TIM_CCER_CC2NE);
     assert_true((f.tim1.BDTR & BR_TIM_BDTR_MOE) != 0u);
     assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, 48u);
@@ -414,6 +421,234 @@ static void test_rcc_and_gpio(void **st)
     assert_int_equal(br_stm32h7_gpio_af(&gpio, 3u, 16u), BR_E_PARAM);
 }
 
+/* ---- fail-safe: the PWM goes off (docs/reliability.md) --------------------- */
+
+static int pwm_off(const fake_regs_t *f)
+{
+    return (f->tim1.BDTR & BR_TIM_BDTR_MOE) == 0u && f->tim1.CCER == 0u && f->tim1.CCR1 == 0u &&
+           f->tim1.CCR2 == 0u;
+}
+
+static void test_deadline_disables_pwm(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    uint32_t tick = 0u;
+    port_up(&port, &f, 32u);
+    assert_int_equal(br_stm32h7_pwm_enable(&port), BR_OK);
+    assert_int_equal(br_stm32h7_pwm_write(&port, 0.5f), BR_OK);
+    /* the fake keeps COUNTFLAG: every tick_wait is a missed period */
+    f.systick.CTRL |= BR_SYSTICK_CTRL_COUNTFLAG;
+    for (uint32_t k = 0u; k < 2u; ++k) {
+        assert_int_equal(br_stm32h7_tick_wait(&port, &tick), BR_OK);
+        assert_int_equal(br_stm32h7_deadline_check(&port, 2u), BR_OK);
+        assert_false(pwm_off(&f));
+    }
+    assert_int_equal(br_stm32h7_tick_wait(&port, &tick), BR_OK);
+    assert_int_equal(br_stm32h7_deadline_check(&port, 2u), BR_E_FAULT); /* 3 > 2 */
+    assert_true(pwm_off(&f));
+    /* an arm restarts the count */
+    assert_int_equal(br_stm32h7_pwm_enable(&port), BR_OK);
+    assert_int_equal(br_stm32h7_deadline_check(&port, 2u), BR_OK);
+    assert_int_equal(br_stm32h7_deadline_check(NULL, 2u), BR_E_NULL);
+}
+
+/* br_app over the port on the fake registers: a latched fault turns TIM1 off */
+typedef struct {
+    fake_regs_t f;
+    br_stm32h7_t port;
+    br_hal_t hal;
+    br_ctrl_cfg_t k;
+    br_app_cfg_t c;
+    br_app_t app;
+} app_rig_t;
+
+static void app_up(app_rig_t *g)
+{
+    memset(g, 0, sizeof *g);
+    port_up(&g->port, &g->f, 32u);
+    assert_int_equal(br_stm32h7_hal(&g->port, &g->hal), BR_OK);
+    g->k = (br_ctrl_cfg_t){{-0.5f, -0.01f, -10.0f}, 1e-3f, 0.64f, 0.64f, 6.0e-6f, 1.27e-3f};
+    const br_app_guard_cfg_t guard = {100u, 3u, 0.5f, 5u};
+    g->c = (br_app_cfg_t){&g->k, BR_APP_EST_NONE, NULL, NULL, NULL, guard};
+    assert_int_equal(br_app_init(&g->app, &g->c, &g->hal, NULL), BR_OK);
+    assert_true(pwm_off(&g->f)); /* disarmed */
+    assert_int_equal(br_app_arm(&g->app), BR_OK);
+    assert_true((g->f.tim1.BDTR & BR_TIM_BDTR_MOE) != 0u);
+    /* a large position error: a large duty */
+    const br_ref_t r = {120000, 0.0f, 0.0f};
+    assert_int_equal(br_app_step(&g->app, &r), BR_OK);
+    assert_true(g->f.tim1.CCR1 > 3000u);
+    assert_false(pwm_off(&g->f));
+}
+
+static void test_app_faults_disable_pwm(void **st)
+{
+    (void)st;
+    app_rig_t g;
+    const br_ref_t r = {120000, 0.0f, 0.0f};
+    /* encoder jump: the counter leaps 101 counts in one period */
+    app_up(&g);
+    g.f.tim2.CNT += 101u;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_JUMP);
+    assert_true(pwm_off(&g.f));
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT); /* stays off */
+    assert_true(pwm_off(&g.f));
+    /* encoder frozen: the counter stops under a large duty */
+    app_up(&g);
+    for (int i = 0; i < 4; i++) {
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    }
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_FROZEN);
+    assert_true(pwm_off(&g.f));
+    /* a latched application fault (a non-finite reference) */
+    app_up(&g);
+    const br_ref_t bad = {0, 0.0f, NAN};
+    assert_int_equal(br_app_step(&g.app, &bad), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_CTRL_INPUT);
+    assert_true(pwm_off(&g.f));
+    /* deadline: the port trips, the application latches */
+    app_up(&g);
+    uint32_t tick = 0u;
+    g.f.systick.CTRL |= BR_SYSTICK_CTRL_COUNTFLAG;
+    assert_int_equal(br_stm32h7_tick_wait(&g.port, &tick), BR_OK);
+    assert_int_equal(br_stm32h7_deadline_check(&g.port, 0u), BR_E_FAULT);
+    assert_true(pwm_off(&g.f));
+    assert_int_equal(br_app_fault(&g.app, BR_APP_FAULT_DEADLINE), BR_E_FAULT);
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_true(pwm_off(&g.f));
+    /* re-arm: on again */
+    g.f.tim2.CNT += 1u;
+    assert_int_equal(br_app_arm(&g.app), BR_OK);
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    assert_false(pwm_off(&g.f));
+}
+
+/* ---- control period that is no whole frequency ---------------------------- */
+
+static void test_control_period_ns(void **st)
+{
+    (void)st;
+    fake_regs_t f;
+    br_stm32h7_t port;
+    fake_fill(&f, 0);
+    br_stm32h7_cfg_t c = cfg_for(&f);
+    c.control_hz = 0u;
+    c.control_period_ns = 1500000u; /* the PF's 1.5 ms: 720000 cycles at 480 MHz */
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_OK);
+    assert_int_equal(f.systick.LOAD, 719999u);
+    c.control_hz = 1000u; /* both */
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_E_PARAM);
+    c.control_hz = 0u;
+    c.control_period_ns = 0u; /* neither */
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_E_PARAM);
+    c.control_period_ns = 1500001u; /* not a whole number of cycles */
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_E_PARAM);
+    c.control_period_ns = 40000000u; /* 19.2e6 cycles > 2^24 */
+    assert_int_equal(br_stm32h7_init(&port, &c), BR_E_PARAM);
+}
+
+/* ---- watchdog ---------------------------------------------------------------- */
+
+static void test_iwdg(void **st)
+{
+    (void)st;
+    br_stm32h7_iwdg_t w;
+    memset(&w, 0, sizeof w);
+    assert_int_equal(br_stm32h7_iwdg_start(&w, 0u, 79u), BR_OK); /* /4, 80 ticks: 10 ms */
+    assert_int_equal(w.PR, 0u);
+    assert_int_equal(w.RLR, 79u);
+    assert_int_equal(w.KR, 0xAAAAu); /* the last key: the first refresh */
+    w.KR = 0u;
+    br_stm32h7_iwdg_refresh(&w);
+    assert_int_equal(w.KR, 0xAAAAu);
+    memset(&w, 0, sizeof w);
+    assert_int_equal(br_stm32h7_iwdg_start(&w, 7u, 79u), BR_E_PARAM);
+    assert_int_equal(br_stm32h7_iwdg_start(&w, 0u, 0x1000u), BR_E_PARAM);
+    assert_int_equal(br_stm32h7_iwdg_start(&w, 0u, 0u), BR_E_PARAM);
+    assert_int_equal(w.KR, 0u); /* rejected before any key */
+    assert_int_equal(br_stm32h7_iwdg_start(NULL, 0u, 79u), BR_E_NULL);
+    w.SR = 1u; /* a prescaler update that never ends: bounded, no refresh */
+    assert_int_equal(br_stm32h7_iwdg_start(&w, 0u, 79u), BR_E_STATE);
+    assert_int_equal(w.KR, 0x5555u);
+}
+
+/* ---- clocks: HSI 64 MHz -> PLL1 480 MHz ------------------------------------ */
+
+typedef struct {
+    br_stm32h7_rcc_t rcc;
+    br_stm32h7_pwr_t pwr;
+    br_stm32h7_syscfg_t syscfg;
+    br_stm32h7_flash_t flash;
+} fake_clock_t;
+
+/* reset values where they matter (RM0433), with the ready flags a running
+ * part would raise already set (a fake register does not change by itself) */
+static br_stm32h7_clock_regs_t clock_up(fake_clock_t *k, int pll_locks)
+{
+    memset(k, 0, sizeof *k);
+    k->rcc.CR = BR_RCC_CR_HSION | BR_RCC_CR_HSIRDY | (pll_locks ? BR_RCC_CR_PLL1RDY : 0u);
+    k->rcc.CFGR = BR_RCC_CFGR_SWS_PLL1; /* the switch "completes" */
+    k->rcc.PLLCKSELR = 0x02020200u;     /* DIVM1..3 = 32, HSI */
+    k->rcc.PLLCFGR = 0x01FF0000u;       /* every DIVxyEN set */
+    k->pwr.CR3 = BR_PWR_CR3_SCUEN | BR_PWR_CR3_LDOEN;
+    k->pwr.CSR1 = BR_PWR_CSR1_ACTVOSRDY;
+    k->pwr.D3CR = (1u << 14) | BR_PWR_D3CR_VOSRDY; /* VOS3 after reset */
+    k->flash.ACR = 0x37u;                          /* 7 WS, WRHIGHFREQ 3 */
+    const br_stm32h7_clock_regs_t r = {&k->rcc, &k->pwr, &k->syscfg, &k->flash};
+    return r;
+}
+
+static void test_clock_480(void **st)
+{
+    (void)st;
+    fake_clock_t k;
+    br_stm32h7_clock_regs_t r = clock_up(&k, 1);
+    assert_int_equal(br_stm32h7_clock_480(&r), BR_OK);
+    /* supply LDO, VOS1 + ODEN = VOS0 */
+    assert_int_equal(k.pwr.CR3 & 7u, BR_PWR_CR3_LDOEN);
+    assert_int_equal(k.pwr.D3CR & BR_PWR_D3CR_VOS_Msk, 3u << 14);
+    assert_int_equal(k.rcc.APB4ENR & BR_RCC_APB4ENR_SYSCFGEN, BR_RCC_APB4ENR_SYSCFGEN);
+    assert_int_equal(k.syscfg.PWRCR & 1u, 1u);
+    /* flash: 4 WS, WRHIGHFREQ = 2 */
+    assert_int_equal(k.flash.ACR & 0x3Fu, 0x24u);
+    /* PLL1: HSI, M = 4; range 8..16 MHz, wide VCO, integer; P on, Q/R off */
+    assert_int_equal(k.rcc.PLLCKSELR, 0x02020040u);
+    /* reset 0x01FF0000 with PLL1's Q and R enables cleared, RGE = 11 */
+    assert_int_equal(k.rcc.PLLCFGR, 0x01F9000Cu);
+    /* N - 1 = 59, P - 1 = 1, Q - 1 = R - 1 = 3 */
+    assert_int_equal(k.rcc.PLL1DIVR, 59u | (1u << 9) | (3u << 16) | (3u << 24));
+    assert_true((k.rcc.CR & BR_RCC_CR_PLL1ON) != 0u);
+    /* D1CPRE /1, HPRE /2, D1PPRE /2; APB1, APB2, APB4 /2 */
+    assert_int_equal(k.rcc.D1CFGR, 0x0048u);
+    assert_int_equal(k.rcc.D2CFGR, 0x0440u);
+    assert_int_equal(k.rcc.D3CFGR, 0x0040u);
+    /* SYSCLK = PLL1, TIMPRE 0 */
+    assert_int_equal(k.rcc.CFGR & 7u, 3u);
+    assert_int_equal(k.rcc.CFGR & BR_RCC_CFGR_TIMPRE, 0u);
+    /* the frequencies the board's constants state */
+    assert_int_equal(64000000u / BR_STM32H7_PLL1_DIVM * BR_STM32H7_PLL1_DIVN / BR_STM32H7_PLL1_DIVP,
+                     BR_STM32H7_SYSCLK_HZ);
+
+    /* PLL1 never locks: bounded wait, the system clock stays on HSI */
+    r = clock_up(&k, 0);
+    k.rcc.CFGR = 0u;
+    assert_int_equal(br_stm32h7_clock_480(&r), BR_E_STATE);
+    assert_int_equal(k.rcc.CFGR & 7u, 0u);
+    assert_int_equal(k.rcc.D1CFGR, 0u);
+    /* the voltage never ready: nothing past it written */
+    r = clock_up(&k, 1);
+    k.pwr.D3CR = 1u << 14;
+    assert_int_equal(br_stm32h7_clock_480(&r), BR_E_STATE);
+    assert_int_equal(k.flash.ACR, 0x37u);
+    assert_int_equal(k.rcc.CR & BR_RCC_CR_PLL1ON, 0u);
+    r.flash = NULL;
+    assert_int_equal(br_stm32h7_clock_480(&r), BR_E_NULL);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -428,6 +663,11 @@ int main(void)
         cmocka_unit_test(test_tick_polling),
         cmocka_unit_test(test_hal_adapter),
         cmocka_unit_test(test_rcc_and_gpio),
+        cmocka_unit_test(test_deadline_disables_pwm),
+        cmocka_unit_test(test_app_faults_disable_pwm),
+        cmocka_unit_test(test_control_period_ns),
+        cmocka_unit_test(test_iwdg),
+        cmocka_unit_test(test_clock_480),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

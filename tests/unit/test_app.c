@@ -2,27 +2,52 @@
  * runs the same loop as wiring the estimator into br_axis by hand. */
 #include "br_test.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "circle/br_circle_est.h"
 #include "bristle/br_app.h"
+#include "bristle/br_machine_cfg.h"
 
 typedef struct {
     int32_t counts;
     float duty;
+    br_status_t enc_st; /* what encoder_read returns (it writes counts on BR_OK only) */
+    br_status_t pwm_st; /* what pwm_write returns */
+    int on;             /* outputs enabled (pwm_enable / pwm_disable) */
+    int disables;
 } fake_t;
 
 static br_status_t fake_enc(void *ctx, int32_t *c)
 {
-    *c = ((fake_t *)ctx)->counts;
-    return BR_OK;
+    fake_t *f = ctx;
+    if (f->enc_st == BR_OK) {
+        *c = f->counts;
+    }
+    return f->enc_st;
 }
 static br_status_t fake_pwm(void *ctx, float d)
 {
     ((fake_t *)ctx)->duty = d;
+    return ((fake_t *)ctx)->pwm_st;
+}
+static br_status_t fake_disable(void *ctx)
+{
+    fake_t *f = ctx;
+    f->on = 0;
+    f->disables++;
     return BR_OK;
 }
+static br_status_t fake_enable(void *ctx)
+{
+    ((fake_t *)ctx)->on = 1;
+    return BR_OK;
+}
+
+/* guards of the tests: 100 counts per period, 3 held reads, frozen at
+ * |duty| >= 0.5 for 5 periods */
+#define GUARD {100u, 3u, 0.5f, 5u}
 static br_status_t fake_tick(void *ctx, uint32_t *t)
 {
     (void)ctx;
@@ -47,8 +72,8 @@ static br_status_t const_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm
 static void test_init_guards(void **st)
 {
     (void)st;
-    fake_t f = {0, 0.0f};
-    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
+    fake_t f = {0, 0.0f, BR_OK, BR_OK, 0, 0};
+    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     br_ctrl_cfg_t k = ctrl_cfg();
     br_pf_cfg_t pfc = br_circle_pf_cfg_tuned(1e-3f);
     br_ukf_cfg_t ukfc = br_circle_ukf_cfg_tuned(1e-3f);
@@ -60,7 +85,7 @@ static void test_init_guards(void **st)
     br_app_t app;
     br_est_t est;
 
-    br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL};
+    br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD};
     assert_int_equal(br_app_init(NULL, &c, &hal, NULL), BR_E_NULL);
     assert_int_equal(br_app_init(&app, NULL, &hal, NULL), BR_E_NULL);
     assert_int_equal(br_app_init(&app, &c, NULL, NULL), BR_E_NULL);
@@ -131,13 +156,14 @@ static void test_init_guards(void **st)
 static void test_none_is_hinf_only(void **st)
 {
     (void)st;
-    fake_t f = {1000, 0.0f};
-    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
+    fake_t f = {1000, 0.0f, BR_OK, BR_OK, 0, 0};
+    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     const br_ctrl_cfg_t k = ctrl_cfg();
-    const br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL};
+    const br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD};
     br_app_t app;
     const br_ref_t r = {0, 0.0f, 0.0f};
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
+    assert_int_equal(br_app_arm(&app), BR_OK);
     assert_int_equal(br_app_step(&app, &r), BR_OK);
     BR_ASSERT_NEAR(f.duty, -0.5 * 1000 * 6.0e-6 / 0.64, 1e-7);
     BR_ASSERT_NEAR(app.axis.F_hat_N, 0.0, 0.0);
@@ -146,15 +172,16 @@ static void test_none_is_hinf_only(void **st)
 static void test_extern_drives_compensation(void **st)
 {
     (void)st;
-    fake_t f = {0, 0.0f};
-    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
+    fake_t f = {0, 0.0f, BR_OK, BR_OK, 0, 0};
+    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     const br_ctrl_cfg_t k = ctrl_cfg();
     const float F = 10.0f;
     const br_est_t ext = {(void *)&F, const_est_step};
-    const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext};
+    const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD};
     br_app_t app;
     const br_ref_t r = {0, 0.0f, 0.0f};
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
+    assert_int_equal(br_app_arm(&app), BR_OK);
     assert_int_equal(br_app_step(&app, &r), BR_OK);
     /* zero error: the duty is the compensation alone, L F / tau_per_duty */
     BR_ASSERT_NEAR(f.duty, 1.27e-3 * 10.0 / 0.64, 1e-7);
@@ -164,8 +191,8 @@ static void test_extern_drives_compensation(void **st)
  * wired by hand: bit-identical estimates and duties. */
 static void run_against_axis(br_app_est_kind_t kind)
 {
-    fake_t fa = {0, 0.0f}, fb = {0, 0.0f};
-    const br_hal_t ha = {&fa, fake_enc, fake_pwm, fake_tick}, hb = {&fb, fake_enc, fake_pwm, fake_tick};
+    fake_t fa = {0, 0.0f, BR_OK, BR_OK, 0, 0}, fb = {0, 0.0f, BR_OK, BR_OK, 0, 0};
+    const br_hal_t ha = {&fa, fake_enc, fake_pwm, fake_tick, NULL, NULL}, hb = {&fb, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     const br_ctrl_cfg_t k = ctrl_cfg();
     br_pf_cfg_t pfc = br_circle_pf_cfg_tuned(1e-3f);
     pfc.n_particles = 200u;
@@ -174,10 +201,11 @@ static void run_against_axis(br_app_est_kind_t kind)
     br_ukf_t *ukf = calloc(2, sizeof *ukf);
     assert_non_null(pf);
     assert_non_null(ukf);
-    const br_app_cfg_t c = {&k, kind, &pfc, &ukfc, NULL};
+    const br_app_cfg_t c = {&k, kind, &pfc, &ukfc, NULL, GUARD};
     const br_app_mem_t mem = {&pf[0], &ukf[0]};
     br_app_t app;
     assert_int_equal(br_app_init(&app, &c, &ha, &mem), BR_OK);
+    assert_int_equal(br_app_arm(&app), BR_OK); /* re-initialises the filter: the same as init */
     br_est_t est;
     if (kind == BR_APP_EST_PF) {
         assert_int_equal(br_pf_init(&pf[1], &pfc), BR_OK);
@@ -214,6 +242,322 @@ static void test_ukf_as_wired_by_hand(void **st)
     run_against_axis(BR_APP_EST_UKF);
 }
 
+/* ---- fail-safe: latched faults (docs/reliability.md) ----------------------- */
+
+
+typedef struct {
+    fake_t f;
+    br_hal_t hal;
+    br_ctrl_cfg_t k;
+    br_est_t ext;
+    br_app_cfg_t c;
+    br_app_t app;
+} rig_t;
+
+static br_status_t bad_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    (void)y;
+    (void)u_prev_Nm;
+    *F_hat_N = 0.0f;
+    return *(const br_status_t *)ctx;
+}
+
+static br_status_t est_status = BR_OK;
+
+/* armed NONE application (or EXTERN with bad_est_step) at counts 0 */
+static void rig_init(rig_t *g, int ext)
+{
+    memset(g, 0, sizeof *g);
+    g->hal = (br_hal_t){&g->f, fake_enc, fake_pwm, fake_tick, fake_disable, fake_enable};
+    g->k = ctrl_cfg();
+    g->ext = (br_est_t){&est_status, bad_est_step};
+    est_status = BR_OK;
+    g->c = (br_app_cfg_t){&g->k, ext ? BR_APP_EST_EXTERN : BR_APP_EST_NONE, NULL, NULL, &g->ext, GUARD};
+    assert_int_equal(br_app_init(&g->app, &g->c, &g->hal, NULL), BR_OK);
+    assert_int_equal(br_app_arm(&g->app), BR_OK);
+    assert_true(g->f.on);
+}
+
+/* the latched state: every step writes 0, outputs off, BR_E_FAULT, cause kept */
+static void assert_latched(rig_t *g, br_app_fault_t cause)
+{
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    assert_int_equal(g->app.fault, cause);
+    assert_false(g->f.on);
+    assert_true(g->f.duty == 0.0f);
+    for (int i = 0; i < 3; i++) {
+        g->f.duty = 0.3f;
+        g->f.enc_st = BR_OK;
+        assert_int_equal(br_app_step(&g->app, &r), BR_E_FAULT);
+        assert_true(g->f.duty == 0.0f);
+        assert_false(g->f.on);
+        assert_int_equal(g->app.fault, cause);
+    }
+}
+
+static void test_outputs_off_until_armed(void **st)
+{
+    (void)st;
+    rig_t g;
+    memset(&g, 0, sizeof g);
+    g.hal = (br_hal_t){&g.f, fake_enc, fake_pwm, fake_tick, fake_disable, fake_enable};
+    g.k = ctrl_cfg();
+    g.c = (br_app_cfg_t){&g.k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD};
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    g.f.counts = 1000;
+    g.f.on = 1;
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_OK);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_DISARMED);
+    assert_int_equal(g.f.disables, 1);
+    assert_latched(&g, BR_APP_FAULT_DISARMED);
+    assert_int_equal(br_app_arm(&g.app), BR_OK);
+    assert_true(g.f.on);
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    assert_true(g.f.duty != 0.0f);
+    assert_int_equal(br_app_arm(NULL), BR_E_NULL);
+}
+
+static void test_ctrl_input_latches_until_rearmed(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 0);
+    g.f.counts = 1000;
+    const br_ref_t r = {0, 0.0f, 0.0f}, bad = {0, NAN, 0.0f};
+    for (int i = 0; i < 5; i++) {
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    }
+    assert_true(g.app.axis.ctrl.eps_rads != 0.0f);
+    assert_int_equal(br_app_step(&g.app, &bad), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_CTRL_INPUT);
+    /* a good reference does not clear it; only the arm does, restarting the integral */
+    assert_int_equal(br_app_arm(&g.app), BR_OK);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_NONE);
+    assert_true(g.app.axis.ctrl.eps_rads == 0.0f);
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    assert_true(g.f.duty < 0.0f && g.f.on);
+}
+
+static void test_ctrl_state_latches(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 0);
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    g.app.axis.ctrl.eps_rads = INFINITY; /* a corrupted integrator */
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_CTRL_STATE);
+}
+
+static void test_estimator_error_latches(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 1);
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    est_status = BR_W_OUTLIER; /* a warning: control goes on */
+    assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
+    assert_true(g.f.on);
+    est_status = BR_E_NUMERIC;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_ESTIMATOR);
+}
+
+static void test_hal_error_latches(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 0);
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    g.f.pwm_st = BR_E_INPUT;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_HAL);
+    assert_false(g.f.on);
+    assert_true(g.f.duty == 0.0f);
+}
+
+static void test_encoder_jump_latches(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 0);
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    /* across the int32 wrap both ways, at the speed limit: fine */
+    g.f.counts = INT32_MAX - 40;
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    g.f.counts = (int32_t)((uint32_t)INT32_MAX + 60u); /* +100 through the wrap */
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    g.f.counts = INT32_MAX - 40; /* -100 back */
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    /* one count above the axis's maximum speed: a glitch, not a count */
+    g.f.counts -= 101;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_ENC_JUMP);
+    /* INT32_MIN apart (|delta| 2^31) as well */
+    rig_init(&g, 0);
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    g.f.counts = INT32_MIN;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_JUMP);
+}
+
+static void test_encoder_stale_holds_then_latches(void **st)
+{
+    (void)st;
+    fake_t f = {0, 0.0f, BR_OK, BR_OK, 0, 0};
+    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, fake_disable, fake_enable};
+    const br_ctrl_cfg_t k = ctrl_cfg();
+    br_pf_cfg_t pfc = br_circle_pf_cfg_tuned(1e-3f);
+    pfc.n_particles = 100u;
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    const br_app_cfg_t c = {&k, BR_APP_EST_PF, &pfc, NULL, NULL, GUARD};
+    const br_app_mem_t mem = {pf, NULL};
+    br_app_t app;
+    assert_int_equal(br_app_init(&app, &c, &hal, &mem), BR_OK);
+    assert_int_equal(br_app_arm(&app), BR_OK);
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    f.counts = 50;
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    const float duty0 = f.duty;
+    /* three failed reads: the last count is held, the PF predicts only */
+    f.enc_st = BR_E_INPUT;
+    for (uint32_t i = 1u; i <= 3u; i++) {
+        assert_int_equal(br_app_step(&app, &r), BR_OK);
+        assert_int_equal(pf->n_predicted, i);
+        assert_true(f.on);
+        assert_true(f.duty < 0.0f && duty0 < 0.0f); /* still pushing towards the reference */
+    }
+    /* a good read resets the count of failed reads */
+    f.enc_st = BR_OK;
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_int_equal(pf->n_predicted, 0u);
+    f.enc_st = BR_E_INPUT;
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(br_app_step(&app, &r), BR_OK);
+    }
+    /* the fourth in a row: timeout */
+    assert_int_equal(br_app_step(&app, &r), BR_E_FAULT);
+    assert_int_equal(app.fault, BR_APP_FAULT_ENC_STALE);
+    assert_false(f.on);
+    assert_true(f.duty == 0.0f);
+    /* re-arm: the PF is primed again at the next measurement; a failed first
+     * read writes duty 0 without turning the outputs off (nothing latched) */
+    assert_int_equal(br_app_arm(&app), BR_OK);
+    f.duty = 0.3f;
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_true(f.duty == 0.0f);
+    assert_true(f.on);
+    f.enc_st = BR_OK;
+    assert_int_equal(pf->primed, 0);
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_int_equal(pf->primed, 1);
+    free(pf);
+}
+
+static void test_encoder_frozen_latches(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 0);
+    /* a position error that commands |duty| >= 0.5 (gain 0.5 Nm/rad, 0.64 Nm per duty) */
+    const int32_t far = 120000;
+    const br_ref_t r = {far, 0.0f, 0.0f};
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    assert_true(fabsf(g.f.duty) >= 0.5f);
+    /* the axis moves: no fault however long */
+    for (int i = 0; i < 20; i++) {
+        g.f.counts += 1;
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    }
+    /* the counter stops while commanded: 4 periods pass, the 5th faults */
+    for (int i = 0; i < 4; i++) {
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    }
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_ENC_FROZEN);
+    /* a still axis at a small duty is not frozen */
+    rig_init(&g, 0);
+    const br_ref_t near = {10, 0.0f, 0.0f};
+    for (int i = 0; i < 20; i++) {
+        assert_int_equal(br_app_step(&g.app, &near), BR_OK);
+    }
+}
+
+static void test_external_fault_latches(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 0);
+    assert_int_equal(br_app_fault(&g.app, BR_APP_FAULT_NONE), BR_E_PARAM);
+    assert_int_equal(br_app_fault(&g.app, (br_app_fault_t)99), BR_E_PARAM);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_NONE);
+    assert_int_equal(br_app_fault(&g.app, BR_APP_FAULT_DEADLINE), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_DEADLINE);
+}
+
+static void test_guard_config(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 0);
+    const br_app_guard_cfg_t ok = GUARD;
+    br_app_guard_cfg_t bad[6] = {ok, ok, ok, ok, ok, ok};
+    bad[0].enc_max_delta_counts = 0u;
+    bad[1].enc_max_delta_counts = (1u << 30) + 1u;
+    bad[2].enc_stale_periods = 1001u;
+    bad[3].frozen_duty = NAN;
+    bad[4].frozen_duty = 1.5f;
+    bad[5].frozen_periods = 0u;
+    for (int i = 0; i < 6; i++) {
+        g.c.guard = bad[i];
+        assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
+        assert_int_equal(br_app_arm(&g.app), BR_E_STATE);
+    }
+    /* the machine's: 1 ms at 0.1 m/s = 13107.2 counts -> 13108; 50 ms of periods */
+    const br_app_guard_cfg_t m = br_app_guard_cfg(1e-3f, 13107200.0f);
+    assert_int_equal(m.enc_max_delta_counts, 13108u);
+    assert_true((float)m.frozen_periods * 1e-3f >= BR_APP_GUARD_FROZEN_S);
+    assert_true((float)(m.frozen_periods - 1u) * 1e-3f < BR_APP_GUARD_FROZEN_S);
+    g.c.guard = br_app_guard_cfg(NAN, 1.0f);
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
+    g.c.guard = br_app_guard_cfg(1e-3f, -1.0f);
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
+}
+
+/* One home: the image's const PF configuration (compile-time initialiser, in
+ * flash) is the simulator's run-time one, value for value. */
+static const br_pf_cfg_t k_image_pf = BR_MACHINE_PF_CFG_TUNED(BR_EST_PF_PERIOD_S_F);
+
+static void test_machine_cfg_one_home(void **st)
+{
+    (void)st;
+    const br_pf_cfg_t c = br_circle_pf_cfg_tuned((float)BR_EST_PF_PERIOD_S);
+    assert_memory_equal(&c.est.model, &k_image_pf.est.model, sizeof c.est.model);
+    assert_memory_equal(c.est.q_var, k_image_pf.est.q_var, sizeof c.est.q_var);
+    assert_memory_equal(&c.est.r_var_rad2, &k_image_pf.est.r_var_rad2, sizeof(float));
+    assert_memory_equal(c.x0_std, k_image_pf.x0_std, sizeof c.x0_std);
+    assert_true(c.est.gp0_N == k_image_pf.est.gp0_N && c.est.gp_min_N == k_image_pf.est.gp_min_N &&
+                c.est.gp_max_N == k_image_pf.est.gp_max_N &&
+                c.est.outlier_sigma == k_image_pf.est.outlier_sigma &&
+                c.est.rad_per_count == k_image_pf.est.rad_per_count);
+    assert_int_equal(c.est.reanchor_after, k_image_pf.est.reanchor_after);
+    assert_int_equal(c.n_particles, k_image_pf.n_particles);
+    assert_int_equal(k_image_pf.n_particles, BR_EST_PF_N_PARTICLES);
+    assert_ptr_equal(c.noise, k_image_pf.noise);
+    assert_int_equal(c.noise_len, k_image_pf.noise_len);
+    assert_int_equal(c.noise_skip, k_image_pf.noise_skip);
+    /* and it is a configuration the PF accepts, at the image's period */
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    assert_int_equal(br_pf_init(pf, &k_image_pf), BR_OK);
+    free(pf);
+    /* the image's tick in whole ns is the period */
+    assert_true(fabs((double)BR_EST_PF_PERIOD_NS * 1e-9 - BR_EST_PF_PERIOD_S) < 0.5e-9);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -222,6 +566,17 @@ int main(void)
         cmocka_unit_test(test_extern_drives_compensation),
         cmocka_unit_test(test_pf_as_wired_by_hand),
         cmocka_unit_test(test_ukf_as_wired_by_hand),
+        cmocka_unit_test(test_outputs_off_until_armed),
+        cmocka_unit_test(test_ctrl_input_latches_until_rearmed),
+        cmocka_unit_test(test_ctrl_state_latches),
+        cmocka_unit_test(test_estimator_error_latches),
+        cmocka_unit_test(test_hal_error_latches),
+        cmocka_unit_test(test_encoder_jump_latches),
+        cmocka_unit_test(test_encoder_stale_holds_then_latches),
+        cmocka_unit_test(test_encoder_frozen_latches),
+        cmocka_unit_test(test_external_fault_latches),
+        cmocka_unit_test(test_guard_config),
+        cmocka_unit_test(test_machine_cfg_one_home),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

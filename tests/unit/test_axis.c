@@ -49,7 +49,7 @@ static void test_init_guards(void **st)
 {
     (void)st;
     fake_t f = {0};
-    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
+    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     br_axis_t a;
     br_ctrl_cfg_t k = cfg();
     assert_int_equal(br_axis_init(&a, NULL, &k, NULL), BR_E_NULL);
@@ -67,7 +67,7 @@ static void test_step_writes_duty(void **st)
 {
     (void)st;
     fake_t f = {1000, BR_OK, 0.0f, 0};
-    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
+    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     br_axis_t a;
     br_ctrl_cfg_t k = cfg();
     assert_int_equal(br_axis_init(&a, &hal, &k, NULL), BR_OK);
@@ -81,7 +81,7 @@ static void test_encoder_fault_zeroes_pwm(void **st)
 {
     (void)st;
     fake_t f = {1000, BR_OK, 0.0f, 0};
-    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
+    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     br_axis_t a;
     br_ctrl_cfg_t k = cfg();
     assert_int_equal(br_axis_init(&a, &hal, &k, NULL), BR_OK);
@@ -115,7 +115,7 @@ static void test_estimator_drives_compensation(void **st)
 {
     (void)st;
     fake_t f = {0, BR_OK, 0.0f, 0};
-    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick};
+    br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     fake_est_t e = {10.0f, BR_OK, {0, 0.0f}, 0.0f, 0};
     br_est_t est = {&e, fake_est_step};
     br_axis_t a;

@@ -32,6 +32,44 @@ typedef enum {
                              simulator's true-friction oracle, a wrapper around a PF or UKF */
 } br_app_est_kind_t;
 
+/* Why the outputs are off (br_app_t.fault). Every cause but NONE is latched:
+ * each br_app_step then writes duty 0 and returns BR_E_FAULT until br_app_arm. */
+typedef enum {
+    BR_APP_FAULT_NONE = 0,       /* armed, running */
+    BR_APP_FAULT_DISARMED = 1,   /* after init, before the first br_app_arm */
+    BR_APP_FAULT_CTRL_INPUT = 2, /* br_ctrl_step BR_E_INPUT: reference or compensation bad */
+    BR_APP_FAULT_CTRL_STATE = 3, /* br_ctrl_step BR_E_NUMERIC (or another error): integrator or law */
+    BR_APP_FAULT_ESTIMATOR = 4,  /* the estimator's step or predict failed */
+    BR_APP_FAULT_ENC_JUMP = 5,   /* |counts delta| above the axis's maximum speed */
+    BR_APP_FAULT_ENC_STALE = 6,  /* more failed encoder reads in a row than enc_stale_periods */
+    BR_APP_FAULT_ENC_FROZEN = 7, /* counter unchanged while |duty| >= frozen_duty, frozen_periods long */
+    BR_APP_FAULT_DEADLINE = 8,   /* missed control periods (reported by the caller, br_app_fault) */
+    BR_APP_FAULT_HAL = 9         /* pwm_write failed */
+} br_app_fault_t;
+
+/* The guards of one period (docs/reliability.md). br_app_guard_cfg builds them
+ * from the machine's maximum speed. */
+typedef struct {
+    uint32_t enc_max_delta_counts; /* largest |counts delta| the axis can make in one period
+                                      (max speed x period), 1..2^30; above: BR_APP_FAULT_ENC_JUMP */
+    uint32_t enc_stale_periods;    /* failed reads in a row that are held (last count, the
+                                      estimator predicts); the next one faults. 0..1000 */
+    float frozen_duty;             /* |duty| of the last period from which an unchanged count
+                                      counts as frozen, in (0, 1] */
+    uint32_t frozen_periods;       /* frozen periods in a row before the fault, 1..2^20 */
+} br_app_guard_cfg_t;
+
+/* Defaults of br_app_guard_cfg (docs/reliability.md). */
+#define BR_APP_GUARD_STALE_PERIODS 3u   /* three missed reads are held, the fourth faults */
+#define BR_APP_GUARD_FROZEN_DUTY 0.5f   /* half the amplifier's duty ... */
+#define BR_APP_GUARD_FROZEN_S 0.05f     /* ... for 50 ms without a count */
+
+/* The guards for a period dt_s and a maximum speed in counts/s (the machine's
+ * BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F): enc_max_delta_counts = ceil(speed dt),
+ * frozen_periods = ceil(BR_APP_GUARD_FROZEN_S / dt), the defaults above. A
+ * non-finite or non-positive input gives a configuration br_app_init rejects. */
+br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s);
+
 /* Can be const, in flash. Only the pointer the kind names is read. */
 typedef struct {
     const br_ctrl_cfg_t *ctrl;
@@ -39,6 +77,7 @@ typedef struct {
     const br_pf_cfg_t *pf;
     const br_ukf_cfg_t *ukf;
     const br_est_t *ext;
+    br_app_guard_cfg_t guard;
 } br_app_cfg_t;
 
 /* The estimator's state, owned by the caller (see above); only the pointer
@@ -50,6 +89,14 @@ typedef struct {
 
 typedef struct {
     br_axis_t axis; /* the loop; axis.F_hat_N and axis.last are the period's outputs */
+    br_app_guard_cfg_t guard;
+    br_app_est_kind_t kind;
+    br_app_mem_t mem;       /* the PF's / UKF's storage: predict and re-initialise at an arm */
+    br_app_fault_t fault;   /* NONE while armed; the latched cause otherwise */
+    int32_t last_counts;    /* last good encoder read */
+    int have_counts;        /* last_counts valid (a good read since the arm) */
+    uint32_t n_stale;       /* failed reads in a row */
+    uint32_t n_frozen;      /* frozen periods in a row */
 } br_app_t;
 
 /* The estimator the configuration names, initialised in its storage, as the
@@ -62,14 +109,40 @@ typedef struct {
  * (equal to 1e-6 relative); else the filter's own init status. */
 br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br_est_t *est);
 
-/* Validates and initialises: the estimator (br_app_est_init), then the axis
- * loop over hal with the controller (br_axis_init). On any error app is left
- * not ready (br_app_step then returns BR_E_STATE). */
+/* Validates and initialises: the guards (BR_E_PARAM), the estimator
+ * (br_app_est_init), then the axis loop over hal with the controller
+ * (br_axis_init). On any error app is left not ready (br_app_step then returns
+ * BR_E_STATE). On success the application is DISARMED: outputs off (duty 0,
+ * hal.pwm_disable) until br_app_arm. */
 br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *hal, const br_app_mem_t *mem);
 
-/* One control period, after the tick: br_axis_step's status (BR_OK, the
- * estimator's warning BR_W_OUTLIER with control gone on, or an error after a
- * zero-duty write). */
+/* Arms (after init) or re-arms (after a fault): the controller restarts (its
+ * integral and its previous count cleared), the PF / UKF are re-initialised
+ * from their own configuration (primed again at the next measurement; an
+ * EXTERN estimator is the caller's), the encoder guards restart, the fault
+ * is cleared and hal.pwm_enable (if any) turns the outputs on at duty 0.
+ * BR_E_NULL, BR_E_STATE (not initialised), or the re-initialisation's error
+ * (the application then stays latched). */
+br_status_t br_app_arm(br_app_t *app);
+
+/* Latches a fault from outside the period (BR_APP_FAULT_DEADLINE from the
+ * port's missed ticks, a supervisor): duty 0, outputs off. BR_E_FAULT, or
+ * BR_E_NULL / BR_E_STATE / BR_E_PARAM (cause NONE or unknown). */
+br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause);
+
+/* One control period, after the tick (docs/modules/app.md):
+ *   encoder read    a failed read holds the last count (the PF / UKF predict
+ *                   only, an EXTERN estimate is held) for up to
+ *                   enc_stale_periods periods, then ENC_STALE; a delta above
+ *                   enc_max_delta_counts is ENC_JUMP; an unchanged count while
+ *                   the last |duty| >= frozen_duty for frozen_periods is
+ *                   ENC_FROZEN;
+ *   estimator       an error is ESTIMATOR (BR_W_OUTLIER: control goes on);
+ *   controller      BR_E_INPUT is CTRL_INPUT, any other error CTRL_STATE;
+ *   pwm_write       an error is HAL.
+ * BR_OK or BR_W_OUTLIER; BR_E_FAULT when a fault latched in this period or
+ * was latched before (duty 0 written, outputs disabled; cause in app->fault);
+ * BR_E_NULL, BR_E_STATE (not initialised). */
 br_status_t br_app_step(br_app_t *app, const br_ref_t *ref);
 
 #endif

@@ -15,6 +15,11 @@ typedef struct {
     br_status_t (*pwm_write)(void *ctx, float duty);
     /* Blocks until the next control tick; returns the tick index. */
     br_status_t (*tick_wait)(void *ctx, uint32_t *tick);
+    /* Optional (NULL: the port has none; the application then relies on
+     * pwm_write(0)). Outputs off: duty 0 and the power stage disabled
+     * (STM32H7: TIM1 BDTR.MOE and CCER off); and back on, duty 0, at an arm. */
+    br_status_t (*pwm_disable)(void *ctx);
+    br_status_t (*pwm_enable)(void *ctx);
 } br_hal_t;
 
 #endif

@@ -1,7 +1,7 @@
 /* The board's wiring and clocks (br_stm32h7_board.h). */
 #include "br_stm32h7_board.h"
 
-br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_hz)
+br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_period_ns)
 {
     const br_stm32h7_cfg_t cfg = {
         .pwm_tim = (br_stm32h7_tim_t *)BR_STM32H7_TIM1_BASE,
@@ -10,16 +10,27 @@ br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_hz)
         .cpu_clock_hz = BR_BOARD_CPU_HZ,
         .tim_clock_hz = BR_BOARD_TIM_HZ,
         .pwm_hz = BR_BOARD_PWM_HZ,
-        .control_hz = control_hz,
+        .control_hz = 0u,
         .enc_counter_bits = 32u,
         .enc_filter = BR_BOARD_ENC_FILTER,
         .deadtime_ticks = BR_BOARD_DEADTIME,
+        .control_period_ns = control_period_ns,
     };
     return cfg;
 }
 
-br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_hz, br_hal_t *hal)
+br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_period_ns, br_hal_t *hal)
 {
+    const br_stm32h7_clock_regs_t clk = {
+        (br_stm32h7_rcc_t *)BR_STM32H7_RCC_BASE,
+        (br_stm32h7_pwr_t *)BR_STM32H7_PWR_BASE,
+        (br_stm32h7_syscfg_t *)BR_STM32H7_SYSCFG_BASE,
+        (br_stm32h7_flash_t *)BR_STM32H7_FLASH_BASE,
+    };
+    br_status_t st = br_stm32h7_clock_480(&clk);
+    if (st != BR_OK) {
+        return st;
+    }
     br_stm32h7_gpio_t *gpioa = (br_stm32h7_gpio_t *)BR_STM32H7_GPIOA_BASE;
     br_stm32h7_gpio_t *gpiob = (br_stm32h7_gpio_t *)BR_STM32H7_GPIOB_BASE;
     (void)br_stm32h7_rcc_enable((br_stm32h7_rcc_t *)BR_STM32H7_RCC_BASE);
@@ -29,9 +40,27 @@ br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_hz, br_ha
     (void)br_stm32h7_gpio_af(gpioa, 9u, 1u);  /* TIM1_CH2 */
     (void)br_stm32h7_gpio_af(gpiob, 13u, 1u); /* TIM1_CH1N */
     (void)br_stm32h7_gpio_af(gpiob, 14u, 1u); /* TIM1_CH2N */
-    const br_stm32h7_cfg_t cfg = br_stm32h7_board_cfg(control_hz);
-    const br_status_t st = br_stm32h7_init(port, &cfg);
+    const br_stm32h7_cfg_t cfg = br_stm32h7_board_cfg(control_period_ns);
+    st = br_stm32h7_init(port, &cfg);
     return (st != BR_OK) ? st : br_stm32h7_hal(port, hal);
+}
+
+int br_stm32h7_board_reset_by_watchdog(void)
+{
+    br_stm32h7_rcc_t *rcc = (br_stm32h7_rcc_t *)BR_STM32H7_RCC_BASE;
+    const int wd = (rcc->RSR & BR_RCC_RSR_IWDG1RSTF) != 0u;
+    rcc->RSR |= BR_RCC_RSR_RMVF;
+    return wd;
+}
+
+br_status_t br_stm32h7_board_watchdog_start(void)
+{
+    return br_stm32h7_iwdg_start((br_stm32h7_iwdg_t *)BR_STM32H7_IWDG1_BASE, BR_BOARD_IWDG_PR, BR_BOARD_IWDG_RLR);
+}
+
+void br_stm32h7_board_watchdog_refresh(void)
+{
+    br_stm32h7_iwdg_refresh((br_stm32h7_iwdg_t *)BR_STM32H7_IWDG1_BASE);
 }
 
 void br_stm32h7_board_halt(br_stm32h7_t *port)

@@ -2,11 +2,11 @@
  *
  * Pins (RM0433, all AF1): TIM2 encoder on PA0 (CH1) / PA1 (CH2); TIM1 PWM on
  * PA8 (CH1), PA9 (CH2), PB13 (CH1N), PB14 (CH2N); the control tick is SysTick.
- * Clocks: the reset clock (HSI 64 MHz, every bus prescaler 1), so the core
- * and the timer kernel clocks are both 64 MHz. A bring-up that starts PLL1
- * (480 MHz core, 240 MHz timers) only changes BR_BOARD_CPU_HZ and
- * BR_BOARD_TIM_HZ. PWM 20 kHz centre-aligned with 500 ns dead time, encoder
- * input filter f_CK_INT with N = 8. docs/modules/hal.md. */
+ * Clocks: br_stm32h7_clock_480 brings the part from the reset clock (HSI
+ * 64 MHz) to 480 MHz (VOS0, flash 4 WS, PLL1 = HSI / 4 * 60 / 2), AXI/AHB
+ * 240 MHz, APB 120 MHz, timer kernel clocks 240 MHz. PWM 20 kHz
+ * centre-aligned with 500 ns dead time, encoder input filter f_CK_INT with
+ * N = 8. Watchdog IWDG1: 10 ms. docs/modules/hal.md. */
 #ifndef BR_STM32H7_BOARD_H
 #define BR_STM32H7_BOARD_H
 
@@ -15,23 +15,38 @@
 #include "bristle/br_hal.h"
 #include "bristle/br_stm32h7.h"
 
-#define BR_BOARD_CPU_HZ     64000000u /* HSI after reset */
-#define BR_BOARD_TIM_HZ     64000000u /* APB timer kernel clock */
+#define BR_BOARD_CPU_HZ     BR_STM32H7_SYSCLK_HZ  /* 480 MHz, PLL1 */
+#define BR_BOARD_TIM_HZ     BR_STM32H7_TIMCLK_HZ  /* 240 MHz: APB1/APB2 timers at 2 x 120 MHz */
 #define BR_BOARD_PWM_HZ     20000u
-#define BR_BOARD_DEADTIME   32u       /* timer ticks: 500 ns at 64 MHz */
+#define BR_BOARD_DEADTIME   120u      /* timer ticks: 500 ns at 240 MHz */
 #define BR_BOARD_ENC_FILTER 3u        /* f_CK_INT, N = 8 */
+/* IWDG1 on the LSI (32 kHz): prescaler /4 (PR = 0), 80 ticks -> 10 ms */
+#define BR_BOARD_IWDG_PR    0u
+#define BR_BOARD_IWDG_RLR   79u
 
 /* The port configuration of this board (peripheral bases, clocks, PWM,
- * encoder) for a control tick of control_hz. */
-br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_hz);
+ * encoder) for a control period of control_period_ns (a whole number of
+ * 480 MHz cycles). */
+br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_period_ns);
 
-/* Brings the board up: peripheral clocks, pins to their timers, then the
- * port (br_stm32h7_init validates the configuration before writing a timer
- * register) and its br_hal_t. br_stm32h7_init's status. */
-br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_hz, br_hal_t *hal);
+/* Brings the board up: the clock tree (br_stm32h7_clock_480), peripheral
+ * clocks, pins to their timers, then the port (outputs off until the arm;
+ * br_stm32h7_init validates the configuration before writing a timer
+ * register) and its br_hal_t. The first failing status. */
+br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_period_ns, br_hal_t *hal);
 
-/* Motor stopped and outputs off (br_stm32h7_pwm_disable); then waits for a
- * reset or a debugger. */
+/* 1 when the last reset came from IWDG1 (a hung or faulted control loop);
+ * clears the reset flags (RMVF) so that the next pin or power-on reset reads
+ * as such. */
+int br_stm32h7_board_reset_by_watchdog(void);
+
+/* Starts IWDG1 (BR_BOARD_IWDG_*) and refreshes it. */
+br_status_t br_stm32h7_board_watchdog_start(void);
+void br_stm32h7_board_watchdog_refresh(void);
+
+/* Motor stopped and outputs off (br_stm32h7_pwm_disable); then parks without
+ * refreshing the watchdog: a running IWDG1 resets the part, which then comes
+ * up with its outputs off (br_stm32h7_board_reset_by_watchdog). */
 void br_stm32h7_board_halt(br_stm32h7_t *port) __attribute__((noreturn));
 
 #endif

@@ -1,49 +1,60 @@
 /* The bristle firmware image for the STM32H743: one axis tracking a
  * sinusoidal (circle-test) reference with the H-infinity gains of
- * firmware/gen/bristle_gen/ctrl/br_hinf_gains.h, without friction
- * compensation (BR_APP_EST_NONE).
+ * firmware/gen/bristle_gen/ctrl/br_hinf_gains.h and the friction compensation
+ * of the configured estimator: the particle filter of the machine file
+ * (1500 particles for the reference machine) at its period (1.5 ms), as the
+ * simulator's H-inf + PF circle runs it (bristle/br_machine_cfg.h: the same
+ * generated headers, one home).
  *
- * main: board bring-up (hal/stm32h7/board) -> br_app_init -> per tick: the
- * reference, br_app_step. Any error stops the motor and parks.
+ * main: board bring-up (hal/stm32h7/board: 480 MHz, outputs off) -> after a
+ * watchdog reset, park with the outputs off -> IWDG1 started -> br_app_init
+ * (outputs off) -> br_app_arm (the explicit arm, after bring-up) -> per tick:
+ * the deadline (missed ticks), the reference, br_app_step (the same as the
+ * replay's and the simulator's), and the watchdog refresh, only after a
+ * healthy period. Any fault: the application latches (duty 0, TIM1 outputs
+ * off), the board parks without refreshing, IWDG1 resets the part, which
+ * then stays off (br_stm32h7_board_reset_by_watchdog) until a pin or
+ * power-on reset re-arms it.
  *
- * The configuration is const (flash); the state is on main's stack, so the
- * image has no mutable globals. An estimator's state does not belong on this
- * 16 KiB stack: a PF image keeps its br_pf_t (~94 KB) in a static in .bss
- * (DTCM) and passes it in br_app_mem_t (firmware/include/bristle/br_app.h). */
+ * State: the configurations are const (flash); the port, the application and
+ * the reference are on main's stack. The one static is the particle filter's
+ * state (br_pf_t, ~94 KB at BR_PF_MAX_PARTICLES): the documented exception to
+ * "no mutable globals", placed in AXI SRAM by the linker script's NOLOAD
+ * section .axisram (zeroed by Reset_Handler; br_pf_init initialises it), as
+ * it does not belong on the 16 KiB stack. docs/modules/hal.md. */
 #include <stddef.h>
 #include <stdint.h>
 
 #include "br_stm32h7_board.h"
 #include "bristle/br_app.h"
+#include "bristle/br_machine_cfg.h"
 #include "bristle/br_refgen.h"
 #include "bristle_gen/ctrl/br_hinf_gains.h"
+#include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 
-/* The H-inf gains are designed in continuous time and checked sampled at 1 ms
- * (docs/modules/hinf.md): the loop runs at BR_IMAGE_CONTROL_HZ. */
-#define BR_IMAGE_CONTROL_HZ 1000u
-#define BR_IMAGE_DT_S (1.0f / (float)BR_IMAGE_CONTROL_HZ)
+/* The loop runs at the PF's period (as the simulator's H-inf + PF circle). */
+#define BR_IMAGE_DT_S BR_EST_PF_PERIOD_S_F
+#define BR_IMAGE_PERIOD_NS BR_EST_PF_PERIOD_NS
 
 /* Reference: circle of radius 5 mm in 2 s, this axis is the sine. */
 #define BR_IMAGE_REF_AMPLITUDE_M 5.0e-3f
 #define BR_IMAGE_REF_PERIOD_S    2.0f
 #define BR_IMAGE_REF_PHASE_RAD   0.0f
 
-#define BR_IMAGE_TAU_MAX_NM (0.9f * BR_MACHINE_TAU_PER_DUTY_NM_F)
+/* Deadline: more missed ticks than this since the arm turn the outputs off. */
+#define BR_IMAGE_MAX_MISSED 2u
 
 static const br_ctrl_cfg_t br_image_ctrl = {
     .K = BR_HINF_K,
     .dt_s = BR_IMAGE_DT_S,
-    .tau_max_Nm = BR_IMAGE_TAU_MAX_NM,
+    .tau_max_Nm = BR_MACHINE_TORQUE_LIMIT_NM_F,
     .tau_per_duty_Nm = BR_MACHINE_TAU_PER_DUTY_NM_F,
     .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,
     .lead_mprad = BR_MACHINE_LEAD_MPRAD_F,
 };
 
-static const br_app_cfg_t br_image_app = {
-    .ctrl = &br_image_ctrl,
-    .est = BR_APP_EST_NONE,
-};
+static const br_pf_cfg_t br_image_pf_cfg = BR_MACHINE_PF_CFG_TUNED(BR_IMAGE_DT_S);
 
 static const br_refgen_cfg_t br_image_ref = {
     .amplitude_m = BR_IMAGE_REF_AMPLITUDE_M,
@@ -54,6 +65,9 @@ static const br_refgen_cfg_t br_image_ref = {
     .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,
 };
 
+/* The documented exception: the PF's state, in AXI SRAM (see above). */
+static br_pf_t br_image_pf __attribute__((section(".axisram")));
+
 int main(void)
 {
     br_stm32h7_t port = {0};
@@ -62,15 +76,36 @@ int main(void)
     br_refgen_t refgen = {0};
     br_ref_t ref = {0};
     uint32_t tick = 0u;
+    const br_app_cfg_t app_cfg = {
+        .ctrl = &br_image_ctrl,
+        .est = BR_APP_EST_PF,
+        .pf = &br_image_pf_cfg,
+        .guard = br_app_guard_cfg(BR_IMAGE_DT_S, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F),
+    };
+    const br_app_mem_t mem = {.pf = &br_image_pf};
 
-    if (br_stm32h7_board_init(&port, BR_IMAGE_CONTROL_HZ, &hal) != BR_OK ||
-        br_app_init(&app, &br_image_app, &hal, NULL) != BR_OK || br_refgen_init(&refgen, &br_image_ref) != BR_OK) {
+    if (br_stm32h7_board_init(&port, BR_IMAGE_PERIOD_NS, &hal) != BR_OK || br_stm32h7_board_reset_by_watchdog() ||
+        br_stm32h7_board_watchdog_start() != BR_OK || br_app_init(&app, &app_cfg, &hal, &mem) != BR_OK ||
+        br_refgen_init(&refgen, &br_image_ref) != BR_OK || br_app_arm(&app) != BR_OK) {
         br_stm32h7_board_halt(&port);
     }
     for (;;) {
-        if (hal.tick_wait(hal.ctx, &tick) != BR_OK || br_refgen_step(&refgen, &ref) != BR_OK ||
-            br_app_step(&app, &ref) != BR_OK) {
+        if (hal.tick_wait(hal.ctx, &tick) != BR_OK) {
+            (void)br_app_fault(&app, BR_APP_FAULT_HAL);
             br_stm32h7_board_halt(&port);
         }
+        if (br_stm32h7_deadline_check(&port, BR_IMAGE_MAX_MISSED) != BR_OK) {
+            (void)br_app_fault(&app, BR_APP_FAULT_DEADLINE);
+            br_stm32h7_board_halt(&port);
+        }
+        if (br_refgen_step(&refgen, &ref) != BR_OK) {
+            (void)br_app_fault(&app, BR_APP_FAULT_CTRL_INPUT);
+            br_stm32h7_board_halt(&port);
+        }
+        /* BR_OK or BR_W_OUTLIER (a skipped measurement, control went on) */
+        if (BR_FAILED(br_app_step(&app, &ref))) {
+            br_stm32h7_board_halt(&port); /* latched: outputs already off */
+        }
+        br_stm32h7_board_watchdog_refresh();
     }
 }

@@ -9,6 +9,8 @@
 /* the PF's period (its loop runs at it) */
 #define BR_EST_PF_PERIOD_S (0.0015)
 #define BR_EST_PF_PERIOD_S_F (1.500000013e-03f)
+/* the same in whole nanoseconds (an MCU tick) */
+#define BR_EST_PF_PERIOD_NS 1500000u
 /* particle count */
 #define BR_EST_PF_N_PARTICLES 1500u
 /* process noise variance per step */

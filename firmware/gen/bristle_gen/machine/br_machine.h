@@ -57,6 +57,10 @@
 /* largest table speed the axis is used at */
 #define BR_MACHINE_MAX_SPEED_MPS (0.1)
 #define BR_MACHINE_MAX_SPEED_MPS_F (1.000000015e-01f)
+/* that speed in encoder counts per second (max_speed / (L rad_per_count)); times the period:
+ * the largest encoder delta of one period (br_app_guard_cfg) */
+#define BR_MACHINE_MAX_SPEED_COUNTS_PER_S (13107200.0)
+#define BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F (1.310720000e+07f)
 /* stroke of the table */
 #define BR_MACHINE_TRAVEL_M (0.3)
 #define BR_MACHINE_TRAVEL_M_F (3.000000119e-01f)

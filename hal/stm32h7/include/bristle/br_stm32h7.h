@@ -65,6 +65,9 @@ typedef struct {
     uint32_t enc_counter_bits;      /* 32 (TIM2, TIM5) or 16 (other timers) */
     uint32_t enc_filter;            /* IC1F/IC2F input filter code, 0..15 */
     uint32_t deadtime_ticks;        /* dead time in tim_clock ticks, 0..127 */
+    uint32_t control_period_ns;     /* instead of control_hz (then 0) for a period that is no whole
+                                       frequency (the PF's 1.5 ms): cpu_clock_hz * period exact in
+                                       cycles; 0: control_hz sets the tick */
 } br_stm32h7_cfg_t;
 
 typedef struct {
@@ -75,6 +78,7 @@ typedef struct {
     uint32_t tick_reload;   /* SysTick LOAD */
     uint32_t next_tick;     /* index returned by the next tick_wait */
     uint32_t overruns;      /* ticks that had already elapsed on entry to tick_wait */
+    uint32_t overruns_armed;/* overruns at the last pwm_enable: the deadline counts from there */
     int ready;
 } br_stm32h7_t;
 
@@ -89,8 +93,18 @@ br_status_t br_stm32h7_hal(br_stm32h7_t *port, br_hal_t *hal);
 br_status_t br_stm32h7_encoder_read(br_stm32h7_t *port, int32_t *counts);
 br_status_t br_stm32h7_pwm_write(br_stm32h7_t *port, float duty);
 
-/* Safe stop: duty 0 and main output disable (BDTR.MOE = 0, outputs idle). */
+/* Safe stop: duty 0, main output disable (BDTR.MOE = 0, outputs idle) and
+ * the channel outputs off (CCER = 0). Init leaves the outputs in this state. */
 br_status_t br_stm32h7_pwm_disable(br_stm32h7_t *port);
+
+/* Outputs on at duty 0 (CCER: CC1E, CC1NE, CC2E, CC2NE; BDTR.MOE): the arm
+ * (br_app_arm through hal.pwm_enable). Restarts the deadline count. */
+br_status_t br_stm32h7_pwm_enable(br_stm32h7_t *port);
+
+/* Deadline: more than max_missed ticks missed (overruns) since the last
+ * pwm_enable disables the outputs (br_stm32h7_pwm_disable) and returns
+ * BR_E_FAULT; else BR_OK. Called once per period after tick_wait. */
+br_status_t br_stm32h7_deadline_check(br_stm32h7_t *port, uint32_t max_missed);
 
 /* Polls COUNTFLAG for at most LOAD + 1 reads (longer than one period at any
  * poll speed); BR_E_STATE if SysTick never wraps. *tick = 0, 1, 2, ... */
@@ -100,5 +114,44 @@ br_status_t br_stm32h7_tick_wait(br_stm32h7_t *port, uint32_t *tick);
  * TIM2, and a pin to alternate function af (high speed, no pull). */
 br_status_t br_stm32h7_rcc_enable(br_stm32h7_rcc_t *rcc);
 br_status_t br_stm32h7_gpio_af(br_stm32h7_gpio_t *gpio, uint32_t pin, uint32_t af);
+
+/* Bounded wait for a register condition: polls at most this many times. */
+#define BR_STM32H7_WAIT_POLLS 1000000u
+
+/* Clock tree from the reset clock (HSI 64 MHz) to 480 MHz (docs/modules/hal.md,
+ * "Clocks"): LDO supply, VOS1 then VOS0 (SYSCFG ODEN), flash 4 wait states
+ * (WRHIGHFREQ 2), PLL1 = HSI / 4 * 60 / 2 (ref 16 MHz, VCO 960 MHz), D1CPRE /1,
+ * HPRE /2 (AXI/AHB 240 MHz), APB1..4 /2 (120 MHz; timers 240 MHz), then
+ * SYSCLK = PLL1. Each wait is bounded (BR_STM32H7_WAIT_POLLS): BR_E_STATE if a
+ * ready flag never comes (the system clock is then not switched), BR_E_NULL
+ * for a NULL block. */
+typedef struct {
+    br_stm32h7_rcc_t *rcc;
+    br_stm32h7_pwr_t *pwr;
+    br_stm32h7_syscfg_t *syscfg;
+    br_stm32h7_flash_t *flash;
+} br_stm32h7_clock_regs_t;
+
+#define BR_STM32H7_SYSCLK_HZ 480000000u
+#define BR_STM32H7_HCLK_HZ   240000000u
+#define BR_STM32H7_APB_HZ    120000000u
+#define BR_STM32H7_TIMCLK_HZ 240000000u
+#define BR_STM32H7_PLL1_DIVM 4u
+#define BR_STM32H7_PLL1_DIVN 60u
+#define BR_STM32H7_PLL1_DIVP 2u
+#define BR_STM32H7_FLASH_WS  4u
+#define BR_STM32H7_FLASH_WRHIGHFREQ 2u
+
+br_status_t br_stm32h7_clock_480(const br_stm32h7_clock_regs_t *r);
+
+/* Independent watchdog IWDG1 (LSI 32 kHz): start (0xCCCC), unlock (0x5555),
+ * prescaler pr (0..6: /4../256), reload rlr (1..0xFFF), wait SR = 0 (bounded),
+ * first refresh (0xAAAA). Timeout = 4 * 2^pr * (rlr + 1) / f_LSI. Once started
+ * it cannot be stopped: only a refresh within the timeout avoids a reset.
+ * BR_E_NULL, BR_E_PARAM (pr, rlr), BR_E_STATE (SR never cleared). */
+br_status_t br_stm32h7_iwdg_start(br_stm32h7_iwdg_t *iwdg, uint32_t pr, uint32_t rlr);
+
+/* Refresh (0xAAAA): call only from a healthy control period. */
+void br_stm32h7_iwdg_refresh(br_stm32h7_iwdg_t *iwdg);
 
 #endif

@@ -20,6 +20,10 @@
 #define BR_STM32H7_GPIOB_BASE    0x58020400u
 #define BR_STM32H7_RCC_BASE      0x58024400u  /* D3 AHB4 */
 #define BR_STM32H7_SYSTICK_BASE  0xE000E010u  /* Cortex-M7 system timer */
+#define BR_STM32H7_PWR_BASE      0x58024800u  /* D3 AHB4 */
+#define BR_STM32H7_SYSCFG_BASE   0x58000400u  /* D3 APB4 */
+#define BR_STM32H7_IWDG1_BASE    0x58004800u  /* D3 APB4, independent watchdog 1 */
+#define BR_STM32H7_FLASH_BASE    0x52002000u  /* D1 AHB3, flash interface registers */
 
 /* ---- TIMx ---------------------------------------------------------------- */
 typedef struct {
@@ -89,9 +93,25 @@ typedef struct {
 #define BR_TIM_BDTR_OSSR       (1u << 11)
 #define BR_TIM_BDTR_MOE        (1u << 15)
 
-/* ---- RCC (only the enable registers; the rest is reserved padding) ------ */
+/* ---- RCC (clock control, the kernel-clock configuration and the enables) - */
 typedef struct {
-    volatile uint32_t RESERVED0[56]; /* 0x000..0x0DC */
+    volatile uint32_t CR;        /* 0x000 clock control: HSION, PLLxON, ...RDY */
+    volatile uint32_t HSICFGR;   /* 0x004 */
+    volatile uint32_t CRRCR;     /* 0x008 */
+    volatile uint32_t CSICFGR;   /* 0x00C */
+    volatile uint32_t CFGR;      /* 0x010 SW (system clock switch), SWS, TIMPRE */
+    volatile uint32_t RESERVED1; /* 0x014 */
+    volatile uint32_t D1CFGR;    /* 0x018 D1CPRE, HPRE, D1PPRE */
+    volatile uint32_t D2CFGR;    /* 0x01C D2PPRE1, D2PPRE2 */
+    volatile uint32_t D3CFGR;    /* 0x020 D3PPRE */
+    volatile uint32_t RESERVED2; /* 0x024 */
+    volatile uint32_t PLLCKSELR; /* 0x028 PLLSRC, DIVM1..3 */
+    volatile uint32_t PLLCFGR;   /* 0x02C PLLxRGE, PLLxVCOSEL, DIVxyEN */
+    volatile uint32_t PLL1DIVR;  /* 0x030 DIVN1, DIVP1, DIVQ1, DIVR1 */
+    volatile uint32_t PLL1FRACR; /* 0x034 */
+    volatile uint32_t RESERVED3[38]; /* 0x038..0x0CC */
+    volatile uint32_t RSR;       /* 0x0D0 reset status: the reset's cause flags, RMVF clears them */
+    volatile uint32_t RESERVED4[3]; /* 0x0D4..0x0DC */
     volatile uint32_t AHB4ENR;  /* 0x0E0 GPIOx, ... */
     volatile uint32_t APB3ENR;  /* 0x0E4 */
     volatile uint32_t APB1LENR; /* 0x0E8 TIM2..TIM7, TIM12..14, ... */
@@ -104,6 +124,99 @@ typedef struct {
 #define BR_RCC_AHB4ENR_GPIOBEN  (1u << 1)
 #define BR_RCC_APB1LENR_TIM2EN  (1u << 0)
 #define BR_RCC_APB2ENR_TIM1EN   (1u << 0)
+#define BR_RCC_APB4ENR_SYSCFGEN (1u << 1)
+/* RSR */
+#define BR_RCC_RSR_RMVF         (1u << 16)
+#define BR_RCC_RSR_IWDG1RSTF    (1u << 26)
+/* CR */
+#define BR_RCC_CR_HSION         (1u << 0)
+#define BR_RCC_CR_HSIRDY        (1u << 2)
+#define BR_RCC_CR_PLL1ON        (1u << 24)
+#define BR_RCC_CR_PLL1RDY       (1u << 25)
+/* CFGR: SW[2:0], SWS[5:3]; 011 = PLL1 (pll1_p_ck) */
+#define BR_RCC_CFGR_SW_Msk      (7u << 0)
+#define BR_RCC_CFGR_SWS_Msk     (7u << 3)
+#define BR_RCC_CFGR_SW_PLL1     (3u << 0)
+#define BR_RCC_CFGR_SWS_PLL1    (3u << 3)
+#define BR_RCC_CFGR_TIMPRE      (1u << 15)
+/* D1CFGR: HPRE[3:0], D1PPRE[6:4], D1CPRE[11:8] */
+#define BR_RCC_D1CFGR_HPRE_DIV2   (8u << 0)  /* 1000: rcc_hclk = sys_d1cpre_ck / 2 */
+#define BR_RCC_D1CFGR_D1PPRE_DIV2 (4u << 4)  /* 100: APB3 = hclk / 2 */
+#define BR_RCC_D1CFGR_D1CPRE_DIV1 (0u << 8)  /* 0xxx: sys_d1cpre_ck = sys_ck */
+#define BR_RCC_D1CFGR_Msk         0x0F7Fu
+/* D2CFGR: D2PPRE1[6:4] (APB1), D2PPRE2[10:8] (APB2) */
+#define BR_RCC_D2CFGR_D2PPRE1_DIV2 (4u << 4)
+#define BR_RCC_D2CFGR_D2PPRE2_DIV2 (4u << 8)
+#define BR_RCC_D2CFGR_Msk          0x0770u
+/* D3CFGR: D3PPRE[6:4] (APB4) */
+#define BR_RCC_D3CFGR_D3PPRE_DIV2  (4u << 4)
+#define BR_RCC_D3CFGR_Msk          0x0070u
+/* PLLCKSELR: PLLSRC[1:0] (00 HSI), DIVM1[9:4] */
+#define BR_RCC_PLLCKSELR_PLLSRC_Msk  (3u << 0)
+#define BR_RCC_PLLCKSELR_DIVM1_Pos   4u
+#define BR_RCC_PLLCKSELR_DIVM1_Msk   (0x3Fu << 4)
+/* PLLCFGR: PLL1FRACEN[0], PLL1VCOSEL[1], PLL1RGE[3:2], DIVP1EN[16], DIVQ1EN[17], DIVR1EN[18] */
+#define BR_RCC_PLLCFGR_PLL1_Msk      0xFu
+#define BR_RCC_PLLCFGR_PLL1RGE_8_16  (3u << 2) /* 11: ref1_ck in 8..16 MHz */
+#define BR_RCC_PLLCFGR_DIVP1EN       (1u << 16)
+#define BR_RCC_PLLCFGR_DIVQ1EN       (1u << 17)
+#define BR_RCC_PLLCFGR_DIVR1EN       (1u << 18)
+/* PLL1DIVR: DIVN1[8:0] = N - 1, DIVP1[15:9] = P - 1, DIVQ1[22:16], DIVR1[30:24] */
+#define BR_RCC_PLL1DIVR_DIVN1_Pos    0u
+#define BR_RCC_PLL1DIVR_DIVP1_Pos    9u
+#define BR_RCC_PLL1DIVR_DIVQ1_Pos    16u
+#define BR_RCC_PLL1DIVR_DIVR1_Pos    24u
+
+/* ---- PWR (supply and voltage scaling) ------------------------------------ */
+typedef struct {
+    volatile uint32_t CR1;       /* 0x00 */
+    volatile uint32_t CSR1;      /* 0x04 ACTVOSRDY */
+    volatile uint32_t CR2;       /* 0x08 */
+    volatile uint32_t CR3;       /* 0x0C supply configuration: BYPASS, LDOEN, SCUEN */
+    volatile uint32_t CPUCR;     /* 0x10 */
+    volatile uint32_t RESERVED0; /* 0x14 */
+    volatile uint32_t D3CR;      /* 0x18 VOS[15:14], VOSRDY */
+} br_stm32h7_pwr_t;
+
+#define BR_PWR_CSR1_ACTVOSRDY (1u << 13)
+#define BR_PWR_CR3_BYPASS     (1u << 0)
+#define BR_PWR_CR3_LDOEN      (1u << 1)
+#define BR_PWR_CR3_SCUEN      (1u << 2)
+#define BR_PWR_D3CR_VOSRDY    (1u << 13)
+#define BR_PWR_D3CR_VOS_Msk   (3u << 14)
+#define BR_PWR_D3CR_VOS_SCALE1 (3u << 14) /* 11: VOS1 (with SYSCFG ODEN: VOS0) */
+
+/* ---- SYSCFG (only PWRCR: the overdrive that makes VOS1 into VOS0) --------- */
+typedef struct {
+    volatile uint32_t RESERVED0[11]; /* 0x00..0x28 */
+    volatile uint32_t PWRCR;         /* 0x2C ODEN */
+} br_stm32h7_syscfg_t;
+
+#define BR_SYSCFG_PWRCR_ODEN (1u << 0)
+
+/* ---- FLASH (only ACR: latency and programming delay) ------------------- */
+typedef struct {
+    volatile uint32_t ACR; /* 0x000 LATENCY[3:0], WRHIGHFREQ[5:4] */
+} br_stm32h7_flash_t;
+
+#define BR_FLASH_ACR_LATENCY_Msk   0xFu
+#define BR_FLASH_ACR_WRHIGHFREQ_Pos 4u
+#define BR_FLASH_ACR_WRHIGHFREQ_Msk (3u << 4)
+
+/* ---- IWDG (independent watchdog, LSI ~32 kHz) ----------------------------- */
+typedef struct {
+    volatile uint32_t KR;   /* 0x00 key */
+    volatile uint32_t PR;   /* 0x04 prescaler: 0 = /4, 1 = /8, ... 6 = /256 */
+    volatile uint32_t RLR;  /* 0x08 reload, 12 bits */
+    volatile uint32_t SR;   /* 0x0C PVU, RVU, WVU: an update in progress */
+    volatile uint32_t WINR; /* 0x10 window */
+} br_stm32h7_iwdg_t;
+
+#define BR_IWDG_KEY_START   0xCCCCu /* starts the watchdog (and the LSI) */
+#define BR_IWDG_KEY_ACCESS  0x5555u /* unlocks PR, RLR, WINR */
+#define BR_IWDG_KEY_REFRESH 0xAAAAu /* reloads the counter from RLR */
+#define BR_IWDG_PR_MAX      6u      /* /256 */
+#define BR_IWDG_RLR_MAX     0xFFFu
 
 /* ---- GPIO ---------------------------------------------------------------- */
 typedef struct {

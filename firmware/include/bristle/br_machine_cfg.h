@@ -1,0 +1,92 @@
+/* The firmware configurations of the machine the generated headers describe
+ * (bristle_gen/: br_machine.h, br_est_machine.h, br_pf_tuned.h, br_ukf_tuned.h,
+ * br_noise_table.h; docs/machine-file.md): one home for the simulator's
+ * circle (sim/circle/br_circle_est.c) and the STM32H743 image
+ * (hal/stm32h7/image/main.c), which holds them const, in flash.
+ *
+ * Initialisers, not functions, so that a program can place the result in
+ * flash (static const ... = BR_MACHINE_PF_CFG_TUNED(dt)). Every value is a
+ * float constant expression, evaluated in float as the same expression at run
+ * time would be (variances in counts^2 times rad_per_count, twice, in that
+ * order), so a compile-time and a run-time configuration are bit-identical.
+ * Members not named (the model's causes) are zero: the thesis model. */
+#ifndef BR_MACHINE_CFG_H
+#define BR_MACHINE_CFG_H
+
+#include "bristle/br_pf.h"
+#include "bristle/br_ukf.h"
+#include "bristle_gen/est/br_est_machine.h"
+#include "bristle_gen/est/br_noise_table.h"
+#include "bristle_gen/est/br_pf_tuned.h"
+#include "bristle_gen/est/br_ukf_tuned.h"
+#include "bristle_gen/machine/br_machine.h"
+
+/* the eq. 6 estimation model of the machine at period dt (float) */
+#define BR_MACHINE_MODEL_CFG(dt)                                                                   \
+    {                                                                                              \
+        .J_kgm2 = BR_MACHINE_J_KGM2_F, .M_kg = BR_MACHINE_M_KG_F,                                  \
+        .lead_mprad = BR_MACHINE_LEAD_MPRAD_F, .sigma2_Nspm = BR_MACHINE_SIGMA2_NSPM_F,            \
+        .lugre = {.sigma0_Npm = BR_MACHINE_SIGMA0_NPM_F, .sigma1_Nspm = BR_MACHINE_SIGMA1_NSPM_F,  \
+                  .Fc_N = BR_MACHINE_FC_N_F, .Fs_N = BR_MACHINE_FS_N_F,                            \
+                  .vs_mps = BR_MACHINE_VS_MPS_F},                                                  \
+        .dt_s = (dt)                                                                               \
+    }
+
+/* The PF at period dt with the process noise q_omega, q_z, q_gp and the
+ * measurement noise r (rad^2); the rest from the machine file's estimator
+ * section (particles, theta noise and spreads in counts, g_p range, gates). */
+#define BR_MACHINE_PF_CFG_Q(dt, q_omega, q_z, q_gp, r)                                             \
+    {                                                                                              \
+        .est = {.model = BR_MACHINE_MODEL_CFG(dt),                                                 \
+                .q_var = {BR_EST_PF_Q_THETA_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F *               \
+                              BR_MACHINE_RAD_PER_COUNT_F,                                          \
+                          (q_omega), (q_z), (q_gp)},                                               \
+                .r_var_rad2 = (r),                                                                 \
+                .gp0_N = BR_EST_PF_GP0_N_F,                                                        \
+                .gp_min_N = BR_EST_PF_GP_MIN_N_F,                                                  \
+                .gp_max_N = BR_EST_PF_GP_MAX_N_F,                                                  \
+                .outlier_sigma = BR_EST_PF_OUTLIER_SIGMA_F,                                        \
+                .reanchor_after = BR_EST_PF_REANCHOR_AFTER,                                        \
+                .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F},                                      \
+        .n_particles = BR_EST_PF_N_PARTICLES,                                                      \
+        .x0_std = {BR_EST_PF_X0_STD_THETA_COUNTS_F * BR_MACHINE_RAD_PER_COUNT_F,                   \
+                   BR_EST_PF_X0_STD_OMEGA_RADPS_F, BR_EST_PF_X0_STD_Z_M_F, BR_EST_PF_X0_STD_GP_N_F}, \
+        .noise = br_noise_table, .noise_len = BR_NOISE_LEN, .noise_skip = BR_EST_PF_NOISE_SKIP     \
+    }
+
+/* the machine file's (hand-tuned) variances: the start of the tuning */
+#define BR_MACHINE_PF_CFG_DEFAULT(dt)                                                              \
+    BR_MACHINE_PF_CFG_Q(dt, BR_EST_PF_Q_OMEGA_RAD2PS2_F, BR_EST_PF_Q_Z_M2_F, BR_EST_PF_Q_GP_N2_F,  \
+                        BR_EST_PF_R_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F * BR_MACHINE_RAD_PER_COUNT_F)
+/* the variances found by Nelder-Mead (br_pf_tuned.h): what the demo runs */
+#define BR_MACHINE_PF_CFG_TUNED(dt)                                                                \
+    BR_MACHINE_PF_CFG_Q(dt, BR_PF_TUNED_q_omega, BR_PF_TUNED_q_z, BR_PF_TUNED_q_gp, BR_PF_TUNED_r)
+
+/* The UKF at period dt with the process noise q_* (rad^2, (rad/s)^2, m^2, N^2)
+ * and measurement noise r (rad^2); the rest from the estimator section. */
+#define BR_MACHINE_UKF_CFG_Q(dt, q_theta, q_omega, q_z, q_gp, r)                                   \
+    {                                                                                              \
+        .est = {.model = BR_MACHINE_MODEL_CFG(dt),                                                 \
+                .q_var = {(q_theta), (q_omega), (q_z), (q_gp)},                                    \
+                .r_var_rad2 = (r),                                                                 \
+                .gp0_N = BR_EST_UKF_GP0_N_F,                                                       \
+                .gp_min_N = BR_EST_UKF_GP_MIN_N_F,                                                 \
+                .gp_max_N = BR_EST_UKF_GP_MAX_N_F,                                                 \
+                .outlier_sigma = BR_EST_UKF_OUTLIER_SIGMA_F,                                       \
+                .reanchor_after = BR_EST_UKF_REANCHOR_AFTER,                                       \
+                .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F},                                      \
+        .p0_var = {BR_EST_UKF_P0_THETA_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F *                    \
+                       BR_MACHINE_RAD_PER_COUNT_F,                                                 \
+                   BR_EST_UKF_P0_OMEGA_RAD2PS2_F, BR_EST_UKF_P0_Z_M2_F, BR_EST_UKF_P0_GP_N2_F},    \
+        .alpha = BR_EST_UKF_ALPHA_F, .beta = BR_EST_UKF_BETA_F, .kappa = BR_EST_UKF_KAPPA_F        \
+    }
+
+#define BR_MACHINE_UKF_CFG_DEFAULT(dt)                                                             \
+    BR_MACHINE_UKF_CFG_Q(dt, BR_EST_UKF_Q_THETA_RAD2_F, BR_EST_UKF_Q_OMEGA_RAD2PS2_F,              \
+                         BR_EST_UKF_Q_Z_M2_F, BR_EST_UKF_Q_GP_N2_F,                                \
+                         BR_EST_UKF_R_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F * BR_MACHINE_RAD_PER_COUNT_F)
+#define BR_MACHINE_UKF_CFG_TUNED(dt)                                                               \
+    BR_MACHINE_UKF_CFG_Q(dt, BR_UKF_TUNED_q_theta, BR_UKF_TUNED_q_omega, BR_UKF_TUNED_q_z,         \
+                         BR_UKF_TUNED_q_gp, BR_UKF_TUNED_r)
+
+#endif
