@@ -4,7 +4,7 @@
   python -m bristle.diagnose validate --model DIR/model.json --log OTHER.csv
 
 (run with python/ on PYTHONPATH; `make diagnose` and `make validate` do that).
-diagnose writes DIR/report.json, DIR/model.json, DIR/report.md and the figures;
+diagnose writes DIR/report.json, DIR/model.json, DIR/machine.json, DIR/report.md and the figures;
 validate prints the saved model's relerr on another log of the same machine.
 Exit status: 0, 1 when the log, model or machine file cannot be used (a
 message "file:line: problem" on stderr), 2 on a usage error.
@@ -14,7 +14,7 @@ import json
 import os
 import sys
 
-from . import causes, closedloop, logreader, model, modelfile, output, report, selection, signals
+from . import causes, closedloop, logreader, machinefile, model, modelfile, output, report, selection, signals
 
 # figures: (file, what, function(path, prep, diag)); the causes' own between
 # the residuals and the closed loop
@@ -53,7 +53,7 @@ def _known_machine(log):
 def _machine(args):
     """The machine file: --machine, else <log>.machine.json beside the log,
     else one of python/bristle/diagnose/machines/ listing the log's name."""
-    path = args.machine
+    path = None if machinefile.is_machine_file(args.machine) else args.machine  # a machine file: machinefile.py
     if path is None:
         side = os.path.splitext(args.log)[0] + ".machine.json"
         path = side if os.path.exists(side) else _known_machine(args.log)
@@ -90,6 +90,7 @@ def cmd_diagnose(args):
     rep = report.build(prep, diag, machine=machine, closed=closed, log_path=args.log)
     output.write_json(os.path.join(args.out, "report.json"), rep)
     output.write_json(os.path.join(args.out, "model.json"), modelfile.build(prep, diag, log_path=args.log))
+    machinefile.write(args.out, prep, diag, machinefile.is_machine_file(args.machine) and args.machine or None, args.log, say)
     figs = []
     if not args.no_plots:
         for name, what, draw in FIGURES:
