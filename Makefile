@@ -22,7 +22,11 @@ PYTHON     := .venv/bin/python
 # its CMakeLists (hal/<board>/) writes into BOARD_INFO the image's path, its
 # part's flash and RAM sizes (KiB) and the RAM's name.
 BOARD      ?= stm32h7
-BOARD_INFO  = build/cm7-release/board-$(BOARD).txt
+# `make firmware MACHINE=<file>` builds for another machine (docs/configure.md):
+# its own cross build folder, configured with -DBR_MACHINE, headers generated there.
+MACHINE_NAME = $(if $(MACHINE),$(shell $(PYTHON) -c 'import json, sys; print(json.load(open(sys.argv[1])).get("name", "x"))' "$(MACHINE)" 2>/dev/null || echo invalid))
+CM7_DIR     = build/cm7-release$(if $(MACHINE),-$(MACHINE_NAME))
+BOARD_INFO  = $(CM7_DIR)/board-$(BOARD).txt
 DEMO_OUT   := out/demo
 HIDDEN_OUT := out/diagnose-hidden
 TUNE_OUT   := out/tune
@@ -70,7 +74,7 @@ help:
 	@echo "  make validate MODEL=<model.json> LOG=<csv>          a saved model's relerr on another log"
 	@echo "  make diagnose-hidden  the hidden-cause suite -> docs/diagnose-hidden.md"
 	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
-	@echo "  make firmware  cross build (cm7-release), print the image's flash / RAM use (BOARD=$(BOARD))"
+	@echo "  make firmware [MACHINE=<json>]  cross build (cm7-release; another machine: build/cm7-release-<name>), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
@@ -177,8 +181,19 @@ diagnose-hidden: deps
 	    --merge $(HIDDEN_OUT)/shard0.json $(HIDDEN_OUT)/shard1.json --md docs/diagnose-hidden.md || rc=1; exit $$rc
 
 firmware: deps
+ifeq ($(MACHINE),)
 	$(call configure,cm7-release)
 	$(call build,cm7-release)
+else
+	$(Q)$(PYTHON) firmware/design/machine.py "$(MACHINE)" > /dev/null
+	$(Q)echo "== H-infinity synthesis for $(MACHINE) ($(MACHINE_NAME))"
+	$(Q)mkdir -p $(CM7_DIR)/gen/bristle_gen/ctrl
+	$(Q)$(PYTHON) firmware/design/synth_hinf.py --machine "$(MACHINE)" --out $(CM7_DIR)/gen/bristle_gen/ctrl/br_hinf_gains.h
+	$(Q)echo "== configure $(CM7_DIR) (BR_MACHINE=$(abspath $(MACHINE)))"
+	$(Q)log="$$(cmake --preset cm7-release -B $(CM7_DIR) -DBR_MACHINE=$(abspath $(MACHINE)) 2>&1)" || { echo "$$log"; echo "configure $(CM7_DIR) failed" >&2; exit 1; }
+	$(Q)echo "== build $(CM7_DIR)"
+	$(Q)cmake --build $(CM7_DIR) $(NINJA_QUIET)
+endif
 	$(print_size)
 
 # Everything generated from machines/reference.json (docs/machine-file.md):
