@@ -75,13 +75,8 @@ static br_ref_t axis_ref(const br_circle_cfg_t *c, double phase, double t, doubl
     return r;
 }
 
-static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
+br_ctrl_cfg_t br_circle_ctrl_cfg(const br_circle_cfg_t *c)
 {
-    a->phase = phase;
-    a->mem = (br_app_mem_t){NULL, NULL};
-    br_plant_state_t x0 = {c->radius_m * sin(phase) / c->plant.lead_mprad, 0.0, 0.0};
-    if (br_plant_init(&a->plant, &c->plant, &x0) != 0) return -1;
-    if (br_hal_sim_init(&a->port, &a->plant, c->dt_s, &a->hal) != BR_OK) return -1;
     br_ctrl_cfg_t cc;
     for (int i = 0; i < 3; i++) cc.K[i] = c->K[i];
     cc.dt_s = (float)c->dt_s;
@@ -89,6 +84,17 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
     cc.tau_per_duty_Nm = (float)c->plant.tau_per_duty_Nm;
     cc.rad_per_count = (float)(2.0 * BR_PI / c->plant.counts_per_rev);
     cc.lead_mprad = (float)c->plant.lead_mprad;
+    return cc;
+}
+
+static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
+{
+    a->phase = phase;
+    a->mem = (br_app_mem_t){NULL, NULL};
+    br_plant_state_t x0 = {c->radius_m * sin(phase) / c->plant.lead_mprad, 0.0, 0.0};
+    if (br_plant_init(&a->plant, &c->plant, &x0) != 0) return -1;
+    if (br_hal_sim_init(&a->port, &a->plant, c->dt_s, &a->hal) != BR_OK) return -1;
+    const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(c);
     br_est_t ext = {NULL, NULL};
     br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext};
     switch (c->controller) {
