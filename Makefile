@@ -61,7 +61,7 @@ define print_size
 	  END { exit ok ? 0 : 1 }'
 endef
 
-.PHONY: help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control firmware regen clean distclean
+.PHONY: help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control firmware emps regen clean distclean
 
 help:
 	@echo "bristle targets:"
@@ -75,6 +75,7 @@ help:
 	@echo "  make diagnose-hidden  the hidden-cause suite -> docs/diagnose-hidden.md"
 	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
 	@echo "  make firmware [MACHINE=<json>]  cross build (cm7-release; another machine: build/cm7-release-<name>), print the image's flash / RAM use (BOARD=$(BOARD))"
+	@echo "  make emps      the EMPS drive through the chain: its log -> diagnose -> machine.json -> image -> tracking in the simulator -> $(EMPS_OUT), docs/machines/emps.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
@@ -195,6 +196,20 @@ else
 	$(Q)cmake --build $(CM7_DIR) $(NINJA_QUIET)
 endif
 	$(print_size)
+
+# A real machine through the whole chain (docs/machines/emps.md): the EMPS
+# log -> diagnosis -> machine.json -> its image -> its own reference
+# trajectory on the identified plant with the log's PD, H-inf, H-inf + PF.
+EMPS_LOG ?= ../shared/data/emps/emps_estimation.csv
+EMPS_OUT := out/emps-chain
+emps: deps
+	$(Q)$(MAKE) diagnose LOG=$(EMPS_LOG) OUT=$(EMPS_OUT)/diagnose MACHINE=machines/emps.json
+	$(Q)$(MAKE) firmware MACHINE=$(EMPS_OUT)/diagnose/machine.json
+	$(Q)echo "== tracking on the simulator -> $(EMPS_OUT), docs/machines/emps.md"
+	$(Q)$(PYTHON) sim/studies/machine_chain.py --src . --work $(EMPS_OUT) --given machines/emps.json --log $(EMPS_LOG) \
+	  --controller python/bristle/diagnose/machines/emps.json --cross --cross-dir build/cm7-release-emps --track \
+	  --md docs/machines/emps.md > $(EMPS_OUT)/chain.log || { cat $(EMPS_OUT)/chain.log; exit 1; }
+	$(Q)grep -E "tracking RMS|^image" $(EMPS_OUT)/chain.log
 
 # Everything generated from machines/reference.json (docs/machine-file.md):
 # after editing it, `make regen` then `make test` needs no hand edits.

@@ -32,6 +32,8 @@ import math
 import os
 import re
 
+import numpy as np
+
 from . import causes as causes_
 from . import closedloop, output, params
 
@@ -69,6 +71,25 @@ def _leaves(d, prefix=""):
             yield path
 
 
+def encoder_step(pos):
+    """The log's position step (closedloop.position_quantum), also when the
+    printed positions carry a rounding error of their own: then the step is
+    refined over the steps of up to 10 quanta, and the steps must be whole
+    multiples of it within 2 % of a quantum. 0 when they are not (no encoder)."""
+    q = closedloop.position_quantum(pos)
+    if q > 0.0:
+        return q
+    d = np.abs(np.diff(pos))
+    d = d[d > 0]
+    if len(d) == 0:
+        return 0.0
+    n = np.round(d / d.min())
+    small = n <= 10
+    q = float(np.median(d[small] / n[small]))
+    r = d / q
+    return q if np.mean(np.abs(r - np.round(r)) < 0.02) > 0.95 else 0.0
+
+
 def _set(m, dotted, value, prov, kind):
     *head, last = dotted.split(".")
     node = m
@@ -99,7 +120,7 @@ def build(prep, diag, given=None, log_path=None):
     p = diag.extended.params()
 
     # the log's position quantum: the encoder step at the load
-    quantum = closedloop.position_quantum(prep.pos)
+    quantum = encoder_step(prep.pos)
     lead, cpr = m["mechanics"]["lead_m_per_rev"], m["encoder"]["counts_per_rev"]
     if quantum > 0.0:
         if kind("encoder.counts_per_rev") == "given" and kind("mechanics.lead_m_per_rev") != "given":
