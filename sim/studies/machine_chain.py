@@ -17,8 +17,9 @@ circle (br_circle_ext), H-infinity only against H-infinity + PF.
 --cross      the image for WORK/diagnose/machine.json in WORK/cm7 (or --cross-dir):
              flash and RAM against the part's, the PF's entry points linked
 --track      br_track on the log's reference (the identified plant of model.json)
---circle     br_circle_ext --est pf on the plant of the given machine (the
-             truth, for a simulated log) with the firmware of machine.json
+--circle     br_circle_ext --est pf with the firmware of machine.json on the
+             plant of the given machine (the truth of a simulated log), or of
+             the diagnosis's model.json (a measured log)
 --md DOC     the track table into DOC between "<!-- chain:begin -->" and "<!-- chain:end -->"
 --check-ratio R  exit 1 unless H-inf + PF (nominal model) / H-inf only < R on the circle,
              and the image links the PF within the part's memory
@@ -96,31 +97,42 @@ def plot_track(work, names, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-    fig, ax = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True)
+    fig, ax = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
     for name, label in names:
         f = os.path.join(work, "track", "track_%s.csv" % name)
         if not os.path.exists(f):
             continue
         d = np.loadtxt(f, delimiter=",", skiprows=1)
-        if name == "pd":
+        if name == "hinf_only":
             ax[0].plot(d[:, 0], d[:, 1], "k", lw=0.8, label="reference")
-        ax[1].plot(d[:, 0], d[:, 3] * 1e6, lw=0.7, label=label)
+        a = ax[1] if name == "pd" else ax[2]
+        a.plot(d[:, 0], d[:, 3] * 1e6, lw=0.7, label=label)
     ax[0].set_ylabel("position, m")
-    ax[0].legend(loc="upper right")
+    for a in ax:
+        a.legend(loc="upper right", fontsize=8)
     ax[1].set_ylabel("tracking error, µm")
-    ax[1].set_xlabel("t, s")
-    ax[1].legend(loc="upper right", fontsize=8)
+    ax[2].set_ylabel("tracking error, µm")
+    ax[2].set_xlabel("t, s")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
 
 def write_md(doc, s):
-    rows = ["| controller | tracking RMS | max error | against H-inf only |", "|---|---|---|---|"]
+    rows = ["The log's reference trajectory (24.8 s) on the identified plant (model.json):", "",
+            "| controller | tracking RMS | max error | against H-inf only |", "|---|---|---|---|"]
     ref = s["track"]["hinf_only"]["rms_m"]
     for name, label in TRACK:
         r = s["track"].get(name)
         if r:
             rows.append("| %s | %.3e m | %.3e m | %.3f |" % (label, r["rms_m"], r["max_m"], r["rms_m"] / ref))
+    if "circle" in s:
+        c, ref = s["circle"], s["circle"]["hinf_only"]["contour_rms_m"]
+        rows += ["", "The thesis circle (radius 0.1 mm, 8 s) on the same plant, the firmware built for machine.json:", "",
+                 "| controller | contour RMS | max error | against H-inf only |", "|---|---|---|---|"]
+        for name, label in (("hinf_only", "H-infinity only"), ("est_nominal", "H-infinity + PF, nominal model"),
+                            ("est_extended", "H-infinity + PF, extended model")):
+            rows.append("| %s | %.3e m | %.3e m | %.3f |" % (label, c[name]["contour_rms_m"], c[name]["max_err_m"],
+                                                            c[name]["contour_rms_m"] / ref))
     if "image" in s:
         im = s["image"]
         rows += ["", "Image (`make firmware MACHINE=out/emps-chain/diagnose/machine.json`): flash %d B of %d KiB, "
@@ -188,12 +200,12 @@ def main():
         with open(os.path.join(a.work, "track.json"), encoding="utf-8") as f:
             s["track"] = {k: v for k, v in json.load(f).items() if isinstance(v, dict)}
         plot_track(a.work, TRACK, os.path.join(a.work, "track.png"))
-        if a.md:
-            write_md(a.md, s)
     if a.circle:
         ext = host_build(a, machine_json, bdir, "br_circle_ext")
-        truth = os.path.join(a.work, "truth-model.json")
-        truth_model(a.given, truth, a.src)
+        truth = os.path.join(diag, "model.json")  # a measured log: the identified plant
+        if a.simulate:  # a simulated one: the plant it was simulated on
+            truth = os.path.join(a.work, "truth-model.json")
+            truth_model(a.given, truth, a.src)
         run([ext, "--model", truth, "--est", "pf", "--json", os.path.join(a.work, "circle.json")])
         with open(os.path.join(a.work, "circle.json"), encoding="utf-8") as f:
             s["circle"] = {k: v for k, v in json.load(f).items() if isinstance(v, dict)}
@@ -202,6 +214,8 @@ def main():
         print("circle: H-inf only %.3e m, H-inf + PF %.3e m (ratio %.4f), extended model %.3e m"
               % (c["hinf_only"]["contour_rms_m"], c["est_nominal"]["contour_rms_m"], s["circle_ratio_pf_nominal"],
                  c["est_extended"]["contour_rms_m"]))
+    if a.md:
+        write_md(a.md, s)
     with open(os.path.join(a.work, "summary.json"), "w", encoding="utf-8") as f:
         json.dump(s, f, indent=2)
         f.write("\n")
