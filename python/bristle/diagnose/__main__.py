@@ -53,7 +53,7 @@ def _known_machine(log):
 def _machine(args):
     """The machine file: --machine, else <log>.machine.json beside the log,
     else one of python/bristle/diagnose/machines/ listing the log's name."""
-    path = None if machinefile.is_machine_file(args.machine) else args.machine  # a machine file: machinefile.py
+    path = None if machinefile.given(args.machine) else args.machine  # a machine file: machinefile.py
     if path is None:
         side = os.path.splitext(args.log)[0] + ".machine.json"
         path = side if os.path.exists(side) else _known_machine(args.log)
@@ -90,7 +90,7 @@ def cmd_diagnose(args):
     rep = report.build(prep, diag, machine=machine, closed=closed, log_path=args.log)
     output.write_json(os.path.join(args.out, "report.json"), rep)
     output.write_json(os.path.join(args.out, "model.json"), modelfile.build(prep, diag, log_path=args.log))
-    machinefile.write(args.out, prep, diag, machinefile.is_machine_file(args.machine) and args.machine or None, args.log, say)
+    machinefile.write(args.out, prep, diag, machinefile.given(args.machine), args.log, say)
     figs = []
     if not args.no_plots:
         for name, what, draw in FIGURES:

@@ -62,6 +62,20 @@ def is_machine_file(path):
     return isinstance(raw, dict) and "format_version" in raw
 
 
+def given(path):
+    """path when it is a format-1 machine file, checked (ControllerError with
+    the loader's "FILE: field ...: problem" lines when it is not valid); None
+    when path is None or another file (the diagnosis's controller file)."""
+    if path is None or not is_machine_file(path):
+        return None
+    mach = _loader()
+    try:
+        mach.load(path)
+    except mach.MachineError as e:
+        raise closedloop.ControllerError("\n".join(e.lines)) from None
+    return path
+
+
 def _leaves(d, prefix=""):
     for k, v in d.items():
         path = prefix + k
