@@ -22,7 +22,11 @@ PYTHON     := .venv/bin/python
 # its CMakeLists (hal/<board>/) writes into BOARD_INFO the image's path, its
 # part's flash size (KiB) and its RAM regions (NAME:ORIGIN:KiB).
 BOARD      ?= stm32h7
-BOARD_INFO  = build/cm7-release/board-$(BOARD).txt
+# `make firmware MACHINE=<file>` builds for another machine (docs/configure.md):
+# its own cross build folder, configured with -DBR_MACHINE, headers generated there.
+MACHINE_NAME = $(if $(MACHINE),$(shell $(PYTHON) -c 'import json, sys; print(json.load(open(sys.argv[1])).get("name", "x"))' "$(MACHINE)" 2>/dev/null || echo invalid))
+CM7_DIR     = build/cm7-release$(if $(MACHINE),-$(MACHINE_NAME))
+BOARD_INFO  = $(CM7_DIR)/board-$(BOARD).txt
 DEMO_OUT   := out/demo
 HIDDEN_OUT := out/diagnose-hidden
 TUNE_OUT   := out/tune
@@ -62,7 +66,7 @@ define print_size
 	done
 endef
 
-.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench firmware regen clean distclean
+.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench firmware emps regen clean distclean
 
 help:
 	@echo "bristle targets:"
@@ -76,7 +80,8 @@ help:
 	@echo "  make diagnose-hidden  the hidden-cause suite -> docs/diagnose-hidden.md"
 	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
 	@echo "  make diagnose-bench   peak memory of a diagnosis of a 2e6-row log written by br_simlog (docs/diagnose.md, Memory)"
-	@echo "  make firmware  cross build (cm7-release), print the image's flash / RAM use (BOARD=$(BOARD))"
+	@echo "  make firmware [MACHINE=<json>]  cross build (cm7-release; another machine: build/cm7-release-<name>), print the image's flash / RAM use (BOARD=$(BOARD))"
+	@echo "  make emps      the EMPS drive through the chain: its log -> diagnose -> machine.json -> image -> tracking in the simulator -> $(EMPS_OUT), docs/machines/emps.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
@@ -192,9 +197,34 @@ diagnose-hidden: deps
 	    --merge $(HIDDEN_OUT)/shard0.json $(HIDDEN_OUT)/shard1.json --md docs/diagnose-hidden.md || rc=1; exit $$rc
 
 firmware: deps
+ifeq ($(MACHINE),)
 	$(call configure,cm7-release)
 	$(call build,cm7-release)
+else
+	$(Q)$(PYTHON) firmware/design/machine.py "$(MACHINE)" > /dev/null
+	$(Q)echo "== H-infinity synthesis for $(MACHINE) ($(MACHINE_NAME))"
+	$(Q)mkdir -p $(CM7_DIR)/gen/bristle_gen/ctrl
+	$(Q)$(PYTHON) firmware/design/synth_hinf.py --machine "$(MACHINE)" --out $(CM7_DIR)/gen/bristle_gen/ctrl/br_hinf_gains.h
+	$(Q)echo "== configure $(CM7_DIR) (BR_MACHINE=$(abspath $(MACHINE)))"
+	$(Q)log="$$(cmake --preset cm7-release -B $(CM7_DIR) -DBR_MACHINE=$(abspath $(MACHINE)) 2>&1)" || { echo "$$log"; echo "configure $(CM7_DIR) failed" >&2; exit 1; }
+	$(Q)echo "== build $(CM7_DIR)"
+	$(Q)cmake --build $(CM7_DIR) $(NINJA_QUIET)
+endif
 	$(print_size)
+
+# A real machine through the whole chain (docs/machines/emps.md): the EMPS
+# log -> diagnosis -> machine.json -> its image -> its own reference
+# trajectory on the identified plant with the log's PD, H-inf, H-inf + PF.
+EMPS_LOG ?= ../shared/data/emps/emps_estimation.csv
+EMPS_OUT := out/emps-chain
+emps: deps
+	$(Q)$(MAKE) diagnose LOG=$(EMPS_LOG) OUT=$(EMPS_OUT)/diagnose MACHINE=machines/emps.json
+	$(Q)$(MAKE) firmware MACHINE=$(EMPS_OUT)/diagnose/machine.json
+	$(Q)echo "== tracking on the simulator -> $(EMPS_OUT), docs/machines/emps.md"
+	$(Q)$(PYTHON) sim/studies/machine_chain.py --src . --work $(EMPS_OUT) --given machines/emps.json --log $(EMPS_LOG) \
+	  --controller python/bristle/diagnose/machines/emps.json --cross --cross-dir build/cm7-release-emps --track --circle \
+	  --md docs/machines/emps.md > $(EMPS_OUT)/chain.log || { cat $(EMPS_OUT)/chain.log; exit 1; }
+	$(Q)grep -E "tracking RMS|^image|^circle" $(EMPS_OUT)/chain.log
 
 # Everything generated from machines/reference.json (docs/machine-file.md):
 # after editing it, `make regen` then `make test` needs no hand edits.

@@ -89,6 +89,28 @@ class Optional:
         self.section = section
 
 
+# where a value comes from (docs/machine-file.md, "provenance"); a field the
+# block does not list is "given"
+PROVENANCE_KINDS = ("identified", "derived", "assumed", "given")
+
+
+class Provenance:
+    """The optional "provenance" block: {"<field path>": one of PROVENANCE_KINDS};
+    each path names a value (a leaf) of the file's schema."""
+
+    def errors(self, value, path):
+        if not isinstance(value, dict):
+            return [(path, "expected an object, got %s" % _kind(value))]
+        out = []
+        for k, v in value.items():
+            if not isinstance(_leaf(k), (Num, Str)):
+                out.append((_join(path, k), "not a value of the machine file (a field path such as "
+                                            "friction.Fc_N or causes.offset.offset_N)"))
+            elif v not in PROVENANCE_KINDS:
+                out.append((_join(path, k), "%r is not one of %s" % (v, ", ".join(PROVENANCE_KINDS))))
+        return out
+
+
 def _g(v):
     return "%g" % v if isinstance(v, float) else str(v)
 
@@ -211,13 +233,36 @@ SCHEMA = {
         "max_speed_mps": Num(0.0, 100.0, "largest table speed the axis is used at", lo_open=True),
         "travel_m": Num(0.0, 100.0, "stroke of the table", lo_open=True),
     },
+    # where each value comes from (a diagnosis's machine.json writes it); optional
+    "provenance": Optional(Provenance()),
 }
+
+
+def _leaf(dotted):
+    """The schema leaf of a dotted field path, else None."""
+    node = SCHEMA
+    for k in dotted.split(".") if isinstance(dotted, str) else ():
+        if isinstance(node, Optional):
+            node = node.section
+        if not isinstance(node, dict) or k not in node:
+            return None
+        node = node[k]
+    return node if isinstance(node, (Num, Str)) else None
+
+
+def provenance(m, dotted):
+    """Where the value at a dotted path comes from: the file's provenance
+    block, "given" when it does not list the field."""
+    return m.get("provenance", {}).get(dotted, "given")
 
 
 def _walk(schema, value, path, errors):
     """Checks value against schema; returns the cleaned value (numbers as float / int)."""
     if isinstance(schema, Optional):
         schema = schema.section
+    if isinstance(schema, Provenance):
+        errors.extend(schema.errors(value, path))
+        return dict(value) if isinstance(value, dict) else None
     if isinstance(schema, dict):
         if not isinstance(value, dict):
             errors.append((path, "expected an object, got %s" % _kind(value)))

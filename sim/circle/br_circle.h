@@ -52,8 +52,9 @@ typedef struct {
  * the PF). */
 br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller);
 
-/* The controller configuration of the experiment: its gains and period, the
- * machine's torque limit, the plant's amplifier, encoder and lead. */
+/* The firmware's controller configuration of one axis of cfg: its gains and
+ * period, the machine's torque limit, the plant's amplifier, encoder and lead
+ * (also what sim/apps/br_track.c runs). */
 br_ctrl_cfg_t br_circle_ctrl_cfg(const br_circle_cfg_t *cfg);
 
 /* One control period of both axes (load side, true plant positions). */

@@ -101,6 +101,21 @@ def main():
                                             "field estimator.ukf.gp0_N: must lie in [estimator.ukf.gp_min_N, "
                                             "estimator.ukf.gp_max_N]"])
     bad = copy.deepcopy(good)
+    bad["provenance"] = {"friction.Fc_N": "identified", "mechanics.mass_kg": "given",
+                         "causes.offset.offset_N": "measured", "friction": "assumed"}
+    expect_errors(work, "provenance.json", bad, [
+        "field provenance.mechanics.mass_kg: not a value of the machine file (a field path such as friction.Fc_N "
+        "or causes.offset.offset_N)",
+        "field provenance.causes.offset.offset_N: 'measured' is not one of identified, derived, assumed, given",
+        "field provenance.friction: not a value of the machine file (a field path such as friction.Fc_N "
+        "or causes.offset.offset_N)"])
+    ok = copy.deepcopy(good)
+    ok["provenance"] = {"friction.Fc_N": "identified", "causes.asymmetric_friction.dFc_neg_N": "identified",
+                        "mechanics.lead_m_per_rev": "derived", "limits.travel_m": "assumed"}
+    m = machine.load(write(work, "provenance-ok.json", ok))
+    check(machine.provenance(m, "friction.Fc_N") == "identified" and machine.provenance(m, "friction.Fs_N") == "given",
+          "provenance: a listed field has its kind, an unlisted one is given")
+    bad = copy.deepcopy(good)
     bad["format_version"] = 2
     expect_errors(work, "version.json", bad, ["field format_version: 2 is not a version this loader reads (1)"])
     path = write(work, "syntax.json", "{\n  \"name\": \"x\",\n}\n")

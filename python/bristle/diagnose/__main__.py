@@ -4,7 +4,7 @@
   python -m bristle.diagnose validate --model DIR/model.json --log OTHER.csv
 
 (run with python/ on PYTHONPATH; `make diagnose` and `make validate` do that).
-diagnose writes DIR/report.json, DIR/model.json, DIR/report.md and the figures;
+diagnose writes DIR/report.json, DIR/model.json, DIR/machine.json, DIR/report.md and the figures;
 validate prints the saved model's relerr on another log of the same machine.
 Exit status: 0, 1 when the log, model or machine file cannot be used (a
 message "file:line: problem" on stderr), 2 on a usage error.
@@ -14,7 +14,8 @@ import math
 import os
 import sys
 
-from . import causes, closedloop, logreader, machinefile, model, modelfile, output, report, selection, signals
+from . import (causes, closedloop, logreader, machinefile, machinejson, model, modelfile, output, report, selection,
+               signals)
 
 # figures: (file, what, function(path, prep, diag)); the causes' own between
 # the residuals and the closed loop
@@ -55,7 +56,10 @@ def cmd_diagnose(args):
     if problem:
         raise logreader.LogError("--fc", 0, problem)
     check_out(args.out)
-    mpath = machinefile.find(args.log, args.machine)
+    # --machine names the log's controller file, or a firmware machine file
+    # (checked here, before the fit) whose values machine.json takes
+    given = machinejson.given(args.machine)
+    mpath = machinefile.find(args.log, None if given else args.machine)
     machine, ctrl = machinefile.load(mpath) if mpath else (None, None)
     log = logreader.read_log(args.log)
     if ctrl is not None and abs(ctrl["dt_s"] - log.dt) > 1e-6 * log.dt:
@@ -78,6 +82,7 @@ def cmd_diagnose(args):
     rep = report.build(prep, diag, machine=machine, closed=closed, log_path=args.log)
     output.write_json(os.path.join(args.out, "report.json"), rep)
     output.write_json(os.path.join(args.out, "model.json"), modelfile.build(prep, diag, log_path=args.log))
+    machinejson.write(args.out, prep, diag, given, args.log, say)
     figs = []
     if not args.no_plots:
         for name, what, draw in FIGURES:

@@ -1,0 +1,236 @@
+"""machine.json: the firmware machine file (firmware/design/machine.py, format 1) a
+diagnosis writes beside model.json (docs/machine-file.md, "provenance";
+docs/configure.md).
+
+What a log identifies goes in from the extended model (model.json "params"
+and "causes"), what it cannot identify (lead or encoder, amplifier, control
+design, estimator settings, limits) from the given machine file (--machine,
+when it is a format-1 machine file), else from machines/reference.json and
+marked "assumed"; what follows from the log and the rest is "derived". The
+"provenance" block lists every value that is not "given":
+
+  mechanics        Meff_kg = J/L^2 + M split in the given file's proportion
+                   (its inertia and mass both given), else J kept and
+                   M = Meff - J/L^2 ("identified")
+  encoder / lead   the log's position quantum is the encoder step at the load,
+                   lead / counts_per_rev: with the counts given and the lead not,
+                   the lead is derived; with the counts not given, the counts
+  friction         params.NOMINAL's friction terms ("identified"), except what
+                   the log cannot resolve: vs_mps below its velocity resolution
+                   (quantum / dt), and with it Fs_N; sigma0_Npm whose presliding
+                   length Fc/sigma0 is under 2 quanta, and with it sigma1_Nspm:
+                   these keep the base's values ("assumed"; Fs_N scaled by the
+                   base's Fs/Fc if the base's would be below Fc)
+  causes           model.json's causes and their parameters, same names ("identified")
+  estimator g_p    the g_p settings scaled from the base by Fs / Fs_base
+                   (variances by its square): "derived"
+"""
+import copy
+import importlib.util
+import json
+import math
+import os
+import re
+
+import numpy as np
+
+from . import causes as causes_
+from . import closedloop, output, params
+
+REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", ".."))
+# presliding lengths shorter than this many position quanta are not resolved
+PRESLIDING_MIN_QUANTA = 2.0
+
+
+def _loader():
+    """firmware/design/machine.py, the one loader and schema of machine files."""
+    spec = importlib.util.spec_from_file_location("br_machine_loader",
+                                                  os.path.join(REPO, "firmware", "design", "machine.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def is_machine_file(path):
+    """True when path is a format-1 machine file (it has "format_version"),
+    not the diagnosis's controller file (python/bristle/diagnose/machines/)."""
+    try:
+        with open(path, encoding="utf-8-sig") as f:
+            raw = json.load(f)
+    except (OSError, ValueError, TypeError):
+        return False
+    return isinstance(raw, dict) and "format_version" in raw
+
+
+def given(path):
+    """path when it is a format-1 machine file, checked (ControllerError with
+    the loader's "FILE: field ...: problem" lines when it is not valid); None
+    when path is None or another file (the diagnosis's controller file)."""
+    if path is None or not is_machine_file(path):
+        return None
+    mach = _loader()
+    try:
+        mach.load(path)
+    except mach.MachineError as e:
+        raise closedloop.ControllerError("\n".join(e.lines)) from None
+    return path
+
+
+def _leaves(d, prefix=""):
+    for k, v in d.items():
+        path = prefix + k
+        if isinstance(v, dict):
+            yield from _leaves(v, path + ".")
+        else:
+            yield path
+
+
+def encoder_step(pos):
+    """The log's position step (closedloop.position_quantum), also when the
+    printed positions carry a rounding error of their own: then the step is
+    refined over the steps of up to 10 quanta, and the steps must be whole
+    multiples of it within 2 % of a quantum. 0 when they are not (no encoder)."""
+    q = closedloop.position_quantum(pos)
+    if q > 0.0:
+        return q
+    d = np.abs(np.diff(pos))
+    d = d[d > 0]
+    if len(d) == 0:
+        return 0.0
+    n = np.round(d / d.min())
+    small = n <= 10
+    q = float(np.median(d[small] / n[small]))
+    r = d / q
+    return q if np.mean(np.abs(r - np.round(r)) < 0.02) > 0.95 else 0.0
+
+
+def _set(m, dotted, value, prov, kind):
+    *head, last = dotted.split(".")
+    node = m
+    for k in head:
+        node = node.setdefault(k, {})
+    node[last] = value
+    prov[dotted] = kind
+
+
+def build(prep, diag, given=None, log_path=None):
+    """The machine file as a dict (not yet rounded) and a list of notes."""
+    mach = _loader()
+    notes = []
+    if given is not None:
+        try:
+            base = mach.load(given)
+        except mach.MachineError as e:
+            raise closedloop.ControllerError("\n".join(e.lines)) from None
+        prov = {k: v for k, v in base.get("provenance", {}).items() if v != "given"}
+    else:
+        base = mach.load(mach.REFERENCE_MACHINE)
+        prov = {}
+        for path in _leaves({k: v for k, v in base.items()
+                             if k not in ("format_version", "name", "source", "file", "causes", "provenance")}):
+            prov[path] = "assumed"
+    m = {k: copy.deepcopy(v) for k, v in base.items() if k not in ("file", "provenance")}
+    kind = lambda path: prov.get(path, "given")  # noqa: E731
+    p = diag.extended.params()
+
+    # the log's position quantum: the encoder step at the load
+    quantum = encoder_step(prep.pos)
+    lead, cpr = m["mechanics"]["lead_m_per_rev"], m["encoder"]["counts_per_rev"]
+    if quantum > 0.0:
+        if kind("encoder.counts_per_rev") == "given" and kind("mechanics.lead_m_per_rev") != "given":
+            _set(m, "mechanics.lead_m_per_rev", quantum * cpr, prov, "derived")
+        elif kind("encoder.counts_per_rev") != "given":
+            counts = int(round(lead / quantum))
+            _set(m, "encoder.counts_per_rev", counts, prov, "derived")
+        elif abs(lead / cpr - quantum) > 0.01 * quantum:
+            notes.append("the log's position step %.4g m is not the given encoder step lead / counts_per_rev = "
+                         "%.4g m" % (quantum, lead / cpr))
+    L = m["mechanics"]["lead_m_per_rev"] / (2.0 * math.pi)
+
+    # the moving mass at the load
+    Meff = p["Meff_kg"]
+    J, M = m["mechanics"]["inertia_kgm2"], m["mechanics"]["table_mass_kg"]
+    if kind("mechanics.inertia_kgm2") == "given" and kind("mechanics.table_mass_kg") == "given" and given:
+        share = M / (J / L ** 2 + M)
+        _set(m, "mechanics.table_mass_kg", share * Meff, prov, "identified")
+        _set(m, "mechanics.inertia_kgm2", (1.0 - share) * Meff * L ** 2, prov, "identified")
+    elif Meff - J / L ** 2 > 0.0:
+        _set(m, "mechanics.table_mass_kg", Meff - J / L ** 2, prov, "identified")
+    else:
+        raise closedloop.ControllerError(
+            "%s: field mechanics.inertia_kgm2: J/L^2 = %.4g kg exceeds the identified moving mass Meff_kg = %.4g kg"
+            % (given or mach.REFERENCE_MACHINE, J / L ** 2, Meff))
+
+    # friction: what the log resolves is identified, the rest keeps the base's values
+    fr = m["friction"]
+    base_fr = dict(fr)
+    v_res = quantum / prep.dt if quantum > 0.0 else 0.0
+    unresolved = set()
+    if p["vs_mps"] < v_res:
+        unresolved |= {"vs_mps", "Fs_N"}
+        notes.append("vs_mps %.3g m/s is below the log's velocity resolution %.3g m/s: vs_mps and Fs_N are not "
+                     "identified" % (p["vs_mps"], v_res))
+    if quantum > 0.0 and p["Fc_N"] / p["sigma0_Npm"] < PRESLIDING_MIN_QUANTA * quantum:
+        unresolved |= {"sigma0_Npm", "sigma1_Nspm"}
+        notes.append("the presliding length Fc/sigma0 %.3g m is under %g position steps: sigma0_Npm and "
+                     "sigma1_Nspm are not identified" % (p["Fc_N"] / p["sigma0_Npm"], PRESLIDING_MIN_QUANTA))
+    for q in params.NOMINAL:
+        if q.name not in fr:
+            continue  # Meff_kg: above
+        if q.name in unresolved:
+            prov["friction." + q.name] = "assumed"
+        else:
+            _set(m, "friction." + q.name, p[q.name], prov, "identified")
+    if fr["Fs_N"] < fr["Fc_N"]:
+        fr["Fs_N"] = fr["Fc_N"] * base_fr["Fs_N"] / base_fr["Fc_N"]
+
+    # the causes, under the names of model.json (one table: the causes' PARAMS)
+    m["causes"] = {}
+    for c in causes_.of(diag.extended.causes):
+        for q in c.PARAMS:
+            _set(m, "causes.%s.%s" % (c.NAME, q.name), p[q.name], prov, "identified")
+
+    # the estimators' friction-level settings follow the friction
+    s = fr["Fs_N"] / base_fr["Fs_N"]
+    if abs(s - 1.0) > 1e-9:
+        est = m["estimator"]
+        for e in ("pf", "ukf"):
+            for f in ("gp0_N", "gp_min_N", "gp_max_N"):
+                _set(m, "estimator.%s.%s" % (e, f), est[e][f] * s, prov, "derived")
+            _set(m, "estimator.%s.q_var.gp_N2" % e, est[e]["q_var"]["gp_N2"] * s * s, prov, "derived")
+        _set(m, "estimator.pf.x0_std.gp_N", est["pf"]["x0_std"]["gp_N"] * s, prov, "derived")
+        _set(m, "estimator.ukf.p0_var.gp_N2", est["ukf"]["p0_var"]["gp_N2"] * s * s, prov, "derived")
+
+    log_name = os.path.basename(log_path or prep.path)
+    if given is None:
+        m["name"] = re.sub(r"[^a-z0-9_-]+", "-", os.path.splitext(log_name)[0].lower()).strip("-_") or "machine"
+        if not re.fullmatch(r"[a-z0-9][a-z0-9_-]*", m["name"]):
+            m["name"] = "m" + m["name"]
+    m["source"] = ("generated by python/bristle/diagnose (python -m bristle.diagnose), do not edit: the diagnosis "
+                   "of %s on %s; provenance lists what the log identified, what is derived and what is assumed"
+                   % (log_name, mach.display_name(given) if given else "no machine file (defaults of "
+                      "machines/reference.json, assumed)"))
+    m["provenance"] = {k: prov[k] for k in sorted(prov) if prov[k] != "given"}
+    return m, notes
+
+
+def write(out_dir, prep, diag, given=None, log_path=None, say=print):
+    """Writes out_dir/machine.json and checks that it loads; returns its path."""
+    m, notes = build(prep, diag, given=given, log_path=log_path)
+    m = output.rounded(m)
+    for f in ("counts_per_rev", "counter_bits"):
+        m["encoder"][f] = int(m["encoder"][f])
+    path = os.path.join(out_dir, "machine.json")
+    output.write_json(path, m)
+    mach = _loader()
+    try:
+        mach.load(path)
+    except mach.MachineError as e:
+        raise closedloop.ControllerError("the machine file written does not load:\n" + "\n".join(e.lines)) from None
+    for n in notes:
+        say("machine.json: " + n)
+    kinds = {}
+    for k, v in m["provenance"].items():
+        kinds[v] = kinds.get(v, 0) + 1
+    say("machine.json: %s" % ", ".join("%d %s" % (kinds[k], k) for k in sorted(kinds)))
+    return path

@@ -1,0 +1,315 @@
+/* br_track: a measured log's own reference trajectory (its t,ref columns) on
+ * the plant of the machine this build is for (BR_MACHINE), or of a model.json
+ * (--model: the identified plant with its causes), with each controller:
+ *
+ *   pd           the log's position loop (the EMPS form of sim/simlog/br_ident.h:
+ *                u = kp kv (ref - q) - kv qdot, |u| <= u_max, F = gain u), --pd
+ *   hinf_only    the firmware (br_app_step), H-infinity only, control period
+ *   hinf_pf      the firmware with the PF on the nominal model, the PF's period
+ *   hinf_pf_ext  the same PF on the extended model: est.model.causes set from
+ *                the plant's causes (--model), the firmware's extended model
+ *   hinf_true    the limit: H-infinity compensating the plant's true friction
+ *                (an oracle no real machine has)
+ *
+ * The firmware's configuration (gains, periods, estimator settings) is the
+ * build's machine's (br_circle_cfg_thesis). The tracking error is the
+ * reference minus the plant's true load position at each control period.
+ * docs/configure.md, docs/machines/emps.md.
+ *
+ * Usage: br_track --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]
+ *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true] [--json OUT] [--trace DIR]
+ * Prints one line per controller: tracking RMS and maximum error. */
+#define _POSIX_C_SOURCE 200809L
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bristle/br_app.h"
+#include "circle/br_circle.h"
+#include "hal/br_hal_sim.h"
+#include "plant/br_model_params.h"
+#include "plant/br_plant_json.h"
+#include "simlog/br_cause_args.h"
+
+#define BR_PI 3.14159265358979323846
+
+typedef struct {
+    double t0, dt;
+    double *ref;
+    long n;
+} traj_t;
+
+/* the t and ref columns of a measured log (../shared/spec/measured-log.md) */
+static int read_traj(const char *path, traj_t *tr)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "br_track: cannot read %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    char line[4096];
+    int col_t = -1, col_ref = -1, ncol = 0;
+    if (!fgets(line, sizeof line, f)) goto bad_header;
+    for (char *tok = strtok(line, ",\r\n"); tok; tok = strtok(NULL, ",\r\n"), ncol++) {
+        while (isspace((unsigned char)*tok) || *tok == '"' || (unsigned char)*tok == 0xEF || (unsigned char)*tok == 0xBB ||
+               (unsigned char)*tok == 0xBF)
+            tok++;
+        char name[16] = {0};
+        for (int i = 0; i < 15 && tok[i] && tok[i] != '"' && !isspace((unsigned char)tok[i]); i++)
+            name[i] = (char)tolower((unsigned char)tok[i]);
+        if (strcmp(name, "t") == 0) col_t = ncol;
+        if (strcmp(name, "ref") == 0) col_ref = ncol;
+    }
+    if (col_t < 0 || col_ref < 0) goto bad_header;
+    long cap = 65536, lineno = 1;
+    double t_first = 0.0, t_second = 0.0;
+    tr->ref = malloc((size_t)cap * sizeof *tr->ref);
+    tr->n = 0;
+    while (tr->ref && fgets(line, sizeof line, f)) {
+        lineno++;
+        double t = NAN, r = NAN;
+        int c = 0;
+        for (char *tok = strtok(line, ",\r\n"); tok; tok = strtok(NULL, ",\r\n"), c++) {
+            char *end;
+            const double v = strtod(tok, &end);
+            if (c == col_t) t = end != tok ? v : NAN;
+            if (c == col_ref) r = end != tok ? v : NAN;
+        }
+        if (!isfinite(t) || !isfinite(r)) {
+            fprintf(stderr, "br_track: %s:%ld: t or ref is not a number\n", path, lineno);
+            fclose(f);
+            return -1;
+        }
+        if (tr->n == cap) {
+            double *p = realloc(tr->ref, (size_t)(cap *= 2) * sizeof *tr->ref);
+            if (!p) break;
+            tr->ref = p;
+        }
+        if (tr->n == 0) t_first = t;
+        if (tr->n == 1) t_second = t;
+        tr->ref[tr->n++] = r;
+    }
+    fclose(f);
+    if (!tr->ref || tr->n < 2 || !(t_second > t_first)) {
+        fprintf(stderr, "br_track: %s: fewer than two samples (or out of memory)\n", path);
+        return -1;
+    }
+    tr->t0 = t_first;
+    tr->dt = t_second - t_first;
+    return 0;
+bad_header:
+    fprintf(stderr, "br_track: %s:1: the header lacks a t or a ref column\n", path);
+    fclose(f);
+    return -1;
+}
+
+/* the reference at t (from the log's start), linear between samples, held
+ * outside; its velocity by a central difference over one log sample */
+static double traj_ref(const traj_t *tr, double t)
+{
+    const double u = t / tr->dt;
+    if (u <= 0.0) return tr->ref[0];
+    const long i = (long)floor(u);
+    if (i >= tr->n - 1) return tr->ref[tr->n - 1];
+    return tr->ref[i] + (u - (double)i) * (tr->ref[i + 1] - tr->ref[i]);
+}
+
+static double traj_vel(const traj_t *tr, double t)
+{
+    return (traj_ref(tr, t + tr->dt) - traj_ref(tr, t - tr->dt)) / (2.0 * tr->dt);
+}
+
+typedef struct {
+    double sum2, emax;
+    long n;
+    FILE *trace;
+} err_t;
+
+static void err_add(err_t *e, double t, double ref, double pos, double force_N)
+{
+    const double er = ref - pos;
+    e->sum2 += er * er;
+    if (fabs(er) > e->emax) e->emax = fabs(er);
+    e->n++;
+    if (e->trace) fprintf(e->trace, "%.6f,%.10e,%.10e,%.6e,%.6e\n", t, ref, pos, er, force_N);
+}
+
+/* the log's position loop on the plant, at the log's period */
+static int run_pd(const traj_t *tr, const br_plant_cfg_t *pc, const double pd[4], err_t *e)
+{
+    br_plant_t p;
+    const br_plant_state_t x0 = {tr->ref[0] / pc->lead_mprad, 0.0, 0.0};
+    if (br_plant_init(&p, pc, &x0) != 0) return -1;
+    const double m_per_count = pc->lead_mprad * 2.0 * BR_PI / pc->counts_per_rev;
+    double q_prev = 0.0, qf_prev = 0.0;
+    for (long k = 0; k < tr->n; k++) {
+        const double t = (double)k * tr->dt, r = tr->ref[k];
+        const double q = (double)br_plant_encoder(&p) * m_per_count;
+        if (k == 0) q_prev = qf_prev = q;
+        const double qf = 0.5 * (q + q_prev), qdot = (qf - qf_prev) / tr->dt;
+        q_prev = q;
+        qf_prev = qf;
+        const double u = fmin(fmax(pd[0] * pd[1] * (r - q) - pd[1] * qdot, -pd[3]), pd[3]);
+        err_add(e, t, r, br_plant_pos_m(&p), pd[2] * u);
+        br_plant_step(&p, pd[2] * u * pc->lead_mprad / pc->tau_per_duty_Nm, tr->dt);
+    }
+    return 0;
+}
+
+/* the limit's "estimator": the plant's true friction at t_k */
+static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    (void)y;
+    (void)u_prev_Nm;
+    *F_hat_N = (float)((const br_plant_t *)ctx)->fnl_N;
+    return BR_OK;
+}
+
+/* the firmware (br_app_step) with the build's machine configuration */
+static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int extended, err_t *e,
+                  int *fault, double *fault_t)
+{
+    br_circle_cfg_t c = br_circle_cfg_thesis(ctrl);
+    c.plant = *pc;
+    if (extended) c.pf.est.model.causes = br_causes_from_model(pc);
+    const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(&c);
+    br_plant_t p;
+    br_hal_sim_t port;
+    br_hal_t hal;
+    br_app_t app;
+    br_app_mem_t mem = {NULL, NULL};
+    const br_est_t ext = {&p, oracle_step};
+    br_app_cfg_t ac = {&cc, ctrl == BR_CTRL_HINF_PF ? BR_APP_EST_PF : BR_APP_EST_NONE, &c.pf, &c.ukf, &ext};
+    if (ctrl == BR_CTRL_HINF_TRUE) ac.est = BR_APP_EST_EXTERN;
+    const br_plant_state_t x0 = {tr->ref[0] / pc->lead_mprad, 0.0, 0.0};
+    int rc = -1;
+    if (ctrl == BR_CTRL_HINF_PF && (mem.pf = calloc(1, sizeof *mem.pf)) == NULL) return -1;
+    if (br_plant_init(&p, pc, &x0) != 0 || br_hal_sim_init(&port, &p, c.dt_s, &hal) != BR_OK) goto done;
+    br_status_t st = br_app_init(&app, &ac, &hal, &mem);
+    if (st != BR_OK) {
+        fprintf(stderr, "br_track: application init failed (status %d)\n", (int)st);
+        goto done;
+    }
+    const double L = pc->lead_mprad, rpc = 2.0 * BR_PI / pc->counts_per_rev;
+    const long n = lround((double)(tr->n - 1) * tr->dt / c.dt_s);
+    *fault = 0;
+    for (long k = 0; k <= n; k++) {
+        const double t = (double)k * c.dt_s;
+        uint32_t tick;
+        hal.tick_wait(hal.ctx, &tick);
+        const double x_ref = traj_ref(tr, t), counts = x_ref / L / rpc, whole = floor(counts);
+        const br_ref_t r = {(int32_t)whole, (float)(counts - whole), (float)(traj_vel(tr, t) / L)};
+        const double pos = br_plant_pos_m(&p);
+        st = br_app_step(&app, &r);
+        if (st != BR_OK && st != BR_W_OUTLIER) {
+            *fault = (int)st;
+            *fault_t = t;
+            break;
+        }
+        err_add(e, t, x_ref, pos, (double)app.axis.last.duty * pc->tau_per_duty_Nm / L);
+    }
+    rc = 0;
+done:
+    free(mem.pf);
+    return rc;
+}
+
+static int usage(const char *argv0)
+{
+    fprintf(stderr,
+            "usage: %s --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]\n"
+            "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true] [--json OUT] [--trace DIR]\n",
+            argv0);
+    return 2;
+}
+
+int main(int argc, char **argv)
+{
+    const char *ref = NULL, *model = NULL, *json = NULL, *trace = NULL, *ctrls = NULL;
+    double pd[4];
+    int have_pd = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!val) return usage(argv[0]);
+        i++;
+        if (strcmp(a, "--ref") == 0) ref = val;
+        else if (strcmp(a, "--model") == 0) model = val;
+        else if (strcmp(a, "--json") == 0) json = val;
+        else if (strcmp(a, "--trace") == 0) trace = val;
+        else if (strcmp(a, "--ctrl") == 0) ctrls = val;
+        else if (strcmp(a, "--pd") == 0) {
+            have_pd = br_parse_numbers(val, pd, 4) == 4 && pd[0] > 0.0 && pd[1] > 0.0 && pd[2] > 0.0 && pd[3] > 0.0;
+            if (!have_pd) {
+                fprintf(stderr, "br_track: --pd needs KP,KV,GAIN,UMAX, all > 0: %s\n", val);
+                return 2;
+            }
+        } else return usage(argv[0]);
+    }
+    if (!ref) return usage(argv[0]);
+    if (!ctrls) ctrls = have_pd ? "pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true" : "hinf_only,hinf_pf,hinf_pf_ext,hinf_true";
+    br_plant_cfg_t plant = br_plant_cfg_reference();
+    char msg[512];
+    if (model && br_plant_cfg_from_model_json(model, &plant, &plant, msg, sizeof msg) != 0) {
+        fprintf(stderr, "br_track: %s\n", msg);
+        return 1;
+    }
+    traj_t tr;
+    if (read_traj(ref, &tr) != 0) return 1;
+    FILE *js = NULL;
+    if (json && (js = fopen(json, "w")) == NULL) {
+        fprintf(stderr, "br_track: cannot write %s: %s\n", json, strerror(errno));
+        return 1;
+    }
+    if (js)
+        fprintf(js, "{\n  \"generator\": \"br_track (sim/apps/br_track.c); generated, do not edit\",\n"
+                    "  \"duration_s\": %.6g", (double)(tr.n - 1) * tr.dt);
+    static const char *const names[] = {"pd", "hinf_only", "hinf_pf", "hinf_pf_ext", "hinf_true"};
+    int rc = 0;
+    for (int w = 0; w < 5 && rc == 0; w++) {
+        const size_t len = strlen(names[w]);
+        const char *hit = strstr(ctrls, names[w]);
+        while (hit && ((hit != ctrls && hit[-1] != ',') || (hit[len] != ',' && hit[len] != '\0')))
+            hit = strstr(hit + 1, names[w]);
+        if (!hit) continue;
+        err_t e = {0.0, 0.0, 0, NULL};
+        if (trace) {
+            char path[1024];
+            snprintf(path, sizeof path, "%s/track_%s.csv", trace, names[w]);
+            if ((e.trace = fopen(path, "w")) == NULL) {
+                fprintf(stderr, "br_track: cannot write %s: %s\n", path, strerror(errno));
+                rc = 1;
+                break;
+            }
+            fprintf(e.trace, "t,ref,pos,err,force\n");
+        }
+        int fault = 0;
+        double fault_t = 0.0;
+        if (w == 0) {
+            if (!have_pd) {
+                fprintf(stderr, "br_track: the pd controller needs --pd KP,KV,GAIN,UMAX\n");
+                rc = 2;
+            } else if (run_pd(&tr, &plant, pd, &e) != 0) rc = 1;
+        } else {
+            const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : w == 4 ? BR_CTRL_HINF_TRUE : BR_CTRL_HINF_PF;
+            if (run_fw(&tr, &plant, ctrl, w == 3, &e, &fault, &fault_t) != 0) rc = 1;
+        }
+        if (e.trace && fclose(e.trace) != 0) rc = 1;
+        if (rc != 0) break;
+        const double rms = e.n > 0 ? sqrt(e.sum2 / (double)e.n) : 0.0;
+        printf("%-12s tracking RMS %.4e m, max %.4e m", names[w], rms, e.emax);
+        if (fault) printf(", fault (status %d) at %.4f s", fault, fault_t);
+        printf("\n");
+        if (js)
+            fprintf(js, ",\n  \"%s\": {\"rms_m\": %.6e, \"max_m\": %.6e, \"fault_status\": %d, \"fault_t_s\": %.6g}",
+                    names[w], rms, e.emax, fault, fault_t);
+    }
+    if (js) {
+        fprintf(js, "\n}\n");
+        if (fclose(js) != 0) rc = 1;
+    }
+    free(tr.ref);
+    return rc;
+}
