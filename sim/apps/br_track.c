@@ -182,13 +182,20 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     br_app_t app;
     br_app_mem_t mem = {NULL, NULL};
     const br_est_t ext = {&p, oracle_step};
-    br_app_cfg_t ac = {&cc, ctrl == BR_CTRL_HINF_PF ? BR_APP_EST_PF : BR_APP_EST_NONE, &c.pf, &c.ukf, &ext};
+    /* the encoder's plausibility guard from the trajectory's own top speed
+     * (twice it: the axis lags and overshoots), in counts/s of this plant */
+    double vmax = 0.0;
+    for (long i = 0; i < tr->n; i++) vmax = fmax(vmax, fabs(traj_vel(tr, (double)i * tr->dt)));
+    const double counts_per_m = pc->counts_per_rev / (2.0 * BR_PI * pc->lead_mprad);
+    br_app_cfg_t ac = {&cc, ctrl == BR_CTRL_HINF_PF ? BR_APP_EST_PF : BR_APP_EST_NONE, &c.pf, &c.ukf, &ext,
+                       br_app_guard_cfg(cc.dt_s, (float)(2.0 * vmax * counts_per_m + 1.0 / c.dt_s))};
     if (ctrl == BR_CTRL_HINF_TRUE) ac.est = BR_APP_EST_EXTERN;
     const br_plant_state_t x0 = {tr->ref[0] / pc->lead_mprad, 0.0, 0.0};
     int rc = -1;
     if (ctrl == BR_CTRL_HINF_PF && (mem.pf = calloc(1, sizeof *mem.pf)) == NULL) return -1;
     if (br_plant_init(&p, pc, &x0) != 0 || br_hal_sim_init(&port, &p, c.dt_s, &hal) != BR_OK) goto done;
     br_status_t st = br_app_init(&app, &ac, &hal, &mem);
+    if (st == BR_OK) st = br_app_arm(&app); /* the simulator arms right after init */
     if (st != BR_OK) {
         fprintf(stderr, "br_track: application init failed (status %d)\n", (int)st);
         goto done;
