@@ -63,18 +63,30 @@ def cross_build(a, machine, bdir):
     if r.returncode != 0:
         sys.exit(r.stdout + r.stderr + "machine_chain: configuring %s failed" % bdir)
     run(["cmake", "--build", bdir], stdout=subprocess.DEVNULL)
+    # the board's info file: image path, flash KiB, then one NAME:ORIGIN:KIB per RAM region
     with open(os.path.join(bdir, "board-stm32h7.txt"), encoding="utf-8") as f:
-        img, fk, rk, rn = f.read().split()[:4]
+        img, fk, *regions = f.read().split()
     size = subprocess.run(["arm-none-eabi-size", img], capture_output=True, text=True, check=True).stdout
-    text, data, bss = (int(x) for x in size.splitlines()[1].split()[:3])
+    text, data, _ = (int(x) for x in size.splitlines()[1].split()[:3])
+    sections = subprocess.run(["arm-none-eabi-size", "-A", img], capture_output=True, text=True,
+                              check=True).stdout.splitlines()
+    ram = []
+    for r in regions:
+        name, org, kib = r.split(":")
+        lo, hi = int(org, 0), int(org, 0) + 1024 * int(kib)
+        used = sum(int(ln.split()[1]) for ln in sections
+                   if len(ln.split()) == 3 and ln.split()[2].isdigit() and lo <= int(ln.split()[2]) < hi)
+        ram.append({"name": name, "bytes": used, "kib": int(kib)})
     syms = subprocess.run(["arm-none-eabi-nm", img], capture_output=True, text=True, check=True).stdout
     linked = sorted({ln.split()[-1] for ln in syms.splitlines()
                      if ln.split()[-1] in ("br_pf_init", "br_pf_est_step", "br_ukf_init", "br_ukf_est_step")})
-    out = {"image": os.path.relpath(img, a.src), "flash_bytes": text + data, "flash_kib": int(fk),
-           "ram_bytes": data + bss, "ram_kib": int(rk), "ram_name": rn, "estimator_symbols": linked}
-    print("image %s: flash %d B (%.2f %% of %s KiB), RAM %d B (%.2f %% of %s KiB %s); linked: %s"
-          % (out["image"], out["flash_bytes"], 100.0 * out["flash_bytes"] / (1024 * int(fk)), fk, out["ram_bytes"],
-             100.0 * out["ram_bytes"] / (1024 * int(rk)), rk, rn, ", ".join(linked) or "no estimator"))
+    out = {"image": os.path.relpath(img, a.src), "flash_bytes": text + data, "flash_kib": int(fk), "ram": ram,
+           "estimator_symbols": linked}
+    print("image %s: flash %d B (%.2f %% of %s KiB), RAM %s; linked: %s"
+          % (out["image"], out["flash_bytes"], 100.0 * out["flash_bytes"] / (1024 * int(fk)), fk,
+             ", ".join("%s %d B (%.2f %% of %d KiB)" % (r["name"], r["bytes"], 100.0 * r["bytes"] / (1024 * r["kib"]),
+                                                       r["kib"]) for r in ram),
+             ", ".join(linked) or "no estimator"))
     return out
 
 
@@ -136,8 +148,9 @@ def write_md(doc, s):
     if "image" in s:
         im = s["image"]
         rows += ["", "Image (`make firmware MACHINE=out/emps-chain/diagnose/machine.json`): flash %d B of %d KiB, "
-                 "RAM %d B of %d KiB %s; estimator entry points linked: %s."
-                 % (im["flash_bytes"], im["flash_kib"], im["ram_bytes"], im["ram_kib"], im["ram_name"],
+                 "RAM %s; estimator entry points linked: %s."
+                 % (im["flash_bytes"], im["flash_kib"],
+                    ", ".join("%s %d B of %d KiB" % (r["name"], r["bytes"], r["kib"]) for r in im["ram"]),
                     ", ".join(im["estimator_symbols"]) or "none")]
     with open(doc, encoding="utf-8") as f:
         text = f.read()
@@ -228,7 +241,7 @@ def main():
         if im is not None:
             if "br_pf_est_step" not in im["estimator_symbols"]:
                 bad.append("the image does not link the PF (br_pf_est_step)")
-            if im["flash_bytes"] > 1024 * im["flash_kib"] or im["ram_bytes"] > 1024 * im["ram_kib"]:
+            if im["flash_bytes"] > 1024 * im["flash_kib"] or any(r["bytes"] > 1024 * r["kib"] for r in im["ram"]):
                 bad.append("the image does not fit the part's flash / RAM")
         for b in bad:
             print("machine_chain: " + b, file=sys.stderr)
