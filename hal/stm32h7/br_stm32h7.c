@@ -206,13 +206,21 @@ br_status_t br_stm32h7_init(br_stm32h7_t *port, const br_stm32h7_cfg_t *cfg)
 
 /* ---- run time ----------------------------------------------------------- */
 
-br_status_t br_stm32h7_encoder_read(br_stm32h7_t *port, int32_t *counts)
+/* The run-time calls' common check: a port (and an output pointer, where the
+ * call has one: out_ok 0 when it is NULL), initialised. */
+static br_status_t port_usable(const br_stm32h7_t *port, int out_ok)
 {
-    if (port == NULL || counts == NULL) {
+    if (port == NULL || !out_ok) {
         return BR_E_NULL;
     }
-    if (!port->ready) {
-        return BR_E_STATE;
+    return port->ready ? BR_OK : BR_E_STATE;
+}
+
+br_status_t br_stm32h7_encoder_read(br_stm32h7_t *port, int32_t *counts)
+{
+    const br_status_t use = port_usable(port, counts != NULL);
+    if (use != BR_OK) {
+        return use;
     }
     *counts = br_stm32h7_count_ext_update(&port->enc, port->cfg.enc_tim->CNT);
     return BR_OK;
@@ -224,11 +232,9 @@ br_status_t br_stm32h7_pwm_write(br_stm32h7_t *port, float duty)
     float mag;
     uint32_t ccr;
 
-    if (port == NULL) {
-        return BR_E_NULL;
-    }
-    if (!port->ready) {
-        return BR_E_STATE;
+    const br_status_t use = port_usable(port, 1);
+    if (use != BR_OK) {
+        return use;
     }
     t = port->cfg.pwm_tim;
     if (!isfinite(duty)) {
@@ -260,11 +266,9 @@ br_status_t br_stm32h7_pwm_disable(br_stm32h7_t *port)
 {
     br_stm32h7_tim_t *t;
 
-    if (port == NULL) {
-        return BR_E_NULL;
-    }
-    if (!port->ready) {
-        return BR_E_STATE;
+    const br_status_t use = port_usable(port, 1);
+    if (use != BR_OK) {
+        return use;
     }
     t = port->cfg.pwm_tim;
     t->CCR1 = 0u;
@@ -278,11 +282,9 @@ br_status_t br_stm32h7_pwm_enable(br_stm32h7_t *port)
 {
     br_stm32h7_tim_t *t;
 
-    if (port == NULL) {
-        return BR_E_NULL;
-    }
-    if (!port->ready) {
-        return BR_E_STATE;
+    const br_status_t use = port_usable(port, 1);
+    if (use != BR_OK) {
+        return use;
     }
     t = port->cfg.pwm_tim;
     t->CCR1 = 0u;
@@ -295,11 +297,9 @@ br_status_t br_stm32h7_pwm_enable(br_stm32h7_t *port)
 
 br_status_t br_stm32h7_deadline_check(br_stm32h7_t *port, uint32_t max_missed)
 {
-    if (port == NULL) {
-        return BR_E_NULL;
-    }
-    if (!port->ready) {
-        return BR_E_STATE;
+    const br_status_t use = port_usable(port, 1);
+    if (use != BR_OK) {
+        return use;
     }
     if (port->overruns - port->overruns_armed > max_missed) {
         (void)br_stm32h7_pwm_disable(port);
@@ -314,11 +314,9 @@ br_status_t br_stm32h7_tick_wait(br_stm32h7_t *port, uint32_t *tick)
     uint32_t polls;
     int seen = 0;
 
-    if (port == NULL || tick == NULL) {
-        return BR_E_NULL;
-    }
-    if (!port->ready) {
-        return BR_E_STATE;
+    const br_status_t use = port_usable(port, tick != NULL);
+    if (use != BR_OK) {
+        return use;
     }
     st = port->cfg.systick;
     if ((st->CTRL & BR_SYSTICK_CTRL_COUNTFLAG) != 0u) {
@@ -369,11 +367,9 @@ static br_status_t br_stm32h7_hal_pwm_enable(void *ctx)
 
 br_status_t br_stm32h7_hal(br_stm32h7_t *port, br_hal_t *hal)
 {
-    if (port == NULL || hal == NULL) {
-        return BR_E_NULL;
-    }
-    if (!port->ready) {
-        return BR_E_STATE;
+    const br_status_t use = port_usable(port, hal != NULL);
+    if (use != BR_OK) {
+        return use;
     }
     hal->ctx = port;
     hal->encoder_read = br_stm32h7_hal_encoder_read;
