@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # bristle: top-level entry points, a thin wrapper over the CMake presets
 # (CMakePresets.json). `make help` lists the targets; V=1 shows the commands.
 SHELL := bash
@@ -25,9 +26,13 @@ BOARD      ?= stm32h7
 # `make firmware MACHINE=<file>` builds for another machine (docs/configure.md):
 # its own cross build folder, configured with -DBR_MACHINE, headers generated there.
 MACHINE_NAME = $(if $(MACHINE),$(shell $(PYTHON) -c 'import json, sys; print(json.load(open(sys.argv[1])).get("name", "x"))' "$(MACHINE)" 2>/dev/null || echo invalid))
-CM7_DIR     = build/cm7-release$(if $(MACHINE),-$(MACHINE_NAME))
+# the cross preset of BOARD: stm32h7 (Cortex-M7) cm7-release, stm32g4 (Cortex-M4F) cm4-release
+BOARD_PRESET = $(if $(filter stm32g4,$(BOARD)),cm4-release,cm7-release)
+CM7_DIR     = build/$(BOARD_PRESET)$(if $(MACHINE),-$(MACHINE_NAME))
 BOARD_INFO  = $(CM7_DIR)/board-$(BOARD).txt
 DEMO_OUT   := out/demo
+ROBUST_OUT := out/robustness
+N          ?= 200
 HIDDEN_OUT := out/diagnose-hidden
 TUNE_OUT   := out/tune
 BENCH_OUT  := out/bench
@@ -66,7 +71,7 @@ define print_size
 	done
 endef
 
-.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench firmware emps regen clean distclean
+.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness
 
 help:
 	@echo "bristle targets:"
@@ -79,14 +84,17 @@ help:
 	@echo "  make validate MODEL=<model.json> LOG=<csv>          a saved model's relerr on another log"
 	@echo "  make diagnose-hidden  the hidden-cause suite -> docs/diagnose-hidden.md"
 	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
+	@echo "  make detection-limits smallest effect of each cause detected in 95 % of logs, false positives -> docs/detection-limits.md"
 	@echo "  make diagnose-bench   peak memory of a diagnosis of a 2e6-row log written by br_simlog (docs/diagnose.md, Memory)"
-	@echo "  make firmware [MACHINE=<json>]  cross build (cm7-release; another machine: build/cm7-release-<name>), print the image's flash / RAM use (BOARD=$(BOARD))"
+	@echo "  make firmware [MACHINE=<json>] [BOARD=stm32g4]  cross build (cm7-release; BOARD=stm32g4: cm4-release; another machine: build/<preset>-<name>), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make emps      the EMPS drive through the chain: its log -> diagnose -> machine.json -> image -> tracking in the simulator -> $(EMPS_OUT), docs/machines/emps.md"
-	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7, flash / RAM"
+	@echo "  make robustness [N=200] [DIAGNOSE_FIRST=K]  Monte Carlo over N plants around the reference machine -> $(ROBUST_OUT), docs/robustness-results.md"
+	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
 	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
 	@echo "  make fuzz [FUZZ_SECONDS=600]  every libFuzzer target (clang, ASan + UBSan) for that long (ctest runs 20 s each)"
+	@echo "  make mutants [MUTANTS_BUDGET=s]  the mutation check: C set + cosmic-ray on the diagnosis -> out/mutants (docs/mutants.md)"
 	@echo "  make clean     remove build/ and out/ (distclean also removes .venv)"
 	@echo "  V=1 shows the commands; JOBS=n sets the ctest parallelism (default 2)"
 
@@ -111,6 +119,7 @@ test: deps
 	$(Q)echo "== test host-debug"
 	$(Q)ctest --preset host-debug --output-on-failure -j$(JOBS)
 	$(print_size)
+	$(Q)$(MAKE) firmware BOARD=stm32g4
 
 demo: deps
 	$(call configure,host-release)
@@ -158,6 +167,11 @@ target-bench: deps
 	$(call build,cm7-release)
 	$(Q)echo "== target-bench -> $(TARGET_BENCH_OUT)"
 	$(Q)target/mps2/target_bench.sh build/host-release build/cm7-release $(TARGET_BENCH_OUT)
+	$(call configure,cm4-release)
+	$(call build,cm4-release)
+	$(Q)echo "== target-bench on the Cortex-M4 (mps2-an386) -> $(TARGET_BENCH_OUT)/m4"
+	$(Q)BR_QEMU_MACHINE=mps2-an386 BR_BENCH_CPU=Cortex-M4 BR_BENCH_MHZ=170 \
+	  target/mps2/target_bench.sh build/host-release build/cm4-release $(TARGET_BENCH_OUT)/m4
 
 # Measured logs (docs/diagnose.md): diagnose one, validate a saved model on
 # another, and the hidden-cause suite that writes docs/diagnose-hidden.md.
@@ -196,17 +210,31 @@ diagnose-hidden: deps
 	  BR_HIDDEN_COMMAND="make diagnose-hidden" $(PYTHON) tests/diagnose/hidden_cause.py \
 	    --merge $(HIDDEN_OUT)/shard0.json $(HIDDEN_OUT)/shard1.json --md docs/diagnose-hidden.md || rc=1; exit $$rc
 
+# Detection limits (docs/detection-limits.md): N logs per effect size and
+# N_NOMINAL nominal logs per noise level, on every core; 8 sizes per cause; several hours with the
+# defaults on 2 cores.
+N ?= 20
+N_NOMINAL ?= 100
+detection-limits: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== detection limits -> out/detection-limits, docs/detection-limits.md"
+	$(Q)OPENBLAS_NUM_THREADS=1 BR_DETECTION_COMMAND="make detection-limits N=$(N) N_NOMINAL=$(N_NOMINAL)" \
+	  $(PYTHON) sim/studies/detection_limits.py --simlog build/host-release/sim/br_simlog --work out/detection-limits/logs \
+	  --n $(N) --n-nominal $(N_NOMINAL) --md docs/detection-limits.md --png docs/detection-limits.png \
+	  --json out/detection-limits/summary.json
+
 firmware: deps
 ifeq ($(MACHINE),)
-	$(call configure,cm7-release)
-	$(call build,cm7-release)
+	$(call configure,$(BOARD_PRESET))
+	$(call build,$(BOARD_PRESET))
 else
 	$(Q)$(PYTHON) firmware/design/machine.py "$(MACHINE)" > /dev/null
 	$(Q)echo "== H-infinity synthesis for $(MACHINE) ($(MACHINE_NAME))"
 	$(Q)mkdir -p $(CM7_DIR)/gen/bristle_gen/ctrl
 	$(Q)$(PYTHON) firmware/design/synth_hinf.py --machine "$(MACHINE)" --out $(CM7_DIR)/gen/bristle_gen/ctrl/br_hinf_gains.h
 	$(Q)echo "== configure $(CM7_DIR) (BR_MACHINE=$(abspath $(MACHINE)))"
-	$(Q)log="$$(cmake --preset cm7-release -B $(CM7_DIR) -DBR_MACHINE=$(abspath $(MACHINE)) 2>&1)" || { echo "$$log"; echo "configure $(CM7_DIR) failed" >&2; exit 1; }
+	$(Q)log="$$(cmake --preset $(BOARD_PRESET) -B $(CM7_DIR) -DBR_MACHINE=$(abspath $(MACHINE)) 2>&1)" || { echo "$$log"; echo "configure $(CM7_DIR) failed" >&2; exit 1; }
 	$(Q)echo "== build $(CM7_DIR)"
 	$(Q)cmake --build $(CM7_DIR) $(NINJA_QUIET)
 endif
@@ -248,10 +276,30 @@ fuzz: deps
 	$(call configure,fuzz)
 	$(call build,fuzz)
 	$(Q)for f in build/fuzz/tests/fuzz/fuzz_*; do \
-	  n=$$(basename $$f); mkdir -p out/fuzz/$$n; echo "== $$n for $(FUZZ_SECONDS) s"; \
-	  $$f -max_total_time=$(FUZZ_SECONDS) -max_len=1024 -rss_limit_mb=2048 -print_final_stats=1 out/fuzz/$$n \
+	  n=$$(basename $$f); mkdir -p out/fuzz/$$n out/fuzz/$$n.findings; echo "== $$n for $(FUZZ_SECONDS) s"; \
+	  $$f -max_total_time=$(FUZZ_SECONDS) -max_len=1024 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=out/fuzz/$$n.findings/ out/fuzz/$$n \
 	    2>&1 | grep -E "^stat::number_of_executed_units|ERROR|SUMMARY"; \
 	  test $${PIPESTATUS[0]} -eq 0; done
+
+# Robustness study (docs/robustness.md): N plants drawn around the reference
+# machine, every controller on each, all cores; DIAGNOSE_FIRST=K limits the
+# identified-model runs (simulated identification log + diagnosis) to the first K.
+robustness: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== robustness study, $(N) plants -> $(ROBUST_OUT), docs/robustness-results.md"
+	$(Q)MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 $(PYTHON) sim/studies/robustness.py --bin build/host-release/sim --out $(ROBUST_OUT) \
+	  --n $(N) $(if $(DIAGNOSE_FIRST),--diagnose-first $(DIAGNOSE_FIRST)) --md docs/robustness-results.md \
+	  --command "make robustness N=$(N)$(if $(DIAGNOSE_FIRST), DIAGNOSE_FIRST=$(DIAGNOSE_FIRST))"
+
+# The mutation check (docs/mutants.md): every mutant of tests/mutants/ in
+# scratch copies under build/mutants (the tree itself is never written),
+# $(JOBS) at a time, within MUTANTS_BUDGET seconds -> out/mutants/summary.json, report.md.
+MUTANTS_BUDGET ?= 3600
+.PHONY: mutants
+mutants: deps
+	$(Q)echo "== mutation check -> out/mutants (budget $(MUTANTS_BUDGET) s)"
+	$(Q)$(PYTHON) tests/mutants/mutate.py --jobs $(JOBS) --budget $(MUTANTS_BUDGET) --work build/mutants --out out/mutants
 
 clean:
 	$(Q)rm -rf build out

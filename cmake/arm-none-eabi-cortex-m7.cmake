@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Cross toolchain: arm-none-eabi-gcc for a Cortex-M7 with the single-precision
 # FPU (STM32H743). Used by the cm7-release preset (CMakePresets.json).
 #
@@ -6,6 +7,8 @@
 # calls, which the firmware warnings (-Wdouble-promotion) keep out.
 set(CMAKE_SYSTEM_NAME Generic)
 set(CMAKE_SYSTEM_PROCESSOR arm)
+# which images this build makes (hal/, target/mps2)
+set(BR_TARGET_CPU cortex-m7)
 
 set(BR_CROSS_PREFIX arm-none-eabi- CACHE STRING "Prefix of the cross tools")
 find_program(BR_CROSS_GCC ${BR_CROSS_PREFIX}gcc REQUIRED)

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs what building and testing bristle needs, idempotently:
-#   Debian packages: host compiler, CMake, Ninja, cmocka, the Arm cross
+#   Debian packages: host compiler, CMake, Ninja, cmocka, cJSON (the
+#   simulator's model.json reader), the Arm cross
 #   toolchain with newlib, qemu-system-arm (the emulated Cortex-M7 of the
 #   target tests and make target-bench, docs/target.md), cppcheck (the
 #   static test), clang with its compiler-rt (the libFuzzer targets of the
@@ -23,6 +25,7 @@ say() { echo "setup-deps: $*"; }
 pkgs=(
   gcc libc6-dev make cmake ninja-build
   libcmocka-dev
+  libcjson-dev
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
   qemu-system-arm
   cppcheck

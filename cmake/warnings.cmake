@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Warning sets. Firmware: float32 only, every implicit conversion is an error.
 set(BR_FIRMWARE_WARNINGS
     -Wall -Wextra -Wpedantic -Werror

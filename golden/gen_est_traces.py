@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Golden traces of the friction estimators (PF, UKF), called by
 golden/gen_traces.py (see docs/golden.md, "Estimator traces"):
 

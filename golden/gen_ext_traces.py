@@ -1,8 +1,10 @@
+# SPDX-License-Identifier: Apache-2.0
 """Golden trace of the extended estimation model (the causes of a diagnosis),
 called by golden/gen_traces.py (docs/golden.md, "Extended model"):
 
   model_ext.csv  one-step rows of br_model_step_at for each cause alone and
-                 for all of them together: the load position p0 of theta's
+                 for all of them together: the model's clock n (the step
+                 starts at t = n dt), the load position p0 of theta's
                  origin, x_k (theta relative to p0), u_k, the expected
                  status and branch, x_{k+1}, and the force to compensate at
                  x_k, from golden/ref/model.py's extended model (float64)
@@ -17,17 +19,20 @@ import numpy as np
 
 from ref import model as rmodel
 
-EXT_COLUMNS = ["k", "seg", "p0", "u", "theta", "omega", "z", "gp", "status", "branch",
+EXT_COLUMNS = ["k", "seg", "n", "p0", "u", "theta", "omega", "z", "gp", "status", "branch",
                "theta1", "omega1", "z1", "gp1", "fcomp"]
-EXT_SEG_NAMES = ["offset", "asymmetric_friction", "position_ripple", "position_gradient", "all"]
+EXT_SEG_NAMES = ["offset", "asymmetric_friction", "position_ripple", "position_gradient", "all", "friction_drift"]
 ROWS_PER_SEG = 400
 # the order of a segment's cause values in its seg<n> metadata line (the model.json names)
 CAUSE_KEYS = ["offset_N", "dFc_neg_N", "dsigma2_neg_Nspm", "ripple_amp_N", "ripple_period_m",
-              "ripple_phase_rad", "grad_per_m"]
+              "ripple_phase_rad", "grad_per_m", "drift_per_s"]
+# the model's clock of a row: up to this many steps (40 s at the traces' 1 ms)
+CLOCK_MAX = 40000
+DRIFT = 0.02  # 1/s: the friction level grows by 2 % of its starting value a second (s up to 1.8)
 
 
 def seg_causes(m):
-    """The cause sets of segments 1..5, relative to the machine (float32-exact:
+    """The cause sets of segments 1..6, relative to the machine (float32-exact:
     the C side reads them into float)."""
     def f32(x):
         return float(np.float32(x))
@@ -36,10 +41,11 @@ def seg_causes(m):
     asym = rmodel.Causes(dFc_neg=f32(0.3 * m["Fc_N"]), dsigma2_neg=f32(0.6 * m["sigma2_Nspm"]))
     rip = rmodel.Causes(ripple_amp=f32(0.1 * m["Fc_N"]), ripple_period=f32(lead_m / 3.0), ripple_phase=f32(0.4))
     grad = rmodel.Causes(grad=2.0)
+    drift = rmodel.Causes(drift=f32(DRIFT))
     both = rmodel.Causes(offset=off.offset, dFc_neg=asym.dFc_neg, dsigma2_neg=asym.dsigma2_neg,
                          ripple_amp=rip.ripple_amp, ripple_period=rip.ripple_period,
-                         ripple_phase=rip.ripple_phase, grad=grad.grad)
-    return [off, asym, rip, grad, both]
+                         ripple_phase=rip.ripple_phase, grad=grad.grad, drift=drift.drift)
+    return [off, asym, rip, grad, both, drift]
 
 
 def generate(out_dir, m, gt):
@@ -62,24 +68,27 @@ def generate(out_dir, m, gt):
             th = f32(rng.uniform(-20.0, 20.0) * rpc)
             p0 = f32(rng.uniform(-0.15, 0.15))
             u = f32(rng.uniform(-0.5, 0.5) * m["tau_per_duty_Nm"])
+            n = int(rng.integers(0, CLOCK_MAX + 1))
+            t = n * DT
             x = np.array([th, w, z, gp], dtype=np.float64)
-            status, x1, branch = rmodel.step_ext(p, c, p0, x, u, DT)
-            x_rk = rmodel.rk4_ext(p, c, p0, x, u, DT)
+            status, x1, branch = rmodel.step_ext(p, c, p0, x, u, DT, t)
+            x_rk = rmodel.rk4_ext(p, c, p0, x, u, DT, t)
             if any(abs(rmodel.ah_ext(p, c, wv, gp, DT) / rmodel.RK4_AH_MAX - 1.0) < gt.BRANCH_MARGIN
                    for wv in (x[1], x_rk[1])):
                 skipped += 1
                 continue
-            fc = rmodel.fcomp_ext(p, c, p0, x)
-            rows.append([len(rows), seg, p0, u, *x, status, branch, *x1, fc])
+            fc = rmodel.fcomp_ext(p, c, p0, x, t)
+            rows.append([len(rows), seg, n, p0, u, *x, status, branch, *x1, fc])
     meta = gt.machine_meta(m, gt.MODEL_KEYS) + [("dt_s", DT), ("skipped_near_branch_threshold", skipped)]
     meta.append(("causes_order", " ".join(CAUSE_KEYS)))
     for seg, (name, c) in enumerate(zip(EXT_SEG_NAMES, seg_causes(m)), start=1):
         meta.append(("seg%d_name" % seg, name))
         meta.append(("seg%d" % seg, [c.offset, c.dFc_neg, c.dsigma2_neg, c.ripple_amp, c.ripple_period,
-                                     c.ripple_phase, c.grad]))
+                                     c.ripple_phase, c.grad, c.drift]))
     return gt.write_trace(out_dir, "model_ext", meta, EXT_COLUMNS, rows, [
         "br_model_step_at one-step rows of the extended model (golden/ref/model.py,",
-        "float64): segment seg's causes in the seg<n> metadata line (causes_order); p0 the load",
+        "float64): segment seg's causes in the seg<n> metadata line (causes_order); n the",
+        "model's clock (the step starts at t = n dt_s: the friction scale 1 + drift t); p0 the load",
         "position of theta's origin, x_k (theta relative to it) and u_k (float32-",
         "exact), expected status and branch (0 RK4, 1 bounded), x_{k+1}, and",
         "fcomp = the force to compensate at x_k (F - sigma2 v)."])

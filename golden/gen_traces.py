@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Writes the golden traces golden/traces/*.csv from the float64 references
 in golden/ref (see docs/golden.md).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # ctest fixture setup (br_add_preset_build in tests/CMakeLists.txt): configures
 # a preset and builds some of its targets from the source tree, as
 #   cmake --preset PRESET && cmake --build --preset PRESET --target T1 T2 ...

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The application: configuration -> estimator -> axis loop (br_app.h). */
 #include "bristle/br_app.h"
 
@@ -69,14 +70,19 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
 
 br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s)
 {
-    br_app_guard_cfg_t g = {0u, BR_APP_GUARD_STALE_PERIODS, BR_APP_GUARD_FROZEN_DUTY, 0u};
+    br_app_guard_cfg_t g = {0u, BR_APP_GUARD_STALE_PERIODS, BR_APP_GUARD_FROZEN_DUTY, 0u, 0u, 0u};
     if (!br_finite_pos(dt_s) || !br_finite_pos(max_speed_counts_per_s)) {
-        return g; /* zero delta and frozen periods: rejected by br_app_init */
+        return g; /* zero delta, frozen periods and lock window: rejected by br_app_init */
     }
     const float d = ceilf(max_speed_counts_per_s * dt_s);
     const float f = ceilf(BR_APP_GUARD_FROZEN_S / dt_s);
+    const float w = ceilf(BR_APP_GUARD_LOCK_S / dt_s);
     g.enc_max_delta_counts = (d <= (float)BR_APP_MAX_DELTA_LIMIT) ? (uint32_t)d : BR_APP_MAX_DELTA_LIMIT + 1u;
     g.frozen_periods = (f <= (float)BR_APP_FROZEN_LIMIT) ? (uint32_t)f : BR_APP_FROZEN_LIMIT + 1u;
+    g.lock_window_periods = (w <= (float)BR_APP_LOCK_WINDOW_MAX) ? (uint32_t)w : BR_APP_LOCK_WINDOW_MAX + 1u;
+    if (g.lock_window_periods <= BR_APP_LOCK_WINDOW_MAX) {
+        g.lock_max_outliers = (uint32_t)ceilf(BR_APP_GUARD_LOCK_FRACTION * (float)g.lock_window_periods);
+    }
     return g;
 }
 
@@ -84,8 +90,9 @@ static br_status_t guard_check(const br_app_guard_cfg_t *g)
 {
     if (g->enc_max_delta_counts < 1u || g->enc_max_delta_counts > BR_APP_MAX_DELTA_LIMIT ||
         g->enc_stale_periods > BR_APP_STALE_LIMIT || g->frozen_periods < 1u ||
-        g->frozen_periods > BR_APP_FROZEN_LIMIT) {
-        return BR_E_PARAM;
+        g->frozen_periods > BR_APP_FROZEN_LIMIT || g->lock_window_periods < 1u ||
+        g->lock_window_periods > BR_APP_LOCK_WINDOW_MAX || g->lock_max_outliers >= g->lock_window_periods) {
+        return BR_E_PARAM; /* a lock limit of the whole window or more could never trip */
     }
     /* written so that a NaN fails */
     if (!(g->frozen_duty > 0.0f && g->frozen_duty <= 1.0f)) {
@@ -110,6 +117,35 @@ static br_status_t latch(br_app_t *app, br_app_fault_t cause)
     app->fault = cause;
     outputs_off(app);
     return BR_E_FAULT;
+}
+
+/* The lock monitor's window emptied (at init and at every arm). */
+static void lock_reset(br_app_t *app)
+{
+    for (uint32_t i = 0u; i < BR_APP_LOCK_WORDS; i++) {
+        app->lock_bits[i] = 0u;
+    }
+    app->lock_pos = 0u;
+    app->n_lock = 0u;
+}
+
+/* One period into the lock monitor's sliding window: the oldest period leaves
+ * it, this one enters. 1 when the window then holds more outlier periods than
+ * lock_max_outliers. */
+static int lock_lost(br_app_t *app, int outlier)
+{
+    const uint32_t word = app->lock_pos / 32u, bit = 1u << (app->lock_pos % 32u);
+    if ((app->lock_bits[word] & bit) != 0u) {
+        app->n_lock--;
+    }
+    if (outlier) {
+        app->lock_bits[word] |= bit;
+        app->n_lock++;
+    } else {
+        app->lock_bits[word] &= ~bit;
+    }
+    app->lock_pos = (app->lock_pos + 1u < app->guard.lock_window_periods) ? app->lock_pos + 1u : 0u;
+    return app->n_lock > app->guard.lock_max_outliers;
 }
 
 br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *hal, const br_app_mem_t *mem)
@@ -141,6 +177,7 @@ br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *
     app->have_counts = 0;
     app->n_stale = 0u;
     app->n_frozen = 0u;
+    lock_reset(app);
     (void)latch(app, BR_APP_FAULT_DISARMED);
     return BR_OK;
 }
@@ -171,6 +208,7 @@ br_status_t br_app_arm(br_app_t *app)
     app->have_counts = 0;
     app->n_stale = 0u;
     app->n_frozen = 0u;
+    lock_reset(app);
     const br_hal_t *hal = app->axis.hal;
     st = hal->pwm_write(hal->ctx, 0.0f);
     if (st == BR_OK && hal->pwm_enable != NULL) {
@@ -192,7 +230,7 @@ br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause)
     if (!app->axis.ready) {
         return BR_E_STATE;
     }
-    if (cause <= BR_APP_FAULT_NONE || cause > BR_APP_FAULT_HAL) {
+    if (cause <= BR_APP_FAULT_NONE || cause > BR_APP_FAULT_LOST_LOCK) {
         return BR_E_PARAM;
     }
     return latch(app, cause);
@@ -278,6 +316,11 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
      * usable): control goes on and the status is passed up */
     if (BR_FAILED(est_st)) {
         return latch(app, BR_APP_FAULT_ESTIMATOR);
+    }
+    /* an estimator that keeps rejecting the measurement (and re-anchoring on
+     * it) has lost the axis: stop rather than compensate with its estimate */
+    if (a->est.step != NULL && lock_lost(app, est_st == BR_W_OUTLIER)) {
+        return latch(app, BR_APP_FAULT_LOST_LOCK);
     }
     br_ctrl_in_t in = {counts, ref->ref_counts, ref->ref_frac_counts, ref->ref_omega_radps, a->F_hat_N};
     st = br_ctrl_step(&a->ctrl, &in, &a->last);

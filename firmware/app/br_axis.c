@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* One axis's control loop over the HAL. */
 #include "bristle/br_axis.h"
 

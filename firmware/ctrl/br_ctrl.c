@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Gain-matrix state feedback with integral action (thesis eq. 7), float32.
  * See br_ctrl.h and docs/modules/ctrl.md. */
 #include "bristle/br_ctrl.h"

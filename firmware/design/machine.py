@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Machine description (machines/*.json, format version 1): loader, validator
 and the values derived from it. Documented field by field in
 docs/machine-file.md; the reference machine is machines/reference.json.
@@ -17,7 +18,12 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO_ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-REFERENCE_MACHINE = os.path.join(REPO_ROOT, "machines", "reference.json")
+# machines/ of the source tree; installed (pyproject.toml), the same folder is
+# the package bristle.machines beside this file's bristle.design
+MACHINES_DIR = os.path.join(REPO_ROOT, "machines")
+if not os.path.isdir(MACHINES_DIR):
+    MACHINES_DIR = os.path.join(HERE, "..", "machines")
+REFERENCE_MACHINE = os.path.join(MACHINES_DIR, "reference.json")
 # generated headers: one root on the include path, one folder per kind below bristle_gen/
 GEN_DIR = os.path.join(REPO_ROOT, "firmware", "gen")
 
@@ -187,6 +193,9 @@ SCHEMA = {
         }),
         "actuator_delay": Optional({
             "delay_s": Num(0.0, 0.1, "actuator dead time"),
+        }),
+        "friction_drift": Optional({
+            "drift_per_s": Num(-1.0, 1.0, "friction level scaled by max(0, 1 + drift_per_s t), t since the start"),
         }),
     },
     "control": {

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Configuration and step-input checks shared by the friction estimators. See br_est.h. */
 #include "bristle/br_est.h"
 

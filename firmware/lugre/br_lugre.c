@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* LuGre dynamic friction, float32. Equations in br_lugre.h and docs/modules/lugre.md. */
 #include "bristle/br_lugre.h"
 

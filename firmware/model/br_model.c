@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Four-state estimation model (thesis eq. 6) and its discretisation, float32.
  * See br_model.h and docs/modules/model.md. */
 #include "bristle/br_model.h"
@@ -32,7 +33,7 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
     const br_causes_t *c = &cfg->causes;
     if (!isfinite(c->offset_N) || !isfinite(c->dFc_neg_N) || !isfinite(c->dsigma2_neg_Nspm) ||
         !isfinite(c->ripple_amp_N) || !isfinite(c->ripple_phase_rad) || !isfinite(c->grad_per_m) ||
-        !br_finite_nonneg(c->delay_s)) {
+        !br_finite_nonneg(c->delay_s) || !isfinite(c->drift_per_s)) {
         return BR_E_PARAM;
     }
     /* the level in -x stays positive, the viscous friction in -x not negative,
@@ -47,19 +48,34 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
     m->inv_Jeff = 1.0f / (cfg->J_kgm2 + L * L * cfg->M_kg);
     m->visc_Nmsprad = L * L * cfg->sigma2_Nspm;
     m->extended = c->offset_N != 0.0f || c->dFc_neg_N != 0.0f || c->dsigma2_neg_Nspm != 0.0f ||
-                  c->ripple_amp_N != 0.0f || c->grad_per_m != 0.0f;
+                  c->ripple_amp_N != 0.0f || c->grad_per_m != 0.0f || c->drift_per_s != 0.0f;
     m->c_neg = (cfg->lugre.Fc_N + c->dFc_neg_N) / cfg->lugre.Fc_N;
     m->sigma2_neg_Nspm = cfg->sigma2_Nspm + c->dsigma2_neg_Nspm;
     m->ripple_k_radpm = (c->ripple_amp_N != 0.0f) ? 6.28318531f / c->ripple_period_m : 0.0f;
+    br_model_set_clock(m, 0u);
     m->ready = 1;
     return BR_OK;
+}
+
+void br_model_set_clock(br_model_t *m, uint32_t n_steps)
+{
+    m->n_steps = n_steps;
+    /* friction_drift: s(t) = max(0, 1 + drift t), t = n dt (the count is exact in
+     * float up to 2^24 steps, to 6e-8 of t beyond) */
+    const float t = (float)n_steps * m->cfg.dt_s;
+    m->drift_k = (m->cfg.causes.drift_per_s != 0.0f) ? fmaxf(0.0f, 1.0f + m->cfg.causes.drift_per_s * t) : 1.0f;
+}
+
+void br_model_tick(br_model_t *m)
+{
+    br_model_set_clock(m, (m->n_steps < UINT32_MAX) ? m->n_steps + 1u : m->n_steps);
 }
 
 float br_model_fnl_N(const br_model_t *m, const float x[BR_NX])
 {
     const br_model_k_t k = br_model_k(m);
-    /* eq. 3 with dz/dt from eq. 4, g = g_p (c g_p for bristles deflected towards -x) */
-    const float gp = (x[BR_X_Z] < 0.0f) ? m->c_neg * x[BR_X_GP] : x[BR_X_GP];
+    /* eq. 3 with dz/dt from eq. 4, g = g_p (c g_p moving towards -x) */
+    const float gp = (x[BR_X_OMEGA] < 0.0f) ? m->c_neg * x[BR_X_GP] : x[BR_X_GP];
     return br_model_k_fnl(&k, x[BR_X_Z], br_model_k_zdot(&k, x[BR_X_OMEGA], x[BR_X_Z], gp));
 }
 
@@ -118,7 +134,7 @@ void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u, f
 
 /* The bounded scheme of the extended model: as above with the level c g_p
  * and sigma2_d by the direction of the move, the friction impulse scaled by
- * k(p) and the offset and ripple impulses added, k and the ripple taken at
+ * k(p) s(t) and the offset and ripple impulses added, k and the ripple taken at
  * the middle of the move. */
 void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float u, float out[BR_NX])
 {
@@ -135,7 +151,7 @@ void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float
         const float zint = ls.zint_ms;
         z1 = ls.z1_m;
         const float tm = t0 + 0.5f * dth;
-        const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + L * tm));
+        const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + L * tm)) * k->ks;
         /* the load impulse: k (sigma2_d dx + sigma0 int z + sigma1 dz) + (offset + ripple) h */
         const float imp = kp * ((neg ? k->s2_neg : k->s2) * dx + s0 * zint + k->n.s1 * (z1 - z0)) +
                           (k->off + br_model_kx_ripple_N(k, tm)) * h;

@@ -1,15 +1,47 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Particle filter for the friction of one axis, float32. See br_pf.h and
  * docs/modules/pf.md. */
 #include "bristle/br_pf.h"
 
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "bristle/br_encoder.h"
 #include "br_check.h"
 #include "br_inline.h"
 #include "br_math.h"
 #include "br_model_kernel.h"
+
+/* BR_PF_SIMD: the target has vector registers for float (x86-64 SSE2, Arm
+ * NEON). There the weights' exponentials run in a loop of their own (vectorised)
+ * and the in-place copy is branch-free; without (the Cortex-M7) one fused
+ * weight loop and a copy that skips the particles staying put cost fewer
+ * instructions. The results are the same either way. */
+#if defined(__SSE2__) || defined(__ARM_NEON)
+#define BR_PF_SIMD 1
+#else
+#define BR_PF_SIMD 0
+#endif
+
+/* f_nl (eqs. 3, 4) of a predicted particle: eq. 4 with its k_p = sigma0 L / g_p
+ * (BR_PF_ONE_DIVISION) or divided by g_p, as the build selects */
+static inline float fnl_sel(const br_model_k_t *k, float om, float z, float gp, float kg)
+{
+    const float zd = BR_PF_ONE_DIVISION ? br_model_kp_zdot(k->L, kg, om, z) : br_model_k_zdot(k, om, z, gp);
+    return br_model_k_fnl(k, z, zd);
+}
+
+/* BR_PF_CLONES: on x86-64 hosts (GCC), the vectorised loops are also compiled
+ * for AVX2 and picked at run time by the CPU (target_clones): 8 lanes instead
+ * of SSE2's 4. The same IEEE operations lane by lane (-ffp-contract=off holds
+ * in every clone: no FMA), so the results do not depend on the clone. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__)
+#define BR_PF_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define BR_PF_CLONES
+#endif
 
 /* W of a particle of weight 1 (the best one after the max-shift) */
 #define BR_PF_W_ONE (1u << BR_PF_W_BITS)
@@ -55,7 +87,10 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     pf->inv_2r = 0.5f / cfg->est.r_var_rad2;
     pf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
     br_est_delay_init(&pf->delay, &cfg->est);
-    pf->outlier_l = -0.5f * cfg->est.outlier_sigma * cfg->est.outlier_sigma;
+    /* gate (docs/modules/pf.md): outlier when min_j e_j^2 > g^2 (R + rpc^2 / 12), R with
+     * the encoder's quantisation; in log-weights l = -e^2 / (2 R): max_j l_j < -g^2 (R + rpc^2 / 12) / (2 R) */
+    pf->outlier_l = -0.5f * cfg->est.outlier_sigma * cfg->est.outlier_sigma *
+                    (1.0f + cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f) / cfg->est.r_var_rad2);
     pf->noise_pos = 0u;
     pf->origin_counts = 0;
     pf->primed = 0;
@@ -83,17 +118,27 @@ static void noise_advance(br_pf_t *pf)
  * one count up to 2^24 counts, to 2^(n-24) counts at 2^n) */
 static float origin_pos_m(const br_pf_t *pf) { return (float)pf->origin_counts * pf->m_per_count; }
 
+/* the state vector of particle j */
+static void particle_get(const br_pf_t *pf, uint32_t j, float x[BR_NX])
+{
+    for (int i = 0; i < BR_NX; i++) {
+        x[i] = pf->x[i][j];
+    }
+}
+
 /* Estimate of the freshly drawn set: means and the mean of f_nl (eq. 6). */
 static void estimate_current(br_pf_t *pf, float ess)
 {
     const uint32_t m = pf->cfg.n_particles;
     float s[BR_NX] = {0.0f, 0.0f, 0.0f, 0.0f}, sf = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
+        float xj[BR_NX];
+        particle_get(pf, j, xj);
         for (int i = 0; i < BR_NX; i++) {
-            s[i] += pf->x[j][i];
+            s[i] += xj[i];
         }
         /* thesis estimate: the mean of f_nl (eq. 6) over the particles */
-        sf += br_model_fcomp_N(&pf->model, pf->x[j], origin_pos_m(pf));
+        sf += br_model_fcomp_N(&pf->model, xj, origin_pos_m(pf));
     }
     const float inv_m = 1.0f / (float)m;
     for (int i = 0; i < BR_NX; i++) {
@@ -111,9 +156,12 @@ static void prime(br_pf_t *pf, const br_meas_t *y)
     const float mean[BR_NX] = {y->frac * pf->cfg.est.rad_per_count, 0.0f, 0.0f, pf->cfg.est.gp0_N};
     for (uint32_t j = 0; j < m; j++) {
         for (uint32_t i = 0; i < BR_NX; i++) {
-            pf->x[j][i] = mean[i] + pf->cfg.x0_std[i] * noise_at(pf, j, i);
+            pf->x[i][j] = mean[i] + pf->cfg.x0_std[i] * noise_at(pf, j, i);
         }
-        pf->x[j][BR_X_GP] = br_clampf(pf->x[j][BR_X_GP], pf->cfg.est.gp_min_N, pf->cfg.est.gp_max_N);
+        pf->x[BR_X_GP][j] = br_clampf(pf->x[BR_X_GP][j], pf->cfg.est.gp_min_N, pf->cfg.est.gp_max_N);
+        if (BR_PF_ONE_DIVISION) {
+            pf->kgp[j] = br_model_kp_of(&pf->model, pf->x[BR_X_GP][j]);
+        }
     }
     noise_advance(pf);
     pf->origin_counts = y->counts;
@@ -150,6 +198,117 @@ static void resample(const uint32_t *W, uint32_t m, uint32_t total, uint16_t *id
     }
 }
 
+/* The same resampling without a data-dependent inner loop (the vector path
+ * on hosts with SIMD, where resample()'s inner loop mispredicts): for each
+ * particle j the number of points below its cumulative weight,
+ *   N(C) = #{i < m : t_i < C} = (Q + 1) / 2,  Q = floor((2 m C - 1) / C_m)
+ * (t_i < C <=> (2 i + 1) C_m < 2 m C for integer C), in float32 with an
+ * exact integer correction: |error| of the float quotient <= 2^-10 for
+ * quotients <= 2 m <= 2^12, so it is off by at most one, which the two
+ * 64-bit comparisons remove. Particle i copies the j with
+ * N(C_{j-1}) <= i < N(C_j): j is written at i = N(C_{j-1}) (the last j
+ * written there is the one with copies) and carried forward by a running
+ * maximum. Gives resample()'s indices exactly (test_vector_path_is_scalar_path). */
+static uint32_t n_below(uint32_t c, uint32_t two_m, uint32_t cm, float inv_cm)
+{
+    const int64_t a = (int64_t)two_m * (int64_t)c - 1;
+    int64_t q = (int64_t)((float)a * inv_cm);
+    q += ((q + 1) * (int64_t)cm <= a) ? 1 : 0;
+    q -= (q * (int64_t)cm > a) ? 1 : 0;
+    return (c == 0u) ? 0u : (uint32_t)((q + 1) / 2);
+}
+
+static void resample_count(const uint32_t *W, uint32_t m, uint32_t total, uint16_t *idx)
+{
+    const uint32_t two_m = 2u * m;
+    const float inv_cm = 1.0f / (float)total;
+    uint16_t spare = 0u; /* the write of a particle whose N(C_{j-1}) = m (no copies) */
+    for (uint32_t i = 0; i < m; i++) {
+        idx[i] = 0u;
+    }
+    uint32_t c = 0u;
+    for (uint32_t j = 0; j < m; j++) {
+        const uint32_t n = n_below(c, two_m, total, inv_cm);
+        uint16_t *const dst = (n < m) ? &idx[n] : &spare;
+        *dst = (uint16_t)j;
+        c += W[j];
+    }
+    uint16_t run = 0u;
+    for (uint32_t i = 0; i < m; i++) {
+        run = (idx[i] > run) ? idx[i] : run;
+        idx[i] = run;
+    }
+}
+
+/* resample()'s indices, fused with the forward pass of the in-place copy
+ * (copy_resampled) and with step 5's sums (sum_set), for targets without
+ * float SIMD (one loop instead of three): particle i is the predicted
+ * particle j = idx_i, so the sums over the resampled set, in particle order,
+ * add the predicted j's values, held in registers while j stays. Particle i
+ * takes j's state now when j > i: a later i' reads only j' >= j > i, and a
+ * position j' is read (when j reaches it) before it is written (at i = j',
+ * which needs idx_j' > j'). The backward pass (idx_i < i) follows in
+ * copy_back. The same indices, states and sums as the three loops. */
+static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const uint32_t *BR_RESTRICT W = pf->W;
+    uint16_t *BR_RESTRICT idx = pf->idx;
+    float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA];
+    float *const zz = pf->x[BR_X_Z], *const gg = pf->x[BR_X_GP], *const ia = pf->kgp;
+    const float *const fnl = pf->fnl;
+    const uint32_t den = 2u * m;
+    const uint32_t dq = (2u * total) / den, dr = (2u * total) % den;
+    uint32_t t = total / den, r = total % den;
+    uint32_t j = 0u, c = W[0];
+    float a0 = th[0], a1 = om[0], a2 = zz[0], a3 = gg[0], af = fnl[0];
+    float ai = BR_PF_ONE_DIVISION ? ia[0] : 0.0f;
+    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
+    for (uint32_t i = 0; i < m; i++) {
+        if (c <= t && j + 1u < m) {
+            do {
+                j++;
+                c += W[j];
+            } while (c <= t && j + 1u < m);
+            a0 = th[j];
+            a1 = om[j];
+            a2 = zz[j];
+            a3 = gg[j];
+            af = fnl[j];
+            if (BR_PF_ONE_DIVISION) {
+                ai = ia[j];
+            }
+        }
+        idx[i] = (uint16_t)j;
+        s0 += a0;
+        s1 += a1;
+        s2 += a2;
+        s3 += a3;
+        sf += af;
+        if (j > i) {
+            th[i] = a0;
+            om[i] = a1;
+            zz[i] = a2;
+            gg[i] = a3;
+            if (BR_PF_ONE_DIVISION) {
+                ia[i] = ai;
+            }
+        }
+        /* t_{i+1} = t_i + dq, plus 1 when the remainder carries */
+        t += dq;
+        r += dr;
+        if (r >= den) {
+            t++;
+            r -= den;
+        }
+    }
+    s[0] = s0;
+    s[1] = s1;
+    s[2] = s2;
+    s[3] = s3;
+    return sf;
+}
+
 br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
 {
     if (W == NULL || idx == NULL) {
@@ -172,127 +331,284 @@ br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
     return BR_OK;
 }
 
-/* Steps 1 and 2 for every particle: prediction into xp, the force to
- * compensate (f_nl for the thesis model), log-weight. ext: the extended
- * model's kernel mx (theta relative to the origin at its p0) instead of the
- * thesis model's; a constant at each call site, so that each case is its own
- * loop. Returns the number of valid (finite) predicted particles and their
- * largest log-weight in *lmax. */
-BR_INLINE uint32_t predict_and_weigh_with(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, float *lmax,
-                                          const int ext, const br_model_kx_t *mx)
-{
-    /* the model's constants and the loop's invariants, held in registers */
-    const br_model_k_t mk = br_model_k(&pf->model);
-    const float q0 = pf->q_std[0], q1 = pf->q_std[1], q2 = pf->q_std[2], q3 = pf->q_std[3];
-    const float gp_min = pf->cfg.est.gp_min_N, gp_max = pf->cfg.est.gp_max_N, inv_2r = pf->inv_2r;
-    const float *const noise = pf->cfg.noise;
-    const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
-    uint32_t pos = pf->noise_pos, n_valid = 0u;
-    float lm = -INFINITY;
+/* The constants of one prediction pass (steps 1 and 2), for every particle. */
+typedef struct {
+    br_model_k_t mk;  /* the thesis model's kernel constants */
+    br_model_kp_t kp; /* the PF's RK4 constants (BR_PF_ONE_DIVISION) */
+    float s0L;        /* sigma0 L: k_p = s0L / g_p */
+    br_model_kx_t mx; /* the extended model's (theta relative to the origin at its p0) */
+    float q[BR_NX];   /* process noise standard deviations */
+    float gp_min, gp_max, inv_2r;
+    float u;          /* torque over the period, N m */
+    float shift;      /* theta of the new origin relative to the old one, rad */
+    float y_rel;      /* the measurement relative to the new origin, rad */
+} pred_t;
 
-    for (uint32_t j = 0; j < m; j++, pos += BR_NX) {
-        const float *const xj = pf->x[j];
-        float *const xo = pf->xp[j];
-        /* 1. predict: eq. 6 discretised as br_model_step (RK4, or the bounded scheme
-         * beyond its a h limit); the particles are finite with g_p >= gp_min > 0.
-         * xn stays in registers; only the rare bounded step goes through memory. */
-        float xn[BR_NX];
-        if (ext ? !br_model_kx_rk4(mx, xj, u_prev_Nm, xn) : !br_model_k_rk4(&mk, xj, u_prev_Nm, xn)) {
-            float xb[BR_NX];
-            if (ext) {
-                br_model_bounded_step_x(mx, xj, u_prev_Nm, xb);
-            } else {
-                br_model_bounded_step(&pf->model, xj, u_prev_Nm, xb);
-            }
-            for (int i = 0; i < BR_NX; i++) {
-                xn[i] = xb[i];
-            }
-        }
-        /* process noise: the next BR_NX standard-normal samples of the ROM table,
-         * read in one block unless they wrap round its end */
-        float n0, n1, n2, n3;
-        const uint32_t p0 = pos & mask;
-        if (p0 + (BR_NX - 1u) <= mask) {
-            n0 = noise[p0];
-            n1 = noise[p0 + 1u];
-            n2 = noise[p0 + 2u];
-            n3 = noise[p0 + 3u];
-        } else {
-            n0 = noise[p0];
-            n1 = noise[(pos + 1u) & mask];
-            n2 = noise[(pos + 2u) & mask];
-            n3 = noise[(pos + 3u) & mask];
-        }
-        const float th_old = xn[BR_X_THETA] + q0 * n0; /* relative to the last origin */
-        const float th = th_old - shift;
-        const float om = xn[BR_X_OMEGA] + q1 * n1;
-        const float z = xn[BR_X_Z] + q2 * n2;
-        const float gp = br_clampf(xn[BR_X_GP] + q3 * n3, gp_min, gp_max);
-        /* the force to compensate of the predicted particle: eq. 6's f_nl, or
-         * the extended model's (at its position relative to the last origin) */
-        float fnl;
-        if (ext) {
-            const float xe[BR_NX] = {th_old, om, z, gp};
-            fnl = br_model_kx_fcomp_N(mx, xe);
-        } else {
-            fnl = br_model_k_fnl(&mk, z, br_model_k_zdot(&mk, om, z, gp));
-        }
-        /* Validity: x - x is 0 for finite x and NaN otherwise. g_p is finite after
-         * the clamp; a non-finite omega or z makes f_nl non-finite (inf - inf,
-         * 0 * inf or inf in eqs. 3-4), so theta and f_nl tell all four states. */
-        if ((th - th) + (fnl - fnl) == 0.0f) {
-            xo[BR_X_THETA] = th;
-            xo[BR_X_OMEGA] = om;
-            xo[BR_X_Z] = z;
-            xo[BR_X_GP] = gp;
-            pf->fnl[j] = fnl;
-            /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R) */
-            const float e = th - y_rel;
-            /* may be -inf for a particle far from y: still valid (NaN marks invalid) */
-            const float l = -(e * e) * inv_2r;
-            pf->l[j] = l;
-            lm = fmaxf(lm, l);
-            n_valid++;
-        } else {
-            /* unusable: the particle keeps its state and gets weight 0; its
-             * log-weight is NaN, which no valid particle's can be (fmaxf and
-             * the max-shifted exponential both skip it) */
-            for (int i = 0; i < BR_NX; i++) {
-                xo[i] = xj[i];
-            }
-            pf->fnl[j] = 0.0f;
-            pf->l[j] = NAN;
-        }
-    }
-    *lmax = lm;
-    return n_valid;
+/* g_p limited to [lo, hi] with selects (fmaxf/fminf are library calls on
+ * some hosts): br_clampf's result for every input, lo > 0 */
+static inline float clamp_sel(float v, float lo, float hi)
+{
+    const float a = (v > lo) ? v : lo; /* a NaN gives lo, as fmaxf */
+    return (a < hi) ? a : hi;
 }
 
-/* Steps 1 and 2 with the configured model; theta of the particles relative
- * to pf->origin_counts */
+/* Steps 1 and 2 for particle j, one at a time: the scalar reference path,
+ * and the fix-up of the vector loop's rare cases (the bounded scheme, an
+ * invalid prediction). n: its BR_NX standard-normal samples. The particle is
+ * overwritten by its prediction when that is valid; returns 1 and its
+ * log-weight in *l then, else 0 (the particle keeps its state, f_nl = 0,
+ * l = NaN). ext: the extended model's kernel (a constant at each call site). */
+BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j, const float n[BR_NX], float *l_out)
+{
+    float x[BR_NX], xn[BR_NX];
+    particle_get(pf, j, x);
+    /* 1. predict: eq. 6 discretised as br_model_step (RK4, or the bounded scheme
+     * beyond its a h limit); the particles are finite with g_p >= gp_min > 0 */
+    if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !(BR_PF_ONE_DIVISION ? br_model_kp_rk4(&c->kp, x, pf->kgp[j], xn) : br_model_k_rk4(&c->mk, x, c->u, xn))) {
+        if (ext) {
+            br_model_bounded_step_x(&c->mx, x, c->u, xn);
+        } else {
+            br_model_bounded_step(&pf->model, x, c->u, xn);
+        }
+    }
+    /* process noise sqrt(Q) n */
+    const float th_old = xn[BR_X_THETA] + c->q[0] * n[0]; /* relative to the last origin */
+    const float th = th_old - c->shift;
+    const float om = xn[BR_X_OMEGA] + c->q[1] * n[1];
+    const float z = xn[BR_X_Z] + c->q[2] * n[2];
+    const float gp = clamp_sel(xn[BR_X_GP] + c->q[3] * n[3], c->gp_min, c->gp_max);
+    /* BR_PF_ONE_DIVISION: the particle's one division, k_p = sigma0 L / g_p for eq. 4 here and in the next step */
+    const float kg = BR_PF_ONE_DIVISION ? c->s0L / gp : 0.0f;
+    /* the force to compensate of the predicted particle: eq. 6's f_nl, or
+     * the extended model's (at its position relative to the last origin) */
+    float fnl;
+    if (ext) {
+        const float xe[BR_NX] = {th_old, om, z, gp};
+        fnl = br_model_kx_fcomp_N(&c->mx, xe);
+    } else {
+        fnl = fnl_sel(&c->mk, om, z, gp, kg);
+    }
+    /* Validity: x - x is 0 for finite x and NaN otherwise. g_p is finite after
+     * the clamp; a non-finite omega or z makes f_nl non-finite (inf - inf,
+     * 0 * inf or inf in eqs. 3-4), so theta and f_nl tell all four states. */
+    if ((th - th) + (fnl - fnl) == 0.0f) {
+        pf->x[BR_X_THETA][j] = th;
+        pf->x[BR_X_OMEGA][j] = om;
+        pf->x[BR_X_Z][j] = z;
+        pf->x[BR_X_GP][j] = gp;
+        if (BR_PF_ONE_DIVISION) {
+            pf->kgp[j] = kg;
+        }
+        pf->fnl[j] = fnl;
+        /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R);
+         * may be -inf for a particle far from y: still valid (NaN marks invalid) */
+        const float e = th - c->y_rel;
+        const float l = -(e * e) * c->inv_2r;
+        pf->l[j] = l;
+        *l_out = l;
+        return 1;
+    }
+    /* unusable: the particle keeps its state and gets weight 0; its log-weight
+     * is NaN, which no valid particle's can be */
+    pf->fnl[j] = 0.0f;
+    pf->l[j] = NAN;
+    return 0;
+}
+
+/* the BR_NX samples of particle j, read round the end of the table */
+static void noise_wrapped(const br_pf_t *pf, uint32_t j, float n[BR_NX])
+{
+    for (uint32_t i = 0; i < BR_NX; i++) {
+        n[i] = noise_at(pf, j, i);
+    }
+}
+
+/* Largest log-weight so far and the count of valid particles. l <= -0 for a
+ * valid particle, so its bit pattern as int32 (its key) is negative and
+ * orders the other way round: the largest l has the smallest key (the vector
+ * loop reduces the keys with an integer min, which vectorises where fmaxf
+ * does not). */
+typedef struct {
+    float lmax;
+    uint32_t n_valid;
+} lsum_t;
+
+static inline void lsum_add(lsum_t *s, float l)
+{
+    s->lmax = (l > s->lmax) ? l : s->lmax; /* fmaxf for l not NaN */
+    s->n_valid++;
+}
+
+/* Steps 1 and 2, thesis model, particles j0 .. j1 - 1 whose noise samples
+ * are the contiguous nz[BR_NX (j - j0) + i]: branch-free, so that the
+ * compiler vectorises it. A particle that needs the bounded scheme or whose
+ * prediction is not valid keeps its state here (l = NaN) and is redone by
+ * particle_one afterwards. Adds its valid particles to *ls; returns the
+ * number of particles left for the fix-up. */
+BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                                         lsum_t *ls)
+{
+    const br_model_k_t mk = c->mk;
+#if BR_PF_ONE_DIVISION
+    const br_model_kp_t kp = c->kp;
+    const float s0L = c->s0L;
+#else
+    const float u = c->u;
+#endif
+    const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
+    const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
+    const float shift = c->shift, y_rel = c->y_rel;
+    float *BR_RESTRICT th = pf->x[BR_X_THETA] + j0;
+    float *BR_RESTRICT om = pf->x[BR_X_OMEGA] + j0;
+    float *BR_RESTRICT zz = pf->x[BR_X_Z] + j0;
+    float *BR_RESTRICT gg = pf->x[BR_X_GP] + j0;
+#if BR_PF_ONE_DIVISION
+    float *BR_RESTRICT ka = pf->kgp + j0;
+#endif
+    float *BR_RESTRICT fo = pf->fnl + j0;
+    float *BR_RESTRICT lo = pf->l + j0;
+    const float *BR_RESTRICT nn = nz;
+    const size_t n = j1 - j0;
+    int32_t kmin = INT32_MAX;
+    uint32_t n_ok = 0u;
+    for (size_t j = 0; j < n; j++) {
+        const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
+        float xn[BR_NX];
+        /* 1. predict (RK4 of eq. 6; ok_rk = 0 where the bounded scheme is needed) */
+#if BR_PF_ONE_DIVISION
+        const float kg0 = ka[j];
+        const int ok_rk = br_model_kp_rk4(&kp, x, kg0, xn);
+#else
+        const int ok_rk = br_model_k_rk4(&mk, x, u, xn);
+#endif
+        /* process noise sqrt(Q) n */
+        const float t = (xn[BR_X_THETA] + q0 * nn[BR_NX * j]) - shift;
+        const float w = xn[BR_X_OMEGA] + q1 * nn[BR_NX * j + 1u];
+        const float z = xn[BR_X_Z] + q2 * nn[BR_NX * j + 2u];
+        const float g = clamp_sel(xn[BR_X_GP] + q3 * nn[BR_NX * j + 3u], gp_min, gp_max);
+        /* BR_PF_ONE_DIVISION: the particle's one division */
+#if BR_PF_ONE_DIVISION
+        const float kg = s0L / g;
+#else
+        const float kg = 0.0f;
+#endif
+        /* f_nl of the predicted particle (eqs. 3, 4) */
+        const float f = fnl_sel(&mk, w, z, g, kg);
+        /* validity as particle_one's */
+        const int ok = ok_rk & ((t - t) + (f - f) == 0.0f);
+        /* 2. log-likelihood */
+        const float e = t - y_rel;
+        const float l = -(e * e) * inv_2r;
+        th[j] = ok ? t : x[BR_X_THETA];
+        om[j] = ok ? w : x[BR_X_OMEGA];
+        zz[j] = ok ? z : x[BR_X_Z];
+        gg[j] = ok ? g : x[BR_X_GP];
+#if BR_PF_ONE_DIVISION
+        ka[j] = ok ? kg : kg0;
+#endif
+        fo[j] = ok ? f : 0.0f;
+        const float lk = ok ? l : NAN;
+        lo[j] = lk;
+        /* NAN is a positive NaN: its key is above every valid one */
+        int32_t key;
+        memcpy(&key, &lk, sizeof key);
+        kmin = (key < kmin) ? key : kmin;
+        n_ok += (uint32_t)ok;
+    }
+    if (n_ok > 0u) {
+        float lm;
+        memcpy(&lm, &kmin, sizeof lm);
+        ls->lmax = (lm > ls->lmax) ? lm : ls->lmax;
+        ls->n_valid += n_ok;
+    }
+    return (uint32_t)n - n_ok;
+}
+
+/* Steps 1 and 2 for every particle: prediction in place, the force to
+ * compensate (f_nl for the thesis model), log-weight. Returns the number of
+ * valid (finite) predicted particles and their largest log-weight in *lmax. */
 static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, float *lmax)
 {
+    /* the model's clock moves on by one period (friction_drift) */
+    br_model_tick(&pf->model);
+    pred_t c;
+    c.mk = br_model_k(&pf->model);
+    c.kp = br_model_kp(&pf->model, u_prev_Nm);
+    c.s0L = pf->model.cfg.lugre.sigma0_Npm * pf->model.cfg.lead_mprad;
     /* the extended kernel's constants (a few operations per step; unused by the thesis model) */
-    const br_model_kx_t mx = br_model_kx(&pf->model, origin_pos_m(pf));
-    if (pf->model.extended) {
-        return predict_and_weigh_with(pf, u_prev_Nm, shift, y_rel, lmax, 1, &mx);
+    c.mx = br_model_kx(&pf->model, origin_pos_m(pf));
+    for (int i = 0; i < BR_NX; i++) {
+        c.q[i] = pf->q_std[i];
     }
-    return predict_and_weigh_with(pf, u_prev_Nm, shift, y_rel, lmax, 0, &mx);
+    c.gp_min = pf->cfg.est.gp_min_N;
+    c.gp_max = pf->cfg.est.gp_max_N;
+    c.inv_2r = pf->inv_2r;
+    c.u = u_prev_Nm;
+    c.shift = shift;
+    c.y_rel = y_rel;
+    const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
+    lsum_t ls = {-INFINITY, 0u};
+    float l, n[BR_NX];
+    if (pf->model.extended || pf->cfg.scalar_path) {
+        /* one particle at a time (the extended model always: its kernel branches) */
+        for (uint32_t j = 0; j < m; j++) {
+            noise_wrapped(pf, j, n);
+            if (pf->model.extended ? particle_one(pf, &c, 1, j, n, &l) : particle_one(pf, &c, 0, j, n, &l)) {
+                lsum_add(&ls, l);
+            }
+        }
+    } else {
+        /* runs of particles whose samples lie in one block of the table; a
+         * particle whose samples wrap round its end on its own */
+        uint32_t j = 0u;
+        while (j < m) {
+            const uint32_t p = (pf->noise_pos + BR_NX * j) & mask;
+            const uint32_t room = (mask + 1u - p) / BR_NX; /* particles before the wrap */
+            if (room == 0u) {
+                noise_wrapped(pf, j, n);
+                if (particle_one(pf, &c, 0, j, n, &l)) {
+                    lsum_add(&ls, l);
+                }
+                j++;
+                continue;
+            }
+            const uint32_t j1 = (m - j < room) ? m : j + room;
+            const float *const nz = pf->cfg.noise + p;
+            if (predict_vec(pf, &c, j, j1, nz, &ls) > 0u) {
+                /* the fix-up: redo the particles the vector loop left (l = NaN) in scalar */
+                for (uint32_t k = j; k < j1; k++) {
+                    if (pf->l[k] != pf->l[k] && particle_one(pf, &c, 0, k, nz + BR_NX * (k - j), &l)) {
+                        lsum_add(&ls, l);
+                    }
+                }
+            }
+            j = j1;
+        }
+    }
+    *lmax = ls.lmax;
+    return ls.n_valid;
+}
+
+/* w_j = e^(l_j - lmax) for j < m, stored as their bit patterns in W */
+BR_PF_CLONES static void exp_vec(const float *BR_RESTRICT l, uint32_t *BR_RESTRICT W, float lmax, uint32_t m)
+{
+    for (uint32_t j = 0; j < m; j++) {
+        const float w = br_exp_neg(l[j] - lmax);
+        memcpy(&W[j], &w, sizeof w);
+    }
 }
 
 /* Step 3: max-shifted weights w_j = e^(l_j - lmax), quantised to W_j (an invalid
  * particle has l_j = NaN and br_exp_neg gives 0 for it); on an outlier every
- * valid particle (l_j not NaN, even -inf when its residual overflowed) gets w = 1. Returns the total of W; *sw and *sw2 get the sums of w and w^2
- * (for the ESS). */
+ * valid particle (l_j not NaN, even -inf when its residual overflowed) gets w = 1.
+ * Returns the total of W; *sw and *sw2 get the sums of w and w^2 (for the ESS). */
 static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw, float *sw2)
 {
     const uint32_t m = pf->cfg.n_particles;
-    const float *const l = pf->l;
-    uint32_t *const W = pf->W;
+    const float *BR_RESTRICT l = pf->l;
+    uint32_t *BR_RESTRICT W = pf->W;
     uint32_t total = 0u;
     float s1 = 0.0f, s2 = 0.0f;
-    /* two loops, so that the common one has no per-particle branch on the verdict
-     * (one loop with the branch costs 5 more instructions per particle on the M7) */
     if (outlier) {
         for (uint32_t j = 0; j < m; j++) {
             const float w = (l[j] == l[j]) ? 1.0f : 0.0f; /* valid: not NaN */
@@ -302,12 +618,26 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
             s2 += w * w;
         }
     } else {
-        for (uint32_t j = 0; j < m; j++) {
-            const float w = br_exp_neg(l[j] - lmax);
-            W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
-            total += W[j];
-            s1 += w;
-            s2 += w * w;
+        if (pf->cfg.scalar_path || !BR_PF_SIMD) {
+            for (uint32_t j = 0; j < m; j++) {
+                const float w = br_exp_neg(l[j] - lmax);
+                W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
+                total += W[j];
+                s1 += w;
+                s2 += w * w;
+            }
+        } else {
+            /* the exponentials in a loop of their own (vectorised), w parked in
+             * W's storage as its bit pattern; then the sums in order, as above */
+            exp_vec(l, W, lmax, m);
+            for (uint32_t j = 0; j < m; j++) {
+                float w;
+                memcpy(&w, &W[j], sizeof w);
+                W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
+                total += W[j];
+                s1 += w;
+                s2 += w * w;
+            }
         }
     }
     *sw = s1;
@@ -315,28 +645,82 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
     return total;
 }
 
-/* Step 4's copy and step 5's sums: x_i <- xp_{idx_i}; s gets the sums of the
- * states, the return value the sum of f_nl over the resampled set. */
-static float copy_resampled(br_pf_t *pf, float s[BR_NX])
+/* Step 4's copy, in place: particle i becomes the predicted particle idx_i.
+ * The indices never decrease (systematic resampling), so a forward pass can
+ * take every particle from a later one (not yet overwritten) and a backward
+ * pass every particle from an earlier one (idx_k <= k there, so its source
+ * was left alone by the forward pass); a particle with idx_i = i copies
+ * itself. Branch-free (the vector path on hosts with SIMD): each pass copies
+ * every particle, from itself where it is not its turn. */
+static void copy_resampled(br_pf_t *pf)
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const uint16_t *BR_RESTRICT idx = pf->idx;
+    float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA];
+    float *const zz = pf->x[BR_X_Z], *const gg = pf->x[BR_X_GP], *const ia = pf->kgp;
+    for (uint32_t i = 0; i < m; i++) {
+        const uint32_t k = idx[i];
+        const uint32_t s = (k > i) ? k : i;
+        th[i] = th[s];
+        om[i] = om[s];
+        zz[i] = zz[s];
+        gg[i] = gg[s];
+        if (BR_PF_ONE_DIVISION) {
+            ia[i] = ia[s];
+        }
+    }
+    for (uint32_t i = m; i-- > 0u;) {
+        const uint32_t k = idx[i];
+        const uint32_t s = (k < i) ? k : i;
+        th[i] = th[s];
+        om[i] = om[s];
+        zz[i] = zz[s];
+        gg[i] = gg[s];
+        if (BR_PF_ONE_DIVISION) {
+            ia[i] = ia[s];
+        }
+    }
+}
+
+/* The backward pass alone, skipping the particles that stay (after
+ * resample_fused, which made the forward pass) */
+static void copy_back(br_pf_t *pf)
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const uint16_t *BR_RESTRICT idx = pf->idx;
+    float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA];
+    float *const zz = pf->x[BR_X_Z], *const gg = pf->x[BR_X_GP], *const ia = pf->kgp;
+    for (uint32_t i = m; i-- > 0u;) {
+        const uint32_t k = idx[i];
+        if (k < i) {
+            th[i] = th[k];
+            om[i] = om[k];
+            zz[i] = zz[k];
+            gg[i] = gg[k];
+            if (BR_PF_ONE_DIVISION) {
+                ia[i] = ia[k];
+            }
+        }
+    }
+}
+
+/* Step 5's sums over the set, in particle order: s gets the sums of the
+ * states, the return value the sum of f_nl of the set's predicted
+ * particles idx_j. */
+static float sum_set(const br_pf_t *pf, float s[BR_NX])
 {
     const uint32_t m = pf->cfg.n_particles;
     const uint16_t *const idx = pf->idx;
-    float(*const xp)[BR_NX] = pf->xp; /* read only */
+    const float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA];
+    const float *const zz = pf->x[BR_X_Z], *const gg = pf->x[BR_X_GP];
     const float *const fnl = pf->fnl;
-    float(*const x)[BR_NX] = pf->x;
     float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
-        const uint32_t k = idx[j];
-        const float a = xp[k][0], b = xp[k][1], c = xp[k][2], d = xp[k][3];
-        x[j][0] = a;
-        x[j][1] = b;
-        x[j][2] = c;
-        x[j][3] = d;
-        s0 += a;
-        s1 += b;
-        s2 += c;
-        s3 += d;
-        sf += fnl[k];
+        s0 += th[j];
+        s1 += om[j];
+        s2 += zz[j];
+        s3 += gg[j];
+        sf += fnl[idx[j]];
     }
     s[0] = s0;
     s[1] = s1;
@@ -383,10 +767,17 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER, &sw, &sw2);
     /* 4. deterministic systematic resampling on the integer weights (total >= 2^16:
      * the best valid particle has W = 2^16) */
-    resample(pf->W, m, total, pf->idx);
     /* 5. estimate over the resampled set: particle mean and the mean of f_nl (eq. 6) */
-    float s[BR_NX];
-    float sf = copy_resampled(pf, s);
+    float s[BR_NX], sf;
+    if (BR_PF_SIMD && !pf->cfg.scalar_path) {
+        resample_count(pf->W, m, total, pf->idx);
+        copy_resampled(pf);
+        sf = sum_set(pf, s);
+    } else {
+        /* one loop for the indices, the forward copy and the sums, then the backward copy */
+        sf = resample_fused(pf, total, s);
+        copy_back(pf);
+    }
     const float inv_m = 1.0f / (float)m;
     pf->n_outliers = (verdict == BR_W_OUTLIER) ? pf->n_outliers + 1u : 0u;
     if (pf->n_outliers >= pf->cfg.est.reanchor_after) {
@@ -397,10 +788,12 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         const float d_th = y_rel - s[BR_X_THETA] * inv_m, d_om = omega_meas - s[BR_X_OMEGA] * inv_m;
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
-            pf->x[j][BR_X_THETA] += d_th;
-            pf->x[j][BR_X_OMEGA] += d_om;
+            pf->x[BR_X_THETA][j] += d_th;
+            pf->x[BR_X_OMEGA][j] += d_om;
             /* f_nl depends on omega: the estimate is that of the moved cloud */
-            sf += br_model_fcomp_N(&pf->model, pf->x[j], (float)y->counts * pf->m_per_count);
+            float xj[BR_NX];
+            particle_get(pf, j, xj);
+            sf += br_model_fcomp_N(&pf->model, xj, (float)y->counts * pf->m_per_count);
         }
         s[BR_X_THETA] += d_th * (float)m;
         s[BR_X_OMEGA] += d_om * (float)m;
@@ -437,12 +830,12 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
     }
-    /* every particle moves on unweighted (an invalid one kept its state in xp) */
+    /* every particle moves on unweighted (an invalid one kept its state) */
     for (uint32_t j = 0; j < m; j++) {
         pf->idx[j] = (uint16_t)j;
     }
     float s[BR_NX];
-    const float sf = copy_resampled(pf, s);
+    const float sf = sum_set(pf, s);
     const float inv_m = 1.0f / (float)m;
     for (int i = 0; i < BR_NX; i++) {
         pf->est.mean[i] = s[i] * inv_m;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Range checks every module's init shares (private to the firmware). */
 #ifndef BR_CHECK_H
 #define BR_CHECK_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The LuGre friction kernel (thesis eqs. 3-5), float32, inline; private to
  * the firmware. The one place these equations are coded in C for the
  * firmware: br_lugre (the stand-alone friction model), br_model (eq. 6, RK4

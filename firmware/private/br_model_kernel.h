@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Inline kernel of the eq. 6 model's RK4 step (private to the firmware).
  *
  * br_model_step and the particle filter's prediction loop both step through
@@ -14,6 +15,7 @@
 #include <math.h>
 
 #include "bristle/br_model.h"
+#include "br_inline.h"
 #include "br_lugre_kernel.h"
 
 typedef struct {
@@ -66,13 +68,13 @@ static inline int br_model_k_rk4_ok(const br_model_k_t *k, float omega, float gp
     return k->s0Lh * fabsf(omega) <= BR_MODEL_RK4_AH_MAX * gp;
 }
 
-/* Classic RK4 on eq. 6 over h with u held. theta does not enter the
- * right-hand side and g_p' = 0, so the stages carry (omega, z) only:
+/* Classic RK4 on eq. 6 over h with u held (br_model_step's). theta does not
+ * enter the right-hand side and g_p' = 0, so the stages carry (omega, z) only:
  * theta' of a stage is its omega, and g_p comes out unchanged.
  * Returns 1 when a h is inside the RK4 limit at both ends of the step
  * (the result is then the step), 0 when the caller must use the bounded
  * scheme instead. */
-static inline int br_model_k_rk4(const br_model_k_t *k, const float x[BR_NX], float u, float out[BR_NX])
+BR_INLINE int br_model_k_rk4(const br_model_k_t *k, const float x[BR_NX], float u, float out[BR_NX])
 {
     const float w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z], gp = x[BR_X_GP];
     /* stage 1 at x */
@@ -95,7 +97,89 @@ static inline int br_model_k_rk4(const br_model_k_t *k, const float x[BR_NX], fl
     out[BR_X_OMEGA] = w0 + k->h_6 * (wd1 + 2.0f * wd2 + 2.0f * wd3 + wd4);
     out[BR_X_Z] = z0 + k->h_6 * (zd1 + 2.0f * zd2 + 2.0f * zd3 + zd4);
     out[BR_X_GP] = gp;
-    return br_model_k_rk4_ok(k, w0, gp) && br_model_k_rk4_ok(k, out[BR_X_OMEGA], gp);
+    /* & rather than &&: no branch, so that a loop over particles vectorises */
+    return br_model_k_rk4_ok(k, w0, gp) & br_model_k_rk4_ok(k, out[BR_X_OMEGA], gp);
+}
+
+/* ---- The particle filter's RK4 (BR_PF_ONE_DIVISION) ----
+ * The same classic RK4 of eq. 6 over h with u held, in the form with the
+ * fewest operations per stage: each particle carries k_p = sigma0 L / g_p
+ * (its one division, made when g_p changes), and the constants are folded:
+ *   eq. 4:          dz/dt     = L omega - k_p |omega| z            (L > 0)
+ *   eqs. 3, 6:      domega/dt = u/Jeff - (L^2 sigma2/Jeff) omega
+ *                               - (L sigma0/Jeff) z - (L sigma1/Jeff) dz/dt
+ *   combination:    x + (h/6 (k1 + k4) + h/3 (k2 + k3))
+ *   RK4 limit:      a h = k_p |omega| h <= 2  <=>  k_p |omega| <= 2 / h.
+ * It rounds differently from br_model_k_rk4 (an ulp or so per operation), so
+ * the PF's tuned variances belong to it (docs/modules/pf.md). */
+typedef struct {
+    float L;      /* lead, m/rad */
+    float a;      /* u / Jeff */
+    float cw;     /* L^2 sigma2 / Jeff */
+    float cz;     /* L sigma0 / Jeff */
+    float czd;    /* L sigma1 / Jeff */
+    float h, h_half, h_6, h_3;
+    float ah_lim; /* BR_MODEL_RK4_AH_MAX / h */
+} br_model_kp_t;
+
+/* the constants for a step with torque u */
+static inline br_model_kp_t br_model_kp(const br_model_t *m, float u)
+{
+    const float L = m->cfg.lead_mprad, ij = m->inv_Jeff, h = m->cfg.dt_s;
+    const br_model_kp_t k = {L,
+                             u * ij,
+                             m->visc_Nmsprad * ij,
+                             (L * m->cfg.lugre.sigma0_Npm) * ij,
+                             (L * m->cfg.lugre.sigma1_Nspm) * ij,
+                             h,
+                             0.5f * h,
+                             h / 6.0f,
+                             h / 3.0f,
+                             BR_MODEL_RK4_AH_MAX / h};
+    return k;
+}
+
+/* k_p = sigma0 L / g_p of a particle: the step's one division */
+static inline float br_model_kp_of(const br_model_t *m, float gp)
+{
+    return (m->cfg.lugre.sigma0_Npm * m->cfg.lead_mprad) / gp;
+}
+
+/* eq. 4 with k_p: L omega - k_p |omega| z */
+static inline float br_model_kp_zdot(float L, float kp, float omega, float z)
+{
+    return L * omega - (kp * fabsf(omega)) * z;
+}
+
+/* RK4 of the particle (theta, omega, z, g_p) with its k_p; returns 1 when
+ * a h is inside the RK4 limit at both ends of the step (as br_model_k_rk4) */
+BR_INLINE int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX])
+{
+    const float L = k->L, hh = k->h_half;
+    const float w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z];
+    /* stage 1 at x */
+    const float kw1 = kp * fabsf(w0);
+    const float zd1 = L * w0 - kw1 * z0;
+    const float wd1 = ((k->a - k->cw * w0) - k->cz * z0) - k->czd * zd1;
+    /* stage 2 at x + h/2 k1 */
+    const float w2 = w0 + hh * wd1, z2 = z0 + hh * zd1;
+    const float zd2 = br_model_kp_zdot(L, kp, w2, z2);
+    const float wd2 = ((k->a - k->cw * w2) - k->cz * z2) - k->czd * zd2;
+    /* stage 3 at x + h/2 k2 */
+    const float w3 = w0 + hh * wd2, z3 = z0 + hh * zd2;
+    const float zd3 = br_model_kp_zdot(L, kp, w3, z3);
+    const float wd3 = ((k->a - k->cw * w3) - k->cz * z3) - k->czd * zd3;
+    /* stage 4 at x + h k3 */
+    const float w4 = w0 + k->h * wd3, z4 = z0 + k->h * zd3;
+    const float zd4 = br_model_kp_zdot(L, kp, w4, z4);
+    const float wd4 = ((k->a - k->cw * w4) - k->cz * z4) - k->czd * zd4;
+    /* x + (h/6 (k1 + k4) + h/3 (k2 + k3)) */
+    out[BR_X_THETA] = x[BR_X_THETA] + (k->h_6 * (w0 + w4) + k->h_3 * (w2 + w3));
+    out[BR_X_OMEGA] = w0 + (k->h_6 * (wd1 + wd4) + k->h_3 * (wd2 + wd3));
+    out[BR_X_Z] = z0 + (k->h_6 * (zd1 + zd4) + k->h_3 * (zd2 + zd3));
+    out[BR_X_GP] = x[BR_X_GP];
+    /* & rather than &&: no branch, so that a loop over particles vectorises */
+    return (kw1 <= k->ah_lim) & (kp * fabsf(out[BR_X_OMEGA]) <= k->ah_lim);
 }
 
 /* ---- The extended model (causes on; docs/modules/model.md, "Extended model") ----
@@ -115,6 +199,7 @@ typedef struct {
     float s2_neg;    /* sigma2 + dsigma2_neg */
     float off;       /* offset, N */
     float grad;      /* gradient, 1/m */
+    float ks;        /* friction_drift: s(t) = max(0, 1 + drift t) at the model's clock (1 without) */
     float kL;        /* 2 pi L / P: ripple phase per radian of theta (0 without ripple) */
     float rs, rc;    /* A sin(phi0), A cos(phi0), phi0 = 2 pi p0 / P + phase */
 } br_model_kx_t;
@@ -131,6 +216,7 @@ static inline br_model_kx_t br_model_kx(const br_model_t *m, float p0_m)
     k.s2_neg = m->sigma2_neg_Nspm;
     k.off = c->offset_N;
     k.grad = c->grad_per_m;
+    k.ks = m->drift_k;
     k.kL = m->ripple_k_radpm * m->cfg.lead_mprad;
     k.rs = 0.0f;
     k.rc = 0.0f;
@@ -152,19 +238,20 @@ static inline float br_model_kx_ripple_N(const br_model_kx_t *k, float th)
 }
 
 /* The load force of the extended model at (theta, omega, z, g_p), N, and the
- * bristle rate in *zd: eq. 4 with the level c g_p for bristles deflected
- * towards -x (z < 0), eq. 3, then
- * k(p) (sigma2_d v + f_nl) + offset + ripple, k(p) = max(0, 1 + grad p). */
+ * bristle rate in *zd: eq. 4 with the level c g_p moving towards -x (v < 0),
+ * eq. 3, then
+ * k(p) s(t) (sigma2_d v + f_nl) + offset + ripple, k(p) = max(0, 1 + grad p),
+ * s(t) = max(0, 1 + drift t) held over the step (the model's clock). */
 static inline float br_model_kx_load_N(const br_model_kx_t *k, float th, float w, float z, float gp, float *zd)
 {
     const float v = k->n.L * w;
     const int neg = v < 0.0f;
-    /* the level by the direction the bristles are deflected (the sliding
-     * direction once they are loaded): continuous through a reversal, where
-     * z crosses 0 and the level's term sigma0 |v| z / g vanishes */
-    *zd = br_lk_zdot_mps(k->n.s0, v, z, (z < 0.0f) ? k->c_neg * gp : gp);
+    /* the level by the direction of motion, as the Stribeck curve g(v) of
+     * eq. 5 and the plant: continuous through a reversal, where v crosses 0
+     * and the level's term sigma0 |v| z / g vanishes */
+    *zd = br_lk_zdot_mps(k->n.s0, v, z, neg ? k->c_neg * gp : gp);
     const float f = br_lk_force_N(k->n.s0, k->n.s1, z, *zd);
-    const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + k->n.L * th));
+    const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + k->n.L * th)) * k->ks;
     return kp * ((neg ? k->s2_neg : k->s2) * v + f) + k->off + br_model_kx_ripple_N(k, th);
 }
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Sinusoidal axis reference with a Q0.64 phase accumulator, float32.
  * See bristle/br_refgen.h and docs/modules/refgen.md. */
 #include "bristle/br_refgen.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Unscented Kalman filter for the friction of one axis, float32. See br_ukf.h
  * and docs/modules/ukf.md. */
 #include "bristle/br_ukf.h"
@@ -73,6 +74,8 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->wi = wi;
     ukf->cmm = cfg->beta - cfg->alpha * cfg->alpha;
     ukf->out_s2 = cfg->est.outlier_sigma * cfg->est.outlier_sigma;
+    /* the encoder's quantisation variance rpc^2 / 12 (a uniform error over one count) */
+    ukf->quant_var_rad2 = cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f);
     ukf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
     br_est_delay_init(&ukf->delay, &cfg->est);
     for (int i = 0; i < BR_NX; i++) {
@@ -236,6 +239,7 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
 static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[BR_NX], float Pm[BR_NX][BR_NX], int *chol_reset)
 {
     const float p0 = (float)ukf->origin_counts * ukf->m_per_count; /* theta's origin */
+    br_model_tick(&ukf->model); /* the model's clock moves on by one period (friction_drift) */
     *chol_reset = sigma_points(ukf, ukf->x, ukf->P) != BR_OK;
     for (int s = 0; s < BR_UKF_NSIG; s++) {
         if (br_model_step_at(&ukf->model, ukf->X[s], p0, u_prev_Nm, ukf->Y[s]) != BR_OK) {
@@ -364,7 +368,9 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     }
     br_status_t verdict = BR_OK;
     int32_t origin_new = y->counts;
-    if (nu * nu > ukf->out_s2 * S) {
+    /* gate (docs/modules/ukf.md): outlier when nu^2 > g^2 (P-_00 + R + rpc^2 / 12),
+     * the innovation's variance with the encoder's quantisation */
+    if (nu * nu > ukf->out_s2 * (S + ukf->quant_var_rad2)) {
         /* outlier: keep the prediction in the old origin's frame, no update */
         verdict = BR_W_OUTLIER;
         origin_new = ukf->origin_counts;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Golden references of the bristle numerics, float64, written from the
 algorithm descriptions (docs/golden.md), independently of the C sources.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Gain-matrix state feedback with integral action (thesis eq. 7), float64
 golden reference of one control period.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Four-state estimation model of one ball-screw axis (thesis eq. 6),
 float64 golden reference.
 
@@ -135,18 +136,20 @@ def step(p, x, u, h):
 # Extended model: the causes of a diagnosis (docs/modules/model.md, "Extended
 # model"), written from the equations, not from the C kernel. theta is
 # relative to an origin at load position p0, so the load position is
-# pos = p0 + L theta and the load velocity v = L omega:
+# pos = p0 + L theta and the load velocity v = L omega; t is the time since
+# the estimator started (the model's clock):
 #
-#   Jeff omega' = u - L F,   F = k(pos) (sigma2_d v + f_nl) + offset + A sin(2 pi pos / P + phi)
-#   k(pos) = max(0, 1 + grad pos)
-#   z' = v - sigma0 |v| z / g,  g = g_p for z >= 0, c g_p for z < 0,  c = (Fc + dFc_neg) / Fc
-#        (the level by the direction the bristles are deflected; in a bounded
+#   Jeff omega' = u - L F,   F = k(pos) s(t) (sigma2_d v + f_nl) + offset + A sin(2 pi pos / P + phi)
+#   k(pos) = max(0, 1 + grad pos),  s(t) = max(0, 1 + drift t)
+#   z' = v - sigma0 |v| z / g,  g = g_p for v >= 0, c g_p for v < 0,  c = (Fc + dFc_neg) / Fc
+#        (the level by the direction of motion, as eq. 5's g(v); in a bounded
 #        step, by the direction of the move)
 #   f_nl = sigma0 z + sigma1 z',  sigma2_d = sigma2 (+ dsigma2_neg for v < 0)
 #
 # The force to compensate is F - sigma2 v. The ripple is evaluated exactly
-# here (the C kernel expands it about p0; docs/golden.md bounds the
-# difference).
+# here (the C kernel expands it about p0), and s(t) at each RK4 stage's time
+# (the C kernel holds it over the step at its clock); docs/golden.md bounds
+# both differences.
 # --------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Causes:
@@ -157,6 +160,7 @@ class Causes:
     ripple_period: float = 1.0  # m
     ripple_phase: float = 0.0   # rad
     grad: float = 0.0         # 1/m
+    drift: float = 0.0        # 1/s
 
     def level_factor(self, p, d):
         """The Stribeck level's factor for a deflection or move d: 1 towards
@@ -164,45 +168,46 @@ class Causes:
         return (p.lugre.Fc + self.dFc_neg) / p.lugre.Fc if d < 0.0 else 1.0
 
 
-def load_force_ext(p, c, pos, w, z, gp):
-    """(F, z') of the extended model at load position pos."""
+def load_force_ext(p, c, pos, w, z, gp, t=0.0):
+    """(F, z') of the extended model at load position pos and time t."""
     s0, s1, L = p.lugre.sigma0, p.lugre.sigma1, p.L
     v = L * w
-    g = c.level_factor(p, z) * gp
+    g = c.level_factor(p, v) * gp
     zd = v - s0 * abs(v) * z / g
     f = s0 * z + s1 * zd
-    k = max(0.0, 1.0 + c.grad * pos)
+    k = max(0.0, 1.0 + c.grad * pos) * max(0.0, 1.0 + c.drift * t)
     s2 = p.sigma2 + (c.dsigma2_neg if v < 0.0 else 0.0)
     ripple = c.ripple_amp * math.sin(2.0 * math.pi * pos / c.ripple_period + c.ripple_phase)
     return k * (s2 * v + f) + c.offset + ripple, zd
 
 
-def fcomp_ext(p, c, p0, x):
-    """The force a compensation must cancel: F - sigma2 v."""
+def fcomp_ext(p, c, p0, x, t=0.0):
+    """The force a compensation must cancel at time t: F - sigma2 v."""
     th, w, z, gp = (float(v) for v in x)
-    F, _ = load_force_ext(p, c, p0 + p.L * th, w, z, gp)
+    F, _ = load_force_ext(p, c, p0 + p.L * th, w, z, gp, t)
     return F - p.sigma2 * p.L * w
 
 
-def deriv_ext(p, c, p0, x, u):
+def deriv_ext(p, c, p0, x, u, t=0.0):
     th, w, z, gp = (float(v) for v in x)
-    F, zd = load_force_ext(p, c, p0 + p.L * th, w, z, gp)
+    F, zd = load_force_ext(p, c, p0 + p.L * th, w, z, gp, t)
     return np.array([w, (u - p.L * F) / p.Jeff, zd, 0.0], dtype=np.float64)
 
 
-def rk4_ext(p, c, p0, x, u, h):
+def rk4_ext(p, c, p0, x, u, h, t=0.0):
+    """RK4 from time t, each stage at its own time."""
     x = np.asarray(x, dtype=np.float64)
-    k1 = deriv_ext(p, c, p0, x, u)
-    k2 = deriv_ext(p, c, p0, x + (h / 2.0) * k1, u)
-    k3 = deriv_ext(p, c, p0, x + (h / 2.0) * k2, u)
-    k4 = deriv_ext(p, c, p0, x + h * k3, u)
+    k1 = deriv_ext(p, c, p0, x, u, t)
+    k2 = deriv_ext(p, c, p0, x + (h / 2.0) * k1, u, t + h / 2.0)
+    k3 = deriv_ext(p, c, p0, x + (h / 2.0) * k2, u, t + h / 2.0)
+    k4 = deriv_ext(p, c, p0, x + h * k3, u, t + h)
     return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
-def bounded_ext(p, c, p0, x, u, h):
+def bounded_ext(p, c, p0, x, u, h, t=0.0):
     """B2 with the causes: the level and sigma2_d by the direction of the move,
-    the friction impulse scaled by k, the offset and ripple impulses added; k
-    and the ripple at the middle of the move."""
+    the friction impulse scaled by k s, the offset and ripple impulses added; k
+    and the ripple at the middle of the move, s at the middle of the step."""
     theta, w, z, gp = (float(v) for v in x)
     s0, s1, L = p.lugre.sigma0, p.lugre.sigma1, p.L
     wm = w
@@ -220,7 +225,7 @@ def bounded_ext(p, c, p0, x, u, h):
             z1 = z
             zint = z * h
         pos = p0 + L * (theta + 0.5 * dth)
-        k = max(0.0, 1.0 + c.grad * pos)
+        k = max(0.0, 1.0 + c.grad * pos) * max(0.0, 1.0 + c.drift * (t + 0.5 * h))
         s2 = p.sigma2 + (c.dsigma2_neg if dx < 0.0 else 0.0)
         ripple = c.ripple_amp * math.sin(2.0 * math.pi * pos / c.ripple_period + c.ripple_phase)
         imp = k * (s2 * dx + s0 * zint + s1 * (z1 - z)) + (c.offset + ripple) * h
@@ -235,12 +240,12 @@ def ah_ext(p, c, w, gp, h):
     return p.lugre.sigma0 * p.L * abs(w) * h / (cmin * gp)
 
 
-def step_ext(p, c, p0, x, u, h):
-    """br_model_step_at of the extended model: (status, x_next, branch)."""
+def step_ext(p, c, p0, x, u, h, t=0.0):
+    """br_model_step_at of the extended model from time t: (status, x_next, branch)."""
     x = np.asarray(x, dtype=np.float64)
     if not (np.all(np.isfinite(x)) and math.isfinite(u) and math.isfinite(p0)) or not x[3] > 0.0:
         return BR_E_INPUT, x.copy(), BRANCH_INVALID
-    x1 = rk4_ext(p, c, p0, x, u, h)
+    x1 = rk4_ext(p, c, p0, x, u, h, t)
     if ah_ext(p, c, x[1], x[3], h) <= RK4_AH_MAX and ah_ext(p, c, x1[1], x[3], h) <= RK4_AH_MAX:
         return BR_OK, x1, BRANCH_RK4
-    return BR_OK, bounded_ext(p, c, p0, x, u, h), BRANCH_BOUNDED
+    return BR_OK, bounded_ext(p, c, p0, x, u, h, t), BRANCH_BOUNDED

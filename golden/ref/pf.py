@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Particle filter for the friction of one axis (thesis sections 2.3, 4),
 float64 golden reference, written from the description in
 firmware/include/bristle/br_pf.h (not from br_pf.c).
@@ -19,7 +20,8 @@ One step with y_k = (counts, frac) and the torque u_{k-1} of the last period:
                 A particle whose model step fails or that is non-finite (or whose
                 f_nl is) is invalid: it keeps its previous state and weight 0.
     2. weigh    l_j = -(theta_j - y)^2 / (2 R),  w_j = exp(l_j - max l)   (valid j)
-                max l < -outlier_sigma^2 / 2 (y further than outlier_sigma sqrt(R)
+                max l < -outlier_sigma^2 (R + rpc^2/12) / (2 R) (y further than
+                outlier_sigma sqrt(R + rpc^2/12), R with the encoder's quantisation,
                 from every particle): outlier, every valid particle gets w = 1.
     3. quantise W_j = floor(w_j 2^16)          (integers, the best particle 2^16)
     4. resample particle i copies j with C_{j-1} <= xi_i C_m < C_j,
@@ -178,7 +180,7 @@ class Pf:
         if lmax == -math.inf:
             self.W = self.idx = None
             return BR_E_NUMERIC
-        outlier = lmax < -0.5 * c.outlier_sigma ** 2
+        outlier = lmax < -0.5 * c.outlier_sigma ** 2 * (c.r_var + rpc * rpc / 12.0) / c.r_var
         w = [0.0 if lj == -math.inf else (1.0 if outlier else math.exp(lj - lmax)) for lj in l]
         W = [int(math.floor(wj * 2.0 ** W_BITS)) for wj in w]
         idx = resample_idx(W)

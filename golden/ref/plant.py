@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Double-precision plant of one ball-screw axis (thesis eqs. 1-5), float64
 golden reference of sim/plant.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Unscented Kalman filter for the friction of one axis (thesis sections 2.3, 4),
 float64 golden reference, written from firmware/include/bristle/br_ukf.h and
 docs/modules/ukf.md (not from br_ukf.c).
@@ -17,9 +18,9 @@ One step with y_k = (counts, frac) and u_{k-1}:
  2. Y_j = f_d(X_j, u); x- = sum Wm_j Y_j; P- = sum Wc_j (Y_j - x-)(Y_j - x-)^T + Q
     (the standard form here; the C evaluates the same sum expanded about Y_0)
  3. theta- -= wrapdiff(counts, origin) rpc; nu = frac rpc - theta-; S = P-_00 + R
- 4. nu^2 > outlier_sigma^2 S: outlier. (x, P) = the prediction in the old
-    origin's frame, no update; from the reanchor_after-th consecutive outlier
-    on: re-anchored: origin = counts, x = [frac rpc, (wrapdiff(counts,
+ 4. nu^2 > outlier_sigma^2 (S + rpc^2/12) (with the encoder's quantisation):
+    outlier. (x, P) = the prediction in the old origin's frame, no update; from
+    the reanchor_after-th consecutive outlier on: re-anchored: origin = counts, x = [frac rpc, (wrapdiff(counts,
     prev_counts) + frac - frac_prev) rpc / dt, z, g_p], P = diag(p0_var).
  5. else the linear Kalman update (h(x) = theta): K = P-[:, 0] / S,
     x = x- + K nu, P = (I - K H) P- (I - K H)^T + K R K^T, symmetrised;
@@ -169,7 +170,8 @@ class Ukf:
         th_new = xm[0] - delta * rpc
         nu = frac * rpc - th_new
         S = Pm[0][0] + c.r_var
-        if nu * nu > c.outlier_sigma ** 2 * S:
+        # the gate: the innovation's variance with the encoder's quantisation rpc^2/12
+        if nu * nu > c.outlier_sigma ** 2 * (S + rpc * rpc / 12.0):
             # 4. outlier: the prediction, old frame; re-anchoring after a run
             status_o = BR_W_OUTLIER
             x_new, P_new, origin_new = xm, Pm, self.origin

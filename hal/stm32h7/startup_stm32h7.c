@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Startup for the STM32H743 (Cortex-M7): vector table and Reset_Handler.
  *
  * Reset_Handler, in order: enables the FPU (CPACR CP10/CP11 full access, with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* br_circle_ext: the gain of a diagnosis in control terms. The thesis circle
  * on the reference machine with causes switched on (the "hidden" ones), with
  * H-inf only, with H-inf + an estimator on the nominal model (the firmware's
@@ -24,8 +25,14 @@
 
 static int usage(const char *argv0, FILE *to)
 {
-    fprintf(to, "usage: %s [--model MODEL.json] [--est ukf|pf] [--json OUT] [--offset F] [--asym DFC,DFV]\n"
-                "       [--ripple A,P[,PH]] [--gradient S] [--delay D]\n", argv0);
+    fprintf(to,
+            "usage: %s [--model MODEL.json] [--est ukf|pf] [--json OUT] [--offset F] [--asym DFC,DFV]\n"
+            "       [--ripple A,P[,PH]] [--gradient S] [--delay D] [--drift R]\n" BR_ARGS_COMMON_USAGE
+            "  --model MODEL.json  a diagnosis's saved model: adds the extended-model run\n"
+            "  --est ukf|pf        the estimator beside H-inf (default ukf)\n"
+            "  --json OUT          write the runs' figures to OUT as well\n"
+            "  cause options       switch causes on in the plant (docs/simlog.md)\n",
+            argv0, argv0);
     return 2;
 }
 
@@ -33,25 +40,29 @@ int main(int argc, char **argv)
 {
     const char *model = NULL, *json = NULL, *est = "ukf";
     br_plant_cfg_t plant = br_plant_cfg_reference();
-    if (br_args_want_help(argc, argv)) {
+    static const struct option opts[] = {{"model", required_argument, NULL, 'm'},
+                                         {"json", required_argument, NULL, 'j'},
+                                         {"est", required_argument, NULL, 'e'},
+                                         BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
+    br_args_t p;
+    const int args = br_args_begin(&p, TOOL, argc, argv);
+    if (args == BR_ARGS_HELP) {
         usage(argv[0], stdout);
         return 0;
     }
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!val) {
-            fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
-            return usage(argv[0], stderr);
-        }
-        i++;
-        const int ca = br_cause_arg(a, val, &plant);
-        if (ca < 0) return 2;
-        if (ca > 0) continue;
-        if (strcmp(a, "--model") == 0) model = val;
-        else if (strcmp(a, "--json") == 0) json = val;
-        else if (strcmp(a, "--est") == 0 && (strcmp(val, "ukf") == 0 || strcmp(val, "pf") == 0)) est = val;
+    if (args == BR_ARGS_VERSION) {
+        br_args_print_version(TOOL, stdout);
+        return 0;
+    }
+    const char *val;
+    for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
+        if (c == BR_CAUSE_OPT) {
+            if (br_cause_arg(p.opt, val, &plant) < 0) return 2;
+        } else if (c == 'm') model = val;
+        else if (c == 'j') json = val;
+        else if (c == 'e' && (strcmp(val, "ukf") == 0 || strcmp(val, "pf") == 0)) est = val;
         else {
-            fprintf(stderr, "%s: bad option or value: %s %s\n", TOOL, a, val);
+            if (c == 'e') fprintf(stderr, "%s: --est %s: must be ukf or pf\n", TOOL, val);
             return usage(argv[0], stderr);
         }
     }

@@ -1,9 +1,15 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* make demo: the thesis's X-Y circle experiment on the simulator, with each
- * controller of thesis section 5 and the true-friction limit.
+ * controller of thesis section 5, the static friction feedforward and the
+ * true-friction limit; first on the plant the estimators model exactly (the
+ * reference machine), then on the realistic plant (br_circle_cfg_realistic:
+ * parameters away from the model, drift and noise).
  *
  * Usage: br_demo_circle --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N]
  * Writes DIR/trace_<name>.csv per controller, DIR/gp_hist_hinf_pf.csv (the PF's
- * g_p particle histogram per step) and DIR/summary.json; prints the table.
+ * g_p particle histogram per step), the same with the prefix real_ for the
+ * realistic plant, and DIR/summary.json (the realistic plant's under
+ * "realistic"); prints the tables.
  * --gains, --dt and --nsub override the generated H-inf gains, the thesis
  * periods and the plant's substeps (design and accuracy studies), within the
  * bounds of br_tool_limits.h. Every option is checked before a file is
@@ -38,6 +44,7 @@ static const demo_row_t rows[] = {
     {BR_CTRL_HINF_UKF, "H-inf + UKF", 1.3e-6},
     {BR_CTRL_HINF_PF, "H-inf + PF", 4.0e-7},
     {BR_CTRL_HINF_TRUE, "true friction", 0.0},
+    {BR_CTRL_HINF_FF, "H-inf + FF", 0.0},
 };
 #define N_ROWS (sizeof rows / sizeof rows[0])
 
@@ -54,7 +61,7 @@ static void demo_sink(void *user, const br_circle_sample_t *s)
         const br_pf_t *pf = s->pf[a];
         int h[BR_HIST_BINS] = {0};
         for (uint32_t j = 0; j < pf->cfg.n_particles; j++) {
-            int b = (int)((double)pf->x[j][BR_X_GP] / BR_HIST_W_N);
+            int b = (int)((double)pf->x[BR_X_GP][j] / BR_HIST_W_N);
             if (b >= 0 && b < BR_HIST_BINS) h[b]++;
         }
         fprintf(k->hist, "%.6f,%d", s->t_s, a);
@@ -64,15 +71,21 @@ static void demo_sink(void *user, const br_circle_sample_t *s)
 }
 
 /* the outputs, as temporary files until every run succeeded (br_outfile.h) */
+/* the two plants: [0] the reference machine (the estimators' model), [1] the realistic one */
+#define N_PLANTS 2
+static const char *const plant_prefix[N_PLANTS] = {"", "real_"};
+
 typedef struct {
-    br_outfile_t summary, trace[N_ROWS], hist;
+    br_outfile_t summary, trace[N_PLANTS][N_ROWS], hist[N_PLANTS];
 } outputs_t;
 
 static void discard_all(outputs_t *o)
 {
     br_outfile_discard(&o->summary);
-    br_outfile_discard(&o->hist);
-    for (unsigned r = 0; r < N_ROWS; r++) br_outfile_discard(&o->trace[r]);
+    for (int pl = 0; pl < N_PLANTS; pl++) {
+        br_outfile_discard(&o->hist[pl]);
+        for (unsigned r = 0; r < N_ROWS; r++) br_outfile_discard(&o->trace[pl][r]);
+    }
 }
 
 static int open_in(br_outfile_t *f, const char *dir, const char *name)
@@ -88,9 +101,11 @@ static int open_in(br_outfile_t *f, const char *dir, const char *name)
 static int commit_all(outputs_t *o, const int selected[N_ROWS], int pf_selected)
 {
     int rc = 0;
-    for (unsigned r = 0; r < N_ROWS; r++)
-        if (selected[r] && rc == 0) rc = br_outfile_commit(&o->trace[r], TOOL);
-    if (pf_selected && rc == 0) rc = br_outfile_commit(&o->hist, TOOL);
+    for (int pl = 0; pl < N_PLANTS; pl++) {
+        for (unsigned r = 0; r < N_ROWS; r++)
+            if (selected[r] && rc == 0) rc = br_outfile_commit(&o->trace[pl][r], TOOL);
+        if (pf_selected && rc == 0) rc = br_outfile_commit(&o->hist[pl], TOOL);
+    }
     if (rc == 0) rc = br_outfile_commit(&o->summary, TOOL); /* last: its presence says the rest is there */
     return rc;
 }
@@ -106,9 +121,14 @@ typedef struct {
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N]\n"
+            "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N]\n" BR_ARGS_COMMON_USAGE
+            "  --out DIR           where summary.json and the traces go\n"
+            "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
+            "  --gains K0,K1,K2    the H-inf gains instead of the generated ones\n"
+            "  --dt S              control period\n"
+            "  --nsub N            plant substeps per period\n"
             "bounds: --dt %g .. %g s, --nsub 1 .. %d, |gain| <= %g (docs/tools.md)\n",
-            argv0, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX, BR_TOOL_GAIN_MAX);
+            argv0, argv0, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX, BR_TOOL_GAIN_MAX);
     return 2;
 }
 
@@ -121,30 +141,33 @@ static int parse_gains(const char *val, float K[3])
     return 0;
 }
 
-/* every option checked: 0, 1 (--help) or 2 (usage error, message printed) */
+/* every option checked: 0, 1 (--help), 3 (--version) or 2 (usage error, message printed) */
 static int parse(int argc, char **argv, opts_t *o)
 {
-    if (br_args_want_help(argc, argv)) return 1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (i + 1 >= argc) {
-            fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
-            return 2;
-        }
-        const char *val = argv[++i];
+    static const struct option opts[] = {{"out", required_argument, NULL, 'o'},
+                                         {"only", required_argument, NULL, 'y'},
+                                         {"gains", required_argument, NULL, 'g'},
+                                         {"dt", required_argument, NULL, 'd'},
+                                         {"nsub", required_argument, NULL, 'n'},
+                                         {NULL, 0, NULL, 0}};
+    br_args_t p;
+    const int st = br_args_begin(&p, TOOL, argc, argv);
+    if (st != BR_ARGS_RUN) return st == BR_ARGS_HELP ? 1 : 3;
+    const char *val;
+    for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
         int bad = 0;
-        if (strcmp(a, "--out") == 0) o->out = val;
-        else if (strcmp(a, "--only") == 0) o->only = val;
-        else if (strcmp(a, "--gains") == 0) {
+        switch (c) {
+        case 'o': o->out = val; break;
+        case 'y': o->only = val; break;
+        case 'g':
             o->have_gains = 1;
             bad = parse_gains(val, o->K);
             if (bad) fprintf(stderr, "%s: --gains %s: three comma-separated numbers, |K| <= %g\n", TOOL, val,
                              BR_TOOL_GAIN_MAX);
-        } else if (strcmp(a, "--dt") == 0) bad = br_arg_double(TOOL, a, val, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, &o->dt);
-        else if (strcmp(a, "--nsub") == 0) bad = br_arg_long(TOOL, a, val, 1, BR_TOOL_NSUB_MAX, &o->nsub);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", TOOL, a);
-            bad = 1;
+            break;
+        case 'd': bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, &o->dt); break;
+        case 'n': bad = br_arg_long(TOOL, p.opt, val, 1, BR_TOOL_NSUB_MAX, &o->nsub); break;
+        default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
     }
@@ -176,6 +199,10 @@ int main(int argc, char **argv)
         usage(argv[0], stdout);
         return 0;
     }
+    if (p == 3) {
+        br_args_print_version(TOOL, stdout);
+        return 0;
+    }
     if (p != 0) return usage(argv[0], stderr);
     const char *out = opt.out;
     if (mkdir(out, 0775) != 0 && errno != EEXIST) {
@@ -185,16 +212,19 @@ int main(int argc, char **argv)
     int selected[N_ROWS] = {0}, pf_selected = 0;
     static outputs_t o; /* zeroed: nothing open */
     int rc = open_in(&o.summary, out, "summary.json");
-    for (unsigned r = 0; r < N_ROWS && rc == 0; r++) {
-        const char *name = br_circle_ctrl_name(rows[r].ctrl);
-        selected[r] = !opt.only || strcmp(opt.only, name) == 0;
-        if (!selected[r]) continue;
-        char fname[256];
-        snprintf(fname, sizeof fname, "trace_%s.csv", name);
-        rc = open_in(&o.trace[r], out, fname);
-        if (rc == 0 && rows[r].ctrl == BR_CTRL_HINF_PF) {
-            pf_selected = 1;
-            rc = open_in(&o.hist, out, "gp_hist_hinf_pf.csv");
+    for (int pl = 0; pl < N_PLANTS; pl++) {
+        for (unsigned r = 0; r < N_ROWS && rc == 0; r++) {
+            const char *name = br_circle_ctrl_name(rows[r].ctrl);
+            selected[r] = !opt.only || strcmp(opt.only, name) == 0;
+            if (!selected[r]) continue;
+            char fname[256];
+            snprintf(fname, sizeof fname, "trace_%s%s.csv", plant_prefix[pl], name);
+            rc = open_in(&o.trace[pl][r], out, fname);
+            if (rc == 0 && rows[r].ctrl == BR_CTRL_HINF_PF) {
+                pf_selected = 1;
+                snprintf(fname, sizeof fname, "gp_hist_%shinf_pf.csv", plant_prefix[pl]);
+                rc = open_in(&o.hist[pl], out, fname);
+            }
         }
     }
     if (rc != 0) {
@@ -204,54 +234,77 @@ int main(int argc, char **argv)
     FILE *js = o.summary.f;
     fprintf(js, "{\n  \"experiment\": {\"radius_m\": 1e-4, \"period_s\": 8, \"duration_s\": 8}");
     printf("X-Y circle, radius 1.0e-04 m, period 8 s, 8 s simulated\n");
-    printf("%-14s %8s %16s %16s %16s %12s %12s\n", "controller", "dt [ms]", "contour RMS [m]", "max error [m]",
-           "thesis RMS [m]", "/ H-inf only", "F err [N]");
-    double rms_hinf = 0.0;
-    for (unsigned r = 0; r < N_ROWS; r++) {
-        if (!selected[r]) continue;
-        const char *name = br_circle_ctrl_name(rows[r].ctrl);
-        br_circle_cfg_t cfg = br_circle_cfg_thesis(rows[r].ctrl);
-        if (opt.have_gains) memcpy(cfg.K, opt.K, sizeof opt.K);
-        if (opt.dt > 0.0) {
-            cfg.dt_s = opt.dt;
-            cfg.pf.est.model.dt_s = (float)opt.dt;
-            cfg.ukf.est.model.dt_s = (float)opt.dt;
+    for (int pl = 0; pl < N_PLANTS; pl++) {
+        const char *ind = pl == 0 ? "  " : "    ";
+        if (pl == 0) {
+            printf("plant = the estimators' and the feedforward's model (the reference machine's numbers):"
+                   " the best case, docs/demo.md\n");
+        } else {
+            const br_circle_cfg_t rc0 = br_circle_cfg_realistic(BR_CTRL_HINF_ONLY);
+            const br_plant_cfg_t *rp = &rc0.plant;
+            printf("\nrealistic plant (docs/demo.md): the models stay the reference machine's; the plant has "
+                   "sigma0 x0.6, sigma1 x1.5, Fc x1.12, Fs x0.90, vs x1.8, sigma2 x1.15, mass x1.05,\n"
+                   "friction drift %+.0f %% over the run, force noise %.2g N per period, encoder one count off "
+                   "with probability %.0e\n",
+                   100.0 * rc0.real.drift_frac, rc0.real.force_noise_N, rc0.real.enc_noise_p);
+            fprintf(js,
+                    ",\n  \"realistic\": {\n    \"plant\": {\"sigma0_Npm\": %.6g, \"sigma1_Nspm\": %.6g, "
+                    "\"Fc_N\": %.6g, \"Fs_N\": %.6g, \"vs_mps\": %.6g, \"sigma2_Nspm\": %.6g, \"J_kgm2\": %.6g, "
+                    "\"M_kg\": %.6g, \"drift_frac\": %.6g, \"force_noise_N\": %.6g, \"enc_noise_p\": %.6g, "
+                    "\"seed\": %llu}",
+                    rp->sigma0_Npm, rp->sigma1_Nspm, rp->Fc_N, rp->Fs_N, rp->vs_mps, rp->sigma2_Nspm, rp->J_kgm2,
+                    rp->M_kg, rc0.real.drift_frac, rc0.real.force_noise_N, rc0.real.enc_noise_p, rc0.real.seed);
         }
-        if (opt.nsub > 0) cfg.plant.n_sub = (int)opt.nsub;
-        sinks_t k = {o.trace[r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist.f : NULL};
-        br_circle_csv_header(k.trace);
-        if (k.hist)
-            fprintf(k.hist, "# g_p particle histogram per step: t,axis, then %d bins of %g N from 0 N\n",
-                    BR_HIST_BINS, BR_HIST_W_N);
-        br_circle_result_t res;
-        if (br_circle_run(&cfg, demo_sink, &k, &res) != 0) {
-            fprintf(stderr, "%s: run %s failed; nothing written\n", TOOL, name);
-            discard_all(&o);
-            return 1;
+        printf("%-14s %8s %16s %16s %16s %12s %12s\n", "controller", "dt [ms]", "contour RMS [m]", "max error [m]",
+               "thesis RMS [m]", "/ H-inf only", "F err [N]");
+        double rms_hinf = 0.0;
+        for (unsigned r = 0; r < N_ROWS; r++) {
+            if (!selected[r]) continue;
+            const char *name = br_circle_ctrl_name(rows[r].ctrl);
+            br_circle_cfg_t cfg = pl == 0 ? br_circle_cfg_thesis(rows[r].ctrl) : br_circle_cfg_realistic(rows[r].ctrl);
+            if (opt.have_gains) memcpy(cfg.K, opt.K, sizeof opt.K);
+            if (opt.dt > 0.0) {
+                cfg.dt_s = opt.dt;
+                cfg.pf.est.model.dt_s = (float)opt.dt;
+                cfg.ukf.est.model.dt_s = (float)opt.dt;
+            }
+            if (opt.nsub > 0) cfg.plant.n_sub = (int)opt.nsub;
+            sinks_t k = {o.trace[pl][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl].f : NULL};
+            br_circle_csv_header(k.trace);
+            if (k.hist)
+                fprintf(k.hist, "# g_p particle histogram per step: t,axis, then %d bins of %g N from 0 N\n",
+                        BR_HIST_BINS, BR_HIST_W_N);
+            br_circle_result_t res;
+            if (br_circle_run(&cfg, demo_sink, &k, &res) != 0) {
+                fprintf(stderr, "%s: run %s failed; nothing written\n", TOOL, name);
+                discard_all(&o);
+                return 1;
+            }
+            if (!finite_result(&res)) {
+                fprintf(stderr, "%s: run %s gave a non-finite result; nothing written\n", TOOL, name);
+                discard_all(&o);
+                return 1;
+            }
+            if (rows[r].ctrl == BR_CTRL_HINF_ONLY) rms_hinf = res.contour_rms_m;
+            char thesis_js[32] = "null", thesis[32] = "-", ratio[32] = "-";
+            if (rows[r].thesis_rms_m > 0.0) {
+                snprintf(thesis_js, sizeof thesis_js, "%.6e", rows[r].thesis_rms_m);
+                snprintf(thesis, sizeof thesis, "%.3e", rows[r].thesis_rms_m);
+            }
+            char fname[256];
+            snprintf(fname, sizeof fname, "trace_%s%s.csv", plant_prefix[pl], name);
+            fprintf(js,
+                    ",\n%s\"%s\": {\"dt_s\": %.6g, \"contour_rms_m\": %.6e, \"max_err_m\": %.6e, "
+                    "\"thesis_contour_rms_m\": %s, \"fhat_rms_err_N\": %.6e, \"saturated_steps\": %d, "
+                    "\"outlier_steps\": %d, \"trace\": \"%s\"}",
+                    ind, name, cfg.dt_s, res.contour_rms_m, res.max_err_m, thesis_js, res.fhat_rms_err_N,
+                    res.saturated_steps, res.outlier_steps, fname);
+            if (rms_hinf > 0.0) snprintf(ratio, sizeof ratio, "%.3f", res.contour_rms_m / rms_hinf);
+            printf("%-14s %8.1f %16.3e %16.3e %16s %12s %12.3f\n", rows[r].label, cfg.dt_s * 1e3, res.contour_rms_m,
+                   res.max_err_m, thesis, ratio, res.fhat_rms_err_N);
+            fflush(stdout);
         }
-        if (!finite_result(&res)) {
-            fprintf(stderr, "%s: run %s gave a non-finite result; nothing written\n", TOOL, name);
-            discard_all(&o);
-            return 1;
-        }
-        if (rows[r].ctrl == BR_CTRL_HINF_ONLY) rms_hinf = res.contour_rms_m;
-        char thesis_js[32] = "null", thesis[32] = "-", ratio[32] = "-";
-        if (rows[r].thesis_rms_m > 0.0) {
-            snprintf(thesis_js, sizeof thesis_js, "%.6e", rows[r].thesis_rms_m);
-            snprintf(thesis, sizeof thesis, "%.3e", rows[r].thesis_rms_m);
-        }
-        char fname[256];
-        snprintf(fname, sizeof fname, "trace_%s.csv", name);
-        fprintf(js,
-                ",\n  \"%s\": {\"dt_s\": %.6g, \"contour_rms_m\": %.6e, \"max_err_m\": %.6e, "
-                "\"thesis_contour_rms_m\": %s, \"fhat_rms_err_N\": %.6e, \"saturated_steps\": %d, "
-                "\"outlier_steps\": %d, \"trace\": \"%s\"}",
-                name, cfg.dt_s, res.contour_rms_m, res.max_err_m, thesis_js, res.fhat_rms_err_N, res.saturated_steps,
-                res.outlier_steps, fname);
-        if (rms_hinf > 0.0) snprintf(ratio, sizeof ratio, "%.3f", res.contour_rms_m / rms_hinf);
-        printf("%-14s %8.1f %16.3e %16.3e %16s %12s %12.3f\n", rows[r].label, cfg.dt_s * 1e3, res.contour_rms_m,
-               res.max_err_m, thesis, ratio, res.fhat_rms_err_N);
-        fflush(stdout);
+        if (pl == 1) fprintf(js, "\n  }");
     }
     fprintf(js, "\n}\n");
     if (commit_all(&o, selected, pf_selected) != 0) {

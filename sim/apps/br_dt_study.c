@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Sampling-time study (thesis section 3.3, Fig. 2): offline friction
  * estimation by the PF on a logged H-inf-only circle, at periods
  * dt = 0.5 ... 3.0 ms.
@@ -54,8 +55,14 @@ static void log_sink(void *user, const br_circle_sample_t *s)
 
 static int usage(const char *argv0, FILE *to)
 {
-    fprintf(to, "usage: %s [--m-per-ms K | --budget F --cost-ns c] [--seeds S]\n"
-                "bounds: K 1e-3 .. 1e6, F 1e-6 .. 1, c 1e-3 .. 1e9 ns, S 2 .. %d\n", argv0, MAX_SEEDS);
+    fprintf(to,
+            "usage: %s [--m-per-ms K | --budget F --cost-ns c] [--seeds S]\n" BR_ARGS_COMMON_USAGE
+            "  --m-per-ms K        particles per ms of control period\n"
+            "  --budget F          fraction of the period the PF may use, with --cost-ns\n"
+            "  --cost-ns c         cost of one particle step, ns\n"
+            "  --seeds S           noise seeds per period\n"
+            "bounds: K 1e-3 .. 1e6, F 1e-6 .. 1, c 1e-3 .. 1e9 ns, S 2 .. %d\n",
+            argv0, argv0, MAX_SEEDS);
     return 2;
 }
 
@@ -63,22 +70,30 @@ int main(int argc, char **argv)
 {
     double m_per_ms = 1000.0, budget = 0.0, cost_ns = 0.0;
     long seeds = 4;
-    if (br_args_want_help(argc, argv)) {
+    static const struct option opts[] = {{"m-per-ms", required_argument, NULL, 'm'},
+                                         {"budget", required_argument, NULL, 'b'},
+                                         {"cost-ns", required_argument, NULL, 'c'},
+                                         {"seeds", required_argument, NULL, 's'},
+                                         {NULL, 0, NULL, 0}};
+    br_args_t p;
+    const int args = br_args_begin(&p, TOOL, argc, argv);
+    if (args == BR_ARGS_HELP) {
         usage(argv[0], stdout);
         return 0;
     }
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[++i] : NULL;
-        int bad = v == NULL;
-        if (bad) fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
-        else if (strcmp(a, "--m-per-ms") == 0) bad = br_arg_double(TOOL, a, v, 1e-3, 1e6, &m_per_ms);
-        else if (strcmp(a, "--budget") == 0) bad = br_arg_double(TOOL, a, v, 1e-6, 1.0, &budget);
-        else if (strcmp(a, "--cost-ns") == 0) bad = br_arg_double(TOOL, a, v, 1e-3, 1e9, &cost_ns);
-        else if (strcmp(a, "--seeds") == 0) bad = br_arg_long(TOOL, a, v, 2, MAX_SEEDS, &seeds);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", TOOL, a);
-            bad = 1;
+    if (args == BR_ARGS_VERSION) {
+        br_args_print_version(TOOL, stdout);
+        return 0;
+    }
+    const char *v;
+    for (int o; (o = br_args_next(&p, opts, &v)) != BR_ARGS_END;) {
+        int bad = 0;
+        switch (o) {
+        case 'm': bad = br_arg_double(TOOL, p.opt, v, 1e-3, 1e6, &m_per_ms); break;
+        case 'b': bad = br_arg_double(TOOL, p.opt, v, 1e-6, 1.0, &budget); break;
+        case 'c': bad = br_arg_double(TOOL, p.opt, v, 1e-3, 1e9, &cost_ns); break;
+        case 's': bad = br_arg_long(TOOL, p.opt, v, 2, MAX_SEEDS, &seeds); break;
+        default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return usage(argv[0], stderr);
     }

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* One H-inf + PF circle run with a given filter setting, for the studies in
  * sim/studies/ (noise-table length and indexing, later Q/R and dt).
  *
@@ -55,8 +56,16 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s [--table FILE] [--skip N] [--particles M] [--dt S] [--q QTH,QW,QZ,QG] [--r R] [--duration S]\n"
+            BR_ARGS_COMMON_USAGE
+            "  --table FILE        raw little-endian float32 standard-normal samples (2^k); default the ROM table\n"
+            "  --skip N            table samples skipped per draw\n"
+            "  --particles M       number of particles\n"
+            "  --dt S              control period\n"
+            "  --q QTH,QW,QZ,QG    process noise: theta counts^2, omega (rad/s)^2, z m^2, g_p N^2\n"
+            "  --r R               measurement variance, counts^2 (> 0)\n"
+            "  --duration S        length of the circle run\n"
             "bounds: --particles 1 .. %u, --dt %g .. %g s, --duration %g .. %g s (docs/tools.md)\n",
-            argv0, BR_TOOL_PARTICLES_MAX, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_DURATION_MIN_S,
+            argv0, argv0, BR_TOOL_PARTICLES_MAX, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_DURATION_MIN_S,
             BR_TOOL_DURATION_MAX_S);
     return 2;
 }
@@ -80,42 +89,56 @@ int main(int argc, char **argv)
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     const float rpc = c.pf.est.rad_per_count;
     const char *table_path = NULL;
-    if (br_args_want_help(argc, argv)) {
+    static const struct option opts[] = {{"table", required_argument, NULL, 't'},
+                                         {"skip", required_argument, NULL, 's'},
+                                         {"particles", required_argument, NULL, 'p'},
+                                         {"dt", required_argument, NULL, 'd'},
+                                         {"duration", required_argument, NULL, 'D'},
+                                         {"q", required_argument, NULL, 'q'},
+                                         {"r", required_argument, NULL, 'r'},
+                                         {NULL, 0, NULL, 0}};
+    br_args_t p;
+    const int args = br_args_begin(&p, TOOL, argc, argv);
+    if (args == BR_ARGS_HELP) {
         usage(argv[0], stdout);
         return 0;
     }
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = (i + 1 < argc) ? argv[++i] : NULL;
+    if (args == BR_ARGS_VERSION) {
+        br_args_print_version(TOOL, stdout);
+        return 0;
+    }
+    const char *v;
+    for (int o; (o = br_args_next(&p, opts, &v)) != BR_ARGS_END;) {
         long n = 0;
-        int bad = v == NULL;
-        if (bad) {
-            fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
-        } else if (strcmp(a, "--table") == 0) {
-            table_path = v;
-        } else if (strcmp(a, "--skip") == 0) {
-            bad = br_arg_long(TOOL, a, v, 0, BR_TOOL_TABLE_MAX_SAMPLES, &n);
+        int bad = 0;
+        switch (o) {
+        case 't': table_path = v; break;
+        case 's':
+            bad = br_arg_long(TOOL, p.opt, v, 0, BR_TOOL_TABLE_MAX_SAMPLES, &n);
             c.pf.noise_skip = (uint32_t)n;
-        } else if (strcmp(a, "--particles") == 0) {
-            bad = br_arg_long(TOOL, a, v, 1, BR_TOOL_PARTICLES_MAX, &n);
+            break;
+        case 'p':
+            bad = br_arg_long(TOOL, p.opt, v, 1, BR_TOOL_PARTICLES_MAX, &n);
             c.pf.n_particles = (uint32_t)n;
-        } else if (strcmp(a, "--dt") == 0) {
-            bad = br_arg_double(TOOL, a, v, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, &c.dt_s);
+            break;
+        case 'd':
+            bad = br_arg_double(TOOL, p.opt, v, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, &c.dt_s);
             c.pf.est.model.dt_s = (float)c.dt_s;
-        } else if (strcmp(a, "--duration") == 0) {
-            bad = br_arg_double(TOOL, a, v, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &c.duration_s);
-        } else if (strcmp(a, "--q") == 0) {
+            break;
+        case 'D': bad = br_arg_double(TOOL, p.opt, v, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &c.duration_s); break;
+        case 'q': {
             float *q = c.pf.est.q_var;
             bad = parse_variances(v, q, 4);
             q[0] *= rpc * rpc;
             if (bad) fprintf(stderr, "%s: --q %s: four comma-separated numbers >= 0\n", TOOL, v);
-        } else if (strcmp(a, "--r") == 0) {
+            break;
+        }
+        case 'r':
             bad = parse_variances(v, &c.pf.est.r_var_rad2, 1) || c.pf.est.r_var_rad2 <= 0.0f;
             c.pf.est.r_var_rad2 *= rpc * rpc;
             if (bad) fprintf(stderr, "%s: --r %s: a number > 0\n", TOOL, v);
-        } else {
-            fprintf(stderr, "%s: unknown option %s\n", TOOL, a);
-            bad = 1;
+            break;
+        default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return usage(argv[0], stderr);
     }

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* br_simlog: writes a log in the measured-log format (t,ref,pos,force;
  * ../shared/spec/measured-log.md) from the plant simulator, with any of the
  * causes a diagnosis names switched on. docs/simlog.md.
@@ -5,7 +6,7 @@
  * Usage: br_simlog --out FILE [--traj ident|circle] [--cycles N] [--duration S]
  *                  [--seed N] [--force-noise N] [--model MODEL.json]
  *                  [--offset F] [--asym DFC,DFV] [--ripple A,P[,PHASE]]
- *                  [--gradient S] [--delay D] [--machine-out FILE]
+ *                  [--gradient S] [--delay D] [--drift R] [--machine-out FILE]
  *                  [--truth]
  *
  * --machine-out (identification run) writes the position loop as a machine
@@ -29,44 +30,16 @@
 #include "simlog/br_ident.h"
 #include "tools/br_args.h"
 #include "tools/br_outfile.h"
+#include "tools/br_rng.h"
 #include "tools/br_tool_limits.h"
 #include "plant/br_plant_json.h"
 
 #define TOOL "br_simlog"
 #define BR_PI 3.14159265358979323846
 
-/* splitmix64 and Box-Muller: seeded force noise, the same on every machine */
-typedef struct {
-    uint64_t s;
-    int have;
-    double spare;
-} rng_t;
-
-static double rng_uniform(rng_t *r)
-{
-    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return ((double)(z >> 11) + 0.5) / 9007199254740992.0; /* (0, 1) */
-}
-
-static double rng_gauss(rng_t *r)
-{
-    if (r->have) {
-        r->have = 0;
-        return r->spare;
-    }
-    const double u = rng_uniform(r), v = rng_uniform(r);
-    const double m = sqrt(-2.0 * log(u));
-    r->spare = m * sin(2.0 * BR_PI * v);
-    r->have = 1;
-    return m * cos(2.0 * BR_PI * v);
-}
-
 typedef struct {
     FILE *f;
-    rng_t rng;
+    br_rng_t rng;
     double noise_N;
     int truth;
     long nonfinite; /* rows with a non-finite value: the run fails */
@@ -80,7 +53,7 @@ static void write_header(const out_t *o)
 static void write_row(out_t *o, double t, double ref, double pos, double force, double pos_true, double vel_true,
                       double fnl)
 {
-    const double f = o->noise_N > 0.0 ? force + o->noise_N * rng_gauss(&o->rng) : force;
+    const double f = o->noise_N > 0.0 ? force + o->noise_N * br_rng_gauss(&o->rng) : force;
     if (!(isfinite(t) && isfinite(ref) && isfinite(pos) && isfinite(f) && isfinite(pos_true) && isfinite(fnl) &&
           !isinf(vel_true)))
         o->nonfinite++;
@@ -117,9 +90,19 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s --out FILE [--traj ident|circle] [--cycles N] [--duration S] [--seed N]\n"
             "          [--force-noise N] [--model MODEL.json] [--offset F] [--asym DFC,DFV]\n"
-            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--machine-out FILE] [--truth]\n"
+            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--drift R] [--machine-out FILE] [--truth]\n"
+            BR_ARGS_COMMON_USAGE
+            "  --out FILE          the log (CSV t,ref,pos,force; with --truth the plant's truth too)\n"
+            "  --traj ident|circle an identification run (default) or the circle's x axis\n"
+            "  --cycles N          repetitions of the identification moves\n"
+            "  --duration S        length of the circle run\n"
+            "  --seed N            seed of the force noise\n"
+            "  --force-noise N     standard deviation of the noise on the logged force\n"
+            "  --model MODEL.json  the plant from a diagnosis's saved model\n"
+            "  --machine-out FILE  the run's machine file (ident only)\n"
+            "  cause options       switch causes on in the plant (docs/simlog.md)\n"
             "bounds: --cycles 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N (docs/tools.md)\n",
-            argv0, BR_TOOL_CYCLES_MAX, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
+            argv0, argv0, BR_TOOL_CYCLES_MAX, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
     return 2;
 }
 
@@ -142,36 +125,39 @@ typedef struct {
     br_plant_cfg_t causes;
 } opts_t;
 
-/* every option checked: 0, 1 (--help), or 2 (usage error, message printed) */
+/* every option checked: 0, 1 (--help), 3 (--version) or 2 (usage error, message printed) */
 static int parse(int argc, char **argv, opts_t *o)
 {
-    if (br_args_want_help(argc, argv)) return 1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "--truth") == 0) {
-            o->truth = 1;
-            continue;
-        }
-        if (!val) {
-            fprintf(stderr, "%s: %s needs a value\n", TOOL, a);
-            return 2;
-        }
-        i++;
-        const int ca = br_cause_arg(a, val, &o->causes);
+    static const struct option opts[] = {{"truth", no_argument, NULL, 't'},
+                                         {"out", required_argument, NULL, 'o'},
+                                         {"traj", required_argument, NULL, 'j'},
+                                         {"model", required_argument, NULL, 'm'},
+                                         {"machine-out", required_argument, NULL, 'M'},
+                                         {"cycles", required_argument, NULL, 'c'},
+                                         {"seed", required_argument, NULL, 's'},
+                                         {"duration", required_argument, NULL, 'd'},
+                                         {"force-noise", required_argument, NULL, 'n'},
+                                         BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
+    br_args_t p;
+    const int st = br_args_begin(&p, TOOL, argc, argv);
+    if (st != BR_ARGS_RUN) return st == BR_ARGS_HELP ? 1 : 3;
+    const char *val;
+    for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
         int bad = 0;
-        if (ca != 0) bad = ca < 0;
-        else if (strcmp(a, "--out") == 0) o->out = val;
-        else if (strcmp(a, "--traj") == 0) o->traj = val;
-        else if (strcmp(a, "--model") == 0) o->model = val;
-        else if (strcmp(a, "--machine-out") == 0) o->machine_out = val;
-        else if (strcmp(a, "--cycles") == 0) bad = br_arg_long(TOOL, a, val, 1, BR_TOOL_CYCLES_MAX, &o->cycles);
-        else if (strcmp(a, "--seed") == 0) bad = br_arg_long(TOOL, a, val, 0, LONG_MAX, &o->seed);
-        else if (strcmp(a, "--duration") == 0)
-            bad = br_arg_double(TOOL, a, val, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &o->duration);
-        else if (strcmp(a, "--force-noise") == 0) bad = br_arg_double(TOOL, a, val, 0.0, BR_TOOL_NOISE_MAX_N, &o->noise);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", TOOL, a);
-            bad = 1;
+        switch (c) {
+        case BR_CAUSE_OPT: bad = br_cause_arg(p.opt, val, &o->causes) < 0; break;
+        case 't': o->truth = 1; break;
+        case 'o': o->out = val; break;
+        case 'j': o->traj = val; break;
+        case 'm': o->model = val; break;
+        case 'M': o->machine_out = val; break;
+        case 'c': bad = br_arg_long(TOOL, p.opt, val, 1, BR_TOOL_CYCLES_MAX, &o->cycles); break;
+        case 's': bad = br_arg_long(TOOL, p.opt, val, 0, LONG_MAX, &o->seed); break;
+        case 'd':
+            bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &o->duration);
+            break;
+        case 'n': bad = br_arg_double(TOOL, p.opt, val, 0.0, BR_TOOL_NOISE_MAX_N, &o->noise); break;
+        default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
     }
@@ -210,6 +196,7 @@ static void apply_causes(br_plant_cfg_t *plant, const br_plant_cfg_t *causes)
     }
     if (causes->grad_per_m != 0.0) plant->grad_per_m = causes->grad_per_m;
     if (causes->delay_s != 0.0) plant->delay_s = causes->delay_s;
+    if (causes->drift_per_s != 0.0) plant->drift_per_s = causes->drift_per_s;
 }
 
 int main(int argc, char **argv)
@@ -218,6 +205,10 @@ int main(int argc, char **argv)
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
+        return 0;
+    }
+    if (p == 3) {
+        br_args_print_version(TOOL, stdout);
         return 0;
     }
     if (p != 0) return usage(argv[0], stderr);

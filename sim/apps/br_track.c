@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* br_track: a measured log's own reference trajectory (its t,ref columns) on
  * the plant of the machine this build is for (BR_MACHINE), or of a model.json
  * (--model: the identified plant with its causes), with each controller:
@@ -10,6 +11,11 @@
  *                the plant's causes (--model), the firmware's extended model
  *   hinf_true    the limit: H-infinity compensating the plant's true friction
  *                (an oracle no real machine has)
+ *   hinf_ff      H-infinity + the static feedforward (firmware/ff) of the plant's
+ *                model (--model): friction on the reference velocity, its
+ *                causes, and the moving mass times the reference acceleration
+ *   hinf_pf_ff   H-infinity + the PF (nominal model) + the feedforward's inertia
+ *                term alone (moving mass times the reference acceleration)
  *
  * The firmware's configuration (gains, periods, estimator settings) is the
  * build's machine's (br_circle_cfg_thesis). The tracking error is the
@@ -17,7 +23,8 @@
  * docs/configure.md, docs/machines/emps.md.
  *
  * Usage: br_track --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]
- *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true] [--json OUT] [--trace DIR]
+ *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff]
+ *                 [--json OUT] [--trace DIR]
  * Prints one line per controller: tracking RMS and maximum error. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
@@ -33,6 +40,7 @@
 #include "plant/br_model_params.h"
 #include "plant/br_plant_json.h"
 #include "simlog/br_cause_args.h"
+#include "tools/br_args.h"
 
 #define BR_PI 3.14159265358979323846
 
@@ -122,6 +130,30 @@ static double traj_vel(const traj_t *tr, double t)
     return (traj_ref(tr, t + tr->dt) - traj_ref(tr, t - tr->dt)) / (2.0 * tr->dt);
 }
 
+/* its acceleration by a central second difference over one log sample */
+static double traj_acc(const traj_t *tr, double t)
+{
+    return (traj_ref(tr, t + tr->dt) - 2.0 * traj_ref(tr, t) + traj_ref(tr, t - tr->dt)) / (tr->dt * tr->dt);
+}
+
+/* the PF's estimate plus the feedforward, clamped to what the controller accepts */
+typedef struct {
+    br_est_t inner;
+    br_ff_t ff;
+} pf_ff_t;
+
+static br_status_t pf_ff_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    pf_ff_t *w = ctx;
+    float f_ff = 0.0f;
+    const br_status_t st = w->inner.step(w->inner.ctx, y, u_prev_Nm, F_hat_N);
+    if (BR_FAILED(st)) return st;
+    const br_status_t s2 = br_ff_est_step(&w->ff, y, u_prev_Nm, &f_ff);
+    if (BR_FAILED(s2)) return s2;
+    *F_hat_N = fminf(fmaxf(*F_hat_N + f_ff, -w->ff.cfg.comp_max_N), w->ff.cfg.comp_max_N);
+    return st;
+}
+
 typedef struct {
     double sum2, emax;
     long n;
@@ -169,12 +201,31 @@ static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, f
 }
 
 /* the firmware (br_app_step) with the build's machine configuration */
-static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int extended, err_t *e,
+/* ff: 0 none, 1 the feedforward of the plant's model (friction, causes, inertia; ctrl
+ * BR_CTRL_HINF_FF), 2 the PF plus the feedforward's inertia term (ctrl BR_CTRL_HINF_PF) */
+static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int extended, int ff, err_t *e,
                   int *fault, double *fault_t)
 {
     br_circle_cfg_t c = br_circle_cfg_thesis(ctrl);
     c.plant = *pc;
     if (extended) c.pf.est.model.causes = br_causes_from_model(pc);
+    static pf_ff_t w; /* the feedforward (and the PF's br_est_t for ff 2) */
+    if (ff) {
+        br_circle_cfg_t m = c;
+        br_circle_use_model(&m, pc); /* the feedforward from the plant's model */
+        c.ff = m.ff;
+        c.ff.mass_kg = (float)(pc->J_kgm2 / (pc->lead_mprad * pc->lead_mprad) + pc->M_kg);
+        if (ff == 2) {
+            /* the inertia term alone: the PF estimates the friction */
+            c.ff.Fs_N = c.ff.Fc_N = 1e-20f;
+            c.ff.sigma2_Nspm = 0.0f;
+            memset(&c.ff.causes, 0, sizeof c.ff.causes);
+        }
+        if (br_ff_init(&w.ff, &c.ff) != BR_OK) {
+            fprintf(stderr, "br_track: invalid feedforward configuration\n");
+            return -1;
+        }
+    }
     const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(&c);
     br_plant_t p;
     br_hal_sim_t port;
@@ -193,6 +244,20 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     const br_plant_state_t x0 = {tr->ref[0] / pc->lead_mprad, 0.0, 0.0};
     int rc = -1;
     if (ctrl == BR_CTRL_HINF_PF && (mem.pf = calloc(1, sizeof *mem.pf)) == NULL) return -1;
+    br_est_t ffe = {&w.ff, br_ff_est_step};
+    if (ff == 1) {
+        ac.est = BR_APP_EST_EXTERN;
+        ac.ext = &ffe;
+    } else if (ff == 2) {
+        /* the PF as configured, behind the wrapper that adds the inertia term */
+        if (br_app_est_init(&ac, &mem, &w.inner) != BR_OK) {
+            fprintf(stderr, "br_track: PF init failed\n");
+            goto done;
+        }
+        ffe = (br_est_t){&w, pf_ff_step};
+        ac.est = BR_APP_EST_EXTERN;
+        ac.ext = &ffe;
+    }
     if (br_plant_init(&p, pc, &x0) != 0 || br_hal_sim_init(&port, &p, c.dt_s, &hal) != BR_OK) goto done;
     br_status_t st = br_app_init(&app, &ac, &hal, &mem);
     if (st == BR_OK) st = br_app_arm(&app); /* the simulator arms right after init */
@@ -209,6 +274,10 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
         hal.tick_wait(hal.ctx, &tick);
         const double x_ref = traj_ref(tr, t), counts = x_ref / L / rpc, whole = floor(counts);
         const br_ref_t r = {(int32_t)whole, (float)(counts - whole), (float)(traj_vel(tr, t) / L)};
+        if (ff) {
+            const br_ff_in_t in = {(float)traj_vel(tr, t), (float)traj_acc(tr, t), (float)x_ref};
+            br_ff_set_ref(&w.ff, &in);
+        }
         const double pos = br_plant_pos_m(&p);
         st = br_app_step(&app, &r);
         if (st != BR_OK && st != BR_W_OUTLIER) {
@@ -224,12 +293,21 @@ done:
     return rc;
 }
 
-static int usage(const char *argv0)
+#define TOOL "br_track"
+
+static int usage(const char *argv0, FILE *to)
 {
-    fprintf(stderr,
+    fprintf(to,
             "usage: %s --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]\n"
-            "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true] [--json OUT] [--trace DIR]\n",
-            argv0);
+            "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff] [--json OUT] [--trace DIR]\n"
+            BR_ARGS_COMMON_USAGE
+            "  --ref LOG.csv       the measured log whose reference trajectory is tracked\n"
+            "  --model MODEL.json  the plant from a diagnosis's saved model\n"
+            "  --pd KP,KV,GAIN,UMAX the log's position loop (all > 0): adds the pd run\n"
+            "  --ctrl LIST         the controllers to run, comma-separated\n"
+            "  --json OUT          the runs' figures as JSON\n"
+            "  --trace DIR         each run's trace as CSV into DIR\n",
+            argv0, argv0);
     return 2;
 }
 
@@ -238,24 +316,45 @@ int main(int argc, char **argv)
     const char *ref = NULL, *model = NULL, *json = NULL, *trace = NULL, *ctrls = NULL;
     double pd[4];
     int have_pd = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!val) return usage(argv[0]);
-        i++;
-        if (strcmp(a, "--ref") == 0) ref = val;
-        else if (strcmp(a, "--model") == 0) model = val;
-        else if (strcmp(a, "--json") == 0) json = val;
-        else if (strcmp(a, "--trace") == 0) trace = val;
-        else if (strcmp(a, "--ctrl") == 0) ctrls = val;
-        else if (strcmp(a, "--pd") == 0) {
+    static const struct option opts[] = {{"ref", required_argument, NULL, 'r'},
+                                         {"model", required_argument, NULL, 'm'},
+                                         {"json", required_argument, NULL, 'j'},
+                                         {"trace", required_argument, NULL, 't'},
+                                         {"ctrl", required_argument, NULL, 'c'},
+                                         {"pd", required_argument, NULL, 'p'},
+                                         {NULL, 0, NULL, 0}};
+    br_args_t p;
+    const int args = br_args_begin(&p, TOOL, argc, argv);
+    if (args == BR_ARGS_HELP) {
+        usage(argv[0], stdout);
+        return 0;
+    }
+    if (args == BR_ARGS_VERSION) {
+        br_args_print_version(TOOL, stdout);
+        return 0;
+    }
+    const char *val;
+    for (int o; (o = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
+        switch (o) {
+        case 'r': ref = val; break;
+        case 'm': model = val; break;
+        case 'j': json = val; break;
+        case 't': trace = val; break;
+        case 'c': ctrls = val; break;
+        case 'p':
             have_pd = br_parse_numbers(val, pd, 4) == 4 && pd[0] > 0.0 && pd[1] > 0.0 && pd[2] > 0.0 && pd[3] > 0.0;
             if (!have_pd) {
-                fprintf(stderr, "br_track: --pd needs KP,KV,GAIN,UMAX, all > 0: %s\n", val);
+                fprintf(stderr, "%s: --pd needs KP,KV,GAIN,UMAX, all > 0: %s\n", TOOL, val);
                 return 2;
             }
-        } else return usage(argv[0]);
+            break;
+        default: return usage(argv[0], stderr); /* BR_ARGS_BAD: reported */
+        }
     }
-    if (!ref) return usage(argv[0]);
+    if (!ref) {
+        fprintf(stderr, "%s: --ref is required\n", TOOL);
+        return usage(argv[0], stderr);
+    }
     if (!ctrls) ctrls = have_pd ? "pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true" : "hinf_only,hinf_pf,hinf_pf_ext,hinf_true";
     br_plant_cfg_t plant = br_plant_cfg_reference();
     char msg[512];
@@ -273,9 +372,10 @@ int main(int argc, char **argv)
     if (js)
         fprintf(js, "{\n  \"generator\": \"br_track (sim/apps/br_track.c); generated, do not edit\",\n"
                     "  \"duration_s\": %.6g", (double)(tr.n - 1) * tr.dt);
-    static const char *const names[] = {"pd", "hinf_only", "hinf_pf", "hinf_pf_ext", "hinf_true"};
+    static const char *const names[] = {"pd", "hinf_only", "hinf_pf", "hinf_pf_ext", "hinf_true", "hinf_ff",
+                                        "hinf_pf_ff"};
     int rc = 0;
-    for (int w = 0; w < 5 && rc == 0; w++) {
+    for (int w = 0; w < 7 && rc == 0; w++) {
         const size_t len = strlen(names[w]);
         const char *hit = strstr(ctrls, names[w]);
         while (hit && ((hit != ctrls && hit[-1] != ',') || (hit[len] != ',' && hit[len] != '\0')))
@@ -300,8 +400,9 @@ int main(int argc, char **argv)
                 rc = 2;
             } else if (run_pd(&tr, &plant, pd, &e) != 0) rc = 1;
         } else {
-            const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : w == 4 ? BR_CTRL_HINF_TRUE : BR_CTRL_HINF_PF;
-            if (run_fw(&tr, &plant, ctrl, w == 3, &e, &fault, &fault_t) != 0) rc = 1;
+            const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : w == 4 ? BR_CTRL_HINF_TRUE
+                                          : w == 5 ? BR_CTRL_HINF_FF : BR_CTRL_HINF_PF;
+            if (run_fw(&tr, &plant, ctrl, w == 3, w == 5 ? 1 : w == 6 ? 2 : 0, &e, &fault, &fault_t) != 0) rc = 1;
         }
         if (e.trace && fclose(e.trace) != 0) rc = 1;
         if (rc != 0) break;

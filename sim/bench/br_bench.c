@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* make bench: host cost of the friction estimators, and their memory.
  *
  * 1. Records a realistic input: the x axis of the thesis circle (A sin(2 pi t / 8),
@@ -37,6 +38,9 @@
 #include "bristle_gen/est/br_noise_table.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_app.h"
+#include "tools/br_args.h"
+
+#define TOOL "br_bench"
 
 #define BR_PI 3.14159265358979323846
 
@@ -412,9 +416,9 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
     json_f4(f, c->x0_std);
     fprintf(f,
             ", \"gp_min_N\": %.9g, \"gp_max_N\": %.9g, \"outlier_sigma\": %.9g, \"reanchor_after\": %u, "
-            "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"noise_fnv1a64\": \"%016llx\"}",
+            "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"one_division\": %d, \"noise_fnv1a64\": \"%016llx\"}",
             (double)c->est.gp_min_N, (double)c->est.gp_max_N, (double)c->est.outlier_sigma, (unsigned)c->est.reanchor_after,
-            (double)c->est.rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip,
+            (double)c->est.rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip, (int)BR_PF_ONE_DIVISION,
             (unsigned long long)fnv1a(c->noise, (size_t)c->noise_len * sizeof *c->noise));
 }
 
@@ -439,29 +443,117 @@ static int write_record(const char *path, const br_pf_cfg_t *cfg, const rec_t *r
     return 0;
 }
 
+/* ---- the PF's two paths, its cost against m, the demo per controller ---- */
+
+/* median thread-CPU ns per particle-step of reps replays of rec into a PF of
+ * configuration c (one untimed warm-up); estimates not compared (m may
+ * differ from the recording's) */
+static int pf_cpu_per_particle(br_pf_t *pf, const br_pf_cfg_t *c, const rec_t *rec, int reps, float *fhat, double *out)
+{
+    timing_t tm;
+    memset(&tm, 0, sizeof tm);
+    double w, per[256];
+    if (replay(pf, c, pf_init_w, pf_step_w, rec, NULL, &w, &per[0], &tm, fhat) != 0) return -1;
+    for (int r = 0; r < reps; r++) {
+        if (replay(pf, c, pf_init_w, pf_step_w, rec, NULL, &w, &per[r], &tm, fhat) != 0) return -1;
+    }
+    *out = median_of(per, reps) / (double)c->n_particles;
+    return 0;
+}
+
+/* the particle counts of the scaling table */
+static const uint32_t bench_m[] = {100u, 250u, 500u, 1000u, 1500u, 2048u};
+#define BENCH_NM (sizeof bench_m / sizeof bench_m[0])
+
+/* thread CPU time of one whole demo run (both axes, 8 s) per controller */
+static const struct {
+    br_circle_ctrl_t ctrl;
+    const char *name;
+    uint32_t scalar_path;
+} bench_demo[] = {{BR_CTRL_HINF_ONLY, "hinf_only", 0u}, {BR_CTRL_HINF_UKF, "hinf_ukf", 0u},
+                  {BR_CTRL_HINF_PF, "hinf_pf", 0u},    {BR_CTRL_HINF_PF, "hinf_pf_scalar", 1u},
+                  {BR_CTRL_HINF_TRUE, "true_friction", 0u}};
+#define BENCH_ND (sizeof bench_demo / sizeof bench_demo[0])
+
+static int demo_cpu_s(size_t i, double *out)
+{
+    br_circle_cfg_t c = br_circle_cfg_thesis(bench_demo[i].ctrl);
+    c.pf.scalar_path = bench_demo[i].scalar_path;
+    br_circle_result_t res;
+    const int64_t c0 = cpu_ns();
+    if (br_circle_run(&c, NULL, NULL, &res) != 0) return -1;
+    *out = (double)(cpu_ns() - c0) * 1e-9;
+    return 0;
+}
+
+static void json_timing_pf(FILE *f, const char *key, const br_circle_cfg_t *cpf, uint32_t m, const timing_t *t,
+                           int reps, double med, double mn, double mx, double cmed, double cmin, double cmax)
+{
+    fprintf(f,
+            "  \"%s\": {\"input\": \"x axis of the thesis circle, H-inf + PF closed loop\", \"dt_s\": %.9g, "
+            "\"n_particles\": %u, \"steps_timed\": %ld, \"reps\": %d,\n"
+            "    \"ns_per_particle_step\": {\"median\": %.3f, \"min\": %.3f, \"max\": %.3f, \"per_rep\": [",
+            key, cpf->dt_s, m, t->steps_timed, reps, med, mn, mx);
+    for (int r = 0; r < reps; r++) fprintf(f, "%s%.3f", r ? ", " : "", t->per_rep_ns[r] / (double)m);
+    fprintf(f, "]},\n    \"cpu_ns_per_particle_step\": {\"median\": %.3f, \"min\": %.3f, \"max\": %.3f},\n", cmed,
+            cmin, cmax);
+    fprintf(f,
+            "    \"step_us\": {\"median_rep_mean\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"max\": %.3f},\n"
+            "    \"replay_mismatches\": %ld, \"fhat_rms_err_N\": %.6f, \"outlier_steps\": %ld, "
+            "\"error_steps\": %ld},\n",
+            med * (double)m * 1e-3, t->step_p50_ns * 1e-3, t->step_p99_ns * 1e-3, t->step_max_ns * 1e-3, t->mismatches,
+            t->fhat_rms_err_N, t->outliers, t->errors);
+}
+
+static int usage(const char *argv0, FILE *to)
+{
+    fprintf(to,
+            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N]\n" BR_ARGS_COMMON_USAGE
+            "  --json FILE         the figures as JSON (make bench: out/bench/bench.json)\n"
+            "  --record FILE       the replayed stream's per-step record (CSV)\n"
+            "  --reps N            repetitions of each PF timing, 1 .. 256 (default 7)\n"
+            "  --ukf-reps N        repetitions of each UKF timing, 1 .. 256 (default 21)\n",
+            argv0, argv0);
+    return 2;
+}
+
 int main(int argc, char **argv)
 {
     const char *json_path = NULL, *rec_path = NULL;
     int reps = 7, ukf_reps = 21;
-    for (int i = 1; i < argc; i++) {
-        const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
-        int ok = v != NULL;
-        if (ok && strcmp(argv[i], "--json") == 0) {
-            json_path = v;
-        } else if (ok && strcmp(argv[i], "--record") == 0) {
-            rec_path = v;
-        } else if (ok && strcmp(argv[i], "--reps") == 0) {
-            ok = sscanf(v, "%d", &reps) == 1 && reps >= 1 && reps <= 256;
-        } else if (ok && strcmp(argv[i], "--ukf-reps") == 0) {
-            ok = sscanf(v, "%d", &ukf_reps) == 1 && ukf_reps >= 1 && ukf_reps <= 256;
-        } else {
-            ok = 0;
+    static const struct option opts[] = {{"json", required_argument, NULL, 'j'},
+                                         {"record", required_argument, NULL, 'r'},
+                                         {"reps", required_argument, NULL, 'n'},
+                                         {"ukf-reps", required_argument, NULL, 'u'},
+                                         {NULL, 0, NULL, 0}};
+    br_args_t p;
+    const int args = br_args_begin(&p, TOOL, argc, argv);
+    if (args == BR_ARGS_HELP) {
+        usage(argv[0], stdout);
+        return 0;
+    }
+    if (args == BR_ARGS_VERSION) {
+        br_args_print_version(TOOL, stdout);
+        return 0;
+    }
+    const char *v;
+    for (int o; (o = br_args_next(&p, opts, &v)) != BR_ARGS_END;) {
+        int bad = 0;
+        long n = 0;
+        switch (o) {
+        case 'j': json_path = v; break;
+        case 'r': rec_path = v; break;
+        case 'n':
+            bad = br_arg_long(TOOL, p.opt, v, 1, 256, &n);
+            if (!bad) reps = (int)n;
+            break;
+        case 'u':
+            bad = br_arg_long(TOOL, p.opt, v, 1, 256, &n);
+            if (!bad) ukf_reps = (int)n;
+            break;
+        default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
-        if (!ok) {
-            fprintf(stderr, "usage: br_bench [--json FILE] [--record FILE] [--reps 1..256] [--ukf-reps 1..256]\n");
-            return 2;
-        }
-        i++;
+        if (bad) return usage(argv[0], stderr);
     }
 
     char cpu[256];
@@ -477,7 +569,7 @@ int main(int argc, char **argv)
     br_pf_t *pf = calloc(1, sizeof *pf);
     br_ukf_t *ukf = calloc(1, sizeof *ukf);
     rec_t rpf = {0}, rukf = {0};
-    float *fhat_pf = NULL, *fhat_ukf = NULL;
+    float *fhat_pf = NULL, *fhat_ukf = NULL, *fhat_tmp = NULL;
     int rc = 1;
     if (!pf || !ukf) goto done;
 
@@ -506,6 +598,32 @@ int main(int argc, char **argv)
     rep_stats(tpf.per_rep_cpu_ns, reps, 1.0 / (double)m, &pf_cmed, &pf_cmin, &pf_cmax);
     rep_stats(tukf.per_rep_cpu_ns, ukf_reps, 1e-3, &ukf_cmed, &ukf_cmin, &ukf_cmax);
     const double pf_step_med_us = pf_med * (double)m * 1e-3;
+    /* the scalar reference path on the same recording, in the same run: its
+     * replays must reproduce the closed loop's estimates (made by the vector
+     * path) bit for bit too */
+    br_pf_cfg_t cfg_scalar = cpf.pf;
+    cfg_scalar.scalar_path = 1u;
+    timing_t tpfs;
+    /* (fhat_pf keeps the default path's estimates for the recording; the
+     * other runs write theirs into fhat_tmp) */
+    fhat_tmp = malloc((size_t)rpf.n * sizeof *fhat_tmp);
+    if (!fhat_tmp) goto done;
+    if (time_replays(pf, &cfg_scalar, pf_init_w, pf_step_w, &rpf, reps, &tpfs, fhat_tmp) != 0) goto done;
+    double pfs_med, pfs_min, pfs_max, pfs_cmed, pfs_cmin, pfs_cmax;
+    rep_stats(tpfs.per_rep_ns, reps, 1.0 / (double)m, &pfs_med, &pfs_min, &pfs_max);
+    rep_stats(tpfs.per_rep_cpu_ns, reps, 1.0 / (double)m, &pfs_cmed, &pfs_cmin, &pfs_cmax);
+    /* cost against m, both paths, and the demo per controller */
+    double scale_vec[BENCH_NM], scale_sca[BENCH_NM], demo_s[BENCH_ND];
+    for (size_t i = 0; i < BENCH_NM; i++) {
+        br_pf_cfg_t c = cpf.pf;
+        c.n_particles = bench_m[i];
+        if (pf_cpu_per_particle(pf, &c, &rpf, 3, fhat_tmp, &scale_vec[i]) != 0) goto done;
+        c.scalar_path = 1u;
+        if (pf_cpu_per_particle(pf, &c, &rpf, 3, fhat_tmp, &scale_sca[i]) != 0) goto done;
+    }
+    for (size_t i = 0; i < BENCH_ND; i++) {
+        if (demo_cpu_s(i, &demo_s[i]) != 0) goto done;
+    }
 
     printf("PF recording: x axis of the thesis circle, H-inf + PF in closed loop, dt %.1f ms, %ld steps\n",
            cpf.dt_s * 1e3, rpf.n);
@@ -519,6 +637,20 @@ int main(int argc, char **argv)
     printf("    replays reproduce the in-loop estimates: %s (%ld mismatches); F_hat RMS error vs true friction "
            "%.4f N; %ld outlier, %ld error steps\n",
            tpf.mismatches ? "NO" : "yes, bit for bit", tpf.mismatches, tpf.fhat_rms_err_N, tpf.outliers, tpf.errors);
+    printf("PF scalar reference path (cfg.scalar_path = 1), same recording and run: %.1f ns per particle-step "
+           "(median; min %.1f, max %.1f), thread CPU %.1f (min %.1f, max %.1f)\n",
+           pfs_med, pfs_min, pfs_max, pfs_cmed, pfs_cmin, pfs_cmax);
+    printf("    replays reproduce the in-loop estimates: %s (%ld mismatches)\n",
+           tpfs.mismatches ? "NO" : "yes, bit for bit", tpfs.mismatches);
+    printf("PF scalar / vector, thread CPU time: %.2fx (wall medians %.2fx)\n", pfs_cmed / pf_cmed, pfs_med / pf_med);
+    printf("PF cost against m (thread CPU ns per particle-step, median of 3 replays; us per step at m):\n");
+    printf("    %6s %10s %10s %10s %10s\n", "m", "vector", "scalar", "vec us", "sca us");
+    for (size_t i = 0; i < BENCH_NM; i++) {
+        printf("    %6u %10.1f %10.1f %10.1f %10.1f\n", (unsigned)bench_m[i], scale_vec[i], scale_sca[i],
+               scale_vec[i] * bench_m[i] * 1e-3, scale_sca[i] * bench_m[i] * 1e-3);
+    }
+    printf("demo (br_circle_run, two axes, 8 s simulated, plant included), thread CPU time per controller:\n");
+    for (size_t i = 0; i < BENCH_ND; i++) printf("    %-16s %8.3f s\n", bench_demo[i].name, demo_s[i]);
     printf("UKF recording: the same axis, H-inf + UKF in closed loop, dt %.1f ms, %ld steps\n", cukf.dt_s * 1e3,
            rukf.n);
     printf("UKF: %.3f us per step (median of %d replays of %ld steps; min %.3f, max %.3f); single steps: p50 %.3f us, "
@@ -533,7 +665,7 @@ int main(int argc, char **argv)
 
     const double load1 = loadavg1();
     /* 3. memory (host sizes; see docs/bench.md for the Cortex-M7 ones) */
-    const size_t per_particle = (sizeof(((br_pf_t *)0)->x) + sizeof(((br_pf_t *)0)->xp) +
+    const size_t per_particle = (sizeof(((br_pf_t *)0)->x) + (BR_PF_ONE_DIVISION ? sizeof(((br_pf_t *)0)->kgp) : 0u) +
                                  sizeof(((br_pf_t *)0)->fnl) + sizeof(((br_pf_t *)0)->l) +
                                  sizeof(((br_pf_t *)0)->W) + sizeof(((br_pf_t *)0)->idx)) /
                                 BR_PF_MAX_PARTICLES;
@@ -563,21 +695,18 @@ int main(int argc, char **argv)
                 ", \"ndebug\": %s, \"loadavg1_start\": %.2f, \"loadavg1_end\": %.2f, "
                 "\"clock_monotonic_call_ns\": %.1f},\n",
                 BENCH_NDEBUG ? "true" : "false", load0, load1, tovh);
-        fprintf(f,
-                "  \"pf\": {\"input\": \"x axis of the thesis circle, H-inf + PF closed loop\", \"dt_s\": %.9g, "
-                "\"n_particles\": %u, \"steps_timed\": %ld, \"reps\": %d,\n"
-                "    \"ns_per_particle_step\": {\"median\": %.3f, \"min\": %.3f, \"max\": %.3f, \"per_rep\": [",
-                cpf.dt_s, m, tpf.steps_timed, reps, pf_med, pf_min, pf_max);
-        for (int r = 0; r < reps; r++) fprintf(f, "%s%.3f", r ? ", " : "", tpf.per_rep_ns[r] / (double)m);
-        fprintf(f,
-                "]},\n    \"cpu_ns_per_particle_step\": {\"median\": %.3f, \"min\": %.3f, \"max\": %.3f},\n",
-                pf_cmed, pf_cmin, pf_cmax);
-        fprintf(f,
-                "    \"step_us\": {\"median_rep_mean\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"max\": %.3f},\n"
-                "    \"replay_mismatches\": %ld, \"fhat_rms_err_N\": %.6f, \"outlier_steps\": %ld, "
-                "\"error_steps\": %ld},\n",
-                pf_step_med_us, tpf.step_p50_ns * 1e-3, tpf.step_p99_ns * 1e-3, tpf.step_max_ns * 1e-3,
-                tpf.mismatches, tpf.fhat_rms_err_N, tpf.outliers, tpf.errors);
+        json_timing_pf(f, "pf", &cpf, m, &tpf, reps, pf_med, pf_min, pf_max, pf_cmed, pf_cmin, pf_cmax);
+        json_timing_pf(f, "pf_scalar", &cpf, m, &tpfs, reps, pfs_med, pfs_min, pfs_max, pfs_cmed, pfs_cmin, pfs_cmax);
+        fprintf(f, "  \"ratio_pf_scalar_over_pf_cpu\": %.3f, \"ratio_pf_scalar_over_pf_wall\": %.3f,\n",
+                pfs_cmed / pf_cmed, pfs_med / pf_med);
+        fprintf(f, "  \"pf_scaling\": {\"metric\": \"thread CPU ns per particle-step, median of 3 replays\", \"rows\": [");
+        for (size_t i = 0; i < BENCH_NM; i++) {
+            fprintf(f, "%s\n    {\"m\": %u, \"pf\": %.3f, \"pf_scalar\": %.3f}", i ? "," : "", (unsigned)bench_m[i],
+                    scale_vec[i], scale_sca[i]);
+        }
+        fprintf(f, "]},\n  \"demo_cpu_s\": {");
+        for (size_t i = 0; i < BENCH_ND; i++) fprintf(f, "%s\"%s\": %.4f", i ? ", " : "", bench_demo[i].name, demo_s[i]);
+        fprintf(f, "},\n");
         fprintf(f,
                 "  \"ukf\": {\"input\": \"x axis of the thesis circle, H-inf + UKF closed loop\", \"dt_s\": %.9g, "
                 "\"steps_timed\": %ld, \"reps\": %d,\n"
@@ -603,13 +732,14 @@ int main(int argc, char **argv)
             goto done;
         }
     }
-    rc = (tpf.mismatches || tukf.mismatches || tpf.errors || tukf.errors) ? 1 : 0;
+    rc = (tpf.mismatches || tpfs.mismatches || tukf.mismatches || tpf.errors || tukf.errors) ? 1 : 0;
     if (rc) fprintf(stderr, "br_bench: a replay differed from the closed loop or failed\n");
 done:
     free(pf);
     free(ukf);
     free(fhat_pf);
     free(fhat_ukf);
+    free(fhat_tmp);
     rec_free(&rpf);
     rec_free(&rukf);
     return rc;

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """make bench, numpy side: the particle filter of firmware/pf/br_pf.c written
 in numpy, vectorised over the particles, timed on the recording br_bench made
 (br_bench --record FILE), and compared with the C filter.
@@ -105,9 +106,20 @@ class NumpyPf:
         self.inv_jeff = F(1.0) / (J + self.L * self.L * M)   # br_model_init
         self.visc = self.L * self.L * s2
         self.s0L = self.s0 * self.L
+        # BR_PF_ONE_DIVISION builds: the PF's RK4 form (br_model_kp_rk4): each
+        # particle's k_p = sigma0 L / g_p (recomputed here from g_p: the same
+        # float the C filter carries) and folded constants
+        self.one_div = bool(cfg.get("one_division", 0))
+        self.kp_cw = self.visc * self.inv_jeff
+        self.kp_cz = (self.L * self.s0) * self.inv_jeff
+        self.kp_czd = (self.L * self.s1) * self.inv_jeff
+        self.ah_lim = RK4_AH_MAX / self.h
         self.q_std = np.sqrt(np.array(cfg["q_var"], dtype=F)).reshape(4, 1)
         self.inv_2r = F(0.5) / F(cfg["r_var_rad2"])
-        self.outlier_l = F(-0.5) * F(cfg["outlier_sigma"]) * F(cfg["outlier_sigma"])
+        # the gate with the encoder's quantisation: -g^2 (R + rpc^2 / 12) / (2 R), as br_pf_init
+        rpc = F(cfg["rad_per_count"])
+        self.outlier_l = F(-0.5) * F(cfg["outlier_sigma"]) * F(cfg["outlier_sigma"]) * \
+            (F(1.0) + rpc * rpc * F(1.0 / 12.0) / F(cfg["r_var_rad2"]))
         self.reanchor_after = int(cfg["reanchor_after"])
         self.rpc = F(cfg["rad_per_count"])
         self.gp0 = F(cfg["gp0_N"])
@@ -134,10 +146,42 @@ class NumpyPf:
         self.pos = (self.pos + 4 * self.m + self.skip) & self.mask
         return n
 
-    def _fnl(self, om, z, gp):
-        v = self.L * om
-        zdot = v - self.s0 * np.abs(v) * z / gp
+    def _fnl(self, om, z, gp, div=False):
+        """f_nl (eqs. 3, 4): divided by g_p, or with k_p as the C filter's prediction in a one-division build"""
+        if self.one_div and not div:
+            zdot = self.L * om - (self.s0L / gp * np.abs(om)) * z
+        else:
+            v = self.L * om
+            zdot = v - self.s0 * np.abs(v) * z / gp
         return self.s0 * z + self.s1 * zdot
+
+    def _model_step_kp(self, th, om, z, gp, u):
+        """br_model_kp_rk4 on every particle, the bounded scheme where a h > 2"""
+        L, h, hh = self.L, self.h, F(0.5) * self.h
+        h6, h3 = h / F(6.0), h / F(3.0)
+        a, cw, cz, czd = u * self.inv_jeff, self.kp_cw, self.kp_cz, self.kp_czd
+        kp = self.s0L / gp
+
+        def stage(w, zz):
+            kw = kp * np.abs(w)
+            zd = L * w - kw * zz
+            return ((a - cw * w) - cz * zz) - czd * zd, zd, kw
+
+        k1w, k1z, kw1 = stage(om, z)
+        om2, z2 = om + hh * k1w, z + hh * k1z
+        k2w, k2z, _ = stage(om2, z2)
+        om3, z3 = om + hh * k2w, z + hh * k2z
+        k3w, k3z, _ = stage(om3, z3)
+        om4, z4 = om + h * k3w, z + h * k3z
+        k4w, k4z, _ = stage(om4, z4)
+        th1 = th + (h6 * (om + om4) + h3 * (om2 + om3))
+        om1 = om + (h6 * (k1w + k4w) + h3 * (k2w + k3w))
+        z1 = z + (h6 * (k1z + k4z) + h3 * (k2z + k3z))
+        rk4 = (kw1 <= self.ah_lim) & (kp * np.abs(om1) <= self.ah_lim)
+        b = np.flatnonzero(~rk4)
+        if b.size:
+            th1[b], om1[b], z1[b] = self._bounded(th[b], om[b], z[b], gp[b], u)
+        return th1, om1, z1
 
     def _deriv(self, om, z, gp, u):
         """eq. 6: (domega/dt, dz/dt); dtheta/dt = omega, dg_p/dt = 0."""
@@ -195,7 +239,7 @@ class NumpyPf:
         self.prev_frac = frac
         self.primed = True
         self.mean = seqsum(x) * self.inv_m
-        self.F_hat = seqsum(self._fnl(x[1], x[2], x[3])) * self.inv_m
+        self.F_hat = seqsum(self._fnl(x[1], x[2], x[3], div=True)) * self.inv_m  # br_model_fcomp_N
         self.ess = F(self.m)
         return BR_OK
 
@@ -209,7 +253,8 @@ class NumpyPf:
         y_rel = frac * rpc
         x = self.x
         # 1. predict
-        th, om, z = self._model_step(x[0], x[1], x[2], x[3], u)
+        step = self._model_step_kp if self.one_div else self._model_step
+        th, om, z = step(x[0], x[1], x[2], x[3], u)
         n = self._noise()
         th = th + self.q_std[0] * n[0]
         om = om + self.q_std[1] * n[1]
@@ -320,6 +365,10 @@ def summary_table(c, npy, ratio):
         ("  in thread CPU time, median", "%.1f" % c["pf"]["cpu_ns_per_particle_step"]["median"],
          "%.1f" % npy["cpu_ns_per_particle_step"]["median"],
          "%.2f x" % (npy["cpu_ns_per_particle_step"]["median"] / c["pf"]["cpu_ns_per_particle_step"]["median"])),
+        ("C scalar path (pf_scalar), thread CPU", "%.1f" % c["pf_scalar"]["cpu_ns_per_particle_step"]["median"], "",
+         "scalar / vector %.2f x" % c["ratio_pf_scalar_over_pf_cpu"]),
+        ("  numpy / C scalar path, thread CPU", "", "",
+         "%.2f x" % (npy["cpu_ns_per_particle_step"]["median"] / c["pf_scalar"]["cpu_ns_per_particle_step"]["median"])),
         ("PF step us (m = %d), per-step p50" % m, "%.1f" % pf["step_us"]["p50"], "%.1f" % npy["step_us"]["p50"],
          "%.2f x" % (npy["step_us"]["p50"] / pf["step_us"]["p50"])),
         ("  share of the %.1f ms period" % (pf["dt_s"] * 1e3), "%.1f %%" % (pf["step_us"]["p50"] * 1e-4 / pf["dt_s"]),
@@ -336,6 +385,9 @@ def summary_table(c, npy, ratio):
         ("UKF RAM, br_ukf_t (host sizeof)", "%d B" % mem["ukf_t_bytes"], "", ""),
         ("PF ROM, noise table", "%d B" % mem["noise_table_rom_bytes"], "", "%d float32" % mem["noise_len"]),
     ]
+    rows += [("PF cost vs m: m = %d, CPU ns / particle-step" % r["m"], "%.1f" % r["pf"], "",
+              "scalar %.1f" % r["pf_scalar"]) for r in c["pf_scaling"]["rows"]]
+    rows += [("demo run (two axes, 8 s), CPU s: %s" % k, "%.3f" % v, "", "") for k, v in c["demo_cpu_s"].items()]
     w = [max(len(r[i]) for r in rows) for i in range(4)]
     print("== bench summary: %s, %d CPUs; C %s; numpy %s float32"
           % (c["machine"]["cpu_model"], c["machine"]["cpus_online"], c["machine"]["build"], npy["numpy"]))

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* X-Y circle experiment on the simulator. */
 #include "br_circle.h"
 
@@ -10,6 +11,8 @@
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_app.h"
+#include "plant/br_model_params.h"
+#include "tools/br_rng.h"
 
 #define BR_PI 3.14159265358979323846
 
@@ -20,6 +23,7 @@ const char *br_circle_ctrl_name(br_circle_ctrl_t c)
     case BR_CTRL_HINF_UKF: return "hinf_ukf";
     case BR_CTRL_HINF_PF: return "hinf_pf";
     case BR_CTRL_HINF_TRUE: return "hinf_true";
+    case BR_CTRL_HINF_FF: return "hinf_ff";
     }
     return "unknown";
 }
@@ -38,7 +42,50 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     for (int i = 0; i < 3; i++) c.K[i] = K[i];
     c.pf = br_circle_pf_cfg_tuned((float)c.dt_s);
     c.ukf = br_circle_ukf_cfg_tuned((float)c.dt_s);
+    c.ff = br_circle_ff_cfg_machine();
+    c.real = (br_circle_real_t){0.0, 0.0, 0.0, 0u};
     return c;
+}
+
+br_circle_cfg_t br_circle_cfg_realistic(br_circle_ctrl_t controller)
+{
+    br_circle_cfg_t c = br_circle_cfg_thesis(controller);
+    /* the draw (docs/demo.md): factors on the reference machine, within the
+     * distributions of docs/robustness.md */
+    c.plant.sigma0_Npm *= 0.6;   /* bristle stiffness */
+    c.plant.sigma1_Nspm *= 1.5;  /* bristle damping */
+    c.plant.Fc_N *= 1.12;        /* Coulomb */
+    c.plant.Fs_N *= 0.90;        /* stiction */
+    c.plant.vs_mps *= 1.8;       /* Stribeck velocity */
+    c.plant.sigma2_Nspm *= 1.15; /* viscous */
+    c.plant.J_kgm2 *= 1.05;      /* moving mass (J and M alike) */
+    c.plant.M_kg *= 1.05;
+    c.real.drift_frac = 0.05;    /* friction +5 % over the 8 s */
+    c.real.force_noise_N = 0.05; /* per control period */
+    c.real.enc_noise_p = 1.0e-3; /* one read in a thousand one count off */
+    c.real.seed = 1;
+    return c;
+}
+
+void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *m)
+{
+    br_model_cfg_t *ms[2] = {&c->pf.est.model, &c->ukf.est.model};
+    for (int i = 0; i < 2; i++) {
+        ms[i]->J_kgm2 = (float)m->J_kgm2;
+        ms[i]->M_kg = (float)m->M_kg;
+        ms[i]->sigma2_Nspm = (float)m->sigma2_Nspm;
+        ms[i]->lugre.sigma0_Npm = (float)m->sigma0_Npm;
+        ms[i]->lugre.sigma1_Nspm = (float)m->sigma1_Nspm;
+        ms[i]->lugre.Fc_N = (float)m->Fc_N;
+        ms[i]->lugre.Fs_N = (float)m->Fs_N;
+        ms[i]->lugre.vs_mps = (float)m->vs_mps;
+        ms[i]->causes = br_causes_from_model(m);
+    }
+    c->ff.Fc_N = (float)m->Fc_N;
+    c->ff.Fs_N = (float)m->Fs_N;
+    c->ff.vs_mps = (float)m->vs_mps;
+    c->ff.sigma2_Nspm = (float)m->sigma2_Nspm;
+    c->ff.causes = br_causes_from_model(m);
 }
 
 /* The limit: an "estimator" that reads the plant's true friction at t_k. */
@@ -56,8 +103,55 @@ typedef struct {
     br_hal_t hal;
     br_app_t app;
     br_app_mem_t mem; /* the filter's state, owned: PF or UKF only */
+    br_ff_t ff;       /* the feedforward (BR_CTRL_HINF_FF) */
     double phase;
+    /* the run's drift and noise (br_circle_real_t) */
+    br_circle_real_t real;
+    br_rng_t rng;
+    br_plant_cfg_t base;  /* the plant's configuration before drift and noise */
+    br_hal_t inner;       /* the simulator's HAL behind the noisy encoder */
 } axis_sim_t;
+
+/* encoder noise: the simulator's reading, one count off with probability p */
+static br_status_t noisy_encoder_read(void *ctx, int32_t *counts)
+{
+    axis_sim_t *a = ctx;
+    const br_status_t st = a->inner.encoder_read(a->inner.ctx, counts);
+    if (st == BR_OK && br_rng_uniform(&a->rng) < a->real.enc_noise_p) {
+        const uint32_t u = (uint32_t)*counts + (br_rng_uniform(&a->rng) < 0.5 ? 1u : UINT32_MAX); /* wraps */
+        *counts = u <= (uint32_t)INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1;
+    }
+    return st;
+}
+static br_status_t inner_pwm_write(void *ctx, float duty)
+{
+    axis_sim_t *a = ctx;
+    return a->inner.pwm_write(a->inner.ctx, duty);
+}
+static br_status_t inner_tick_wait(void *ctx, uint32_t *tick)
+{
+    axis_sim_t *a = ctx;
+    return a->inner.tick_wait(a->inner.ctx, tick);
+}
+static br_status_t inner_pwm_disable(void *ctx)
+{
+    axis_sim_t *a = ctx;
+    return a->inner.pwm_disable ? a->inner.pwm_disable(a->inner.ctx) : BR_OK;
+}
+static br_status_t inner_pwm_enable(void *ctx)
+{
+    axis_sim_t *a = ctx;
+    return a->inner.pwm_enable ? a->inner.pwm_enable(a->inner.ctx) : BR_OK;
+}
+
+/* force noise for the next period: a Gaussian force held over the
+ * period (added to the plant's offset). The run's drift is the plant's own
+ * friction_drift cause (axis_init), not a second model of it. */
+static void axis_perturb(axis_sim_t *a)
+{
+    const br_circle_real_t *r = &a->real;
+    if (r->force_noise_N > 0.0) a->plant.cfg.offset_N = a->base.offset_N + r->force_noise_N * br_rng_gauss(&a->rng);
+}
 
 /* Reference of one axis at t: position split into integer counts and a
  * fraction, plus the velocity, all on the motor side. */
@@ -87,13 +181,25 @@ br_ctrl_cfg_t br_circle_ctrl_cfg(const br_circle_cfg_t *c)
     return cc;
 }
 
-static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
+static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int index)
 {
     a->phase = phase;
     a->mem = (br_app_mem_t){NULL, NULL};
+    a->real = c->real;
+    a->base = c->plant;
+    a->rng = (br_rng_t){c->real.seed * 2654435761ull + (uint64_t)index * 0x632BE59BD9B4E019ull, 0, 0.0};
     br_plant_state_t x0 = {c->radius_m * sin(phase) / c->plant.lead_mprad, 0.0, 0.0};
-    if (br_plant_init(&a->plant, &c->plant, &x0) != 0) return -1;
+    /* the run's warm-up: the plant's friction_drift, drift_frac over the run's duration */
+    br_plant_cfg_t pc = c->plant;
+    pc.drift_per_s += c->real.drift_frac / c->duration_s;
+    if (br_plant_init(&a->plant, &pc, &x0) != 0) return -1;
     if (br_hal_sim_init(&a->port, &a->plant, c->dt_s, &a->hal) != BR_OK) return -1;
+    if (c->real.enc_noise_p > 0.0) {
+        /* the noisy encoder in front of the simulator's HAL */
+        a->inner = a->hal;
+        a->hal = (br_hal_t){a, noisy_encoder_read, inner_pwm_write, inner_tick_wait, inner_pwm_disable,
+                            inner_pwm_enable};
+    }
     const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(c);
     br_est_t ext = {NULL, NULL};
     br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext,
@@ -103,6 +209,14 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase)
         break;
     case BR_CTRL_HINF_TRUE:
         ext = (br_est_t){&a->plant, oracle_step};
+        ac.est = BR_APP_EST_EXTERN;
+        break;
+    case BR_CTRL_HINF_FF:
+        if (br_ff_init(&a->ff, &c->ff) != BR_OK) {
+            fprintf(stderr, "br_circle: invalid feedforward configuration\n");
+            return -1;
+        }
+        ext = (br_est_t){&a->ff, br_ff_est_step};
         ac.est = BR_APP_EST_EXTERN;
         break;
     case BR_CTRL_HINF_UKF:
@@ -152,16 +266,25 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
         fprintf(stderr, "br_circle: radius, period, duration and dt must be > 0\n");
         return -1;
     }
+    const br_circle_real_t *rl = &c->real;
+    if (!(isfinite(rl->drift_frac) && rl->drift_frac > -0.9 && rl->drift_frac < 10.0 && isfinite(rl->force_noise_N) &&
+          rl->force_noise_N >= 0.0 && isfinite(rl->enc_noise_p) && rl->enc_noise_p >= 0.0 && rl->enc_noise_p <= 1.0)) {
+        fprintf(stderr, "br_circle: drift in (-0.9, 10), force noise >= 0, encoder noise in [0, 1]\n");
+        return -1;
+    }
     axis_sim_t ax[2];
     ax[0].mem = ax[1].mem = (br_app_mem_t){NULL, NULL};
     int rc = -1;
-    if (axis_init(&ax[0], c, 0.0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI) != 0) goto done;
+    if (axis_init(&ax[0], c, 0.0, 0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI, 1) != 0) goto done;
     const long n = lround(c->duration_s / c->dt_s);
     double sum2 = 0.0, emax = 0.0, fe2 = 0.0;
     int nsat = 0, nout = 0;
     long k_end = n; /* the last period run */
     res->fault_status = 0;
     res->fault_t_s = 0.0;
+    res->fault_cause = 0;
+    res->fault_duty = 0.0;
+    res->last_outlier_t_s = -1.0;
     for (long k = 0; k <= n && res->fault_status == 0; k++) {
         const double t = (double)k * c->dt_s;
         br_circle_sample_t s;
@@ -169,18 +292,30 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
         int sat = 0;
         for (int i = 0; i < 2; i++) {
             uint32_t tick;
+            /* force noise over the period the tick ends (k > 0) */
+            if (k > 0) axis_perturb(&ax[i]);
             ax[i].hal.tick_wait(ax[i].hal.ctx, &tick);
             s.pos_m[i] = br_plant_pos_m(&ax[i].plant);
             s.counts[i] = br_plant_encoder(&ax[i].plant);
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
+            if (c->controller == BR_CTRL_HINF_FF) {
+                /* the feedforward's reference at t_k, load side */
+                const double w = 2.0 * BR_PI / c->period_s, ph = w * t + ax[i].phase;
+                const br_ff_in_t in = {(float)(c->radius_m * w * cos(ph)), (float)(-c->radius_m * w * w * sin(ph)),
+                                       (float)s.ref_m[i]};
+                br_ff_set_ref(&ax[i].ff, &in);
+            }
             br_status_t st = br_app_step(&ax[i].app, &r);
             if (st == BR_W_OUTLIER) {
                 nout++; /* the estimator skipped the update; control went on */
+                res->last_outlier_t_s = t;
             } else if (st != BR_OK) {
                 /* the firmware zeroed the drive: the axis stops safe; so does the run */
                 res->fault_status = (int)st;
                 res->fault_t_s = t;
+                res->fault_cause = (int)ax[i].app.fault;
+                res->fault_duty = ax[i].port.duty;
                 k_end = k;
                 break;
             }

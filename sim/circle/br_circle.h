@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The thesis's X-Y circle experiment (section 5) on the simulator: two
  * identical axes, each a plant, the simulator's HAL (sim/hal) and the
  * firmware application (br_app_step), tracking x_ref = A sin(2 pi t / T),
@@ -8,6 +9,7 @@
 #include <stdio.h>
 
 #include "bristle/br_ctrl.h"
+#include "bristle/br_ff.h"
 #include "bristle/br_pf.h"
 #include "bristle/br_ukf.h"
 #include "plant/br_sim_plant.h"
@@ -18,8 +20,19 @@ typedef enum {
     BR_CTRL_HINF_ONLY = 0,
     BR_CTRL_HINF_UKF = 1,
     BR_CTRL_HINF_PF = 2,
-    BR_CTRL_HINF_TRUE = 3
+    BR_CTRL_HINF_TRUE = 3,
+    BR_CTRL_HINF_FF = 4 /* H-inf + static friction feedforward on the reference (firmware/ff) */
 } br_circle_ctrl_t;
+
+/* What a real machine adds during the run (docs/robustness.md); all 0: the
+ * plant as configured, bit for bit. */
+typedef struct {
+    double drift_frac;    /* friction level +drift_frac over the run (warm-up): the plant's friction_drift
+                             cause with drift_per_s = drift_frac / duration */
+    double force_noise_N; /* standard deviation of a force held over each control period (Gaussian) */
+    double enc_noise_p;   /* probability per read that the encoder reads one count off (+1 or -1) */
+    unsigned long long seed; /* of the noise; each axis draws its own stream */
+} br_circle_real_t;
 
 /* Name used in summary.json and file names: "hinf_only", "hinf_pf", ... */
 const char *br_circle_ctrl_name(br_circle_ctrl_t c);
@@ -34,6 +47,8 @@ typedef struct {
     float K[3];          /* state-feedback gains */
     br_pf_cfg_t pf;      /* BR_CTRL_HINF_PF: the filter (its model.dt_s must equal dt_s) */
     br_ukf_cfg_t ukf;    /* BR_CTRL_HINF_UKF: likewise (an extended model: est.model.causes) */
+    br_ff_cfg_t ff;      /* BR_CTRL_HINF_FF: the feedforward's identified model */
+    br_circle_real_t real; /* drift and noise of the run (all 0 for the thesis experiment) */
 } br_circle_cfg_t;
 
 typedef struct {
@@ -45,12 +60,27 @@ typedef struct {
     double fhat_rms_err_N;  /* RMS of (compensation - true friction) over both axes */
     int fault_status;       /* 0, or the negative status with which the firmware stopped an axis */
     double fault_t_s;       /* when it did */
+    int fault_cause;        /* the latched br_app_fault_t of that axis (0 without a fault) */
+    double fault_duty;      /* the duty the simulator's PWM holds after the fault (0: drive off) */
+    double last_outlier_t_s; /* time of the last outlier step (-1: none) */
 } br_circle_result_t;
 
 /* The thesis experiment with the reference machine, the H-inf gains and the
  * given controller at its thesis period (1 ms; 1.5 ms and 1500 particles for
- * the PF). */
+ * the PF); the feedforward from the machine's nominal model, no drift or
+ * noise. */
 br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller);
+
+/* The same on the demo's realistic plant (docs/demo.md, "Realistic plant"):
+ * one documented draw of the uncertainty of docs/robustness.md (the plant's
+ * parameters away from the estimators' and the feedforward's, which stay the
+ * machine's nominal ones; drift, force and encoder noise). */
+br_circle_cfg_t br_circle_cfg_realistic(br_circle_ctrl_t controller);
+
+/* The estimators' and the feedforward's model from an identified one (a
+ * diagnosis's model.json loaded as a plant configuration): its mass, LuGre
+ * and viscous parameters and its causes (br_causes_from_model). */
+void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *model);
 
 /* The firmware's controller configuration of one axis of cfg: its gains and
  * period, the machine's torque limit, the plant's amplifier, encoder and lead

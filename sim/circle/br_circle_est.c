@@ -1,37 +1,60 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Estimator configurations for the circle experiment, from the machine
  * description: the firmware's one home for them, bristle/br_machine_cfg.h
  * (bristle_gen/est/, docs/machine-file.md; docs/modules/pf.md), which the
- * STM32H743 image uses too. */
+ * STM32H743 image uses too. The image takes the machine file's causes
+ * (BR_MACHINE_CAUSES); here the estimators are on the thesis model, so that
+ * "nominal" stays nominal for any machine: the tools that run the extended
+ * model set est.model.causes themselves (br_circle_ext, br_track). */
 #include "br_circle_est.h"
 
 #include "bristle/br_machine_cfg.h"
 
 br_model_cfg_t br_machine_model_cfg(float dt_s)
 {
-    const br_model_cfg_t m = BR_MACHINE_MODEL_CFG(dt_s); /* no causes: the thesis model */
+    br_model_cfg_t m = BR_MACHINE_MODEL_CFG(dt_s);
+    m.causes = (br_causes_t){0}; /* the thesis model */
     return m;
 }
 
 br_pf_cfg_t br_circle_pf_cfg_default(float dt_s)
 {
-    const br_pf_cfg_t c = BR_MACHINE_PF_CFG_DEFAULT(dt_s);
+    br_pf_cfg_t c = BR_MACHINE_PF_CFG_DEFAULT(dt_s);
+    c.est.model.causes = (br_causes_t){0}; /* the thesis model */
     return c;
 }
 
 br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s)
 {
-    const br_ukf_cfg_t c = BR_MACHINE_UKF_CFG_DEFAULT(dt_s);
+    br_ukf_cfg_t c = BR_MACHINE_UKF_CFG_DEFAULT(dt_s);
+    c.est.model.causes = (br_causes_t){0}; /* the thesis model */
     return c;
 }
 
 br_pf_cfg_t br_circle_pf_cfg_tuned(float dt_s)
 {
-    const br_pf_cfg_t c = BR_MACHINE_PF_CFG_TUNED(dt_s);
+    br_pf_cfg_t c = BR_MACHINE_PF_CFG_TUNED(dt_s);
+    c.est.model.causes = (br_causes_t){0}; /* the thesis model */
     return c;
 }
 
 br_ukf_cfg_t br_circle_ukf_cfg_tuned(float dt_s)
 {
-    const br_ukf_cfg_t c = BR_MACHINE_UKF_CFG_TUNED(dt_s);
+    br_ukf_cfg_t c = BR_MACHINE_UKF_CFG_TUNED(dt_s);
+    c.est.model.causes = (br_causes_t){0}; /* the thesis model */
+    return c;
+}
+
+br_ff_cfg_t br_circle_ff_cfg_machine(void)
+{
+    br_ff_cfg_t c = {0};
+    const br_model_cfg_t m = BR_MACHINE_MODEL_CFG(1.0e-3f);
+    c.Fc_N = m.lugre.Fc_N;
+    c.Fs_N = m.lugre.Fs_N;
+    c.vs_mps = m.lugre.vs_mps;
+    c.sigma2_Nspm = m.sigma2_Nspm;
+    c.v_eps_mps = (float)BR_CIRCLE_FF_VEPS_MPS;
+    c.mass_kg = 0.0f;
+    c.comp_max_N = BR_MACHINE_TORQUE_LIMIT_NM_F / m.lead_mprad;
     return c;
 }

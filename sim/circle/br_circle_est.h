@@ -1,8 +1,10 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Estimator configurations for the circle experiment on the configured
  * machine (BR_MACHINE; the reference machine by default). */
 #ifndef BR_CIRCLE_EST_H
 #define BR_CIRCLE_EST_H
 
+#include "bristle/br_ff.h"
 #include "bristle/br_pf.h"
 #include "bristle/br_ukf.h"
 
@@ -22,5 +24,14 @@ br_ukf_cfg_t br_circle_ukf_cfg_default(float dt_s);
  * what the demo runs. */
 br_pf_cfg_t br_circle_pf_cfg_tuned(float dt_s);
 br_ukf_cfg_t br_circle_ukf_cfg_tuned(float dt_s);
+
+/* Width of the feedforward's smoothed sign on the circle (docs/modules/ff.md:
+ * chosen by measurement on the nominal plant). */
+#define BR_CIRCLE_FF_VEPS_MPS 4.0e-5
+
+/* The static friction feedforward from the machine's nominal model (eq. 5 and
+ * the viscous coefficient; no causes, no inertia term), clamped to the
+ * machine's torque limit / L. */
+br_ff_cfg_t br_circle_ff_cfg_machine(void);
 
 #endif

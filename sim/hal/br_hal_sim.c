@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Host HAL port bound to the plant simulator. */
 #include "br_hal_sim.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Host HAL port bound to the double-precision plant simulator: the encoder
  * reads the plant's quantised position, the PWM sets the amplifier duty, and
  * each tick advances the plant by one control period with the duty held. */

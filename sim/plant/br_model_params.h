@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The parameters of a saved model, model.json's "params" (docs/diagnose.md,
  * "Parameters"): the one table of their names in C. The model loader
  * (br_plant_json.c) reads them by it, the simulators' cause options
@@ -58,7 +59,8 @@
     X("ripple_period_m", ripple_period_m, "m", BR_GT0, 10.0, "position_ripple", "--ripple", 1)             \
     X("ripple_phase_rad", ripple_phase_rad, "rad", -1e3, 1e3, "position_ripple", "--ripple", 0)            \
     X("grad_per_m", grad_per_m, "1/m", -1e3, 1e3, "position_gradient", "--gradient", 1)                    \
-    X("delay_s", delay_s, "s", 0.0, BR_PLANT_DELAY_MAX_S, "actuator_delay", "--delay", 1)
+    X("delay_s", delay_s, "s", 0.0, BR_PLANT_DELAY_MAX_S, "actuator_delay", "--delay", 1)                \
+    X("drift_per_s", drift_per_s, "1/s", -1.0, 1.0, "friction_drift", "--drift", 1)
 
 /* The causes of a model (a diagnosis's model.json, loaded into a plant
  * configuration) for the firmware's extended estimation model: br_causes_t

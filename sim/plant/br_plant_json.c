@@ -1,8 +1,10 @@
-/* model.json -> br_plant_cfg_t (br_plant_json.h): a small recursive-descent
- * JSON reader that keeps only the numbers under the top-level "params", by
- * the table of br_model_params.h. */
+/* SPDX-License-Identifier: Apache-2.0 */
+/* model.json -> br_plant_cfg_t (br_plant_json.h). The JSON is read by cJSON
+ * (Debian's libcjson-dev, docs/architecture.md); this file keeps only the
+ * numbers under the top-level "params", by the table of br_model_params.h. */
 #include "br_plant_json.h"
 
+#include <cjson/cJSON.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -11,18 +13,7 @@
 
 #include "br_model_params.h"
 
-#define MAX_DEPTH 32
 #define MAX_FILE_BYTES (1L << 20)
-#define KEY_LEN 64
-
-typedef struct {
-    const char *s;
-    size_t i;
-    int line;
-    const char *name;
-    char *msg;
-    size_t msg_len;
-} json_t;
 
 /* the parameters a model may hold (br_model_params.h): the moving mass and
  * the nominal ones are required, the causes' optional */
@@ -41,242 +32,87 @@ static const param_t params[P_COUNT] = {BR_MEFF_PARAM(ROW) BR_NOMINAL_PARAMS(ROW
 #undef ROW
 #undef CAUSE_ROW
 
-static int fail(const json_t *j, const char *what)
+/* "name:line: what" (line 0: the file as a whole), or "name: where: what" for
+ * a field, named by its path ("params"."Fc_N"): cJSON keeps no line numbers */
+static int fail_at(char *msg, size_t msg_len, const char *name, int line, const char *what)
 {
-    if (j->msg && j->msg_len) snprintf(j->msg, j->msg_len, "%s:%d: %s", j->name, j->line, what);
+    if (msg && msg_len) snprintf(msg, msg_len, "%s:%d: %s", name, line, what);
     return -1;
 }
 
-static int fail_file(char *msg, size_t msg_len, const char *path, const char *what, const char *detail)
+static int fail_field(char *msg, size_t msg_len, const char *name, const char *key, const char *what)
 {
-    if (msg && msg_len) snprintf(msg, msg_len, "%s:0: %s%s", path, what, detail ? detail : "");
+    if (msg && msg_len) {
+        if (key)
+            snprintf(msg, msg_len, "%s: \"params\".\"%s\": %s", name, key, what);
+        else
+            snprintf(msg, msg_len, "%s: %s", name, what);
+    }
     return -1;
 }
 
-static void skip_ws(json_t *j)
+/* the line of a position in text (1-based) */
+static int line_of(const char *text, const char *at)
 {
-    for (;;) {
-        const char c = j->s[j->i];
-        if (c == '\n') j->line++;
-        if (c == ' ' || c == '\t' || c == '\r' || c == '\n') j->i++;
-        else return;
-    }
+    int line = 1;
+    for (const char *p = text; p < at && *p; p++) line += *p == '\n';
+    return line;
 }
 
-/* a string into buf (escapes reduced to one character; too long is an error) */
-static int parse_string(json_t *j, char *buf, size_t cap)
+/* the "params" object into val/have: numbers only, known keys only, each once */
+static int read_params(const cJSON *po, const char *name, double val[P_COUNT], int have[P_COUNT], char *msg,
+                       size_t msg_len)
 {
-    if (j->s[j->i] != '"') return fail(j, "a string was expected");
-    j->i++;
-    size_t n = 0;
-    for (;;) {
-        char c = j->s[j->i];
-        if (c == '\0' || c == '\n') return fail(j, "unterminated string");
-        j->i++;
-        if (c == '"') break;
-        if (c == '\\') {
-            c = j->s[j->i];
-            if (c == '\0') return fail(j, "unterminated string");
-            j->i++;
-            if (c == 'u') {
-                for (int k = 0; k < 4; k++, j->i++) {
-                    if (!strchr("0123456789abcdefABCDEF", j->s[j->i]) || j->s[j->i] == '\0') return fail(j, "bad \\u escape");
-                }
-                c = '?';
-            } else if (!strchr("\"\\/bfnrt", c)) {
-                return fail(j, "bad escape in a string");
-            }
-        }
-        if (buf) {
-            if (n + 1 >= cap) return fail(j, "string too long");
-            buf[n++] = c;
-        }
-    }
-    if (buf) buf[n] = '\0';
-    return 0;
-}
-
-/* a JSON number (RFC 8259 grammar) */
-static int parse_number(json_t *j, double *out)
-{
-    const char *p = j->s + j->i, *q = p;
-    if (*q == '-') q++;
-    if (*q == '0') q++;
-    else if (*q >= '1' && *q <= '9') while (*q >= '0' && *q <= '9') q++;
-    else return fail(j, "a number was expected");
-    if (*q == '.') {
-        q++;
-        if (!(*q >= '0' && *q <= '9')) return fail(j, "malformed number");
-        while (*q >= '0' && *q <= '9') q++;
-    }
-    if (*q == 'e' || *q == 'E') {
-        q++;
-        if (*q == '+' || *q == '-') q++;
-        if (!(*q >= '0' && *q <= '9')) return fail(j, "malformed number");
-        while (*q >= '0' && *q <= '9') q++;
-    }
-    errno = 0;
-    char *end = NULL;
-    const double v = strtod(p, &end);
-    if (end != q) return fail(j, "malformed number");
-    if (errno == ERANGE || !isfinite(v)) return fail(j, "number out of range");
-    *out = v;
-    j->i += (size_t)(q - p);
-    return 0;
-}
-
-static int skip_value(json_t *j, int depth);
-
-static int skip_container(json_t *j, int depth, char close, int keyed)
-{
-    if (depth > MAX_DEPTH) return fail(j, "nested too deeply");
-    j->i++;
-    skip_ws(j);
-    if (j->s[j->i] == close) {
-        j->i++;
-        return 0;
-    }
-    for (;;) {
-        skip_ws(j);
-        if (keyed) {
-            if (parse_string(j, NULL, 0) != 0) return -1;
-            skip_ws(j);
-            if (j->s[j->i] != ':') return fail(j, "':' expected after a key");
-            j->i++;
-            skip_ws(j);
-        }
-        if (skip_value(j, depth + 1) != 0) return -1;
-        skip_ws(j);
-        if (j->s[j->i] == ',') {
-            j->i++;
-            continue;
-        }
-        if (j->s[j->i] == close) {
-            j->i++;
-            return 0;
-        }
-        return fail(j, keyed ? "',' or '}' expected" : "',' or ']' expected");
-    }
-}
-
-static int skip_value(json_t *j, int depth)
-{
-    const char c = j->s[j->i];
-    double d;
-    if (c == '{') return skip_container(j, depth, '}', 1);
-    if (c == '[') return skip_container(j, depth, ']', 0);
-    if (c == '"') return parse_string(j, NULL, 0);
-    static const char *const lit[3] = {"true", "false", "null"};
-    for (int k = 0; k < 3; k++) {
-        const size_t n = strlen(lit[k]);
-        if (strncmp(j->s + j->i, lit[k], n) == 0) {
-            j->i += n;
-            return 0;
-        }
-    }
-    return parse_number(j, &d);
-}
-
-/* the "params" object: numbers only, known keys only, each once */
-static int parse_params(json_t *j, double val[P_COUNT], int have[P_COUNT])
-{
-    char key[KEY_LEN], msg[200], bounds[64];
-    if (j->s[j->i] != '{') return fail(j, "\"params\" must be an object");
-    j->i++;
-    skip_ws(j);
-    if (j->s[j->i] == '}') {
-        j->i++;
-        return 0;
-    }
-    for (;;) {
-        skip_ws(j);
-        if (parse_string(j, key, sizeof key) != 0) return -1;
+    char what[160], bounds[64];
+    if (!cJSON_IsObject(po)) return fail_field(msg, msg_len, name, NULL, "\"params\" must be an object");
+    for (const cJSON *it = po->child; it; it = it->next) {
+        const char *key = it->string;
         int k = 0;
         while (k < P_COUNT && strcmp(key, params[k].name) != 0) k++;
-        if (k == P_COUNT) {
-            snprintf(msg, sizeof msg, "unknown parameter \"%s\" in \"params\"", key);
-            return fail(j, msg);
-        }
-        if (have[k]) {
-            snprintf(msg, sizeof msg, "parameter \"%s\" given twice", key);
-            return fail(j, msg);
-        }
-        skip_ws(j);
-        if (j->s[j->i] != ':') return fail(j, "':' expected after a key");
-        j->i++;
-        skip_ws(j);
-        const char c = j->s[j->i];
-        if (!(c == '-' || (c >= '0' && c <= '9'))) {
-            snprintf(msg, sizeof msg, "parameter \"%s\" is not a number", key);
-            return fail(j, msg);
-        }
-        if (parse_number(j, &val[k]) != 0) return -1;
-        if (!br_param_in_bounds(val[k], params[k].lo, params[k].hi)) {
+        if (k == P_COUNT) return fail_field(msg, msg_len, name, key, "unknown parameter");
+        if (have[k]) return fail_field(msg, msg_len, name, key, "given twice");
+        if (!cJSON_IsNumber(it)) return fail_field(msg, msg_len, name, key, "not a number");
+        const double v = it->valuedouble;
+        if (!isfinite(v)) return fail_field(msg, msg_len, name, key, "number out of range");
+        if (!br_param_in_bounds(v, params[k].lo, params[k].hi)) {
             br_param_bounds_text(params[k].lo, params[k].hi, bounds, sizeof bounds);
-            snprintf(msg, sizeof msg, "parameter \"%s\" = %g %s", key, val[k], bounds);
-            return fail(j, msg);
+            snprintf(what, sizeof what, "%g %s", v, bounds);
+            return fail_field(msg, msg_len, name, key, what);
         }
+        val[k] = v;
         have[k] = 1;
-        skip_ws(j);
-        if (j->s[j->i] == ',') {
-            j->i++;
-            continue;
-        }
-        if (j->s[j->i] == '}') {
-            j->i++;
-            return 0;
-        }
-        return fail(j, "',' or '}' expected");
     }
+    return 0;
 }
 
 int br_plant_cfg_from_model_text(const char *text, const char *name, const br_plant_cfg_t *base, br_plant_cfg_t *out,
                                  char *msg, size_t msg_len)
 {
-    json_t j = {text, 0, 1, name, msg, msg_len};
+    const char *end = NULL;
+    /* the whole text one JSON value, nothing after it */
+    cJSON *root = cJSON_ParseWithOpts(text, &end, 1);
+    if (!root) {
+        const char *at = end ? end : text;
+        return fail_at(msg, msg_len, name, line_of(text, at), "not valid JSON (or nested too deeply) here");
+    }
     double val[P_COUNT] = {0};
-    int have[P_COUNT] = {0}, seen_params = 0, params_line = 0;
-    char key[KEY_LEN], what[160];
-    skip_ws(&j);
-    if (j.s[j.i] != '{') return fail(&j, "a JSON object was expected");
-    j.i++;
-    skip_ws(&j);
-    if (j.s[j.i] != '}') {
-        for (;;) {
-            skip_ws(&j);
-            if (parse_string(&j, key, sizeof key) != 0) return -1;
-            skip_ws(&j);
-            if (j.s[j.i] != ':') return fail(&j, "':' expected after a key");
-            j.i++;
-            skip_ws(&j);
-            if (strcmp(key, "params") == 0) {
-                if (seen_params) return fail(&j, "\"params\" given twice");
-                seen_params = 1;
-                params_line = j.line;
-                if (parse_params(&j, val, have) != 0) return -1;
-            } else if (skip_value(&j, 1) != 0) {
-                return -1;
-            }
-            skip_ws(&j);
-            if (j.s[j.i] == ',') {
-                j.i++;
-                continue;
-            }
-            if (j.s[j.i] == '}') break;
-            return fail(&j, "',' or '}' expected");
+    int have[P_COUNT] = {0}, rc = 0;
+    const cJSON *po = NULL;
+    if (!cJSON_IsObject(root)) {
+        rc = fail_field(msg, msg_len, name, NULL, "a JSON object was expected");
+    } else {
+        for (const cJSON *it = root->child; it && rc == 0; it = it->next) {
+            if (strcmp(it->string, "params") != 0) continue; /* everything outside "params" is ignored */
+            if (po) rc = fail_field(msg, msg_len, name, NULL, "\"params\" given twice");
+            po = it;
         }
+        if (rc == 0 && !po) rc = fail_field(msg, msg_len, name, NULL, "no \"params\" object");
+        if (rc == 0) rc = read_params(po, name, val, have, msg, msg_len);
+        for (int k = 0; rc == 0 && k < N_REQUIRED; k++)
+            if (!have[k]) rc = fail_field(msg, msg_len, name, params[k].name, "required, missing");
     }
-    j.i++;
-    skip_ws(&j);
-    if (j.s[j.i] != '\0') return fail(&j, "text after the JSON object");
-    if (!seen_params) return fail(&j, "no \"params\" object");
-    for (int k = 0; k < N_REQUIRED; k++) {
-        if (!have[k]) {
-            snprintf(what, sizeof what, "\"params\" lacks \"%s\"", params[k].name);
-            j.line = params_line; /* the line where "params" opens */
-            return fail(&j, what);
-        }
-    }
+    cJSON_Delete(root);
+    if (rc != 0) return rc;
     *out = *base;
     /* the moving mass at the load, split between J and M like the base machine */
     const double L = base->lead_mprad;
@@ -295,22 +131,26 @@ int br_plant_cfg_from_model_json(const char *path, const br_plant_cfg_t *base, b
                                  size_t msg_len)
 {
     FILE *f = fopen(path, "rb");
-    if (!f) return fail_file(msg, msg_len, path, "cannot open: ", strerror(errno));
+    if (!f) {
+        char what[256];
+        snprintf(what, sizeof what, "cannot open: %s", strerror(errno));
+        return fail_at(msg, msg_len, path, 0, what);
+    }
     char *buf = malloc((size_t)MAX_FILE_BYTES + 1);
     if (!buf) {
         fclose(f);
-        return fail_file(msg, msg_len, path, "out of memory", NULL);
+        return fail_at(msg, msg_len, path, 0, "out of memory");
     }
     const size_t n = fread(buf, 1, (size_t)MAX_FILE_BYTES + 1, f);
     const int err = ferror(f);
     fclose(f);
     int rc = -1;
     if (err) {
-        fail_file(msg, msg_len, path, "read error", NULL);
+        fail_at(msg, msg_len, path, 0, "read error");
     } else if (n > (size_t)MAX_FILE_BYTES) {
-        fail_file(msg, msg_len, path, "larger than 1 MiB, not a model file", NULL);
+        fail_at(msg, msg_len, path, 0, "larger than 1 MiB, not a model file");
     } else if (memchr(buf, '\0', n)) {
-        fail_file(msg, msg_len, path, "binary content (NUL byte)", NULL);
+        fail_at(msg, msg_len, path, 0, "binary content (NUL byte)");
     } else {
         buf[n] = '\0';
         /* a UTF-8 byte-order mark is tolerated */

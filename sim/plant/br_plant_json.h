@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A saved model (the "model.json" the diagnosis writes, docs/diagnose.md)
  * turned into a plant configuration, so the simulator can run an identified,
  * extended model.
@@ -19,10 +20,11 @@
 
 #include "br_sim_plant.h"
 
-/* 0 on success; -1 with "path:line: problem" in msg (unreadable file,
- * malformed JSON, a missing, unknown or non-numeric parameter). msg may be
- * NULL; msg_len bytes at most, NUL-terminated. The result is not validated
- * beyond that: br_plant_init does it. */
+/* 0 on success; -1 with the problem in msg: "path:line: ..." for an
+ * unreadable file (line 0) or malformed JSON (the line where cJSON stopped),
+ * "path: "params"."key": ..." for a missing, unknown, repeated, non-numeric
+ * or out-of-bounds parameter. msg may be NULL; msg_len bytes at most,
+ * NUL-terminated. The result is not validated beyond that: br_plant_init does it. */
 int br_plant_cfg_from_model_json(const char *path, const br_plant_cfg_t *base, br_plant_cfg_t *out, char *msg,
                                  size_t msg_len);
 

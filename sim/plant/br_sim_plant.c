@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Double-precision plant of one ball-screw axis. Scheme in br_sim_plant.h and
  * docs/modules/plant.md. */
 #include "br_sim_plant.h"
@@ -38,6 +39,7 @@ br_plant_cfg_t br_plant_cfg_reference(void)
     c.ripple_phase_rad = 0.0;
     c.grad_per_m = 0.0;
     c.delay_s = 0.0;
+    c.drift_per_s = 0.0;
     return c;
 }
 
@@ -46,7 +48,7 @@ static double lugre_force(const br_plant_t *p);
 int br_plant_causes_on(const br_plant_cfg_t *c)
 {
     return c->offset_N != 0.0 || c->dFc_neg_N != 0.0 || c->dsigma2_neg_Nspm != 0.0 || c->ripple_amp_N != 0.0 ||
-           c->grad_per_m != 0.0 || c->delay_s != 0.0;
+           c->grad_per_m != 0.0 || c->delay_s != 0.0 || c->drift_per_s != 0.0;
 }
 
 static int bad(const char *what)
@@ -84,6 +86,7 @@ int br_plant_init(br_plant_t *p, const br_plant_cfg_t *cfg, const br_plant_state
     if (!(isfinite(cfg->ripple_period_m) && (cfg->ripple_amp_N == 0.0 || cfg->ripple_period_m > 0.0)))
         return bad("ripple_period_m (must be > 0 with a ripple)");
     if (!isfinite(cfg->grad_per_m)) return bad("grad_per_m (must be finite)");
+    if (!isfinite(cfg->drift_per_s)) return bad("drift_per_s (must be finite)");
     if (!(isfinite(cfg->delay_s) && cfg->delay_s >= 0.0 && cfg->delay_s <= BR_PLANT_DELAY_MAX_S))
         return bad("delay_s (must be in 0..BR_PLANT_DELAY_MAX_S)");
     p->cfg = *cfg;
@@ -117,6 +120,12 @@ static double grad_k(const br_plant_cfg_t *c, double x)
     return fmax(0.0, 1.0 + c->grad_per_m * x);
 }
 
+/* time factor of the friction (friction_drift), s(t) = max(0, 1 + drift_per_s t) */
+static double drift_s(const br_plant_cfg_t *c, double t)
+{
+    return fmax(0.0, 1.0 + c->drift_per_s * t);
+}
+
 /* offset + ripple at load position x */
 static double dist_force(const br_plant_cfg_t *c, double x)
 {
@@ -125,14 +134,15 @@ static double dist_force(const br_plant_cfg_t *c, double x)
     return f;
 }
 
-/* eq. 3 at the current state (times k(x) with a gradient) */
+/* eq. 3 at the current state (times k(x) with a gradient, s(t) with a drift) */
 static double lugre_force(const br_plant_t *p)
 {
     const br_plant_cfg_t *c = &p->cfg;
     const double v = c->lead_mprad * p->x.omega_radps;
     const double g = stribeck_g(c, v);
     const double f = c->sigma0_Npm * p->x.z_m + c->sigma1_Nspm * (v - c->sigma0_Npm * fabs(v) * p->x.z_m / g);
-    if (c->grad_per_m != 0.0) return grad_k(c, c->lead_mprad * p->x.theta_rad) * f;
+    if (c->grad_per_m != 0.0 || c->drift_per_s != 0.0)
+        return grad_k(c, c->lead_mprad * p->x.theta_rad) * drift_s(c, p->t_s) * f;
     return f;
 }
 
@@ -161,11 +171,12 @@ static double cmd_integral(br_plant_t *p, double a, double b)
     return s;
 }
 
-/* One substep of h with the mean torque tau over it. With the causes on
- * (causes != 0): the viscous coefficient and g by the direction of the mean
- * velocity, the friction impulse times k(x) and offset + ripple, both at the
- * substep's mean position (midpoint rule, second order like the rest). */
-static void substep(br_plant_t *p, double tau, double h, int causes)
+/* One substep of h with the mean torque tau over it, tm the substep's middle
+ * time. With the causes on (causes != 0): the viscous coefficient and g by the
+ * direction of the mean velocity, the friction impulse times k(x) s(tm) and
+ * offset + ripple, at the substep's mean position and time (midpoint rule,
+ * second order like the rest). */
+static void substep(br_plant_t *p, double tau, double h, int causes, double tm)
 {
     const br_plant_cfg_t *c = &p->cfg;
     const double L = c->lead_mprad;
@@ -191,7 +202,7 @@ static void substep(br_plant_t *p, double tau, double h, int causes)
         if (causes) {
             const double xm = L * (p->x.theta_rad + 0.5 * dth);
             const double s2 = dth < 0.0 ? c->sigma2_Nspm + c->dsigma2_neg_Nspm : c->sigma2_Nspm;
-            const double fric = grad_k(c, xm) * (L * s2 * dth + c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0));
+            const double fric = grad_k(c, xm) * drift_s(c, tm) * (L * s2 * dth + c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0));
             w1 = w0 + (tau * h - L * (fric + dist_force(c, xm) * h)) / p->Jeff_kgm2;
         } else {
             /* eq. 1 integrated over h: Jeff dw = tau h - L^2 sigma2 dtheta - L (sigma0 int z + sigma1 dz) (eq. 3) */
@@ -226,14 +237,14 @@ void br_plant_step(br_plant_t *p, double duty, double dt_s)
             const double ta = p->t_s + (double)i * h - c->delay_s;
             const double ti = cmd_integral(p, ta, ta + h) / h;
             sum += ti;
-            substep(p, ti, h, causes);
+            substep(p, ti, h, causes, p->t_s + ((double)i + 0.5) * h);
         }
         /* one overrun per step at most */
         if (p->delay_overruns > over0) p->delay_overruns = over0 + 1;
         tau = sum / c->n_sub;
     } else {
         for (int i = 0; i < c->n_sub; i++) {
-            substep(p, tau, h, causes);
+            substep(p, tau, h, causes, p->t_s + ((double)i + 0.5) * h);
         }
     }
     p->t_s += dt_s;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Double-precision plant of one ball-screw axis (thesis eqs. 1-5): rigid
  * body + viscous + LuGre friction, encoder quantisation, amplifier.
  *
@@ -15,10 +16,11 @@
  * Causes (../shared/spec/measured-log.md, docs/simlog.md): fields at the end
  * of br_plant_cfg_t switch on what a measured log may show beyond the thesis
  * model. All zero is the thesis model, bit for bit. With x = L theta the load
- * position and k(x) = max(0, 1 + grad_per_m x):
+ * position, k(x) = max(0, 1 + grad_per_m x) and s(t) = max(0, 1 + drift_per_s t),
+ * t the plant time since init:
  *
  *   (J + L^2 M) domega/dt = tau(t - delay_s)
- *        - L [ k(x) (sigma2_d L omega + F_nl) + offset_N + ripple_amp_N sin(2 pi x / ripple_period_m + ripple_phase_rad) ]
+ *        - L [ k(x) s(t) (sigma2_d L omega + F_nl) + offset_N + ripple_amp_N sin(2 pi x / ripple_period_m + ripple_phase_rad) ]
  *
  * where, while the axis moves in -x, sigma2_d = sigma2_Nspm + dsigma2_neg_Nspm
  * and the Stribeck curve g is scaled by (Fc_N + dFc_neg_N) / Fc_N. */
@@ -42,6 +44,8 @@ typedef struct {
     double ripple_phase_rad;  /* its phase at x = 0 */
     double grad_per_m;        /* friction (viscous + LuGre) scaled by max(0, 1 + grad_per_m x) along the travel */
     double delay_s;           /* actuator dead time, 0 .. BR_PLANT_DELAY_MAX_S */
+    double drift_per_s;       /* friction level (Coulomb, stiction, viscous together) scaled by
+                                 max(0, 1 + drift_per_s t) with the time since init (warm-up) */
 } br_plant_cfg_t;
 
 /* Actuator delay: the commanded torques of the last BR_PLANT_DELAY_RING
@@ -65,7 +69,7 @@ typedef struct {
     br_plant_state_t x;
     double Jeff_kgm2;
     double tau_Nm;     /* torque applied during the last step (its mean with a delay) */
-    double fnl_N;      /* LuGre force at the end of the last step (direction level and k(x) included) */
+    double fnl_N;      /* LuGre force at the end of the last step (direction level, k(x) and s(t) included) */
     /* Causes: bookkeeping (zero and unused while the causes are off). */
     double fdist_N;    /* offset + ripple force at the end of the last step */
     double t_s;        /* plant time: the sum of the steps taken */

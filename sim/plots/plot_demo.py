@@ -1,14 +1,20 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Plots of the X-Y circle demo (thesis Figs. 4-8) from DIR/summary.json and
 the traces it names.
 
 Usage: plot_demo.py DIR
-  fig4_trajectory_<ctrl>.png  trajectory vs reference, radial error magnified (Fig. 4)
-  fig5_radial_error.png       radial error vs angle, every controller (Fig. 5)
-  fig6_friction.png           estimated friction (PF, UKF) and the true one, x axis (Fig. 6)
+  fig4_trajectory_<ctrl>.png  trajectory vs reference, radial error magnified, and the
+                              radial error at the controller's own scale (Fig. 4)
+  fig5_radial_error.png       radial error vs angle, every controller; a second panel
+                              with the compensated ones only (Fig. 5)
+  fig6_friction.png           estimated friction (PF, UKF) and the true one, x axis, and
+                              the estimation error (Fig. 6)
   fig7_gp.png                 the PF's mean g_p over time, both axes (Fig. 7)
-  fig8_gp_hist.png            g_p particle histograms before, during and after
-                              its largest transition (Fig. 8)"""
+  fig8_gp_hist.png            g_p particle histograms 30 ms before, at and after the
+                              largest g_p transition at a reversal after start-up (Fig. 8)
+The realistic plant's traces (summary.json "realistic", prefix real_) give the
+same figures with the prefix real_."""
 import json
 import os
 import sys
@@ -20,77 +26,118 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 LABELS = {"hinf_only": "H-inf only", "hinf_ukf": "H-inf + UKF", "hinf_pf": "H-inf + PF",
-          "hinf_true": "true friction (limit)"}
+          "hinf_true": "true friction (limit)", "hinf_ff": "H-inf + feedforward"}
+COMPENSATED = ("hinf_ukf", "hinf_pf", "hinf_true")  # errors in nm: their own panel
+STARTUP_S = 1.0   # Fig. 8 looks for its transition after the start-up
+REVERSAL_WIN_S = 0.5  # ... within this of an axis reversal
 MAGNIFY = 10.0  # radial error magnification in the trajectory plot
+# the PF's g_p clamp (machines/reference.json, estimator.pf.gp_min_N / gp_max_N)
+with open(os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                       "machines", "reference.json")) as _f:
+    _pf = json.load(_f)["estimator"]["pf"]
+GP_CLAMPS_N = (_pf["gp_min_N"], _pf["gp_max_N"])
 
 
 def load_trace(d, s, name):
     return np.genfromtxt(os.path.join(d, s[name]["trace"]), delimiter=",", names=True)
 
 
-def fig4(d, s, name, tr):
-    A = s["experiment"]["radius_m"]
+def circle_angle(tr):
+    return np.degrees(np.mod(np.arctan2(tr["x"], tr["y"]), 2 * np.pi))  # 0 deg at the start, clockwise
+
+
+def fig4(d, s, name, tr, pre="", A=1e-4):
     ang = np.arctan2(tr["y"], tr["x"])
     r = A + MAGNIFY * tr["radial_err"]
-    fig, ax = plt.subplots(figsize=(6, 6))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 5.2), gridspec_kw={"width_ratios": [1, 1.15]})
     ax.plot(tr["x_ref"] * 1e6, tr["y_ref"] * 1e6, "k--", lw=1, label="reference")
     ax.plot(r * np.cos(ang) * 1e6, r * np.sin(ang) * 1e6, "C0", lw=1,
             label="%s (radial error x%g)" % (LABELS[name], MAGNIFY))
     ax.set_aspect("equal")
     ax.set_xlabel("x [um]")
     ax.set_ylabel("y [um]")
-    ax.set_title("X-Y circle, %s: contour RMS %.2e m" % (LABELS[name], s[name]["contour_rms_m"]))
+    ax.set_title("%s: contour RMS %.2e m" % (LABELS[name], s[name]["contour_rms_m"]), fontsize=10)
     ax.legend(loc="lower right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(d, "fig4_trajectory_%s.png" % name), dpi=120)
-    plt.close(fig)
-
-
-def fig5(d, traces):
-    fig, ax = plt.subplots(figsize=(8, 4))
-    for name, tr in traces.items():
-        ang = np.degrees(np.mod(np.arctan2(tr["x"], tr["y"]), 2 * np.pi))  # 0 deg at the start, clockwise
-        ax.plot(ang, tr["radial_err"] * 1e6, ".", ms=1.5, label=LABELS[name])
+    # the radial error at its own scale: visible for the compensated controllers too
+    nm = name in COMPENSATED
+    ax2.plot(circle_angle(tr), tr["radial_err"] * (1e9 if nm else 1e6), ".", ms=1.2, color="C0")
     for q in (90, 180, 270):
-        ax.axvline(q, color="0.7", lw=0.8)
-    ax.set_xlabel("angle along the circle [deg] (quadrant lines = axis reversals)")
-    ax.set_ylabel("radial error [um] (+ = outward)")
-    ax.set_xlim(0, 360)
-    ax.legend(markerscale=6)
+        ax2.axvline(q, color="0.7", lw=0.8)
+    ax2.set_xlim(0, 360)
+    ax2.set_xlabel("angle along the circle [deg]")
+    ax2.set_ylabel("radial error [%s] (+ = outward)" % ("nm" if nm else "um"))
+    ax2.set_title("radial error at its own scale", fontsize=10)
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "fig5_radial_error.png"), dpi=120)
+    fig.savefig(os.path.join(d, "%sfig4_trajectory_%s.png" % (pre, name)), dpi=120)
     plt.close(fig)
 
 
-def fig6(d, traces):
+def fig5(d, traces, pre=""):
+    comp = [n for n in COMPENSATED if n in traces]
+    fig, axs = plt.subplots(2 if comp else 1, 1, figsize=(8, 7 if comp else 4), squeeze=False)
+    for name, tr in traces.items():
+        axs[0, 0].plot(circle_angle(tr), tr["radial_err"] * 1e6, ".", ms=1.5, label=LABELS[name])
+    axs[0, 0].set_ylabel("radial error [um] (+ = outward)")
+    if comp:
+        for name in comp:
+            axs[1, 0].plot(circle_angle(traces[name]), traces[name]["radial_err"] * 1e9, ".", ms=1.5,
+                           color="C%d" % list(traces).index(name), label=LABELS[name])
+        axs[1, 0].set_ylabel("radial error [nm]: compensated only")
+    for ax in axs[:, 0]:
+        for q in (90, 180, 270):
+            ax.axvline(q, color="0.7", lw=0.8)
+        ax.set_xlim(0, 360)
+        ax.legend(markerscale=6, fontsize=8)
+    axs[-1, 0].set_xlabel("angle along the circle [deg] (quadrant lines = axis reversals)")
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "%sfig5_radial_error.png" % pre), dpi=120)
+    plt.close(fig)
+
+
+def fig6(d, traces, pre=""):
     est = [n for n in ("hinf_pf", "hinf_ukf") if n in traces]
     if not est:
         return
-    fig, ax = plt.subplots(figsize=(9, 4))
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True, gridspec_kw={"height_ratios": [1.4, 1]})
     for n in est:
         tr = traces[n]
         ax.plot(tr["t"], tr["fhat_x"], lw=0.8, label="%s estimate" % LABELS[n])
+        # each run's own error: the plant's true f_nl of that run
+        ax2.plot(tr["t"], tr["fhat_x"] - tr["fnl_x"], lw=0.6,
+                 label="%s: F^ - f_nl (RMS %.3f N)" % (LABELS[n], np.sqrt(np.mean((tr["fhat_x"] - tr["fnl_x"]) ** 2))))
     tr = traces[est[0]]
     ax.plot(tr["t"], tr["fnl_x"], "k", lw=0.8, label="true (run with %s)" % LABELS[est[0]])
-    ax.set_xlabel("t [s]")
     ax.set_ylabel("friction f_nl, x axis [N]")
     ax.legend(fontsize=8)
+    ax2.set_xlabel("t [s]")
+    ax2.set_ylabel("estimation error, x [N]")
+    ax2.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "fig6_friction.png"), dpi=120)
+    fig.savefig(os.path.join(d, "%sfig6_friction.png" % pre), dpi=120)
     plt.close(fig)
 
 
-def gp_transition(tr, axis):
-    """Time of the largest drop of the mean g_p over 60 ms."""
+def gp_transition(tr, axis, period_s=8.0):
+    """The largest change of the mean g_p over 60 ms within REVERSAL_WIN_S of a
+    reversal of that axis after STARTUP_S: (time, change). x = A sin reverses at
+    T/4 + k T/2, y = A cos at k T/2."""
     g = tr["gp_%s" % axis]
     t = tr["t"]
     lag = max(1, int(round(0.06 / (t[1] - t[0]))))
-    drop = g[:-lag] - g[lag:]
-    k = int(np.argmax(drop))
-    return t[k + lag // 2], drop[k]
+    ch = np.abs(g[lag:] - g[:-lag])
+    tm = t[:-lag] + 0.5 * lag * (t[1] - t[0])
+    first = period_s / 4 if axis == "x" else 0.0
+    revs = np.arange(first, t[-1] + 1e-9, period_s / 2)
+    if len(revs) == 0 or len(tm) == 0:
+        return (tm[0] if len(tm) else t[0]), 0.0  # a run shorter than its first reversal
+    ok = (tm > STARTUP_S) & (np.min(np.abs(tm[:, None] - revs[None, :]), axis=1) < REVERSAL_WIN_S)
+    if not ok.any():
+        return tm[0], 0.0
+    k = int(np.argmax(np.where(ok, ch, -1.0)))
+    return tm[k], float(ch[k])
 
 
-def fig7_8(d, traces):
+def fig7_8(d, traces, pre=""):
     if "hinf_pf" not in traces:
         return
     tr = traces["hinf_pf"]
@@ -101,9 +148,9 @@ def fig7_8(d, traces):
     ax.set_ylabel("PF mean g_p [N]")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "fig7_gp.png"), dpi=120)
+    fig.savefig(os.path.join(d, "%sfig7_gp.png" % pre), dpi=120)
     plt.close(fig)
-    hist_path = os.path.join(d, "gp_hist_hinf_pf.csv")
+    hist_path = os.path.join(d, "gp_hist_%shinf_pf.csv" % pre)
     if not os.path.exists(hist_path):
         return
     h = np.loadtxt(hist_path, delimiter=",", comments="#")
@@ -113,29 +160,42 @@ def fig7_8(d, traces):
     tc, drop = gp_transition(tr, "xy"[axis])
     dt = tr["t"][1] - tr["t"][0]
     times = [tc - 0.03, tc, tc + 0.03]
-    fig, axs = plt.subplots(1, 3, figsize=(11, 3.5), sharey=True)
+    fig, axs = plt.subplots(1, 3, figsize=(11, 3.7), sharey=True)
     edges = np.arange(h.shape[1] - 2) * width
     for ax, tq in zip(axs, times):
         rows = h[(h[:, 1] == axis) & (np.abs(h[:, 0] - tq) < dt / 2)]
         if len(rows):
-            ax.bar(edges, rows[0, 2:], width=width, align="edge")
+            b = rows[0, 2:]
+            ax.bar(edges, b, width=width, align="edge")
+            # the bins that hold the g_p clamp (docs/demo.md, "Fig. 8"): drawn apart
+            for lim in GP_CLAMPS_N:
+                j = int(lim / width)
+                if 0 <= j < len(b) and b[j] > 0:
+                    ax.bar(edges[j], b[j], width=width, align="edge", color="0.6")
+                    ax.annotate("clamp %.1f N: %.0f %%" % (lim, 100 * b[j] / b.sum()), (edges[j], b[j]),
+                                fontsize=7, ha="center", va="bottom")
         ax.set_title("t = %.3f s" % tq)
         ax.set_xlabel("g_p [N]")
     axs[0].set_ylabel("particles (%s axis)" % "xy"[axis])
-    fig.suptitle("PF g_p histogram around its largest transition (mean drop %.1f N in 60 ms)" % drop)
+    fig.suptitle("PF g_p histogram at the largest g_p transition at a reversal after start-up "
+                 "(mean g_p changes %.1f N in 60 ms; grey: particles held at the clamp)" % drop, fontsize=9)
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "fig8_gp_hist.png"), dpi=120)
+    fig.savefig(os.path.join(d, "%sfig8_gp_hist.png" % pre), dpi=120)
     plt.close(fig)
 
 
 def main(d):
     s = json.load(open(os.path.join(d, "summary.json")))
-    traces = {n: load_trace(d, s, n) for n in LABELS if n in s}
-    for name, tr in traces.items():
-        fig4(d, s, name, tr)
-    fig5(d, traces)
-    fig6(d, traces)
-    fig7_8(d, traces)
+    A = s["experiment"]["radius_m"]
+    for pre, sec in (("", s), ("real_", s.get("realistic"))):
+        if not sec:
+            continue
+        traces = {n: load_trace(d, sec, n) for n in LABELS if n in sec}
+        for name, tr in traces.items():
+            fig4(d, sec, name, tr, pre, A)
+        fig5(d, traces, pre)
+        fig6(d, traces, pre)
+        fig7_8(d, traces, pre)
     print("wrote plots to %s" % d)
 
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Thesis Fig. 1: contour RMS against the Nelder-Mead iteration, from the
 progress logs written by br_tune_est --log.
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Cause options (br_cause_args.h), by the table of br_model_params.h. */
 #include "br_cause_args.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Identification run: trajectory and EMPS-form position loop (br_ident.h). */
 #include "br_ident.h"
 

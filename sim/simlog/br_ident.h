@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Identification run on the simulator (docs/simlog.md): a repeated cycle of
  * bang-bang-acceleration moves (trapezoidal velocity) over about 0.1 m at up
  * to 0.05 m/s with dwells, like the EMPS benchmark's excitation, tracked by an

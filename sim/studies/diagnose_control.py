@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The gain of a diagnosis in control terms (docs/diagnose.md, "Control terms").
 
 For each cause: the reference machine with the cause switched on (hidden
@@ -30,6 +31,7 @@ CASES = (
     ("position_ripple", ["--ripple", "1.0,0.004,0.5"], "1 N ripple, 4 mm period"),
     ("position_gradient", ["--gradient", "4"], "friction +4 %/cm along the travel"),
     ("actuator_delay", ["--delay", "0.003"], "3 ms actuator dead time"),
+    ("friction_drift", ["--drift", "0.01"], "friction level +1 % of its start a second (warm-up)"),
 )
 
 
@@ -112,8 +114,9 @@ def main():
              "(radius 0.1 mm, 8 s; 1 ms for the UKF, 1.5 ms and 1500 particles for the PF) on that machine. "
              "\"Nominal model\": the firmware's estimator as configured; \"extended model\": the same estimator "
              "with the causes of model.json in its own model (br_model_cfg_t.causes: the firmware's extended "
-             "model). \"Safe stop\": the firmware faulted (its estimate out of range) and zeroed the drive at that "
-             "time; the contour RMS is that of the run before it.", ""]
+             "model). \"Safe stop\": the firmware faulted (its estimate out of range, or it lost lock: "
+             "br_app's lock monitor) and zeroed the drive at that time; the contour RMS is that of the run "
+             "before it.", ""]
         for est in ests:
             E = est.upper()
             L += [f"## H-inf + {E}", "",

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Peak memory of a diagnosis of a long log (docs/diagnose.md, "Memory"):
 br_simlog writes an identification log of at least --rows rows, then
 `python -m bristle.diagnose diagnose` runs on it in a child process (no

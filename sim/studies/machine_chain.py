@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """A machine through the whole chain (docs/configure.md): a log (measured, or
 simulated on the given machine's plant) -> the diagnosis -> OUT/machine.json
 -> the STM32H743 image built for it -> the simulator with the firmware built

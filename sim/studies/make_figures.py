@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """make figures: regenerates thesis Figs. 1-8 into docs/figures/ and writes
 docs/results.md (the thesis's claim beside ours, with the command for each).
 
@@ -115,7 +116,8 @@ def write_results(s, st, logs, same, demo):
              "peaks at %.1f N at t = %.2f s (the reversal at 6 s), falls through the midpoint at t = %.2f s and "
              "settles near %.1f N | `make demo` |" % (gpk, tpk, tmid, gsl))
     L.append("| Fig. 8: g_p histograms | two-peaked during the transition (6.33 / 6.36 / 6.39 s) | fig8_gp_hist.png "
-             "(before / at / after the largest drop) | `make demo` |")
+             "(30 ms before / at / after the largest g_p transition at a reversal after start-up: one broad "
+             "cloud, not two peaks; the particles held at the g_p clamps drawn grey, docs/demo.md) | `make demo` |")
     L.append("| Table: contour RMS, H-inf only | 2.4e-6 m | %.3e m | `make demo` |" % h["contour_rms_m"])
     L.append("| Table: contour RMS, H-inf + UKF | 1.3e-6 m | %.3e m | `make demo` |" % u["contour_rms_m"])
     L.append("| Table: contour RMS, H-inf + PF | 4.0e-7 m | %.3e m | `make demo` |" % p["contour_rms_m"])

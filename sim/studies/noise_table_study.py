@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Noise-table study for the PF's ROM tables (docs/modules/pf.md): friction
 estimation error and contour RMS of the H-inf + PF circle against the table
 length, for three indexing schemes, averaged over table seeds.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Sampling-time study (thesis section 3.3, Fig. 2): runs br_dt_study with the
 thesis's particle count (1000 dt[ms]) and with a CPU budget, writes
 OUT/sampling_time.json and OUT/fig2_sampling_time.png, prints markdown tables.

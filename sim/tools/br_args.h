@@ -1,12 +1,58 @@
-/* Option values of the host tools (sim/apps): whole strings only, checked
- * against their bounds (br_tool_limits.h), with one message form:
- * "tool: OPT VALUE: must be a number in LO .. HI". */
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The host tools' command lines (sim/apps, sim/bench; docs/tools.md): GNU
+ * getopt_long underneath, with what every tool shares on top:
+ *
+ *   --help / -h   anywhere, even where a value is expected ("--out --help"
+ *                 asks for help, never names a file --help): usage on stdout, exit 0
+ *   --version     anywhere, likewise: "TOOL (bristle) X.Y.Z" (BR_VERSION_STRING), exit 0
+ *   an unknown option, an option without its value, a stray argument:
+ *                 one line "tool: ..." on stderr, then the tool's usage, exit 2
+ *
+ * and the option values: whole strings only, checked against their bounds
+ * (br_tool_limits.h), with one message form "tool: OPT VALUE: must be a
+ * number in LO .. HI".
+ *
+ * A tool's loop:
+ *   static const struct option opts[] = {{"out", required_argument, NULL, 'o'}, ..., {0}};
+ *   br_args_t p;
+ *   const int st = br_args_begin(&p, TOOL, argc, argv);   (BR_ARGS_HELP, BR_ARGS_VERSION: print, exit 0)
+ *   for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;)
+ *       switch (c) { case 'o': ...; case BR_ARGS_BAD: return usage(...); } */
 #ifndef BR_ARGS_H
 #define BR_ARGS_H
 
-/* 1 when any argument is --help or -h, wherever it stands (so it is never
- * taken as an option's value: "--out --help" asks for help) */
-int br_args_want_help(int argc, char **argv);
+#include <getopt.h>
+#include <stdio.h>
+
+enum {
+    BR_ARGS_END = -1,  /* br_args_next: no more options */
+    BR_ARGS_BAD = '?', /* br_args_next: a usage error, already reported */
+    BR_ARGS_RUN = 0,   /* br_args_begin: parse the options */
+    BR_ARGS_HELP = 1,  /* br_args_begin: --help or -h was given */
+    BR_ARGS_VERSION = 2 /* br_args_begin: --version was given (and not --help) */
+};
+
+typedef struct {
+    const char *tool;
+    int argc;
+    char **argv;
+    char opt[48]; /* the last option as written on a command line ("--dt"), for messages */
+} br_args_t;
+
+/* Starts a parse (resets getopt): BR_ARGS_HELP, BR_ARGS_VERSION or BR_ARGS_RUN. */
+int br_args_begin(br_args_t *p, const char *tool, int argc, char **argv);
+
+/* The next option: its val from longopts (a {0}-terminated getopt_long
+ * table; long options only), its argument in *arg (NULL for a flag) and its
+ * name in p->opt; BR_ARGS_END after the last; BR_ARGS_BAD after printing the
+ * problem (unknown option, missing value, a stray non-option argument). */
+int br_args_next(br_args_t *p, const struct option *longopts, const char **arg);
+
+/* "TOOL (bristle) X.Y.Z" */
+void br_args_print_version(const char *tool, FILE *to);
+
+/* the options every tool has, for its usage text */
+#define BR_ARGS_COMMON_USAGE "       %s --help | --version\n"
 
 /* the whole of val as a finite number in [lo, hi] into *out: 0, or -1 with a
  * message on stderr (*out untouched) */

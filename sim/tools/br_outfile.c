@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Temporary file + rename (br_outfile.h). */
 #define _POSIX_C_SOURCE 200809L
 #include "br_outfile.h"

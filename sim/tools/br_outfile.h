@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Writing a tool's output so that a failed run leaves nothing behind: the
  * text goes to a temporary file in the destination's directory and is
  * renamed onto the destination only when the whole run succeeded. Until

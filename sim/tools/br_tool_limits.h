@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The bounds of the host tools' options (sim/apps), in one place; a value
  * outside them is refused before any file is touched. docs/tools.md lists
  * them with the reasons.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Nelder-Mead simplex minimiser. See br_nm.h. */
 #include "br_nm.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Nelder-Mead simplex minimiser (thesis section 3.2), host side, double.
  *
  * Reflection, expansion, outside/inside contraction and shrink with the

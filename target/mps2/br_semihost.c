@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Minimal Arm semihosting: see br_semihost.h. */
 #include "br_semihost.h"
 

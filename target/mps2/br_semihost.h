@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Minimal Arm semihosting (bkpt 0xAB, Thumb) for the QEMU replay image:
  * only the calls it needs. QEMU: -semihosting-config enable=on,target=native. */
 #ifndef BR_SEMIHOST_H

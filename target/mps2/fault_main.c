@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* br_fault_mps2.elf: the check of startup_mps2.c's fault handler (ctest
  * target_qemu_fault). An undefined instruction raises a UsageFault, taken as
  * a HardFault (the configurable faults are not enabled): the emulation must

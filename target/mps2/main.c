@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Replay image for QEMU's mps2-an500 (Cortex-M7, FPU): reads a recorded
  * stream through semihosting, runs it through br_app_step with the PF
  * (target/replay/br_replay.h) and writes one output record per step.
@@ -13,7 +14,7 @@
  * and printed ("calib insns=... ticks=..."), so the conversion is measured,
  * not assumed (docs/target.md).
  *
- * All state (br_replay_t, ~95 KB) is in main's stack frame: no mutable
+ * All state (br_replay_t, two axes of ~62 KB) is in main's stack frame: no mutable
  * globals; mps2_an500.ld reserves a 512 KiB stack. */
 #include <stdint.h>
 
@@ -113,7 +114,8 @@ int main(void)
     const char *in = next_tok(&p);
     const char *out = next_tok(&p);
     const char *m = next_tok(&p);
-    if (in == 0 || out == 0) fail("usage: replay IN OUT [M]");
+    const char *sp = next_tok(&p); /* optional: 1 = the PF's scalar reference path */
+    if (in == 0 || out == 0) fail("usage: replay IN OUT [M [SCALAR_PATH]]");
 
     BR_SYST_RVR = 0xFFFFFFu;
     BR_SYST_CVR = 0u;
@@ -137,7 +139,7 @@ int main(void)
     if (mio.out_fd < 0) fail("cannot open the output file");
 
     const br_replay_io_t io = {&mio, io_read, io_write, io_stamp};
-    const int rc = br_replay_run(&replay, &io, (m != 0) ? parse_u32(m) : 0u);
+    const int rc = br_replay_run(&replay, &io, (m != 0) ? parse_u32(m) : 0u, (sp != 0) ? parse_u32(sp) : 0u);
     (void)br_sh_close(mio.in_fd);
     (void)br_sh_close(mio.out_fd);
     if (rc != 0) {
@@ -148,7 +150,8 @@ int main(void)
     say_u32("replay steps=", replay.cfg.n_steps);
     say_u32(" m=", replay.cfg.pf.n_particles);
     say_u32(" sizeof_replay=", (uint32_t)sizeof replay);
-    say_u32(" sizeof_pf=", (uint32_t)sizeof replay.pf);
+    say_u32(" axes=", replay.cfg.n_axes);
+    say_u32(" sizeof_pf=", (uint32_t)sizeof replay.ax[0].pf);
     br_sh_puts("\n");
     br_sh_exit(0u);
 }

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Startup of the replay image on QEMU's mps2-an500 (Cortex-M7 with FPU):
  * vector table, Reset_Handler and the fault handler.
  *

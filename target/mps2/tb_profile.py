@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Where the instructions go: a profile of the replay image from QEMU's
 translation-block log (make target-bench, docs/target.md).
 
@@ -23,9 +24,14 @@ INSN_RE = re.compile(r"^0x([0-9a-f]+):")
 TRACE_RE = re.compile(r"^Trace \d+: (0x[0-9a-f]+) \[[0-9a-f]+/([0-9a-f]+)/")
 
 
+LONG_RE = re.compile(r"\b(vdiv|vsqrt)\.f32\b")
+
+
 def parse(path):
-    """Returns {(function, start pc): executed instructions}, unattributed count."""
-    blocks = {}  # host address -> (function, start pc, instruction count)
+    """Returns {(function, start pc): executed instructions}, unattributed
+    count, and {(function, start pc): [executed vdiv.f32, executed vsqrt.f32]}."""
+    blocks = {}  # host address -> (function, start pc, instruction count, divisions, square roots)
+    longs = collections.defaultdict(lambda: [0, 0])
     pending = None  # the last translated block, waiting for its first execution
     counts = collections.Counter()
     unattributed = 0
@@ -34,7 +40,7 @@ def parse(path):
         for line in it:
             m = IN_RE.match(line)
             if m:
-                fn, first, n = m.group(1) or "?", None, 0
+                fn, first, n, nd, ns = m.group(1) or "?", None, 0, 0, 0
                 for l2 in it:
                     if not l2.strip():
                         break
@@ -43,7 +49,11 @@ def parse(path):
                         n += 1
                         if first is None:
                             first = int(mi.group(1), 16)
-                pending = (fn, first, n)
+                        ml = LONG_RE.search(l2)
+                        if ml:
+                            nd += ml.group(1) == "vdiv"
+                            ns += ml.group(1) == "vsqrt"
+                pending = (fn, first, n, nd, ns)
                 continue
             m = TRACE_RE.match(line)
             if m:
@@ -56,7 +66,10 @@ def parse(path):
                     unattributed += 1
                     continue
                 counts[(b[0], b[1])] += b[2]
-    return counts, unattributed
+                if b[3] or b[4]:
+                    longs[(b[0], b[1])][0] += b[3]
+                    longs[(b[0], b[1])][1] += b[4]
+    return counts, unattributed, longs
 
 
 def main():
@@ -64,14 +77,17 @@ def main():
     ap.add_argument("log")
     ap.add_argument("elf")
     ap.add_argument("--particle-steps", type=int, required=True)
+    ap.add_argument("--periods", type=int, default=0, help="control periods of the run (for the per-period counts)")
     ap.add_argument("--addr2line", default="arm-none-eabi-addr2line")
     ap.add_argument("--top", type=int, default=12)
     ap.add_argument("--skip", action="append", default=[], help="leave out a function (e.g. the calibration loop)")
     a = ap.parse_args()
     if a.particle_steps < 1:
         sys.exit("tb_profile: --particle-steps must be >= 1")
-    counts, unattributed = parse(a.log)
+    counts, unattributed, longs = parse(a.log)
     counts = collections.Counter({k: c for k, c in counts.items() if k[0] not in a.skip})
+    n_div = sum(v[0] for k, v in longs.items() if k[0] not in a.skip)
+    n_sqrt = sum(v[1] for k, v in longs.items() if k[0] not in a.skip)
     total = sum(counts.values())
     if total == 0:
         sys.exit(f"tb_profile: no executed blocks in {a.log}")
@@ -93,6 +109,16 @@ def main():
     for ((fn, pc), c), src in zip(hot, lines):
         src = re.sub(r".*/(firmware|hal|sim|tests)/", r"\1/", src)
         print(f"      {pc:#07x} {fn:20s} {c / per:7.1f}  {src}")
+    # the long-latency FPU instructions the cycle estimate charges (docs/target.md)
+    by_fn_div = collections.Counter()
+    for (fn, _), v in longs.items():
+        if fn not in a.skip:
+            by_fn_div[fn] += v[0]
+    print(f"    executed vdiv.f32 per particle-step {n_div / per:.3f}, vsqrt.f32 {n_sqrt / per:.3f}; by function: "
+          + ", ".join(f"{fn} {c / per:.3f}" for fn, c in by_fn_div.most_common(4)))
+    if a.periods > 0:
+        print(f"long_ops per_particle_step_div={n_div / per:.4f} per_particle_step_sqrt={n_sqrt / per:.4f} "
+              f"per_period_div={n_div / a.periods:.2f} per_period_sqrt={n_sqrt / a.periods:.2f}")
 
 
 if __name__ == "__main__":

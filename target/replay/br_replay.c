@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Replay core (br_replay.h): portable C99, no libc I/O, no globals. */
 #include "br_replay.h"
 
@@ -25,7 +26,7 @@ void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WOR
     uint32_t i = 0u;
     const br_model_cfg_t *m = &c->pf.est.model;
     w[i++] = BR_REPLAY_MAGIC;
-    w[i++] = BR_REPLAY_VERSION;
+    w[i++] = (c->n_axes == 2u) ? BR_REPLAY_VERSION_XY : BR_REPLAY_VERSION;
     w[i++] = c->n_steps;
     for (uint32_t j = 0u; j < 3u; ++j) w[i++] = f2w(c->ctrl.K[j]);
     w[i++] = f2w(c->ctrl.dt_s);
@@ -62,7 +63,10 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
 {
     uint32_t i = 0u;
     br_model_cfg_t *m = &c->pf.est.model;
-    if (w[i++] != BR_REPLAY_MAGIC || w[i++] != BR_REPLAY_VERSION) return BR_E_PARAM;
+    if (w[i++] != BR_REPLAY_MAGIC) return BR_E_PARAM;
+    const uint32_t version = w[i++];
+    if (version != BR_REPLAY_VERSION && version != BR_REPLAY_VERSION_XY) return BR_E_PARAM;
+    c->n_axes = (version == BR_REPLAY_VERSION_XY) ? 2u : 1u;
     c->n_steps = w[i++];
     for (uint32_t j = 0u; j < 3u; ++j) c->ctrl.K[j] = w2f(w[i++]);
     c->ctrl.dt_s = w2f(w[i++]);
@@ -110,13 +114,13 @@ uint32_t br_replay_idx_hash(const uint16_t *idx, uint32_t m)
 
 static br_status_t enc_read(void *ctx, int32_t *counts)
 {
-    *counts = ((const br_replay_t *)ctx)->enc_counts;
+    *counts = ((const br_replay_axis_t *)ctx)->enc_counts;
     return BR_OK;
 }
 
 static br_status_t pwm_write(void *ctx, float duty)
 {
-    ((br_replay_t *)ctx)->duty = duty;
+    ((br_replay_axis_t *)ctx)->duty = duty;
     return BR_OK;
 }
 
@@ -127,41 +131,50 @@ static br_status_t tick_wait(void *ctx, uint32_t *tick)
     return BR_OK;
 }
 
-int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles_override)
+int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles_override, uint32_t scalar_path)
 {
     uint32_t hdr[BR_REPLAY_HDR_WORDS];
     if (io->read(io->ctx, hdr, (uint32_t)sizeof hdr) != 0) return -1;
     if (br_replay_hdr_decode(hdr, &r->cfg) != BR_OK) return -2;
     if (n_particles_override != 0u) r->cfg.pf.n_particles = n_particles_override;
-    r->hal.ctx = r;
-    r->hal.encoder_read = enc_read;
-    r->hal.pwm_write = pwm_write;
-    r->hal.tick_wait = tick_wait;
-    r->hal.pwm_disable = NULL;
-    r->hal.pwm_enable = NULL;
-    r->duty = 0.0f;
+    r->cfg.pf.scalar_path = scalar_path;
+    const uint32_t na = r->cfg.n_axes;
     const br_app_cfg_t app_cfg = {&r->cfg.ctrl, BR_APP_EST_PF, &r->cfg.pf, NULL, NULL,
                                  br_app_guard_cfg(r->cfg.ctrl.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
-    const br_app_mem_t mem = {&r->pf, NULL};
-    /* the replay arms right after init, as the simulator */
-    if (br_app_init(&r->app, &app_cfg, &r->hal, &mem) != BR_OK || br_app_arm(&r->app) != BR_OK) return -3;
+    for (uint32_t a = 0u; a < na; ++a) {
+        br_replay_axis_t *x = &r->ax[a];
+        x->hal.ctx = x;
+        x->hal.encoder_read = enc_read;
+        x->hal.pwm_write = pwm_write;
+        x->hal.tick_wait = tick_wait;
+        x->hal.pwm_disable = NULL;
+        x->hal.pwm_enable = NULL;
+        x->duty = 0.0f;
+        const br_app_mem_t mem = {&x->pf, NULL};
+        /* the replay arms right after init, as the simulator */
+        if (br_app_init(&x->app, &app_cfg, &x->hal, &mem) != BR_OK || br_app_arm(&x->app) != BR_OK) return -3;
+    }
     for (uint32_t k = 0u; k < r->cfg.n_steps; ++k) {
-        uint32_t in[BR_REPLAY_STEP_WORDS];
-        uint32_t out[BR_REPLAY_OUT_WORDS];
-        if (io->read(io->ctx, in, (uint32_t)sizeof in) != 0) return -1;
-        r->enc_counts = (int32_t)in[0];
-        const br_ref_t ref = {(int32_t)in[1], w2f(in[2]), w2f(in[3])};
+        uint32_t in[BR_REPLAY_MAX_AXES][BR_REPLAY_STEP_WORDS];
+        if (io->read(io->ctx, in, (uint32_t)(na * sizeof in[0])) != 0) return -1;
+        /* the axes one after the other in the period, as on one MCU */
         const uint32_t t0 = io->stamp ? io->stamp(io->ctx) : 0u;
-        const br_status_t st = br_app_step(&r->app, &ref);
-        const uint32_t t1 = io->stamp ? io->stamp(io->ctx) : 0u;
-        out[0] = k;
-        out[1] = (uint32_t)(int32_t)st;
-        out[2] = br_replay_idx_hash(r->pf.idx, r->cfg.pf.n_particles);
-        out[3] = f2w(r->app.axis.F_hat_N);
-        out[4] = f2w(r->duty);
-        out[5] = t1 - t0;
-        if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;
-        if (BR_FAILED(st)) return -4;
+        for (uint32_t a = 0u; a < na; ++a) {
+            br_replay_axis_t *x = &r->ax[a];
+            uint32_t out[BR_REPLAY_OUT_WORDS];
+            x->enc_counts = (int32_t)in[a][0];
+            const br_ref_t ref = {(int32_t)in[a][1], w2f(in[a][2]), w2f(in[a][3])};
+            const br_status_t st = br_app_step(&x->app, &ref);
+            const uint32_t t1 = io->stamp ? io->stamp(io->ctx) : 0u;
+            out[0] = k;
+            out[1] = (uint32_t)(int32_t)st;
+            out[2] = br_replay_idx_hash(x->pf.idx, r->cfg.pf.n_particles);
+            out[3] = f2w(x->app.axis.F_hat_N);
+            out[4] = f2w(x->duty);
+            out[5] = t1 - t0;
+            if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;
+            if (BR_FAILED(st)) return -4;
+        }
     }
     return 0;
 }

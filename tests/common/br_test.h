@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Shared helpers for the cmocka tests. */
 #ifndef BR_TEST_H
 #define BR_TEST_H

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Hidden-cause suite: logs whose cause and parameters come from a seeded
 generator the diagnosis never sees, diagnosed from the log alone.
 
@@ -36,10 +37,12 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(REPO, "python"))
 from bristle.diagnose import __main__ as diagnose_cli  # noqa: E402
 from bristle.diagnose import causes  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import axis_sim  # noqa: E402
 
 CAUSES = ("none",) + causes.NAMES
 MASTER_SEED = 20261121
-DEFAULT_CASES = 36
+DEFAULT_CASES = 42  # 6 per class: none and each of the six causes
 PARAM_TOL = 0.20
 # the reference machine's friction, which br_simlog's plant has (through the
 # machine file's loader, firmware/design/machine.py)
@@ -80,10 +83,67 @@ def draw(i, n_cases, master=MASTER_SEED):
         d = rng.uniform(1e-3, 5e-3)
         truth = {"delay_s": d}
         flags = ["--delay", f"{d:.6g}"]
+    elif cause == "friction_drift":
+        r = sign() * rng.uniform(0.004, 0.02)  # 10 … 55 % over the 28 s log
+        truth = {"relative_rate_per_s": r}
+        flags = ["--drift", f"{r:.6g}"]
     elif cause != "none":
         raise ValueError(f"no generator for the cause {cause}: add one here")
     return {"case": i, "cause": cause, "truth": truth, "flags": flags, "noise_N": noise,
             "sim_seed": int(rng.integers(1, 2 ** 31))}
+
+
+# Beyond the single causes on br_simlog's reference machine (EXTRA, one
+# list, spread over the shards): pairs and triples, forces no named cause
+# describes ("unexplained"), other machines, 0.5 ms logs and force noise,
+# most of them from axis_sim.py, a generator that is not the diagnosis's
+# model (another trajectory, a finer integrator). Each: (label, generator,
+# machine, causes as the generator takes them, noise N, truth by cause).
+def _asym_truth(m, r, fv):
+    mc = axis_sim.MACHINES[m]
+    return {"Fc_pos_N": mc["Fc"], "Fc_neg_N": mc["Fc"] * r, "Fv_pos_Nspm": mc["s2"], "Fv_neg_Nspm": mc["s2"] * fv}
+
+
+EXTRA = (
+    ("unexplained", "axis", "reference", {"drag": 3000.0}, 0.1, {"unexplained": {}}),
+    ("unexplained", "axis", "heavy", {"bump": (0.3, 0.06, 0.008)}, 0.15, {"unexplained": {}}),
+    ("pair", "simlog", None, ["--offset", "1.2", "--delay", "0.002"], 0.1,
+     {"offset": {"force_N": 1.2}, "actuator_delay": {"delay_s": 0.002}}),
+    ("pair", "simlog", None, ["--ripple", "0.6,0.009,2.0", "--gradient", "-2.5"], 0.05,
+     {"position_ripple": {"period_m": 0.009, "amplitude_N": 0.6}, "position_gradient": {"relative_slope_per_m": -2.5}}),
+    ("triple", "simlog", None, ["--offset", "2.0", "--asym", "1.4,20", "--delay", "0.003"], 0.1,
+     {"offset": {"force_N": 2.0}, "asymmetric_friction": _asym_truth("reference", 1.2, 1.4),
+      "actuator_delay": {"delay_s": 0.003}}),
+    ("triple", "simlog", None, ["--offset", "-1.5", "--ripple", "0.8,0.006,1", "--delay", "0.0025"], 0.2,
+     {"offset": {"force_N": -1.5}, "position_ripple": {"period_m": 0.006, "amplitude_N": 0.8},
+      "actuator_delay": {"delay_s": 0.0025}}),
+    ("heavy machine", "axis", "heavy", {"asym": (4.0, 60.0)}, 0.2,
+     {"asymmetric_friction": _asym_truth("heavy", 1.2, 60.0 / 170.0 + 1.0)}),
+    ("light machine", "axis", "light", {"offset": 0.5}, 0.05, {"offset": {"force_N": 0.5}}),
+    ("0.5 ms log", "axis", "fast", {"delay": 0.002}, 0.1, {"actuator_delay": {"delay_s": 0.002}}),
+    ("none, 0.5 ms log", "axis", "fast", {}, 0.2, {}),
+    # not yet: offset -1 N + gradient 3 /m from axis_sim gets "unexplained" with no
+    # finding (nominal residual 13 %, no cause significant alone); docs/diagnose.md, Limits
+    ("none, heavy machine", "axis", "heavy", {}, 0.2, {}),
+    ("coarse encoder", "axis", "coarse", {"offset": 0.5}, 0.1, {"offset": {"force_N": 0.5}}),
+    ("none, coarse encoder", "axis", "coarse", {}, 0.1, {}),
+)
+
+
+def draw_extra(j):
+    label, gen, mach, cz, nz, truth = EXTRA[j]
+    expect = sorted(truth) if truth else ["none"]
+    return {"case": 1000 + j, "cause": "+".join(expect), "label": label, "generator": gen, "machine": mach,
+            "gen_causes": cz, "flags": cz if gen == "simlog" else [], "noise_N": nz, "truth": truth,
+            "expect": expect, "sim_seed": int(np.random.default_rng([MASTER_SEED, 1000 + j]).integers(1, 2 ** 31))}
+
+
+def write_log(case, simlog, log):
+    if case.get("generator") == "axis":
+        axis_sim.write_log(log, case["machine"], case["gen_causes"], case["noise_N"], case["sim_seed"])
+    else:
+        subprocess.run([simlog, "--out", log, "--seed", str(case["sim_seed"]), "--force-noise",
+                        f"{case['noise_N']:.6g}"] + case["flags"], check=True)
 
 
 def run_case(case, simlog, work):
@@ -91,8 +151,7 @@ def run_case(case, simlog, work):
     shutil.rmtree(d, ignore_errors=True)
     os.makedirs(os.path.join(d, "log"))
     log = os.path.join(d, "log", "log.csv")  # alone in its directory: no truth, no machine file beside it
-    subprocess.run([simlog, "--out", log, "--seed", str(case["sim_seed"]), "--force-noise", f"{case['noise_N']:.6g}"]
-                   + case["flags"], check=True)
+    write_log(case, simlog, log)
     out = os.path.join(d, "out")
     # the diagnosis's own command line, in this process (one interpreter start
     # for all the cases); it is given the log path and nothing else
@@ -109,7 +168,40 @@ def run_case(case, simlog, work):
     return judge(case, rep, secs)
 
 
+def judge_extra(case, rep, secs):
+    """An EXTRA case: the findings are exactly the hidden causes (none: no
+    finding and the verdict "none"), every hidden parameter within
+    PARAM_TOL. A force no cause names: never "none", and the report's
+    `unexplained` says the residual stays above the floor (a cause may be
+    found that stands in for part of such a force: it is listed)."""
+    reasons, errs = [], {}
+    verdict = rep["verdict"]
+    found = {f["cause"]: f["params"] for f in rep["findings"]}
+    exp = case["expect"]
+    if exp == ["none"]:
+        if verdict != "none" or found:
+            reasons.append(f"verdict {verdict}, findings {sorted(found)}; hidden none")
+    elif exp == ["unexplained"]:
+        if verdict == "none" or rep.get("unexplained") is None:
+            reasons.append(f"verdict {verdict} with nothing unexplained; hidden: a force no cause names")
+    else:
+        if sorted(found) != exp:
+            reasons.append(f"findings {sorted(found)}, hidden {exp}")
+        for c, tr in case["truth"].items():
+            for k, v in tr.items():
+                if c in found:
+                    e = (found[c][k] - v) / abs(v)
+                    errs[f"{c}.{k}"] = e
+                    if not abs(e) <= PARAM_TOL:
+                        reasons.append(f"{c}.{k} = {found[c][k]:.4g}, hidden {v:.4g} ({100 * e:+.1f} %)")
+    return dict(case, verdict=verdict, ok=not reasons, reasons=reasons, param_errors=errs,
+                relerr_nominal=rep["nominal"]["relerr_percent"], relerr_extended=rep["extended"]["relerr_percent"],
+                noise_floor=rep["noise_floor_percent"], findings=sorted(found), seconds=secs)
+
+
 def judge(case, rep, secs):
+    if "expect" in case:
+        return judge_extra(case, rep, secs)
     reasons = []
     verdict = rep["verdict"]
     nom, ext = rep["nominal"]["relerr_percent"], rep["extended"]["relerr_percent"]
@@ -134,7 +226,31 @@ def judge(case, rep, secs):
                 seconds=secs)
 
 
+def markdown_extra(extras):
+    L = ["## Pairs, triples, unexplained forces, other machines (EXTRA)", "",
+         "Generator `axis` is tests/diagnose/axis_sim.py (cosine moves between random targets, 20 substeps, "
+         "its own machines), `simlog` br_simlog. A case passes when the findings are exactly the hidden causes "
+         "(for none / unexplained: no finding and that verdict) with every parameter within 20 %.", "",
+         "| case | what | generator, machine | hidden | verdict, findings | parameter errors | held-out relerr "
+         "nominal → extended (floor) | noise [N] |", "|---|---|---|---|---|---|---|---|"]
+    for r in sorted(extras, key=lambda r: r["case"]):
+        hid = "; ".join(f"{c}: " + (", ".join(f"{k} = {v:.4g}" for k, v in tr.items()) or "—")
+                        for c, tr in r["truth"].items()) or "none"
+        er = ", ".join(f"{k} {100 * v:+.2f} %" for k, v in r.get("param_errors", {}).items()) or "—"
+        if not r["ok"]:
+            er += " — FAILED: " + "; ".join(r["reasons"])
+        gen = r["generator"] + (f", {r['machine']}" if r.get("machine") else ", reference")
+        rel = (f"{r.get('relerr_nominal', float('nan')):.3g} % → {r.get('relerr_extended', float('nan')):.3g} % "
+               f"({r.get('noise_floor', float('nan')):.3g} %)")
+        L.append(f"| {r['case']} | {r['label']} | {gen} | {hid} | {r['verdict']}, {', '.join(r.get('findings', [])) or '—'} "
+                 f"| {er} | {rel} | {r['noise_N']:.3g} |")
+    L.append("")
+    return L
+
+
 def markdown(results, command):
+    extras = [r for r in results if "expect" in r]
+    results = [r for r in results if "expect" not in r]
     n = len(results)
     idx = {c: k for k, c in enumerate(CAUSES)}
     cols = list(CAUSES) + ["error"]
@@ -170,6 +286,11 @@ def markdown(results, command):
     for (c, k), v in sorted(worst.items(), key=lambda x: (CAUSES.index(x[0][0]), x[0][1])):
         L.append(f"| {c} | {k} | {100 * v:.2f} % |")
     L.append("")
+    if extras:
+        ok_x = sum(r["ok"] for r in extras)
+        L[7:7] = [f"Beyond them: {len(extras)} cases of pairs, triples, unexplained forces and other machines, "
+                  f"{ok_x} passing.", ""]
+        L += markdown_extra(extras)
     return "\n".join(L)
 
 
@@ -183,6 +304,7 @@ def main():
     ap.add_argument("--merge", nargs="*")
     ap.add_argument("--md")
     ap.add_argument("--min-cases", type=int, default=30)
+    ap.add_argument("--no-extra", action="store_true", help="only the single-cause cases")
     ap.add_argument("--master-seed", type=int, default=MASTER_SEED,
                     help="another seed draws other cases (the thresholds were tuned on seeds other than the default)")
     a = ap.parse_args()
@@ -191,14 +313,14 @@ def main():
         for p in a.merge:
             with open(p) as f:
                 results += json.load(f)
-        covered = {r["cause"] for r in results}
+        covered = {r["cause"] for r in results if "expect" not in r}
         bad = [r for r in results if not r["ok"]]
         if a.md:
             with open(a.md, "w") as f:
                 f.write(markdown(results, " ".join(sys.argv[1:]) if not os.environ.get("BR_HIDDEN_COMMAND")
                                  else os.environ["BR_HIDDEN_COMMAND"]))
         print(f"{len(results)} cases, {len(bad)} failing, causes covered: {', '.join(sorted(covered))}")
-        if len(results) < a.min_cases or covered != set(CAUSES):
+        if len(results) < a.min_cases or not covered >= set(CAUSES):
             print(f"error: need at least {a.min_cases} cases covering every cause", file=sys.stderr)
             return 1
         return 1 if bad else 0
@@ -206,16 +328,17 @@ def main():
         ap.error("--simlog and --work are needed to run cases")
     k, K = (int(x) for x in a.shard.split("/"))
     mine = [i for i in range(a.cases) if i % K == k]
+    extra = [j for j in range(len(EXTRA)) if j % K == k] if not a.no_extra else []
     os.makedirs(a.work, exist_ok=True)
     if a.json and os.path.exists(a.json):
         os.remove(a.json)  # never leave an older shard's results for the merge
     results = []
-    for i in mine:
-        case = draw(i, a.cases, a.master_seed)
+    for case in [draw(i, a.cases, a.master_seed) for i in mine] + [draw_extra(j) for j in extra]:
+        i = case["case"]
         r = run_case(case, a.simlog, a.work)
         results.append(r)
         status = "ok  " if r["ok"] else "FAIL"
-        print(f"{status} case {i:3d}: hidden {r['cause']:20s} verdict {r['verdict']:20s} "
+        print(f"{status} case {i:4d}: hidden {r['cause']:20s} verdict {r['verdict']:20s} "
               f"({r['seconds']:.1f} s){'  ' + '; '.join(r['reasons']) if r['reasons'] else ''}", flush=True)
     if a.json:
         with open(a.json, "w") as f:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Log reader (python/bristle/diagnose/logreader.py): what real files contain is
 accepted, every problem is rejected with "file:line: problem", and a large
 file streams in bounded memory. One test per guard."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Numerics and guards of the diagnosis (python/bristle/diagnose): the parallel scan,
 the bounded bristle update, the force model's exactness, every cause's
 parameters through a saved model and back, the block test, the controller
@@ -98,8 +99,9 @@ class ModelTest(unittest.TestCase):
         exactly (variable projection + the searches) from the nominal start."""
         truth = {"Meff_kg": 30.0, "sigma2_Nspm": 60.0, "Fc_N": 8.0, "Fs_N": 12.0, "vs_mps": 1e-3, "sigma0_Npm": 4e6,
                  "sigma1_Nspm": 0.0, "offset_N": 1.5, "dFc_neg_N": 1.6, "dsigma2_neg_Nspm": 20.0, "ripple_amp_N": 0.8,
-                 "ripple_period_m": 0.006, "ripple_phase_rad": 0.4, "grad_per_m": 3.0, "delay_s": 0.0}
-        cs = ("offset", "asymmetric_friction", "position_ripple", "position_gradient")
+                 "ripple_period_m": 0.006, "ripple_phase_rad": 0.4, "grad_per_m": 3.0, "delay_s": 0.0,
+                 "drift_per_s": 0.01}
+        cs = ("offset", "asymmetric_friction", "position_ripple", "position_gradient", "friction_drift")
         f_true = model.from_params(truth, cs)
 
         def force(prep):
@@ -205,6 +207,8 @@ class GuardTest(unittest.TestCase):
                                (good.replace(', "offset_N": %s', ''), ":2: \"params\" lacks offset_N"),
                                (good % '"2"', ":3: parameter offset_N is not a number ('2')"),
                                (good.replace('"Fc_N": 1', '"Fc_N": 0') % "2", ":2: parameter Fc_N = 0 must be > 0 and <= 100000"),
+                               (good.replace('"Fc_N": 1', '"Fc_N": 1' + '0' * 400) % "2",
+                                ":2: parameter Fc_N = 1" + "0" * 38 + "… must be > 0 and <= 100000"),
                                (good.replace('"sigma2_Nspm"', '"Fv_Nspm"') % "2", ":2: \"params\" lacks sigma2_Nspm"),
                                (good % '2, "Fv_Nspm": 3', ":3: unknown parameter Fv_Nspm"),
                                (good % '2, "delay_s": 0.001',
@@ -224,7 +228,8 @@ class RegistryTest(unittest.TestCase):
 
     truth = {"Meff_kg": 30.0, "sigma2_Nspm": 60.0, "Fc_N": 8.0, "Fs_N": 12.0, "vs_mps": 1e-3, "sigma0_Npm": 4e6,
              "sigma1_Nspm": 500.0, "offset_N": 1.5, "dFc_neg_N": 1.5, "dsigma2_neg_Nspm": 20.0, "ripple_amp_N": 0.8,
-             "ripple_period_m": 0.006, "ripple_phase_rad": 0.4, "grad_per_m": 3.0, "delay_s": 0.002}
+             "ripple_period_m": 0.006, "ripple_phase_rad": 0.4, "grad_per_m": 3.0, "delay_s": 0.002,
+             "drift_per_s": 0.01}
 
     def test_every_parameter_round_trips(self):
         names = [q.name for q in causes.MODEL_PARAMS]
@@ -248,7 +253,7 @@ class RegistryTest(unittest.TestCase):
         """The names ../shared/spec/measured-log.md gives each cause's findings."""
         spec = {"offset": {"force_N"}, "asymmetric_friction": {"Fc_pos_N", "Fc_neg_N", "Fv_pos_Nspm", "Fv_neg_Nspm"},
                 "position_ripple": {"period_m", "amplitude_N"}, "position_gradient": {"relative_slope_per_m"},
-                "actuator_delay": {"delay_s"}}
+                "actuator_delay": {"delay_s"}, "friction_drift": {"relative_rate_per_s"}}
         self.assertEqual(set(spec), set(causes.NAMES))
         for m in causes.REGISTRY:
             self.assertLessEqual(spec[m.NAME], set(m.report_params(self.truth)), m.NAME)

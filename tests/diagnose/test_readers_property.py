@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Property-based tests (hypothesis) of the diagnosis's readers: the log
 reader (logreader.read_log), the model-file reader (modelfile.load) and the
 machine-file reader (machinefile.load).

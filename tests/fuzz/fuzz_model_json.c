@@ -1,5 +1,9 @@
-/* libFuzzer target: the model reader (sim/plant/br_plant_json.c), which reads
- * a diagnosis's model.json, outside data. The input is XORed over a valid
+/* SPDX-License-Identifier: Apache-2.0 */
+/* libFuzzer target: the model reader (sim/plant/br_plant_json.c: cJSON, then
+ * the checks of the parameter table), which reads a diagnosis's model.json,
+ * outside data. (Debian's libcjson is not instrumented for coverage: the
+ * fuzzer is guided by the checks' branches, and ASan still watches cJSON's
+ * allocations.) The input is XORed over a valid
  * model (every parameter of the table in br_model_params.h, the reference
  * machine's values and 0.5 for each cause), the rest appended, so the fuzzer
  * works inside the structure, not only on its first brace. Every input must

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* libFuzzer target: the replay stream (target/replay), outside data that the
  * host tool and the M7 image read. The input is laid over a valid stream of
  * the reference machine's H-inf + PF configuration: its first bytes are
@@ -45,7 +46,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size > sizeof buf) return 0;
     /* a valid header of the reference configuration ... */
     const br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
-    br_replay_cfg_t cfg = {16u, br_circle_ctrl_cfg(&c), c.pf};
+    br_replay_cfg_t cfg = {16u, br_circle_ctrl_cfg(&c), c.pf, 1u};
     uint32_t hdr[BR_REPLAY_HDR_WORDS];
     br_replay_hdr_encode(&cfg, hdr);
     memcpy(buf, hdr, hdr_bytes);
@@ -57,9 +58,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     stream_t s = {buf, total, 0u};
     const br_replay_io_t io = {&s, io_read, io_write, NULL};
     memset(&r, 0, sizeof r);
-    const int rc = br_replay_run(&r, &io, 0u);
+    const int rc = br_replay_run(&r, &io, 0u, 0u);
     /* nothing runs the motor on a NaN or beyond full scale */
-    if (!(fabsf(r.duty) <= 1.0f)) abort();
+    if (!(fabsf(r.ax[0].duty) <= 1.0f) || !(fabsf(r.ax[1].duty) <= 1.0f)) abort();
     (void)rc;
     return 0;
 }

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """ctest golden_regen: regenerate the golden traces into a scratch directory
 and compare them byte for byte with the committed golden/traces. Prints the
 first differing line of every differing file; exit status 1 on any difference."""

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Golden test: br_ctrl_step (float32) against golden/traces/ctrl.csv
  * (float64 reference golden/ref/ctrl.py): one continuous run from init, the
  * configuration read from the trace header. Tolerances: docs/golden.md. */

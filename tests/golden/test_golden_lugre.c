@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Golden test: br_lugre_step (float32) against golden/traces/lugre.csv
  * (float64 reference golden/ref/lugre.py), one continuous run from z = 0.
  * Tolerances: docs/golden.md. */

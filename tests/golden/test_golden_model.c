@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Golden test: br_model_step / br_model_fnl_N (float32) against
  * golden/traces/model.csv (float64 reference golden/ref/model.py).
  * One-step rows: each row gives x_k, u_k and the float64 x_{k+1}, so

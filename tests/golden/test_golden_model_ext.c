@@ -1,10 +1,13 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Golden test: the extended model (the causes of a diagnosis) of
  * br_model_step_at / br_model_fcomp_N (float32) against
  * golden/traces/model_ext.csv (float64 reference golden/ref/model.py): each
  * cause alone and all together, one-step rows. Tolerances: docs/golden.md,
  * "Extended model": the rounding chains of the thesis model's test, with the
  * load force's scale grown by the causes, plus the bound of the kernel's
- * third-order expansion of the ripple about the origin. */
+ * third-order expansion of the ripple about the origin and of the friction
+ * scale s(t) held over the step at the model's clock (the reference takes it
+ * at each stage's time). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -23,8 +26,8 @@
 #define C_OMEGA 32.0
 #define C_Z 64.0
 #define C_FNL 32.0
-#define N_SEG 5
-#define N_CAUSE 7 /* the trace's causes_order */
+#define N_SEG 6
+#define N_CAUSE 8 /* the trace's causes_order */
 #define PI 3.14159265358979323846
 
 static br_causes_t seg_causes(const br_trace_t *t, int seg)
@@ -34,7 +37,7 @@ static br_causes_t seg_causes(const br_trace_t *t, int seg)
     snprintf(key, sizeof key, "seg%d", seg);
     br_trace_meta_nums(t, key, v, N_CAUSE);
     const br_causes_t c = {(float)v[0], (float)v[1], (float)v[2], (float)v[3], (float)v[4], (float)v[5],
-                           (float)v[6], 0.0f};
+                           (float)v[6], 0.0f, (float)v[7]};
     return c;
 }
 
@@ -65,6 +68,7 @@ static void test_model_ext_one_step(void **state)
         assert_int_equal(br_model_init(&m[seg], &cfg), BR_OK);
         assert_true(m[seg].extended);
     }
+    const int cn = br_trace_col(&t, "n");
     const int cseg = br_trace_col(&t, "seg"), cp0 = br_trace_col(&t, "p0"), cu = br_trace_col(&t, "u");
     const int cst = br_trace_col(&t, "status"), cbr = br_trace_col(&t, "branch"), cfc = br_trace_col(&t, "fcomp");
     const int cx[BR_NX] = {br_trace_col(&t, "theta"), br_trace_col(&t, "omega"), br_trace_col(&t, "z"),
@@ -92,6 +96,9 @@ static void test_model_ext_one_step(void **state)
         }
         const double p0 = br_trace_get(&t, r, cp0), u = br_trace_get(&t, r, cu);
         n_rows[seg][(int)br_trace_get(&t, r, cbr) == 1]++;
+        /* the model's clock: the step starts at t = n dt */
+        const double n = br_trace_get(&t, r, cn);
+        br_model_set_clock(&m[seg], (uint32_t)n);
         const br_status_t st = br_model_step_at(&m[seg], x, (float)p0, (float)u, xn);
         if ((int)st != (int)br_trace_get(&t, r, cst)) {
             if (bad_status++ < 5) {
@@ -101,7 +108,9 @@ static void test_model_ext_one_step(void **state)
         }
         /* the load force's scale: k(p) (friction) + |offset| + |A| */
         const double c_neg = (Fc + c->dFc_neg_N) / Fc;
-        const double kmax = fmax(1.0, 1.0 + fabs((double)c->grad_per_m) * (fabs(p0) + L * fabs(xd[0]) + 1e-3));
+        const double drift = fabs((double)c->drift_per_s);
+        const double kmax = fmax(1.0, 1.0 + fabs((double)c->grad_per_m) * (fabs(p0) + L * fabs(xd[0]) + 1e-3)) *
+                            (1.0 + drift * (n + 1.0) * h);
         const double w0 = fabs(xd[1]), z0 = fabs(xd[2]), gp = xd[3], g = fmax(1.0, c_neg) * gp;
         const double s2d = s2 + fmax(0.0, (double)c->dsigma2_neg_Nspm);
         const double F_scale = kmax * (fmax(s0 * z0, g) + (2.0 * s1 + s2d) * L * w0) +
@@ -109,20 +118,25 @@ static void test_model_ext_one_step(void **state)
         const double S_th = fabs(xd[0]) + fabs(x1d[0]) + h * (w0 + fabs(x1d[1]));
         const double S_w = w0 + fabs(x1d[1]) + h / Jeff * (fabs(u) + L * F_scale);
         const double S_z = fmax(fmax(z0, fabs(x1d[2])), g / s0);
+        /* s(t) held over the step: the friction's scale is off by at most drift h
+         * (the reference's stages span [t, t + h]), its impulse by that times the
+         * friction over h; theta and z follow omega over the step (|dz'/domega| <= 2 L) */
+        const double hold_w = h / Jeff * L * drift * h * F_scale;
         /* the ripple's expansion, over the stages' positions and over theta alone */
         const double rip_step = ripple_expansion_bound(c, L, fabs(xd[0]) + h * (w0 + fabs(x1d[1])));
         const double rip_x = ripple_expansion_bound(c, L, fabs(xd[0]));
-        br_errstat_add(&e[0], &t, r, (double)xn[0], x1d[0], C_THETA * U32 * S_th);
-        br_errstat_add(&e[1], &t, r, (double)xn[1], x1d[1], C_OMEGA * U32 * S_w + 2.0 * h / Jeff * L * rip_step);
-        br_errstat_add(&e[2], &t, r, (double)xn[2], x1d[2], C_Z * U32 * S_z);
+        br_errstat_add(&e[0], &t, r, (double)xn[0], x1d[0], C_THETA * U32 * S_th + h * hold_w);
+        br_errstat_add(&e[1], &t, r, (double)xn[1], x1d[1],
+                       C_OMEGA * U32 * S_w + 2.0 * h / Jeff * L * rip_step + hold_w);
+        br_errstat_add(&e[2], &t, r, (double)xn[2], x1d[2], C_Z * U32 * S_z + 2.0 * L * h * hold_w);
         br_errstat_add(&e[3], &t, r, (double)xn[3], (double)x[3], 0.0); /* g_p is held exactly */
         br_errstat_add(&efc, &t, r, (double)br_model_fcomp_N(&m[seg], x, (float)p0), br_trace_get(&t, r, cfc),
                        C_FNL * U32 * (F_scale + s2 * L * w0) + 2.0 * rip_x);
     }
     for (int seg = 1; seg <= N_SEG; seg++) {
-        print_message("golden model_ext seg %d (%s): %ld RK4, %ld bounded rows\n", seg,
-                      br_trace_meta(&t, seg == 1 ? "seg1_name" : seg == 2 ? "seg2_name" : seg == 3 ? "seg3_name"
-                                                 : seg == 4 ? "seg4_name" : "seg5_name"),
+        char key[16];
+        snprintf(key, sizeof key, "seg%d_name", seg);
+        print_message("golden model_ext seg %d (%s): %ld RK4, %ld bounded rows\n", seg, br_trace_meta(&t, key),
                       n_rows[seg][0], n_rows[seg][1]);
         /* every cause goes through both schemes */
         assert_true(n_rows[seg][0] > 0 && n_rows[seg][1] > 0);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Golden test: the particle filter br_pf (float32) against the float64
  * reference golden/ref/pf.py, through golden/traces/est_input.csv (the
  * recorded closed-loop input), pf.csv (status, origin, noise position, max
@@ -13,7 +14,10 @@
  *     flips at a boundary, so the test keeps the C filter on the reference's
  *     ancestry: after every br_pf_step whose own indices differ from the
  *     trace's, the harness rebuilds the resampled set from the trace's
- *     indices (x[.][i] = xp[.][idx_trace[i]], the public fields of br_pf_t)
+ *     indices out of the predicted set (the filter predicts and resamples in
+ *     place; the harness gets the predicted set from br_pf_predict on a copy
+ *     of the filter taken before the step, with theta moved to the step's new
+ *     origin as br_pf_step does for a valid particle)
  *     and recomputes the estimate from it the way br_pf.h defines it. The
  *     particle states themselves drift apart too (every particle carries the
  *     rounding of its whole ancestry, and the model is locally expanding), so
@@ -207,14 +211,17 @@ static void test_pf_resample_identical(void **state)
 
 /* the estimate of the current set as br_pf.h defines it: particle means, mean
  * of f_nl over the resampled set (float32, as the filter) */
-static void resample_forced(br_pf_t *pf, const uint16_t *idx)
+static void resample_forced(br_pf_t *pf, const br_pf_t *pred, const uint16_t *idx)
 {
     const uint32_t m = pf->cfg.n_particles;
     float s[BR_NX] = {0.0f, 0.0f, 0.0f, 0.0f}, sf = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
         for (int i = 0; i < BR_NX; i++) {
-            pf->x[j][i] = pf->xp[idx[j]][i];
-            s[i] += pf->x[j][i];
+            pf->x[i][j] = pred->x[i][idx[j]];
+            s[i] += pf->x[i][j];
+        }
+        if (BR_PF_ONE_DIVISION) {
+            pf->kgp[j] = pred->kgp[idx[j]];
         }
         sf += pf->fnl[idx[j]];
         pf->idx[j] = idx[j];
@@ -223,6 +230,20 @@ static void resample_forced(br_pf_t *pf, const uint16_t *idx)
         pf->est.mean[i] = s[i] / (float)m;
     }
     pf->est.F_hat_N = sf / (float)m;
+}
+
+/* The predicted set of the step from the filter as it was before it (*pred):
+ * br_pf_predict makes the same prediction in place; a valid particle's theta
+ * is then taken to the new origin, th - shift, as br_pf_step does. */
+static void predicted_set(br_pf_t *pred, const br_meas_t *y, float u)
+{
+    const float shift = (float)br_counts_delta(y->counts, pred->origin_counts) * pred->cfg.est.rad_per_count;
+    assert_true(br_pf_predict(pred, u) == BR_OK);
+    for (uint32_t j = 0; j < pred->cfg.n_particles; j++) {
+        if (pred->l[j] == pred->l[j]) {
+            pred->x[BR_X_THETA][j] -= shift;
+        }
+    }
 }
 
 /* Model constants for the error bounds (double, from the trace header). */
@@ -298,7 +319,7 @@ static double dfnl_bound(const pf_consts_t *c, const float *x, const double *d)
            C_FNL * U32 * S_f;
 }
 
-static br_pf_t g_pf; /* ~100 KiB: static */
+static br_pf_t g_pf, g_pred; /* ~70 KiB each: static */
 
 /* (b) and (c) */
 static void test_pf_forced_run(void **state)
@@ -384,6 +405,12 @@ static void test_pf_forced_run(void **state)
             drift_advance(&dr, &c, S);
         }
 
+        /* the predicted set of this step, for the forced resampling below */
+        br_pf_t *const pred = &g_pred;
+        memcpy(pred, pf, sizeof *pred);
+        if (pf->primed) {
+            predicted_set(pred, &y, u);
+        }
         const br_status_t st = br_pf_step(pf, &y, u);
         if ((int)st != st_exp) {
             if (bad_status++ < 5) {
@@ -461,7 +488,7 @@ static void test_pf_forced_run(void **state)
                  * its indices cannot differ */
                 assert_int_equal(st_exp, BR_OK);
                 /* (b) stay on the reference's ancestry */
-                resample_forced(pf, idx_t);
+                resample_forced(pf, pred, idx_t);
             }
         }
         /* largest |x| of the C set: scale of the sums over the particles */
@@ -469,8 +496,8 @@ static void test_pf_forced_run(void **state)
         for (uint32_t j = 0; j < m; j++) {
             float xj[BR_NX];
             for (int i = 0; i < BR_NX; i++) {
-                xj[i] = (k > 0) ? pf->xp[pf->idx[j]][i] : pf->x[j][i];
-                xmax[i] = fmax(xmax[i], fabs((double)pf->x[j][i]));
+                xj[i] = (k > 0) ? pred->x[i][pf->idx[j]] : pf->x[i][j];
+                xmax[i] = fmax(xmax[i], fabs((double)pf->x[i][j]));
             }
             const double f = (k > 0) ? pf->fnl[pf->idx[j]] : br_model_fnl_N(&pf->model, xj);
             fmax_ = fmax(fmax_, fabs(f));
@@ -505,8 +532,12 @@ static void test_pf_forced_run(void **state)
                 assert_int_equal((int)br_trace_get(&g.x, xrow, cx_j), (int)j);
                 for (int i = 0; i < BR_NX; i++) {
                     const double ref = br_trace_get(&g.x, xrow, cx[i]);
-                    br_errstat_add(&e_x[i], &g.x, xrow, (double)pf->x[j][i], ref, dr.d[i]);
-                    pf->x[j][i] = (float)ref;
+                    br_errstat_add(&e_x[i], &g.x, xrow, (double)pf->x[i][j], ref, dr.d[i]);
+                    pf->x[i][j] = (float)ref;
+                }
+                if (BR_PF_ONE_DIVISION) {
+                    pf->kgp[j] = (pf->cfg.est.model.lugre.sigma0_Npm * pf->cfg.est.model.lead_mprad) /
+                                  pf->x[BR_X_GP][j]; /* the filter carries sigma0 L / g_p with g_p */
                 }
             }
             step_scales(&c, xm, xm, 0.0, 0.0, S);

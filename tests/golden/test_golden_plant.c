@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Golden test: the double-precision plant br_plant_step against
  * golden/traces/plant.csv and plant_wrap.csv (float64 reference
  * golden/ref/plant.py): full trajectories from x0, never reset.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Golden test: the UKF br_ukf (float32) against the float64 reference
  * golden/ref/ukf.py, through golden/traces/est_input.csv (the recorded
  * closed-loop input, shared with the PF test) and ukf.csv (status, origin,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Golden trace reader; see trace_reader.h. */
 #include <stdarg.h>
 #include <stddef.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Reader of the golden traces (golden/traces/NAME.csv, written by
  * golden/gen_traces.py) for the cmocka golden tests, plus a small per-signal
  * error accumulator.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Builds and checks the firmware for another machine (tests/machine/CMakeLists.txt).
 # Variables: SOURCE_DIR, BUILD_DIR, MACHINE, PYTHON, GENERATOR, C_COMPILER.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """The machine-file loader (firmware/design/machine.py, docs/machine-file.md):
 every machine of machines/ loads; a broken file fails with one
 "FILE: field a.b.c: problem" line per problem and exit status 1, without a
@@ -123,6 +124,20 @@ def main():
     check(rc == 1 and err.startswith("%s: not valid JSON: line 3" % machine.display_name(path))
           and "Traceback" not in err,
           "syntax.json: names the file and the line")
+
+    # the causes a diagnosis found reach the firmware's model configuration
+    # (BR_MACHINE_CAUSES, br_machine_cfg.h); a cause left out is 0 (off)
+    withc = copy.deepcopy(good)
+    withc["causes"] = {"friction_drift": {"drift_per_s": 0.01}, "offset": {"offset_N": -1.5}}
+    path = write(work, "causes.json", withc)
+    rc, err = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, "causes_gen"))
+    with open(os.path.join(work, "causes_gen", "bristle_gen", "machine", "br_machine.h")) as f:
+        hdr = f.read()
+    check(rc == 0 and ".drift_per_s = %s," % machine.c_float(0.01) in hdr
+          and ".offset_N = %s," % machine.c_float(-1.5) in hdr and ".delay_s = %s," % machine.c_float(0.0) in hdr,
+          "causes.json: gen_machine.py writes the causes into BR_MACHINE_CAUSES")
+    withc["causes"] = {"friction_drift": {"drift_per_s": 2.0}}
+    expect_errors(work, "drift.json", withc, ["field causes.friction_drift.drift_per_s: 2 is outside [-1, 1]"])
 
     # weights that make the sampled loop unstable: no design, a clear message
     bad = copy.deepcopy(good)

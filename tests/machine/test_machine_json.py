@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """The machine.json a diagnosis writes (python/bristle/diagnose/machinejson.py,
 docs/configure.md), on an identification log of the reference machine's
 plant (br_simlog), whose truth is machines/reference.json:

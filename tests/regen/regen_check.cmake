@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Regenerates one generated file into the build tree and fails on any difference
 # from the committed copy. Variables: PYTHON, SCRIPT, COMMITTED, OUT, OUT_FLAG
 # (--out: OUT is the file; --out-dir: OUT is a directory that receives files

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Reruns the estimator tuning and fails on any difference from the committed
 # header. Variables: TUNER, EST, COMMITTED, OUT.
 if(NOT EXISTS ${TUNER})

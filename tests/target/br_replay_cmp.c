@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Compares replay outputs (target/replay/br_replay.h), and summarises their cost.
  *
  *   br_replay_cmp HOST.bin TARGET.bin [--expect EXPECT.bin]
@@ -59,15 +60,23 @@ static int cost(const char *path)
     size_t n;
     rec_t *r = load(path, &n, BR_REPLAY_OUT_WORDS);
     if (n < 2) return 1;
-    uint32_t *c = malloc((n - 1) * sizeof *c);
-    double sum = 0.0;
-    for (size_t k = 1; k < n; k++) {
-        c[k - 1] = r[k][5];
-        sum += (double)r[k][5];
+    /* one cost per period k >= 1 (k = 0 is the PF's priming step): the
+     * largest of its records' (the last axis's record holds the whole period) */
+    uint32_t *c = calloc(n, sizeof *c);
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (r[i][0] == 0u) continue;
+        if (i > 0 && r[i][0] == r[i - 1][0] && m > 0) {
+            c[m - 1] = (r[i][5] > c[m - 1]) ? r[i][5] : c[m - 1];
+        } else {
+            c[m++] = r[i][5];
+        }
     }
-    qsort(c, n - 1, sizeof *c, cmp_u32);
-    const size_t m = n - 1;
-    printf("%zu %.1f %u %u %u %u\n", n, sum / (double)m, c[m / 2], c[0], c[m - 1], c[(m * 99) / 100]);
+    if (m == 0) return 1;
+    double sum = 0.0;
+    for (size_t k = 0; k < m; k++) sum += (double)c[k];
+    qsort(c, m, sizeof *c, cmp_u32);
+    printf("%zu %.1f %u %u %u %u\n", m + 1, sum / (double)m, c[m / 2], c[0], c[m - 1], c[(m * 99) / 100]);
     free(c);
     free(r);
     return 0;

@@ -1,5 +1,6 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Host build of the replay (target/replay/br_replay.h) with a stdio shim: the
- * same core the mps2-an500 image runs under QEMU.  br_replay_host IN OUT [M] */
+ * same core the mps2-an500 image runs under QEMU.  br_replay_host IN OUT [M [SCALAR_PATH]] */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -17,8 +18,8 @@ static int io_write(void *ctx, const void *buf, uint32_t n)
 
 int main(int argc, char **argv)
 {
-    if (argc < 3 || argc > 4) {
-        fprintf(stderr, "usage: br_replay_host IN OUT [M]\n");
+    if (argc < 3 || argc > 5) {
+        fprintf(stderr, "usage: br_replay_host IN OUT [M [SCALAR_PATH]]\n");
         return 2;
     }
     FILE *f[2] = {fopen(argv[1], "rb"), fopen(argv[2], "wb")};
@@ -29,14 +30,15 @@ int main(int argc, char **argv)
     br_replay_t *r = calloc(1, sizeof *r);
     if (r == NULL) return 1;
     const br_replay_io_t io = {f, io_read, io_write, NULL};
-    const int rc = br_replay_run(r, &io, (argc == 4) ? (uint32_t)strtoul(argv[3], NULL, 10) : 0u);
+    const int rc = br_replay_run(r, &io, (argc >= 4) ? (uint32_t)strtoul(argv[3], NULL, 10) : 0u,
+                                 (argc == 5) ? (uint32_t)strtoul(argv[4], NULL, 10) : 0u);
     fclose(f[0]);
     if (fclose(f[1]) != 0 || rc != 0) {
         fprintf(stderr, "br_replay_host: replay failed (%d)\n", rc);
         free(r);
         return 1;
     }
-    printf("br_replay_host: %u steps, m = %u\n", r->cfg.n_steps, r->cfg.pf.n_particles);
+    printf("br_replay_host: %u steps, m = %u, %u axes\n", r->cfg.n_steps, r->cfg.pf.n_particles, r->cfg.n_axes);
     free(r);
     return 0;
 }

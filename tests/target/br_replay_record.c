@@ -1,10 +1,12 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Records the replay stream (target/replay/br_replay.h) from the simulator:
- * the x axis of the thesis circle, H-inf + PF at 1.5 ms, m = 1500, for
- * --duration seconds. Per period: the encoder counts the axis read and the
- * reference it was given. --expect also writes the closed loop's own
- * (F_hat, duty) per step as float bits, which the host replay must reproduce.
+ * the x axis of the thesis circle (--axes 2: both axes, x then y), H-inf + PF
+ * at 1.5 ms, m = 1500, for --duration seconds. Per period and axis: the
+ * encoder counts the axis read and the reference it was given. --expect also
+ * writes the closed loop's own (F_hat, duty) per step and axis as float bits,
+ * which the host replay must reproduce.
  *
- *   br_replay_record --out stream.bin [--expect expect.bin] [--duration 1.0] */
+ *   br_replay_record --out stream.bin [--expect expect.bin] [--duration 1.0] [--axes 1|2] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,6 +22,7 @@ typedef struct {
     FILE *steps;   /* temporary: step records */
     FILE *expect;  /* may be NULL */
     uint32_t n;
+    uint32_t n_axes;
 } rec_t;
 
 static uint32_t f2w(float f)
@@ -29,27 +32,30 @@ static uint32_t f2w(float f)
     return w;
 }
 
-/* The reference of axis x (phase 0), as sim/circle/br_circle.c computes it. */
+/* The reference of axis a (x: phase 0, y: phase pi/2), as sim/circle/br_circle.c computes it. */
 static void sink(void *user, const br_circle_sample_t *s)
 {
     rec_t *r = user;
     const br_circle_cfg_t *c = r->c;
     const double L = c->plant.lead_mprad, rpc = 2.0 * BR_PI / c->plant.counts_per_rev;
     const double w = 2.0 * BR_PI / c->period_s;
-    const double x_ref = c->radius_m * sin(w * s->t_s);
-    const double counts = x_ref / L / rpc;
-    const double whole = floor(counts);
-    if (x_ref != s->ref_m[0]) {
-        fprintf(stderr, "br_replay_record: reference mismatch at t=%g\n", s->t_s);
-        exit(1);
-    }
-    const uint32_t rec[BR_REPLAY_STEP_WORDS] = {
-        (uint32_t)s->counts[0], (uint32_t)(int32_t)whole, f2w((float)(counts - whole)),
-        f2w((float)(c->radius_m * w * cos(w * s->t_s) / L))};
-    fwrite(rec, sizeof rec, 1, r->steps);
-    if (r->expect) {
-        const uint32_t e[2] = {f2w((float)s->F_hat_N[0]), f2w((float)s->duty[0])};
-        fwrite(e, sizeof e, 1, r->expect);
+    for (uint32_t a = 0u; a < r->n_axes; a++) {
+        const double phase = (a == 0u) ? 0.0 : 0.5 * BR_PI;
+        const double x_ref = c->radius_m * sin(w * s->t_s + phase);
+        const double counts = x_ref / L / rpc;
+        const double whole = floor(counts);
+        if (x_ref != s->ref_m[a]) {
+            fprintf(stderr, "br_replay_record: reference mismatch at t=%g\n", s->t_s);
+            exit(1);
+        }
+        const uint32_t rec[BR_REPLAY_STEP_WORDS] = {
+            (uint32_t)s->counts[a], (uint32_t)(int32_t)whole, f2w((float)(counts - whole)),
+            f2w((float)(c->radius_m * w * cos(w * s->t_s + phase) / L))};
+        fwrite(rec, sizeof rec, 1, r->steps);
+        if (r->expect) {
+            const uint32_t e[2] = {f2w((float)s->F_hat_N[a]), f2w((float)s->duty[a])};
+            fwrite(e, sizeof e, 1, r->expect);
+        }
     }
     r->n++;
 }
@@ -58,22 +64,24 @@ int main(int argc, char **argv)
 {
     const char *out = NULL, *expect = NULL;
     double duration = 1.0;
+    uint32_t n_axes = 1u;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
         else if (!strcmp(argv[i], "--expect") && i + 1 < argc) expect = argv[++i];
         else if (!strcmp(argv[i], "--duration") && i + 1 < argc) duration = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--axes") && i + 1 < argc) n_axes = (uint32_t)atoi(argv[++i]);
         else {
-            fprintf(stderr, "usage: br_replay_record --out FILE [--expect FILE] [--duration S]\n");
+            fprintf(stderr, "usage: br_replay_record --out FILE [--expect FILE] [--duration S] [--axes 1|2]\n");
             return 2;
         }
     }
-    if (out == NULL || !(duration > 0.0)) {
-        fprintf(stderr, "br_replay_record: --out is required, duration > 0\n");
+    if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u) {
+        fprintf(stderr, "br_replay_record: --out is required, duration > 0, axes 1 or 2\n");
         return 2;
     }
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     c.duration_s = duration;
-    rec_t r = {&c, tmpfile(), NULL, 0u};
+    rec_t r = {&c, tmpfile(), NULL, 0u, n_axes};
     if (r.steps == NULL) return 1;
     if (expect && (r.expect = fopen(expect, "wb")) == NULL) {
         perror(expect);
@@ -85,6 +93,7 @@ int main(int argc, char **argv)
     /* the controller configuration the circle's axes use (br_circle.c axis_init) */
     br_replay_cfg_t rc;
     rc.n_steps = r.n;
+    rc.n_axes = n_axes;
     for (int i = 0; i < 3; i++) rc.ctrl.K[i] = c.K[i];
     rc.ctrl.dt_s = (float)c.dt_s;
     rc.ctrl.tau_max_Nm = (float)c.plant.tau_per_duty_Nm;
@@ -106,7 +115,7 @@ int main(int argc, char **argv)
     while ((n = fread(buf, 1, sizeof buf, r.steps)) > 0) fwrite(buf, 1, n, f);
     if (fclose(f) != 0 || (r.expect && fclose(r.expect) != 0)) return 1;
     fclose(r.steps);
-    printf("br_replay_record: %u steps (%.3f s at %.4g s, m = %u) -> %s\n", r.n, duration, c.dt_s,
-           c.pf.n_particles, out);
+    printf("br_replay_record: %u steps (%.3f s at %.4g s, m = %u, %u axes) -> %s\n", r.n, duration, c.dt_s,
+           c.pf.n_particles, n_axes, out);
     return 0;
 }

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # ctest target_qemu_fault: the mps2-an500 startup's fault handler
 # (target/mps2/startup_mps2.c). The image executes an undefined instruction;
 # QEMU must exit with status 3 and the handler's message, not hang (the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* br_outfile (sim/tools/br_outfile.h): an existing destination survives a
  * discarded write byte for byte, a committed write replaces it whole, no
  * temporary file is left behind, and a destination that cannot be written

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The host tools' command lines (docs/tools.md): every option checked
 against its bound (sim/tools/br_tool_limits.h) before a file is touched,
 --help never taken as an option needing a value, an output that cannot be
@@ -13,9 +14,12 @@ import sys
 import unittest
 
 ARGS = None
-TOOLS = ("br_simlog", "br_demo_circle", "br_circle_ext", "br_pf_study", "br_dt_study", "br_tune_est")
+TOOLS = ("br_simlog", "br_demo_circle", "br_circle_ext", "br_pf_study", "br_dt_study", "br_tune_est", "br_track",
+         "br_robust_run", "bench/br_bench")
 VALUED = {"br_simlog": "--out", "br_demo_circle": "--out", "br_circle_ext": "--json", "br_pf_study": "--table",
-          "br_dt_study": "--seeds", "br_tune_est": "--out"}  # an option that takes a value
+          "br_dt_study": "--seeds", "br_tune_est": "--out", "br_track": "--json", "br_robust_run": "--json",
+          "bench/br_bench": "--json"}  # an option that takes a value
+VERSION_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "VERSION")
 OLD = b"an existing file\r\nwith two lines\n"
 
 
@@ -58,6 +62,33 @@ class ToolsTest(unittest.TestCase):
             self.assertEqual(r.returncode, 0, f"{tool}: {r.stderr}")
             self.assertIn("usage:", r.stdout, tool)
             self.assertEqual(os.listdir(self.w), [], tool)
+
+    def test_version_everywhere(self):
+        with open(VERSION_FILE) as f:
+            version = f.read().strip()
+        for tool in TOOLS:
+            name = os.path.basename(tool)
+            for a in (["--version"], [VALUED[tool], "--version"]):
+                r = run(tool, *a, cwd=self.w)
+                self.assertEqual(r.returncode, 0, f"{tool} {a}: {r.stderr}")
+                self.assertEqual(r.stdout, f"{name} (bristle) {version}\n", tool)
+            self.assertEqual(os.listdir(self.w), [], tool)
+
+    def test_usage_errors_everywhere(self):
+        for tool in TOOLS:
+            for bad, word in ((["--bogus", "1"], "unknown option --bogus"), ([VALUED[tool]], "needs a value"),
+                              (["stray"], "unexpected argument stray"), (["-x"], "unknown option -x")):
+                r = run(tool, *bad, cwd=self.w)
+                self.assert_refused(r, 2, word, "usage:")
+            self.assertEqual(os.listdir(self.w), [], tool)
+        # an unambiguous prefix of a long option is the option; an ambiguous one is refused
+        r = run("br_dt_study", "--see", "1")
+        self.assert_refused(r, 2, "--seeds 1: must be a whole number in 2 .. 16")  # named in full
+        r = run("br_simlog", "--m", "x", cwd=self.w)
+        self.assert_refused(r, 2, "ambiguous option --m")
+        r = run("br_simlog", "--out", "x.csv", "--truth=1", cwd=self.w)
+        self.assert_refused(r, 2, "--truth=1: the option takes no value")
+        self.assertEqual(os.listdir(self.w), [])
 
     def test_simlog_bad_options_touch_nothing(self):
         out = self.existing("log.csv")
@@ -137,6 +168,21 @@ class ToolsTest(unittest.TestCase):
         self.assertNotIn("contour", r.stdout)
         self.assert_untouched(plain)
 
+    def test_robust_run_bad_options_touch_nothing(self):
+        keep = self.existing("robust.json")
+        for bad in (["--drift", "0.6"], ["--drift", "nan"], ["--force-noise", "-1"], ["--enc-noise", "1.5"],
+                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
+                    ["--bogus", "1"], ["--drift"]):
+            r = run("br_robust_run", "--json", keep, *bad)
+            self.assert_refused(r, 2)
+            self.assertNotIn("contour RMS", r.stdout)
+            self.assert_untouched(keep)
+        r = run("br_robust_run", "--json", keep, "--only", "hinf_pf_id")
+        self.assert_refused(r, 2, "needs --model")
+        r = run("br_robust_run", "--json", keep, "--plant", os.path.join(self.w, "none.json"))
+        self.assert_refused(r, 1, "cannot open")
+        self.assert_untouched(keep)
+
     def test_circle_ext_output_checked_before_the_runs(self):
         keep = self.existing("ext.json")
         r = run("br_circle_ext", "--json", os.path.join(self.w, "no", "x.json"))
@@ -168,9 +214,14 @@ class ToolsTest(unittest.TestCase):
         r = run("br_tune_est", "--est", "pf", "--out", header, "--log", os.path.join(self.w, "no", "l.csv"))
         self.assert_refused(r, 1, "cannot write")
         self.assertNotIn("tuning", r.stdout)
-        for bad in (["--max-fev", "0"], ["--max-fev", "1e9"], ["--est", "kf"], ["--log", header]):
+        for bad in (["--max-fev", "0"], ["--max-fev", "1e9"], ["--est", "kf"], ["--log", header],
+                    ["--stat", "mean"], ["--plants"]):
             r = run("br_tune_est", "--est", "pf", "--out", header, *bad)
             self.assert_refused(r, 2)
+        # a plant set with a file that cannot be read: refused before the tuning, nothing written
+        r = run("br_tune_est", "--est", "pf", "--out", header, "--plants", os.path.join(self.w, "none.json"))
+        self.assert_refused(r, 1, "cannot open")
+        self.assertNotIn("tuning", r.stdout)
         self.assert_untouched(header, log)
 
 

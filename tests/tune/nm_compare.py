@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Holds the C Nelder-Mead (nm_functions) against scipy.optimize's on the same
 functions and starting points: the same minimum within tolerance and
 evaluation counts of the same order (ratio within 1/3..3); prints both.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Runs br_nm_minimize on three standard test functions and prints, per
  * function, the minimiser, the minimum and the evaluation count as JSON, for
  * nm_compare.py to hold against scipy.optimize. */

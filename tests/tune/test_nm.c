@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Nelder-Mead: bounds by the change of variables, guards, progress. */
 #include "br_test.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The application module: configuration guards, and that each estimator kind
  * runs the same loop as wiring the estimator into br_axis by hand. */
 #include "br_test.h"
@@ -46,8 +47,8 @@ static br_status_t fake_enable(void *ctx)
 }
 
 /* guards of the tests: 100 counts per period, 3 held reads, frozen at
- * |duty| >= 0.5 for 5 periods */
-#define GUARD {100u, 3u, 0.5f, 5u}
+ * |duty| >= 0.5 for 5 periods, lost lock at 3 outlier steps within 10 periods */
+#define GUARD {100u, 3u, 0.5f, 5u, 10u, 2u}
 static br_status_t fake_tick(void *ctx, uint32_t *t)
 {
     (void)ctx;
@@ -201,7 +202,10 @@ static void run_against_axis(br_app_est_kind_t kind)
     br_ukf_t *ukf = calloc(2, sizeof *ukf);
     assert_non_null(pf);
     assert_non_null(ukf);
-    const br_app_cfg_t c = {&k, kind, &pfc, &ukfc, NULL, GUARD};
+    br_app_cfg_t c = {&k, kind, &pfc, &ukfc, NULL, GUARD};
+    /* the jumpy counts below make the filters reject measurements: the axis
+     * loop has no lock monitor, so it must not trip here */
+    c.guard.lock_max_outliers = c.guard.lock_window_periods - 1u;
     const br_app_mem_t mem = {&pf[0], &ukf[0]};
     br_app_t app;
     assert_int_equal(br_app_init(&app, &c, &ha, &mem), BR_OK);
@@ -365,6 +369,57 @@ static void test_estimator_error_latches(void **st)
     assert_latched(&g, BR_APP_FAULT_ESTIMATOR);
 }
 
+/* The lock monitor: an estimator that keeps rejecting the measurement (the
+ * UKF re-anchoring for ever on an axis with an unmodelled dead time) stops
+ * the axis; outliers as sparse as the limit allows never do. */
+static void test_lost_lock_latches(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 1);
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    /* 2 outliers in every 10 periods (the limit) for 200 periods: runs on */
+    for (int k = 0; k < 200; k++) {
+        est_status = (k % 5 == 0) ? BR_W_OUTLIER : BR_OK;
+        assert_int_equal(br_app_step(&g.app, &r), est_status);
+        assert_int_equal(g.app.fault, BR_APP_FAULT_NONE);
+        assert_true(g.f.on);
+    }
+    /* the pattern's next outlier (period 200: 195 and 200 in the window), then
+     * one more: the third of the last 10 periods */
+    est_status = BR_W_OUTLIER;
+    assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
+    g.f.duty = 0.3f;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_LOST_LOCK);
+    /* a good estimate does not clear it; the arm does, with an empty window */
+    est_status = BR_OK;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(br_app_arm(&g.app), BR_OK);
+    est_status = BR_W_OUTLIER;
+    assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
+    assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
+    /* outliers for ever (re-anchoring at every step): the third faults */
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_LOST_LOCK);
+    /* predict-only periods (failed reads) leave the window as clean periods */
+    rig_init(&g, 1);
+    est_status = BR_W_OUTLIER;
+    assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
+    assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
+    est_status = BR_OK;
+    for (int k = 0; k < 8; k++) {
+        g.f.enc_st = (k % 2 == 0) ? BR_E_INPUT : BR_OK;
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    }
+    g.f.enc_st = BR_OK;
+    est_status = BR_W_OUTLIER; /* the first two have left the window */
+    assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
+    assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_LOST_LOCK);
+}
+
 static void test_hal_error_latches(void **st)
 {
     (void)st;
@@ -472,6 +527,15 @@ static void test_encoder_frozen_latches(void **st)
         g.f.counts += 1;
         assert_int_equal(br_app_step(&g.app, &r), BR_OK);
     }
+    /* stops shorter than 5 periods, each ended by a move, do not add up: the
+     * count starts again at every move */
+    for (int k = 0; k < 3; k++) {
+        for (int i = 0; i < 4; i++) {
+            assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+        }
+        g.f.counts += 1;
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    }
     /* the counter stops while commanded: 4 periods pass, the 5th faults */
     for (int i = 0; i < 4; i++) {
         assert_int_equal(br_app_step(&g.app, &r), BR_OK);
@@ -504,14 +568,18 @@ static void test_guard_config(void **st)
     rig_t g;
     rig_init(&g, 0);
     const br_app_guard_cfg_t ok = GUARD;
-    br_app_guard_cfg_t bad[6] = {ok, ok, ok, ok, ok, ok};
+    br_app_guard_cfg_t bad[10] = {ok, ok, ok, ok, ok, ok, ok, ok, ok, ok};
     bad[0].enc_max_delta_counts = 0u;
     bad[1].enc_max_delta_counts = (1u << 30) + 1u;
     bad[2].enc_stale_periods = 1001u;
     bad[3].frozen_duty = NAN;
     bad[4].frozen_duty = 1.5f;
     bad[5].frozen_periods = 0u;
-    for (int i = 0; i < 6; i++) {
+    bad[6].lock_window_periods = 0u;
+    bad[7].lock_window_periods = BR_APP_LOCK_WINDOW_MAX + 1u;
+    bad[8].lock_max_outliers = ok.lock_window_periods; /* could never trip */
+    bad[9].lock_window_periods = 1u;                   /* likewise: 2 of 1 */
+    for (int i = 0; i < 10; i++) {
         g.c.guard = bad[i];
         assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
         assert_int_equal(br_app_arm(&g.app), BR_E_STATE);
@@ -521,6 +589,17 @@ static void test_guard_config(void **st)
     assert_int_equal(m.enc_max_delta_counts, 13108u);
     assert_true((float)m.frozen_periods * 1e-3f >= BR_APP_GUARD_FROZEN_S);
     assert_true((float)(m.frozen_periods - 1u) * 1e-3f < BR_APP_GUARD_FROZEN_S);
+    /* the lock window: 100 ms of periods, a quarter of them */
+    assert_true((float)m.lock_window_periods * 1e-3f >= BR_APP_GUARD_LOCK_S);
+    assert_true((float)(m.lock_window_periods - 1u) * 1e-3f < BR_APP_GUARD_LOCK_S);
+    assert_true((float)m.lock_max_outliers >= BR_APP_GUARD_LOCK_FRACTION * (float)m.lock_window_periods);
+    assert_true((float)(m.lock_max_outliers - 1u) < BR_APP_GUARD_LOCK_FRACTION * (float)m.lock_window_periods);
+    print_message("lock monitor at 1 ms: %u outliers in %u periods\n", (unsigned)m.lock_max_outliers,
+                  (unsigned)m.lock_window_periods);
+    g.c.guard = br_app_guard_cfg(1e-3f, 13107200.0f);
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_OK);
+    g.c.guard = br_app_guard_cfg(1e-6f, 13107200.0f); /* a window of 1e5 periods: too long */
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
     g.c.guard = br_app_guard_cfg(NAN, 1.0f);
     assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
     g.c.guard = br_app_guard_cfg(1e-3f, -1.0f);
@@ -570,6 +649,7 @@ int main(void)
         cmocka_unit_test(test_ctrl_input_latches_until_rearmed),
         cmocka_unit_test(test_ctrl_state_latches),
         cmocka_unit_test(test_estimator_error_latches),
+        cmocka_unit_test(test_lost_lock_latches),
         cmocka_unit_test(test_hal_error_latches),
         cmocka_unit_test(test_encoder_jump_latches),
         cmocka_unit_test(test_encoder_stale_holds_then_latches),

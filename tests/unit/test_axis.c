@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Axis loop over the HAL, with a fake port. */
 #include "br_test.h"
 

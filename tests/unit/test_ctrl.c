@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Controller (eq. 7): guards, control law, saturation with anti-windup,
  * wrap-safe velocity, compensation input. */
 #include "br_test.h"

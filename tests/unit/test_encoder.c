@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Wrap-safe count differences. */
 #include "br_test.h"
 

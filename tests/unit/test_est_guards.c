@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The estimators' fail-safe guards (docs/reliability.md): noise variances
  * that would break a filter are rejected at init; a residual so large that
  * its log-weight overflows does not turn a valid particle invalid; the UKF
@@ -95,8 +96,8 @@ static void test_pf_log_weight_overflow(void **st)
     const br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     for (uint32_t j = 0; j < c.n_particles; j++) {
-        pf->x[j][BR_X_THETA] = 1.0e18f; /* e^2 / 2R ~ 1e36 / 4e-11 */
-        pf->x[j][BR_X_OMEGA] = 0.0f;
+        pf->x[BR_X_THETA][j] = 1.0e18f; /* e^2 / 2R ~ 1e36 / 4e-11 */
+        pf->x[BR_X_OMEGA][j] = 0.0f;
     }
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
     const br_pf_est_t *e = br_pf_estimate(pf);
@@ -106,7 +107,7 @@ static void test_pf_log_weight_overflow(void **st)
     /* the same with the threshold itself at -inf (init keeps the gate's square a
      * float; the step does not rely on it): still an outlier step, not 0/0 */
     for (uint32_t j = 0; j < c.n_particles; j++) {
-        pf->x[j][BR_X_THETA] = 1.0e18f;
+        pf->x[BR_X_THETA][j] = 1.0e18f;
     }
     pf->outlier_l = -INFINITY;
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
@@ -144,11 +145,11 @@ static double pf_theta_std(const br_pf_t *pf)
     const uint32_t m = pf->cfg.n_particles;
     double s = 0.0, s2 = 0.0;
     for (uint32_t j = 0; j < m; j++) {
-        s += pf->x[j][BR_X_THETA];
+        s += pf->x[BR_X_THETA][j];
     }
     const double mean = s / m;
     for (uint32_t j = 0; j < m; j++) {
-        const double d = pf->x[j][BR_X_THETA] - mean;
+        const double d = pf->x[BR_X_THETA][j] - mean;
         s2 += d * d;
     }
     return sqrt(s2 / m);
@@ -237,14 +238,14 @@ static void test_pf_spread_survives_resampling(void **st)
     }
     const uint32_t m = c.n_particles;
     double s = 0.0, s2 = 0.0;
-    for (uint32_t j = 0; j < m; j++) s += pf->x[j][BR_X_GP];
+    for (uint32_t j = 0; j < m; j++) s += pf->x[BR_X_GP][j];
     const double mean = s / m;
     uint32_t distinct = 0;
     for (uint32_t j = 0; j < m; j++) {
-        const double d = pf->x[j][BR_X_GP] - mean;
+        const double d = pf->x[BR_X_GP][j] - mean;
         s2 += d * d;
         int seen = 0;
-        for (uint32_t i = 0; i < j && !seen; i++) seen = pf->x[i][BR_X_GP] == pf->x[j][BR_X_GP];
+        for (uint32_t i = 0; i < j && !seen; i++) seen = pf->x[BR_X_GP][i] == pf->x[BR_X_GP][j];
         distinct += !seen;
     }
     const double sd = sqrt(s2 / m), q = sqrt((double)c.est.q_var[BR_X_GP]);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Host HAL port bound to the plant. */
 #include "br_test.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* LuGre module: configuration guards, eqs. 3-5, bounded bristle update. */
 #include "br_test.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* LuGre drift under a cyclic load below breakaway (docs/modules/lugre.md,
  * "Drift below breakaway"). The LuGre bristle equation has no purely elastic
  * region: every bristle move with v != 0 relaxes z towards g/sigma0 a little,

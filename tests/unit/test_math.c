@@ -1,8 +1,10 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* br_exp_neg (br_math.h): accuracy over its range against double exp, the
  * edges (underflow, NaN, -inf, positive input), monotonicity. */
 #include "br_test.h"
 
 #include "br_math.h"
+#include "br_lugre_kernel.h"
 
 /* every float in (-87, 0] would be 1.1e9 points; a dense geometric-plus-linear
  * sweep of 2e6 points covers each binade and every exponent n */
@@ -61,12 +63,37 @@ static void test_monotone(void **st)
     assert_int_equal(n_bad, 0);
 }
 
+/* The LuGre kernel's move over a step (br_lk_move_over, docs/modules/lugre.md)
+ * where r = sigma0 |dx| / g is below 1e-6 and (1 - e^-r) / r is taken by its
+ * series 1 - r/2: from rest (z0 = 0) the bristle deflects linearly, so
+ * int z dt = h zss (1 - q) = h zss r / 2 + O(r^2) (= h dx / 2). A series with the
+ * wrong sign or order gives the wrong sign or size here. */
+static void test_lk_move_over_series(void **st)
+{
+    (void)st;
+    const float sigma0 = 1.0e5f, g = 20.0f, h = 1.0e-3f;
+    const float rs[] = {9.0e-7f, 5.0e-7f};
+    for (unsigned i = 0; i < 2; i++) {
+        for (int sgn = -1; sgn <= 1; sgn += 2) {
+            const float dx = (float)sgn * rs[i] * g / sigma0;
+            const br_lk_step_t s = br_lk_move_over(sigma0, 0.0f, dx, g, h);
+            const double want = 0.5 * (double)h * (double)dx; /* h zss r / 2 */
+            /* zss + (z0 - zss) q rounds q and the sum: 4u of h |zss| (27 % of want at
+             * r = 9e-7, 48 % at 5e-7); the wrong series gives -want, off by 200 % */
+            const double zss = (double)g / (double)sigma0;
+            BR_ASSERT_NEAR(s.zint_ms, want, 4.0 * 5.9604644775390625e-08 * (double)h * zss);
+            BR_ASSERT_NEAR(s.z1_m, (double)dx, 1e-3 * fabs((double)dx)); /* z1 = zss r = dx to first order */
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_accuracy),
         cmocka_unit_test(test_edges),
         cmocka_unit_test(test_monotone),
+        cmocka_unit_test(test_lk_move_over_series),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Estimation model (eq. 6): guards, right-hand side, discretisation accuracy
  * against a fine double-precision integration, boundedness at speed. */
 #include "br_test.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The extended estimation model's guards and the estimators' actuator-delay
  * history (docs/modules/model.md, "Extended model"); the equations themselves
  * are held to the float64 reference by tests/golden/test_golden_model_ext.c. */
@@ -19,6 +20,9 @@ static void test_causes_guards(void **st)
     assert_false(m.extended); /* no cause: the thesis model's kernel */
     c = ok; c.causes.offset_N = NAN;                  assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
     c = ok; c.causes.grad_per_m = INFINITY;           assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ok; c.causes.drift_per_s = NAN;               assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = ok; c.causes.drift_per_s = 0.01f;             assert_int_equal(br_model_init(&m, &c), BR_OK);
+    assert_true(m.extended);
     /* the level in -x must stay positive */
     c = ok; c.causes.dFc_neg_N = -ok.lugre.Fc_N;      assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
     c = ok; c.causes.dFc_neg_N = -0.5f * ok.lugre.Fc_N; assert_int_equal(br_model_init(&m, &c), BR_OK);
@@ -103,6 +107,41 @@ static void test_ripple_and_gradient_follow_position(void **st)
     BR_ASSERT_NEAR(br_model_fcomp_N(&m, xs, 0.1f), 1.2 * F0 + 0.2 * c.sigma2_Nspm * 0.01, 1e-4 * F0);
 }
 
+/* friction_drift: the model's clock scales the friction (LuGre and viscous)
+ * by s = max(0, 1 + r t), t = n dt; the clock starts at 0 on init, ticks by
+ * one step, saturates, and stays 1 without a drift. */
+static void test_drift_follows_the_clock(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = br_machine_model_cfg(DT_S);
+    c.causes.drift_per_s = 0.02f;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    const float g = c.lugre.Fc_N;
+    const float xs[BR_NX] = {0.0f, 0.01f / c.lead_mprad, g / c.lugre.sigma0_Npm, g};
+    const double F0 = br_model_fcomp_N(&m, xs, 0.0f);
+    assert_true(m.n_steps == 0u && m.drift_k == 1.0f);
+    br_model_set_clock(&m, 10000u); /* t = 10 s: s = 1.2 */
+    BR_ASSERT_NEAR(br_model_fcomp_N(&m, xs, 0.0f), 1.2 * F0 + 0.2 * c.sigma2_Nspm * 0.01, 1e-4 * F0);
+    br_model_tick(&m);
+    assert_true(m.n_steps == 10001u);
+    BR_ASSERT_NEAR(m.drift_k, 1.0 + 0.02 * 10.001, 1e-6);
+    br_model_set_clock(&m, UINT32_MAX);
+    br_model_tick(&m);
+    assert_true(m.n_steps == UINT32_MAX && isfinite(m.drift_k));
+    /* a falling level stops at 0: no friction, the torque alone accelerates */
+    c.causes.drift_per_s = -1.0f;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    br_model_set_clock(&m, 2000u);
+    assert_true(m.drift_k == 0.0f);
+    BR_ASSERT_NEAR(br_model_fcomp_N(&m, xs, 0.0f), -c.sigma2_Nspm * 0.01, 1e-6);
+    /* without a drift the clock leaves the scale at 1 */
+    c = br_machine_model_cfg(DT_S);
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    br_model_set_clock(&m, 123456u);
+    assert_true(m.drift_k == 1.0f);
+}
+
 /* br_model_step on an absolute theta equals br_model_step_at about the
  * state's own position, for the extended model. */
 static void test_step_absolute_equals_relative(void **st)
@@ -158,6 +197,7 @@ int main(void)
         cmocka_unit_test(test_offset_at_rest),
         cmocka_unit_test(test_asymmetry_in_minus_x),
         cmocka_unit_test(test_ripple_and_gradient_follow_position),
+        cmocka_unit_test(test_drift_follows_the_clock),
         cmocka_unit_test(test_step_absolute_equals_relative),
         cmocka_unit_test(test_delay_history),
     };

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Particle filter: configuration guards, integer resampling, bad input,
  * outliers, all-invalid and single invalid particles, underflow-proof weights,
  * the inline prediction against br_model_step, tracking. */
@@ -43,7 +44,7 @@ static int all_finite(const br_pf_t *pf)
 {
     for (uint32_t j = 0; j < pf->cfg.n_particles; j++)
         for (int i = 0; i < BR_NX; i++)
-            if (!isfinite(pf->x[j][i])) return 0;
+            if (!isfinite(pf->x[i][j])) return 0;
     return 1;
 }
 
@@ -129,7 +130,7 @@ static void test_bad_input_keeps_state(void **st)
     br_meas_t y = {1000, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK); /* primes */
     assert_int_equal(br_pf_step(pf, &y, 0.001f), BR_OK);
-    float th0 = pf->x[7][0], gp0 = pf->x[7][3];
+    float th0 = pf->x[0][7], gp0 = pf->x[3][7];
     uint32_t pos = pf->noise_pos;
     const float bad[] = {NAN, INFINITY, -INFINITY};
     for (int k = 0; k < 3; k++) {
@@ -141,7 +142,7 @@ static void test_bad_input_keeps_state(void **st)
     assert_int_equal(br_pf_step(pf, &yr, 0.0f), BR_E_INPUT);
     yr.frac = -0.1f;
     assert_int_equal(br_pf_step(pf, &yr, 0.0f), BR_E_INPUT);
-    assert_true(pf->x[7][0] == th0 && pf->x[7][3] == gp0 && pf->noise_pos == pos);
+    assert_true(pf->x[0][7] == th0 && pf->x[3][7] == gp0 && pf->noise_pos == pos);
     assert_int_equal(br_pf_step(pf, NULL, 0.0f), BR_E_NULL);
     free(pf);
 }
@@ -173,6 +174,44 @@ static void test_outlier_100_sigma(void **st)
     free(pf);
 }
 
+/* The gate's sigma (docs/modules/pf.md): sqrt(R + rpc^2 / 12), R with the
+ * encoder's quantisation. A PF sure of itself (R = 1e-3 count^2, a tight
+ * cloud at rest): a one-count innovation is accepted (without the rpc^2 / 12
+ * term the 8-sigma gate is 0.25 count from the nearest particle and rejects
+ * it); a jump of 10 gate sigmas is rejected. */
+static void test_gate_quantisation(void **st)
+{
+    (void)st;
+    br_pf_cfg_t c = cfg(300);
+    /* the gate's formula, not a machine's value: 8 sigma as the reference machine ships
+     * (a machine with a wider gate, e.g. the heavy one, would not meet the premise) */
+    c.est.outlier_sigma = 8.0f;
+    c.est.r_var_rad2 = 1.0e-3f * RPC * RPC;
+    c.est.q_var[BR_X_THETA] = 0.0f;
+    c.est.q_var[BR_X_OMEGA] = 1.0e-12f;
+    c.x0_std[BR_X_THETA] = 0.0f;
+    c.x0_std[BR_X_OMEGA] = 0.0f;
+    c.x0_std[BR_X_Z] = 0.0f;
+    c.est.q_var[BR_X_Z] = 0.0f;
+    const double sig_counts = sqrt((double)c.est.r_var_rad2 + (double)RPC * (double)RPC / 12.0) / (double)RPC;
+    const double k = (c.est.outlier_sigma < 10.0f) ? 10.0 : (double)c.est.outlier_sigma + 1.0;
+    /* the premise: R alone would put a count beyond the gate */
+    assert_true((double)c.est.outlier_sigma * sqrt((double)c.est.r_var_rad2) < 0.5 * (double)RPC);
+    br_pf_t *pf = calloc(2, sizeof *pf);
+    assert_non_null(pf);
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    br_meas_t y = {0, 0.5f};
+    for (int k0 = 0; k0 < 20; k0++) assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    pf[1] = pf[0];
+    /* one count: accepted */
+    const br_meas_t y1 = {1, 0.5f};
+    assert_int_equal(br_pf_step(&pf[1], &y1, 0.0f), BR_OK);
+    /* 10 gate sigmas: rejected */
+    const br_meas_t y10 = {(int32_t)ceil(k * sig_counts), 0.5f};
+    assert_int_equal(br_pf_step(&pf[0], &y10, 0.0f), BR_W_OUTLIER);
+    free(pf);
+}
+
 static void test_all_invalid_keeps_previous(void **st)
 {
     (void)st;
@@ -180,13 +219,13 @@ static void test_all_invalid_keeps_previous(void **st)
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    float th = pf->x[3][0];
+    float th = pf->x[0][3];
     int32_t origin = pf->origin_counts;
     /* a torque that overflows every particle's velocity: no particle is usable */
     y.counts = 5;
     assert_int_equal(br_pf_step(pf, &y, 3.0e38f), BR_E_NUMERIC);
     assert_true(all_finite(pf));
-    assert_true(pf->x[3][0] == th && pf->origin_counts == origin);
+    assert_true(pf->x[0][3] == th && pf->origin_counts == origin);
     free(pf);
 }
 
@@ -268,12 +307,12 @@ static void test_tracks_plant_friction(void **st)
  * for bit: without process noise, every predicted particle equals br_model_step
  * of its parent shifted to the new origin, at circle speeds and beyond the RK4
  * a h limit (the bounded scheme). */
-static void test_predict_is_model_step(void **st)
+static void predict_is_model_step(uint32_t scalar_path)
 {
-    (void)st;
     br_pf_t *pf = calloc(1, sizeof *pf);
     assert_non_null(pf);
     br_pf_cfg_t c = cfg(64);
+    c.scalar_path = scalar_path;
     for (int i = 0; i < BR_NX; i++) c.est.q_var[i] = 0.0f;
     /* the PF requires g_p noise > 0; the smallest normal variance moves no g_p
      * of this size by even one ulp, so the prediction stays noise-free */
@@ -287,29 +326,175 @@ static void test_predict_is_model_step(void **st)
     int n_bounded = 0;
     for (uint32_t j = 0; j < 64; j++) {
         const float v = (j % 2 ? 1.0f : -1.0f) * 2.0f * powf(10.0f, -6.0f + 6.0f * (float)j / 63.0f);
-        pf->x[j][BR_X_OMEGA] = v / c.est.model.lead_mprad;
-        pf->x[j][BR_X_Z] = (j % 3 == 0) ? 0.0f : 1e-6f;
-        for (int i = 0; i < BR_NX; i++) parent[j][i] = pf->x[j][i];
+        pf->x[BR_X_OMEGA][j] = v / c.est.model.lead_mprad;
+        pf->x[BR_X_Z][j] = (j % 3 == 0) ? 0.0f : 1e-6f;
+        for (int i = 0; i < BR_NX; i++) parent[j][i] = pf->x[i][j];
         const float ah = c.est.model.lugre.sigma0_Npm * fabsf(v) * c.est.model.dt_s / parent[j][BR_X_GP];
         n_bounded += ah > BR_MODEL_RK4_AH_MAX;
     }
     assert_true(n_bounded >= 10 && n_bounded <= 54); /* both schemes are exercised */
     const float u = 0.05f;
-    y.counts = 3;
-    assert_int_equal(br_pf_step(pf, &y, u), BR_OK);
+    /* predict only: the set is the predicted set (no resampling), in place */
+    assert_int_equal(br_pf_predict(pf, u), BR_OK);
     for (uint32_t j = 0; j < 64; j++) {
         float xn[BR_NX];
         assert_int_equal(br_model_step(&pf->model, parent[j], u, xn), BR_OK);
-        xn[BR_X_THETA] -= 3.0f * RPC;
+        const float ah = c.est.model.lugre.sigma0_Npm * c.est.model.lead_mprad * fabsf(parent[j][BR_X_OMEGA]) *
+                         c.est.model.dt_s / parent[j][BR_X_GP];
+        /* RK4 steps: the PF's own RK4 form (k_p = sigma0 L / g_p, folded
+         * constants) rounds differently from br_model_step's (an ulp or so per
+         * operation, relative to the size of each term of eqs. 4 and 6, which
+         * may cancel): equal to 1e-5 of the step's change plus 1e-5 of the
+         * step's terms taken in absolute value (s[]: h |omega| + h^2 |eq. 6|,
+         * h |eq. 6|, h |eq. 4|) plus 2 ulp; the bounded scheme (both use it as
+         * is): bit for bit */
+        const br_model_cfg_t *mc = &c.est.model;
+        const double L = mc->lead_mprad, h = mc->dt_s, w = fabs((double)parent[j][BR_X_OMEGA]);
+        const double zabs = fabs((double)parent[j][BR_X_Z]), v = L * w;
+        const double zd_abs = v + mc->lugre.sigma0_Npm * v * zabs / parent[j][BR_X_GP];
+        const double wd_abs = (fabs((double)u) + L * L * mc->sigma2_Nspm * w +
+                               L * (mc->lugre.sigma0_Npm * zabs + mc->lugre.sigma1_Nspm * zd_abs)) /
+                              (mc->J_kgm2 + L * L * mc->M_kg);
+        const double s[BR_NX] = {h * w + h * h * wd_abs, h * wd_abs, h * zd_abs, 0.0};
+        if (ah > 0.9f * BR_MODEL_RK4_AH_MAX && ah < 1.1f * BR_MODEL_RK4_AH_MAX) {
+            continue; /* near the limit either scheme may be taken at the step's end */
+        }
+        const int bounded = ah >= 1.1f * BR_MODEL_RK4_AH_MAX;
         for (int i = 0; i < BR_NX; i++) {
-            if (memcmp(&xn[i], &pf->xp[j][i], sizeof(float)) != 0) {
-                fail_msg("particle %u state %d: PF %.9g, br_model_step %.9g", (unsigned)j, i,
-                         (double)pf->xp[j][i], (double)xn[i]);
+            const double d = fabs((double)pf->x[i][j] - (double)xn[i]);
+            const double tol = (bounded || !BR_PF_ONE_DIVISION) ? 0.0
+                                       : 1e-5 * (fabs((double)xn[i] - (double)parent[j][i]) + s[i]) +
+                                             2.0 * (double)FLT_EPSILON * fabs((double)xn[i]);
+            if (!(d <= tol)) {
+                fail_msg("path %u particle %u state %d: PF %.9g, br_model_step %.9g", (unsigned)scalar_path,
+                         (unsigned)j, i, (double)pf->x[i][j], (double)xn[i]);
             }
         }
         assert_true(pf->l[j] > -INFINITY);
     }
     free(pf);
+}
+
+/* The prediction is br_model_step's bit for bit (RK4, and the bounded scheme
+ * beyond the a h limit), on both paths (the vector path fixes the bounded
+ * particles up in scalar); in a BR_PF_ONE_DIVISION build (the default: the
+ * PF's own RK4 form, br_model_kp_rk4)
+ * RK4 to an ulp-level tolerance. */
+static void test_predict_is_model_step(void **st)
+{
+    (void)st;
+    predict_is_model_step(0u);
+    predict_is_model_step(1u);
+}
+
+/* The vector path and the scalar reference path give identical particles,
+ * weights, indices and estimates, step after step, on an input that takes
+ * particles into the bounded scheme, makes some invalid, and has outliers,
+ * at a particle count whose noise blocks wrap round the table. */
+static void test_vector_path_is_scalar_path(void **st)
+{
+    (void)st;
+    br_pf_t *a = calloc(1, sizeof *a), *b = calloc(1, sizeof *b);
+    assert_non_null(a);
+    assert_non_null(b);
+    br_pf_cfg_t c = cfg(1499);
+    c.noise_skip = 3u;
+    assert_int_equal(br_pf_init(a, &c), BR_OK);
+    c.scalar_path = 1u;
+    assert_int_equal(br_pf_init(b, &c), BR_OK);
+    int n_bounded = 0, n_invalid = 0, n_outlier = 0;
+    for (int k = 0; k < 60; k++) {
+        /* a ramp with a jump (outliers) and, at k = 20 and 40, particles
+         * made fast (bounded scheme) or non-finite (invalid) */
+        const br_meas_t y = {(int32_t)(k * 3 + (k >= 30 && k < 34 ? 5000 : 0)), 0.25f + 0.01f * (float)(k % 7)};
+        const float u = 0.02f * sinf(0.3f * (float)k);
+        if (k == 20 || k == 40) {
+            for (uint32_t j = 0; j < c.n_particles; j += 37) {
+                const float w = (j % 2 ? 1.0f : -1.0f) * 5.0e3f;
+                a->x[BR_X_OMEGA][j] = b->x[BR_X_OMEGA][j] = w;
+                n_bounded++;
+            }
+            for (uint32_t j = 5; j < c.n_particles; j += 211) {
+                a->x[BR_X_Z][j] = b->x[BR_X_Z][j] = 3.0e38f;
+                a->x[BR_X_OMEGA][j] = b->x[BR_X_OMEGA][j] = 1.0e3f;
+                n_invalid++;
+            }
+        }
+        if (k == 31) {
+            /* an outlier step (every valid particle W = 2^16) with 5 invalid
+             * particles (W = 0): V = 1494 valid of m = 1499, total = V 2^16, so
+             * the point t_749 = floor(1499 V 2^16 / (2 m)) = 747 2^16 falls
+             * exactly on the cumulative weight of the 747th valid particle:
+             * a tie, which systematic resampling (C_{j-1} <= t < C_j) gives
+             * to the next particle */
+            for (uint32_t j = 7; j < c.n_particles; j += 300) {
+                a->x[BR_X_Z][j] = b->x[BR_X_Z][j] = 3.0e38f;
+                a->x[BR_X_OMEGA][j] = b->x[BR_X_OMEGA][j] = 1.0e3f;
+                n_invalid++;
+            }
+        }
+        const br_status_t sa = br_pf_step(a, &y, u), sb = br_pf_step(b, &y, u);
+        assert_int_equal(sa, sb);
+        n_outlier += sa == BR_W_OUTLIER;
+        if (k == 31) {
+            assert_int_equal(sa, BR_W_OUTLIER); /* the tie above is made */
+        }
+        if (k > 0 && !BR_FAILED(sa)) {
+            /* (step 0 primes the cloud: no weights) both paths' indices are
+             * systematic resampling's (br_pf_resample_idx) on the step's weights */
+            static uint16_t ref[BR_PF_MAX_PARTICLES];
+            assert_int_equal(br_pf_resample_idx(a->W, c.n_particles, ref), BR_OK);
+            assert_memory_equal(a->idx, ref, c.n_particles * sizeof ref[0]);
+        }
+        assert_memory_equal(a->x, b->x, sizeof a->x);
+        assert_memory_equal(a->fnl, b->fnl, sizeof a->fnl);
+        assert_memory_equal(a->l, b->l, sizeof a->l);
+        assert_memory_equal(a->W, b->W, sizeof a->W);
+        assert_memory_equal(a->idx, b->idx, sizeof a->idx);
+        assert_memory_equal(&a->est, &b->est, sizeof a->est);
+        assert_int_equal(a->noise_pos, b->noise_pos);
+    }
+    assert_true(n_bounded > 0 && n_invalid > 0 && n_outlier > 0);
+    free(a);
+    free(b);
+}
+
+/* g_p stays in [gp_min, gp_max] after every step on both paths (the clamp
+ * after the process noise), with particles started on both bounds and a
+ * g_p noise of a tenth of the range per step. */
+static void test_gp_stays_in_range(void **st)
+{
+    (void)st;
+    for (uint32_t path = 0; path < 2u; path++) {
+        br_pf_t *pf = calloc(1, sizeof *pf);
+        assert_non_null(pf);
+        br_pf_cfg_t c = cfg(200);
+        c.scalar_path = path;
+        const float lo = c.est.gp_min_N, hi = c.est.gp_max_N, sd = 0.1f * (hi - lo);
+        c.est.q_var[BR_X_GP] = sd * sd;
+        assert_int_equal(br_pf_init(pf, &c), BR_OK);
+        br_meas_t y = {0, 0.5f};
+        assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+        for (uint32_t j = 0; j < c.n_particles; j++) {
+            pf->x[BR_X_GP][j] = (j % 2) ? lo : hi;
+            pf->kgp[j] = (c.est.model.lugre.sigma0_Npm * c.est.model.lead_mprad) / pf->x[BR_X_GP][j]; /* k_p = sigma0 L / g_p */
+        }
+        int n_lo = 0, n_hi = 0;
+        for (int k = 0; k < 20; k++) {
+            assert_false(BR_FAILED(br_pf_predict(pf, 0.0f)));
+            for (uint32_t j = 0; j < c.n_particles; j++) {
+                const float g = pf->x[BR_X_GP][j];
+                if (!(g >= lo && g <= hi)) {
+                    fail_msg("path %u step %d particle %u: g_p %.9g outside [%.9g, %.9g]", (unsigned)path, k,
+                             (unsigned)j, (double)g, (double)lo, (double)hi);
+                }
+                n_lo += g == lo;
+                n_hi += g == hi;
+            }
+        }
+        assert_true(n_lo > 0 && n_hi > 0); /* both bounds were reached */
+        free(pf);
+    }
 }
 
 /* A particle whose prediction is not finite is kept as it was, with weight 0,
@@ -322,19 +507,26 @@ static void test_one_invalid_particle(void **st)
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     const int bad[3] = {5, 6, 7};
-    pf->x[5][BR_X_Z] = 3.0e38f;     /* f_nl overflows */
-    pf->x[6][BR_X_OMEGA] = 3.0e38f; /* the velocity overflows */
-    pf->x[7][BR_X_OMEGA] = -3.0e38f;
+    pf->x[BR_X_Z][5] = 3.0e38f;     /* f_nl overflows */
+    pf->x[BR_X_OMEGA][6] = 3.0e38f; /* the velocity overflows */
+    pf->x[BR_X_OMEGA][7] = -3.0e38f;
     float keep[3][BR_NX];
     for (int b = 0; b < 3; b++)
-        for (int i = 0; i < BR_NX; i++) keep[b][i] = pf->x[bad[b]][i];
+        for (int i = 0; i < BR_NX; i++) keep[b][i] = pf->x[i][bad[b]];
+    /* the predicted set (predict only, on a copy): the invalid ones kept their state */
+    br_pf_t *pc = malloc(sizeof *pc);
+    assert_non_null(pc);
+    memcpy(pc, pf, sizeof *pc);
+    assert_int_equal(br_pf_predict(pc, 0.0f), BR_OK);
+    for (int b = 0; b < 3; b++)
+        for (int i = 0; i < BR_NX; i++) assert_true(pc->x[i][bad[b]] == keep[b][i]);
+    free(pc);
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     for (int b = 0; b < 3; b++) {
         const int j = bad[b];
         assert_true(isnan(pf->l[j]));
         assert_int_equal(pf->W[j], 0u);
         assert_true(pf->fnl[j] == 0.0f);
-        for (int i = 0; i < BR_NX; i++) assert_true(pf->xp[j][i] == keep[b][i]);
     }
     for (uint32_t j = 0; j < 100; j++) {
         assert_true(pf->idx[j] < 5 || pf->idx[j] > 7); /* never resampled */
@@ -359,8 +551,8 @@ static void test_fnl_overflow_is_invalid(void **st)
     /* every other particle: a deflection so large that sigma0 |v| z / g_p
      * overflows float at this speed, while its theta stays finite */
     for (uint32_t j = 0; j < 100; j += 2) {
-        pf->x[j][BR_X_OMEGA] = 1.0e3f;
-        pf->x[j][BR_X_Z] = 3.0e38f;
+        pf->x[BR_X_OMEGA][j] = 1.0e3f;
+        pf->x[BR_X_Z][j] = 3.0e38f;
     }
     const br_status_t s = br_pf_step(pf, &y, 0.0f);
     assert_true(s == BR_OK || s == BR_E_NUMERIC);
@@ -375,15 +567,59 @@ static void test_fnl_overflow_is_invalid(void **st)
     free(pf);
 }
 
+/* The measurement likelihood's scale: each valid particle's log-weight is the
+ * Gaussian -(theta_j - y)^2 / (2 R) of its predicted theta (relative to the new
+ * origin) and the measurement, R the configured variance (docs/modules/pf.md,
+ * step 2). A likelihood with 1 / R, or R^2, or no square, fails here; the golden
+ * test sees such a change only through the weights' rounding chain. */
+static void test_likelihood_scale(void **st)
+{
+    (void)st;
+    br_pf_t *pf = new_pf(200);
+    const br_meas_t y0 = {1000, 0.5f}, y1 = {1003, 0.25f};
+    assert_int_equal(br_pf_step(pf, &y0, 0.0f), BR_OK);
+    /* the predicted set of the next step: br_pf_predict on a copy makes the
+     * same prediction in place (the filter keeps only the resampled set) */
+    br_pf_t *pred = malloc(sizeof *pred);
+    assert_non_null(pred);
+    memcpy(pred, pf, sizeof *pf);
+    const double shift = (double)((int64_t)y1.counts - (int64_t)pf->origin_counts) * (double)pf->cfg.est.rad_per_count;
+    (void)br_pf_step(pf, &y1, 0.01f);
+    assert_int_equal(br_pf_predict(pred, 0.01f), BR_OK);
+    const double R = (double)pf->cfg.est.r_var_rad2;
+    const double y_rel = (double)(y1.frac * pf->cfg.est.rad_per_count);
+    int n = 0;
+    double lmin = 0.0;
+    for (uint32_t j = 0; j < pf->cfg.n_particles; j++) {
+        if (isnan(pf->l[j])) continue;
+        /* eq. of the weights: l = -(theta - y)^2 / (2 R), theta at the new origin */
+        const double e = ((double)pred->x[BR_X_THETA][j] - shift) - y_rel;
+        const double want = -(e * e) / (2.0 * R);
+        BR_ASSERT_NEAR(pf->l[j], want, 1e-4 * fabs(want) + 1e-5);
+        lmin = fmin(lmin, want);
+        n++;
+    }
+    assert_int_equal(n, (int)pf->cfg.n_particles);
+    /* the particles spread over several sigma: the scale is exercised, not only l ~ 0 */
+    assert_true(lmin < -1.0);
+    free(pred);
+    free(pf);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_init_guards),          cmocka_unit_test(test_resample_idx),
         cmocka_unit_test(test_bad_input_keeps_state), cmocka_unit_test(test_outlier_100_sigma),
+        cmocka_unit_test(test_gate_quantisation),
         cmocka_unit_test(test_all_invalid_keeps_previous), cmocka_unit_test(test_weights_survive_underflow),
         cmocka_unit_test(test_ess_reported),         cmocka_unit_test(test_tracks_plant_friction),
-        cmocka_unit_test(test_predict_is_model_step), cmocka_unit_test(test_one_invalid_particle),
+        cmocka_unit_test(test_predict_is_model_step),
+        cmocka_unit_test(test_vector_path_is_scalar_path),
+        cmocka_unit_test(test_gp_stays_in_range),
+        cmocka_unit_test(test_one_invalid_particle),
         cmocka_unit_test(test_fnl_overflow_is_invalid),
+        cmocka_unit_test(test_likelihood_scale),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Plant simulator: guards, stiction, accuracy by step halving at 0.05 m/s,
  * boundedness at every speed the axis reaches, encoder quantisation. */
 #include "br_test.h"

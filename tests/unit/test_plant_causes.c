@@ -1,7 +1,8 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Plant simulator, the causes of ../shared/spec/measured-log.md: one guard
  * test per new configuration field, and one physical check per cause
  * (offset, asymmetric friction, position ripple, position gradient, actuator
- * delay), each against the cause switched off. The causes-off path is held
+ * delay, friction drift), each against the cause switched off. The causes-off path is held
  * bit for bit by the golden plant test. */
 #include "br_test.h"
 
@@ -41,6 +42,9 @@ static void test_cause_guards(void **st)
     c.ripple_phase_rad = INFINITY;                               assert_int_equal(init_with(c), -1);
     c = br_plant_cfg_reference(); c.ripple_period_m = NAN;       assert_int_equal(init_with(c), -1);
     c = br_plant_cfg_reference(); c.grad_per_m = NAN;            assert_int_equal(init_with(c), -1);
+    c = br_plant_cfg_reference(); c.drift_per_s = INFINITY;      assert_int_equal(init_with(c), -1);
+    c = br_plant_cfg_reference(); c.drift_per_s = -0.01;         assert_int_equal(init_with(c), 0);
+    assert_int_equal(br_plant_causes_on(&c), 1);
     c = br_plant_cfg_reference(); c.delay_s = -1e-3;             assert_int_equal(init_with(c), -1);
     c = br_plant_cfg_reference(); c.delay_s = BR_PLANT_DELAY_MAX_S * 1.01; assert_int_equal(init_with(c), -1);
     c = br_plant_cfg_reference(); c.delay_s = NAN;              assert_int_equal(init_with(c), -1);
@@ -161,6 +165,37 @@ static void test_position_gradient(void **st)
     BR_ASSERT_NEAR(p.x.omega_radps, duty * c.tau_per_duty_Nm * 1e-3 / Jeff, 1e-9);
 }
 
+/* Friction drift: sliding under a force that grows like the friction
+ * level, the Coulomb level follows Fc (1 + r t) with the plant's time; with
+ * r < 0 the level stops at 0 (friction vanishes, never pushes). */
+static void test_friction_drift(void **st)
+{
+    (void)st;
+    br_plant_cfg_t c = br_plant_cfg_reference();
+    c.drift_per_s = 0.1; /* +20 % after 2 s */
+    br_plant_t p;
+    assert_int_equal(br_plant_init(&p, &c, &rest), 0);
+    for (int k = 0; k < 2000; k++) {
+        const double t = p.t_s + 0.5e-3;
+        const double duty = (1.0 + c.drift_per_s * t) * (c.Fc_N + c.sigma2_Nspm * V_SLIDE_MPS) * c.lead_mprad /
+                            c.tau_per_duty_Nm;
+        br_plant_step(&p, duty, 1e-3);
+        if (k > 1000) {
+            BR_ASSERT_NEAR(p.fnl_N, c.Fc_N * (1.0 + c.drift_per_s * p.t_s), 1e-3);
+        }
+    }
+    c.drift_per_s = -1.0; /* s = 0 from t = 1 s */
+    assert_int_equal(br_plant_init(&p, &c, &rest), 0);
+    for (int k = 0; k < 1001; k++) {
+        br_plant_step(&p, 0.0, 1e-3);
+    }
+    const double duty = 0.01, w0 = p.x.omega_radps;
+    br_plant_step(&p, duty, 1e-3);
+    assert_true(p.fnl_N == 0.0);
+    const double Jeff = c.J_kgm2 + c.lead_mprad * c.lead_mprad * c.M_kg;
+    BR_ASSERT_NEAR(p.x.omega_radps - w0, duty * c.tau_per_duty_Nm * 1e-3 / Jeff, 1e-9);
+}
+
 /* Actuator delay: a plant with a 2 ms dead time reproduces, two steps later,
  * the plant without one; a 2.5 ms dead time reproduces a plant stepped at
  * 0.5 ms whose commands come 5 half-steps late. */
@@ -254,6 +289,7 @@ int main(void)
         cmocka_unit_test(test_offset_shifts_sliding),
         cmocka_unit_test(test_asymmetric_friction),
         cmocka_unit_test(test_position_gradient),
+        cmocka_unit_test(test_friction_drift),
         cmocka_unit_test(test_delay_shifts_the_command),
         cmocka_unit_test(test_delay_overrun_is_counted),
         cmocka_unit_test(test_all_causes_bounded),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Sinusoidal reference generator: guards, amplitude and phase against a
  * double-precision evaluation of the same float configuration, phase
  * accuracy after a million steps, fractional counts in [0, 1). */

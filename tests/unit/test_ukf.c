@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Unscented Kalman filter: init guards, priming, input/NULL/state guards,
  * outlier, Cholesky failure and recovery, covariance health over a long run,
  * friction convergence on the double-precision plant (open loop and in the
@@ -236,6 +237,15 @@ static float innov_var(const br_ukf_t *u, const br_meas_t *y)
     return dry.est.innov_var_rad2;
 }
 
+/* The gate's sigma (docs/modules/ukf.md): sqrt(S + rpc^2 / 12), the
+ * innovation's predicted spread with the encoder's quantisation, in counts,
+ * for the next step at rest. */
+static double gate_sigma_counts(const br_ukf_t *u, const br_meas_t *rest)
+{
+    const double q = (double)RPC_F * (double)RPC_F / 12.0;
+    return sqrt((double)innov_var(u, rest) + q) / (double)RPC_F;
+}
+
 static void test_outlier(void **st)
 {
     (void)st;
@@ -260,12 +270,73 @@ static void test_outlier(void **st)
     BR_ASSERT_NEAR(u.x[BR_X_THETA], 0.5 * RPC_F, 0.05 * RPC_F);
     /* the next good measurement is accepted */
     assert_int_equal(br_ukf_step(&u, &rest, 0.0f), BR_OK);
-    /* and a 30-sigma step is not an outlier at outlier_sigma = 50 */
+    /* the machine's gate rejects a 10-sigma jump (checklist 11; the reference
+     * machine's gate is 8 sigma, test_circle checks it is below 10), or on a
+     * machine with a wider gate a jump just beyond it, with the state
+     * unchanged ... */
+    const double k = (c.est.outlier_sigma < 10.0f) ? 10.0 : (double)c.est.outlier_sigma + 1.0;
     run_at_rest(&u, 1000, 20);
-    const br_meas_t y3 = {1000 + (int32_t)floor(30.0 * sqrt((double)innov_var(&u, &rest)) / (double)RPC_F), 0.5f};
+    const double sig_counts = gate_sigma_counts(&u, &rest);
+    const br_meas_t y10 = {1000 + (int32_t)ceil(k * sig_counts), 0.5f};
+    br_ukf_t *pred = malloc(sizeof *pred); /* the prediction alone, for comparison */
+    assert_non_null(pred);
+    *pred = u;
+    assert_int_equal(br_ukf_predict(pred, 0.0f), BR_OK);
+    assert_int_equal(br_ukf_step(&u, &y10, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(u.origin_counts, 1000);
+    assert_memory_equal(u.x, pred->x, sizeof u.x); /* no update: the prediction, bit for bit */
+    free(pred);
+    assert_true(u.est.innov_rad / sqrt((double)u.est.innov_var_rad2 + (double)RPC_F * (double)RPC_F / 12.0) >=
+                k * 0.99);
+    /* ... and takes a step of 0.8 of the gate */
+    run_at_rest(&u, 1000, 20);
+    const br_meas_t y3 = {1000 + (int32_t)floor(0.8 * c.est.outlier_sigma * gate_sigma_counts(&u, &rest)), 0.5f};
     assert_true(y3.counts > 1001);
     assert_int_equal(br_ukf_step(&u, &y3, 0.0f), BR_OK);
     assert_int_equal(u.origin_counts, y3.counts);
+}
+
+/* A filter sure of itself (R = 1e-3 count^2, small process noise, converged
+ * at rest): S alone is far below a count. A one-count innovation is the encoder's quantisation,
+ * never an outlier (without the rpc^2 / 12 term the 8-sigma gate is about
+ * 0.3 count and rejects it); a 10-sigma jump of the gate's sigma is rejected. */
+static void test_gate_quantisation(void **st)
+{
+    (void)st;
+    br_ukf_cfg_t c = ref_cfg();
+    /* the gate's formula, not a machine's value: 8 sigma as the reference machine ships
+     * (a machine with a wider gate, e.g. the heavy one, would not meet the premise) */
+    c.est.outlier_sigma = 8.0f;
+    c.est.r_var_rad2 = 1.0e-3f * RPC_F * RPC_F;
+    c.p0_var[BR_X_THETA] = 1.0e-2f * RPC_F * RPC_F;
+    c.est.q_var[BR_X_THETA] = 0.0f;
+    c.est.q_var[BR_X_OMEGA] = 1.0e-12f;
+    c.est.q_var[BR_X_GP] = 1.0e-6f;
+    c.p0_var[BR_X_OMEGA] = 1.0e-10f;
+    c.p0_var[BR_X_GP] = 1.0e-4f;
+    c.est.q_var[BR_X_Z] = 0.0f;
+    c.p0_var[BR_X_Z] = 1.0e-20f;
+    br_ukf_t u;
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    run_at_rest(&u, 1000, 50);
+    const br_meas_t rest = {1000, 0.5f};
+    /* the premise: S alone would put a count beyond the gate */
+    print_message("gate: sqrt(S) %.3g count, gate sigma %.3g count\n", sqrt((double)innov_var(&u, &rest)) / (double)RPC_F,
+                  gate_sigma_counts(&u, &rest));
+    assert_true((double)c.est.outlier_sigma * sqrt((double)innov_var(&u, &rest)) < 0.5 * (double)RPC_F);
+    const double k = (c.est.outlier_sigma < 10.0f) ? 10.0 : (double)c.est.outlier_sigma + 1.0;
+    const br_meas_t y10 = {1000 + (int32_t)ceil(k * gate_sigma_counts(&u, &rest)), 0.5f};
+    const br_meas_t y1 = {1001, 0.5f};
+    br_ukf_t *v = malloc(sizeof *v);
+    assert_non_null(v);
+    *v = u;
+    /* one count: accepted, the update moves theta toward it */
+    assert_int_equal(br_ukf_step(v, &y1, 0.0f), BR_OK);
+    assert_int_equal(v->origin_counts, 1001);
+    /* 10 gate sigmas: rejected, the origin stays */
+    assert_int_equal(br_ukf_step(&u, &y10, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(u.origin_counts, 1000);
+    free(v);
 }
 
 static void test_reanchor_after_lost_lock(void **st)
@@ -602,6 +673,45 @@ static void test_long_run_covariance(void **st)
     trace_free(&t);
 }
 
+/* A measurement variance far below the prior covariance (R = 2e-6 counts^2,
+ * twice the smallest the configuration accepts, against P0_theta = 1 count^2,
+ * the reference's p0): the gain K_0 = P_00 / (P_00 + R) is 1 to within 2e-6, so the posterior P = (I - K H) P- is almost singular
+ * in theta, and only an update that keeps it symmetric PSD in float32 (the
+ * Joseph form, docs/modules/ukf.md) keeps the filter healthy: every step
+ * BR_OK on the open-loop run, no recovery, P positive definite throughout.
+ * The short form (I - K H) P- loses definiteness here (its rounding is of
+ * the size of the tiny posterior variance): measured, its first update
+ * already fails (BR_E_NUMERIC, a recovery), where the Joseph form runs all
+ * 8000 steps OK; at R = 1e-5 counts^2 and above both forms pass. */
+static void test_small_r_stays_healthy(void **st)
+{
+    (void)st;
+    trace_t t = simulate(SCEN_OPEN_LOOP, 8000);
+    br_ukf_cfg_t c = ref_cfg();
+    c.est.r_var_rad2 = 2.0f * BR_EST_R_MIN_COUNTS2 * RPC_F * RPC_F;
+    assert_true(c.est.r_var_rad2 >= BR_EST_R_MIN_COUNTS2 * RPC_F * RPC_F);
+    /* the gate at its widest: this test is about the update's covariance, and
+     * with R this small a count's quantisation is many sigma of the innovation */
+    c.est.outlier_sigma = BR_EST_GATE_MAX_SIGMA;
+    assert_true(c.est.r_var_rad2 <= 1.0e-3f * c.p0_var[BR_X_THETA]);
+    br_ukf_t u;
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    int n_ok = 0;
+    for (int k = 0; k < t.n; k++) {
+        const br_meas_t y = {t.counts[k], 0.5f};
+        const br_status_t s = br_ukf_step(&u, &y, k ? t.tau[k - 1] : 0.0f);
+        n_ok += (s == BR_OK);
+        if (s != BR_OK || u.n_recover != 0u) {
+            fail_msg("step %d of %d: status %d, %u recoveries (%d steps OK before)", k, t.n, (int)s,
+                     (unsigned)u.n_recover, n_ok);
+        }
+        assert_cov_healthy(&u);
+    }
+    assert_int_equal(n_ok, t.n);
+    assert_int_equal(u.n_recover, 0u);
+    trace_free(&t);
+}
+
 static void test_tuning_sensitivity(void **st)
 {
     (void)st;
@@ -692,6 +802,7 @@ int main(void)
         cmocka_unit_test(test_prime),
         cmocka_unit_test(test_bad_input_leaves_state),
         cmocka_unit_test(test_outlier),
+        cmocka_unit_test(test_gate_quantisation),
         cmocka_unit_test(test_reanchor_after_lost_lock),
         cmocka_unit_test(test_chol4),
         cmocka_unit_test(test_cholesky_failure_recovers),
@@ -700,6 +811,7 @@ int main(void)
         cmocka_unit_test(test_converges_open_loop),
         cmocka_unit_test(test_converges_in_hinf_loop),
         cmocka_unit_test(test_long_run_covariance),
+        cmocka_unit_test(test_small_r_stays_healthy),
         cmocka_unit_test(test_tuning_sensitivity),
         cmocka_unit_test(test_wrap_invariance),
     };

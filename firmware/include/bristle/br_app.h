@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The application: one control period of one axis, the only place where the
  * pieces are wired together. A configuration names the controller and the
  * friction estimator; br_app_step then runs
@@ -44,7 +45,10 @@ typedef enum {
     BR_APP_FAULT_ENC_STALE = 6,  /* more failed encoder reads in a row than enc_stale_periods */
     BR_APP_FAULT_ENC_FROZEN = 7, /* counter unchanged while |duty| >= frozen_duty, frozen_periods long */
     BR_APP_FAULT_DEADLINE = 8,   /* missed control periods (reported by the caller, br_app_fault) */
-    BR_APP_FAULT_HAL = 9         /* pwm_write failed */
+    BR_APP_FAULT_HAL = 9,        /* pwm_write failed */
+    BR_APP_FAULT_LOST_LOCK = 10  /* more than lock_max_outliers outlier steps (BR_W_OUTLIER: the
+                                    estimator rejected the measurement, re-anchoring included)
+                                    within the last lock_window_periods periods */
 } br_app_fault_t;
 
 /* The guards of one period (docs/reliability.md). br_app_guard_cfg builds them
@@ -57,16 +61,28 @@ typedef struct {
     float frozen_duty;             /* |duty| of the last period from which an unchanged count
                                       counts as frozen, in (0, 1] */
     uint32_t frozen_periods;       /* frozen periods in a row before the fault, 1..2^20 */
+    uint32_t lock_window_periods;  /* the lock monitor's window: the last so many periods,
+                                      1..BR_APP_LOCK_WINDOW_MAX */
+    uint32_t lock_max_outliers;    /* outlier steps allowed in the window, 0..window - 1; one
+                                      more is BR_APP_FAULT_LOST_LOCK */
 } br_app_guard_cfg_t;
+
+/* Largest lock window (the window is a bit per period in br_app_t). */
+#define BR_APP_LOCK_WINDOW_MAX 1024u
+#define BR_APP_LOCK_WORDS (BR_APP_LOCK_WINDOW_MAX / 32u)
 
 /* Defaults of br_app_guard_cfg (docs/reliability.md). */
 #define BR_APP_GUARD_STALE_PERIODS 3u   /* three missed reads are held, the fourth faults */
 #define BR_APP_GUARD_FROZEN_DUTY 0.5f   /* half the amplifier's duty ... */
 #define BR_APP_GUARD_FROZEN_S 0.05f     /* ... for 50 ms without a count */
+#define BR_APP_GUARD_LOCK_S 0.1f        /* lock monitor: outlier steps in the last 100 ms ... */
+#define BR_APP_GUARD_LOCK_FRACTION 0.25f /* ... above a quarter of its periods: lost lock (docs/reliability.md) */
 
 /* The guards for a period dt_s and a maximum speed in counts/s (the machine's
  * BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F): enc_max_delta_counts = ceil(speed dt),
- * frozen_periods = ceil(BR_APP_GUARD_FROZEN_S / dt), the defaults above. A
+ * frozen_periods = ceil(BR_APP_GUARD_FROZEN_S / dt), lock_window_periods =
+ * ceil(BR_APP_GUARD_LOCK_S / dt), lock_max_outliers = ceil(BR_APP_GUARD_LOCK_FRACTION
+ * window) (25 of 100 periods at 1 ms, 17 of 67 at 1.5 ms), the defaults above. A
  * non-finite or non-positive input gives a configuration br_app_init rejects. */
 br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s);
 
@@ -97,6 +113,9 @@ typedef struct {
     int have_counts;        /* last_counts valid (a good read since the arm) */
     uint32_t n_stale;       /* failed reads in a row */
     uint32_t n_frozen;      /* frozen periods in a row */
+    uint32_t lock_bits[BR_APP_LOCK_WORDS]; /* lock monitor: bit k = period k of the window was an outlier */
+    uint32_t lock_pos;      /* the window's slot of the next period */
+    uint32_t n_lock;        /* outlier periods in the window (the bits set) */
 } br_app_t;
 
 /* The estimator the configuration names, initialised in its storage, as the
@@ -138,6 +157,10 @@ br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause);
  *                   the last |duty| >= frozen_duty for frozen_periods is
  *                   ENC_FROZEN;
  *   estimator       an error is ESTIMATOR (BR_W_OUTLIER: control goes on);
+ *   lock monitor    more than lock_max_outliers BR_W_OUTLIER steps within the
+ *                   last lock_window_periods periods is LOST_LOCK (a filter
+ *                   that keeps re-anchoring has lost the axis: the estimate it
+ *                   compensates with is not the axis's friction);
  *   controller      BR_E_INPUT is CTRL_INPUT, any other error CTRL_STATE;
  *   pwm_write       an error is HAL.
  * BR_OK or BR_W_OUTLIER; BR_E_FAULT when a fault latched in this period or

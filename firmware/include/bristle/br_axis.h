@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The control loop of one axis over the HAL: read the encoder, let the
  * friction estimator (if any) update, run the controller with its estimate as
  * the compensation, write the PWM. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Gain-matrix state feedback with integral action (thesis eq. 7), float32.
  *
  *   e_theta = theta - theta_ref            (from integer counts, wrap-safe)

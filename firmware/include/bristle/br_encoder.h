@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Encoder counts: wrap-safe differences and the counts-to-radians conversion.
  * Position stays in integer counts; only differences become float. */
 #ifndef BR_ENCODER_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* What every friction estimator (PF, UKF) shares: the configuration common
  * to both, the measurement it takes and the interface through which the axis
  * loop drives it. */

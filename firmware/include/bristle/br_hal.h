@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The hardware abstraction: encoder counts in, PWM duty out, a control tick.
  * A port fills the function pointers and owns ctx; conversions (counts to
  * radians, torque to duty) live in the firmware core, not in a port. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* LuGre dynamic friction (thesis eqs. 3-5), float32.
  *
  *   F_nl = sigma0 z + sigma1 dz/dt                       (eq. 3)

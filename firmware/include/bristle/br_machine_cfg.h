@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The firmware configurations of the machine the generated headers describe
  * (bristle_gen/: br_machine.h, br_est_machine.h, br_pf_tuned.h, br_ukf_tuned.h,
  * br_noise_table.h; docs/machine-file.md): one home for the simulator's
@@ -9,7 +10,8 @@
  * float constant expression, evaluated in float as the same expression at run
  * time would be (variances in counts^2 times rad_per_count, twice, in that
  * order), so a compile-time and a run-time configuration are bit-identical.
- * Members not named (the model's causes) are zero: the thesis model. */
+ * The model's causes are the machine file's (BR_MACHINE_CAUSES; none: the
+ * thesis model). */
 #ifndef BR_MACHINE_CFG_H
 #define BR_MACHINE_CFG_H
 
@@ -29,7 +31,7 @@
         .lugre = {.sigma0_Npm = BR_MACHINE_SIGMA0_NPM_F, .sigma1_Nspm = BR_MACHINE_SIGMA1_NSPM_F,  \
                   .Fc_N = BR_MACHINE_FC_N_F, .Fs_N = BR_MACHINE_FS_N_F,                            \
                   .vs_mps = BR_MACHINE_VS_MPS_F},                                                  \
-        .dt_s = (dt)                                                                               \
+        .dt_s = (dt), .causes = BR_MACHINE_CAUSES                                                  \
     }
 
 /* The PF at period dt with the process noise q_omega, q_z, q_gp and the

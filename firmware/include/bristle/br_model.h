@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Four-state estimation model of one ball-screw axis (thesis eq. 6), float32.
  *
  * State x = [theta (rad), omega (rad/s), z (m), g_p (N)] on the motor side;
@@ -10,6 +11,8 @@
  * See docs/modules/model.md for the discretisation. */
 #ifndef BR_MODEL_H
 #define BR_MODEL_H
+
+#include <stdint.h>
 
 #include "bristle/br_lugre.h"
 #include "bristle/br_status.h"
@@ -25,9 +28,10 @@ enum { BR_X_THETA = 0, BR_X_OMEGA = 1, BR_X_Z = 2, BR_X_GP = 3, BR_NX = 4 };
  * "Extended model"; the causes of a measured log, docs/diagnose.md): all 0 is
  * eq. 6 exactly, bit for bit. The names are those of model.json and of the
  * machine file. With p = L theta_abs the load position and v = L omega:
- *   J_eff omega' = u(t - delay) - L [ k(p) (sigma2_d v + f_nl) + offset + A sin(2 pi p / P + phi) ]
+ *   J_eff omega' = u(t - delay) - L [ k(p) s(t) (sigma2_d v + f_nl) + offset + A sin(2 pi p / P + phi) ]
  *   k(p) = max(0, 1 + grad p);  in -x (v < 0): sigma2_d = sigma2 + dsigma2_neg and the
- *   Stribeck level is c g_p, c = (Fc + dFc_neg) / Fc (eq. 4 with that level). */
+ *   Stribeck level is c g_p, c = (Fc + dFc_neg) / Fc (eq. 4 with that level);
+ *   s(t) = max(0, 1 + drift t), t the model's clock (br_model_tick), held over a step. */
 typedef struct {
     float offset_N;          /* constant load force, + opposes motion in +x (gravity, cable drag) */
     float dFc_neg_N;         /* Coulomb level in -x minus that in +x (Stribeck curve scaled alike) */
@@ -38,6 +42,8 @@ typedef struct {
     float grad_per_m;        /* friction scaled by max(0, 1 + grad p) along the travel */
     float delay_s;           /* actuator dead time; the estimators delay the torque they predict
                                 with through a command history (br_est.h), the model step not */
+    float drift_per_s;       /* friction level (Coulomb, stiction, viscous together) scaled by
+                                max(0, 1 + drift t) with the time t since the estimator started */
 } br_causes_t;
 
 typedef struct {
@@ -58,10 +64,20 @@ typedef struct {
     float c_neg;        /* (Fc + dFc_neg) / Fc, the Stribeck level's factor in -x */
     float sigma2_neg_Nspm; /* sigma2 + dsigma2_neg */
     float ripple_k_radpm;  /* 2 pi / P (0 without ripple) */
+    uint32_t n_steps;      /* the model's clock: steps of dt_s since init (saturates) */
+    float drift_k;         /* s(t) = max(0, 1 + drift n_steps dt_s): the friction scale now (1 without drift) */
     int ready;
 } br_model_t;
 
 br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg);
+
+/* The model's clock (friction_drift): br_model_set_clock sets it to n steps of
+ * dt_s, br_model_tick advances it by one (saturating at UINT32_MAX); both update
+ * the friction scale s(t) = max(0, 1 + drift t), t = n dt_s, that every step and
+ * force of the extended model use until the clock moves again. The estimators
+ * tick once per prediction. Without a drift the scale stays 1. */
+void br_model_set_clock(br_model_t *m, uint32_t n_steps);
+void br_model_tick(br_model_t *m);
 
 /* Eq. 6 right-hand side f(x, u), extended by the causes; theta absolute
  * (the load position is p = L theta). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Particle filter for the friction of one axis (thesis sections 2.3, 4), float32.
  *
  * Particles x_j = [theta, omega, z, g_p] of the eq. 6 model (br_model.h).
@@ -23,6 +24,17 @@
 #ifndef BR_PF_MAX_PARTICLES
 #define BR_PF_MAX_PARTICLES 2048u
 #endif
+/* BR_PF_ONE_DIVISION (build option, CMake BR_PF_ONE_DIVISION, default 1):
+ * 1 = each particle carries k_p = sigma0 L / g_p (kgp), one division per
+ * particle-step where the RK4 stages and f_nl would divide by g_p five times
+ * (the Cortex-M7's vdiv.f32 takes 14 cycles), and predicts with the RK4 form
+ * of br_model_kp_rk4 (constants folded); 0 = br_model_step's RK4. They round
+ * differently, so the tuned variances and the demo's figures belong to the
+ * default, 1 (docs/modules/pf.md). */
+#ifndef BR_PF_ONE_DIVISION
+#define BR_PF_ONE_DIVISION 1
+#endif
+
 /* weight quantisation: W in [0, 2^16]; the resampling works on 2 C_m <= 2^17 m,
  * which fits uint32 for m < 2^15 (and the indices fit uint16) */
 #define BR_PF_W_BITS 16u
@@ -33,12 +45,15 @@
 typedef struct {
     br_est_cfg_t est;        /* what the PF shares with the UKF: model (est.model.dt_s is the PF's
                                 period), noise, g_p range, gates; outlier: |y - theta_j| >
-                                est.outlier_sigma sqrt(R) for every particle j */
+                                est.outlier_sigma sqrt(R + rpc^2 / 12) for every particle j */
     uint32_t n_particles;    /* m, 1..BR_PF_MAX_PARTICLES */
     float x0_std[BR_NX];     /* initial spread around [y_0, 0, 0, gp0]; >= 0 */
     const float *noise;      /* standard-normal ROM table (e.g. br_noise_table) */
     uint32_t noise_len;      /* its length, a power of two >= 2 */
     uint32_t noise_skip;     /* extra table advance per step (indexing scheme, docs/modules/pf.md) */
+    uint32_t scalar_path;    /* 1: the scalar reference path (one particle at a time, with branches);
+                                0 (default): the structure-of-arrays loops the compiler vectorises,
+                                the rare cases fixed up in scalar; both give identical results */
 } br_pf_cfg_t;
 
 typedef struct {
@@ -55,17 +70,19 @@ typedef struct {
     float inv_2r;                 /* 1 / (2 R) */
     float m_per_count;            /* L rpc: load position per encoder count */
     br_est_delay_t delay;         /* commands for the actuator delay (model.causes.delay_s) */
-    float outlier_l;              /* -outlier_sigma^2 / 2: log-weight threshold */
+    float outlier_l;              /* -outlier_sigma^2 (R + rpc^2 / 12) / (2 R): log-weight threshold */
     uint32_t noise_pos;           /* table position, advances every step */
     int32_t origin_counts;
     float prev_frac;              /* the last measurement's fraction */
     uint32_t n_outliers;          /* consecutive outlier steps */
     uint32_t n_predicted;         /* predict-only steps since the last measurement */
     int primed;                   /* particles drawn around the first measurement */
-    /* particles, one state vector each: current set, and the predicted set */
-    float x[BR_PF_MAX_PARTICLES][BR_NX];
-    float xp[BR_PF_MAX_PARTICLES][BR_NX];
-    float fnl[BR_PF_MAX_PARTICLES];   /* f_nl of the predicted particles */
+    /* particles as a structure of arrays: x[i][j] is state i of particle j.
+     * One set, predicted and resampled in place (docs/modules/pf.md). */
+    float x[BR_NX][BR_PF_MAX_PARTICLES];
+    float kgp[BR_PF_ONE_DIVISION ? BR_PF_MAX_PARTICLES : 1u]; /* sigma0 L / g_p of each particle, 1/rad
+                                                                  (BR_PF_ONE_DIVISION builds only) */
+    float fnl[BR_PF_MAX_PARTICLES];   /* f_nl of the predicted particles (by predicted index) */
     float l[BR_PF_MAX_PARTICLES];     /* log-weights; NaN marks an invalid particle */
     uint32_t W[BR_PF_MAX_PARTICLES];  /* quantised weights */
     uint16_t idx[BR_PF_MAX_PARTICLES];/* resampling indices of the last step */
@@ -77,7 +94,7 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg);
 
 /* One filter step (see above). Statuses: BR_E_INPUT for a non-finite u or
  * frac outside [0, 1] (state untouched); BR_W_OUTLIER when y is further than
- * outlier_sigma from every particle (no weighting: the valid predicted
+ * outlier_sigma sqrt(R + rpc^2 / 12) from every particle (no weighting: the valid predicted
  * particles are kept with equal weights; after reanchor_after consecutive
  * outliers the cloud is re-anchored, its mean theta moved to y and its mean
  * omega to the measured velocity, so the filter regains lock);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Sinusoidal reference for one axis of a circle test, float32.
  *
  * Load-side position and its motor-side images, at phase phi_k:

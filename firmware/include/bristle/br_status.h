@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Status codes shared by every bristle module: BR_OK is zero, a warning is
  * positive (the step succeeded and its outputs are valid), an error is
  * negative (the step failed; what was kept is said where it is returned). So

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Unscented Kalman filter for the friction of one axis (thesis sections 2.3, 4), float32.
  *
  * State x = [theta, omega, z, g_p] of the eq. 6 model (br_model.h), mean x and
@@ -15,7 +16,8 @@
  *   4. estimate      F_hat = sum_j Wm_j f_nl(X+_j) over the posterior sigma points
  * A failed Cholesky (pivot <= 0 or non-finite) resets P to diag(p0_var),
  * keeping the mean, and reports BR_E_NUMERIC. An outlier (|y - theta-| >
- * outlier_sigma sqrt(S)) skips the update; reanchor_after of them in a row
+ * outlier_sigma sqrt(S + rpc^2 / 12), the innovation's spread with the
+ * encoder's quantisation) skips the update; reanchor_after of them in a row
  * re-anchor the filter on the measurement (as the PF does).
  * theta is stored relative to an integer origin (the latest accepted count),
  * as in the PF, so float32 keeps sub-count resolution at any travel.
@@ -35,7 +37,7 @@
 typedef struct {
     br_est_cfg_t est;        /* what the UKF shares with the PF: model (est.model.dt_s is the UKF's
                                 period), noise, g_p range (every sigma point and the mean are kept
-                                in it), gates; outlier: |y - theta-| > est.outlier_sigma sqrt(S) */
+                                in it), gates; outlier: |y - theta-| > est.outlier_sigma sqrt(S + rpc^2 / 12) */
     float p0_var[BR_NX];     /* initial (and recovery) variances P0 = diag(p0_var), > 0 */
     float alpha;             /* sigma-point spread, in (0, 1]; use >= 0.1 in float32 (1 recommended) */
     float beta;              /* prior-distribution weight, >= 0 (2 for a Gaussian) */
@@ -58,6 +60,7 @@ typedef struct {
     float wm0, wc0, wi;              /* weights: Wm_0, Wc_0, and Wm_i = Wc_i = W for i >= 1 */
     float cmm;                       /* beta - alpha^2: the m m^T term of P- about the central point */
     float out_s2;                    /* outlier_sigma^2 */
+    float quant_var_rad2;            /* rpc^2 / 12: the encoder's quantisation variance, in the gate */
     float m_per_count;               /* L rpc: load position per encoder count */
     br_est_delay_t delay;            /* commands for the actuator delay (model.causes.delay_s) */
     float x[BR_NX];                  /* mean; theta relative to origin_counts */
@@ -84,7 +87,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg);
  * Statuses:
  *   BR_E_NULL / BR_E_STATE  NULL argument / not initialised;
  *   BR_E_INPUT    non-finite u, or frac non-finite or outside [0, 1]: state untouched;
- *   BR_W_OUTLIER  |y - theta-| > outlier_sigma sqrt(S): the prediction is kept
+ *   BR_W_OUTLIER  |y - theta-| > outlier_sigma sqrt(S + rpc^2 / 12): the prediction is kept
  *                 (origin unchanged), no update; on the reanchor_after-th
  *                 consecutive outlier the filter has lost lock and is
  *                 re-anchored: origin = y.counts, x = [frac rpc, measured

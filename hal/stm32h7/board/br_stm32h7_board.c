@@ -1,12 +1,13 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The board's wiring and clocks (br_stm32h7_board.h). */
 #include "br_stm32h7_board.h"
 
-br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_period_ns)
+br_stm32_cfg_t br_stm32h7_board_cfg(uint32_t control_period_ns)
 {
-    const br_stm32h7_cfg_t cfg = {
-        .pwm_tim = (br_stm32h7_tim_t *)BR_STM32H7_TIM1_BASE,
-        .enc_tim = (br_stm32h7_tim_t *)BR_STM32H7_TIM2_BASE,
-        .systick = (br_stm32h7_systick_t *)BR_STM32H7_SYSTICK_BASE,
+    const br_stm32_cfg_t cfg = {
+        .pwm_tim = (br_stm32_tim_t *)BR_STM32H7_TIM1_BASE,
+        .enc_tim = (br_stm32_tim_t *)BR_STM32H7_TIM2_BASE,
+        .systick = (br_stm32_systick_t *)BR_STM32H7_SYSTICK_BASE,
         .cpu_clock_hz = BR_BOARD_CPU_HZ,
         .tim_clock_hz = BR_BOARD_TIM_HZ,
         .pwm_hz = BR_BOARD_PWM_HZ,
@@ -19,7 +20,7 @@ br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_period_ns)
     return cfg;
 }
 
-br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_period_ns, br_hal_t *hal)
+br_status_t br_stm32h7_board_init(br_stm32_t *port, uint32_t control_period_ns, br_hal_t *hal)
 {
     const br_stm32h7_clock_regs_t clk = {
         (br_stm32h7_rcc_t *)BR_STM32H7_RCC_BASE,
@@ -31,18 +32,18 @@ br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_period_ns
     if (st != BR_OK) {
         return st;
     }
-    br_stm32h7_gpio_t *gpioa = (br_stm32h7_gpio_t *)BR_STM32H7_GPIOA_BASE;
-    br_stm32h7_gpio_t *gpiob = (br_stm32h7_gpio_t *)BR_STM32H7_GPIOB_BASE;
+    br_stm32_gpio_t *gpioa = (br_stm32_gpio_t *)BR_STM32H7_GPIOA_BASE;
+    br_stm32_gpio_t *gpiob = (br_stm32_gpio_t *)BR_STM32H7_GPIOB_BASE;
     (void)br_stm32h7_rcc_enable((br_stm32h7_rcc_t *)BR_STM32H7_RCC_BASE);
-    (void)br_stm32h7_gpio_af(gpioa, 0u, 1u);  /* TIM2_CH1 */
-    (void)br_stm32h7_gpio_af(gpioa, 1u, 1u);  /* TIM2_CH2 */
-    (void)br_stm32h7_gpio_af(gpioa, 8u, 1u);  /* TIM1_CH1 */
-    (void)br_stm32h7_gpio_af(gpioa, 9u, 1u);  /* TIM1_CH2 */
-    (void)br_stm32h7_gpio_af(gpiob, 13u, 1u); /* TIM1_CH1N */
-    (void)br_stm32h7_gpio_af(gpiob, 14u, 1u); /* TIM1_CH2N */
-    const br_stm32h7_cfg_t cfg = br_stm32h7_board_cfg(control_period_ns);
-    st = br_stm32h7_init(port, &cfg);
-    return (st != BR_OK) ? st : br_stm32h7_hal(port, hal);
+    (void)br_stm32_gpio_af(gpioa, 0u, 1u);  /* TIM2_CH1 */
+    (void)br_stm32_gpio_af(gpioa, 1u, 1u);  /* TIM2_CH2 */
+    (void)br_stm32_gpio_af(gpioa, 8u, 1u);  /* TIM1_CH1 */
+    (void)br_stm32_gpio_af(gpioa, 9u, 1u);  /* TIM1_CH2 */
+    (void)br_stm32_gpio_af(gpiob, 13u, 1u); /* TIM1_CH1N */
+    (void)br_stm32_gpio_af(gpiob, 14u, 1u); /* TIM1_CH2N */
+    const br_stm32_cfg_t cfg = br_stm32h7_board_cfg(control_period_ns);
+    st = br_stm32_init(port, &cfg);
+    return (st != BR_OK) ? st : br_stm32_hal(port, hal);
 }
 
 int br_stm32h7_board_reset_by_watchdog(void)
@@ -55,17 +56,17 @@ int br_stm32h7_board_reset_by_watchdog(void)
 
 br_status_t br_stm32h7_board_watchdog_start(void)
 {
-    return br_stm32h7_iwdg_start((br_stm32h7_iwdg_t *)BR_STM32H7_IWDG1_BASE, BR_BOARD_IWDG_PR, BR_BOARD_IWDG_RLR);
+    return br_stm32_iwdg_start((br_stm32_iwdg_t *)BR_STM32H7_IWDG1_BASE, BR_BOARD_IWDG_PR, BR_BOARD_IWDG_RLR);
 }
 
 void br_stm32h7_board_watchdog_refresh(void)
 {
-    br_stm32h7_iwdg_refresh((br_stm32h7_iwdg_t *)BR_STM32H7_IWDG1_BASE);
+    br_stm32_iwdg_refresh((br_stm32_iwdg_t *)BR_STM32H7_IWDG1_BASE);
 }
 
-void br_stm32h7_board_halt(br_stm32h7_t *port)
+void br_stm32h7_board_halt(br_stm32_t *port)
 {
-    (void)br_stm32h7_pwm_disable(port);
+    (void)br_stm32_pwm_disable(port);
     for (;;) {
         __asm__ volatile("nop");
     }

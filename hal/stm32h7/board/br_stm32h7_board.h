@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The board: how the STM32H743 of the bristle image is wired and clocked.
  *
  * Pins (RM0433, all AF1): TIM2 encoder on PA0 (CH1) / PA1 (CH2); TIM1 PWM on
@@ -27,13 +28,13 @@
 /* The port configuration of this board (peripheral bases, clocks, PWM,
  * encoder) for a control period of control_period_ns (a whole number of
  * 480 MHz cycles). */
-br_stm32h7_cfg_t br_stm32h7_board_cfg(uint32_t control_period_ns);
+br_stm32_cfg_t br_stm32h7_board_cfg(uint32_t control_period_ns);
 
 /* Brings the board up: the clock tree (br_stm32h7_clock_480), peripheral
  * clocks, pins to their timers, then the port (outputs off until the arm;
- * br_stm32h7_init validates the configuration before writing a timer
+ * br_stm32_init validates the configuration before writing a timer
  * register) and its br_hal_t. The first failing status. */
-br_status_t br_stm32h7_board_init(br_stm32h7_t *port, uint32_t control_period_ns, br_hal_t *hal);
+br_status_t br_stm32h7_board_init(br_stm32_t *port, uint32_t control_period_ns, br_hal_t *hal);
 
 /* 1 when the last reset came from IWDG1 (a hung or faulted control loop);
  * clears the reset flags (RMVF) so that the next pin or power-on reset reads
@@ -44,9 +45,9 @@ int br_stm32h7_board_reset_by_watchdog(void);
 br_status_t br_stm32h7_board_watchdog_start(void);
 void br_stm32h7_board_watchdog_refresh(void);
 
-/* Motor stopped and outputs off (br_stm32h7_pwm_disable); then parks without
+/* Motor stopped and outputs off (br_stm32_pwm_disable); then parks without
  * refreshing the watchdog: a running IWDG1 resets the part, which then comes
  * up with its outputs off (br_stm32h7_board_reset_by_watchdog). */
-void br_stm32h7_board_halt(br_stm32h7_t *port) __attribute__((noreturn));
+void br_stm32h7_board_halt(br_stm32_t *port) __attribute__((noreturn));
 
 #endif

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The bristle firmware image for the STM32H743: one axis tracking a
  * sinusoidal (circle-test) reference with the H-infinity gains of
  * firmware/gen/bristle_gen/ctrl/br_hinf_gains.h and the friction compensation
@@ -70,7 +71,7 @@ static br_pf_t br_image_pf __attribute__((section(".axisram")));
 
 int main(void)
 {
-    br_stm32h7_t port = {0};
+    br_stm32_t port = {0};
     br_hal_t hal = {0};
     br_app_t app = {0};
     br_refgen_t refgen = {0};
@@ -94,7 +95,7 @@ int main(void)
             (void)br_app_fault(&app, BR_APP_FAULT_HAL);
             br_stm32h7_board_halt(&port);
         }
-        if (br_stm32h7_deadline_check(&port, BR_IMAGE_MAX_MISSED) != BR_OK) {
+        if (br_stm32_deadline_check(&port, BR_IMAGE_MAX_MISSED) != BR_OK) {
             (void)br_app_fault(&app, BR_APP_FAULT_DEADLINE);
             br_stm32h7_board_halt(&port);
         }

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Diagnosis of measured logs: what the nominal (thesis) model gets wrong,
 which cause of ../shared/spec/measured-log.md explains it, and the gain of
 the extended model on a held-out part of the log. docs/diagnose.md."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Closed-loop re-simulation of a log: the fitted model as the plant, the
 log's position controller (when it is known), the log's reference as input.
 
@@ -192,10 +193,14 @@ def resimulate(prep, params, ctrl):
     def rel(a, b):
         return 100.0 * float(np.linalg.norm((a - b)[w]) / np.linalg.norm(a[w]))
 
-    return {
-        "q": q, "force": f,
-        "relerr_position_percent": rel(prep.pos, q),
-        "relerr_velocity_percent": rel(v_meas, v_sim),
-        "relerr_acceleration_percent": rel(a_meas, a_sim),
-        "relerr_force_percent": rel(f_meas, f_sim),
-    }
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = {
+            "relerr_position_percent": rel(prep.pos, q),
+            "relerr_velocity_percent": rel(v_meas, v_sim),
+            "relerr_acceleration_percent": rel(a_meas, a_sim),
+            "relerr_force_percent": rel(f_meas, f_sim),
+        }
+    # a loop that ran away to finite but huge values overflows the norms
+    if not all(math.isfinite(v) for v in out.values()):
+        raise ControllerError("the closed-loop re-simulation diverged (its relative errors are not finite)")
+    return {"q": q, "force": f, **out}

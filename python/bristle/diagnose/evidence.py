@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What a cause's evidence sentence is computed from: the nominal model's
 residual over the log (edges left out) and the motion it goes with."""
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Reading a JSON file the diagnosis takes (model.json, a machine file):
 LogError "file:line: problem" when it cannot be read or parsed, and the line
 of a key for the checks that follow. At most MAX_BYTES: these files are a

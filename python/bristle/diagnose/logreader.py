@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Reader for measured logs (../shared/spec/measured-log.md): CSV with a
 header naming at least t, ref, pos, force.
 

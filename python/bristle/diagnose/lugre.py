@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """LuGre bristle state, bounded at any speed: the one implementation the fit
 (model.py, along a measured motion) and the closed-loop re-simulation
 (closedloop.py, substep by substep) share.

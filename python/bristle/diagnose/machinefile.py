@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The machine file of a log (docs/diagnose.md, "Machine file"): which one,
 and its checked reading. Every field the diagnosis uses is checked before
 the fit, with "file:line: problem":

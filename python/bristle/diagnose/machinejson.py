@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """machine.json: the firmware machine file (firmware/design/machine.py, format 1) a
 diagnosis writes beside model.json (docs/machine-file.md, "provenance";
 docs/configure.md).
@@ -26,6 +27,7 @@ marked "assumed"; what follows from the log and the rest is "derived". The
                    (variances by its square): "derived"
 """
 import copy
+import importlib
 import importlib.util
 import json
 import math
@@ -43,9 +45,12 @@ PRESLIDING_MIN_QUANTA = 2.0
 
 
 def _loader():
-    """firmware/design/machine.py, the one loader and schema of machine files."""
-    spec = importlib.util.spec_from_file_location("br_machine_loader",
-                                                  os.path.join(REPO, "firmware", "design", "machine.py"))
+    """firmware/design/machine.py, the one loader and schema of machine files;
+    installed, the same file is bristle.design.machine (pyproject.toml)."""
+    path = os.path.join(REPO, "firmware", "design", "machine.py")
+    if not os.path.isfile(path):
+        return importlib.import_module("bristle.design.machine")
+    spec = importlib.util.spec_from_file_location("br_machine_loader", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
@@ -156,6 +161,14 @@ def build(prep, diag, given=None, log_path=None):
         _set(m, "mechanics.inertia_kgm2", (1.0 - share) * Meff * L ** 2, prov, "identified")
     elif Meff - J / L ** 2 > 0.0:
         _set(m, "mechanics.table_mass_kg", Meff - J / L ** 2, prov, "identified")
+    elif kind("mechanics.inertia_kgm2") != "given":
+        # an axis lighter than the assumed screw's inertia alone: the
+        # identified mass split in the assumed machine's proportion
+        share = M / (J / L ** 2 + M)
+        _set(m, "mechanics.table_mass_kg", share * Meff, prov, "identified")
+        _set(m, "mechanics.inertia_kgm2", (1.0 - share) * Meff * L ** 2, prov, "identified")
+        notes.append("the identified moving mass %.4g kg is below the assumed screw inertia's J/L^2 = %.4g kg: "
+                     "split between table and screw in the assumed machine's proportion" % (Meff, J / L ** 2))
     else:
         raise closedloop.ControllerError(
             "%s: field mechanics.inertia_kgm2: J/L^2 = %.4g kg exceeds the identified moving mass Meff_kg = %.4g kg"

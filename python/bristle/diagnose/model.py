@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The force model fitted to a log: the nominal (thesis) model and its
 extensions by the causes (causes/, one module each).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """model.json: the extended model a diagnosis saves, and its checked
 loading (docs/diagnose.md, "Outputs" and "Parameters").
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Parameters of a saved model (model.json "params"): a name (with its unit
 in it, the name of the br_plant_cfg_t field it sets), the unit, what it
 means, and its bounds [lo, hi] (lo = GT0: "> 0"). NOMINAL are the thesis
@@ -38,7 +39,9 @@ class Param(NamedTuple):
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             return f"parameter {self.name} is not a number ({_short(v)})"
         if not (self.lo <= v <= self.hi):  # NaN fails too
-            return f"parameter {self.name} = {v:g} {bounds_text(self.lo, self.hi)}"
+            # an int beyond the float range is shown as written (format 'g' would overflow)
+            shown = f"{v:g}" if isinstance(v, float) or abs(v) < 1e300 else _short(v)
+            return f"parameter {self.name} = {shown} {bounds_text(self.lo, self.hi)}"
         return None
 
 

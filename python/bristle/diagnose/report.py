@@ -1,8 +1,9 @@
+# SPDX-License-Identifier: Apache-2.0
 """report.json and report.md of a diagnosis (docs/diagnose.md); model.json
 is modelfile.py's. Generated files carry output.GENERATOR and no timestamp,
 numbers rounded (output.rounded), so that a rerun writes the same files."""
 from . import causes as causes_
-from . import model, output, selection, signals
+from . import intervals, model, noise, output, selection, signals, unexplained
 from .evidence import Residual
 
 # The EMPS paper's two IDIM-LS model structures (rigid + viscous + Coulomb as
@@ -12,6 +13,26 @@ from .evidence import Residual
 PUBLISHED_STRUCTURES = (("rigid + viscous + symmetric Coulomb + offset", "offset"),
                         ("rigid + asymmetric viscous/Coulomb", "asymmetric_friction"))
 SIGN_SHAPE = (model.RHO_BOUNDS[1], 1.0, 1.0)  # 1 nm presliding: Coulomb as sgn(v)
+
+
+# figures of every report (beside __main__'s and the causes'): (file, what, function(path, prep, diag))
+FIGURES = (
+    ("friction_map.png", "friction against velocity by direction, with the fitted models' steady friction",
+     lambda path, prep, diag: _plots().friction_map(path, prep, diag)),
+    ("unexplained.png", "what the extended model's residual goes with: time, position, velocity, acceleration, "
+                        "direction, time since a reversal",
+     lambda path, prep, diag: unexplained.figure(path, prep, diag)),
+)
+
+
+def _plots():
+    from . import plots  # matplotlib: only when figures are drawn
+    return plots
+
+
+CLOSED_LOOP_SKIPPED = ("The closed loop was not re-simulated: no machine file gives this log's position controller "
+                       "(pass --machine FILE, or put <log>.machine.json beside the log; docs/diagnose.md, Machine "
+                       "files).")
 
 
 def evidence(prep, nominal, cause, fit):
@@ -33,18 +54,43 @@ def published_structures(prep):
     return out
 
 
-def build(prep, diag, machine=None, closed=None, log_path=None):
+def verdict(prep, diag, floor):
+    """The spec's verdict and `unexplained` object: the first finding; else
+    "none" when the nominal model's held-out residual is at the log's noise
+    floor (noise.py), "unexplained" when it is above. `unexplained` is
+    described whenever the best model's residual stays above the floor."""
+    ext_rel = diag.extended.relerr(prep, prep.test)
+    above = not floor.at_floor(ext_rel)
+    une = unexplained.describe(prep, diag.extended, floor, ext_rel) if above else None
+    if diag.findings:
+        return diag.findings[0][0].cause, une
+    return ("unexplained" if above else "none"), une
+
+
+def build(prep, diag, machine=None, closed=None, log_path=None, floor=None):
     te, tr = prep.test, prep.train
     nom = diag.nominal
+    floor = floor or noise.measure(prep, diag.nominal)
+    verdict_, une = verdict(prep, diag, floor)
     findings = []
+    ext = diag.extended
+    ivals = intervals.jackknife(prep, ext)
+    ext_params = ext.params()
+    unident = intervals.unidentified(prep, ext_params, ivals)
     for cand, refined in diag.findings:
+        mod = causes_.get(cand.cause)
         findings.append({
             "cause": cand.cause,
-            "params": refined.cause_params(cand.cause),
+            # the final joint model's parameters (selection.py)
+            "params": ext.cause_params(cand.cause),
+            "intervals_95": {k: list(ivals[f"{cand.cause}.{k}"]) for k in ext.cause_params(cand.cause)
+                             if f"{cand.cause}.{k}" in ivals},
+            "meaning": mod.MEANING,
+            "action": getattr(mod, "ACTION", "see docs/diagnose.md, Causes"),
             "relerr_after_percent": refined.relerr(prep, te),
             "relerr_before_percent": cand.base_relerr,
             "p_value": cand.p_value,
-            "evidence": evidence(prep, nom, cand.cause, refined),
+            "evidence": evidence(prep, nom, cand.cause, ext),
         })
     rep = {
         "generator": output.GENERATOR,
@@ -62,11 +108,18 @@ def build(prep, diag, machine=None, closed=None, log_path=None):
         "nominal": {"params": nom.params(), "relerr_percent": nom.relerr(prep, te),
                     "relerr_train_percent": nom.relerr(prep, tr)},
         "findings": findings,
-        "verdict": findings[0]["cause"] if findings else "none",
-        "extended": {"causes": list(diag.extended.causes), "params": diag.extended.params(),
+        "verdict": verdict_,
+        "borderline": [dict(c, meaning=causes_.get(c["cause"]).MEANING) for c in selection.borderline(diag)],
+        "dropped": diag.dropped,
+        "extended": {"causes": list(diag.extended.causes), "params": ext_params,
+                     "intervals_95": {k: list(v) for k, v in ivals.items() if "." not in k},
+                     "not_identified": unident,
                      "relerr_percent": diag.extended.relerr(prep, te),
                      "relerr_train_percent": diag.extended.relerr(prep, tr)},
         "gain_percent_points": nom.relerr(prep, te) - diag.extended.relerr(prep, te),
+        "noise_floor_percent": floor.percent,
+        "noise_floor": floor.summary(),
+        "unexplained": une,
         "tested": diag.rounds,
         "published_structures_refitted": published_structures(prep),
     }
@@ -76,6 +129,8 @@ def build(prep, diag, machine=None, closed=None, log_path=None):
             rep["published"] = machine["published"]
     if closed:
         rep["closed_loop"] = closed
+    else:
+        rep["closed_loop_skipped"] = CLOSED_LOOP_SKIPPED
     return output.rounded(rep)
 
 
@@ -102,13 +157,49 @@ def markdown(rep, figures):
             L.append(f"| {m['name']} (published) | — | {_fmt(m['relerr_percent'], ' %')} (whole run, decimated) |")
     L.append("")
     L += [f"Gain of the extended model on the held-out part: {rep['gain_percent_points']:.3g} percentage points.", ""]
+    fl = rep["noise_floor"]
+    L += [f"Noise floor measured from the log: {_fmt(rep['noise_floor_percent'], ' %')} held-out relerr: "
+          f"force noise {fl['force_noise_N']:.3g} N (from the force above {fl['band_hz'][0]:.3g} Hz) "
+          f"{_fmt(fl['noise_percent'], ' %')}, encoder step {fl['position_step_m']:.3g} m "
+          f"{_fmt(fl['resolution_percent'], ' %')}; a residual up to {_fmt(fl['at_floor_threshold_percent'], ' %')} "
+          "is at the floor.", ""]
     L += ["## Findings (strongest first)", ""]
     if not rep["findings"]:
-        L += ["None: no cause improves the held-out error significantly.", ""]
+        L += [("None: no cause improves the held-out error significantly, and the nominal model's residual is at "
+               "the noise floor." if rep["verdict"] == "none" else
+               "No named cause improves the held-out error significantly, but the nominal model's residual is "
+               "above the noise floor: see Unexplained."), ""]
     for i, f in enumerate(rep["findings"], 1):
-        ps = ", ".join(f"{k} = {v:.4g}" for k, v in f["params"].items())
-        L += [f"{i}. **{f['cause']}**, {causes_.get(f['cause']).MEANING} ({ps}): held-out relerr {f['relerr_before_percent']:.3g} % → "
-              f"{f['relerr_after_percent']:.3g} % (p = {f['p_value']:.2g}). {f['evidence']}"]
+        ps = ", ".join(f"{k} = {v:.4g}" + (f" [{f['intervals_95'][k][0]:.4g} .. {f['intervals_95'][k][1]:.4g}]"
+                                            if k in f.get("intervals_95", {}) else "")
+                       for k, v in f["params"].items())
+        L += [f"{i}. **{f['cause']}**: {f['meaning']}. Parameters of the joint model with 95 % intervals: {ps}. "
+              f"Held-out relerr {f['relerr_before_percent']:.3g} % → {f['relerr_after_percent']:.3g} % when it was "
+              f"added (p = {f['p_value']:.2g}). {f['evidence']}", "",
+              f"   *What to check or do:* {f['action']}", ""]
+    if rep.get("borderline"):
+        L += ["Borderline (significant only at the looser level: relative gain ≥ "
+              f"{100 * selection.BORDERLINE_GAIN:g} %, p < {selection.BORDERLINE_P:g}; not findings, not in the "
+              "model; worth a second log):", ""]
+        for c in rep["borderline"]:
+            ps = ", ".join(f"{k} = {v:.4g}" for k, v in c["params"].items())
+            L.append(f"- {c['cause']} ({c['meaning']}; {ps}): held-out relerr {c['base_relerr_percent']:.4g} % → "
+                     f"{c['relerr_percent']:.4g} % ({100 * c['relative_gain']:.3g} %, p = {c['p_value']:.2g})")
+        L.append("")
+    for c in rep.get("dropped", []):
+        L += [f"Dropped: {c['cause']} was found in round {c['round']} and left the joint model when later findings "
+              f"explained it (held-out relerr without it {c['base_relerr_percent']:.4g} %, with it "
+              f"{c['relerr_percent']:.4g} %, p = {c['p_value']:.2g}).", ""]
+    L += ["## Unexplained", ""]
+    une = rep.get("unexplained")
+    if une is None:
+        L += ["Nothing: the extended model's held-out residual is at the noise floor.", ""]
+    else:
+        sh = ", ".join(f"{k} {100 * v:.1f} %" for k, v in une["shares"].items())
+        L += [une["evidence"], "", f"Share of the residual each signal explains: {sh} (`unexplained.png`).", ""]
+    ni = rep["extended"].get("not_identified", {})
+    if ni:
+        L += ["## Parameters this log cannot identify", ""] + [f"- `{k}`: {why}" for k, why in ni.items()] + [""]
     L += ["", "## Every cause tested", ""]
     for k, rnd in enumerate(rep["tested"], 1):
         L += [f"Round {k}:", "", "| cause | held-out relerr | relative gain | p | significant |", "|---|---|---|---|---|"]
@@ -116,12 +207,17 @@ def markdown(rep, figures):
             L.append(f"| {c['cause']} | {c['relerr_percent']:.4g} % | {100 * c['relative_gain']:.3g} % | "
                      f"{c['p_value']:.2g} | {'yes' if c['significant'] else 'no'} |")
         L.append("")
-    L += ["## Parameters (load side, model.json's)", "", "| parameter | unit | nominal | extended |", "|---|---|---|---|"]
+    L += ["## Parameters (load side, model.json's)", "",
+          "| parameter | unit | nominal | extended | 95 % interval (jackknife over training blocks) |",
+          "|---|---|---|---|---|"]
+    iv = rep["extended"].get("intervals_95", {})
     units = {q.name: q.unit for q in causes_.MODEL_PARAMS}
     keys = list(dict.fromkeys(list(rep["nominal"]["params"]) + list(rep["extended"]["params"])))
     for k in keys:
+        flag = " (not identified)" if k in ni else ""
         L.append(f"| {k} | {units[k]} | {_fmt(rep['nominal']['params'].get(k))} | "
-                 f"{_fmt(rep['extended']['params'].get(k))} |")
+                 f"{_fmt(rep['extended']['params'].get(k))}{flag} | "
+                 + (f"{iv[k][0]:.4g} .. {iv[k][1]:.4g} |" if k in iv else "— |"))
     L.append("")
     if "closed_loop" in rep:
         cl = rep["closed_loop"]
@@ -140,6 +236,8 @@ def markdown(rep, figures):
                      f"{pub['relerr_velocity_percent']:.3g} % | {pub['relerr_acceleration_percent']:.3g} % | "
                      f"{pub['relerr_force_percent']:.3g} % |")
         L.append("")
+    else:
+        L += ["## Closed-loop re-simulation", "", rep["closed_loop_skipped"], ""]
     L += ["## Figures", ""] + [f"- `{name}`: {what}" for name, what in figures] + [""]
     L += ["## Method", "", f"- filter: {rep['method']['filter']}", f"- relerr: {rep['method']['relerr']}",
           f"- a cause is significant when the held-out relerr drops by at least "

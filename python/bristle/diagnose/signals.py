@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """From a log to the quantities the force model is fitted on.
 
 Filter: a 4th-order Butterworth low-pass at FC_HZ (FC_MAX_FRAC of Nyquist at

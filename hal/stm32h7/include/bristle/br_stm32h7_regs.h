@@ -1,8 +1,9 @@
-/* Minimal register definitions for the STM32H743 peripherals the bristle
- * port uses, written from the reference manual (RM0433) register maps:
- * the TIMx block (advanced TIM1/TIM8 and general-purpose TIM2..TIM5 share
- * the layout; registers a timer lacks, e.g. RCR/BDTR on TIM2, are reserved),
- * the RCC clock-enable registers, GPIO, and the Cortex-M7 SysTick.
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Minimal register definitions for the STM32H743's own peripherals the
+ * bristle port uses, written from the reference manual (RM0433) register
+ * maps: RCC, PWR, SYSCFG, FLASH, and the base addresses. The blocks every
+ * STM32 port shares (TIMx up to BDTR, GPIO, IWDG, SysTick) are in
+ * hal/stm32 (bristle/br_stm32_regs.h).
  *
  * Each block is a struct of volatile 32-bit registers so that the port can be
  * pointed either at the real peripheral address or, in host tests, at a plain
@@ -13,85 +14,19 @@
 
 #include <stdint.h>
 
+#include "bristle/br_stm32_regs.h"
+
 /* ---- Base addresses (RM0433 memory map; ARMv7-M for SysTick) ------------ */
 #define BR_STM32H7_TIM2_BASE     0x40000000u  /* D2 APB1, 32-bit GP timer */
 #define BR_STM32H7_TIM1_BASE     0x40010000u  /* D2 APB2, advanced timer */
 #define BR_STM32H7_GPIOA_BASE    0x58020000u  /* D3 AHB4 */
 #define BR_STM32H7_GPIOB_BASE    0x58020400u
 #define BR_STM32H7_RCC_BASE      0x58024400u  /* D3 AHB4 */
-#define BR_STM32H7_SYSTICK_BASE  0xE000E010u  /* Cortex-M7 system timer */
+#define BR_STM32H7_SYSTICK_BASE  BR_STM32_SYSTICK_BASE  /* Cortex-M7 system timer */
 #define BR_STM32H7_PWR_BASE      0x58024800u  /* D3 AHB4 */
 #define BR_STM32H7_SYSCFG_BASE   0x58000400u  /* D3 APB4 */
 #define BR_STM32H7_IWDG1_BASE    0x58004800u  /* D3 APB4, independent watchdog 1 */
 #define BR_STM32H7_FLASH_BASE    0x52002000u  /* D1 AHB3, flash interface registers */
-
-/* ---- TIMx ---------------------------------------------------------------- */
-typedef struct {
-    volatile uint32_t CR1;    /* 0x00 control 1 */
-    volatile uint32_t CR2;    /* 0x04 control 2 */
-    volatile uint32_t SMCR;   /* 0x08 slave mode control */
-    volatile uint32_t DIER;   /* 0x0C DMA/interrupt enable */
-    volatile uint32_t SR;     /* 0x10 status */
-    volatile uint32_t EGR;    /* 0x14 event generation */
-    volatile uint32_t CCMR1;  /* 0x18 capture/compare mode 1 */
-    volatile uint32_t CCMR2;  /* 0x1C capture/compare mode 2 */
-    volatile uint32_t CCER;   /* 0x20 capture/compare enable */
-    volatile uint32_t CNT;    /* 0x24 counter (32 bits on TIM2/TIM5) */
-    volatile uint32_t PSC;    /* 0x28 prescaler */
-    volatile uint32_t ARR;    /* 0x2C auto-reload */
-    volatile uint32_t RCR;    /* 0x30 repetition counter (advanced only) */
-    volatile uint32_t CCR1;   /* 0x34 */
-    volatile uint32_t CCR2;   /* 0x38 */
-    volatile uint32_t CCR3;   /* 0x3C */
-    volatile uint32_t CCR4;   /* 0x40 */
-    volatile uint32_t BDTR;   /* 0x44 break and dead-time (advanced only) */
-    volatile uint32_t DCR;    /* 0x48 DMA control */
-    volatile uint32_t DMAR;   /* 0x4C DMA address for full transfer */
-    volatile uint32_t RESERVED0; /* 0x50 */
-    volatile uint32_t CCMR3;  /* 0x54 (advanced only) */
-    volatile uint32_t CCR5;   /* 0x58 (advanced only) */
-    volatile uint32_t CCR6;   /* 0x5C (advanced only) */
-    volatile uint32_t AF1;    /* 0x60 alternate function option 1 */
-    volatile uint32_t AF2;    /* 0x64 alternate function option 2 */
-    volatile uint32_t TISEL;  /* 0x68 timer input selection */
-} br_stm32h7_tim_t;
-
-/* CR1 */
-#define BR_TIM_CR1_CEN         (1u << 0)
-#define BR_TIM_CR1_UDIS        (1u << 1)
-#define BR_TIM_CR1_DIR         (1u << 4)
-#define BR_TIM_CR1_CMS_Pos     5u
-#define BR_TIM_CR1_CMS_Msk     (3u << BR_TIM_CR1_CMS_Pos)
-#define BR_TIM_CR1_CMS_CENTER1 (1u << BR_TIM_CR1_CMS_Pos) /* centre-aligned mode 1 */
-#define BR_TIM_CR1_ARPE        (1u << 7)
-/* SMCR: SMS[2:0] at bits 2:0, SMS[3] at bit 16 */
-#define BR_TIM_SMCR_SMS_Msk    ((7u << 0) | (1u << 16))
-#define BR_TIM_SMCR_SMS_ENC3   (3u << 0) /* encoder mode 3: count on TI1 and TI2 edges */
-/* EGR */
-#define BR_TIM_EGR_UG          (1u << 0)
-/* CCMR1, input capture */
-#define BR_TIM_CCMR1_CC1S_TI1  (1u << 0)  /* CC1 input, IC1 on TI1 */
-#define BR_TIM_CCMR1_IC1F_Pos  4u
-#define BR_TIM_CCMR1_CC2S_TI2  (1u << 8)  /* CC2 input, IC2 on TI2 */
-#define BR_TIM_CCMR1_IC2F_Pos  12u
-/* CCMR1, output compare */
-#define BR_TIM_CCMR1_OC1PE     (1u << 3)
-#define BR_TIM_CCMR1_OC1M_Pos  4u
-#define BR_TIM_CCMR1_OC2PE     (1u << 11)
-#define BR_TIM_CCMR1_OC2M_Pos  12u
-#define BR_TIM_OCM_PWM1        6u          /* OCxREF high while CNT < CCRx */
-/* CCER */
-#define BR_TIM_CCER_CC1E       (1u << 0)
-#define BR_TIM_CCER_CC1P       (1u << 1)
-#define BR_TIM_CCER_CC1NE      (1u << 2)
-#define BR_TIM_CCER_CC2E       (1u << 4)
-#define BR_TIM_CCER_CC2P       (1u << 5)
-#define BR_TIM_CCER_CC2NE      (1u << 6)
-/* BDTR */
-#define BR_TIM_BDTR_DTG_Msk    0xFFu
-#define BR_TIM_BDTR_OSSI       (1u << 10)
-#define BR_TIM_BDTR_OSSR       (1u << 11)
-#define BR_TIM_BDTR_MOE        (1u << 15)
 
 /* ---- RCC (clock control, the kernel-clock configuration and the enables) - */
 typedef struct {
@@ -202,50 +137,5 @@ typedef struct {
 #define BR_FLASH_ACR_LATENCY_Msk   0xFu
 #define BR_FLASH_ACR_WRHIGHFREQ_Pos 4u
 #define BR_FLASH_ACR_WRHIGHFREQ_Msk (3u << 4)
-
-/* ---- IWDG (independent watchdog, LSI ~32 kHz) ----------------------------- */
-typedef struct {
-    volatile uint32_t KR;   /* 0x00 key */
-    volatile uint32_t PR;   /* 0x04 prescaler: 0 = /4, 1 = /8, ... 6 = /256 */
-    volatile uint32_t RLR;  /* 0x08 reload, 12 bits */
-    volatile uint32_t SR;   /* 0x0C PVU, RVU, WVU: an update in progress */
-    volatile uint32_t WINR; /* 0x10 window */
-} br_stm32h7_iwdg_t;
-
-#define BR_IWDG_KEY_START   0xCCCCu /* starts the watchdog (and the LSI) */
-#define BR_IWDG_KEY_ACCESS  0x5555u /* unlocks PR, RLR, WINR */
-#define BR_IWDG_KEY_REFRESH 0xAAAAu /* reloads the counter from RLR */
-#define BR_IWDG_PR_MAX      6u      /* /256 */
-#define BR_IWDG_RLR_MAX     0xFFFu
-
-/* ---- GPIO ---------------------------------------------------------------- */
-typedef struct {
-    volatile uint32_t MODER;   /* 0x00 2 bits per pin: 00 in, 01 out, 10 AF, 11 analog */
-    volatile uint32_t OTYPER;  /* 0x04 */
-    volatile uint32_t OSPEEDR; /* 0x08 2 bits per pin */
-    volatile uint32_t PUPDR;   /* 0x0C 2 bits per pin */
-    volatile uint32_t IDR;     /* 0x10 */
-    volatile uint32_t ODR;     /* 0x14 */
-    volatile uint32_t BSRR;    /* 0x18 */
-    volatile uint32_t LCKR;    /* 0x1C */
-    volatile uint32_t AFR[2];  /* 0x20 AFRL (pins 0..7), 0x24 AFRH (8..15), 4 bits per pin */
-} br_stm32h7_gpio_t;
-
-#define BR_GPIO_MODE_AF   2u
-#define BR_GPIO_SPEED_HI  2u
-
-/* ---- SysTick (ARMv7-M) ---------------------------------------------------- */
-typedef struct {
-    volatile uint32_t CTRL;  /* 0x00 control and status */
-    volatile uint32_t LOAD;  /* 0x04 reload value, 24 bits */
-    volatile uint32_t VAL;   /* 0x08 current value; any write clears it and COUNTFLAG */
-    volatile uint32_t CALIB; /* 0x0C */
-} br_stm32h7_systick_t;
-
-#define BR_SYSTICK_CTRL_ENABLE    (1u << 0)
-#define BR_SYSTICK_CTRL_TICKINT   (1u << 1)
-#define BR_SYSTICK_CTRL_CLKSOURCE (1u << 2)  /* 1: processor clock */
-#define BR_SYSTICK_CTRL_COUNTFLAG (1u << 16) /* set on reload, cleared by reading CTRL */
-#define BR_SYSTICK_LOAD_MAX       0x00FFFFFFu
 
 #endif

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The causes a diagnosis can name (../shared/spec/measured-log.md), one
 module each, and their registry: REGISTRY is the ordered list the rest of
 the package iterates (the order of the columns, of model.json's keys and of
@@ -7,6 +8,7 @@ REGISTRY (docs/diagnose.md, "Adding a cause").
 What a cause module holds:
 
   NAME, MEANING        the spec's name; what it is physically (report.md)
+  ACTION               what to check or do on the machine (report.md, with each finding)
   OPTION               br_simlog's / br_circle_ext's option that switches it on
                        (the C table sim/plant/br_model_params.h)
   PARAMS               its model.json parameters (params.Param), in the
@@ -37,7 +39,7 @@ and, for the force model (model.py), the hooks it needs of:
 and FIGURES, ((file, what, function(path, prep, diag)), ...), if it draws any.
 """
 from .. import params
-from . import actuator_delay, asymmetric_friction, offset, position_gradient, position_ripple
+from . import actuator_delay, asymmetric_friction, friction_drift, offset, position_gradient, position_ripple
 
 REGISTRY = (
     offset,
@@ -45,6 +47,7 @@ REGISTRY = (
     position_ripple,
     position_gradient,
     actuator_delay,
+    friction_drift,
 )
 
 NAMES = tuple(m.NAME for m in REGISTRY)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """actuator_delay: a dead time between the commanded and the applied force
 (amplifier, fieldbus, a filter in the drive).
 
@@ -15,6 +16,8 @@ from ..params import Param
 
 NAME = "actuator_delay"
 MEANING = "a dead time between the commanded and the applied force"
+ACTION = ("Look for the dead time in the drive chain: fieldbus cycles, the drive's current-loop filters, the "
+          "sampling of the command; shorten it or give the estimator the delay (the extended model does).")
 OPTION = "--delay"
 PARAMS = (Param("delay_s", "s", "actuator dead time d", 0.0, 0.1),)  # upper: BR_PLANT_DELAY_MAX_S
 NL = ("delay_s",)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """asymmetric_friction: Coulomb and/or viscous friction that differ by the
 direction of motion (wear or fatigue of the screw on one side, a preload
 that depends on the direction).
@@ -22,6 +23,9 @@ from ..params import Param
 
 NAME = "asymmetric_friction"
 MEANING = "Coulomb and/or viscous friction that differ by the direction of motion"
+ACTION = ("Inspect the screw and nut for wear or fatigue on one side, the preload and the lubrication; compare "
+          "with a log after service. The firmware's extended model compensates each direction with its own "
+          "level.")
 OPTION = "--asym"
 PARAMS = (Param("dFc_neg_N", "N", "Coulomb level in −x minus that in +x (the stiction level scaled alike)",
                 -1e5, 1e5),

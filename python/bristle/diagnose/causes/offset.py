@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """offset: a constant force on the axis (gravity on a tilted axis, cable
 drag, an amplifier offset).
 
@@ -11,6 +12,9 @@ from ..params import Param
 
 NAME = "offset"
 MEANING = "a constant force: gravity on a tilted axis, cable drag, an amplifier offset"
+ACTION = ("Check whether the axis is tilted (gravity), a cable chain or hose pulls on the table, or the "
+          "amplifier has an offset (command 0 with the motor free); a constant load is compensated by feed-"
+          "forward of offset_N.")
 OPTION = "--offset"
 PARAMS = (Param("offset_N", "N", "constant load force, + opposes motion in +x", -1e5, 1e5),)
 NL = ()

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """position_gradient: friction that grows or shrinks along the travel
 (misalignment of screw and guides, a preload that varies).
 
@@ -13,6 +14,8 @@ from ..params import Param
 
 NAME = "position_gradient"
 MEANING = "friction that grows or shrinks along the travel: misalignment, preload variation"
+ACTION = ("Check the alignment of screw and guides along the travel and the preload of the guides; the end "
+          "where the friction grows is where they bind.")
 OPTION = "--gradient"
 PARAMS = (Param("grad_per_m", "1/m", "relative slope s of the friction along the travel: friction × max(0, 1 + s x)",
                  -1e3, 1e3),)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """position_ripple: a force periodic in the load position (screw lead
 error, ball recirculation, motor cogging).
 
@@ -17,6 +18,9 @@ from ..params import GT0, Param
 
 NAME = "position_ripple"
 MEANING = "a force periodic in position: screw lead error, ball recirculation, motor cogging"
+ACTION = ("Compare the period with the screw lead (lead error), the ball circulation length and the motor's "
+          "pole pitch (cogging); inspect the screw at that period, or compensate the ripple as a function of "
+          "position.")
 OPTION = "--ripple"
 PARAMS = (Param("ripple_amp_N", "N", "amplitude A of A sin(2πx/P + φ)", -1e5, 1e5),
           Param("ripple_period_m", "m", "its period P in load position", GT0, 10.0),
@@ -73,7 +77,7 @@ def search(prep, base, fit_with):
     if not pmax > 1.5 * pmin:
         return None
     periods = np.geomspace(pmin, pmax, PERIODS)
-    tr = slice(prep.train.start, prep.train.stop, PERIODOGRAM_DECIMATE)
+    tr = np.arange(prep.n)[prep.train][::PERIODOGRAM_DECIMATE]  # a slice, or the intervals' indices
     amps = position_periodogram(base.residual(prep)[tr], prep.xm[tr], periods)
     g = periods[1] / periods[0]
     best = None

@@ -1,0 +1,116 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Static friction feedforward, float32. Equations in br_ff.h and docs/modules/ff.md. */
+#include "bristle/br_ff.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "br_check.h"
+
+#define BR_FF_2PI 6.28318530717958647692f
+
+static int causes_ok(const br_ff_cfg_t *c)
+{
+    const br_causes_t *k = &c->causes;
+    if (!isfinite(k->offset_N) || !isfinite(k->ripple_amp_N) || !isfinite(k->ripple_phase_rad) ||
+        !isfinite(k->grad_per_m) || !isfinite(k->delay_s) || !isfinite(k->ripple_period_m)) {
+        return 0;
+    }
+    if (!(isfinite(k->dFc_neg_N) && c->Fc_N + k->dFc_neg_N > 0.0f)) {
+        return 0;
+    }
+    if (!(isfinite(k->dsigma2_neg_Nspm) && c->sigma2_Nspm + k->dsigma2_neg_Nspm >= 0.0f)) {
+        return 0;
+    }
+    if (k->ripple_amp_N != 0.0f && !(k->ripple_period_m > 0.0f)) {
+        return 0;
+    }
+    return 1;
+}
+
+br_status_t br_ff_init(br_ff_t *ff, const br_ff_cfg_t *cfg)
+{
+    if (ff == NULL || cfg == NULL) {
+        return BR_E_NULL;
+    }
+    ff->ready = 0;
+    if (!br_finite_pos(cfg->Fc_N) || !isfinite(cfg->Fs_N) || cfg->Fs_N < cfg->Fc_N ||
+        !br_finite_pos(cfg->vs_mps) || !br_finite_nonneg(cfg->sigma2_Nspm) || !br_finite_pos(cfg->v_eps_mps) ||
+        !br_finite_nonneg(cfg->mass_kg) || !br_finite_pos(cfg->comp_max_N) || !causes_ok(cfg)) {
+        return BR_E_PARAM;
+    }
+    ff->cfg = *cfg;
+    ff->c_neg = (cfg->Fc_N + cfg->causes.dFc_neg_N) / cfg->Fc_N;
+    ff->ripple_k_radpm = (cfg->causes.ripple_amp_N != 0.0f) ? BR_FF_2PI / cfg->causes.ripple_period_m : 0.0f;
+    ff->in.v_mps = 0.0f;
+    ff->in.a_mps2 = 0.0f;
+    ff->in.p_m = 0.0f;
+    ff->ready = 1;
+    return BR_OK;
+}
+
+static int in_ok(const br_ff_in_t *in)
+{
+    return isfinite(in->v_mps) && isfinite(in->a_mps2) && isfinite(in->p_m);
+}
+
+br_status_t br_ff_step(const br_ff_t *ff, const br_ff_in_t *in, float *comp_N)
+{
+    if (ff == NULL || in == NULL || comp_N == NULL) {
+        return BR_E_NULL;
+    }
+    *comp_N = 0.0f;
+    if (!ff->ready) {
+        return BR_E_STATE;
+    }
+    if (!in_ok(in)) {
+        return BR_E_INPUT;
+    }
+    const br_ff_cfg_t *c = &ff->cfg;
+    const br_causes_t *k = &c->causes;
+    const float v = in->v_mps;
+    const int neg = v < 0.0f;
+    /* eq. 5, the Stribeck level (scaled by c in -x) */
+    float g = c->Fc_N + (c->Fs_N - c->Fc_N) * expf(-fabsf(v) / c->vs_mps);
+    if (neg) {
+        g *= ff->c_neg;
+    }
+    /* the steady-state LuGre force with a smoothed sign, plus viscous friction */
+    const float s2 = neg ? c->sigma2_Nspm + k->dsigma2_neg_Nspm : c->sigma2_Nspm;
+    float f = tanhf(v / c->v_eps_mps) * g + s2 * v;
+    /* position gradient k(p) */
+    if (k->grad_per_m != 0.0f) {
+        f *= fmaxf(0.0f, 1.0f + k->grad_per_m * in->p_m);
+    }
+    /* offset and position ripple (a cogging / lead-error map) */
+    f += k->offset_N;
+    if (k->ripple_amp_N != 0.0f) {
+        f += k->ripple_amp_N * sinf(ff->ripple_k_radpm * fmodf(in->p_m, k->ripple_period_m) + k->ripple_phase_rad);
+    }
+    /* inertia */
+    f += c->mass_kg * in->a_mps2;
+    if (!isfinite(f)) {
+        return BR_E_INPUT;
+    }
+    *comp_N = br_clampf(f, -c->comp_max_N, c->comp_max_N);
+    return BR_OK;
+}
+
+br_status_t br_ff_set_ref(br_ff_t *ff, const br_ff_in_t *in)
+{
+    if (ff == NULL || in == NULL) {
+        return BR_E_NULL;
+    }
+    if (!in_ok(in)) {
+        return BR_E_INPUT;
+    }
+    ff->in = *in;
+    return BR_OK;
+}
+
+br_status_t br_ff_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    (void)y;
+    (void)u_prev_Nm;
+    return br_ff_step((const br_ff_t *)ctx, ctx ? &((const br_ff_t *)ctx)->in : NULL, F_hat_N);
+}

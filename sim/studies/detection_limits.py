@@ -1,0 +1,224 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Detection limits of the diagnosis (docs/detection-limits.md, `make
+detection-limits`).
+
+For each cause with a generator here (GENERATORS: br_simlog's option for an
+effect of size s), at two force-noise levels (the EMPS log's, as the noise
+floor measures it from ../shared/data/emps/emps_estimation.csv, and a quiet
+log's, QUIET_N), over a geometric ladder of sizes: N logs per size (seeds
+fixed: the same logs on every run), each diagnosed from the log alone
+(selection.diagnose). A cause is detected in a log when it is among the
+findings. The detection limit is the smallest size detected in at least
+95 % of the logs (and in every larger size of the ladder). On N_NOMINAL
+nominal logs per noise level: the false-positive rate (any finding) and
+the rate of the verdict "unexplained" (the residual judged above the
+noise floor).
+
+Runs on every core (multiprocessing), one log per task.
+
+Usage: detection_limits.py --simlog BIN --work DIR [--n N] [--n-nominal N] [--md OUT.md] [--png OUT.png]
+"""
+import argparse
+import json
+import math
+import multiprocessing as mp
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "python"))
+from bristle.diagnose import causes, logreader, noise, report, selection, signals  # noqa: E402
+
+EMPS_LOG = os.path.join(REPO, "..", "shared", "data", "emps", "emps_estimation.csv")
+QUIET_N = 0.02
+RATE = 0.95
+MASTER_SEED = 20261123
+FC_N, SIGMA2 = 7.0, 50.0   # the reference machine's Coulomb and viscous levels (machines/reference.json)
+
+# cause: (size name, unit, ladder, flags(size)); sizes of the effect
+GENERATORS = {
+    "offset": ("offset", "N", np.geomspace(0.004, 0.5, 8), lambda s: ["--offset", f"{s:.6g}"]),
+    "asymmetric_friction": ("relative asymmetry of Fc and Fv in -x", "", np.geomspace(0.001, 0.12, 8),
+                            lambda s: ["--asym", f"{FC_N * s:.6g},{SIGMA2 * s:.6g}"]),
+    "position_ripple": ("ripple amplitude, period 6 mm", "N", np.geomspace(0.004, 0.5, 8),
+                        lambda s: ["--ripple", f"{s:.6g},0.006,1.0"]),
+    "position_gradient": ("relative slope", "1/m", np.geomspace(0.03, 1.5, 8),
+                          lambda s: ["--gradient", f"{s:.6g}"]),
+    "actuator_delay": ("dead time", "s", np.geomspace(2e-5, 1.5e-3, 8), lambda s: ["--delay", f"{s:.6g}"]),
+}
+
+
+def emps_noise():
+    if not os.path.isfile(EMPS_LOG):
+        raise SystemExit(f"error: {EMPS_LOG} is missing (docs/diagnose.md says where the EMPS log comes from)")
+    return noise.measure(signals.Prepared(logreader.read_log(EMPS_LOG))).sigma_N
+
+
+def run(task):
+    """One log: br_simlog, then the diagnosis. Returns (task, verdict, findings)."""
+    simlog, work, key, flags, sigma, seed = task
+    path = os.path.join(work, f"{key}.csv")
+    subprocess.run([simlog, "--out", path, "--seed", str(seed), "--force-noise", f"{sigma:.6g}"] + flags,
+                   check=True)
+    prep = signals.Prepared(logreader.read_log(path))
+    diag = selection.diagnose(prep)
+    verdict, _ = report.verdict(prep, diag, noise.measure(prep, diag.nominal))
+    os.remove(path)
+    return key, verdict, [c.cause for c, _ in diag.findings]
+
+
+def tasks(simlog, work, levels, n, n_nominal):
+    out = []
+    for li, (lname, sigma) in enumerate(levels):
+        for j in range(n_nominal):
+            out.append((simlog, work, f"{lname}-none-{j}", [], sigma, 1 + hash_seed(li, 0, 0, j)))
+        for ci, (cause, (_, _, ladder, flags)) in enumerate(GENERATORS.items()):
+            for si, s in enumerate(ladder):
+                for j in range(n):
+                    out.append((simlog, work, f"{lname}-{cause}-{si}-{j}", flags(s), sigma,
+                                1 + hash_seed(li, ci + 1, si, j)))
+    return out
+
+
+def hash_seed(*k):
+    return int(np.random.default_rng([MASTER_SEED, *k]).integers(1, 2 ** 30))
+
+
+def summarize(results, levels, n, n_nominal):
+    s = {"levels": {}, "n": n, "n_nominal": n_nominal}
+    for lname, sigma in levels:
+        lv = {"force_noise_N": sigma, "causes": {}}
+        nom = [results[f"{lname}-none-{j}"] for j in range(n_nominal)]
+        lv["false_positive_rate"] = sum(bool(f) for _, f in nom) / max(len(nom), 1)
+        lv["unexplained_rate"] = sum(v == "unexplained" for v, _ in nom) / max(len(nom), 1)
+        for cause, (_, _, ladder, _) in GENERATORS.items():
+            rates = [sum(cause in results[f"{lname}-{cause}-{si}-{j}"][1] for j in range(n)) / n
+                     for si in range(len(ladder))]
+            limit = None
+            for si in range(len(ladder) - 1, -1, -1):
+                if rates[si] >= RATE:
+                    limit = float(ladder[si])
+                else:
+                    break
+            lv["causes"][cause] = {"sizes": [float(x) for x in ladder], "rates": rates, "limit": limit}
+        s["levels"][lname] = lv
+    return s
+
+
+def markdown(s, command):
+    L = ["<!-- generated by sim/studies/detection_limits.py; do not edit -->", "", "# Detection limits", "",
+         f"Command: `{command}` ({s['n']} logs per size, {s['n_nominal']} nominal logs per noise level; "
+         "seeds fixed).", "",
+         "br_simlog identification logs of the reference machine (3 cycles, 27.96 s) with one cause of a given "
+         "size and Gaussian force noise; each diagnosed from the log alone. A cause is detected when it is among "
+         "the findings; the limit is the smallest size of the ladder detected in at least "
+         f"{100 * RATE:.0f} % of the logs (and at every larger size). Noise levels: the EMPS log's force noise as "
+         "the noise floor measures it, and a quiet log's.", "",
+         "| cause | size | " + " | ".join(f"limit at {k} noise ({v['force_noise_N']:.3g} N)"
+                                          for k, v in s["levels"].items()) + " |",
+         "|---|---|" + "---|" * len(s["levels"])]
+    for cause, (what, unit, _, _) in GENERATORS.items():
+        cells = []
+        for k, v in s["levels"].items():
+            c = v["causes"][cause]
+            lim = c["limit"]
+            if lim is None:
+                cells.append("not within the ladder")
+            else:
+                # the smallest size tested was found: the limit is at most that
+                cells.append(("≤ " if lim == c["sizes"][0] else "") + f"{lim:.3g} {unit}".rstrip())
+        L.append(f"| {cause} | {what} | " + " | ".join(cells) + " |")
+    L += ["", "| noise level | false positives on nominal logs (any finding) | verdict unexplained on nominal logs |",
+          "|---|---|---|"]
+    for k, v in s["levels"].items():
+        L.append(f"| {k} ({v['force_noise_N']:.3g} N) | {100 * v['false_positive_rate']:.1f} % | "
+                 f"{100 * v['unexplained_rate']:.1f} % |")
+    L += ["", "Goal: false positives at most 2 %.", "", "## Detection rate per size", ""]
+    for k, v in s["levels"].items():
+        L += [f"### {k} noise ({v['force_noise_N']:.3g} N)", "", "| cause | sizes → rates |", "|---|---|"]
+        for cause, c in v["causes"].items():
+            L.append(f"| {cause} | " + ", ".join(f"{x:.3g}: {100 * r:.0f} %" for x, r in zip(c["sizes"], c["rates"]))
+                     + " |")
+        L.append("")
+    L += ["![detection rate against effect size](detection-limits.png)", ""]
+    return "\n".join(L)
+
+
+def plot(s, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(1, len(GENERATORS), figsize=(4 * len(GENERATORS), 3.6), sharey=True)
+    for ax, (cause, (what, unit, _, _)) in zip(axs, GENERATORS.items()):
+        for k, v in s["levels"].items():
+            c = v["causes"][cause]
+            ax.semilogx(c["sizes"], [100 * r for r in c["rates"]], "o-", label=f"{k} ({v['force_noise_N']:.2g} N)")
+        ax.axhline(100 * RATE, color="k", lw=0.6, ls=":")
+        ax.set_title(cause, fontsize=9)
+        ax.set_xlabel(f"{what} [{unit}]" if unit else what, fontsize=8)
+        ax.grid(alpha=0.3)
+    axs[0].set_ylabel("detected [% of logs]")
+    axs[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--simlog", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--n", type=int, default=20)
+    ap.add_argument("--n-nominal", type=int, default=100)
+    ap.add_argument("--md")
+    ap.add_argument("--png")
+    ap.add_argument("--json")
+    ap.add_argument("--jobs", type=int, default=os.cpu_count())
+    ap.add_argument("--every", type=int, default=1, help="every k-th size of each ladder (a quick run)")
+    ap.add_argument("--from-json", help="write --md / --png from a saved --json summary, running nothing")
+    a = ap.parse_args()
+    if a.from_json:
+        with open(a.from_json) as f:
+            s = json.load(f)
+        cmd = os.environ.get("BR_DETECTION_COMMAND", "detection_limits.py")
+        if a.md:
+            with open(a.md, "w") as f:
+                f.write(markdown(s, cmd))
+        if a.png:
+            plot(s, a.png)
+        return 0
+    os.makedirs(a.work, exist_ok=True)
+    if a.every > 1:
+        for c, (w, u, ladder, fl) in list(GENERATORS.items()):
+            GENERATORS[c] = (w, u, ladder[::-1][::a.every][::-1], fl)  # keeps the largest size
+    levels = (("EMPS", emps_noise()), ("quiet", QUIET_N))
+    todo = tasks(os.path.abspath(a.simlog), os.path.abspath(a.work), levels, a.n, a.n_nominal)
+    print(f"{len(todo)} logs on {a.jobs} processes", flush=True)
+    results = {}
+    with mp.Pool(a.jobs) as pool:
+        for i, (key, verdict, found) in enumerate(pool.imap_unordered(run, todo, chunksize=1)):
+            results[key] = (verdict, found)
+            if (i + 1) % 25 == 0:
+                print(f"  {i + 1}/{len(todo)}", flush=True)
+    s = summarize(results, levels, a.n, a.n_nominal)
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(s, f, indent=1)
+    cmd = os.environ.get("BR_DETECTION_COMMAND", " ".join(["detection_limits.py"] + sys.argv[1:]))
+    if a.md:
+        with open(a.md, "w") as f:
+            f.write(markdown(s, cmd))
+    if a.png:
+        plot(s, a.png)
+    for k, v in s["levels"].items():
+        print(f"{k} noise {v['force_noise_N']:.3g} N: false positives {100 * v['false_positive_rate']:.1f} %, "
+              f"unexplained on nominal {100 * v['unexplained_rate']:.1f} %; limits " +
+              ", ".join(f"{c} {d['limit']}" for c, d in v["causes"].items()))
+    fp = max(v["false_positive_rate"] for v in s["levels"].values())
+    return 0 if fp <= 0.02 or math.isnan(fp) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
