@@ -98,6 +98,45 @@ static int cmp_double(const void *a, const void *b)
 /* the force noise of the PF's second guard plant, N (the robustness study's
  * largest, sim/studies/robustness.py) */
 #define BR_TUNE_GUARD_FORCE_NOISE_N 0.2
+/* the bristle stiffness and damping factor of its third (the study's largest) */
+#define BR_TUNE_GUARD_BRISTLE_FACTOR 2.0
+/* the objective of a tuning that stops safe on a guard plant: above any
+ * contour RMS a tuning that passes could have (H-inf only's is 2.3e-6 m), and
+ * falling the later the stops come, so that the search can leave such a region */
+#define BR_TUNE_GUARD_PENALTY_M 1.0e-5
+
+/* The PF's guard plants, each without a safe stop: 0 when all pass, otherwise
+ * BR_TUNE_GUARD_PENALTY_M times (failed guards + the share of the run lost).
+ * 1. the demo's realistic plant (docs/demo.md): a tuning that only the exact
+ *    model tolerates is none (make demo runs both plants);
+ * 2. the same with the largest force noise of the robustness study's plants
+ *    (docs/robustness.md: up to 0.2 N per period): a tuning too confident for
+ *    a noisy machine is none either;
+ * 3. the same with bristles at the top of the study's stiffness and damping
+ *    range (a factor 2 on the reference's): a tuning that holds lock only on
+ *    soft bristles is none either. */
+static double guard_penalty(const br_circle_cfg_t *c)
+{
+    const br_circle_cfg_t ref = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
+    double failed = 0.0;
+    for (int k = 0; k < 3; k++) {
+        br_circle_cfg_t cr = br_circle_cfg_realistic(BR_CTRL_HINF_PF);
+        cr.pf = c->pf;
+        if (k >= 1) cr.real.force_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N;
+        if (k == 2) {
+            cr.plant.sigma0_Npm = BR_TUNE_GUARD_BRISTLE_FACTOR * ref.plant.sigma0_Npm;
+            cr.plant.sigma1_Nspm = BR_TUNE_GUARD_BRISTLE_FACTOR * ref.plant.sigma1_Nspm;
+        }
+        br_circle_result_t r;
+        /* 1: a safe stop (br_circle_run), its time in r.fault_t_s */
+        if (br_circle_run(&cr, NULL, NULL, &r) < 0) return INFINITY;
+        if (r.fault_status != 0) {
+            const double T = cr.duration_s;
+            failed += 1.0 + (T - r.fault_t_s) / T;
+        }
+    }
+    return failed * BR_TUNE_GUARD_PENALTY_M;
+}
 
 static double objective(void *user, const double *x, int n)
 {
@@ -107,17 +146,8 @@ static double objective(void *user, const double *x, int n)
     if (t->n_plants == 0) {
         const double f = one_plant(&c, 0);
         if (t->pf && isfinite(f)) {
-            /* the PF must also run through the demo's realistic plant (docs/demo.md)
-             * without a safe stop: a tuning that only the exact model tolerates is
-             * none (make demo runs both plants) */
-            br_circle_cfg_t cr = br_circle_cfg_realistic(BR_CTRL_HINF_PF);
-            cr.pf = c.pf;
-            if (!isfinite(one_plant(&cr, 1))) return INFINITY;
-            /* ... and with the largest force noise of the robustness study's
-             * plants (docs/robustness.md: up to 0.2 N per period), so that a
-             * tuning too confident for a noisy machine is none either */
-            cr.real.force_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N;
-            if (!isfinite(one_plant(&cr, 1))) return INFINITY;
+            const double g = guard_penalty(&c);
+            if (g > 0.0) return g;
         }
         return f;
     }
@@ -312,6 +342,10 @@ int main(int argc, char **argv)
         t.nfev0 = nfev_all;
         t.f_prev = r.f;
         memcpy(t.x_prev, r.x, sizeof(double) * (size_t)n);
+    }
+    if (ok && r.f >= BR_TUNE_GUARD_PENALTY_M) {
+        fprintf(stderr, "%s: no variances found that pass the guard plants (best %.4e m); nothing written\n", TOOL, r.f);
+        ok = 0;
     }
     if (!ok) {
         fprintf(stderr, "%s: the tuning failed or gave a non-finite result; nothing written\n", TOOL);

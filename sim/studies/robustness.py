@@ -7,13 +7,15 @@ identified from a simulated identification log of that plant.
 
 Usage:
   robustness.py --bin BUILD/sim --out DIR [--n N] [--seed S] [--jobs J] [--diagnose-first K]
-                [--md OUT.md] [--check]
+                [--md OUT.md] [--check | --check-safe]
 Per plant i (seed S + i): DIR/plants/NNNN/{plant.json, ident.csv, diag/model.json, result.json};
 then DIR/summary.json ("controllers": median_m, p90_m, max_m, lost per
 controller; the paired tests; the regime analysis) and DIR/cdf.png.
 --diagnose-first K: the identified-model runs for the first K plants only
 (all by default). --check: exit 1 when an estimator on the nominal model is
-lost on any plant (docs/robustness.md, "Goals").
+lost on any plant (docs/robustness.md, "Goals"). --check-safe (CI): exit 1
+when an estimator leaves the axis worse than H-inf only without a safe stop,
+or its median is not below a tenth of H-inf only's.
 """
 import argparse
 import json
@@ -145,6 +147,11 @@ def lost(run_, hinf):
     if hinf is not None and run_["contour_rms_m"] > hinf:
         return "worse_than_hinf_only"
     return None
+
+
+def harmful(run_, hinf_run):
+    """an estimator run that went on (no safe stop) with a contour RMS above H-inf only's"""
+    return run_["fault_status"] == 0 and run_["contour_rms_m"] > hinf_run["contour_rms_m"]
 
 
 def wilcoxon(a, b):
@@ -326,6 +333,8 @@ def main():
     ap.add_argument("--md")
     ap.add_argument("--command", default="make robustness")
     ap.add_argument("--check", action="store_true")
+    ap.add_argument("--check-safe", action="store_true",
+                    help="exit 1 when an estimator makes the axis worse than H-inf only without a safe stop (the CI check)")
     ap.add_argument("--from-summary", help="recompute the statistics from an earlier summary.json's plants")
     a = ap.parse_args()
     if a.from_summary:
@@ -382,9 +391,16 @@ def finish(a, good, bad, t0):
     print(f"wrote {a.out}/summary.json, {a.out}/cdf.png")
     if bad:
         return 1
-    if a.check:
-        fails = [f"{k}: lost on plants {ctl[k]['lost_plants']}" for k in ("hinf_ukf", "hinf_pf") if k in ctl
-                 and ctl[k]["lost"]]
+    if a.check or a.check_safe:
+        if a.check:
+            fails = [f"{k}: lost on plants {ctl[k]['lost_plants']}" for k in ("hinf_ukf", "hinf_pf") if k in ctl
+                     and ctl[k]["lost"]]
+        else:
+            # the safety property: an estimator never leaves the axis worse than H-inf only
+            # unless the lock monitor stopped it safe (outputs off); outliers above
+            # LOST_OUTLIER_FRAC without harm are reported (the study's goal), not failed here
+            fails = [f"{k}: worse than H-inf only without a safe stop on plant {r['i']}" for r in good
+                     for k in ESTIMATORS if k in r["runs"] and harmful(r["runs"][k], r["runs"]["hinf_only"])]
         # the estimators must compensate: their median well below H-inf only's
         fails += [f"{k}: median {ctl[k]['median_m']:.3e} m not below a tenth of H-inf only's" for k in ESTIMATORS
                   if k in ctl and not ctl[k]["median_m"] < 0.1 * ctl["hinf_only"]["median_m"]]
