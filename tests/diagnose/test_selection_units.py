@@ -266,6 +266,10 @@ class BackwardTest(WorldTest):
             self.assertEqual(w.calls[0][:3], ("solve", left, ("joint",)))
             self.assertEqual(w.calls[-1][:2], ("refine", left))
             self.assertGreaterEqual(w.calls[-1][2], 1)
+        # a cause named by its value (read from a file, a command line), not by the registry's object
+        name = "".join(["actuator", "_", "delay"])
+        self.assertIsNot(name, "actuator_delay")
+        self.assertEqual(selection.without(w.prep, joint, name).causes, ("offset", "asymmetric_friction"))
 
     def test_backward_candidates(self):
         w = self.use(World(STAND_IN, STAND_IN_SIZES))
@@ -325,6 +329,10 @@ class DiagnoseBackwardStepTest(WorldTest):
         drop = [m for m in msgs if m.startswith("  dropped ")]
         self.assertEqual(len(drop), 1)
         self.assertTrue(drop[0].startswith("  dropped offset: left out of the joint model"))
+        rec = d.dropped[0]
+        self.assertIn(f"held-out relerr {rec['base_relerr_percent']:.3f} % against {rec['relerr_percent']:.3f} %",
+                      drop[0])
+        self.assertIn(f"(gain {100 * rec['relative_gain']:.1f} %, p = {rec['p_value']:.2g})", drop[0])
 
     def test_without_a_stand_in_nothing_is_dropped(self):
         # the offset takes only its own share: every finding stays
@@ -341,7 +349,8 @@ class DiagnoseBackwardStepTest(WorldTest):
         # dropped although two causes are left
         takes = {"offset": ("m", "q*"), "position_ripple": ("m", "b")}
         w = self.use(World(takes, {"m": 1.0, "q*": 2.0, "b": 0.5}))
-        d = selection.diagnose(w.prep)
+        msgs = []
+        d = selection.diagnose(w.prep, msgs.append)
         self.assertEqual(max(d.rounds[0], key=lambda c: c["relative_gain"])["cause"], "offset")
         self.assertEqual([x["cause"] for x in d.dropped], ["offset"])
         self.assertEqual(d.dropped[0]["round"], 2)
@@ -349,6 +358,8 @@ class DiagnoseBackwardStepTest(WorldTest):
         self.assertGreaterEqual(d.dropped[0]["p_value"], selection.P_REMOVE)
         self.assertEqual([f[0].cause for f in d.findings], ["position_ripple"])
         self.assertEqual(d.extended.causes, ("position_ripple",))
+        drop, = [m for m in msgs if m.startswith("  dropped ")]
+        self.assertIn(f"(gain {100 * d.dropped[0]['relative_gain']:.1f} %, p = {d.dropped[0]['p_value']:.2g})", drop)
 
     def test_the_weakest_goes_first(self):
         # with all four in, two findings are not needed: the offset gains nothing (the
@@ -385,6 +396,7 @@ class BorderlineTest(unittest.TestCase):
                 self.row("position_ripple", g, p * 0.999),           # at the edges: listed
                 self.row("position_gradient", g * 0.999, 1e-6),      # too small a gain
                 self.row("friction_drift", 0.2, p),                  # p not below the level
+                self.row("friction_drift", 0.2, 0.3),
                 self.row("actuator_delay", 0.3, 0.02, True),         # significant: not borderline
                 self.row("asymmetric_friction", 0.04, 0.01)]
         first = [self.row("friction_drift", 0.04, 0.01)]
