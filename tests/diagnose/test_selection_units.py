@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The selection's rules stated on constructed inputs (python/bristle/diagnose/
 selection.py; docs/diagnose.md "Significance", "Ranking", "Borderline"), no
-log and no fit, well under a second:
+log and no fit, about a second:
 
 - the levels are docs/diagnose.md's: each is read from the doc's text;
 - the gate's two levels (gain >= 5 % at p < 0.01, or gain >= 25 % at
