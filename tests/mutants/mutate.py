@@ -270,7 +270,9 @@ def run_py(a, deadline, sample):
     import tomllib
     with open(PY_SET, "rb") as f:
         spec = tomllib.load(f)
-    groups = spec["group"]
+    # --only: the groups with a module matching it (each keeps its index, so its scratch copy)
+    groups = [(k, g) for k, g in enumerate(spec["group"])
+              if not a.only or any(re.search(a.only, m) for m in g["modules"])]
     results = []
 
     def one(k, g):
@@ -336,8 +338,8 @@ def run_py(a, deadline, sample):
                 break  # one mutation per work item
         return rows
 
-    with cf.ThreadPoolExecutor(min(a.jobs, len(groups))) as ex:
-        for rows in ex.map(lambda kg: one(*kg), enumerate(groups)):
+    with cf.ThreadPoolExecutor(max(1, min(a.jobs, len(groups)))) as ex:
+        for rows in ex.map(lambda kg: one(*kg), groups):
             results.extend(rows)
     return results
 
@@ -484,7 +486,8 @@ def main():
     ap.add_argument("--seed", type=int, default=17)
     ap.add_argument("--work", default=os.path.join(REPO, "build", "mutants"))
     ap.add_argument("--out", default=os.path.join(REPO, "out", "mutants"))
-    ap.add_argument("--only", help="C mutants whose id or file matches this regex")
+    ap.add_argument("--only", help="C mutants whose id or file matches this regex, and the Python groups "
+                                   "with a module matching it")
     ap.add_argument("--check", action="store_true", help="parse the sets and exit")
     ap.add_argument("--min-score", type=float, help="exit 1 when the score is below this fraction")
     ap.add_argument("--no-new-survivors", action="store_true",

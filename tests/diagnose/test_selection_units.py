@@ -1,0 +1,414 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The selection's rules stated on constructed inputs (python/bristle/diagnose/
+selection.py; docs/diagnose.md "Significance", "Ranking", "Borderline"), no
+log and no fit, about a second:
+
+- the levels are docs/diagnose.md's: each is read from the doc's text;
+- the gate's two levels (gain >= 5 % at p < 0.01, or gain >= 25 % at
+  p < 0.05) and the backward step's (gain >= 5 % at p < 0.05) at their
+  edges, on Candidates whose relerr and p are given;
+- the block test: 10 blocks, all improving -> p = 2^-10; no block changed -> 1;
+- `test` refits with the shape only from REFINE_GAIN on; `without` and
+  `backward` on a joint model of three causes;
+- the backward step in `diagnose`: an offset that stood in for the mean
+  force of two causes found after it is dropped once both are in, recorded
+  with its round, and not tested again;
+- `borderline`: the last round's causes, not significant and not in the
+  model, at the looser level, its edges included.
+
+The joint-model tests run `selection` against a small world of known
+explained shares (World below: which share of the held-out residual each
+cause takes away) in place of the force model, so that the outcome of
+every round is known in advance; the selection with the real model on
+synthetic logs is test_selection.py's.
+"""
+import os
+import re
+import sys
+import types
+import unittest
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(REPO, "python"))
+from bristle.diagnose import causes, selection  # noqa: E402
+
+
+def doc_text():
+    with open(os.path.join(REPO, "docs", "diagnose.md")) as f:
+        return " ".join(f.read().split())  # one space for every line break
+
+
+def doc_number(pattern, text):
+    m = re.search(pattern, text)
+    if m is None:
+        raise AssertionError(f"docs/diagnose.md no longer says {pattern!r}")
+    return [float(g) for g in m.groups()]
+
+
+class LevelsAreTheDocsTest(unittest.TestCase):
+    """Each level of selection.py against the sentence of docs/diagnose.md
+    that states it (percent in the doc, fractions in the code)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.doc = doc_text()
+
+    def test_significance(self):
+        gain, = doc_number(r"held-out relerr is at least ([\d.]+) % \(relative\) below", self.doc)
+        self.assertEqual(selection.MIN_REL_GAIN, gain / 100)
+        blocks, = doc_number(r"cut into (\d+) consecutive blocks", self.doc)
+        self.assertEqual(selection.N_BLOCKS, blocks)
+        p, = doc_number(r"signed-rank test at p < ([\d.]+)", self.doc)
+        self.assertEqual(selection.P_MAX, p)
+        strong, p_strong = doc_number(r"A gain of at least ([\d.]+) % needs only p < ([\d.]+)", self.doc)
+        self.assertEqual(selection.STRONG_GAIN, strong / 100)
+        self.assertEqual(selection.P_STRONG, p_strong)
+        refine, = doc_number(r"shape-held gain reaches ([\d.]+) %", self.doc)
+        self.assertEqual(selection.REFINE_GAIN, refine / 100)
+
+    def test_backward_and_borderline(self):
+        gain, p = doc_number(r"no longer gains ([\d.]+) % at p < ([\d.]+)", self.doc)
+        self.assertEqual(selection.MIN_REL_GAIN, gain / 100)
+        self.assertEqual(selection.P_REMOVE, p)
+        gain, p = doc_number(r"Borderline\*\*: a cause of the last round that gains at least ([\d.]+) % with "
+                             r"p < ([\d.]+)", self.doc)
+        self.assertEqual(selection.BORDERLINE_GAIN, gain / 100)
+        self.assertEqual(selection.BORDERLINE_P, p)
+
+
+def cand(gain, p, base=1.0):
+    """A Candidate with held-out relerr base (1 - gain) against base."""
+    return selection.Candidate("offset", None, base, base * (1.0 - gain), p)
+
+
+class GateTest(unittest.TestCase):
+    """Candidate.significant and .kept at the edges of their levels."""
+
+    def test_gain_is_relative(self):
+        c = selection.Candidate("offset", None, 4.0, 3.0, 0.5)
+        self.assertEqual(c.rel_gain, 0.25)
+        self.assertEqual((c.base_relerr, c.relerr, c.p_value), (4.0, 3.0, 0.5))
+        # no base error to explain: no gain (and no division by zero)
+        c = selection.Candidate("offset", None, 0.0, 0.0, 1e-9)
+        self.assertEqual(c.rel_gain, 0.0)
+        self.assertFalse(c.significant)
+        self.assertFalse(c.kept)
+
+    def test_first_level(self):
+        g, p = selection.MIN_REL_GAIN, selection.P_MAX
+        self.assertTrue(cand(g * 1.001, p * 0.999).significant)
+        self.assertFalse(cand(g * 0.999, 1e-9).significant)       # too small a gain, however consistent
+        self.assertFalse(cand(g * 1.001, p).significant)          # p must be below the level
+        self.assertFalse(cand(g * 1.001, p * 1.001).significant)
+        # between the levels' p: the first level's gain is not enough
+        self.assertFalse(cand(0.2, 0.5 * (p + selection.P_STRONG)).significant)
+
+    def test_strong_level(self):
+        g, p = selection.STRONG_GAIN, selection.P_STRONG
+        self.assertGreater(p, selection.P_MAX)  # the point of the second level: less consistency
+        self.assertEqual(cand(g, 0.5).rel_gain, g)  # 1 - 0.75 is exact: the edge itself
+        self.assertTrue(cand(g, p * 0.999).significant)            # at least 25 %: the edge counts
+        self.assertTrue(cand(0.9, p * 0.999).significant)
+        self.assertFalse(cand(g * 0.999, p * 0.999).significant)
+        self.assertFalse(cand(g, p).significant)
+        self.assertFalse(cand(0.9, p * 1.001).significant)
+
+    def test_kept_level(self):
+        g, p = selection.MIN_REL_GAIN, selection.P_REMOVE
+        self.assertGreater(p, selection.P_MAX)  # looser than to enter
+        self.assertTrue(cand(g * 1.001, p * 0.999).kept)
+        self.assertFalse(cand(g * 1.001, p * 0.999).significant)  # kept, although it would not enter
+        self.assertFalse(cand(g * 1.001, p).kept)
+        self.assertFalse(cand(g * 0.999, 1e-9).kept)
+        self.assertFalse(cand(0.0, 1e-9).kept)
+        self.assertTrue(cand(0.5, 1e-9).kept)
+
+
+class BlockTest(unittest.TestCase):
+    P = types.SimpleNamespace(test=slice(50, 250))
+
+    def test_blocks(self):
+        rng = np.random.default_rng(5)
+        e = rng.normal(size=250)
+        # every block better: the smallest one-sided signed-rank p, 2^-N over N blocks
+        self.assertAlmostEqual(selection.block_p_value(self.P, e, 0.5 * e), 2.0 ** -selection.N_BLOCKS, places=12)
+        # the blocks are of the held-out part: what the training part does is not seen
+        e_new = 0.5 * e
+        e_new[:50] = 10.0 * e[:50]
+        self.assertAlmostEqual(selection.block_p_value(self.P, e, e_new), 2.0 ** -selection.N_BLOCKS, places=12)
+        # one block of N better, the others the same
+        e_new = e.copy()
+        e_new[50:70] *= 0.5
+        one = selection.block_p_value(self.P, e, e_new)
+        self.assertGreater(one, selection.P_STRONG)
+        # nothing changes: p = 1
+        self.assertEqual(selection.block_p_value(self.P, e, e.copy()), 1.0)
+        # every block worse: p = 1 too
+        self.assertEqual(selection.block_p_value(self.P, 0.5 * e, e), 1.0)
+
+
+class World:
+    """A held-out residual made of named shares, and which shares each cause
+    takes away: a Fit's residual is the noise plus every share none of its
+    causes takes. Stands in for model.py (the same functions, recorded)."""
+
+    N = 300
+    TEST = slice(100, 300)
+
+    def __init__(self, takes, sizes, seed=7):
+        rng = np.random.default_rng(seed)
+        self.takes = takes
+        # each share: in every block of the held-out part, different shapes; a name
+        # ending in "*" only in the held-out part's first block (a gain there is not consistent)
+        self.share = {k: s * (1.0 + 0.3 * rng.uniform(size=self.N)) * np.sign(rng.normal(size=self.N))
+                      for k, s in sizes.items()}
+        for k in self.share:
+            if k.endswith("*"):
+                self.share[k][:self.TEST.start] = 0.0
+                self.share[k][self.TEST.start + (self.TEST.stop - self.TEST.start) // selection.N_BLOCKS:] = 0.0
+        self.noise = 0.01 * rng.normal(size=self.N)
+        self.y = 10.0 * np.ones(self.N)
+        self.prep = types.SimpleNamespace(test=self.TEST, train=slice(0, 100))
+        self.calls = []
+        world = self
+
+        class Fit:
+            def __init__(self, causes_in, nl=None, shape=("shape",)):
+                self.causes, self.shape = tuple(causes_in), shape
+                self.nl = dict(nl) if nl is not None else {
+                    k: 1.0 for c in self.causes for k in causes.get(c).NL}
+
+            def residual(self, prep):
+                left = set(world.share) - {s for c in self.causes for s in world.takes.get(c, ())}
+                return world.noise + sum((world.share[k] for k in sorted(left)), np.zeros(world.N))
+
+            def relerr(self, prep, sl):
+                return 100.0 * float(np.linalg.norm(self.residual(prep)[sl]) / np.linalg.norm(world.y[sl]))
+
+            def cause_params(self, cause):
+                return {}
+
+        self.Fit = Fit
+
+        def refine(prep, fit, rounds=2, max_nfev=40):
+            self.calls.append(("refine", fit.causes, rounds))
+            return Fit(fit.causes, fit.nl, fit.shape)
+
+        def solve(prep, shape, causes_in, nl):
+            self.calls.append(("solve", tuple(causes_in), shape, dict(nl)))
+            return Fit(causes_in, nl, shape)
+
+        self.model = types.SimpleNamespace(
+            fit_nominal=lambda prep: Fit(()),
+            add_cause=lambda prep, base, cause: Fit(base.causes + (cause,)),
+            refine=refine, solve=solve)
+
+
+class WorldTest(unittest.TestCase):
+    def use(self, world):
+        saved = selection.model
+        selection.model = world.model
+        self.addCleanup(setattr, selection, "model", saved)
+        return world
+
+
+# An offset that stands in for the mean force of two causes (docs/diagnose.md,
+# "Backward step"): it takes both their mean shares, so in round 1 it gains
+# more than either; each of them takes its mean and its own share.
+STAND_IN = {"offset": ("mean_a", "mean_d"),
+            "asymmetric_friction": ("mean_a", "own_a"),
+            "actuator_delay": ("mean_d", "own_d")}
+STAND_IN_SIZES = {"mean_a": 1.0, "mean_d": 1.0, "own_a": 0.4, "own_d": 0.35}
+
+
+class RefineGateTest(WorldTest):
+    def test_refit_with_the_shape_from_refine_gain_on(self):
+        g = selection.REFINE_GAIN
+        for gain, refined in ((g * 0.5, False), (g * 2.0, True), (0.5, True)):
+            # the cause takes a share whose removal gains `gain`: ||r||^2 = ||n||^2 (1 - (1 - gain)^2)
+            w = World({"offset": ("s",)}, {"s": 1.0})
+            n = np.linalg.norm(w.noise[w.TEST])
+            r = w.share["s"]
+            r *= n * np.sqrt(1.0 / (1.0 - gain) ** 2 - 1.0) / np.linalg.norm(r[w.TEST])
+            w.noise[w.TEST] -= r[w.TEST] * (w.noise[w.TEST] @ r[w.TEST]) / (r[w.TEST] @ r[w.TEST])
+            self.use(w)
+            base = w.Fit(())
+            c = selection.test(w.prep, base, "offset")
+            self.assertAlmostEqual(c.rel_gain, gain, delta=0.02 * gain)
+            self.assertEqual(c.base_relerr, base.relerr(w.prep, w.TEST))
+            ref = [x for x in w.calls if x[0] == "refine"]
+            self.assertEqual(bool(ref), refined, gain)
+            if refined:  # the refitted model is the one measured and returned
+                self.assertEqual(ref, [("refine", ("offset",), 1)])
+
+    def test_a_cause_that_cannot_be_fitted_is_no_candidate(self):
+        w = self.use(World({}, {"s": 1.0}))
+        w.model.add_cause = lambda prep, base, cause: None
+        self.assertIsNone(selection.test(w.prep, w.Fit(()), "offset"))
+
+
+class BackwardTest(WorldTest):
+    def test_without(self):
+        w = self.use(World(STAND_IN, STAND_IN_SIZES))
+        joint = w.Fit(("offset", "asymmetric_friction", "actuator_delay"), shape=("joint",))
+        for c in joint.causes:
+            w.calls.clear()
+            rest = selection.without(w.prep, joint, c)
+            left = tuple(x for x in joint.causes if x != c)
+            self.assertEqual(rest.causes, left)
+            # the cause's own nonlinear parameters go, the others' stay
+            self.assertEqual(set(rest.nl), {k for x in left for k in causes.get(x).NL})
+            self.assertFalse(set(rest.nl) & set(causes.get(c).NL))
+            # solved from the joint model's shape, then refitted (at least one round)
+            self.assertEqual(w.calls[0][:3], ("solve", left, ("joint",)))
+            self.assertEqual(w.calls[-1][:2], ("refine", left))
+            self.assertGreaterEqual(w.calls[-1][2], 1)
+        # a cause named by its value (read from a file, a command line), not by the registry's object
+        name = "".join(["actuator", "_", "delay"])
+        self.assertIsNot(name, "actuator_delay")
+        self.assertEqual(selection.without(w.prep, joint, name).causes, ("offset", "asymmetric_friction"))
+
+    def test_backward_candidates(self):
+        w = self.use(World(STAND_IN, STAND_IN_SIZES))
+        joint = w.Fit(("offset", "asymmetric_friction", "actuator_delay"))
+        te = w.TEST
+        back = selection.backward(w.prep, joint)
+        self.assertEqual([b.cause for b in back], list(joint.causes))
+        for b in back:
+            # each cause against the joint model without it
+            self.assertEqual(b.base.causes, tuple(x for x in joint.causes if x != b.cause))
+            self.assertIs(b.fit, joint)
+            self.assertEqual(b.relerr, joint.relerr(w.prep, te))
+            self.assertEqual(b.base_relerr, b.base.relerr(w.prep, te))
+            self.assertEqual(b.p_value, selection.block_p_value(w.prep, b.base.residual(w.prep),
+                                                                joint.residual(w.prep)))
+        by = {b.cause: b for b in back}
+        # the offset is no longer needed: leaving it out changes nothing
+        self.assertAlmostEqual(by["offset"].rel_gain, 0.0, places=12)
+        self.assertEqual(by["offset"].p_value, 1.0)
+        self.assertFalse(by["offset"].kept)
+        for c in ("asymmetric_friction", "actuator_delay"):
+            self.assertTrue(by[c].kept, c)
+            self.assertGreater(by[c].rel_gain, 0.5)
+
+
+class DiagnoseBackwardStepTest(WorldTest):
+    def test_a_stand_in_is_dropped(self):
+        w = self.use(World(STAND_IN, STAND_IN_SIZES))
+        msgs = []
+        d = selection.diagnose(w.prep, msgs.append)
+        found = [[c["cause"] for c in r if c["significant"]] for r in d.rounds]
+        # round 1: the stand-in gains most (both means) and is the first finding
+        r1 = {c["cause"]: c for c in d.rounds[0]}
+        self.assertEqual(set(r1), set(causes.NAMES))
+        self.assertEqual(max(d.rounds[0], key=lambda c: c["relative_gain"])["cause"], "offset")
+        self.assertIn("offset", found[0])
+        # the others enter against the joint model, strongest first
+        self.assertEqual([f[0].cause for f in d.findings], ["asymmetric_friction", "actuator_delay"])
+        # with both in, the offset is left out of the joint model: dropped in round 3, its
+        # gain there (0: the two take its whole share) in the record
+        self.assertEqual(len(d.dropped), 1)
+        self.assertEqual(d.dropped[0]["cause"], "offset")
+        self.assertEqual(d.dropped[0]["round"], 3)
+        self.assertLess(d.dropped[0]["relative_gain"], selection.MIN_REL_GAIN)
+        self.assertFalse(d.dropped[0]["significant"])
+        # not dropped before: in round 2 the joint model still needed it
+        self.assertEqual(len(d.rounds), 4)
+        # a dropped cause is not tested again; the last round has nothing significant
+        self.assertNotIn("offset", {c["cause"] for c in d.rounds[3]})
+        self.assertEqual(found[3], [])
+        # the model is the two causes, refitted after the drop
+        self.assertEqual(set(d.extended.causes), {"asymmetric_friction", "actuator_delay"})
+        pair = ("asymmetric_friction", "actuator_delay")
+        left_out = next(i for i, x in enumerate(w.calls) if x[:2] == ("solve", pair))
+        self.assertIn(("refine", pair, 2), w.calls[left_out:])  # the full refit, not the leave-out's
+        self.assertLess(d.extended.relerr(w.prep, w.TEST), 0.2 * d.nominal.relerr(w.prep, w.TEST))
+        drop = [m for m in msgs if m.startswith("  dropped ")]
+        self.assertEqual(len(drop), 1)
+        self.assertTrue(drop[0].startswith("  dropped offset: left out of the joint model"))
+        rec = d.dropped[0]
+        self.assertIn(f"held-out relerr {rec['base_relerr_percent']:.3f} % against {rec['relerr_percent']:.3f} %",
+                      drop[0])
+        self.assertIn(f"(gain {100 * rec['relative_gain']:.1f} %, p = {rec['p_value']:.2g})", drop[0])
+
+    def test_without_a_stand_in_nothing_is_dropped(self):
+        # the offset takes only its own share: every finding stays
+        takes = {"offset": ("o",), "asymmetric_friction": ("a",), "actuator_delay": ("d",)}
+        w = self.use(World(takes, {"o": 1.0, "a": 0.7, "d": 0.5}))
+        d = selection.diagnose(w.prep)
+        self.assertEqual([f[0].cause for f in d.findings], ["offset", "asymmetric_friction", "actuator_delay"])
+        self.assertEqual(d.dropped, [])
+        self.assertEqual(set(d.extended.causes), set(takes))
+
+    def test_a_finding_left_with_one_block_is_dropped(self):
+        # the offset gains most in round 1 (with a share confined to one block); once the
+        # ripple takes the rest, what the offset adds is that one block: not consistent,
+        # dropped although two causes are left
+        takes = {"offset": ("m", "q*"), "position_ripple": ("m", "b")}
+        w = self.use(World(takes, {"m": 1.0, "q*": 2.0, "b": 0.5}))
+        msgs = []
+        d = selection.diagnose(w.prep, msgs.append)
+        self.assertEqual(max(d.rounds[0], key=lambda c: c["relative_gain"])["cause"], "offset")
+        self.assertEqual([x["cause"] for x in d.dropped], ["offset"])
+        self.assertEqual(d.dropped[0]["round"], 2)
+        self.assertGreater(d.dropped[0]["relative_gain"], selection.MIN_REL_GAIN)  # a gain, inconsistent
+        self.assertGreaterEqual(d.dropped[0]["p_value"], selection.P_REMOVE)
+        self.assertEqual([f[0].cause for f in d.findings], ["position_ripple"])
+        self.assertEqual(d.extended.causes, ("position_ripple",))
+        drop, = [m for m in msgs if m.startswith("  dropped ")]
+        self.assertIn(f"(gain {100 * d.dropped[0]['relative_gain']:.1f} %, p = {d.dropped[0]['p_value']:.2g})", drop)
+
+    def test_the_weakest_goes_first(self):
+        # with all four in, two findings are not needed: the offset gains nothing (the
+        # others take its three shares), the ripple a gain confined to one block. The
+        # weaker (the offset) is dropped first; without it the ripple is needed again.
+        takes = {"offset": ("s", "t", "x"),
+                 "position_ripple": ("s", "u", "sm*"),
+                 "asymmetric_friction": ("t", "u", "v"),
+                 "actuator_delay": ("w", "x")}
+        sizes = {"s": 1.0, "t": 1.0, "x": 1.0, "u": 0.7, "sm*": 2.0, "v": 0.45, "w": 0.55}
+        w = self.use(World(takes, sizes))
+        d = selection.diagnose(w.prep)
+        order = [c for r in d.rounds for c in [max(r, key=lambda c: c["relative_gain"])["cause"]]]
+        self.assertEqual(order[:4], ["offset", "position_ripple", "actuator_delay", "asymmetric_friction"])
+        self.assertEqual([x["cause"] for x in d.dropped], ["offset"])
+        self.assertEqual(d.dropped[0]["round"], 4)
+        self.assertEqual([f[0].cause for f in d.findings],
+                         ["position_ripple", "actuator_delay", "asymmetric_friction"])
+
+
+class BorderlineTest(unittest.TestCase):
+    def diag(self, rounds, causes_in=("offset",)):
+        return selection.Diagnosis(None, [], types.SimpleNamespace(causes=causes_in), rounds)
+
+    @staticmethod
+    def row(cause, gain, p, significant=False):
+        return {"cause": cause, "relative_gain": gain, "p_value": p, "significant": significant}
+
+    def test_borderline(self):
+        g, p = selection.BORDERLINE_GAIN, selection.BORDERLINE_P
+        self.assertLess(g, selection.MIN_REL_GAIN)
+        self.assertEqual(selection.borderline(self.diag([])), [])
+        last = [self.row("offset", 0.5, 1e-6, True),                 # the finding: not listed
+                self.row("position_ripple", g, p * 0.999),           # at the edges: listed
+                self.row("position_gradient", g * 0.999, 1e-6),      # too small a gain
+                self.row("friction_drift", 0.2, p),                  # p not below the level
+                self.row("friction_drift", 0.2, 0.3),
+                self.row("actuator_delay", 0.3, 0.02, True),         # significant: not borderline
+                self.row("asymmetric_friction", 0.04, 0.01)]
+        first = [self.row("friction_drift", 0.04, 0.01)]
+        b = selection.borderline(self.diag([first, last]))
+        self.assertEqual([c["cause"] for c in b], ["position_ripple", "asymmetric_friction"])
+        self.assertIs(b[0], last[1])
+        # a cause of the model (found, even if not significant this round) is never borderline
+        b = selection.borderline(self.diag([last], ("offset", "position_ripple")))
+        self.assertEqual([c["cause"] for c in b], ["asymmetric_friction"])
+        # only the last round counts
+        self.assertEqual(selection.borderline(self.diag([last, [self.row("offset", 0.5, 1e-6, True)]])), [])
+
+
+if __name__ == "__main__":
+    unittest.main()
