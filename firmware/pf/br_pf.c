@@ -244,7 +244,7 @@ BR_PF_CLONES static uint32_t quant_total(const uint32_t *BR_RESTRICT W, uint32_t
 static void resample_count(uint32_t *BR_RESTRICT W, uint32_t m, uint32_t total, uint16_t *BR_RESTRICT idx,
                            const int floats, float *sw, float *sw2)
 {
-    const uint64_t two_m = 2u * m, cm = total;
+    const uint64_t two_m = 2u * (uint64_t)m, cm = total;
     const float m_over_cm = (float)m / (float)total;
     uint16_t spare = 0u; /* the write of a particle whose N(C_{j-1}) = m (no copies) */
     for (uint32_t i = 0; i < m; i++) {
