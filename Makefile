@@ -147,16 +147,21 @@ figures: deps
 	$(call build,host-release)
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/studies/make_figures.py build/host-release out/figures
 
-# C bench (records the input, times PF and UKF, memory), then the numpy PF on
-# the same recording; the script prints the summary table and merges both into
-# bench.json. docs/bench.md.
+# C bench (records the input, times PF and UKF, memory), then the particles
+# library's PF (installed with --no-deps, sim/bench/requirements-particles.txt)
+# and the numpy PF on the same recording; the numpy script prints the summary
+# table and merges everything into bench.json. docs/bench.md.
 bench: deps
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)echo "== bench -> $(BENCH_OUT)"
 	$(Q)mkdir -p $(BENCH_OUT)
 	$(Q)$(BENCH) --json $(BENCH_OUT)/c.json --record $(BENCH_OUT)/pf_input.csv
-	$(Q)$(PYTHON) sim/bench/pf_numpy.py $(BENCH_OUT)/pf_input.csv --c-json $(BENCH_OUT)/c.json --out $(BENCH_OUT)/bench.json
+	$(Q)$(PYTHON) -m pip install --quiet --disable-pip-version-check --require-virtualenv --no-deps \
+	  -r sim/bench/requirements-particles.txt
+	$(Q)$(PYTHON) sim/bench/pf_particles.py $(BENCH_OUT)/pf_input.csv --out $(BENCH_OUT)/particles.json
+	$(Q)$(PYTHON) sim/bench/pf_numpy.py $(BENCH_OUT)/pf_input.csv --c-json $(BENCH_OUT)/c.json \
+	  --particles-json $(BENCH_OUT)/particles.json --out $(BENCH_OUT)/bench.json
 
 # Instructions per PF particle-step and per control period on QEMU's emulated
 # Cortex-M7 (-icount), flash / RAM from the map file. docs/target.md.

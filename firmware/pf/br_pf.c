@@ -34,11 +34,12 @@ static inline float fnl_sel(const br_model_k_t *k, float om, float z, float gp, 
 }
 
 /* BR_PF_CLONES: on x86-64 hosts (GCC), the vectorised loops are also compiled
- * for AVX2 and picked at run time by the CPU (target_clones): 8 lanes instead
- * of SSE2's 4. The same IEEE operations lane by lane (-ffp-contract=off holds
- * in every clone: no FMA), so the results do not depend on the clone. */
+ * for AVX-512F and AVX2 and picked at run time by the CPU (target_clones):
+ * 16 or 8 lanes instead of SSE2's 4. The same IEEE operations lane by lane
+ * (-ffp-contract=off holds in every clone: no FMA), so the results do not
+ * depend on the clone. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__)
-#define BR_PF_CLONES __attribute__((target_clones("avx2", "default")))
+#define BR_PF_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define BR_PF_CLONES
 #endif
@@ -199,45 +200,129 @@ static void resample(const uint32_t *W, uint32_t m, uint32_t total, uint16_t *id
 }
 
 /* The same resampling without a data-dependent inner loop (the vector path
- * on hosts with SIMD, where resample()'s inner loop mispredicts): for each
- * particle j the number of points below its cumulative weight,
- *   N(C) = #{i < m : t_i < C} = (Q + 1) / 2,  Q = floor((2 m C - 1) / C_m)
- * (t_i < C <=> (2 i + 1) C_m < 2 m C for integer C), in float32 with an
- * exact integer correction: |error| of the float quotient <= 2^-10 for
- * quotients <= 2 m <= 2^12, so it is off by at most one, which the two
- * 64-bit comparisons remove. Particle i copies the j with
- * N(C_{j-1}) <= i < N(C_j): j is written at i = N(C_{j-1}) (the last j
- * written there is the one with copies) and carried forward by a running
- * maximum. Gives resample()'s indices exactly (test_vector_path_is_scalar_path). */
-static uint32_t n_below(uint32_t c, uint32_t two_m, uint32_t cm, float inv_cm)
+ * on hosts with SIMD, where resample()'s inner loop mispredicts), made by
+ * counting: for each particle j the number of points below its cumulative
+ * weight C,
+ *   N(C) = #{i < m : t_i < C} = floor(X + 1/2), X = m C / C_m,
+ * one less when X + 1/2 is an integer (t_i < C <=> (2 i + 1) C_m < 2 m C
+ * for integer C, i.e. i < X - 1/2). The float estimate
+ *   e = trunc(fl(fl(C) fl(m / C_m)) + (1/2 - 2^-9))
+ * has |error| <= 2^-11 in the product (four roundings of 2^-24 relative,
+ * X <= m <= 2^11) and 2^-13 in the sum (< 2^12), less than 2^-9 in all, so
+ * its argument lies in (X + 1/2 - 2^-8, X + 1/2) and e is N or N - 1;
+ * one exact 64-bit comparison, t_e < C, makes it N (for e = m it is false:
+ * C <= C_m). Particle i copies the j with N(C_{j-1}) <= i < N(C_j): j is
+ * written at i = N(C_{j-1}) (the last j written there is the one with
+ * copies) and carried forward by a running maximum (resample_forward).
+ * Gives resample()'s indices exactly (test_vector_path_is_scalar_path, whose
+ * tie fails without the comparison; the estimate checked once against the
+ * exact count over 1.75e8 cases, docs/bench.md). */
+static inline uint32_t n_below(uint32_t c, uint64_t two_m, uint64_t cm, float m_over_cm)
 {
-    const int64_t a = (int64_t)two_m * (int64_t)c - 1;
-    int64_t q = (int64_t)((float)a * inv_cm);
-    q += ((q + 1) * (int64_t)cm <= a) ? 1 : 0;
-    q -= (q * (int64_t)cm > a) ? 1 : 0;
-    return (c == 0u) ? 0u : (uint32_t)((q + 1) / 2);
+    const float y = (float)(int32_t)c * m_over_cm + (0.5f - 1.0f / 512.0f);
+    const uint32_t e = (uint32_t)(int32_t)y;
+    return e + (uint32_t)((uint64_t)(2u * e + 1u) * cm < two_m * (uint64_t)c);
 }
 
-static void resample_count(const uint32_t *W, uint32_t m, uint32_t total, uint16_t *idx)
+/* The quantised weights' total: W_j = floor(w_j 2^16) of the w_j parked in
+ * W as bit patterns by exp_vec (any order: an integer sum) */
+BR_PF_CLONES static uint32_t quant_total(const uint32_t *BR_RESTRICT W, uint32_t m)
 {
-    const uint32_t two_m = 2u * m;
-    const float inv_cm = 1.0f / (float)total;
+    uint32_t total = 0u;
+    for (uint32_t j = 0; j < m; j++) {
+        float w;
+        memcpy(&w, &W[j], sizeof w);
+        total += (uint32_t)(w * (float)BR_PF_W_ONE);
+    }
+    return total;
+}
+
+/* The counting resampling's writes: idx[N(C_{j-1})] = j for every j with
+ * copies, 0 elsewhere. floats != 0: W holds the w_j as bit patterns
+ * (exp_vec), quantised here in place; the sums of w and w^2 (for the ESS) in
+ * order, as quantise_weights makes them, into *sw and *sw2. Otherwise W
+ * holds the integer weights already. total: the sum of the W_j. */
+static void resample_count(uint32_t *BR_RESTRICT W, uint32_t m, uint32_t total, uint16_t *BR_RESTRICT idx,
+                           const int floats, float *sw, float *sw2)
+{
+    const uint64_t two_m = 2u * (uint64_t)m, cm = total;
+    const float m_over_cm = (float)m / (float)total;
     uint16_t spare = 0u; /* the write of a particle whose N(C_{j-1}) = m (no copies) */
     for (uint32_t i = 0; i < m; i++) {
         idx[i] = 0u;
     }
     uint32_t c = 0u;
-    for (uint32_t j = 0; j < m; j++) {
-        const uint32_t n = n_below(c, two_m, total, inv_cm);
-        uint16_t *const dst = (n < m) ? &idx[n] : &spare;
-        *dst = (uint16_t)j;
-        c += W[j];
+    if (floats) {
+        float s1 = 0.0f, s2 = 0.0f;
+        for (uint32_t j = 0; j < m; j++) {
+            const uint32_t n = n_below(c, two_m, cm, m_over_cm);
+            uint16_t *const dst = (n < m) ? &idx[n] : &spare;
+            *dst = (uint16_t)j;
+            float w;
+            memcpy(&w, &W[j], sizeof w);
+            const uint32_t q = (uint32_t)(w * (float)BR_PF_W_ONE);
+            W[j] = q;
+            s1 += w;
+            s2 += w * w;
+            c += q;
+        }
+        *sw = s1;
+        *sw2 = s2;
+    } else {
+        for (uint32_t j = 0; j < m; j++) {
+            const uint32_t n = n_below(c, two_m, cm, m_over_cm);
+            uint16_t *const dst = (n < m) ? &idx[n] : &spare;
+            *dst = (uint16_t)j;
+            c += W[j];
+        }
     }
-    uint16_t run = 0u;
+}
+
+/* After resample_count: the running maximum that makes idx, fused with the
+ * forward pass of the in-place copy (copy_backward follows) and with step
+ * 5's sums over the resampled set in particle order (particle i is the
+ * predicted particle k = idx_i). Reading x[k] at i gives the predicted
+ * value: for k >= i, position k is written only at i' = k (after this read
+ * when k = i); for k < i it was written at i' = k with itself (idx_k <= k,
+ * the indices never decrease). The copy takes x[max(k, i)]: particle i
+ * takes a later one now, an earlier one in the backward pass. The same
+ * indices, states and sums (in the same order) as resample_fused. */
+static float resample_forward(br_pf_t *pf, float s[BR_NX])
+{
+    const uint32_t m = pf->cfg.n_particles;
+    uint16_t *BR_RESTRICT idx = pf->idx;
+    float *BR_RESTRICT th = pf->x[BR_X_THETA];
+    float *BR_RESTRICT om = pf->x[BR_X_OMEGA];
+    float *BR_RESTRICT zz = pf->x[BR_X_Z];
+    float *BR_RESTRICT gg = pf->x[BR_X_GP];
+    float *BR_RESTRICT ia = pf->kgp;
+    const float *BR_RESTRICT fnl = pf->fnl;
+    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
+    uint32_t run = 0u;
     for (uint32_t i = 0; i < m; i++) {
-        run = (idx[i] > run) ? idx[i] : run;
-        idx[i] = run;
+        const uint32_t w = idx[i];
+        const uint32_t k = (w > run) ? w : run;
+        run = k;
+        idx[i] = (uint16_t)k;
+        s0 += th[k];
+        s1 += om[k];
+        s2 += zz[k];
+        s3 += gg[k];
+        sf += fnl[k];
+        const uint32_t src = (k > i) ? k : i;
+        th[i] = th[src];
+        om[i] = om[src];
+        zz[i] = zz[src];
+        gg[i] = gg[src];
+        if (BR_PF_ONE_DIVISION) {
+            ia[i] = ia[src];
+        }
     }
+    s[0] = s0;
+    s[1] = s1;
+    s[2] = s2;
+    s[3] = s3;
+    return sf;
 }
 
 /* resample()'s indices, fused with the forward pass of the in-place copy
@@ -618,26 +703,13 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
             s2 += w * w;
         }
     } else {
-        if (pf->cfg.scalar_path || !BR_PF_SIMD) {
-            for (uint32_t j = 0; j < m; j++) {
-                const float w = br_exp_neg(l[j] - lmax);
-                W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
-                total += W[j];
-                s1 += w;
-                s2 += w * w;
-            }
-        } else {
-            /* the exponentials in a loop of their own (vectorised), w parked in
-             * W's storage as its bit pattern; then the sums in order, as above */
-            exp_vec(l, W, lmax, m);
-            for (uint32_t j = 0; j < m; j++) {
-                float w;
-                memcpy(&w, &W[j], sizeof w);
-                W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
-                total += W[j];
-                s1 += w;
-                s2 += w * w;
-            }
+        /* (the vector path's weights: exp_vec, quant_total and resample_count) */
+        for (uint32_t j = 0; j < m; j++) {
+            const float w = br_exp_neg(l[j] - lmax);
+            W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
+            total += W[j];
+            s1 += w;
+            s2 += w * w;
         }
     }
     *sw = s1;
@@ -650,25 +722,15 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
  * take every particle from a later one (not yet overwritten) and a backward
  * pass every particle from an earlier one (idx_k <= k there, so its source
  * was left alone by the forward pass); a particle with idx_i = i copies
- * itself. Branch-free (the vector path on hosts with SIMD): each pass copies
- * every particle, from itself where it is not its turn. */
-static void copy_resampled(br_pf_t *pf)
+ * itself. The backward pass after resample_forward, branch-free (the vector
+ * path on hosts with SIMD): it copies every particle, from itself where it
+ * is not its turn. */
+static void copy_backward(br_pf_t *pf)
 {
     const uint32_t m = pf->cfg.n_particles;
     const uint16_t *BR_RESTRICT idx = pf->idx;
     float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA];
     float *const zz = pf->x[BR_X_Z], *const gg = pf->x[BR_X_GP], *const ia = pf->kgp;
-    for (uint32_t i = 0; i < m; i++) {
-        const uint32_t k = idx[i];
-        const uint32_t s = (k > i) ? k : i;
-        th[i] = th[s];
-        om[i] = om[s];
-        zz[i] = zz[s];
-        gg[i] = gg[s];
-        if (BR_PF_ONE_DIVISION) {
-            ia[i] = ia[s];
-        }
-    }
     for (uint32_t i = m; i-- > 0u;) {
         const uint32_t k = idx[i];
         const uint32_t s = (k < i) ? k : i;
@@ -763,17 +825,27 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     const br_status_t verdict = (lmax < pf->outlier_l || lmax == -INFINITY) ? BR_W_OUTLIER : BR_OK;
 
     /* 3. max-shifted weights, quantised; an outlier gives every valid particle weight 1 */
-    float sw, sw2;
-    const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER, &sw, &sw2);
     /* 4. deterministic systematic resampling on the integer weights (total >= 2^16:
      * the best valid particle has W = 2^16) */
     /* 5. estimate over the resampled set: particle mean and the mean of f_nl (eq. 6) */
-    float s[BR_NX], sf;
+    float sw, sw2, s[BR_NX], sf;
     if (BR_PF_SIMD && !pf->cfg.scalar_path) {
-        resample_count(pf->W, m, total, pf->idx);
-        copy_resampled(pf);
-        sf = sum_set(pf, s);
+        if (verdict == BR_W_OUTLIER) {
+            const uint32_t total = quantise_weights(pf, lmax, 1, &sw, &sw2);
+            resample_count(pf->W, m, total, pf->idx, 0, &sw, &sw2);
+        } else {
+            /* the exponentials in a loop of their own (vectorised), w parked
+             * in W's storage as its bit pattern; the total of the quantised
+             * weights (vectorised); then the quantisation in place and the
+             * sums of w and w^2 in order, in the counting loop */
+            exp_vec(pf->l, pf->W, lmax, m);
+            const uint32_t total = quant_total(pf->W, m);
+            resample_count(pf->W, m, total, pf->idx, 1, &sw, &sw2);
+        }
+        sf = resample_forward(pf, s);
+        copy_backward(pf);
     } else {
+        const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER, &sw, &sw2);
         /* one loop for the indices, the forward copy and the sums, then the backward copy */
         sf = resample_fused(pf, total, s);
         copy_back(pf);

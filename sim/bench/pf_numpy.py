@@ -33,9 +33,11 @@ median over replays (min, max), the same in thread CPU time
 and the per-step latency p50 / p99 / max pooled over replays. The per-step
 clock reads (~0.1 us) are negligible against a step of ~0.5 ms.
 
-Usage: pf_numpy.py RECORDING [--reps N] [--c-json FILE] [--out FILE]
+Usage: pf_numpy.py RECORDING [--reps N] [--c-json FILE] [--out FILE] [--particles-json FILE]
   --c-json  br_bench's JSON: prints the summary table (C, numpy, ratio, UKF,
-            memory) and, with --out, writes both and the ratio to one JSON."""
+            memory) and, with --out, writes both and the ratio to one JSON.
+  --particles-json  pf_particles.py's JSON (the particles library's PF): its
+            column in the table, "pf_particles" in the JSON."""
 import argparse
 import json
 import os
@@ -353,49 +355,62 @@ def rms(a):
     return float(np.sqrt(np.mean(np.square(a))))
 
 
-def summary_table(c, npy, ratio):
+def summary_table(c, npy, ratio, prt=None):
+    """The table of make bench; prt: pf_particles.py's figures (the particles library's PF) or None."""
     pf, ukf, mem = c["pf"], c["ukf"], c["memory_host"]
     cn, nn = pf["ns_per_particle_step"], npy["ns_per_particle_step"]
     m = pf["n_particles"]
+    cc = pf["cpu_ns_per_particle_step"]["median"]
+    pn = prt["ns_per_particle_step"] if prt else None
+    pc = prt["cpu_ns_per_particle_step"] if prt else None
     rows = [
-        ("", "C", "numpy", "numpy / C"),
-        ("PF ns / particle-step, wall, median", "%.1f" % cn["median"], "%.1f" % nn["median"], "%.2f x" % ratio),
+        ("", "C", "numpy", "particles", "ratio"),
+        ("PF ns / particle-step, wall, median", "%.1f" % cn["median"], "%.1f" % nn["median"],
+         "%.1f" % pn["median"] if prt else "-", "numpy / C %.2f x" % ratio
+         + (", particles / C %.1f x" % (pn["median"] / cn["median"]) if prt else "")),
         ("  min .. max over replays", "%.1f .. %.1f" % (cn["min"], cn["max"]),
-         "%.1f .. %.1f" % (nn["min"], nn["max"]), "%d / %d replays" % (pf["reps"], npy["reps"])),
-        ("  in thread CPU time, median", "%.1f" % c["pf"]["cpu_ns_per_particle_step"]["median"],
-         "%.1f" % npy["cpu_ns_per_particle_step"]["median"],
-         "%.2f x" % (npy["cpu_ns_per_particle_step"]["median"] / c["pf"]["cpu_ns_per_particle_step"]["median"])),
+         "%.1f .. %.1f" % (nn["min"], nn["max"]), "%.1f .. %.1f" % (pn["min"], pn["max"]) if prt else "-",
+         "%d / %d / %s replays" % (pf["reps"], npy["reps"], prt["reps"] if prt else "-")),
+        ("  in thread CPU time, median", "%.1f" % cc, "%.1f" % npy["cpu_ns_per_particle_step"]["median"],
+         "%.1f" % pc["median"] if prt else "-",
+         "numpy / C %.2f x" % (npy["cpu_ns_per_particle_step"]["median"] / cc)
+         + (", particles / C %.1f x" % (pc["median"] / cc) if prt else "")),
         ("C scalar path (pf_scalar), thread CPU", "%.1f" % c["pf_scalar"]["cpu_ns_per_particle_step"]["median"], "",
-         "scalar / vector %.2f x" % c["ratio_pf_scalar_over_pf_cpu"]),
-        ("  numpy / C scalar path, thread CPU", "", "",
+         "", "scalar / vector %.2f x" % c["ratio_pf_scalar_over_pf_cpu"]),
+        ("  numpy / C scalar path, thread CPU", "", "", "",
          "%.2f x" % (npy["cpu_ns_per_particle_step"]["median"] / c["pf_scalar"]["cpu_ns_per_particle_step"]["median"])),
-        ("PF step us (m = %d), per-step p50" % m, "%.1f" % pf["step_us"]["p50"], "%.1f" % npy["step_us"]["p50"],
+        ("PF step us (m = %d), per-step p50" % m, "%.1f" % pf["step_us"]["p50"], "%.1f" % npy["step_us"]["p50"], "",
          "%.2f x" % (npy["step_us"]["p50"] / pf["step_us"]["p50"])),
         ("  share of the %.1f ms period" % (pf["dt_s"] * 1e3), "%.1f %%" % (pf["step_us"]["p50"] * 1e-4 / pf["dt_s"]),
-         "%.1f %%" % (npy["step_us"]["p50"] * 1e-4 / pf["dt_s"]), ""),
+         "%.1f %%" % (npy["step_us"]["p50"] * 1e-4 / pf["dt_s"]), "", ""),
         ("PF F_hat RMS error vs true", "%.4f N" % pf["fhat_rms_err_N"], "%.4f N" % npy["fhat_rms_err_N"],
-         "identical %d/%d" % (npy["fhat_identical_to_c_steps"], npy["steps"])),
-        ("UKF us / step, wall, median", "%.3f" % ukf["us_per_step"]["median"], "", ""),
-        ("  min .. max over replays", "%.3f .. %.3f" % (ukf["us_per_step"]["min"], ukf["us_per_step"]["max"]), "",
+         "%.4f N" % prt["fhat_rms_err_N"] if prt else "-",
+         "numpy identical to C %d/%d" % (npy["fhat_identical_to_c_steps"], npy["steps"])),
+        ("UKF us / step, wall, median", "%.3f" % ukf["us_per_step"]["median"], "", "", ""),
+        ("  min .. max over replays", "%.3f .. %.3f" % (ukf["us_per_step"]["min"], ukf["us_per_step"]["max"]), "", "",
          "%d replays" % ukf["reps"]),
-        ("  in thread CPU time, median", "%.3f" % ukf["cpu_us_per_step"]["median"], "", ""),
-        ("PF RAM, br_pf_t (host sizeof)", "%d B" % mem["pf_t_bytes"], "", "at %d particles max" % mem["pf_max_particles"]),
-        ("  of which m = %d uses" % m, "%d B" % mem["pf_used_bytes_at_m"], "",
+        ("  in thread CPU time, median", "%.3f" % ukf["cpu_us_per_step"]["median"], "", "", ""),
+        ("PF RAM, br_pf_t (host sizeof)", "%d B" % mem["pf_t_bytes"], "", "",
+         "at %d particles max" % mem["pf_max_particles"]),
+        ("  of which m = %d uses" % m, "%d B" % mem["pf_used_bytes_at_m"], "", "",
          "%d B/particle + %d" % (mem["pf_bytes_per_particle"], mem["pf_fixed_bytes"])),
-        ("UKF RAM, br_ukf_t (host sizeof)", "%d B" % mem["ukf_t_bytes"], "", ""),
-        ("PF ROM, noise table", "%d B" % mem["noise_table_rom_bytes"], "", "%d float32" % mem["noise_len"]),
+        ("UKF RAM, br_ukf_t (host sizeof)", "%d B" % mem["ukf_t_bytes"], "", "", ""),
+        ("PF ROM, noise table", "%d B" % mem["noise_table_rom_bytes"], "", "", "%d float32" % mem["noise_len"]),
     ]
-    rows += [("PF cost vs m: m = %d, CPU ns / particle-step" % r["m"], "%.1f" % r["pf"], "",
+    rows += [("PF cost vs m: m = %d, CPU ns / particle-step" % r["m"], "%.1f" % r["pf"], "", "",
               "scalar %.1f" % r["pf_scalar"]) for r in c["pf_scaling"]["rows"]]
-    rows += [("demo run (two axes, 8 s), CPU s: %s" % k, "%.3f" % v, "", "") for k, v in c["demo_cpu_s"].items()]
-    w = [max(len(r[i]) for r in rows) for i in range(4)]
-    print("== bench summary: %s, %d CPUs; C %s; numpy %s float32"
-          % (c["machine"]["cpu_model"], c["machine"]["cpus_online"], c["machine"]["build"], npy["numpy"]))
+    rows += [("demo run (two axes, 8 s), CPU s: %s" % k, "%.3f" % v, "", "", "") for k, v in c["demo_cpu_s"].items()]
+    w = [max(len(r[i]) for r in rows) for i in range(5)]
+    print("== bench summary: %s, %d CPUs; C %s; numpy %s float32%s"
+          % (c["machine"]["cpu_model"], c["machine"]["cpus_online"], c["machine"]["build"], npy["numpy"],
+             "; %s float64" % prt["library"] if prt else ""))
     for r in rows:
-        print("  %-*s  %*s  %*s  %s" % (w[0], r[0], w[1], r[1], w[2], r[2], r[3]))
-    print("  load average (1 min) at start / end: C %.2f / %.2f, numpy %.2f / %.2f (%d CPUs: above ~0.5 the host "
+        print("  %-*s  %*s  %*s  %*s  %s" % (w[0], r[0], w[1], r[1], w[2], r[2], w[3], r[3], r[4]))
+    print("  load average (1 min) at start / end: C %.2f / %.2f, numpy %.2f / %.2f%s (%d CPUs: above ~0.5 the host "
           "is shared and the timings are noisy)" % (c["machine"]["loadavg1_start"], c["machine"]["loadavg1_end"],
                                                      npy["loadavg1_start"], npy["loadavg1_end"],
+                                                     ", particles %.2f / %.2f" % (prt["loadavg1_start"],
+                                                                                  prt["loadavg1_end"]) if prt else "",
                                                      c["machine"]["cpus_online"]))
 
 
@@ -405,6 +420,7 @@ def main():
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--c-json")
     ap.add_argument("--out")
+    ap.add_argument("--particles-json")
     a = ap.parse_args()
     if a.reps < 1:
         ap.error("--reps must be >= 1")
@@ -476,13 +492,21 @@ def main():
         with open(a.c_json) as f:
             c = json.load(f)
         ratio = med / c["pf"]["ns_per_particle_step"]["median"]
-        summary_table(c, res, ratio)
+        prt = None
+        if a.particles_json:
+            with open(a.particles_json) as f:
+                prt = json.load(f)
+        summary_table(c, res, ratio, prt)
         if a.out:
             out = dict(c)
             out["pf_numpy"] = res
             out["ratio_numpy_over_c"] = ratio
             out["ratio_numpy_over_c_cpu"] = (res["cpu_ns_per_particle_step"]["median"]
                                              / c["pf"]["cpu_ns_per_particle_step"]["median"])
+            if prt:
+                out["pf_particles"] = prt
+                out["ratio_particles_over_c_cpu"] = (prt["cpu_ns_per_particle_step"]["median"]
+                                                     / c["pf"]["cpu_ns_per_particle_step"]["median"])
             with open(a.out, "w") as f:
                 json.dump(out, f, indent=2)
                 f.write("\n")
