@@ -86,6 +86,9 @@ def est_fields(m):
         out.append(("BR_EST_PF_" + c, pf["x0_std"][k], "initial spread"))
     out += gate_fields("PF", pf)
     out.append(("BR_EST_PF_NOISE_SKIP", pf["noise_skip"], "extra noise-table advance per step"))
+    out += [("BR_EST_PF_ADAPT_NIS_REF", pf["adapt"]["nis_ref"], "innovation-driven noise of z and g_p (0: off)"),
+            ("BR_EST_PF_ADAPT_ALPHA", pf["adapt"]["alpha"], "its NIS smoothing per step"),
+            ("BR_EST_PF_ADAPT_MAX_SCALE", pf["adapt"]["max_scale"], "its largest variance factor")]
     for k, c in (("theta_rad2", "Q_THETA_RAD2"), ("omega_rad2_per_s2", "Q_OMEGA_RAD2PS2"),
                  ("z_m2", "Q_Z_M2"), ("gp_N2", "Q_GP_N2")):
         out.append(("BR_EST_UKF_" + c, ukf["q_var"][k], "process noise variance per step"))

@@ -223,6 +223,12 @@ SCHEMA = {
                 "gp_N": Num(0.0, 1.0e5, "of g_p around gp0_N"),
             },
             "noise_skip": Int(0, 1024, "extra ROM noise-table advance per step (docs/modules/pf.md)"),
+            "adapt": {
+                "nis_ref": Num(0.0, 1.0e6, "innovation-driven noise of z and g_p: the smoothed NIS above which "
+                               "it grows; 0 = off (the thesis filter; docs/modules/pf.md)"),
+                "alpha": Num(0.0, 1.0, "smoothing of the NIS per measured step", lo_open=True),
+                "max_scale": Num(1.0, 1.0e12, "largest factor on the variances of z and g_p"),
+            },
         }, **_gates()),
         "ukf": dict({
             "q_var": _variances("theta, per step", "theta_rad2", (0.0, 1.0)),
@@ -323,6 +329,9 @@ def _cross_checks(m, errors):
         need([e + "gp_min_N", e + "gp_max_N", e + "gp0_N"],
              lambda: get(e + "gp_min_N") <= get(e + "gp0_N") <= get(e + "gp_max_N"),
              e + "gp0_N", "must lie in [%sgp_min_N, %sgp_max_N]" % (e, e))
+    need(["estimator.pf.adapt.nis_ref"],
+         lambda: get("estimator.pf.adapt.nis_ref") == 0.0 or get("estimator.pf.adapt.nis_ref") >= 1.0e-6,
+         "estimator.pf.adapt.nis_ref", "must be 0 (off) or >= 1e-6")
     need(["encoder.counts_per_rev", "encoder.counter_bits"],
          lambda: get("encoder.counts_per_rev") <= 2 ** get("encoder.counter_bits"),
          "encoder.counts_per_rev", "more counts per revolution than the counter holds (2^counter_bits)")

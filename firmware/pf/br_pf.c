@@ -72,6 +72,14 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
+    /* the innovation-driven noise: off (nis_ref = 0) or a finite positive
+     * reference with alpha in (0, 1] and max_scale in [1, BR_EST_VAR_MAX] */
+    const br_pf_adapt_t *ad = &cfg->adapt;
+    if (!(ad->nis_ref == 0.0f ||
+          (br_finite_nonneg(ad->nis_ref) && ad->nis_ref >= BR_PF_ADAPT_REF_MIN && ad->alpha > 0.0f &&
+           ad->alpha <= 1.0f && ad->max_scale >= 1.0f && ad->max_scale <= BR_EST_VAR_MAX))) {
+        return BR_E_PARAM;
+    }
     /* g_p is static in the model: its process noise is the only thing that keeps
      * the resampled particles apart in g_p; without it the cloud collapses */
     if (!(cfg->est.q_var[BR_X_GP] > 0.0f)) {
@@ -92,6 +100,9 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
      * the encoder's quantisation; in log-weights l = -e^2 / (2 R): max_j l_j < -g^2 (R + rpc^2 / 12) / (2 R) */
     pf->outlier_l = -0.5f * cfg->est.outlier_sigma * cfg->est.outlier_sigma *
                     (1.0f + cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f) / cfg->est.r_var_rad2);
+    pf->r_gate = cfg->est.r_var_rad2 + cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f);
+    pf->nis_avg = 0.0f;
+    pf->q_scale_std = 1.0f;
     pf->noise_pos = 0u;
     pf->origin_counts = 0;
     pf->primed = 0;
@@ -625,6 +636,9 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     for (int i = 0; i < BR_NX; i++) {
         c.q[i] = pf->q_std[i];
     }
+    /* cfg.adapt: z's and g_p's noise scaled (by exactly 1 while the smoothed NIS stays below its reference) */
+    c.q[BR_X_Z] *= pf->q_scale_std;
+    c.q[BR_X_GP] *= pf->q_scale_std;
     c.gp_min = pf->cfg.est.gp_min_N;
     c.gp_max = pf->cfg.est.gp_max_N;
     c.inv_2r = pf->inv_2r;
@@ -791,6 +805,35 @@ static float sum_set(const br_pf_t *pf, float s[BR_NX])
     return sf;
 }
 
+/* cfg.adapt: the normalised innovation squared of the predicted cloud,
+ * (y - mean theta_j)^2 / (var theta_j + R + rpc^2 / 12) over the valid
+ * particles (theta relative to the new origin; d_j = theta_j - y), limited
+ * to outlier_sigma^2 (also for a NaN or an overflow); then E and the
+ * factor on z's and g_p's noise std for the next predictions. */
+static void adapt_update(br_pf_t *pf, float y_rel)
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const float *const th = pf->x[BR_X_THETA], *const l = pf->l;
+    float s1 = 0.0f, s2 = 0.0f, n = 0.0f;
+    for (uint32_t j = 0; j < m; j++) {
+        const float v = (l[j] == l[j]) ? 1.0f : 0.0f; /* valid: not NaN */
+        const float d = (th[j] - y_rel) * v;
+        s1 += d;
+        s2 += d * d;
+        n += v;
+    }
+    /* n >= 1: called with at least one valid particle */
+    const float mean = s1 / n;
+    const float var = s2 / n - mean * mean;
+    float nis = (mean * mean) / (((var > 0.0f) ? var : 0.0f) + pf->r_gate);
+    const float nis_max = pf->cfg.est.outlier_sigma * pf->cfg.est.outlier_sigma; /* <= 1e8 */
+    nis = (nis <= nis_max) ? nis : nis_max; /* a NaN too */
+    const br_pf_adapt_t *ad = &pf->cfg.adapt;
+    pf->nis_avg += ad->alpha * (nis - pf->nis_avg);
+    const float s = pf->nis_avg / ad->nis_ref;
+    pf->q_scale_std = (s > 1.0f) ? sqrtf((s < ad->max_scale) ? s : ad->max_scale) : 1.0f;
+}
+
 br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
 {
     if (pf == NULL || y == NULL) {
@@ -823,6 +866,9 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     /* an outlier also when every valid particle's log-weight overflowed to -inf
      * (the max-shift needs a finite lmax) */
     const br_status_t verdict = (lmax < pf->outlier_l || lmax == -INFINITY) ? BR_W_OUTLIER : BR_OK;
+    if (pf->cfg.adapt.nis_ref > 0.0f) {
+        adapt_update(pf, y_rel);
+    }
 
     /* 3. max-shifted weights, quantised; an outlier gives every valid particle weight 1 */
     /* 4. deterministic systematic resampling on the integer weights (total >= 2^16:

@@ -7,7 +7,7 @@ identified from a simulated identification log of that plant.
 
 Usage:
   robustness.py --bin BUILD/sim --out DIR [--n N] [--seed S] [--jobs J] [--diagnose-first K]
-                [--md OUT.md] [--check | --check-safe]
+                [--md OUT.md] [--check | --check-safe] [--only a,b,...]
 Per plant i (seed S + i): DIR/plants/NNNN/{plant.json, ident.csv, diag/model.json, result.json};
 then DIR/summary.json ("controllers": median_m, p90_m, max_m, lost per
 controller; the paired tests; the regime analysis) and DIR/cdf.png.
@@ -15,7 +15,8 @@ controller; the paired tests; the regime analysis) and DIR/cdf.png.
 (all by default). --check: exit 1 when an estimator on the nominal model is
 lost on any plant (docs/robustness.md, "Goals"). --check-safe (CI): exit 1
 when an estimator leaves the axis worse than H-inf only without a safe stop,
-or its median is not below a tenth of H-inf only's.
+or its median is not below a tenth of H-inf only's. --only: the controllers
+to run (hinf_only always), e.g. --only hinf_ukf,hinf_pf.
 """
 import argparse
 import json
@@ -93,7 +94,7 @@ def run(cmd, env=None):
 
 
 def one_plant(job):
-    i, seed, binp, out, diagnose = job
+    i, seed, binp, out, diagnose, only = job
     ref = reference()
     p = draw(seed, ref)
     d = os.path.join(out, "plants", f"{i:04d}")
@@ -127,6 +128,8 @@ def one_plant(job):
            os.path.join(d, "result.json")]
     if model:
         cmd += ["--model", model]
+    if only:
+        cmd += ["--only", only]
     rc, _, err = run(cmd)
     if rc != 0:
         rec["error"] = err.strip()
@@ -203,6 +206,8 @@ def regime(recs):
     """where the PF beats the UKF: log(PF / UKF) against each drawn quantity (Spearman), and by cause"""
     from scipy.stats import spearmanr
     rs = [r for r in recs if "hinf_pf" in r["runs"] and "hinf_ukf" in r["runs"]]
+    if not rs:
+        return {}
     y = np.log([r["runs"]["hinf_pf"]["contour_rms_m"] / r["runs"]["hinf_ukf"]["contour_rms_m"] for r in rs])
     out = {"spearman_log_pf_over_ukf": {}, "by_cause": {}}
     keys = [("factor", k) for k in rs[0]["factors"]] + [("real", k) for k in rs[0]["real"]]
@@ -336,6 +341,8 @@ def main():
     ap.add_argument("--check-safe", action="store_true",
                     help="exit 1 when an estimator makes the axis worse than H-inf only without a safe stop (the CI check)")
     ap.add_argument("--from-summary", help="recompute the statistics from an earlier summary.json's plants")
+    ap.add_argument("--only", help="the controllers to run, comma-separated (br_robust_run's --only; "
+                    "hinf_only always runs: the statistics compare with it)")
     a = ap.parse_args()
     if a.from_summary:
         with open(a.from_summary) as f:
@@ -351,7 +358,14 @@ def main():
         shutil.rmtree(os.path.join(a.out, "plants"))
     os.makedirs(a.out, exist_ok=True)
     kd = a.n if a.diagnose_first < 0 else a.diagnose_first
-    jobs = [(i, a.seed + i, a.bin, a.out, i < kd) for i in range(a.n)]
+    only = None
+    if a.only:
+        names = [k for k in a.only.split(",") if k]
+        bad_names = [k for k in names if k not in CONTROLLERS]
+        if bad_names:
+            ap.error(f"--only: unknown controllers {bad_names}")
+        only = ",".join(["hinf_only"] + [k for k in names if k != "hinf_only"])
+    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only) for i in range(a.n)]
     recs, t0 = [], time.time()
     progress(0, a.n, t0)
     with Pool(a.jobs) as pool:

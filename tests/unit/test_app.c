@@ -628,6 +628,7 @@ static void test_machine_cfg_one_home(void **st)
     assert_ptr_equal(c.noise, k_image_pf.noise);
     assert_int_equal(c.noise_len, k_image_pf.noise_len);
     assert_int_equal(c.noise_skip, k_image_pf.noise_skip);
+    assert_memory_equal(&c.adapt, &k_image_pf.adapt, sizeof c.adapt);
     /* and it is a configuration the PF accepts, at the image's period */
     br_pf_t *pf = calloc(1, sizeof *pf);
     assert_non_null(pf);

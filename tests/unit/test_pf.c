@@ -8,7 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
+#include "circle/br_circle.h"
 #include "circle/br_circle_est.h"
 #include "bristle/br_pf.h"
 #include "plant/br_sim_plant.h"
@@ -77,6 +79,21 @@ static void test_init_guards(void **st)
     c = cfg(100); c.est.gp0_N = 1.1f * c.est.gp_max_N;    assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM); /* > max */
     c = cfg(100); c.est.model.dt_s = 0.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg(100); c.est.model.lugre.sigma0_Npm = -1.0f; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    /* cfg.adapt: off (nis_ref 0, the rest unused) or nis_ref >= BR_PF_ADAPT_REF_MIN, alpha in (0, 1],
+     * max_scale in [1, BR_EST_VAR_MAX] */
+    c = cfg(100); c.adapt = (br_pf_adapt_t){0.0f, 0.0f, 0.0f}; assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c = cfg(100); c.adapt.nis_ref = -1.0f;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.nis_ref = NAN;              assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.nis_ref = INFINITY;         assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.nis_ref = 0.5f * BR_PF_ADAPT_REF_MIN; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.nis_ref = BR_PF_ADAPT_REF_MIN; assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c = cfg(100); c.adapt.alpha = 0.0f;               assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.alpha = 1.5f;               assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.alpha = NAN;                assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.alpha = 1.0f;               assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c = cfg(100); c.adapt.max_scale = 0.5f;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.max_scale = 2.0f * BR_EST_VAR_MAX; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.adapt.max_scale = NAN;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_STATE); /* last init failed */
     free(pf);
@@ -606,6 +623,97 @@ static void test_likelihood_scale(void **st)
     free(pf);
 }
 
+/* cfg.adapt keeps the thesis filter's arithmetic while the smoothed NIS
+ * stays at or below nis_ref: a PF with it and one without, on the same
+ * measurements of a slow move (innovations within the cloud), hold the same
+ * particles bit for bit; a jump of 20 gate sigmas raises E above nis_ref
+ * and the filters part (z's and g_p's noise scaled by q_scale_std > 1). */
+static void test_adapt_is_thesis_filter_below_ref(void **st)
+{
+    (void)st;
+    br_pf_t *a = calloc(1, sizeof *a), *b = calloc(1, sizeof *b);
+    assert_non_null(a);
+    assert_non_null(b);
+    br_pf_cfg_t ca = br_circle_pf_cfg_tuned(BR_EST_PF_PERIOD_S), cb = ca;
+    ca.n_particles = cb.n_particles = 300;
+    assert_true(ca.adapt.nis_ref > 0.0f);
+    cb.adapt.nis_ref = 0.0f;
+    assert_int_equal(br_pf_init(a, &ca), BR_OK);
+    assert_int_equal(br_pf_init(b, &cb), BR_OK);
+    for (int k = 0; k < 400; k++) {
+        br_meas_t y = {k / 40, 0.5f}; /* one count every 40 periods */
+        assert_int_equal(br_pf_step(a, &y, 0.0f), br_pf_step(b, &y, 0.0f));
+        assert_true(a->nis_avg <= ca.adapt.nis_ref);
+        assert_true(a->q_scale_std == 1.0f);
+    }
+    assert_memory_equal(a->x, b->x, sizeof a->x);
+    assert_memory_equal(&a->est, &b->est, sizeof a->est);
+    /* a jump far outside the cloud */
+    const float sigma = sqrtf(ca.est.r_var_rad2 + RPC * RPC / 12.0f) / RPC;
+    br_meas_t y = {10 + (int32_t)(20.0f * ca.est.outlier_sigma * sigma), 0.5f};
+    assert_int_equal(br_pf_step(a, &y, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(br_pf_step(b, &y, 0.0f), BR_W_OUTLIER);
+    assert_true(a->nis_avg > ca.adapt.nis_ref);
+    assert_true(a->q_scale_std > 1.0f);
+    assert_true(a->q_scale_std <= sqrtf(ca.adapt.max_scale));
+    assert_true(b->q_scale_std == 1.0f);
+    y.counts = 10;
+    (void)br_pf_step(a, &y, 0.0f);
+    (void)br_pf_step(b, &y, 0.0f);
+    assert_true(memcmp(a->x, b->x, sizeof a->x) != 0);
+    free(a);
+    free(b);
+}
+
+/* Plant 0 of the CI's robustness sample (sim/studies/robustness.py, seed
+ * 20261123; docs/robustness.md): the reference machine with softer bristles
+ * (sigma0 x0.53), less Coulomb friction, friction drift -8 %, 0.17 N of force
+ * noise per period. The circle with H-inf + PF (the tuned PF, br_robust_run's
+ * run of that plant). */
+static br_circle_cfg_t robust_plant0(br_circle_ctrl_t ctrl, float nis_ref)
+{
+    br_circle_cfg_t c = br_circle_cfg_thesis(ctrl);
+    br_plant_cfg_t *p = &c.plant;
+    p->sigma0_Npm *= 0.531522309580413;
+    p->sigma1_Nspm *= 0.6942187034615022;
+    p->Fc_N *= 0.8263604813152723;
+    p->Fs_N *= 0.9731625474543647;
+    p->vs_mps *= 1.6637765081952742;
+    p->sigma2_Nspm *= 1.0080883552941136;
+    p->J_kgm2 *= 1.0064866030910873; /* the moving mass x1.006 */
+    p->M_kg *= 1.0064866030910873;
+    c.real = (br_circle_real_t){-0.0843537, 0.169206, 0.000105894, 20261123u};
+    c.pf.adapt.nis_ref = nis_ref;
+    return c;
+}
+
+/* The innovation-driven process noise (cfg.adapt, docs/modules/pf.md,
+ * "Keeping lock"): on plant 0 the thesis filter's cloud misses the axis at
+ * reversals (its bristles and friction level are not the model's) and the
+ * lock monitor stops the axis (LOST_LOCK, measured at 4.08 s); with the
+ * machine file's adapt the filter keeps lock, outliers below 1 % of the
+ * axis-periods, and the contour stays better than with H-inf only. */
+static void test_adapt_keeps_lock_under_force_noise(void **st)
+{
+    (void)st;
+    const br_circle_cfg_t base = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
+    assert_true(base.pf.adapt.nis_ref > 0.0f); /* the machine file's default: on */
+    br_circle_result_t r_off, r_on, r_hinf;
+    br_circle_cfg_t c = robust_plant0(BR_CTRL_HINF_PF, 0.0f);
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r_off), 1); /* off: the thesis filter stops the axis */
+    assert_true(r_off.fault_status != 0);
+    c = robust_plant0(BR_CTRL_HINF_PF, base.pf.adapt.nis_ref);
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r_on), 0);
+    assert_int_equal(r_on.fault_status, 0);
+    assert_true((double)r_on.outlier_steps < 0.01 * 2.0 * (double)r_on.n_samples);
+    c = robust_plant0(BR_CTRL_HINF_ONLY, 0.0f);
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r_hinf), 0);
+    print_message("plant 0: adapt off: fault %d at %.3f s, %d outliers; on: %.3e m, %d outliers of %ld periods; "
+                  "H-inf only %.3e m\n", r_off.fault_status, r_off.fault_t_s, r_off.outlier_steps, r_on.contour_rms_m,
+                  r_on.outlier_steps, r_on.n_samples, r_hinf.contour_rms_m);
+    assert_true(r_on.contour_rms_m < r_hinf.contour_rms_m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -620,6 +728,8 @@ int main(void)
         cmocka_unit_test(test_one_invalid_particle),
         cmocka_unit_test(test_fnl_overflow_is_invalid),
         cmocka_unit_test(test_likelihood_scale),
+        cmocka_unit_test(test_adapt_is_thesis_filter_below_ref),
+        cmocka_unit_test(test_adapt_keeps_lock_under_force_noise),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -53,7 +53,9 @@
         .n_particles = BR_EST_PF_N_PARTICLES,                                                      \
         .x0_std = {BR_EST_PF_X0_STD_THETA_COUNTS_F * BR_MACHINE_RAD_PER_COUNT_F,                   \
                    BR_EST_PF_X0_STD_OMEGA_RADPS_F, BR_EST_PF_X0_STD_Z_M_F, BR_EST_PF_X0_STD_GP_N_F}, \
-        .noise = br_noise_table, .noise_len = BR_NOISE_LEN, .noise_skip = BR_EST_PF_NOISE_SKIP     \
+        .noise = br_noise_table, .noise_len = BR_NOISE_LEN, .noise_skip = BR_EST_PF_NOISE_SKIP,    \
+        .adapt = {.nis_ref = BR_EST_PF_ADAPT_NIS_REF_F, .alpha = BR_EST_PF_ADAPT_ALPHA_F,            \
+                  .max_scale = BR_EST_PF_ADAPT_MAX_SCALE_F}                                        \
     }
 
 /* the machine file's (hand-tuned) variances: the start of the tuning */

@@ -42,6 +42,26 @@
 #error "BR_PF_MAX_PARTICLES must keep 2^17 m inside uint32 (m < 2^15)"
 #endif
 
+/* cfg.adapt: nis_ref below this is refused (E / nis_ref stays finite:
+ * a step's NIS is limited to outlier_sigma^2 <= 1e8) */
+#define BR_PF_ADAPT_REF_MIN 1.0e-6f
+
+/* Innovation-driven process noise (docs/modules/pf.md, "Keeping lock"): a
+ * variant of the thesis filter, off when nis_ref = 0. Each measured step
+ * takes the normalised innovation squared of the predicted cloud,
+ *   NIS = (y - mean theta_j)^2 / (var theta_j + R + rpc^2 / 12),
+ * limited to est.outlier_sigma^2 (a glitch counts as much as a step at the
+ * gate), smooths it, E <- E + alpha (NIS - E), and the next predictions draw the
+ * process noise of z and g_p with the variances times
+ *   s = min(max(E / nis_ref, 1), max_scale)
+ * (standard deviations times sqrt(s)). While E <= nis_ref, s = 1 and the
+ * arithmetic is the thesis filter's bit for bit. */
+typedef struct {
+    float nis_ref;   /* 0: off; > 0: the smoothed NIS above which the noise grows */
+    float alpha;     /* smoothing per measured step, (0, 1] (when on) */
+    float max_scale; /* largest variance factor, >= 1 (when on) */
+} br_pf_adapt_t;
+
 typedef struct {
     br_est_cfg_t est;        /* what the PF shares with the UKF: model (est.model.dt_s is the PF's
                                 period), noise, g_p range, gates; outlier: |y - theta_j| >
@@ -54,6 +74,7 @@ typedef struct {
     uint32_t scalar_path;    /* 1: the scalar reference path (one particle at a time, with branches);
                                 0 (default): the structure-of-arrays loops the compiler vectorises,
                                 the rare cases fixed up in scalar; both give identical results */
+    br_pf_adapt_t adapt;     /* innovation-driven process noise of z and g_p (all 0: off) */
 } br_pf_cfg_t;
 
 typedef struct {
@@ -76,6 +97,9 @@ typedef struct {
     float prev_frac;              /* the last measurement's fraction */
     uint32_t n_outliers;          /* consecutive outlier steps */
     uint32_t n_predicted;         /* predict-only steps since the last measurement */
+    float r_gate;                 /* R + rpc^2 / 12, rad^2 */
+    float nis_avg;                /* cfg.adapt: the smoothed NIS, E */
+    float q_scale_std;            /* cfg.adapt: sqrt(s), the factor on z's and g_p's noise std (1: the thesis filter) */
     int primed;                   /* particles drawn around the first measurement */
     /* particles as a structure of arrays: x[i][j] is state i of particle j.
      * One set, predicted and resampled in place (docs/modules/pf.md). */

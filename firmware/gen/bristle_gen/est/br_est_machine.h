@@ -56,6 +56,15 @@
 #define BR_EST_PF_REANCHOR_AFTER 3u
 /* extra noise-table advance per step */
 #define BR_EST_PF_NOISE_SKIP 1u
+/* innovation-driven noise of z and g_p (0: off) */
+#define BR_EST_PF_ADAPT_NIS_REF (0.25)
+#define BR_EST_PF_ADAPT_NIS_REF_F (2.500000000e-01f)
+/* its NIS smoothing per step */
+#define BR_EST_PF_ADAPT_ALPHA (0.02)
+#define BR_EST_PF_ADAPT_ALPHA_F (1.999999955e-02f)
+/* its largest variance factor */
+#define BR_EST_PF_ADAPT_MAX_SCALE (100.0)
+#define BR_EST_PF_ADAPT_MAX_SCALE_F (1.000000000e+02f)
 /* process noise variance per step */
 #define BR_EST_UKF_Q_THETA_RAD2 (1e-14)
 #define BR_EST_UKF_Q_THETA_RAD2_F (9.999999825e-15f)
