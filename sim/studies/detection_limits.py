@@ -273,7 +273,8 @@ def markdown(s, command, wall_s):
          f"seeds fixed). {s.get('logs_run', '?')} logs; wall time {wall_s / 60:.1f} min, CPU time "
          f"{s.get('cpu_s', float('nan')) / 60:.1f} min (one process; the machine was shared)"
          + (f"; {s['cached_logs']} logs came from an interrupted earlier run's cache: the logs' own wall "
-            f"times add up to {s['log_seconds'] / 60:.1f} min" if s.get("cached_logs") else "") + ".", "",
+            f"times add up to {s['log_seconds'] / 60:.1f} min" if s.get("cached_logs") else "") + "."
+         + (f" {s['note']}" if s.get("note") else ""), "",
          "br_simlog identification logs of the reference machine (3 cycles, 27.96 s) with one cause of a given "
          "size and Gaussian force noise, each diagnosed from the log alone. A cause is detected when it is "
          "among the findings. Noise levels: the EMPS log's force noise as the noise floor measures it, and a "
@@ -427,6 +428,7 @@ def main():
     s["cached_logs"] = cached
     s["log_seconds"] = sum(SECONDS.get(k, 0.0) for k in USED)
     s["command"] = cmd
+    s["note"] = os.environ.get("BR_DETECTION_NOTE", "")
     s["logs_run"] = (sum(p["logs"] for v in s["levels"].values() for c in v["causes"].values() for p in c["probes"])
                      + sum(v["nominal_logs"] for v in s["levels"].values()))
     if a.json:
