@@ -215,7 +215,7 @@ diagnose-hidden: deps
 # processes (default one core: about an hour with the defaults; docs/detection-limits.md gives the
 # wall time). DL_ prefix: N is the robustness study's.
 DL_N ?= 20
-DL_N_NOMINAL ?= 100
+DL_N_NOMINAL ?= 150
 DL_JOBS ?= 1
 detection-limits: deps
 	$(call configure,host-release)

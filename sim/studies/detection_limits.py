@@ -272,8 +272,8 @@ def markdown(s, command, wall_s):
          f"Command: `{command}` ({n} logs per probed size, {s['n_nominal']} nominal logs per noise level; "
          f"seeds fixed). {s.get('logs_run', '?')} logs; wall time {wall_s / 60:.1f} min, CPU time "
          f"{s.get('cpu_s', float('nan')) / 60:.1f} min (one process; the machine was shared)"
-         + (f"; {s['cached_logs']} logs came from an interrupted earlier run's cache: the logs' own wall "
-            f"times add up to {s['log_seconds'] / 60:.1f} min" if s.get("cached_logs") else "") + "."
+         + (f"; {s['cached_logs']} logs came from an earlier run's cache (WORK/cache.jsonl); the logs' own wall "
+            f"times (cached and new) add up to {s['log_seconds'] / 60:.1f} min" if s.get("cached_logs") else "") + "."
          + (f" {s['note']}" if s.get("note") else ""), "",
          "br_simlog identification logs of the reference machine (3 cycles, 27.96 s) with one cause of a given "
          "size and Gaussian force noise, each diagnosed from the log alone. A cause is detected when it is "
@@ -390,7 +390,7 @@ def main():
     ap.add_argument("--simlog", required=True)
     ap.add_argument("--work", required=True)
     ap.add_argument("--n", type=int, default=20, help="logs per probed size")
-    ap.add_argument("--n-nominal", type=int, default=100, help="nominal logs per noise level")
+    ap.add_argument("--n-nominal", type=int, default=150, help="nominal logs per noise level")
     ap.add_argument("--md")
     ap.add_argument("--png")
     ap.add_argument("--json")
