@@ -215,18 +215,20 @@ diagnose-hidden: deps
 	  BR_HIDDEN_COMMAND="make diagnose-hidden" $(PYTHON) tests/diagnose/hidden_cause.py \
 	    --merge $(HIDDEN_OUT)/shard0.json $(HIDDEN_OUT)/shard1.json --md docs/diagnose-hidden.md || rc=1; exit $$rc
 
-# Detection limits (docs/detection-limits.md): N logs per effect size and
-# N_NOMINAL nominal logs per noise level, on every core; 8 sizes per cause; several hours with the
-# defaults on 2 cores.
-N ?= 20
-N_NOMINAL ?= 100
+# Detection limits (docs/detection-limits.md): per cause and noise level a bisection on a 15-size
+# ladder with DL_N logs per probed size, and DL_N_NOMINAL nominal logs per noise level, on DL_JOBS
+# processes (default one core: about an hour with the defaults; docs/detection-limits.md gives the
+# wall time). DL_ prefix: N is the robustness study's.
+DL_N ?= 20
+DL_N_NOMINAL ?= 150
+DL_JOBS ?= 1
 detection-limits: deps
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)echo "== detection limits -> out/detection-limits, docs/detection-limits.md"
-	$(Q)OPENBLAS_NUM_THREADS=1 BR_DETECTION_COMMAND="make detection-limits N=$(N) N_NOMINAL=$(N_NOMINAL)" \
+	$(Q)OPENBLAS_NUM_THREADS=1 BR_DETECTION_COMMAND="make detection-limits DL_N=$(DL_N) DL_N_NOMINAL=$(DL_N_NOMINAL) DL_JOBS=$(DL_JOBS)" \
 	  $(PYTHON) sim/studies/detection_limits.py --simlog build/host-release/sim/br_simlog --work out/detection-limits/logs \
-	  --n $(N) --n-nominal $(N_NOMINAL) --md docs/detection-limits.md --png docs/detection-limits.png \
+	  --n $(DL_N) --n-nominal $(DL_N_NOMINAL) --jobs $(DL_JOBS) --md docs/detection-limits.md --png docs/detection-limits.png \
 	  --json out/detection-limits/summary.json
 
 firmware: deps

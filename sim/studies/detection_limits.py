@@ -5,49 +5,75 @@ detection-limits`).
 For each cause with a generator here (GENERATORS: br_simlog's option for an
 effect of size s), at two force-noise levels (the EMPS log's, as the noise
 floor measures it from ../shared/data/emps/emps_estimation.csv, and a quiet
-log's, QUIET_N), over a geometric ladder of sizes: N logs per size (seeds
-fixed: the same logs on every run), each diagnosed from the log alone
-(selection.diagnose). A cause is detected in a log when it is among the
-findings. The detection limit is the smallest size detected in at least
-95 % of the logs (and in every larger size of the ladder). On N_NOMINAL
-nominal logs per noise level: the false-positive rate (any finding) and
-the rate of the verdict "unexplained" (the residual judged above the
-noise floor).
+log's, QUIET_N): the smallest size of the cause's ladder (geometric, ratio
+sqrt 2) detected in at least 95 % of N logs. Each log is made by br_simlog
+(seeds fixed: the same logs on every run) and diagnosed from the log alone
+(selection.diagnose); the cause is detected when it is among the findings.
 
-Runs on every core (multiprocessing), one log per task.
+The limit is found by bisection on the ladder, assuming the detection rate
+grows with the size: a probed size passes when at most N - ceil(0.95 N) of its
+N logs miss the cause (N = 20: 19 of 20), and its logs stop at the first miss
+more than that (the size fails). The limit lies between the largest failing
+probe below it and itself. Beside each limit: N, the count detected and the
+one-sided 95 % Clopper-Pearson lower bound of the detection rate (with N of N
+detected it is 0.05^(1/N): 86 % for N = 20; a "95 %" limit is the observed
+rate, not a guaranteed one).
 
-Usage: detection_limits.py --simlog BIN --work DIR [--n N] [--n-nominal N] [--md OUT.md] [--png OUT.png]
+On N_NOMINAL nominal logs per noise level: the false-positive rate (any
+finding) and the rate of the verdict "unexplained", each with its one-sided
+95 % Clopper-Pearson upper bound (0 of 100: 3.0 %; 0 of 150: 2.0 %).
+
+--jobs 1 runs everything in this process; --jobs K spreads the (cause, noise)
+bisections and the nominal logs over K processes. Each log's result is appended
+to WORK/cache.jsonl: an interrupted run started again with the same --work
+skips the logs it already has (--fresh forgets them); the wall time reported
+is the last run's.
+
+Usage: detection_limits.py --simlog BIN --work DIR [--n N] [--n-nominal N] [--jobs K]
+                           [--md OUT.md] [--png OUT.png] [--json OUT.json]
 """
 import argparse
 import json
 import math
 import multiprocessing as mp
 import os
+import resource
 import subprocess
 import sys
+import time
 
 import numpy as np
+from scipy import stats
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "python"))
-from bristle.diagnose import causes, logreader, noise, report, selection, signals  # noqa: E402
+from bristle.diagnose import logreader, noise, report, selection, signals  # noqa: E402
 
 EMPS_LOG = os.path.join(REPO, "..", "shared", "data", "emps", "emps_estimation.csv")
 QUIET_N = 0.02
 RATE = 0.95
+CONF = 0.95
 MASTER_SEED = 20261123
 FC_N, SIGMA2 = 7.0, 50.0   # the reference machine's Coulomb and viscous levels (machines/reference.json)
+LADDER_LEN = 15            # bisection: 4 probes pin the limit to one step of the ladder
+
+
+def ladder(lo):
+    """LADDER_LEN sizes from lo, ratio sqrt 2 (lo .. 128 lo)."""
+    return lo * np.sqrt(2.0) ** np.arange(LADDER_LEN)
+
 
 # cause: (size name, unit, ladder, flags(size)); sizes of the effect
 GENERATORS = {
-    "offset": ("offset", "N", np.geomspace(0.004, 0.5, 8), lambda s: ["--offset", f"{s:.6g}"]),
-    "asymmetric_friction": ("relative asymmetry of Fc and Fv in -x", "", np.geomspace(0.001, 0.12, 8),
+    "offset": ("offset", "N", ladder(0.001), lambda s: ["--offset", f"{s:.6g}"]),
+    "asymmetric_friction": ("relative asymmetry of Fc and Fv in -x", "", ladder(0.0002),
                             lambda s: ["--asym", f"{FC_N * s:.6g},{SIGMA2 * s:.6g}"]),
-    "position_ripple": ("ripple amplitude, period 6 mm", "N", np.geomspace(0.004, 0.5, 8),
+    "position_ripple": ("ripple amplitude, period 6 mm", "N", ladder(0.002),
                         lambda s: ["--ripple", f"{s:.6g},0.006,1.0"]),
-    "position_gradient": ("relative slope", "1/m", np.geomspace(0.03, 1.5, 8),
-                          lambda s: ["--gradient", f"{s:.6g}"]),
-    "actuator_delay": ("dead time", "s", np.geomspace(2e-5, 1.5e-3, 8), lambda s: ["--delay", f"{s:.6g}"]),
+    "position_gradient": ("relative slope", "1/m", ladder(0.008), lambda s: ["--gradient", f"{s:.6g}"]),
+    "actuator_delay": ("dead time", "s", ladder(5e-6), lambda s: ["--delay", f"{s:.6g}"]),
+    "friction_drift": ("relative rate of the friction level", "1/s", ladder(1e-5),
+                       lambda s: ["--drift", f"{s:.6g}"]),
 }
 
 
@@ -57,9 +83,40 @@ def emps_noise():
     return noise.measure(signals.Prepared(logreader.read_log(EMPS_LOG))).sigma_N
 
 
-def run(task):
-    """One log: br_simlog, then the diagnosis. Returns (task, verdict, findings)."""
-    simlog, work, key, flags, sigma, seed = task
+def _cache_path(work):
+    return os.path.join(work, "cache.jsonl")
+
+
+def load_cache(work):
+    """Logs already diagnosed by an earlier run into the same --work directory (the seeds are fixed, so a
+    log's key names the same log): key -> (verdict, findings)."""
+    out = {}
+    try:
+        with open(_cache_path(work)) as f:
+            for line in f:
+                try:
+                    d = json.loads(line)
+                except json.JSONDecodeError:
+                    continue   # a line cut by an interrupted run
+                out[d["key"]] = (d["verdict"], d["findings"])
+                SECONDS[d["key"]] = d.get("s", 0.0)
+    except FileNotFoundError:
+        pass
+    return out
+
+
+CACHE = {}
+USED = set()
+SECONDS = {}   # key -> wall seconds of that log (br_simlog + diagnosis), this run's or the cached run's
+
+
+def run(simlog, work, key, flags, sigma, seed):
+    """One log: br_simlog, then the diagnosis. Returns (verdict, findings)."""
+    ck = f"{key}|{' '.join(flags)}|{sigma:.6g}|{seed}"
+    USED.add(ck)
+    if ck in CACHE:
+        return CACHE[ck]
+    t0 = time.time()
     path = os.path.join(work, f"{key}.csv")
     subprocess.run([simlog, "--out", path, "--seed", str(seed), "--force-noise", f"{sigma:.6g}"] + flags,
                    check=True)
@@ -67,83 +124,217 @@ def run(task):
     diag = selection.diagnose(prep)
     verdict, _ = report.verdict(prep, diag, noise.measure(prep, diag.nominal))
     os.remove(path)
-    return key, verdict, [c.cause for c, _ in diag.findings]
-
-
-def tasks(simlog, work, levels, n, n_nominal):
-    out = []
-    for li, (lname, sigma) in enumerate(levels):
-        for j in range(n_nominal):
-            out.append((simlog, work, f"{lname}-none-{j}", [], sigma, 1 + hash_seed(li, 0, 0, j)))
-        for ci, (cause, (_, _, ladder, flags)) in enumerate(GENERATORS.items()):
-            for si, s in enumerate(ladder):
-                for j in range(n):
-                    out.append((simlog, work, f"{lname}-{cause}-{si}-{j}", flags(s), sigma,
-                                1 + hash_seed(li, ci + 1, si, j)))
-    return out
+    found = [c.cause for c, _ in diag.findings]
+    with open(_cache_path(work), "a") as f:
+        SECONDS[ck] = round(time.time() - t0, 3)
+        f.write(json.dumps({"key": ck, "verdict": verdict, "findings": found, "s": SECONDS[ck]}) + "\n")
+    return verdict, found
 
 
 def hash_seed(*k):
-    return int(np.random.default_rng([MASTER_SEED, *k]).integers(1, 2 ** 30))
+    return 1 + int(np.random.default_rng([MASTER_SEED, *k]).integers(1, 2 ** 30))
 
 
-def summarize(results, levels, n, n_nominal):
-    s = {"levels": {}, "n": n, "n_nominal": n_nominal}
+def cp_lower(k, n, conf=CONF):
+    """One-sided Clopper-Pearson lower bound of a rate with k of n."""
+    return 0.0 if k == 0 else float(stats.beta.ppf(1.0 - conf, k, n - k + 1))
+
+
+def cp_upper(k, n, conf=CONF):
+    """One-sided Clopper-Pearson upper bound of a rate with k of n."""
+    return 1.0 if k == n else float(stats.beta.ppf(conf, k + 1, n - k))
+
+
+def misses_allowed(n):
+    return n - math.ceil(RATE * n - 1e-9)
+
+
+def probe(simlog, work, li, lname, sigma, ci, cause, si, size, flags, n):
+    """Up to n logs of cause at size; stops once the misses exceed what RATE allows."""
+    k = m = 0
+    others = 0
+    for j in range(n):
+        _, found = run(simlog, work, f"{lname}-{cause}-{si}-{j}", flags(size), sigma, hash_seed(li, ci + 1, si, j))
+        if cause in found:
+            k += 1
+        else:
+            m += 1
+        others += any(c != cause for c in found)
+        if m > misses_allowed(n):
+            break
+    return {"size": float(size), "detected": k, "logs": k + m, "other_findings": others,
+            "passed": m <= misses_allowed(n)}
+
+
+def bisect_task(args):
+    """The bisection of one (noise level, cause) on its ladder."""
+    simlog, work, li, lname, sigma, ci, cause, n = args
+    _, _, lad, flags = GENERATORS[cause]
+    lo, hi = -1, len(lad)          # lad[lo] fails (or below the ladder), lad[hi] passes (or above)
+    probes = []
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        p = probe(simlog, work, li, lname, sigma, ci, cause, mid, lad[mid], flags, n)
+        probes.append(p)
+        if p["passed"]:
+            hi = mid
+        else:
+            lo = mid
+    return ("cause", lname, cause, {"probes": sorted(probes, key=lambda p: p["size"]),
+                                    "limit_index": hi if hi < len(lad) else None,
+                                    "limit": float(lad[hi]) if hi < len(lad) else None,
+                                    "ladder": [float(x) for x in lad]})
+
+
+def nominal_task(args):
+    simlog, work, li, lname, sigma, j0, j1 = args
+    out = []
+    for j in range(j0, j1):
+        out.append(run(simlog, work, f"{lname}-none-{j}", [], sigma, hash_seed(li, 0, 0, j)))
+    return ("nominal", lname, (j0, j1), out)
+
+
+def study(simlog, work, levels, n, n_nominal, jobs, causes):
+    todo = []
+    for li, (lname, sigma) in enumerate(levels):
+        for ci, cause in enumerate(GENERATORS):
+            if cause in causes:
+                todo.append((bisect_task, (simlog, work, li, lname, sigma, ci, cause, n)))
+    step = 10
+    for j0 in range(0, n_nominal, step):
+        for li, (lname, sigma) in enumerate(levels):
+            todo.append((nominal_task, (simlog, work, li, lname, sigma, j0, min(j0 + step, n_nominal))))
+    res = {"cause": {}, "nominal": {}}
+
+    def take(r):
+        kind, lname, key, val = r
+        if kind == "cause":
+            res["cause"][(lname, key)] = val
+            lim = val["limit"]
+            print(f"  {lname} {key}: limit {lim if lim is not None else 'not within the ladder'} ("
+                  + ", ".join(f"{p['size']:.3g}: {p['detected']}/{p['logs']}" for p in val["probes"]) + ")",
+                  flush=True)
+        else:
+            res["nominal"].setdefault(lname, {})[key] = val
+            print(f"  {lname} nominal logs {key[0]}..{key[1] - 1}: "
+                  f"{sum(bool(f) for _, f in val)} with a finding", flush=True)
+
+    if jobs <= 1:
+        for fn, a in todo:
+            take(fn(a))
+    else:
+        with mp.Pool(jobs) as pool:
+            for r in pool.imap_unordered(_call, todo, chunksize=1):
+                take(r)
+    return res
+
+
+def _call(t):
+    fn, a = t
+    return fn(a)
+
+
+def summarize(res, levels, n, n_nominal, causes):
+    s = {"levels": {}, "n": n, "n_nominal": n_nominal, "rate": RATE, "conf": CONF}
     for lname, sigma in levels:
-        lv = {"force_noise_N": sigma, "causes": {}}
-        nom = [results[f"{lname}-none-{j}"] for j in range(n_nominal)]
-        lv["false_positive_rate"] = sum(bool(f) for _, f in nom) / max(len(nom), 1)
-        lv["unexplained_rate"] = sum(v == "unexplained" for v, _ in nom) / max(len(nom), 1)
-        for cause, (_, _, ladder, _) in GENERATORS.items():
-            rates = [sum(cause in results[f"{lname}-{cause}-{si}-{j}"][1] for j in range(n)) / n
-                     for si in range(len(ladder))]
-            limit = None
-            for si in range(len(ladder) - 1, -1, -1):
-                if rates[si] >= RATE:
-                    limit = float(ladder[si])
-                else:
-                    break
-            lv["causes"][cause] = {"sizes": [float(x) for x in ladder], "rates": rates, "limit": limit}
+        nom = [v for _, vals in sorted(res["nominal"].get(lname, {}).items()) for v in vals]
+        fp = sum(bool(f) for _, f in nom)
+        un = sum(v == "unexplained" for v, _ in nom)
+        found = {}
+        for _, f in nom:
+            for c in f:
+                found[c] = found.get(c, 0) + 1
+        lv = {"force_noise_N": sigma, "nominal_logs": len(nom), "false_positives": fp,
+              "false_positive_upper": cp_upper(fp, len(nom)) if nom else None,
+              "false_positive_causes": found, "unexplained": un,
+              "unexplained_upper": cp_upper(un, len(nom)) if nom else None, "causes": {}}
+        for cause in GENERATORS:
+            if cause not in causes:
+                continue
+            c = res["cause"][(lname, cause)]
+            at = next((p for p in c["probes"] if c["limit"] is not None and p["size"] == c["limit"]), None)
+            below = [p for p in c["probes"] if not p["passed"] and (c["limit"] is None or p["size"] < c["limit"])]
+            c["at_limit"] = at
+            c["at_limit_lower"] = cp_lower(at["detected"], at["logs"]) if at else None
+            c["failed_below"] = below[-1] if below else None
+            lv["causes"][cause] = c
         s["levels"][lname] = lv
     return s
 
 
-def markdown(s, command):
+def _fmt(x, unit):
+    return f"{x:.3g} {unit}".rstrip()
+
+
+def markdown(s, command, wall_s):
+    n = s["n"]
     L = ["<!-- generated by sim/studies/detection_limits.py; do not edit -->", "", "# Detection limits", "",
-         f"Command: `{command}` ({s['n']} logs per size, {s['n_nominal']} nominal logs per noise level; "
-         "seeds fixed).", "",
+         f"Command: `{command}` ({n} logs per probed size, {s['n_nominal']} nominal logs per noise level; "
+         f"seeds fixed). {s.get('logs_run', '?')} logs; wall time {wall_s / 60:.1f} min, CPU time "
+         f"{s.get('cpu_s', float('nan')) / 60:.1f} min (one process; the machine was shared)"
+         + (f"; {s['cached_logs']} logs came from an earlier run's cache (WORK/cache.jsonl); the logs' own wall "
+            f"times (cached and new) add up to {s['log_seconds'] / 60:.1f} min" if s.get("cached_logs") else "") + "."
+         + (f" {s['note']}" if s.get("note") else ""), "",
          "br_simlog identification logs of the reference machine (3 cycles, 27.96 s) with one cause of a given "
-         "size and Gaussian force noise; each diagnosed from the log alone. A cause is detected when it is among "
-         "the findings; the limit is the smallest size of the ladder detected in at least "
-         f"{100 * RATE:.0f} % of the logs (and at every larger size). Noise levels: the EMPS log's force noise as "
-         "the noise floor measures it, and a quiet log's.", "",
-         "| cause | size | " + " | ".join(f"limit at {k} noise ({v['force_noise_N']:.3g} N)"
+         "size and Gaussian force noise, each diagnosed from the log alone. A cause is detected when it is "
+         "among the findings. Noise levels: the EMPS log's force noise as the noise floor measures it, and a "
+         "quiet log's.", "",
+         "Each cause has a ladder of sizes (ratio √2, 15 sizes). The limit is found by bisection on it: a "
+         f"probed size passes when at most {misses_allowed(n)} of its {n} logs miss the cause (at least "
+         f"{100 * s['rate']:.0f} % detected), and its logs stop as soon as it cannot pass. The bisection assumes "
+         "the detection rate grows with the size: the sizes it did not probe are not checked. The limit is "
+         "the smallest passing size; the largest failing probe below it is beside it (the true 95 % size lies "
+         "between the two). The lower bound is the one-sided "
+         f"{100 * s['conf']:.0f} % Clopper-Pearson bound of the detection rate at the limit (with {n} of {n} "
+         f"detected: 0.05^(1/{n}) = {100 * 0.05 ** (1 / n):.1f} %): {n} logs show a rate of "
+         f"{100 * s['rate']:.0f} % or more at the limit; they do not prove the rate is that high.", "",
+         "| cause | size | " + " | ".join(f"limit at {k} noise ({v['force_noise_N']:.3g} N): detected, "
+                                          f"{100 * s['conf']:.0f} % lower bound | failed below"
                                           for k, v in s["levels"].items()) + " |",
-         "|---|---|" + "---|" * len(s["levels"])]
-    for cause, (what, unit, _, _) in GENERATORS.items():
+         "|---|---|" + "---|---|" * len(s["levels"])]
+    for cause, (what, unit, lad, _) in GENERATORS.items():
+        if not all(cause in v["causes"] for v in s["levels"].values()):
+            continue
         cells = []
-        for k, v in s["levels"].items():
+        for v in s["levels"].values():
             c = v["causes"][cause]
-            lim = c["limit"]
-            if lim is None:
-                cells.append("not within the ladder")
+            if c["limit"] is None:
+                cells.append(f"not within the ladder (> {_fmt(c['ladder'][-1], unit)})")
             else:
-                # the smallest size tested was found: the limit is at most that
-                cells.append(("≤ " if lim == c["sizes"][0] else "") + f"{lim:.3g} {unit}".rstrip())
+                a = c["at_limit"]
+                pre = "≤ " if c["limit_index"] == 0 else ""
+                cells.append(f"{pre}{_fmt(c['limit'], unit)}: {a['detected']}/{a['logs']}, "
+                             f"≥ {100 * c['at_limit_lower']:.0f} %")
+            b = c["failed_below"]
+            cells.append(f"{_fmt(b['size'], unit)}: {b['detected']}/{b['logs']}" if b else
+                         "— (smallest size of the ladder passed)")
         L.append(f"| {cause} | {what} | " + " | ".join(cells) + " |")
-    L += ["", "| noise level | false positives on nominal logs (any finding) | verdict unexplained on nominal logs |",
-          "|---|---|---|"]
+    L += ["", "Nominal logs (no cause), any finding counted as a false positive; the upper bound is the one-sided "
+          f"{100 * s['conf']:.0f} % Clopper-Pearson bound. Goal: false positives at most 2 %.", "",
+          "| noise level | nominal logs | false positives (any finding) | upper bound | verdict unexplained | "
+          "upper bound |", "|---|---|---|---|---|---|"]
     for k, v in s["levels"].items():
-        L.append(f"| {k} ({v['force_noise_N']:.3g} N) | {100 * v['false_positive_rate']:.1f} % | "
-                 f"{100 * v['unexplained_rate']:.1f} % |")
-    L += ["", "Goal: false positives at most 2 %.", "", "## Detection rate per size", ""]
+        nl = v["nominal_logs"]
+        fp = v["false_positives"]
+        fc = ", ".join(f"{c} {m}" for c, m in sorted(v["false_positive_causes"].items()))
+        L.append(f"| {k} ({v['force_noise_N']:.3g} N) | {nl} | {fp} ({100 * fp / nl:.1f} %{'; ' + fc if fc else ''})"
+                 f" | {100 * v['false_positive_upper']:.1f} % | {v['unexplained']} ({100 * v['unexplained'] / nl:.1f} %)"
+                 f" | {100 * v['unexplained_upper']:.1f} % |")
+    L += ["", "## Probed sizes", "",
+          "Detected / logs run at each size the bisection probed (a failing size stops once "
+          f"{misses_allowed(n) + 1} logs have missed the cause); in brackets, the logs where another cause was "
+          "found too.", ""]
     for k, v in s["levels"].items():
-        L += [f"### {k} noise ({v['force_noise_N']:.3g} N)", "", "| cause | sizes → rates |", "|---|---|"]
+        L += [f"### {k} noise ({v['force_noise_N']:.3g} N)", "", "| cause | size: detected/logs (other) |", "|---|---|"]
         for cause, c in v["causes"].items():
-            L.append(f"| {cause} | " + ", ".join(f"{x:.3g}: {100 * r:.0f} %" for x, r in zip(c["sizes"], c["rates"]))
-                     + " |")
+            unit = GENERATORS[cause][1]
+            L.append(f"| {cause} | " + ", ".join(
+                f"{_fmt(p['size'], unit)}: {p['detected']}/{p['logs']}" + (f" ({p['other_findings']})"
+                                                                           if p["other_findings"] else "")
+                for p in c["probes"]) + " |")
         L.append("")
-    L += ["![detection rate against effect size](detection-limits.png)", ""]
+    L += ["![detection rate against effect size at the probed sizes, with 95 % Clopper-Pearson intervals]"
+          "(detection-limits.png)", ""]
     return "\n".join(L)
 
 
@@ -151,73 +342,109 @@ def plot(s, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axs = plt.subplots(1, len(GENERATORS), figsize=(4 * len(GENERATORS), 3.6), sharey=True)
-    for ax, (cause, (what, unit, _, _)) in zip(axs, GENERATORS.items()):
+    import matplotlib.ticker
+    names = [c for c in GENERATORS if all(c in v["causes"] for v in s["levels"].values())]
+    cols = 3
+    rows = (len(names) + cols - 1) // cols
+    fig, axs = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.3 * rows), sharey=True, squeeze=False)
+    for ax, cause in zip(axs.flat, names):
+        what, unit = GENERATORS[cause][:2]
         for k, v in s["levels"].items():
             c = v["causes"][cause]
-            ax.semilogx(c["sizes"], [100 * r for r in c["rates"]], "o-", label=f"{k} ({v['force_noise_N']:.2g} N)")
-        ax.axhline(100 * RATE, color="k", lw=0.6, ls=":")
+            x = np.array([p["size"] for p in c["probes"]])
+            k_ = np.array([p["detected"] for p in c["probes"]])
+            n_ = np.array([p["logs"] for p in c["probes"]])
+            r = 100 * k_ / n_
+            lo = [100 * (k / n - (cp_lower(k, n, 0.975))) for k, n in zip(k_, n_)]
+            hi = [100 * (cp_upper(k, n, 0.975) - k / n) for k, n in zip(k_, n_)]
+            line = ax.errorbar(x, r, yerr=[lo, hi], fmt="o", capsize=2, label=f"{k} ({v['force_noise_N']:.2g} N)")
+            if c["limit"] is not None:
+                ax.axvline(c["limit"], color=line[0].get_color(), lw=0.8, ls="--")
+        ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.axhline(100 * s["rate"], color="k", lw=0.6, ls=":")
         ax.set_title(cause, fontsize=9)
         ax.set_xlabel(f"{what} [{unit}]" if unit else what, fontsize=8)
         ax.grid(alpha=0.3)
-    axs[0].set_ylabel("detected [% of logs]")
-    axs[0].legend(fontsize=7)
+    for ax in axs.flat[len(names):]:
+        ax.set_visible(False)
+    for row in axs:
+        row[0].set_ylabel("detected [% of logs]")
+    axs.flat[0].legend(fontsize=7, loc="center right")
+    fig.suptitle("detection rate at the probed sizes (95 % Clopper-Pearson intervals; dashed: the limit)",
+                 fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
+
+
+def write(s, a, cmd):
+    if a.md:
+        with open(a.md, "w") as f:
+            f.write(markdown(s, cmd, s.get("wall_s", float("nan"))))
+    if a.png:
+        plot(s, a.png)
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--simlog", required=True)
     ap.add_argument("--work", required=True)
-    ap.add_argument("--n", type=int, default=20)
-    ap.add_argument("--n-nominal", type=int, default=100)
+    ap.add_argument("--n", type=int, default=20, help="logs per probed size")
+    ap.add_argument("--n-nominal", type=int, default=150, help="nominal logs per noise level")
     ap.add_argument("--md")
     ap.add_argument("--png")
     ap.add_argument("--json")
-    ap.add_argument("--jobs", type=int, default=os.cpu_count())
-    ap.add_argument("--every", type=int, default=1, help="every k-th size of each ladder (a quick run)")
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--causes", default=",".join(GENERATORS), help="comma-separated subset of the causes")
+    ap.add_argument("--fresh", action="store_true", help="forget the logs an earlier run left in --work")
     ap.add_argument("--from-json", help="write --md / --png from a saved --json summary, running nothing")
     a = ap.parse_args()
+    cmd = os.environ.get("BR_DETECTION_COMMAND", " ".join(["detection_limits.py"] + sys.argv[1:]))
     if a.from_json:
         with open(a.from_json) as f:
             s = json.load(f)
-        cmd = os.environ.get("BR_DETECTION_COMMAND", "detection_limits.py")
-        if a.md:
-            with open(a.md, "w") as f:
-                f.write(markdown(s, cmd))
-        if a.png:
-            plot(s, a.png)
+        write(s, a, s.get("command", cmd))
         return 0
+    causes = [c for c in a.causes.split(",") if c]
+    unknown = [c for c in causes if c not in GENERATORS]
+    if unknown:
+        raise SystemExit(f"error: unknown cause(s) {unknown}; known: {list(GENERATORS)}")
     os.makedirs(a.work, exist_ok=True)
-    if a.every > 1:
-        for c, (w, u, ladder, fl) in list(GENERATORS.items()):
-            GENERATORS[c] = (w, u, ladder[::-1][::a.every][::-1], fl)  # keeps the largest size
+    if a.fresh and os.path.exists(_cache_path(a.work)):
+        os.remove(_cache_path(a.work))
+    CACHE.update(load_cache(a.work))
+    cached = len(CACHE)
+    if CACHE:
+        print(f"{len(CACHE)} logs from {_cache_path(a.work)} (an earlier run's; --fresh runs them again)")
+    t0 = time.time()
     levels = (("EMPS", emps_noise()), ("quiet", QUIET_N))
-    todo = tasks(os.path.abspath(a.simlog), os.path.abspath(a.work), levels, a.n, a.n_nominal)
-    print(f"{len(todo)} logs on {a.jobs} processes", flush=True)
-    results = {}
-    with mp.Pool(a.jobs) as pool:
-        for i, (key, verdict, found) in enumerate(pool.imap_unordered(run, todo, chunksize=1)):
-            results[key] = (verdict, found)
-            if (i + 1) % 25 == 0:
-                print(f"  {i + 1}/{len(todo)}", flush=True)
-    s = summarize(results, levels, a.n, a.n_nominal)
+    print(f"{len(causes)} causes x {len(levels)} noise levels, N = {a.n} per probed size, "
+          f"{a.n_nominal} nominal logs per level, on {a.jobs} process(es)", flush=True)
+    res = study(os.path.abspath(a.simlog), os.path.abspath(a.work), levels, a.n, a.n_nominal, a.jobs, causes)
+    s = summarize(res, levels, a.n, a.n_nominal, causes)
+    s["wall_s"] = time.time() - t0
+    ru = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    s["cpu_s"] = sum(r.ru_utime + r.ru_stime for r in ru)
+    s["cached_logs"] = cached
+    s["log_seconds"] = sum(SECONDS.get(k, 0.0) for k in USED)
+    s["command"] = cmd
+    s["note"] = os.environ.get("BR_DETECTION_NOTE", "")
+    s["logs_run"] = (sum(p["logs"] for v in s["levels"].values() for c in v["causes"].values() for p in c["probes"])
+                     + sum(v["nominal_logs"] for v in s["levels"].values()))
     if a.json:
         with open(a.json, "w") as f:
             json.dump(s, f, indent=1)
-    cmd = os.environ.get("BR_DETECTION_COMMAND", " ".join(["detection_limits.py"] + sys.argv[1:]))
-    if a.md:
-        with open(a.md, "w") as f:
-            f.write(markdown(s, cmd))
-    if a.png:
-        plot(s, a.png)
+    write(s, a, cmd)
+    print(f"{s['logs_run']} logs ({cached} from the cache) in {s['wall_s'] / 60:.1f} min, "
+          f"CPU {s['cpu_s'] / 60:.1f} min")
     for k, v in s["levels"].items():
-        print(f"{k} noise {v['force_noise_N']:.3g} N: false positives {100 * v['false_positive_rate']:.1f} %, "
-              f"unexplained on nominal {100 * v['unexplained_rate']:.1f} %; limits " +
-              ", ".join(f"{c} {d['limit']}" for c, d in v["causes"].items()))
-    fp = max(v["false_positive_rate"] for v in s["levels"].values())
-    return 0 if fp <= 0.02 or math.isnan(fp) else 1
+        nl = max(v["nominal_logs"], 1)
+        print(f"{k} noise {v['force_noise_N']:.3g} N: false positives {v['false_positives']}/{nl} "
+              f"(upper {100 * (v['false_positive_upper'] or 0):.1f} %), unexplained {v['unexplained']}/{nl}; limits "
+              + ", ".join(f"{c} {d['limit']}" for c, d in v["causes"].items()))
+    fp = max((v["false_positives"] / v["nominal_logs"] for v in s["levels"].values() if v["nominal_logs"]),
+             default=0.0)
+    return 0 if fp <= 0.02 else 1
 
 
 if __name__ == "__main__":
