@@ -736,7 +736,7 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
  * take every particle from a later one (not yet overwritten) and a backward
  * pass every particle from an earlier one (idx_k <= k there, so its source
  * was left alone by the forward pass); a particle with idx_i = i copies
- * itself. The backward pass after resample_forward, branch-free (the vector
+ * itself. The backward pass after resample_forward, without branches (the vector
  * path on hosts with SIMD): it copies every particle, from itself where it
  * is not its turn. */
 static void copy_backward(br_pf_t *pf)
