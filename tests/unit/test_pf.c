@@ -632,6 +632,11 @@ static void test_likelihood_scale(void **st)
     free(pf);
 }
 
+/* The adapt tests need the reference machine: its file switches adapt on
+ * (heavy and emps keep it off) and plant 0 is drawn around it. They are
+ * built only in the reference machine's configuration (BR_TEST_THESIS_MACHINE,
+ * tests/unit/CMakeLists.txt), where a file without adapt fails them. */
+#ifdef BR_TEST_THESIS_MACHINE
 /* cfg.adapt keeps the thesis filter's arithmetic while the smoothed NIS
  * stays at or below nis_ref: a PF with it and one without, on the same
  * measurements of a slow move (innovations within the cloud), hold the same
@@ -645,11 +650,7 @@ static void test_adapt_is_thesis_filter_below_ref(void **st)
     assert_non_null(b);
     br_pf_cfg_t ca = br_circle_pf_cfg_tuned(BR_EST_PF_PERIOD_S), cb = ca;
     ca.n_particles = cb.n_particles = 300;
-    if (!(ca.adapt.nis_ref > 0.0f)) {
-        free(a);
-        free(b);
-        skip(); /* the machine file has it off (emps, heavy) */
-    }
+    assert_true(ca.adapt.nis_ref > 0.0f); /* the reference machine's file has it on */
     cb.adapt.nis_ref = 0.0f;
     assert_int_equal(br_pf_init(a, &ca), BR_OK);
     assert_int_equal(br_pf_init(b, &cb), BR_OK);
@@ -710,9 +711,7 @@ static void test_adapt_keeps_lock_under_force_noise(void **st)
 {
     (void)st;
     const br_circle_cfg_t base = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
-    if (!(base.pf.adapt.nis_ref > 0.0f)) {
-        skip(); /* the machine file has it off (emps, heavy; plant 0 is a draw around the reference machine) */
-    }
+    assert_true(base.pf.adapt.nis_ref > 0.0f); /* the reference machine's file has it on */
     br_circle_result_t r_off, r_on, r_hinf;
     br_circle_cfg_t c = robust_plant0(BR_CTRL_HINF_PF, 0.0f);
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r_off), 1); /* off: the thesis filter stops the axis */
@@ -729,6 +728,8 @@ static void test_adapt_keeps_lock_under_force_noise(void **st)
     assert_true(r_on.contour_rms_m < r_hinf.contour_rms_m);
 }
 
+#endif /* BR_TEST_THESIS_MACHINE */
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -743,8 +744,10 @@ int main(void)
         cmocka_unit_test(test_one_invalid_particle),
         cmocka_unit_test(test_fnl_overflow_is_invalid),
         cmocka_unit_test(test_likelihood_scale),
+#ifdef BR_TEST_THESIS_MACHINE
         cmocka_unit_test(test_adapt_is_thesis_filter_below_ref),
         cmocka_unit_test(test_adapt_keeps_lock_under_force_noise),
+#endif
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
