@@ -133,15 +133,7 @@ int main(int argc, char **argv)
         {"pf-n", required_argument, NULL, 'n'},   {"seed", required_argument, NULL, 's'},
         {NULL, 0, NULL, 0}};
     br_args_t ap;
-    const int args = br_args_begin(&ap, TOOL, argc, argv);
-    if (args == BR_ARGS_HELP) {
-        usage(argv[0], stdout);
-        return 0;
-    }
-    if (args == BR_ARGS_VERSION) {
-        br_args_print_version(TOOL, stdout);
-        return 0;
-    }
+    if (br_args_start(&ap, TOOL, argc, argv, usage)) return 0;
     const char *val;
     for (int o; (o = br_args_next(&ap, opts, &val)) != BR_ARGS_END;) {
         int bad = 0;

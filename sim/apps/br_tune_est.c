@@ -209,15 +209,7 @@ int main(int argc, char **argv)
                                          {"stat", required_argument, NULL, 's'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
-    const int args = br_args_begin(&p, TOOL, argc, argv);
-    if (args == BR_ARGS_HELP) {
-        usage(argv[0], stdout);
-        return 0;
-    }
-    if (args == BR_ARGS_VERSION) {
-        br_args_print_version(TOOL, stdout);
-        return 0;
-    }
+    if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
     const char *v;
     for (int o; (o = br_args_next(&p, opts, &v)) != BR_ARGS_END;) {
         int bad = 0;

@@ -26,6 +26,17 @@ int br_args_begin(br_args_t *p, const char *tool, int argc, char **argv)
     return version ? BR_ARGS_VERSION : BR_ARGS_RUN;
 }
 
+int br_args_start(br_args_t *p, const char *tool, int argc, char **argv, br_args_usage_t usage)
+{
+    const int st = br_args_begin(p, tool, argc, argv);
+    if (st == BR_ARGS_HELP) {
+        (void)usage(argv[0], stdout);
+    } else if (st == BR_ARGS_VERSION) {
+        br_args_print_version(tool, stdout);
+    }
+    return st != BR_ARGS_RUN;
+}
+
 /* how many different long options start with what "--" word (before any '=') names */
 static int prefix_matches(const struct option *longopts, const char *word)
 {

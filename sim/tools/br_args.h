@@ -15,7 +15,7 @@
  * A tool's loop:
  *   static const struct option opts[] = {{"out", required_argument, NULL, 'o'}, ..., {0}};
  *   br_args_t p;
- *   const int st = br_args_begin(&p, TOOL, argc, argv);   (BR_ARGS_HELP, BR_ARGS_VERSION: print, exit 0)
+ *   if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;   (--help, --version: printed)
  *   for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;)
  *       switch (c) { case 'o': ...; case BR_ARGS_BAD: return usage(...); } */
 #ifndef BR_ARGS_H
@@ -41,6 +41,14 @@ typedef struct {
 
 /* Starts a parse (resets getopt): BR_ARGS_HELP, BR_ARGS_VERSION or BR_ARGS_RUN. */
 int br_args_begin(br_args_t *p, const char *tool, int argc, char **argv);
+
+/* A tool's usage text, printed to `to` (its return value is the tool's exit
+ * code for a bad command line). */
+typedef int (*br_args_usage_t)(const char *argv0, FILE *to);
+
+/* br_args_begin, then --help (usage on stdout) or --version answered: 1 when
+ * the tool is done (exit 0), 0 when the options are to be parsed. */
+int br_args_start(br_args_t *p, const char *tool, int argc, char **argv, br_args_usage_t usage);
 
 /* The next option: its val from longopts (a {0}-terminated getopt_long
  * table; long options only), its argument in *arg (NULL for a flag) and its
