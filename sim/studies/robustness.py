@@ -147,14 +147,14 @@ def lost(run_, hinf):
         return "fault"
     if run_["outlier_steps"] > LOST_OUTLIER_FRAC * 2 * run_["n_samples"]:
         return "persistent_outliers"
-    if hinf is not None and run_["contour_rms_m"] > hinf:
+    if hinf is not None and harmful(run_, hinf):
         return "worse_than_hinf_only"
     return None
 
 
-def harmful(run_, hinf_run):
-    """an estimator run that went on (no safe stop) with a contour RMS above H-inf only's"""
-    return run_["fault_status"] == 0 and run_["contour_rms_m"] > hinf_run["contour_rms_m"]
+def harmful(run_, hinf_m):
+    """an estimator run that went on (no safe stop) with a contour RMS above H-inf only's hinf_m"""
+    return run_["fault_status"] == 0 and run_["contour_rms_m"] > hinf_m
 
 
 def wilcoxon(a, b):
@@ -414,7 +414,7 @@ def finish(a, good, bad, t0):
             # unless the lock monitor stopped it safe (outputs off); outliers above
             # LOST_OUTLIER_FRAC without harm are reported (the study's goal), not failed here
             fails = [f"{k}: worse than H-inf only without a safe stop on plant {r['i']}" for r in good
-                     for k in ESTIMATORS if k in r["runs"] and harmful(r["runs"][k], r["runs"]["hinf_only"])]
+                     for k in ESTIMATORS if k in r["runs"] and harmful(r["runs"][k], r["runs"]["hinf_only"]["contour_rms_m"])]
         # the estimators must compensate: their median well below H-inf only's
         fails += [f"{k}: median {ctl[k]['median_m']:.3e} m not below a tenth of H-inf only's" for k in ESTIMATORS
                   if k in ctl and not ctl[k]["median_m"] < 0.1 * ctl["hinf_only"]["median_m"]]
