@@ -15,6 +15,25 @@
  * Taylor polynomial of e^(f ln 2); relative error < 5e-6 over [-87, 0], set by
  * the rounding of x log2 e (measured in tests/unit/test_math.c); 0 below x = -87
  * (and for NaN). */
+/* 2^n e^(f ln 2) for n >= -126, |f| <= 1/2: both forms of br_exp_neg end here */
+static inline float br_exp2_parts(int32_t n, float f)
+{
+    /* e^y, y = f ln 2 in [-0.347, 0.347]: Taylor to degree 6 (Horner) */
+    const float y = f * 0.693147181f;
+    float p = 1.0f / 720.0f;
+    p = p * y + 1.0f / 120.0f;
+    p = p * y + 1.0f / 24.0f;
+    p = p * y + 1.0f / 6.0f;
+    p = p * y + 0.5f;
+    p = p * y + 1.0f;
+    p = p * y + 1.0f;
+    /* 2^n by building the exponent field */
+    const uint32_t bits = (uint32_t)(n + 127) << 23;
+    float scale;
+    memcpy(&scale, &bits, sizeof scale);
+    return p * scale;
+}
+
 #if defined(__SSE2__) || defined(__ARM_NEON)
 /* with float SIMD: branch-free, so that a loop over particles vectorises; the
  * range tests are integer masks rather than selects, which the compiler could
@@ -39,20 +58,7 @@ static inline float br_exp_neg(float x)
     const int up = f0 > 0.5f;
     const int32_t n = n0 + up;
     const float f = f0 - (float)up; /* f0 - 0 = f0 exactly */
-    /* e^y, y = f ln 2 in [-0.347, 0.347]: Taylor to degree 6 (Horner) */
-    const float y = f * 0.693147181f;
-    float p = 1.0f / 720.0f;
-    p = p * y + 1.0f / 120.0f;
-    p = p * y + 1.0f / 24.0f;
-    p = p * y + 1.0f / 6.0f;
-    p = p * y + 0.5f;
-    p = p * y + 1.0f;
-    p = p * y + 1.0f;
-    /* 2^n by building the exponent field; n >= -126 where x > -87 */
-    const uint32_t bits = (uint32_t)(n + 127) << 23;
-    float scale;
-    memcpy(&scale, &bits, sizeof scale);
-    const float r = p * scale;
+    const float r = br_exp2_parts(n, f);
     /* 0 below the normal range and for NaN */
     uint32_t rb;
     memcpy(&rb, &r, sizeof rb);
@@ -84,20 +90,7 @@ static inline float br_exp_neg(float x)
         n += 1;
         f -= 1.0f;
     }
-    /* e^y, y = f ln 2 in [-0.347, 0.347]: Taylor to degree 6 (Horner) */
-    const float y = f * 0.693147181f;
-    float p = 1.0f / 720.0f;
-    p = p * y + 1.0f / 120.0f;
-    p = p * y + 1.0f / 24.0f;
-    p = p * y + 1.0f / 6.0f;
-    p = p * y + 0.5f;
-    p = p * y + 1.0f;
-    p = p * y + 1.0f;
-    /* 2^n by building the exponent field; n >= -126 here since x > -87 */
-    const uint32_t bits = (uint32_t)(n + 127) << 23;
-    float scale;
-    memcpy(&scale, &bits, sizeof scale);
-    return p * scale;
+    return br_exp2_parts(n, f);
 }
 #endif
 
