@@ -157,6 +157,13 @@ def harmful(run_, hinf_m):
     return run_["fault_status"] == 0 and run_["contour_rms_m"] > hinf_m
 
 
+def safety_failures(good):
+    """--check-safe's list: each estimator run that left the axis worse than H-inf only on its plant
+    without a safe stop"""
+    return [f"{k}: worse than H-inf only without a safe stop on plant {r['i']}" for r in good
+            for k in ESTIMATORS if k in r["runs"] and harmful(r["runs"][k], r["runs"]["hinf_only"]["contour_rms_m"])]
+
+
 def wilcoxon(a, b):
     from scipy.stats import wilcoxon as w
     a, b = np.asarray(a), np.asarray(b)
@@ -413,8 +420,7 @@ def finish(a, good, bad, t0):
             # the safety property: an estimator never leaves the axis worse than H-inf only
             # unless the lock monitor stopped it safe (outputs off); outliers above
             # LOST_OUTLIER_FRAC without harm are reported (the study's goal), not failed here
-            fails = [f"{k}: worse than H-inf only without a safe stop on plant {r['i']}" for r in good
-                     for k in ESTIMATORS if k in r["runs"] and harmful(r["runs"][k], r["runs"]["hinf_only"]["contour_rms_m"])]
+            fails = safety_failures(good)
         # the estimators must compensate: their median well below H-inf only's
         fails += [f"{k}: median {ctl[k]['median_m']:.3e} m not below a tenth of H-inf only's" for k in ESTIMATORS
                   if k in ctl and not ctl[k]["median_m"] < 0.1 * ctl["hinf_only"]["median_m"]]
