@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* br_circle_ext: the gain of a diagnosis in control terms. The thesis circle
  * on the reference machine with causes switched on (the "hidden" ones), with
- * H-inf only, with H-inf + an estimator on the nominal model (the firmware's
- * as configured), and with H-inf + the same estimator on the extended model a
+ * H-inf only, with H-inf + the plant's own force (an oracle), with H-inf + an
+ * estimator on the nominal model (the firmware's as configured), and with H-inf + the same estimator on the extended model a
  * diagnosis saved (model.json): the firmware's own extended model, its
  * br_model_cfg_t.causes set from the model's. docs/diagnose.md.
  *
@@ -70,14 +70,17 @@ int main(int argc, char **argv)
         const char *name;
         br_circle_ctrl_t ctrl;
         int extended;
-    } runs[3] = {{"hinf_only", BR_CTRL_HINF_ONLY, 0}, {"est_nominal", ctrl, 0}, {"est_extended", ctrl, 1}};
+    } runs[4] = {{"hinf_only", BR_CTRL_HINF_ONLY, 0},
+                 {"hinf_true", BR_CTRL_HINF_TRUE, 0}, /* the oracle: the plant's own force (br_plant_comp_force_N) */
+                 {"est_nominal", ctrl, 0},
+                 {"est_extended", ctrl, 1}};
     br_outfile_t js = {0}; /* a temporary file until every run succeeded (br_outfile.h) */
     if (json) {
         if (br_outfile_open(&js, TOOL, json) != 0) return 1;
         fprintf(js.f, "{\n  \"generator\": \"br_circle_ext (sim/apps/br_circle_ext.c)\",\n  \"estimator\": \"%s\"",
                 est);
     }
-    for (int r = 0; r < (model ? 3 : 2); r++) {
+    for (int r = 0; r < (model ? 4 : 3); r++) {
         br_circle_cfg_t c = br_circle_cfg_thesis(runs[r].ctrl);
         c.plant = plant;
         if (runs[r].extended) {

@@ -196,7 +196,7 @@ static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, f
 {
     (void)y;
     (void)u_prev_Nm;
-    *F_hat_N = (float)((const br_plant_t *)ctx)->fnl_N;
+    *F_hat_N = (float)br_plant_comp_force_N((const br_plant_t *)ctx);
     return BR_OK;
 }
 

@@ -57,7 +57,7 @@ typedef struct {
     long n_samples;
     int saturated_steps;    /* periods where either axis saturated */
     int outlier_steps;      /* axis-periods whose measurement the estimator rejected */
-    double fhat_rms_err_N;  /* RMS of (compensation - true friction) over both axes */
+    double fhat_rms_err_N;  /* RMS of (compensation - the plant's force, br_plant_comp_force_N) over both axes */
     int fault_status;       /* 0, or the negative status with which the firmware stopped an axis */
     double fault_t_s;       /* when it did */
     int fault_cause;        /* the latched br_app_fault_t of that axis (0 without a fault) */

@@ -266,3 +266,14 @@ int32_t br_plant_encoder(const br_plant_t *p)
 double br_plant_pos_m(const br_plant_t *p) { return p->cfg.lead_mprad * p->x.theta_rad; }
 
 double br_plant_vel_mps(const br_plant_t *p) { return p->cfg.lead_mprad * p->x.omega_radps; }
+
+double br_plant_comp_force_N(const br_plant_t *p)
+{
+    const br_plant_cfg_t *c = &p->cfg;
+    const double v = br_plant_vel_mps(p);
+    /* fnl_N carries k(x) s(t) already; the viscous part k s sigma2_d v - sigma2 v
+     * is zero without a gradient, a drift or an asymmetry */
+    const double s2 = v < 0.0 ? c->sigma2_Nspm + c->dsigma2_neg_Nspm : c->sigma2_Nspm;
+    const double ks = grad_k(c, br_plant_pos_m(p)) * drift_s(c, p->t_s);
+    return p->fnl_N + p->fdist_N + (ks * s2 - c->sigma2_Nspm) * v;
+}

@@ -98,6 +98,13 @@ int32_t br_plant_encoder(const br_plant_t *p);
 double br_plant_pos_m(const br_plant_t *p);
 double br_plant_vel_mps(const br_plant_t *p);
 
+/* The force an ideal estimator would hand the controller at the end of the
+ * last step, N: the plant's friction and disturbance less the nominal viscous
+ * term sigma2 v the controller's model holds (the estimators' compensated
+ * force, br_model.h): k(x) s(t) (sigma2_d v + f_nl) + offset + ripple - sigma2 v.
+ * Without causes it is fnl_N. The "true friction" oracle of the studies. */
+double br_plant_comp_force_N(const br_plant_t *p);
+
 /* 1 when any cause of the configuration is switched on. */
 int br_plant_causes_on(const br_plant_cfg_t *cfg);
 

@@ -136,6 +136,36 @@ static void test_asymmetric_friction(void **st)
     BR_ASSERT_NEAR(fnl, -(c.Fc_N + 1.0), 1e-3);
 }
 
+/* The oracle's force (br_plant_comp_force_N): at steady sliding the axis does
+ * not accelerate, so the applied force F is the whole load force, and the
+ * oracle's is F less the nominal viscous sigma2 v, in either direction, with
+ * offset and asymmetry on; without causes it is fnl_N itself. */
+static void test_comp_force_balances_the_drive(void **st)
+{
+    (void)st;
+    br_plant_cfg_t c = br_plant_cfg_reference();
+    c.dFc_neg_N = 1.0;
+    c.dsigma2_neg_Nspm = 30.0;
+    c.offset_N = 0.4;
+    const double Fs[2] = {c.Fc_N + c.sigma2_Nspm * V_SLIDE_MPS + 0.4,
+                          -((c.Fc_N + 1.0) + (c.sigma2_Nspm + 30.0) * V_SLIDE_MPS) + 0.4};
+    for (int d = 0; d < 2; d++) {
+        br_plant_t p;
+        assert_int_equal(br_plant_init(&p, &c, &rest), 0);
+        const double duty = Fs[d] * c.lead_mprad / c.tau_per_duty_Nm;
+        for (int k = 0; k < 6000; k++) br_plant_step(&p, duty, 1e-3);
+        const double v = br_plant_vel_mps(&p);
+        BR_ASSERT_NEAR(fabs(v), V_SLIDE_MPS, 1e-4);
+        /* 1e-3 N: the settling's remaining acceleration (as test_asymmetric_friction) */
+        BR_ASSERT_NEAR(br_plant_comp_force_N(&p), Fs[d] - c.sigma2_Nspm * v, 1e-3);
+    }
+    br_plant_cfg_t r = br_plant_cfg_reference();
+    br_plant_t p;
+    assert_int_equal(br_plant_init(&p, &r, &rest), 0);
+    for (int k = 0; k < 50; k++) br_plant_step(&p, 0.01, 1e-3);
+    assert_true(br_plant_comp_force_N(&p) == p.fnl_N);
+}
+
 static void test_position_gradient(void **st)
 {
     (void)st;
@@ -288,6 +318,7 @@ int main(void)
         cmocka_unit_test(test_offset_and_ripple_force),
         cmocka_unit_test(test_offset_shifts_sliding),
         cmocka_unit_test(test_asymmetric_friction),
+        cmocka_unit_test(test_comp_force_balances_the_drive),
         cmocka_unit_test(test_position_gradient),
         cmocka_unit_test(test_friction_drift),
         cmocka_unit_test(test_delay_shifts_the_command),
