@@ -16,6 +16,9 @@
  *                causes, and the moving mass times the reference acceleration
  *   hinf_pf_ff   H-infinity + the PF (nominal model) + the feedforward's inertia
  *                term alone (moving mass times the reference acceleration)
+ *   hinf_pf_ext_ff  the same with the PF on the extended model
+ *   hinf_true_ff the oracle + the inertia term: the limit of an estimator
+ *                beside an acceleration feedforward
  *
  * The firmware's configuration (gains, periods, estimator settings) is the
  * build's machine's (br_circle_cfg_thesis). The tracking error is the
@@ -23,8 +26,8 @@
  * docs/configure.md, docs/machines/emps.md.
  *
  * Usage: br_track --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]
- *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff]
- *                 [--json OUT] [--trace DIR]
+ *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,
+ *                        hinf_pf_ext_ff,hinf_true_ff] [--json OUT] [--trace DIR]
  * Prints one line per controller: tracking RMS and maximum error. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
@@ -202,7 +205,8 @@ static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, f
 
 /* the firmware (br_app_step) with the build's machine configuration */
 /* ff: 0 none, 1 the feedforward of the plant's model (friction, causes, inertia; ctrl
- * BR_CTRL_HINF_FF), 2 the PF plus the feedforward's inertia term (ctrl BR_CTRL_HINF_PF) */
+ * BR_CTRL_HINF_FF), 2 the estimator (ctrl BR_CTRL_HINF_PF: the PF; BR_CTRL_HINF_TRUE:
+ * the oracle) plus the feedforward's inertia term */
 static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int extended, int ff, err_t *e,
                   int *fault, double *fault_t)
 {
@@ -249,8 +253,9 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
         ac.est = BR_APP_EST_EXTERN;
         ac.ext = &ffe;
     } else if (ff == 2) {
-        /* the PF as configured, behind the wrapper that adds the inertia term */
-        if (br_app_est_init(&ac, &mem, &w.inner) != BR_OK) {
+        /* the PF as configured (or the oracle), behind the wrapper that adds the inertia term */
+        if (ctrl == BR_CTRL_HINF_TRUE) w.inner = ext;
+        else if (br_app_est_init(&ac, &mem, &w.inner) != BR_OK) {
             fprintf(stderr, "br_track: PF init failed\n");
             goto done;
         }
@@ -299,7 +304,8 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]\n"
-            "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff] [--json OUT] [--trace DIR]\n"
+            "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,\n"
+            "                  hinf_pf_ext_ff,hinf_true_ff] [--json OUT] [--trace DIR]\n"
             BR_ARGS_COMMON_USAGE
             "  --ref LOG.csv       the measured log whose reference trajectory is tracked\n"
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
@@ -364,10 +370,10 @@ int main(int argc, char **argv)
     if (js)
         fprintf(js, "{\n  \"generator\": \"br_track (sim/apps/br_track.c); generated, do not edit\",\n"
                     "  \"duration_s\": %.6g", (double)(tr.n - 1) * tr.dt);
-    static const char *const names[] = {"pd", "hinf_only", "hinf_pf", "hinf_pf_ext", "hinf_true", "hinf_ff",
-                                        "hinf_pf_ff"};
+    static const char *const names[] = {"pd",      "hinf_only", "hinf_pf",        "hinf_pf_ext", "hinf_true",
+                                        "hinf_ff", "hinf_pf_ff", "hinf_pf_ext_ff", "hinf_true_ff"};
     int rc = 0;
-    for (int w = 0; w < 7 && rc == 0; w++) {
+    for (int w = 0; w < 9 && rc == 0; w++) {
         const size_t len = strlen(names[w]);
         const char *hit = strstr(ctrls, names[w]);
         while (hit && ((hit != ctrls && hit[-1] != ',') || (hit[len] != ',' && hit[len] != '\0')))
@@ -392,9 +398,10 @@ int main(int argc, char **argv)
                 rc = 2;
             } else if (run_pd(&tr, &plant, pd, &e) != 0) rc = 1;
         } else {
-            const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : w == 4 ? BR_CTRL_HINF_TRUE
+            const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : (w == 4 || w == 8) ? BR_CTRL_HINF_TRUE
                                           : w == 5 ? BR_CTRL_HINF_FF : BR_CTRL_HINF_PF;
-            if (run_fw(&tr, &plant, ctrl, w == 3, w == 5 ? 1 : w == 6 ? 2 : 0, &e, &fault, &fault_t) != 0) rc = 1;
+            const int ff = w == 5 ? 1 : w >= 6 ? 2 : 0;
+            if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &fault, &fault_t) != 0) rc = 1;
         }
         if (e.trace && fclose(e.trace) != 0) rc = 1;
         if (rc != 0) break;
