@@ -19,6 +19,13 @@ one-sided 95 % Clopper-Pearson lower bound of the detection rate (with N of N
 detected it is 0.05^(1/N): 86 % for N = 20; a "95 %" limit is the observed
 rate, not a guaranteed one).
 
+Then the limit is proven (--n-verify M, default 59): M logs at the limit (its
+first N are the bisection's), all of which must detect the cause; on a miss
+the next size up the ladder is tried the same way. M of M detected gives a
+one-sided 95 % Clopper-Pearson lower bound of 0.05^(1/M): 95.05 % for M = 59,
+so the proven limit is a size whose detection rate is at least 95 % at 95 %
+confidence (still under the assumption that the rate grows with the size).
+
 On N_NOMINAL nominal logs per noise level: the false-positive rate (any
 finding) and the rate of the verdict "unexplained", each with its one-sided
 95 % Clopper-Pearson upper bound (0 of 100: 3.0 %; 0 of 150: 2.0 %).
@@ -29,7 +36,7 @@ to WORK/cache.jsonl: an interrupted run started again with the same --work
 skips the logs it already has (--fresh forgets them); the wall time reported
 is the last run's.
 
-Usage: detection_limits.py --simlog BIN --work DIR [--n N] [--n-nominal N] [--jobs K]
+Usage: detection_limits.py --simlog BIN --work DIR [--n N] [--n-verify M] [--n-nominal N] [--jobs K]
                            [--md OUT.md] [--png OUT.png] [--json OUT.json]
 """
 import argparse
@@ -128,6 +135,7 @@ def run(simlog, work, key, flags, sigma, seed):
     with open(_cache_path(work), "a") as f:
         SECONDS[ck] = round(time.time() - t0, 3)
         f.write(json.dumps({"key": ck, "verdict": verdict, "findings": found, "s": SECONDS[ck]}) + "\n")
+    CACHE[ck] = (verdict, found)   # the verification reuses the bisection's logs in this process
     return verdict, found
 
 
@@ -149,8 +157,11 @@ def misses_allowed(n):
     return n - math.ceil(RATE * n - 1e-9)
 
 
-def probe(simlog, work, li, lname, sigma, ci, cause, si, size, flags, n):
-    """Up to n logs of cause at size; stops once the misses exceed what RATE allows."""
+def probe(simlog, work, li, lname, sigma, ci, cause, si, size, flags, n, allowed=None):
+    """Up to n logs of cause at size; stops once the misses exceed `allowed`
+    (default: what RATE allows of n)."""
+    if allowed is None:
+        allowed = misses_allowed(n)
     k = m = 0
     others = 0
     for j in range(n):
@@ -160,15 +171,15 @@ def probe(simlog, work, li, lname, sigma, ci, cause, si, size, flags, n):
         else:
             m += 1
         others += any(c != cause for c in found)
-        if m > misses_allowed(n):
+        if m > allowed:
             break
     return {"size": float(size), "detected": k, "logs": k + m, "other_findings": others,
-            "passed": m <= misses_allowed(n)}
+            "passed": m <= allowed}
 
 
 def bisect_task(args):
     """The bisection of one (noise level, cause) on its ladder."""
-    simlog, work, li, lname, sigma, ci, cause, n = args
+    simlog, work, li, lname, sigma, ci, cause, n, n_verify = args
     _, _, lad, flags = GENERATORS[cause]
     lo, hi = -1, len(lad)          # lad[lo] fails (or below the ladder), lad[hi] passes (or above)
     probes = []
@@ -180,9 +191,21 @@ def bisect_task(args):
             hi = mid
         else:
             lo = mid
+    # the proof: n_verify logs, no miss, from the limit up the ladder
+    verify, v = [], hi
+    while n_verify > 0 and v < len(lad):
+        p = probe(simlog, work, li, lname, sigma, ci, cause, v, lad[v], flags, n_verify, allowed=0)
+        verify.append(p)
+        if p["passed"]:
+            break
+        v += 1
+    proven = n_verify > 0 and v < len(lad)
     return ("cause", lname, cause, {"probes": sorted(probes, key=lambda p: p["size"]),
                                     "limit_index": hi if hi < len(lad) else None,
                                     "limit": float(lad[hi]) if hi < len(lad) else None,
+                                    "verify": verify,
+                                    "proven_index": v if proven else None,
+                                    "proven": float(lad[v]) if proven else None,
                                     "ladder": [float(x) for x in lad]})
 
 
@@ -194,12 +217,12 @@ def nominal_task(args):
     return ("nominal", lname, (j0, j1), out)
 
 
-def study(simlog, work, levels, n, n_nominal, jobs, causes):
+def study(simlog, work, levels, n, n_nominal, jobs, causes, n_verify):
     todo = []
     for li, (lname, sigma) in enumerate(levels):
         for ci, cause in enumerate(GENERATORS):
             if cause in causes:
-                todo.append((bisect_task, (simlog, work, li, lname, sigma, ci, cause, n)))
+                todo.append((bisect_task, (simlog, work, li, lname, sigma, ci, cause, n, n_verify)))
     step = 10
     for j0 in range(0, n_nominal, step):
         for li, (lname, sigma) in enumerate(levels):
@@ -212,7 +235,9 @@ def study(simlog, work, levels, n, n_nominal, jobs, causes):
             res["cause"][(lname, key)] = val
             lim = val["limit"]
             print(f"  {lname} {key}: limit {lim if lim is not None else 'not within the ladder'} ("
-                  + ", ".join(f"{p['size']:.3g}: {p['detected']}/{p['logs']}" for p in val["probes"]) + ")",
+                  + ", ".join(f"{p['size']:.3g}: {p['detected']}/{p['logs']}" for p in val["probes"]) + "); proven "
+                  + f"{val['proven']} ("
+                  + ", ".join(f"{p['size']:.3g}: {p['detected']}/{p['logs']}" for p in val["verify"]) + ")",
                   flush=True)
         else:
             res["nominal"].setdefault(lname, {})[key] = val
@@ -234,8 +259,8 @@ def _call(t):
     return fn(a)
 
 
-def summarize(res, levels, n, n_nominal, causes):
-    s = {"levels": {}, "n": n, "n_nominal": n_nominal, "rate": RATE, "conf": CONF}
+def summarize(res, levels, n, n_nominal, causes, n_verify):
+    s = {"levels": {}, "n": n, "n_nominal": n_nominal, "n_verify": n_verify, "rate": RATE, "conf": CONF}
     for lname, sigma in levels:
         nom = [v for _, vals in sorted(res["nominal"].get(lname, {}).items()) for v in vals]
         fp = sum(bool(f) for _, f in nom)
@@ -257,6 +282,8 @@ def summarize(res, levels, n, n_nominal, causes):
             c["at_limit"] = at
             c["at_limit_lower"] = cp_lower(at["detected"], at["logs"]) if at else None
             c["failed_below"] = below[-1] if below else None
+            pv = c["verify"][-1] if c.get("proven") is not None else None
+            c["proven_lower"] = cp_lower(pv["detected"], pv["logs"]) if pv else None
             lv["causes"][cause] = c
         s["levels"][lname] = lv
     return s
@@ -287,11 +314,22 @@ def markdown(s, command, wall_s):
          "between the two). The lower bound is the one-sided "
          f"{100 * s['conf']:.0f} % Clopper-Pearson bound of the detection rate at the limit (with {n} of {n} "
          f"detected: 0.05^(1/{n}) = {100 * 0.05 ** (1 / n):.1f} %): {n} logs show a rate of "
-         f"{100 * s['rate']:.0f} % or more at the limit; they do not prove the rate is that high.", "",
-         "| cause | size | " + " | ".join(f"limit at {k} noise ({v['force_noise_N']:.3g} N): detected, "
-                                          f"{100 * s['conf']:.0f} % lower bound | failed below"
-                                          for k, v in s["levels"].items()) + " |",
-         "|---|---|" + "---|---|" * len(s["levels"])]
+         f"{100 * s['rate']:.0f} % or more at the limit; they do not prove the rate is that high."]
+    nv = s.get("n_verify", 0)
+    if nv:
+        L += ["", f"The proof: {nv} logs at the limit (its first {n} are the bisection's), all of which must "
+              f"detect the cause, else the next size up the ladder is tried the same way. {nv} of {nv} "
+              f"detected gives a one-sided {100 * s['conf']:.0f} % Clopper-Pearson lower bound of "
+              f"0.05^(1/{nv}) = {100 * 0.05 ** (1 / nv):.2f} %"
+              + (f": at the proven size the detection rate is at least {100 * s['rate']:.0f} % at "
+                 f"{100 * s['conf']:.0f} % confidence (given that the rate grows with the size)."
+                 if 0.05 ** (1 / nv) >= s["rate"] else
+                 f", short of {100 * s['rate']:.0f} %: too few logs to prove the rate.")]
+    L += ["", "| cause | size | " + " | ".join(
+        f"limit at {k} noise ({v['force_noise_N']:.3g} N): detected, {100 * s['conf']:.0f} % lower bound | "
+        "failed below" + (" | proven: detected, lower bound" if nv else "")
+        for k, v in s["levels"].items()) + " |",
+        "|---|---|" + ("---|---|---|" if nv else "---|---|") * len(s["levels"])]
     for cause, (what, unit, lad, _) in GENERATORS.items():
         if not all(cause in v["causes"] for v in s["levels"].values()):
             continue
@@ -308,6 +346,15 @@ def markdown(s, command, wall_s):
             b = c["failed_below"]
             cells.append(f"{_fmt(b['size'], unit)}: {b['detected']}/{b['logs']}" if b else
                          "— (smallest size of the ladder passed)")
+            if nv:
+                if c.get("proven") is None:
+                    cells.append("not within the ladder")
+                else:
+                    pv = c["verify"][-1]
+                    up = len(c["verify"]) - 1
+                    cells.append(f"**{_fmt(c['proven'], unit)}**: {pv['detected']}/{pv['logs']}, "
+                                 f"≥ {100 * c['proven_lower']:.1f} %"
+                                 + (f" ({up} size{'s' if up > 1 else ''} up from the limit)" if up else ""))
         L.append(f"| {cause} | {what} | " + " | ".join(cells) + " |")
     L += ["", "Nominal logs (no cause), any finding counted as a false positive; the upper bound is the one-sided "
           f"{100 * s['conf']:.0f} % Clopper-Pearson bound. Goal: false positives at most 2 %.", "",
@@ -331,7 +378,10 @@ def markdown(s, command, wall_s):
             L.append(f"| {cause} | " + ", ".join(
                 f"{_fmt(p['size'], unit)}: {p['detected']}/{p['logs']}" + (f" ({p['other_findings']})"
                                                                            if p["other_findings"] else "")
-                for p in c["probes"]) + " |")
+                for p in c["probes"]) + ("; proof: " + ", ".join(
+                    f"{_fmt(p['size'], unit)}: {p['detected']}/{p['logs']}" + (f" ({p['other_findings']})"
+                                                                               if p["other_findings"] else "")
+                    for p in c.get("verify", [])) if c.get("verify") else "") + " |")
         L.append("")
     L += ["![detection rate against effect size at the probed sizes, with 95 % Clopper-Pearson intervals]"
           "(detection-limits.png)", ""]
@@ -360,6 +410,8 @@ def plot(s, path):
             line = ax.errorbar(x, r, yerr=[lo, hi], fmt="o", capsize=2, label=f"{k} ({v['force_noise_N']:.2g} N)")
             if c["limit"] is not None:
                 ax.axvline(c["limit"], color=line[0].get_color(), lw=0.8, ls="--")
+            if c.get("proven") is not None:
+                ax.axvline(c["proven"], color=line[0].get_color(), lw=1.2, ls="-")
         ax.set_xscale("log")
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.axhline(100 * s["rate"], color="k", lw=0.6, ls=":")
@@ -371,7 +423,8 @@ def plot(s, path):
     for row in axs:
         row[0].set_ylabel("detected [% of logs]")
     axs.flat[0].legend(fontsize=7, loc="center right")
-    fig.suptitle("detection rate at the probed sizes (95 % Clopper-Pearson intervals; dashed: the limit)",
+    fig.suptitle("detection rate at the probed sizes (95 % Clopper-Pearson intervals; dashed: the limit; "
+                 "solid: the proven limit)",
                  fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
@@ -390,6 +443,8 @@ def main():
     ap.add_argument("--simlog", required=True)
     ap.add_argument("--work", required=True)
     ap.add_argument("--n", type=int, default=20, help="logs per probed size")
+    ap.add_argument("--n-verify", type=int, default=59,
+                    help="logs at the limit that must all detect the cause (0: no proof)")
     ap.add_argument("--n-nominal", type=int, default=150, help="nominal logs per noise level")
     ap.add_argument("--md")
     ap.add_argument("--png")
@@ -420,8 +475,11 @@ def main():
     levels = (("EMPS", emps_noise()), ("quiet", QUIET_N))
     print(f"{len(causes)} causes x {len(levels)} noise levels, N = {a.n} per probed size, "
           f"{a.n_nominal} nominal logs per level, on {a.jobs} process(es)", flush=True)
-    res = study(os.path.abspath(a.simlog), os.path.abspath(a.work), levels, a.n, a.n_nominal, a.jobs, causes)
-    s = summarize(res, levels, a.n, a.n_nominal, causes)
+    if a.n_verify < 0 or (a.n_verify and a.n_verify < a.n):
+        ap.error("--n-verify: 0 or at least --n")
+    res = study(os.path.abspath(a.simlog), os.path.abspath(a.work), levels, a.n, a.n_nominal, a.jobs, causes,
+                a.n_verify)
+    s = summarize(res, levels, a.n, a.n_nominal, causes, a.n_verify)
     s["wall_s"] = time.time() - t0
     ru = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     s["cpu_s"] = sum(r.ru_utime + r.ru_stime for r in ru)
@@ -429,8 +487,13 @@ def main():
     s["log_seconds"] = sum(SECONDS.get(k, 0.0) for k in USED)
     s["command"] = cmd
     s["note"] = os.environ.get("BR_DETECTION_NOTE", "")
-    s["logs_run"] = (sum(p["logs"] for v in s["levels"].values() for c in v["causes"].values() for p in c["probes"])
-                     + sum(v["nominal_logs"] for v in s["levels"].values()))
+    s["logs_run"] = sum(v["nominal_logs"] for v in s["levels"].values())
+    for v in s["levels"].values():
+        for c in v["causes"].values():
+            seen = {p["size"]: p["logs"] for p in c["probes"]}
+            s["logs_run"] += sum(seen.values())
+            # a proof's first logs at a probed size are the bisection's
+            s["logs_run"] += sum(max(0, p["logs"] - seen.get(p["size"], 0)) for p in c.get("verify", []))
     if a.json:
         with open(a.json, "w") as f:
             json.dump(s, f, indent=1)
@@ -441,7 +504,7 @@ def main():
         nl = max(v["nominal_logs"], 1)
         print(f"{k} noise {v['force_noise_N']:.3g} N: false positives {v['false_positives']}/{nl} "
               f"(upper {100 * (v['false_positive_upper'] or 0):.1f} %), unexplained {v['unexplained']}/{nl}; limits "
-              + ", ".join(f"{c} {d['limit']}" for c, d in v["causes"].items()))
+              + ", ".join(f"{c} {d['limit']} (proven {d.get('proven')})" for c, d in v["causes"].items()))
     fp = max((v["false_positives"] / v["nominal_logs"] for v in s["levels"].values() if v["nominal_logs"]),
              default=0.0)
     return 0 if fp <= 0.02 else 1

@@ -1,0 +1,131 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The detection-limits study's statistics (sim/studies/detection_limits.py,
+docs/detection-limits.md) on a stand-in diagnosis whose detections are known:
+the bisection finds the smallest passing size of the ladder, tolerates as many
+misses as the 95 % rate allows and no more, the proof requires every one of
+its logs and steps up the ladder on a miss, and the Clopper-Pearson bounds are
+the published ones. No log is simulated: the study's `run` is replaced."""
+import os
+import re
+import sys
+import unittest
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "sim", "studies"))
+import detection_limits as dl  # noqa: E402
+
+CAUSE = "offset"
+LAD = dl.GENERATORS[CAUSE][2]
+
+
+class Stand:
+    """Detects the cause when its size reaches `threshold`, except at the
+    (ladder index, log index) pairs in `misses`; counts the logs it ran."""
+
+    def __init__(self, threshold, misses=()):
+        self.threshold, self.misses, self.calls = threshold, set(misses), []
+
+    def __call__(self, simlog, work, key, flags, sigma, seed):
+        _, _, si, j = key.rsplit("-", 3)
+        size = float(flags[1])
+        self.calls.append((int(si), int(j)))
+        hit = size >= self.threshold and (int(si), int(j)) not in self.misses
+        return ("found" if hit else "none"), ([CAUSE] if hit else [])
+
+
+def bisect(stand, n=20, n_verify=59):
+    saved = dl.run
+    dl.run = stand
+    try:
+        _, _, _, out = dl.bisect_task(("simlog", "work", 0, "quiet", 0.02, 0, CAUSE, n, n_verify))
+    finally:
+        dl.run = saved
+    return out
+
+
+class Statistics(unittest.TestCase):
+    def test_clopper_pearson_bounds(self):
+        self.assertAlmostEqual(dl.cp_lower(20, 20), 0.05 ** (1 / 20), places=9)
+        self.assertGreaterEqual(dl.cp_lower(59, 59), 0.95)    # the proof's M = 59 reaches 95 %
+        self.assertLess(dl.cp_lower(58, 58), 0.95)            # and 58 does not
+        self.assertAlmostEqual(dl.cp_upper(0, 150), 1 - 0.05 ** (1 / 150), places=9)
+        self.assertLessEqual(dl.cp_upper(0, 150), 0.02)       # the false-positive goal's 150 logs
+        self.assertEqual(dl.cp_lower(0, 5), 0.0)
+        self.assertEqual(dl.cp_upper(5, 5), 1.0)
+
+    def test_misses_allowed_is_the_95_percent_rate(self):
+        self.assertEqual(dl.misses_allowed(20), 1)
+        self.assertEqual(dl.misses_allowed(19), 0)
+        self.assertEqual(dl.misses_allowed(59), 2)
+        self.assertEqual(dl.misses_allowed(100), 5)
+
+
+class Bisection(unittest.TestCase):
+    def test_limit_is_the_smallest_passing_size(self):
+        for k in (0, 1, 5, 9, len(LAD) - 1):
+            # a threshold between ladder sizes k-1 and k
+            th = LAD[k] * 0.9 if k else LAD[0]
+            out = bisect(Stand(th))
+            self.assertEqual(out["limit_index"], k, k)
+            self.assertEqual(out["proven_index"], k, k)
+            failing = [p["size"] for p in out["probes"] if not p["passed"]]
+            self.assertTrue(all(s < LAD[k] for s in failing))
+
+    def test_above_the_ladder(self):
+        out = bisect(Stand(LAD[-1] * 2))
+        self.assertIsNone(out["limit"])
+        self.assertIsNone(out["proven"])
+        self.assertEqual(out["verify"], [])
+
+    def test_one_miss_in_twenty_passes_two_fail(self):
+        k = 7
+        th = LAD[k] * 0.9
+        out = bisect(Stand(th, misses={(k, 3)}), n_verify=0)
+        self.assertEqual(out["limit_index"], k)
+        at = next(p for p in out["probes"] if p["size"] == LAD[k])
+        self.assertEqual((at["detected"], at["logs"]), (19, 20))
+        out = bisect(Stand(th, misses={(k, 3), (k, 11)}), n_verify=0)
+        self.assertEqual(out["limit_index"], k + 1)
+        at = next(p for p in out["probes"] if p["size"] == LAD[k])
+        # the size stops at its second miss
+        self.assertEqual((at["detected"], at["logs"], at["passed"]), (10, 12, False))
+
+
+class Proof(unittest.TestCase):
+    def test_proof_runs_every_log_and_reuses_none_it_should_not(self):
+        k = 6
+        st = Stand(LAD[k] * 0.9)
+        out = bisect(st)
+        self.assertEqual(out["proven_index"], k)
+        pv = out["verify"][-1]
+        self.assertEqual((pv["detected"], pv["logs"], pv["passed"]), (59, 59, True))
+        # the proof's logs at the limit are the bisection's 20 plus 39 more (same keys, j = 0..58)
+        self.assertEqual(sorted(j for si, j in st.calls if si == k and j >= 20), list(range(20, 59)))
+
+    def test_a_miss_in_the_proof_steps_up(self):
+        k = 6
+        # one miss among the proof's extra logs at the limit: the bisection passes
+        # it (1 of 20 allowed is not even used), the proof does not
+        out = bisect(Stand(LAD[k] * 0.9, misses={(k, 40)}))
+        self.assertEqual(out["limit_index"], k)
+        self.assertEqual(out["proven_index"], k + 1)
+        first, second = out["verify"]
+        self.assertEqual((first["detected"], first["logs"], first["passed"]), (40, 41, False))
+        self.assertEqual((second["detected"], second["logs"], second["passed"]), (59, 59, True))
+
+    def test_proof_reported_in_the_summary_and_page(self):
+        k = 4
+        out = bisect(Stand(LAD[k] * 0.9, misses={(k, 25)}))
+        res = {"cause": {(lv, CAUSE): dict(out) for lv in ("EMPS", "quiet")},
+               "nominal": {lv: {(0, 1): [("none", [])]} for lv in ("EMPS", "quiet")}}
+        s = dl.summarize(res, (("EMPS", 0.2), ("quiet", 0.02)), 20, 1, [CAUSE], 59)
+        c = s["levels"]["quiet"]["causes"][CAUSE]
+        self.assertAlmostEqual(c["proven_lower"], dl.cp_lower(59, 59))
+        md = dl.markdown(s, "cmd", 1.0)
+        row = next(line for line in md.splitlines() if line.startswith(f"| {CAUSE} | offset"))
+        self.assertIn(f"**{dl._fmt(LAD[k + 1], 'N')}**: 59/59, ≥ {100 * dl.cp_lower(59, 59):.1f} % (1 size up from the limit)", row)
+        self.assertTrue(re.search(r"at least 95 % at 95 % confidence", md))
+
+
+if __name__ == "__main__":
+    unittest.main()
