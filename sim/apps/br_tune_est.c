@@ -4,7 +4,7 @@
  * H-inf + PF (or + UKF) circle over the log of the noise variances.
  *
  * Usage: br_tune_est --est pf|ukf --out HEADER [--log CSV] [--max-fev N]
- *                    [--plants P1.json,P2.json,... [--stat median|p90]]
+ *                    [--plants P1.json,P2.json,... [--stat median|p90]] [--guard-noise F]
  * --plants: the robust objective (docs/robustness.md, "Robust tuning"): the
  * penalised contour RMS on each plant (model.json files, e.g. the robustness
  * study's plant.json), and its median or 90th percentile (nearest rank) over
@@ -43,6 +43,7 @@ typedef struct {
     int n_plants;           /* 0: the nominal plant alone */
     br_plant_cfg_t plants[MAX_PLANTS];
     int p90;                /* 1: the 90th percentile over the plants, 0: the median */
+    double guard_noise_N;   /* the PF's second guard plant's force noise (--guard-noise) */
     /* the searches before this one (several starts): their iterations,
      * evaluations, best value and point, so that the log runs on monotonically */
     int iter0, nfev0;
@@ -96,8 +97,10 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* the force noise of the PF's second guard plant, N (the robustness study's
- * largest, sim/studies/robustness.py) */
+ * largest, sim/studies/robustness.py); --guard-noise sets another, up to
+ * BR_TUNE_GUARD_NOISE_MAX_N (a noisier machine's) */
 #define BR_TUNE_GUARD_FORCE_NOISE_N 0.2
+#define BR_TUNE_GUARD_NOISE_MAX_N 10.0
 /* the bristle stiffness and damping factor of its third (the study's largest) */
 #define BR_TUNE_GUARD_BRISTLE_FACTOR 2.0
 /* the objective of a tuning that stops safe on a guard plant: above any
@@ -115,14 +118,14 @@ static int cmp_double(const void *a, const void *b)
  * 3. the same with bristles at the top of the study's stiffness and damping
  *    range (a factor 2 on the reference's): a tuning that holds lock only on
  *    soft bristles is none either. */
-static double guard_penalty(const br_circle_cfg_t *c)
+static double guard_penalty(const br_circle_cfg_t *c, double noise_N)
 {
     const br_circle_cfg_t ref = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     double failed = 0.0;
     for (int k = 0; k < 3; k++) {
         br_circle_cfg_t cr = br_circle_cfg_realistic(BR_CTRL_HINF_PF);
         cr.pf = c->pf;
-        if (k >= 1) cr.real.force_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N;
+        if (k >= 1) cr.real.force_noise_N = noise_N;
         if (k == 2) {
             cr.plant.sigma0_Npm = BR_TUNE_GUARD_BRISTLE_FACTOR * ref.plant.sigma0_Npm;
             cr.plant.sigma1_Nspm = BR_TUNE_GUARD_BRISTLE_FACTOR * ref.plant.sigma1_Nspm;
@@ -146,7 +149,7 @@ static double objective(void *user, const double *x, int n)
     if (t->n_plants == 0) {
         const double f = one_plant(&c, 0);
         if (t->pf && isfinite(f)) {
-            const double g = guard_penalty(&c);
+            const double g = guard_penalty(&c, t->guard_noise_N);
             if (g > 0.0) return g;
         }
         return f;
@@ -192,8 +195,9 @@ static int usage(const char *argv0, FILE *to)
             "  --max-fev N         evaluation budget of the Nelder-Mead search\n"
             "  --plants LIST       model.json files, comma-separated: tune for a set of plants (robust objective)\n"
             "  --stat median|p90   the set's statistic the objective takes (default median)\n"
-            "bounds: --max-fev 1 .. %d (docs/tools.md), at most %d plants\n",
-            argv0, argv0, BR_TOOL_MAX_FEV, MAX_PLANTS);
+            "  --guard-noise F     PF: the force noise of the noisy guard plant, N (default %g)\n"
+            "bounds: --max-fev 1 .. %d (docs/tools.md), at most %d plants, --guard-noise 0 .. %g\n",
+            argv0, argv0, BR_TUNE_GUARD_FORCE_NOISE_N, BR_TOOL_MAX_FEV, MAX_PLANTS, BR_TUNE_GUARD_NOISE_MAX_N);
     return 2;
 }
 
@@ -201,12 +205,14 @@ int main(int argc, char **argv)
 {
     const char *est = NULL, *out = NULL, *log_path = NULL, *plants = NULL, *stat = "median";
     long max_fev = 0;
+    double guard_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N;
     static const struct option opts[] = {{"est", required_argument, NULL, 'e'},
                                          {"out", required_argument, NULL, 'o'},
                                          {"log", required_argument, NULL, 'l'},
                                          {"max-fev", required_argument, NULL, 'n'},
                                          {"plants", required_argument, NULL, 'p'},
                                          {"stat", required_argument, NULL, 's'},
+                                         {"guard-noise", required_argument, NULL, 'g'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -219,6 +225,7 @@ int main(int argc, char **argv)
         case 'l': log_path = v; break;
         case 'n': bad = br_arg_long(TOOL, p.opt, v, 1, BR_TOOL_MAX_FEV, &max_fev); break;
         case 'p': plants = v; break;
+        case 'g': bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_TUNE_GUARD_NOISE_MAX_N, &guard_noise_N); break;
         case 's':
             if (strcmp(v, "median") == 0 || strcmp(v, "p90") == 0) {
                 stat = v;
@@ -246,6 +253,7 @@ int main(int argc, char **argv)
     static tune_t t;
     t.pf = strcmp(est, "pf") == 0;
     t.p90 = strcmp(stat, "p90") == 0;
+    t.guard_noise_N = guard_noise_N;
     t.n_plants = 0;
     if (plants) {
         const br_plant_cfg_t ref = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY).plant;

@@ -222,6 +222,8 @@ class ToolsTest(unittest.TestCase):
         r = run("br_tune_est", "--est", "pf", "--out", header, "--plants", os.path.join(self.w, "none.json"))
         self.assert_refused(r, 1, "cannot open")
         self.assertNotIn("tuning", r.stdout)
+        for bad in (["--guard-noise", "-0.1"], ["--guard-noise", "11"], ["--guard-noise", "nan"]):
+            self.assert_refused(run("br_tune_est", "--est", "pf", "--out", header, *bad), 2)
         self.assert_untouched(header, log)
 
 
