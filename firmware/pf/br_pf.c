@@ -48,6 +48,47 @@ static inline float fnl_sel(const br_model_k_t *k, float om, float z, float gp, 
 #define BR_PF_W_ONE (1u << BR_PF_W_BITS)
 
 
+/* cfg.proposal: the step's constants (docs/modules/pf.md, "A proposal that
+ * uses the measurement"). The prior of (theta, omega) around the particle's
+ * noise-free prediction has the covariance
+ *   S_tt = Q_t + c^2 Q_w,  S_tw = c Q_w,  S_ww = Q_w
+ * with c = h/2 (OPT_HELD: omega's noise an acceleration held over the
+ * period) or 0 (OPT); y measures theta with variance R, so S = S_tt + R,
+ * the gains k_t = S_tt / S, k_w = S_tw / S, and given y the covariance
+ *   P_tt = S_tt R / S,  P_tw = S_tw R / S,  P_ww = S_ww - S_tw^2 / S
+ * whose Cholesky factor is l00 = sqrt(P_tt), l10 = P_tw / l00 and
+ * l11 = sqrt(P_ww - l10^2) = sqrt(Q_w Q_t / S_tt) (S_tt > 0; sqrt(Q_w) when
+ * S_tt = 0, where S_tw = 0 too). The gate then compares the predicted
+ * residual with S instead of R. Returns BR_E_PARAM when a constant is not
+ * finite (pf->cfg, q_std and r_gate are set). */
+static br_status_t proposal_init(br_pf_t *pf)
+{
+    const float qt = pf->cfg.est.q_var[BR_X_THETA], qw = pf->cfg.est.q_var[BR_X_OMEGA];
+    const float r = pf->cfg.est.r_var_rad2;
+    const float c = (pf->cfg.proposal == BR_PF_PROPOSAL_OPT_HELD) ? 0.5f * pf->cfg.est.model.dt_s : 0.0f;
+    const float s_tt = qt + c * c * qw, s_tw = c * qw;
+    const float s = s_tt + r;
+    const float r_s = r / s;
+    pf->prop_k_th = s_tt / s;
+    pf->prop_k_om = s_tw / s;
+    pf->prop_l00 = sqrtf(s_tt * r_s);
+    pf->prop_l10 = (s_tt > 0.0f) ? s_tw * sqrtf(r_s) / sqrtf(s_tt) : 0.0f;
+    pf->prop_l11 = (s_tt > 0.0f) ? sqrtf(qw * (qt / s_tt)) : pf->q_std[BR_X_OMEGA];
+    pf->prop_inv_2s = 0.5f / s;
+    pf->prop_hold = c * pf->q_std[BR_X_OMEGA];
+    /* outlier when min_j e_j^2 > g^2 (S + rpc^2 / 12): max_j l_j < -g^2 (S + rpc^2 / 12) / (2 S) */
+    pf->outlier_l = -0.5f * pf->cfg.est.outlier_sigma * pf->cfg.est.outlier_sigma *
+                    (1.0f + pf->cfg.est.rad_per_count * pf->cfg.est.rad_per_count * (1.0f / 12.0f) / s);
+    const float k[] = {pf->prop_k_th, pf->prop_k_om, pf->prop_l00, pf->prop_l10,
+                       pf->prop_l11,  pf->prop_inv_2s, pf->prop_hold, pf->outlier_l};
+    for (size_t i = 0; i < sizeof k / sizeof k[0]; i++) {
+        if (!isfinite(k[i])) {
+            return BR_E_PARAM;
+        }
+    }
+    return BR_OK;
+}
+
 br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
 {
     if (pf == NULL || cfg == NULL) {
@@ -80,6 +121,9 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
            ad->alpha <= 1.0f && ad->max_scale >= 1.0f && ad->max_scale <= BR_EST_VAR_MAX))) {
         return BR_E_PARAM;
     }
+    if (cfg->proposal > BR_PF_PROPOSAL_OPT_HELD) {
+        return BR_E_PARAM;
+    }
     /* g_p is static in the model: its process noise is the only thing that keeps
      * the resampled particles apart in g_p; without it the cloud collapses */
     if (!(cfg->est.q_var[BR_X_GP] > 0.0f)) {
@@ -103,6 +147,9 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     pf->r_gate = cfg->est.r_var_rad2 + cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f);
     pf->nis_avg = 0.0f;
     pf->q_scale_std = 1.0f;
+    if (cfg->proposal != BR_PF_PROPOSAL_PRIOR && proposal_init(pf) != BR_OK) {
+        return BR_E_PARAM;
+    }
     pf->noise_pos = 0u;
     pf->origin_counts = 0;
     pf->primed = 0;
@@ -438,6 +485,8 @@ typedef struct {
     float u;          /* torque over the period, N m */
     float shift;      /* theta of the new origin relative to the old one, rad */
     float y_rel;      /* the measurement relative to the new origin, rad */
+    int prop;         /* cfg.proposal on a measured step: theta and omega drawn given y */
+    float hold;       /* the prior's coupling of omega's sample into theta (OPT_HELD), else 0 */
 } pred_t;
 
 /* g_p limited to [lo, hi] with selects (fmaxf/fminf are library calls on
@@ -467,10 +516,32 @@ BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t
             br_model_bounded_step(&pf->model, x, c->u, xn);
         }
     }
-    /* process noise sqrt(Q) n */
-    const float th_old = xn[BR_X_THETA] + c->q[0] * n[0]; /* relative to the last origin */
-    const float th = th_old - c->shift;
-    const float om = xn[BR_X_OMEGA] + c->q[1] * n[1];
+    float th_old, th, om, l_prop = 0.0f;
+    if (c->prop) {
+        /* cfg.proposal, a measured step: (theta, omega) drawn from their Gaussian
+         * given y around the noise-free prediction mu (proposal_init); the
+         * weight is the predictive likelihood of y, -e^2 / (2 S), e = mu - y */
+        const float mu = xn[BR_X_THETA] - c->shift;
+        const float e = mu - c->y_rel;
+        th = (mu - pf->prop_k_th * e) + pf->prop_l00 * n[0];
+        th_old = th + c->shift;
+        om = ((xn[BR_X_OMEGA] - pf->prop_k_om * e) + pf->prop_l10 * n[0]) + pf->prop_l11 * n[1];
+        l_prop = -(e * e) * pf->prop_inv_2s;
+        /* the prior's draw of theta with the same samples, parked in W (step 3
+         * overwrites it) for cfg.adapt's innovation of the predicted cloud */
+        const float th_prior = ((mu + c->q[0] * n[0]) + c->hold * n[1]);
+        memcpy(&pf->W[j], &th_prior, sizeof th_prior);
+    } else if (c->hold != 0.0f) {
+        /* OPT_HELD without a measurement: the prior, omega's sample moving theta by h/2 of it */
+        th_old = (xn[BR_X_THETA] + c->q[0] * n[0]) + c->hold * n[1];
+        th = th_old - c->shift;
+        om = xn[BR_X_OMEGA] + c->q[1] * n[1];
+    } else {
+        /* process noise sqrt(Q) n */
+        th_old = xn[BR_X_THETA] + c->q[0] * n[0]; /* relative to the last origin */
+        th = th_old - c->shift;
+        om = xn[BR_X_OMEGA] + c->q[1] * n[1];
+    }
     const float z = xn[BR_X_Z] + c->q[2] * n[2];
     const float gp = clamp_sel(xn[BR_X_GP] + c->q[3] * n[3], c->gp_min, c->gp_max);
     /* BR_PF_ONE_DIVISION: the particle's one division, k_p = sigma0 L / g_p for eq. 4 here and in the next step */
@@ -499,7 +570,7 @@ BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t
         /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R);
          * may be -inf for a particle far from y: still valid (NaN marks invalid) */
         const float e = th - c->y_rel;
-        const float l = -(e * e) * c->inv_2r;
+        const float l = c->prop ? l_prop : -(e * e) * c->inv_2r;
         pf->l[j] = l;
         *l_out = l;
         return 1;
@@ -623,7 +694,8 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
 /* Steps 1 and 2 for every particle: prediction in place, the force to
  * compensate (f_nl for the thesis model), log-weight. Returns the number of
  * valid (finite) predicted particles and their largest log-weight in *lmax. */
-static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, float *lmax)
+static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, int measured,
+                                  float *lmax)
 {
     /* the model's clock moves on by one period (friction_drift) */
     br_model_tick(&pf->model);
@@ -645,11 +717,14 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     c.u = u_prev_Nm;
     c.shift = shift;
     c.y_rel = y_rel;
+    c.prop = measured && pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR;
+    c.hold = (pf->cfg.proposal == BR_PF_PROPOSAL_OPT_HELD) ? pf->prop_hold : 0.0f;
     const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
     lsum_t ls = {-INFINITY, 0u};
     float l, n[BR_NX];
-    if (pf->model.extended || pf->cfg.scalar_path) {
-        /* one particle at a time (the extended model always: its kernel branches) */
+    if (pf->model.extended || pf->cfg.scalar_path || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR) {
+        /* one particle at a time (the extended model always: its kernel branches;
+         * cfg.proposal always: the vector loop draws from the prior) */
         for (uint32_t j = 0; j < m; j++) {
             noise_wrapped(pf, j, n);
             if (pf->model.extended ? particle_one(pf, &c, 1, j, n, &l) : particle_one(pf, &c, 0, j, n, &l)) {
@@ -814,10 +889,16 @@ static void adapt_update(br_pf_t *pf, float y_rel)
 {
     const uint32_t m = pf->cfg.n_particles;
     const float *const th = pf->x[BR_X_THETA], *const l = pf->l;
+    const int prop = pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR;
     float s1 = 0.0f, s2 = 0.0f, n = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
         const float v = (l[j] == l[j]) ? 1.0f : 0.0f; /* valid: not NaN */
-        const float d = (th[j] - y_rel) * v;
+        /* cfg.proposal: the prior's draw of theta parked in W by particle_one */
+        float t = th[j];
+        if (prop && v != 0.0f) {
+            memcpy(&t, &pf->W[j], sizeof t);
+        }
+        const float d = (t - y_rel) * v;
         s1 += d;
         s2 += d * d;
         n += v;
@@ -858,7 +939,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     const float shift = (float)br_counts_delta(y->counts, pf->origin_counts) * rpc;
     const float y_rel = y->frac * rpc;
     float lmax;
-    const uint32_t n_valid = predict_and_weigh(pf, u_a, shift, y_rel, &lmax);
+    const uint32_t n_valid = predict_and_weigh(pf, u_a, shift, y_rel, 1, &lmax);
     noise_advance(pf);
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
@@ -943,7 +1024,7 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     const uint32_t m = pf->cfg.n_particles;
     /* step 1 only: the log-weights against a dummy measurement are not used */
     float lmax;
-    const uint32_t n_valid = predict_and_weigh(pf, br_est_delay_apply(&pf->delay, u_prev_Nm), 0.0f, 0.0f, &lmax);
+    const uint32_t n_valid = predict_and_weigh(pf, br_est_delay_apply(&pf->delay, u_prev_Nm), 0.0f, 0.0f, 0, &lmax);
     noise_advance(pf);
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */

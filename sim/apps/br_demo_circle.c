@@ -116,17 +116,20 @@ typedef struct {
     float K[3];
     double dt;
     long nsub;
+    long pf_prop; /* -1: the machine's */
 } opts_t;
 
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N]\n" BR_ARGS_COMMON_USAGE
+            "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
             "  --gains K0,K1,K2    the H-inf gains instead of the generated ones\n"
             "  --dt S              control period\n"
             "  --nsub N            plant substeps per period\n"
+            "  --pf-proposal K     the PF's proposal: 0 the prior (thesis), 1 optimal for theta, 2 with omega's\n"
+            "                      noise held over the period (docs/modules/pf.md)\n"
             "bounds: --dt %g .. %g s, --nsub 1 .. %d, |gain| <= %g (docs/tools.md)\n",
             argv0, argv0, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX, BR_TOOL_GAIN_MAX);
     return 2;
@@ -149,6 +152,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"gains", required_argument, NULL, 'g'},
                                          {"dt", required_argument, NULL, 'd'},
                                          {"nsub", required_argument, NULL, 'n'},
+                                         {"pf-proposal", required_argument, NULL, 'p'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     const int st = br_args_begin(&p, TOOL, argc, argv);
@@ -167,6 +171,7 @@ static int parse(int argc, char **argv, opts_t *o)
             break;
         case 'd': bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, &o->dt); break;
         case 'n': bad = br_arg_long(TOOL, p.opt, val, 1, BR_TOOL_NSUB_MAX, &o->nsub); break;
+        case 'p': bad = br_arg_long(TOOL, p.opt, val, 0, (long)BR_PF_PROPOSAL_OPT_HELD, &o->pf_prop); break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
@@ -193,7 +198,7 @@ static int finite_result(const br_circle_result_t *r)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0};
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -269,6 +274,7 @@ int main(int argc, char **argv)
                 cfg.ukf.est.model.dt_s = (float)opt.dt;
             }
             if (opt.nsub > 0) cfg.plant.n_sub = (int)opt.nsub;
+            if (opt.pf_prop >= 0) cfg.pf.proposal = (uint32_t)opt.pf_prop;
             sinks_t k = {o.trace[pl][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl].f : NULL};
             br_circle_csv_header(k.trace);
             if (k.hist)

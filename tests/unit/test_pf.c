@@ -103,6 +103,13 @@ static void test_init_guards(void **st)
     c = cfg_adapt(); c.adapt.max_scale = 0.5f;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg_adapt(); c.adapt.max_scale = 2.0f * BR_EST_VAR_MAX; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg_adapt(); c.adapt.max_scale = NAN;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    /* cfg.proposal: one of BR_PF_PROPOSAL_*; its constants finite (a period
+     * so long that (h/2)^2 Q_omega overflows is refused with OPT_HELD only) */
+    c = cfg(100); c.proposal = BR_PF_PROPOSAL_OPT_HELD + 1u; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.proposal = BR_PF_PROPOSAL_OPT_HELD;   assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c = cfg(100); c.est.model.dt_s = 1e20f;               assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c.proposal = BR_PF_PROPOSAL_OPT;                      assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c.proposal = BR_PF_PROPOSAL_OPT_HELD;                 assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_E_STATE); /* last init failed */
     free(pf);
@@ -632,6 +639,67 @@ static void test_likelihood_scale(void **st)
     free(pf);
 }
 
+/* cfg.proposal against its equations in float64 (docs/modules/pf.md, "A
+ * proposal that uses the measurement"), one particle (no resampling to hide
+ * the draw), Q_theta = R so that the gain on theta is about 1/2: step k of a
+ * copy through br_pf_predict gives the prior's draw with the same noise
+ * samples n (OPT_HELD: theta + q_t n0 + (h/2) q_w n1), from which the
+ * noise-free prediction mu; then with S = Q_t + c^2 Q_w + R, e = mu - y,
+ *   l = -e^2 / (2 S),  theta = mu - (S_tt / S) e + sqrt(S_tt R / S) n0,
+ *   omega = mu_w - (S_tw / S) e + l10 n0 + l11 n1.
+ * With the prior's draw (the thesis filter) l is -(theta - y)^2 / (2 R) and
+ * theta is not pulled towards y: every assertion on l and theta fails. */
+static void proposal_matches_equations(uint32_t mode)
+{
+    br_pf_t *pf = calloc(1, sizeof *pf), *pred = malloc(sizeof *pred);
+    assert_non_null(pf);
+    assert_non_null(pred);
+    br_pf_cfg_t c = cfg(1);
+    c.proposal = mode;
+    c.est.q_var[BR_X_THETA] = c.est.r_var_rad2;
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    br_meas_t y = {100, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    const double R = c.est.r_var_rad2, qt = c.est.q_var[BR_X_THETA], qw = c.est.q_var[BR_X_OMEGA];
+    const double ch = (mode == BR_PF_PROPOSAL_OPT_HELD) ? 0.5 * (double)c.est.model.dt_s : 0.0;
+    const double stt = qt + ch * ch * qw, stw = ch * qw, S = stt + R;
+    const double l00 = sqrt(stt * R / S), l10 = stw * R / S / l00, l11 = sqrt(qw - stw * stw / S - l10 * l10);
+    double pull = 0.0;
+    for (int k = 0; k < 40; k++) {
+        memcpy(pred, pf, sizeof *pf);
+        const uint32_t pos = pf->noise_pos, mask = c.noise_len - 1u;
+        const double n0 = c.noise[pos & mask], n1 = c.noise[(pos + 1u) & mask];
+        const float u = 0.01f * (float)(k % 4);
+        assert_int_equal(br_pf_predict(pred, u), BR_OK); /* theta relative to the old origin */
+        /* a measurement on either side of the predicted particle, up to 2.1 counts away */
+        static const double d[5] = {-1.5, -0.6, 0.4, 1.3, 2.1};
+        const double target = (double)pf->origin_counts + (double)pred->x[BR_X_THETA][0] / (double)RPC + d[k % 5];
+        const br_meas_t yk = {(int32_t)floor(target), (float)(target - floor(target))};
+        const double shift = (double)(yk.counts - pf->origin_counts) * (double)RPC;
+        const double mu = ((double)pred->x[BR_X_THETA][0] - sqrt(qt) * n0 - ch * sqrt(qw) * n1) - shift;
+        const double mu_w = (double)pred->x[BR_X_OMEGA][0] - sqrt(qw) * n1;
+        const double e = mu - (double)yk.frac * (double)RPC;
+        assert_int_equal(br_pf_step(pf, &yk, u), BR_OK);
+        const double l = -e * e / (2.0 * S);
+        const double th = mu - stt / S * e + l00 * n0, om = mu_w - stw / S * e + l10 * n0 + l11 * n1;
+        BR_ASSERT_NEAR(pf->l[0], l, 1e-4 * fabs(l) + 1e-6);
+        BR_ASSERT_NEAR(pf->x[BR_X_THETA][0], th, 1e-3 * sqrt(R) + 1e-6 * fabs(th));
+        BR_ASSERT_NEAR(pf->x[BR_X_OMEGA][0], om, 1e-3 * sqrt(qw) + 1e-6 * fabs(om));
+        pull = fmax(pull, fabs(stt / S * e) / sqrt(R));
+    }
+    /* the draws were pulled by more than the tolerances: the equations were exercised */
+    assert_true(pull > 0.1);
+    free(pred);
+    free(pf);
+}
+
+static void test_proposal_matches_equations(void **st)
+{
+    (void)st;
+    proposal_matches_equations(BR_PF_PROPOSAL_OPT);
+    proposal_matches_equations(BR_PF_PROPOSAL_OPT_HELD);
+}
+
 /* The adapt tests need the reference machine: its file switches adapt on
  * (heavy and emps keep it off) and plant 0 is drawn around it. They are
  * built only in the reference machine's configuration (BR_TEST_THESIS_MACHINE,
@@ -744,6 +812,7 @@ int main(void)
         cmocka_unit_test(test_one_invalid_particle),
         cmocka_unit_test(test_fnl_overflow_is_invalid),
         cmocka_unit_test(test_likelihood_scale),
+        cmocka_unit_test(test_proposal_matches_equations),
 #ifdef BR_TEST_THESIS_MACHINE
         cmocka_unit_test(test_adapt_is_thesis_filter_below_ref),
         cmocka_unit_test(test_adapt_keeps_lock_under_force_noise),

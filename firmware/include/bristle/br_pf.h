@@ -62,6 +62,20 @@ typedef struct {
     float max_scale; /* largest variance factor, >= 1 (when on) */
 } br_pf_adapt_t;
 
+/* cfg.proposal (docs/modules/pf.md, "A proposal that uses the measurement"):
+ * how step 1 draws theta and omega. PRIOR: the thesis's bootstrap filter
+ * (x_j <- f_d(x_j) + sqrt(Q) n_j, weighed by the likelihood). OPT: the
+ * locally optimal proposal of this model: theta_j drawn from
+ * p(theta | predicted mean, y), the weight the predictive likelihood
+ * N(y; mean theta_j, Q_theta + R); omega, z, g_p as the prior draws them.
+ * OPT_HELD: omega's process noise taken as an acceleration held over the
+ * period (it moves theta by h/2 of it), so theta and omega are correlated in
+ * Q and the proposal corrects both. A measured step only; the scalar path
+ * runs it (the vector path's loops are the prior's). */
+#define BR_PF_PROPOSAL_PRIOR 0u
+#define BR_PF_PROPOSAL_OPT 1u
+#define BR_PF_PROPOSAL_OPT_HELD 2u
+
 typedef struct {
     br_est_cfg_t est;        /* what the PF shares with the UKF: model (est.model.dt_s is the PF's
                                 period), noise, g_p range, gates; outlier: |y - theta_j| >
@@ -75,6 +89,7 @@ typedef struct {
                                 0 (default): the structure-of-arrays loops the compiler vectorises,
                                 the rare cases fixed up in scalar; both give identical results */
     br_pf_adapt_t adapt;     /* innovation-driven process noise of z and g_p (all 0: off) */
+    uint32_t proposal;       /* BR_PF_PROPOSAL_*: 0 (default) the thesis's bootstrap filter */
 } br_pf_cfg_t;
 
 typedef struct {
@@ -100,6 +115,12 @@ typedef struct {
     float r_gate;                 /* R + rpc^2 / 12, rad^2 */
     float nis_avg;                /* cfg.adapt: the smoothed NIS, E */
     float q_scale_std;            /* cfg.adapt: sqrt(s), the factor on z's and g_p's noise std (1: the thesis filter) */
+    /* cfg.proposal (constants of the step, from Q, R and h at init): the gains
+     * of theta and omega on the predicted residual, the Cholesky factor
+     * [l00 0; l10 l11] of their covariance given y, 1 / (2 S) with
+     * S = Q_theta' + R, and the prior's coupling h/2 sqrt(Q_omega) of omega's
+     * sample into theta (OPT_HELD; 0 otherwise) */
+    float prop_k_th, prop_k_om, prop_l00, prop_l10, prop_l11, prop_inv_2s, prop_hold;
     int primed;                   /* particles drawn around the first measurement */
     /* particles as a structure of arrays: x[i][j] is state i of particle j.
      * One set, predicted and resampled in place (docs/modules/pf.md). */
