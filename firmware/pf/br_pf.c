@@ -461,7 +461,7 @@ typedef struct {
     float s1, s2;
 } lsum_t;
 
-/* a valid particle: log-weight l, innovation e = theta_j - y */
+/* a valid particle: log-weight l, innovation e = theta_j - y (d_j = e 1 = e) */
 static inline void lsum_add(lsum_t *s, float l, float e)
 {
     s->lmax = (l > s->lmax) ? l : s->lmax; /* fmaxf for l not NaN */
@@ -483,10 +483,9 @@ static inline void lsum_skip(lsum_t *s, float th, float y_rel)
  * and the fix-up of the vector loop's rare cases (the bounded scheme, an
  * invalid prediction). n: its BR_NX standard-normal samples. The particle is
  * overwritten by its prediction when that is valid and added to *ls
- * (lsum_add); returns 1 then, else 0 (the particle keeps its state, f_nl = 0,
- * l = NaN; lsum_skip). ext: the extended model's kernel (a constant at each
- * call site). */
-BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j, const float n[BR_NX], lsum_t *ls)
+ * (lsum_add); otherwise it keeps its state, f_nl = 0, l = NaN (lsum_skip).
+ * ext: the extended model's kernel (a constant at each call site). */
+BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j, const float n[BR_NX], lsum_t *ls)
 {
     float x[BR_NX], xn[BR_NX];
     particle_get(pf, j, x);
@@ -534,14 +533,13 @@ BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t
         const float l = -(e * e) * c->inv_2r;
         pf->l[j] = l;
         lsum_add(ls, l, e);
-        return 1;
+        return;
     }
     /* unusable: the particle keeps its state and gets weight 0; its log-weight
      * is NaN, which no valid particle's can be */
     pf->fnl[j] = 0.0f;
     pf->l[j] = NAN;
     lsum_skip(ls, x[BR_X_THETA], c->y_rel);
-    return 0;
 }
 
 /* the BR_NX samples of particle j, read round the end of the table */
@@ -646,8 +644,8 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
 
 /* cfg.adapt's sums over particles k0 .. k1 - 1 in their order, from the
  * predicted set (the fix-up's runs): d = (theta_k - y) v with v = 1 for a
- * valid particle (l not NaN) and 0 for one kept at its state; the same
- * operations on the same values as lsum_add and lsum_skip. */
+ * valid particle (l not NaN) and 0 for one kept at its state: the same
+ * additions of the same values as lsum_add and lsum_skip (e 1 = e). */
 static void adapt_sums(const br_pf_t *pf, float y_rel, uint32_t k0, uint32_t k1, lsum_t *ls)
 {
     const float *const th = pf->x[BR_X_THETA], *const l = pf->l;
@@ -697,9 +695,9 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
         for (uint32_t j = 0; j < m; j++) {
             noise_wrapped(pf, j, n);
             if (pf->model.extended) {
-                (void)particle_one(pf, &c, 1, j, n, &ls);
+                particle_one(pf, &c, 1, j, n, &ls);
             } else {
-                (void)particle_one(pf, &c, 0, j, n, &ls);
+                particle_one(pf, &c, 0, j, n, &ls);
             }
         }
     } else {
@@ -711,7 +709,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             const uint32_t room = (mask + 1u - p) / BR_NX; /* particles before the wrap */
             if (room == 0u) {
                 noise_wrapped(pf, j, n);
-                (void)particle_one(pf, &c, 0, j, n, &ls);
+                particle_one(pf, &c, 0, j, n, &ls);
                 j++;
                 continue;
             }
@@ -722,7 +720,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
                 /* the fix-up: redo the particles the vector loop left (l = NaN) in scalar */
                 for (uint32_t k = j; k < j1; k++) {
                     if (pf->l[k] != pf->l[k]) {
-                        (void)particle_one(pf, &c, 0, k, nz + BR_NX * (k - j), &ls);
+                        particle_one(pf, &c, 0, k, nz + BR_NX * (k - j), &ls);
                     }
                 }
                 /* cfg.adapt's sums over the run again, in particle order */
