@@ -497,13 +497,44 @@ static inline float clamp_sel(float v, float lo, float hi)
     return (a < hi) ? a : hi;
 }
 
+/* Largest log-weight so far and the count of valid particles. l <= -0 for a
+ * valid particle, so its bit pattern as int32 (its key) is negative and
+ * orders the other way round: the largest l has the smallest key (the vector
+ * loop reduces the keys with an integer min, which vectorises where fmaxf
+ * does not). s1, s2: cfg.adapt's sums over the particles in their order, of
+ * d_j = theta_j - y and of d_j^2, made from the innovation the log-weight
+ * forms (adapt_update). */
+typedef struct {
+    float lmax;
+    uint32_t n_valid;
+    float s1, s2;
+} lsum_t;
+
+/* a valid particle: log-weight l, innovation e = theta_j - y (d_j = e 1 = e) */
+static inline void lsum_add(lsum_t *s, float l, float e)
+{
+    s->lmax = (l > s->lmax) ? l : s->lmax; /* fmaxf for l not NaN */
+    s->n_valid++;
+    s->s1 += e;
+    s->s2 += e * e;
+}
+
+/* an invalid particle (kept at theta_j): d_j = (theta_j - y) 0, as
+ * adapt_sums adds it (it changes the sums only when theta_j - y is not finite) */
+static inline void lsum_skip(lsum_t *s, float th, float y_rel)
+{
+    const float d = (th - y_rel) * 0.0f;
+    s->s1 += d;
+    s->s2 += d * d;
+}
+
 /* Steps 1 and 2 for particle j, one at a time: the scalar reference path,
  * and the fix-up of the vector loop's rare cases (the bounded scheme, an
  * invalid prediction). n: its BR_NX standard-normal samples. The particle is
- * overwritten by its prediction when that is valid; returns 1 and its
- * log-weight in *l then, else 0 (the particle keeps its state, f_nl = 0,
- * l = NaN). ext: the extended model's kernel (a constant at each call site). */
-BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j, const float n[BR_NX], float *l_out)
+ * overwritten by its prediction when that is valid and added to *ls
+ * (lsum_add); otherwise it keeps its state, f_nl = 0, l = NaN (lsum_skip).
+ * ext: the extended model's kernel (a constant at each call site). */
+BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j, const float n[BR_NX], lsum_t *ls)
 {
     float x[BR_NX], xn[BR_NX];
     particle_get(pf, j, x);
@@ -516,7 +547,7 @@ BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t
             br_model_bounded_step(&pf->model, x, c->u, xn);
         }
     }
-    float th_old, th, om, l_prop = 0.0f;
+    float th_old, th, om, l_prop = 0.0f, th_a;
     if (c->prop) {
         /* cfg.proposal, a measured step: (theta, omega) drawn from their Gaussian
          * given y around the noise-free prediction mu (proposal_init); the
@@ -527,20 +558,21 @@ BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t
         th_old = th + c->shift;
         om = ((xn[BR_X_OMEGA] - pf->prop_k_om * e) + pf->prop_l10 * n[0]) + pf->prop_l11 * n[1];
         l_prop = -(e * e) * pf->prop_inv_2s;
-        /* the prior's draw of theta with the same samples, parked in W (step 3
-         * overwrites it) for cfg.adapt's innovation of the predicted cloud */
-        const float th_prior = ((mu + c->q[0] * n[0]) + c->hold * n[1]);
-        memcpy(&pf->W[j], &th_prior, sizeof th_prior);
+        /* the prior's draw of theta with the same samples: cfg.adapt's
+         * innovation of the predicted cloud is the prior's */
+        th_a = ((mu + c->q[0] * n[0]) + c->hold * n[1]);
     } else if (c->hold != 0.0f) {
         /* OPT_HELD without a measurement: the prior, omega's sample moving theta by h/2 of it */
         th_old = (xn[BR_X_THETA] + c->q[0] * n[0]) + c->hold * n[1];
         th = th_old - c->shift;
         om = xn[BR_X_OMEGA] + c->q[1] * n[1];
+        th_a = th;
     } else {
         /* process noise sqrt(Q) n */
         th_old = xn[BR_X_THETA] + c->q[0] * n[0]; /* relative to the last origin */
         th = th_old - c->shift;
         om = xn[BR_X_OMEGA] + c->q[1] * n[1];
+        th_a = th;
     }
     const float z = xn[BR_X_Z] + c->q[2] * n[2];
     const float gp = clamp_sel(xn[BR_X_GP] + c->q[3] * n[3], c->gp_min, c->gp_max);
@@ -572,14 +604,15 @@ BR_INLINE int particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t
         const float e = th - c->y_rel;
         const float l = c->prop ? l_prop : -(e * e) * c->inv_2r;
         pf->l[j] = l;
-        *l_out = l;
-        return 1;
+        /* cfg.adapt's sums take the prior's innovation (e itself without cfg.proposal) */
+        lsum_add(ls, l, c->prop ? th_a - c->y_rel : e);
+        return;
     }
     /* unusable: the particle keeps its state and gets weight 0; its log-weight
      * is NaN, which no valid particle's can be */
     pf->fnl[j] = 0.0f;
     pf->l[j] = NAN;
-    return 0;
+    lsum_skip(ls, x[BR_X_THETA], c->y_rel);
 }
 
 /* the BR_NX samples of particle j, read round the end of the table */
@@ -590,28 +623,14 @@ static void noise_wrapped(const br_pf_t *pf, uint32_t j, float n[BR_NX])
     }
 }
 
-/* Largest log-weight so far and the count of valid particles. l <= -0 for a
- * valid particle, so its bit pattern as int32 (its key) is negative and
- * orders the other way round: the largest l has the smallest key (the vector
- * loop reduces the keys with an integer min, which vectorises where fmaxf
- * does not). */
-typedef struct {
-    float lmax;
-    uint32_t n_valid;
-} lsum_t;
-
-static inline void lsum_add(lsum_t *s, float l)
-{
-    s->lmax = (l > s->lmax) ? l : s->lmax; /* fmaxf for l not NaN */
-    s->n_valid++;
-}
-
 /* Steps 1 and 2, thesis model, particles j0 .. j1 - 1 whose noise samples
  * are the contiguous nz[BR_NX (j - j0) + i]: branch-free, so that the
  * compiler vectorises it. A particle that needs the bounded scheme or whose
  * prediction is not valid keeps its state here (l = NaN) and is redone by
  * particle_one afterwards. Adds its valid particles to *ls; returns the
- * number of particles left for the fix-up. */
+ * number of particles left for the fix-up. cfg.adapt's sums take every
+ * particle's innovation in order, so they hold only when no particle is
+ * left (the caller makes them again after a fix-up). */
 BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t j0, uint32_t j1, const float *nz,
                                          lsum_t *ls)
 {
@@ -638,6 +657,7 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     const size_t n = j1 - j0;
     int32_t kmin = INT32_MAX;
     uint32_t n_ok = 0u;
+    float s1 = ls->s1, s2 = ls->s2;
     for (size_t j = 0; j < n; j++) {
         const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
         float xn[BR_NX];
@@ -666,6 +686,8 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         /* 2. log-likelihood */
         const float e = t - y_rel;
         const float l = -(e * e) * inv_2r;
+        s1 += e;
+        s2 += e * e;
         th[j] = ok ? t : x[BR_X_THETA];
         om[j] = ok ? w : x[BR_X_OMEGA];
         zz[j] = ok ? z : x[BR_X_Z];
@@ -682,6 +704,8 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         kmin = (key < kmin) ? key : kmin;
         n_ok += (uint32_t)ok;
     }
+    ls->s1 = s1;
+    ls->s2 = s2;
     if (n_ok > 0u) {
         float lm;
         memcpy(&lm, &kmin, sizeof lm);
@@ -691,11 +715,32 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     return (uint32_t)n - n_ok;
 }
 
+/* cfg.adapt's sums over particles k0 .. k1 - 1 in their order, from the
+ * predicted set (the fix-up's runs): d = (theta_k - y) v with v = 1 for a
+ * valid particle (l not NaN) and 0 for one kept at its state: the same
+ * additions of the same values as lsum_add and lsum_skip (e 1 = e). */
+static void adapt_sums(const br_pf_t *pf, float y_rel, uint32_t k0, uint32_t k1, lsum_t *ls)
+{
+    const float *const th = pf->x[BR_X_THETA], *const l = pf->l;
+    float s1 = ls->s1, s2 = ls->s2;
+    for (uint32_t k = k0; k < k1; k++) {
+        const float v = (l[k] == l[k]) ? 1.0f : 0.0f; /* valid: not NaN */
+        const float d = (th[k] - y_rel) * v;
+        s1 += d;
+        s2 += d * d;
+    }
+    ls->s1 = s1;
+    ls->s2 = s2;
+}
+
 /* Steps 1 and 2 for every particle: prediction in place, the force to
  * compensate (f_nl for the thesis model), log-weight. Returns the number of
- * valid (finite) predicted particles and their largest log-weight in *lmax. */
+ * valid (finite) predicted particles, their largest log-weight in *lmax and
+ * cfg.adapt's sums of d_j = theta_j - y_rel and d_j^2 in sums[0], sums[1]
+ * (adapt_sums' over all particles; with cfg.proposal, theta_j of the prior's
+ * draw). measured: 0 for br_pf_predict's step without a measurement. */
 static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, float y_rel, int measured,
-                                  float *lmax)
+                                  float *lmax, float sums[2])
 {
     /* the model's clock moves on by one period (friction_drift) */
     br_model_tick(&pf->model);
@@ -720,15 +765,17 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     c.prop = measured && pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR;
     c.hold = (pf->cfg.proposal == BR_PF_PROPOSAL_OPT_HELD) ? pf->prop_hold : 0.0f;
     const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
-    lsum_t ls = {-INFINITY, 0u};
-    float l, n[BR_NX];
+    lsum_t ls = {-INFINITY, 0u, 0.0f, 0.0f};
+    float n[BR_NX];
     if (pf->model.extended || pf->cfg.scalar_path || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR) {
         /* one particle at a time (the extended model always: its kernel branches;
          * cfg.proposal always: the vector loop draws from the prior) */
         for (uint32_t j = 0; j < m; j++) {
             noise_wrapped(pf, j, n);
-            if (pf->model.extended ? particle_one(pf, &c, 1, j, n, &l) : particle_one(pf, &c, 0, j, n, &l)) {
-                lsum_add(&ls, l);
+            if (pf->model.extended) {
+                particle_one(pf, &c, 1, j, n, &ls);
+            } else {
+                particle_one(pf, &c, 0, j, n, &ls);
             }
         }
     } else {
@@ -740,26 +787,31 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             const uint32_t room = (mask + 1u - p) / BR_NX; /* particles before the wrap */
             if (room == 0u) {
                 noise_wrapped(pf, j, n);
-                if (particle_one(pf, &c, 0, j, n, &l)) {
-                    lsum_add(&ls, l);
-                }
+                particle_one(pf, &c, 0, j, n, &ls);
                 j++;
                 continue;
             }
             const uint32_t j1 = (m - j < room) ? m : j + room;
             const float *const nz = pf->cfg.noise + p;
+            const float s1 = ls.s1, s2 = ls.s2;
             if (predict_vec(pf, &c, j, j1, nz, &ls) > 0u) {
                 /* the fix-up: redo the particles the vector loop left (l = NaN) in scalar */
                 for (uint32_t k = j; k < j1; k++) {
-                    if (pf->l[k] != pf->l[k] && particle_one(pf, &c, 0, k, nz + BR_NX * (k - j), &l)) {
-                        lsum_add(&ls, l);
+                    if (pf->l[k] != pf->l[k]) {
+                        particle_one(pf, &c, 0, k, nz + BR_NX * (k - j), &ls);
                     }
                 }
+                /* cfg.adapt's sums over the run again, in particle order */
+                ls.s1 = s1;
+                ls.s2 = s2;
+                adapt_sums(pf, y_rel, j, j1, &ls);
             }
             j = j1;
         }
     }
     *lmax = ls.lmax;
+    sums[0] = ls.s1;
+    sums[1] = ls.s2;
     return ls.n_valid;
 }
 
@@ -881,28 +933,14 @@ static float sum_set(const br_pf_t *pf, float s[BR_NX])
 }
 
 /* cfg.adapt: the normalised innovation squared of the predicted cloud,
- * (y - mean theta_j)^2 / (var theta_j + R + rpc^2 / 12) over the valid
- * particles (theta relative to the new origin; d_j = theta_j - y), limited
- * to outlier_sigma^2 (also for a NaN or an overflow); then E and the
- * factor on z's and g_p's noise std for the next predictions. */
-static void adapt_update(br_pf_t *pf, float y_rel)
+ * (y - mean theta_j)^2 / (var theta_j + R + rpc^2 / 12) over the n valid
+ * particles (theta relative to the new origin; d_j = theta_j - y, whose
+ * sums s1, s2 predict_and_weigh makes), limited to outlier_sigma^2 (also
+ * for a NaN or an overflow); then E and the factor on z's and g_p's noise
+ * std for the next predictions. */
+static void adapt_update(br_pf_t *pf, float s1, float s2, uint32_t n_valid)
 {
-    const uint32_t m = pf->cfg.n_particles;
-    const float *const th = pf->x[BR_X_THETA], *const l = pf->l;
-    const int prop = pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR;
-    float s1 = 0.0f, s2 = 0.0f, n = 0.0f;
-    for (uint32_t j = 0; j < m; j++) {
-        const float v = (l[j] == l[j]) ? 1.0f : 0.0f; /* valid: not NaN */
-        /* cfg.proposal: the prior's draw of theta parked in W by particle_one */
-        float t = th[j];
-        if (prop && v != 0.0f) {
-            memcpy(&t, &pf->W[j], sizeof t);
-        }
-        const float d = (t - y_rel) * v;
-        s1 += d;
-        s2 += d * d;
-        n += v;
-    }
+    const float n = (float)n_valid; /* exact: n_valid <= BR_PF_MAX_PARTICLES */
     /* n >= 1: called with at least one valid particle */
     const float mean = s1 / n;
     const float var = s2 / n - mean * mean;
@@ -938,8 +976,8 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     /* new integer origin: theta_j is re-expressed relative to y.counts */
     const float shift = (float)br_counts_delta(y->counts, pf->origin_counts) * rpc;
     const float y_rel = y->frac * rpc;
-    float lmax;
-    const uint32_t n_valid = predict_and_weigh(pf, u_a, shift, y_rel, 1, &lmax);
+    float lmax, sums[2];
+    const uint32_t n_valid = predict_and_weigh(pf, u_a, shift, y_rel, 1, &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
@@ -948,7 +986,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
      * (the max-shift needs a finite lmax) */
     const br_status_t verdict = (lmax < pf->outlier_l || lmax == -INFINITY) ? BR_W_OUTLIER : BR_OK;
     if (pf->cfg.adapt.nis_ref > 0.0f) {
-        adapt_update(pf, y_rel);
+        adapt_update(pf, sums[0], sums[1], n_valid);
     }
 
     /* 3. max-shifted weights, quantised; an outlier gives every valid particle weight 1 */
@@ -1023,8 +1061,9 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     }
     const uint32_t m = pf->cfg.n_particles;
     /* step 1 only: the log-weights against a dummy measurement are not used */
-    float lmax;
-    const uint32_t n_valid = predict_and_weigh(pf, br_est_delay_apply(&pf->delay, u_prev_Nm), 0.0f, 0.0f, 0, &lmax);
+    float lmax, sums[2];
+    const uint32_t n_valid = predict_and_weigh(pf, br_est_delay_apply(&pf->delay, u_prev_Nm), 0.0f, 0.0f, 0, &lmax,
+                                               sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
