@@ -5,7 +5,8 @@ publishes rests on it. Properties, not bytes:
 
 - the held-out part is the last part of the log in time, after the fit's
   part, disjoint from it, and together they cover the log less its edges;
-- its share is 1 - TRAIN_FRAC, and the report's description names it;
+- its share is 1 - TRAIN_FRAC, and the report's description names it (at
+  another share too); the edges and the share are docs/diagnose.md's;
 - the fit never sees it: changing the force in the held-out part leaves the
   fitted coefficients unchanged and changes only the held-out error;
 - the relerr a model reports as held out is measured there, not on the fit's part;
@@ -13,13 +14,14 @@ and the interval quantities the fit uses (the interval's position, speed,
 acceleration), the shortest log the split accepts, relerr itself.
 """
 import os
+import re
 import sys
 import unittest
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
-                                "python"))
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "python"))
 from bristle.diagnose import logreader, model, signals  # noqa: E402
 
 SHAPE = (1e-3, 1.0, 1.0)  # a fixed LuGre shape: the linear fit alone, no search
@@ -126,6 +128,36 @@ class SplitTest(unittest.TestCase):
         self.assertIn(f"t = {prep.t[prep.test.start]:.3f} .. {prep.t[prep.test.stop]:.3f} s", d)
         self.assertIn(f"({prep.test.stop - prep.test.start} samples)", d)
         self.assertIn(f"the fit used t = {prep.t[prep.train.start]:.3f} .. {prep.t[prep.test.start]:.3f} s", d)
+
+    def test_description_at_another_share(self):
+        # the description follows the share asked for, not only the default:
+        # 60 % held out (99 or 101 times 0.6 would round to another percent),
+        # and a held-out part longer than the fit's (its count is not hi % split)
+        prep = signals.Prepared(synthetic(), train_frac=0.4)
+        d = prep.held_out_description()
+        self.assertIn("the last 60 % of the log in time", d)
+        n_test = prep.test.stop - prep.test.start
+        self.assertGreater(n_test, prep.test.start)
+        self.assertIn(f"({n_test} samples)", d)
+        self.assertAlmostEqual(n_test / (prep.test.stop - prep.train.start), 0.6,
+                               delta=1.0 / (prep.test.stop - prep.train.start))
+
+    def test_edges_and_share_are_the_docs(self):
+        # docs/diagnose.md "Held-out part": the first and last 0.15 s, at least
+        # 50 samples, are left out; the fit uses the first 70 % of the rest
+        with open(os.path.join(REPO, "docs", "diagnose.md")) as f:
+            doc = " ".join(f.read().split())
+        m = re.search(r"\*\*Held-out part\*\*: the first and last ([\d.]+) s \(at least (\d+) samples\) "
+                      r"are left out \(filter transients\); the fit uses the first (\d+) % of the rest", doc)
+        self.assertIsNotNone(m, "docs/diagnose.md no longer states the held-out part's edges and share")
+        edge_s, edge_min, train_pct = float(m.group(1)), int(m.group(2)), int(m.group(3))
+        self.assertEqual(signals.TRAIN_FRAC * 100, train_pct)
+        # at 1 ms the edge is 0.15 s; at 10 ms 0.15 s is 15 samples, so the least number rules
+        for dt, edge in ((1e-3, int(round(edge_s / 1e-3))), (1e-2, edge_min)):
+            prep = signals.Prepared(synthetic(4000, dt=dt))
+            self.assertEqual((prep.lo, prep.n - prep.hi), (edge, edge), msg=f"dt = {dt}")
+            self.assertEqual(prep.train.start, edge)
+            self.assertEqual(prep.test.stop, prep.n - edge)
 
     def test_fit_never_sees_the_held_out_part(self):
         log = synthetic()

@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The extended estimation model's guards and the estimators' actuator-delay
  * history (docs/modules/model.md, "Extended model"); the equations themselves
- * are held to the float64 reference by tests/golden/test_golden_model_ext.c. */
+ * are held to the float64 reference by tests/golden/test_golden_model_ext.c,
+ * and the extended RK4's stages (each at its own position) to a classic RK4
+ * in double written here, at a state where the positions matter. */
 #include "br_test.h"
 
 #include "circle/br_circle_est.h"
@@ -9,6 +11,7 @@
 #include "bristle/br_model.h"
 
 #define DT_S 1.0e-3f
+#define PI_D 3.14159265358979323846
 
 static void test_causes_guards(void **st)
 {
@@ -190,6 +193,131 @@ static void test_delay_history(void **st)
     assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
 }
 
+/* ---- The extended model's RK4 step against classic RK4 in float64 ----
+ * The right-hand side of docs/modules/model.md, "Extended model", in double,
+ * written here from the equations (not from the kernel): p = p0 + L theta,
+ * v = L omega, z' = v - sigma0 |v| z / g (g = c g_p for v < 0),
+ * F = k(p) (sigma2_d v + sigma0 z + sigma1 z') + offset + A sin(2 pi p / P + phi),
+ * omega' = (u - L F) / Jeff; the drift is left out (s = 1 at the clock's 0). */
+typedef struct {
+    double L, Jeff, s0, s1, s2, s2n, cn, off, grad, A, P, phi, p0, u;
+} ref_rhs_t;
+
+/* dx = f(x); returns the absolute sum of F's terms (its rounding scale) */
+static double ref_deriv(const ref_rhs_t *r, const double x[3], double gp, double dx[3], double *th_max)
+{
+    *th_max = fmax(*th_max, fabs(x[0]));
+    const double v = r->L * x[1];
+    const double g = (v < 0.0) ? r->cn * gp : gp;
+    const double zd = v - r->s0 * fabs(v) * x[2] / g;
+    const double k = fmax(0.0, 1.0 + r->grad * (r->p0 + r->L * x[0]));
+    const double rip = r->A * sin(2.0 * PI_D * (r->p0 + r->L * x[0]) / r->P + r->phi);
+    const double s2d = (v < 0.0) ? r->s2n : r->s2;
+    const double F = k * (s2d * v + r->s0 * x[2] + r->s1 * zd) + r->off + rip;
+    dx[0] = x[1];
+    dx[1] = (r->u - r->L * F) / r->Jeff;
+    dx[2] = zd;
+    return k * (fabs(s2d * v) + fabs(r->s0 * x[2]) + fabs(r->s1 * zd)) + fabs(r->off) + fabs(r->A);
+}
+
+/* one classic RK4 step of h: stages at x, x + h/2 k1, x + h/2 k2, x + h k3;
+ * with stage4_theta_w2 the 4th stage's position is t0 + h w2 instead of
+ * t0 + h w3 (the mutant the test is there to see). Returns the largest force
+ * scale over the stages, and in *th_max the largest |theta| of a stage. */
+static double ref_rk4(const ref_rhs_t *r, const double x[3], double gp, double h, int stage4_theta_w2,
+                      double out[3], double *th_max)
+{
+    double k1[3], k2[3], k3[3], k4[3], xs[3];
+    *th_max = 0.0;
+    double fs = ref_deriv(r, x, gp, k1, th_max);
+    for (int i = 0; i < 3; i++) {
+        xs[i] = x[i] + 0.5 * h * k1[i];
+    }
+    fs = fmax(fs, ref_deriv(r, xs, gp, k2, th_max));
+    for (int i = 0; i < 3; i++) {
+        xs[i] = x[i] + 0.5 * h * k2[i];
+    }
+    fs = fmax(fs, ref_deriv(r, xs, gp, k3, th_max));
+    for (int i = 0; i < 3; i++) {
+        xs[i] = x[i] + h * k3[i];
+    }
+    if (stage4_theta_w2) {
+        xs[0] = x[0] + h * (x[1] + 0.5 * h * k1[1]); /* t0 + h w2 */
+    }
+    fs = fmax(fs, ref_deriv(r, xs, gp, k4, th_max));
+    for (int i = 0; i < 3; i++) {
+        out[i] = x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    }
+    return fs;
+}
+
+/* br_model_step_at's RK4 (the extended kernel br_model_kx_rk4) is classic
+ * RK4 of the extended right-hand side, each stage at its own position. The
+ * state makes the positions matter: a short ripple of large amplitude
+ * (period 200 um, A = 2 Fc, at its steepest at the origin: phase 0, p0 = 0)
+ * and a gradient; the bristle deflected in +x to twice the level g_p / sigma0
+ * while the axis moves in -x at 0.5 rad/s, so that omega' changes by some
+ * 130 rad/s^2 between stages 1 and 2. The 4th stage's position t0 + h w3
+ * then differs from t0 + h w2 by h^2/2 |wd2 - wd1| (6e-5 rad), which moves
+ * the ripple force at that stage by 2 pi L A / P times that (0.035 N), and the
+ * step's omega by 1.3e-4 rad/s: some 25 times the float32 tolerance (the test
+ * holds a margin of ten itself, below). */
+static void test_ext_rk4_is_classic_rk4(void **st)
+{
+    (void)st;
+    br_model_t m;
+    br_model_cfg_t c = br_machine_model_cfg(DT_S);
+    c.causes.ripple_amp_N = 2.0f * c.lugre.Fc_N;
+    c.causes.ripple_period_m = 200e-6f;
+    c.causes.grad_per_m = 5.0f;
+    c.causes.offset_N = 0.2f * c.lugre.Fc_N;
+    c.causes.dFc_neg_N = 0.3f * c.lugre.Fc_N;
+    c.causes.dsigma2_neg_Nspm = 0.5f * c.sigma2_Nspm;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    assert_true(m.extended && m.drift_k == 1.0f);
+    const float gp = c.lugre.Fs_N, p0 = 0.0f, u = 0.0f;
+    const float x[BR_NX] = {0.0f, -0.5f, 2.0f * gp / c.lugre.sigma0_Npm, gp};
+    float xn[BR_NX];
+    const ref_rhs_t r = {c.lead_mprad, (double)c.J_kgm2 + (double)c.lead_mprad * c.lead_mprad * c.M_kg,
+                         c.lugre.sigma0_Npm, c.lugre.sigma1_Nspm, c.sigma2_Nspm,
+                         (double)c.sigma2_Nspm + c.causes.dsigma2_neg_Nspm,
+                         ((double)c.lugre.Fc_N + c.causes.dFc_neg_N) / c.lugre.Fc_N,
+                         c.causes.offset_N, c.causes.grad_per_m, c.causes.ripple_amp_N,
+                         c.causes.ripple_period_m, c.causes.ripple_phase_rad, p0, u};
+    const double h = c.dt_s, xd[3] = {x[0], x[1], x[2]};
+    double ref[3], mut[3], th_max, th_max_mut;
+    const double fs = ref_rk4(&r, xd, gp, h, 0, ref, &th_max);
+    (void)ref_rk4(&r, xd, gp, h, 1, mut, &th_max_mut);
+    /* the kernel's RK4, not the bounded scheme: a h = sigma0 L h |omega| / g
+     * within half the limit at both ends, with the smaller level
+     * (min(c, 1) g_p = g_p here), so float32 rounding cannot tip the test */
+    const double ah = r.s0 * r.L * h / gp;
+    assert_true(ah * fabs(xd[1]) <= 0.5 * BR_MODEL_RK4_AH_MAX && ah * fabs(ref[1]) <= 0.5 * BR_MODEL_RK4_AH_MAX);
+    assert_int_equal(br_model_step_at(&m, x, p0, u, xn), BR_OK);
+    /* Tolerances: float32 rounding of the stages, docs/golden.md's one-step
+     * chains (32u of each signal's scale: some dozens of float32 operations,
+     * each within u of its operands; the stage errors propagate with a gain
+     * h L^2 sigma1 (1 + sigma0 |z| / g) / Jeff < 0.2 per stage here), with
+     * the force scale the largest absolute sum of F's terms over the stages;
+     * omega also gets the kernel's cubic expansion of the ripple about the
+     * origin (the reference's sine is exact), 2 (h/Jeff) L A d^4 / 24 with
+     * d = 2 pi L |theta| / P of the farthest stage. */
+    const double u32 = 5.9604644775390625e-08;
+    const double S_th = fabs(ref[0]) + h * (fabs(xd[1]) + fabs(ref[1]));
+    const double S_w = fabs(xd[1]) + fabs(ref[1]) + h / r.Jeff * (fabs((double)u) + r.L * fs);
+    const double S_z = fmax(fmax(fabs(xd[2]), fabs(ref[2])), gp / r.s0);
+    const double d = 2.0 * PI_D * r.L * th_max / r.P;
+    const double tol_w = 32.0 * u32 * S_w + 2.0 * h / r.Jeff * r.L * r.A * d * d * d * d / 24.0;
+    /* the state is one where the 4th stage's position matters: at t0 + h w2,
+     * the step's omega moves by more than ten tolerances */
+    print_message("ext rk4: omega %.9g, with stage 4 at t0 + h w2 %.9g, tolerance %.3g\n", ref[1], mut[1], tol_w);
+    assert_true(fabs(mut[1] - ref[1]) > 10.0 * tol_w);
+    BR_ASSERT_NEAR(xn[BR_X_THETA], ref[0], 32.0 * u32 * S_th);
+    BR_ASSERT_NEAR(xn[BR_X_OMEGA], ref[1], tol_w);
+    BR_ASSERT_NEAR(xn[BR_X_Z], ref[2], 64.0 * u32 * S_z);
+    assert_true(xn[BR_X_GP] == gp);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -200,6 +328,7 @@ int main(void)
         cmocka_unit_test(test_drift_follows_the_clock),
         cmocka_unit_test(test_step_absolute_equals_relative),
         cmocka_unit_test(test_delay_history),
+        cmocka_unit_test(test_ext_rk4_is_classic_rk4),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
