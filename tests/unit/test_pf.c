@@ -700,6 +700,36 @@ static void proposal_matches_equations(uint32_t mode)
     free(pf);
 }
 
+/* cfg.adapt under cfg.proposal (OPT) measures the prior's draw of theta: two
+ * filters alike but for the proposal, primed alike, take one step from the
+ * same particles with the same noise samples; the prior's draws agree to
+ * rounding, so must their smoothed NIS. With Q_theta = R the proposal pulls
+ * each draw halfway to y: an NIS taken on the proposal's draws is far off. */
+static void test_proposal_adapt_takes_the_prior_draw(void **st)
+{
+    (void)st;
+    br_pf_t *a = calloc(1, sizeof *a), *b = calloc(1, sizeof *b);
+    assert_non_null(a);
+    assert_non_null(b);
+    br_pf_cfg_t c = cfg_adapt();
+    c.est.q_var[BR_X_THETA] = c.est.r_var_rad2;
+    assert_int_equal(br_pf_init(a, &c), BR_OK);
+    c.proposal = BR_PF_PROPOSAL_OPT;
+    assert_int_equal(br_pf_init(b, &c), BR_OK);
+    const br_meas_t y0 = {100, 0.5f}, y1 = {101, 0.9f}; /* 1.4 counts on: a pull of about 0.7 */
+    assert_int_equal(br_pf_step(a, &y0, 0.0f), BR_OK);
+    assert_int_equal(br_pf_step(b, &y0, 0.0f), BR_OK);
+    for (uint32_t j = 0; j < c.n_particles; j++) {
+        assert_true(a->x[BR_X_THETA][j] == b->x[BR_X_THETA][j]); /* primed alike */
+    }
+    assert_int_equal(br_pf_step(a, &y1, 0.0f), BR_OK);
+    assert_int_equal(br_pf_step(b, &y1, 0.0f), BR_OK);
+    assert_true(a->nis_avg > 0.0f);
+    BR_ASSERT_NEAR(b->nis_avg, a->nis_avg, 1e-4 * a->nis_avg);
+    free(a);
+    free(b);
+}
+
 static void test_proposal_matches_equations(void **st)
 {
     (void)st;
@@ -820,6 +850,7 @@ int main(void)
         cmocka_unit_test(test_fnl_overflow_is_invalid),
         cmocka_unit_test(test_likelihood_scale),
         cmocka_unit_test(test_proposal_matches_equations),
+        cmocka_unit_test(test_proposal_adapt_takes_the_prior_draw),
 #ifdef BR_TEST_THESIS_MACHINE
         cmocka_unit_test(test_adapt_is_thesis_filter_below_ref),
         cmocka_unit_test(test_adapt_keeps_lock_under_force_noise),
