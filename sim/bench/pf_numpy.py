@@ -414,6 +414,13 @@ def summary_table(c, npy, ratio, prt=None):
                                                      c["machine"]["cpus_online"]))
 
 
+def write_json(path, obj):
+    """The bench's JSON outputs: indented, one trailing newline."""
+    with open(path, "w") as f:
+        json.dump(obj, f, indent=2)
+        f.write("\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("recording")
@@ -507,13 +514,9 @@ def main():
                 out["pf_particles"] = prt
                 out["ratio_particles_over_c_cpu"] = (prt["cpu_ns_per_particle_step"]["median"]
                                                      / c["pf"]["cpu_ns_per_particle_step"]["median"])
-            with open(a.out, "w") as f:
-                json.dump(out, f, indent=2)
-                f.write("\n")
+            write_json(a.out, out)
     elif a.out:
-        with open(a.out, "w") as f:
-            json.dump(res, f, indent=2)
-            f.write("\n")
+        write_json(a.out, res)
     return 0 if ok else 1
 
 

@@ -29,7 +29,6 @@ particle-step, median over replays (min, max), in wall and thread CPU time.
 
 Usage: pf_particles.py RECORDING [--reps N] [--seed S] [--out FILE]"""
 import argparse
-import json
 import os
 import platform
 import statistics
@@ -184,9 +183,7 @@ def main():
         print("pf_particles: the particles-library PF does not track like the C one", file=sys.stderr)
     res["tracks"] = ok
     if a.out:
-        with open(a.out, "w") as f:
-            json.dump(res, f, indent=2)
-            f.write("\n")
+        pf_numpy.write_json(a.out, res)
     return 0 if ok else 1
 
 
