@@ -459,6 +459,8 @@ def main():
     ap.add_argument("--fresh", action="store_true", help="forget the logs an earlier run left in --work")
     ap.add_argument("--from-json", help="write --md / --png from a saved --json summary, running nothing")
     a = ap.parse_args()
+    if a.n_verify < 0 or (a.n_verify and a.n_verify < a.n):
+        ap.error("--n-verify: 0 or at least --n")   # the proof's first logs are the bisection's
     cmd = os.environ.get("BR_DETECTION_COMMAND", " ".join(["detection_limits.py"] + sys.argv[1:]))
     if a.from_json:
         with open(a.from_json) as f:
@@ -480,8 +482,6 @@ def main():
     levels = (("EMPS", emps_noise()), ("quiet", QUIET_N))
     print(f"{len(causes)} causes x {len(levels)} noise levels, N = {a.n} per probed size, "
           f"{a.n_nominal} nominal logs per level, on {a.jobs} process(es)", flush=True)
-    if a.n_verify < 0 or (a.n_verify and a.n_verify < a.n):
-        ap.error("--n-verify: 0 or at least --n")
     res = study(os.path.abspath(a.simlog), os.path.abspath(a.work), levels, a.n, a.n_nominal, a.jobs, causes,
                 a.n_verify)
     s = summarize(res, levels, a.n, a.n_nominal, causes, a.n_verify)

@@ -91,6 +91,20 @@ class Bisection(unittest.TestCase):
         self.assertEqual((at["detected"], at["logs"], at["passed"]), (10, 12, False))
 
 
+class Options(unittest.TestCase):
+    def test_a_proof_shorter_than_the_bisection_is_refused(self):
+        # before any log is run (nothing is written into --work)
+        import subprocess
+        import tempfile
+        with tempfile.TemporaryDirectory() as w:
+            for bad in (["--n", "20", "--n-verify", "5"], ["--n-verify", "-1"]):
+                r = subprocess.run([sys.executable, dl.__file__, "--simlog", "none", "--work", os.path.join(w, "x"),
+                                    *bad], capture_output=True, text=True, timeout=120)
+                self.assertEqual(r.returncode, 2, r.stderr)
+                self.assertIn("--n-verify", r.stderr)
+                self.assertFalse(os.path.exists(os.path.join(w, "x")))
+
+
 class Proof(unittest.TestCase):
     def test_proof_runs_every_log_and_reuses_none_it_should_not(self):
         k = 6
