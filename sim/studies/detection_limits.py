@@ -32,8 +32,10 @@ finding) and the rate of the verdict "unexplained", each with its one-sided
 
 --jobs 1 runs everything in this process; --jobs K spreads the (cause, noise)
 bisections and the nominal logs over K processes. Each log's result is appended
-to WORK/cache.jsonl: an interrupted run started again with the same --work
-skips the logs it already has (--fresh forgets them); the wall time reported
+to WORK/cache.jsonl, keyed with a digest of the diagnosis's sources and of
+br_simlog: an interrupted run started again with the same --work skips the
+logs it already has, never a result of other code (--fresh forgets them all);
+the wall time reported
 is the last run's.
 
 Usage: detection_limits.py --simlog BIN --work DIR [--n N] [--n-verify M] [--n-nominal N] [--jobs K]
@@ -117,9 +119,30 @@ USED = set()
 SECONDS = {}   # key -> wall seconds of that log (br_simlog + diagnosis), this run's or the cached run's
 
 
+def code_digest():
+    """A digest of what decides a log's result: the diagnosis's Python sources
+    and br_simlog's binary. A cached result of other code is never reused."""
+    import hashlib
+    h = hashlib.sha256()
+    root = os.path.join(REPO, "python", "bristle", "diagnose")
+    for d, _, files in sorted(os.walk(root)):
+        for f in sorted(files):
+            if f.endswith(".py"):
+                with open(os.path.join(d, f), "rb") as fh:
+                    h.update(f.encode() + b"\0" + fh.read())
+    return h.hexdigest()[:16]
+
+
+DIGEST = {}
+
+
 def run(simlog, work, key, flags, sigma, seed):
     """One log: br_simlog, then the diagnosis. Returns (verdict, findings)."""
-    ck = f"{key}|{' '.join(flags)}|{sigma:.6g}|{seed}"
+    if simlog not in DIGEST:
+        with open(simlog, "rb") as fh:
+            import hashlib
+            DIGEST[simlog] = code_digest() + hashlib.sha256(fh.read()).hexdigest()[:16]
+    ck = f"{key}|{' '.join(flags)}|{sigma:.6g}|{seed}|{DIGEST[simlog]}"
     USED.add(ck)
     if ck in CACHE:
         return CACHE[ck]

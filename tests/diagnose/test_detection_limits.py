@@ -4,10 +4,13 @@ docs/detection-limits.md) on a stand-in diagnosis whose detections are known:
 the bisection finds the smallest passing size of the ladder, tolerates as many
 misses as the 95 % rate allows and no more, the proof requires every one of
 its logs and steps up the ladder on a miss, and the Clopper-Pearson bounds are
-the published ones. No log is simulated: the study's `run` is replaced."""
+the published ones; a cached result is reused only for the same diagnosis
+code and br_simlog. No log is simulated: the study's `run` is replaced."""
 import os
 import re
+import shutil
 import sys
+import tempfile
 import unittest
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -41,6 +44,39 @@ def bisect(stand, n=20, n_verify=59):
     finally:
         dl.run = saved
     return out
+
+
+class Cache(unittest.TestCase):
+    def test_digest_follows_the_diagnosis_code(self):
+        with tempfile.TemporaryDirectory() as w:
+            src = os.path.join(w, "python", "bristle", "diagnose")
+            shutil.copytree(os.path.join(REPO, "python", "bristle", "diagnose"), src)
+            saved = dl.REPO
+            dl.REPO = w
+            try:
+                d0 = dl.code_digest()
+                self.assertEqual(d0, dl.code_digest())
+                with open(os.path.join(src, "selection.py"), "a") as f:
+                    f.write("\n# another selection\n")
+                self.assertNotEqual(d0, dl.code_digest())
+            finally:
+                dl.REPO = saved
+
+    def test_a_result_of_other_code_is_not_reused(self):
+        key, flags, sigma, seed = "quiet-offset-0-0", ["--offset", "0.001"], 0.02, 7
+        saved = dict(dl.DIGEST), dict(dl.CACHE)
+        try:
+            dl.DIGEST["no-simlog"] = "old"
+            dl.CACHE[f"{key}|{' '.join(flags)}|{sigma:.6g}|{seed}|old"] = ("offset", ["offset"])
+            self.assertEqual(dl.run("no-simlog", "work", key, flags, sigma, seed), ("offset", ["offset"]))
+            dl.DIGEST["no-simlog"] = "new"   # the code changed: the log is simulated again
+            with self.assertRaises(FileNotFoundError):
+                dl.run("no-simlog", "work", key, flags, sigma, seed)
+        finally:
+            dl.DIGEST.clear()
+            dl.DIGEST.update(saved[0])
+            dl.CACHE.clear()
+            dl.CACHE.update(saved[1])
 
 
 class Statistics(unittest.TestCase):

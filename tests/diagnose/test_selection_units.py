@@ -13,6 +13,11 @@ log and no fit, about a second:
 - the backward step in `diagnose`: an offset that stood in for the mean
   force of two causes found after it is dropped once both are in, recorded
   with its round, and not tested again;
+- the backward step's guard (`worse_than`): a drop that would leave a model
+  worse than the round's start, and not better in the blocks, is refused;
+- pairs: tested only when no cause is significant alone and one gains
+  MIN_REL_GAIN; a pair that hides each other is found as two findings; a
+  pair with a member it does not need is no finding;
 - `borderline`: the last round's causes, not significant and not in the
   model, at the looser level, its edges included.
 
@@ -157,6 +162,7 @@ class World:
 
     N = 300
     TEST = slice(100, 300)
+    SOME = (0, 3, 6)
 
     def __init__(self, takes, sizes, seed=7):
         rng = np.random.default_rng(seed)
@@ -165,10 +171,17 @@ class World:
         # ending in "*" only in the held-out part's first block (a gain there is not consistent)
         self.share = {k: s * (1.0 + 0.3 * rng.uniform(size=self.N)) * np.sign(rng.normal(size=self.N))
                       for k, s in sizes.items()}
+        # a name ending in "~" only in the held-out blocks SOME (three of ten: no consistent gain either way)
+        blk = np.array_split(np.arange(self.TEST.start, self.TEST.stop), selection.N_BLOCKS)
         for k in self.share:
             if k.endswith("*"):
                 self.share[k][:self.TEST.start] = 0.0
                 self.share[k][self.TEST.start + (self.TEST.stop - self.TEST.start) // selection.N_BLOCKS:] = 0.0
+            if k.endswith("~"):
+                keep = np.concatenate([blk[b] for b in self.SOME])
+                mask = np.zeros(self.N, bool)
+                mask[keep] = True
+                self.share[k][~mask] = 0.0
         self.noise = 0.01 * rng.normal(size=self.N)
         self.y = 10.0 * np.ones(self.N)
         self.prep = types.SimpleNamespace(test=self.TEST, train=slice(0, 100))
@@ -182,7 +195,14 @@ class World:
                     k: 1.0 for c in self.causes for k in causes.get(c).NL}
 
             def residual(self, prep):
-                left = set(world.share) - {s for c in self.causes for s in world.takes.get(c, ())}
+                # a share under a tuple of causes is taken only by all of them together,
+                # none of those marked "!" in the model (a joint fit a stand-in spoils)
+                def takes(k):
+                    if isinstance(k, str):
+                        return k in self.causes
+                    return all((c[1:] not in self.causes) if c.startswith("!") else (c in self.causes) for c in k)
+                taken = {s for k, v in world.takes.items() for s in v if takes(k)}
+                left = set(world.share) - taken
                 return world.noise + sum((world.share[k] for k in sorted(left)), np.zeros(world.N))
 
             def relerr(self, prep, sl):
@@ -361,6 +381,49 @@ class DiagnoseBackwardStepTest(WorldTest):
         drop, = [m for m in msgs if m.startswith("  dropped ")]
         self.assertIn(f"(gain {100 * d.dropped[0]['relative_gain']:.1f} %, p = {d.dropped[0]['p_value']:.2g})", drop)
 
+    def test_a_drop_that_would_leave_a_worse_model_is_refused(self):
+        # the offset enters first (its share m and a large share o~ in three blocks of
+        # ten), asymmetric friction then takes a against it. Without the offset the
+        # joint model loses o~: a gain in three blocks, not kept at P_REMOVE. But the
+        # model left (asymmetric friction alone) is worse than the round's start (the
+        # offset alone), and not better in the blocks either: the drop is refused, the
+        # joint model stays (docs/diagnose.md "Backward step").
+        takes = {"offset": ("m", "o~"), "asymmetric_friction": ("m", "a")}
+        w = self.use(World(takes, {"m": 1.0, "o~": 2.5, "a": 0.5}))
+        msgs = []
+        d = selection.diagnose(w.prep, msgs.append)
+        self.assertEqual([f[0].cause for f in d.findings], ["offset", "asymmetric_friction"])
+        self.assertEqual(d.dropped, [])
+        self.assertEqual(set(d.extended.causes), set(takes))
+        # what the guard saw: the offset's removal is weak (not kept) ...
+        joint = w.Fit(("offset", "asymmetric_friction"))
+        by = {b.cause: b for b in selection.backward(w.prep, joint)}
+        self.assertFalse(by["offset"].kept)
+        self.assertGreaterEqual(by["offset"].p_value, selection.P_REMOVE)
+        # ... and leaves a model worse than the round's start, not better in the blocks
+        left, start = w.Fit(("asymmetric_friction",)), w.Fit(("offset",))
+        self.assertGreater(left.relerr(w.prep, w.TEST), start.relerr(w.prep, w.TEST))
+        self.assertGreaterEqual(selection.block_p_value(w.prep, start.residual(w.prep), left.residual(w.prep)),
+                                selection.P_REMOVE)
+        self.assertTrue(selection.worse_than(w.prep, left, start))
+        kept, = [m for m in msgs if m.startswith("  kept ")]
+        self.assertTrue(kept.startswith("  kept offset: without it the held-out relerr"))
+
+    def test_worse_than(self):
+        w = self.use(World({"offset": ("o",), "position_ripple": ("r*",)}, {"o": 1.0, "r*": 4.0}))
+        none, off, rip = w.Fit(()), w.Fit(("offset",)), w.Fit(("position_ripple",))
+        # a lower or equal held-out relerr is never worse
+        self.assertFalse(selection.worse_than(w.prep, off, off))
+        self.assertFalse(selection.worse_than(w.prep, off, none))
+        # higher, and not better in the blocks: worse
+        self.assertGreater(none.relerr(w.prep, w.TEST), off.relerr(w.prep, w.TEST))
+        self.assertTrue(selection.worse_than(w.prep, none, off))
+        # higher (the one block r*), but better in nine blocks of ten: not worse
+        self.assertGreater(off.relerr(w.prep, w.TEST), rip.relerr(w.prep, w.TEST))
+        self.assertLess(selection.block_p_value(w.prep, rip.residual(w.prep), off.residual(w.prep)),
+                        selection.P_REMOVE)
+        self.assertFalse(selection.worse_than(w.prep, off, rip))
+
     def test_the_weakest_goes_first(self):
         # with all four in, two findings are not needed: the offset gains nothing (the
         # others take its three shares), the ripple a gain confined to one block. The
@@ -378,6 +441,125 @@ class DiagnoseBackwardStepTest(WorldTest):
         self.assertEqual(d.dropped[0]["round"], 4)
         self.assertEqual([f[0].cause for f in d.findings],
                          ["position_ripple", "actuator_delay", "asymmetric_friction"])
+
+
+class PairTest(WorldTest):
+    # an offset and a gradient that hide each other: each alone takes a share in three
+    # blocks of ten (a visible gain, not consistent); together they also take j, in every block
+    HIDING = {"offset": ("o~",), "position_gradient": ("g~",), ("offset", "position_gradient"): ("j",)}
+    SIZES = {"o~": 1.0, "g~": 1.0, "j": 0.3}
+
+    def test_pairs_to_test(self):
+        rem = ["offset", "asymmetric_friction", "position_gradient", "actuator_delay"]
+        cs = [cand(selection.MIN_REL_GAIN, 0.5), cand(selection.MIN_REL_GAIN * 0.999, 0.5)]
+        cs[0].cause, cs[1].cause = "position_gradient", "actuator_delay"
+        # a cause gaining MIN_REL_GAIN alone seeds pairs with every other; each pair once
+        self.assertEqual(selection.pairs_to_test(cs, rem),
+                         [("offset", "position_gradient"), ("asymmetric_friction", "position_gradient"),
+                          ("position_gradient", "actuator_delay")])
+        # no cause gains MIN_REL_GAIN alone: no pair
+        self.assertEqual(selection.pairs_to_test(cs[1:], rem), [])
+
+    def test_a_hidden_pair_is_found(self):
+        w = self.use(World(self.HIDING, self.SIZES))
+        msgs = []
+        d = selection.diagnose(w.prep, msgs.append)
+        r1 = {c["cause"]: c for c in d.rounds[0]}
+        # alone: a visible gain, not significant
+        for c in ("offset", "position_gradient"):
+            self.assertGreaterEqual(r1[c]["relative_gain"], selection.MIN_REL_GAIN)
+            self.assertFalse(r1[c]["significant"])
+        self.assertFalse(any(c["significant"] for c in d.rounds[0]))
+        # together: significant, both findings, both kept by the backward step
+        self.assertEqual([f[0].cause for f in d.findings], ["offset", "position_gradient"])
+        self.assertEqual(set(d.extended.causes), {"offset", "position_gradient"})
+        self.assertEqual(d.dropped, [])
+        sig = [p for p in d.pairs if p["significant"]]
+        self.assertEqual([p["causes"] for p in sig], [["offset", "position_gradient"]])
+        self.assertEqual(sig[0]["round"], 1)
+        # each finding carries the pair's measures against the nominal model
+        for cnd, fit in d.findings:
+            self.assertEqual(cnd.base_relerr, d.nominal.relerr(w.prep, w.TEST))
+            self.assertEqual(cnd.p_value, sig[0]["p_value"])
+        self.assertTrue(any(m.startswith("finding 2: offset and position_gradient") for m in msgs))
+        # the pairs tested: each seed with every other cause, once
+        self.assertEqual(len(d.pairs), len(causes.NAMES) * (len(causes.NAMES) - 1) // 2
+                         - (len(causes.NAMES) - 2) * (len(causes.NAMES) - 3) // 2)
+
+    def test_a_pair_with_a_member_it_does_not_need_is_not_a_finding(self):
+        # the ripple gains visibly alone (r~, three blocks of ten: not consistent); the pair
+        # with the gradient passes the gate only through the gradient's small share g, in
+        # every block, worth less than MIN_REL_GAIN in the pair's model: the gradient is not
+        # needed there, so the pair is no finding (the ripple alone is what is tested, and
+        # it is not significant). EMPS: ripple + gradient, the gradient not needed.
+        w = self.use(World({"position_ripple": ("r~",), "position_gradient": ("g",)},
+                           {"r~": 1.0, "g": 0.003}))
+        d = selection.diagnose(w.prep)
+        pr, = [p for p in d.pairs if p["causes"] == ["position_ripple", "position_gradient"]]
+        self.assertTrue(selection.Candidate("x", None, pr["base_relerr_percent"], pr["relerr_percent"],
+                                            pr["p_value"]).significant)   # the gate alone would pass
+        self.assertFalse(pr["needed"]["position_gradient"])
+        self.assertFalse(pr["significant"])
+        self.assertEqual((d.findings, d.extended.causes), ([], ()))
+        self.assertFalse(any(p["significant"] for p in d.pairs))
+
+    def test_without_a_visible_gain_no_pair_is_tested(self):
+        # the pair's share alone, each cause gaining nothing by itself: no pair is tried
+        w = self.use(World({("offset", "position_gradient"): ("j",)}, {"j": 0.3}))
+        d = selection.diagnose(w.prep)
+        self.assertEqual((d.findings, d.pairs), ([], []))
+        self.assertEqual(len(d.rounds), 1)
+
+
+class SwapTest(WorldTest):
+    # asymmetric friction stands in for the offset (its share m, and a hair more); with
+    # it in the model the offset adds nothing (their joint fit spoils k); the gradient
+    # and the offset together take k
+    STAND_IN = {"offset": ("m",), "asymmetric_friction": ("m", "a"), "position_gradient": ("g",),
+                ("offset", "position_gradient", "!asymmetric_friction"): ("k",)}
+
+    def test_a_stand_in_is_swapped_for_the_cause(self):
+        w = self.use(World(self.STAND_IN, {"m": 1.0, "a": 0.15, "g": 0.6, "k": 0.4}))
+        msgs = []
+        d = selection.diagnose(w.prep, msgs.append)
+        r1 = {c["cause"]: c for c in d.rounds[0]}
+        self.assertGreater(r1["asymmetric_friction"]["relative_gain"], r1["offset"]["relative_gain"])
+        found = [m.split(": ")[1].split(",")[0] for m in msgs if m.startswith("finding ")]
+        self.assertEqual(sorted(found), ["asymmetric_friction", "position_gradient"])
+        # the offset takes the stand-in's place; the stand-in is not tested again
+        self.assertEqual([f[0].cause for f in d.findings],
+                         ["offset" if c == "asymmetric_friction" else c for c in found])
+        self.assertEqual(set(d.extended.causes), {"offset", "position_gradient"})
+        sw, = d.swapped
+        self.assertEqual((sw["cause"], sw["out"], sw["round"]), ("offset", "asymmetric_friction", 3))
+        self.assertTrue(sw["significant"])
+        self.assertTrue(all("asymmetric_friction" not in {c["cause"] for c in r} for r in d.rounds[3:]))
+        # in round 3 the offset added nothing beside the stand-in: only the swap finds it
+        r3 = {c["cause"]: c for c in d.rounds[2]}
+        self.assertFalse(r3["offset"]["significant"])
+        self.assertTrue(any(m.startswith("swapped asymmetric_friction for offset") for m in msgs))
+        self.assertLess(d.extended.relerr(w.prep, w.TEST), 0.5 * sw["base_relerr_percent"])
+
+    def test_swaps(self):
+        w = self.use(World(self.STAND_IN, {"m": 1.0, "a": 0.15, "g": 0.6, "k": 0.4}))
+        fit = w.Fit(("asymmetric_friction", "position_gradient"))
+        rem = ["offset", "actuator_delay"]
+        sw = selection.swaps(w.prep, fit, rem)
+        # each finding out, each remaining cause in, measured against the model itself
+        self.assertEqual([(c.out, c.cause) for c in sw],
+                         [(o, r) for o in fit.causes for r in rem])
+        for c in sw:
+            self.assertEqual(c.base_relerr, fit.relerr(w.prep, w.TEST))
+            self.assertEqual(set(c.fit.causes), (set(fit.causes) - {c.out}) | {c.cause})
+        self.assertEqual([(c.out, c.cause) for c in sw if c.significant], [("asymmetric_friction", "offset")])
+
+    def test_a_swap_that_gains_too_little_is_not_made(self):
+        # k no larger than the stand-in's own share a: the swap gains nothing, none is made
+        w = self.use(World(self.STAND_IN, {"m": 1.0, "a": 0.15, "g": 0.6, "k": 0.15}))
+        d = selection.diagnose(w.prep)
+        self.assertEqual(d.swapped, [])
+        self.assertEqual({f[0].cause for f in d.findings}, {"asymmetric_friction", "position_gradient"})
+        self.assertFalse(any(c.significant for c in selection.swaps(w.prep, d.extended, ["offset"])))
 
 
 class BorderlineTest(unittest.TestCase):

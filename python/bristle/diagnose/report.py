@@ -111,6 +111,7 @@ def build(prep, diag, machine=None, closed=None, log_path=None, floor=None):
         "verdict": verdict_,
         "borderline": [dict(c, meaning=causes_.get(c["cause"]).MEANING) for c in selection.borderline(diag)],
         "dropped": diag.dropped,
+        "swapped": diag.swapped,
         "extended": {"causes": list(diag.extended.causes), "params": ext_params,
                      "intervals_95": {k: list(v) for k, v in ivals.items() if "." not in k},
                      "not_identified": unident,
@@ -121,6 +122,7 @@ def build(prep, diag, machine=None, closed=None, log_path=None, floor=None):
         "noise_floor": floor.summary(),
         "unexplained": une,
         "tested": diag.rounds,
+        "tested_pairs": diag.pairs,
         "published_structures_refitted": published_structures(prep),
     }
     if machine:
@@ -190,6 +192,10 @@ def markdown(rep, figures):
         L += [f"Dropped: {c['cause']} was found in round {c['round']} and left the joint model when later findings "
               f"explained it (held-out relerr without it {c['base_relerr_percent']:.4g} %, with it "
               f"{c['relerr_percent']:.4g} %, p = {c['p_value']:.2g}).", ""]
+    for c in rep.get("swapped", []):
+        L += [f"Swapped: {c['out']} was replaced by {c['cause']} in round {c['round']} (held-out relerr "
+              f"{c['base_relerr_percent']:.4g} % → {c['relerr_percent']:.4g} %, p = {c['p_value']:.2g}): it had "
+              "stood in for it.", ""]
     L += ["## Unexplained", ""]
     une = rep.get("unexplained")
     if une is None:
@@ -207,6 +213,14 @@ def markdown(rep, figures):
             L.append(f"| {c['cause']} | {c['relerr_percent']:.4g} % | {100 * c['relative_gain']:.3g} % | "
                      f"{c['p_value']:.2g} | {'yes' if c['significant'] else 'no'} |")
         L.append("")
+        prs = [c for c in rep.get("tested_pairs", []) if c["round"] == k]
+        if prs:
+            L += [f"No cause was significant alone in round {k}; pairs tested jointly (selection.py, Pairs):", "",
+                  "| causes | held-out relerr | relative gain | p | significant |", "|---|---|---|---|---|"]
+            for c in prs:
+                L.append(f"| {' + '.join(c['causes'])} | {c['relerr_percent']:.4g} % | "
+                         f"{100 * c['relative_gain']:.3g} % | {c['p_value']:.2g} | {'yes' if c['significant'] else 'no'} |")
+            L.append("")
     L += ["## Parameters (load side, model.json's)", "",
           "| parameter | unit | nominal | extended | 95 % interval (jackknife over training blocks) |",
           "|---|---|---|---|---|"]
