@@ -45,6 +45,8 @@ br_plant_cfg_t br_plant_cfg_reference(void)
 
 static double lugre_force(const br_plant_t *p);
 
+static double dist_force(const br_plant_cfg_t *c, double x);
+
 int br_plant_causes_on(const br_plant_cfg_t *c)
 {
     return c->offset_N != 0.0 || c->dFc_neg_N != 0.0 || c->dsigma2_neg_Nspm != 0.0 || c->ripple_amp_N != 0.0 ||
@@ -94,13 +96,14 @@ int br_plant_init(br_plant_t *p, const br_plant_cfg_t *cfg, const br_plant_state
     /* eq. 1: effective inertia seen by the motor */
     p->Jeff_kgm2 = cfg->J_kgm2 + cfg->lead_mprad * cfg->lead_mprad * cfg->M_kg;
     p->tau_Nm = 0.0;
-    p->fdist_N = 0.0;
     p->t_s = 0.0;
     p->cmd_head = 0;
     p->cmd_n = 0;
     p->cmd_pushed = 0;
     p->delay_overruns = 0;
     p->fnl_N = lugre_force(p);
+    /* the offset and ripple act from the start: the oracle sees them in the first period */
+    p->fdist_N = br_plant_causes_on(cfg) ? dist_force(cfg, br_plant_pos_m(p)) : 0.0;
     return 0;
 }
 

@@ -164,6 +164,14 @@ static void test_comp_force_balances_the_drive(void **st)
     assert_int_equal(br_plant_init(&p, &r, &rest), 0);
     for (int k = 0; k < 50; k++) br_plant_step(&p, 0.01, 1e-3);
     assert_true(br_plant_comp_force_N(&p) == p.fnl_N);
+    /* before the first step, at rest (z = 0, v = 0): the offset and the ripple at
+     * the start position are the whole force, already (the first period's oracle) */
+    c.ripple_amp_N = 0.3;
+    c.ripple_period_m = 0.01;
+    c.ripple_phase_rad = 0.5;
+    br_plant_state_t x0 = {0.0025 / c.lead_mprad, 0.0, 0.0};
+    assert_int_equal(br_plant_init(&p, &c, &x0), 0);
+    BR_ASSERT_NEAR(br_plant_comp_force_N(&p), 0.4 + 0.3 * cos(0.5), 1e-12); /* sin(2 pi 1/4 + 0.5) */
 }
 
 static void test_position_gradient(void **st)
