@@ -216,10 +216,13 @@ def markdown(rep, figures):
         prs = [c for c in rep.get("tested_pairs", []) if c["round"] == k]
         if prs:
             L += [f"No cause was significant alone in round {k}; pairs tested jointly (selection.py, Pairs):", "",
-                  "| causes | held-out relerr | relative gain | p | significant |", "|---|---|---|---|---|"]
+                  "| causes | held-out relerr | relative gain | p | each needed in the pair | significant |",
+                  "|---|---|---|---|---|---|"]
             for c in prs:
+                need = ", ".join(f"{k} {'yes' if v else 'no'}" for k, v in c.get("needed", {}).items()) or "—"
                 L.append(f"| {' + '.join(c['causes'])} | {c['relerr_percent']:.4g} % | "
-                         f"{100 * c['relative_gain']:.3g} % | {c['p_value']:.2g} | {'yes' if c['significant'] else 'no'} |")
+                         f"{100 * c['relative_gain']:.3g} % | {c['p_value']:.2g} | {need} | "
+                         f"{'yes' if c['significant'] else 'no'} |")
             L.append("")
     L += ["## Parameters (load side, model.json's)", "",
           "| parameter | unit | nominal | extended | 95 % interval (jackknife over training blocks) |",
