@@ -503,6 +503,31 @@ class PairTest(WorldTest):
         self.assertEqual((d.findings, d.extended.causes), ([], ()))
         self.assertFalse(any(p["significant"] for p in d.pairs))
 
+    def test_a_pair_not_checked_for_need_is_not_significant(self):
+        # the gate alone passes; until each member's need is measured the pair is no finding
+        pc = selection.PairCandidate(("offset", "position_gradient"), None, 1.0, 0.5, 1e-6)
+        self.assertTrue(pc.gate)
+        self.assertFalse(pc.significant)
+        both = {"offset": True, "position_gradient": True}
+        self.assertTrue(selection.PairCandidate(("offset", "position_gradient"), None, 1.0, 0.5, 1e-6, both)
+                        .significant)
+        one = dict(both, position_gradient=False)
+        self.assertFalse(selection.PairCandidate(("offset", "position_gradient"), None, 1.0, 0.5, 1e-6, one)
+                         .significant)
+        # need does not make a pair that fails the gate significant
+        self.assertFalse(selection.PairCandidate(("offset", "position_gradient"), None, 1.0, 0.99, 1e-6, both)
+                         .significant)
+
+    def test_pair_messages(self):
+        w = self.use(World(self.HIDING, self.SIZES))
+        msgs = []
+        d = selection.diagnose(w.prep, msgs.append)
+        for pr in d.pairs:
+            line, = [m for m in msgs if m.startswith("  " + "+".join(pr["causes"]) + " ")]
+            self.assertIn(f"held-out relerr {pr['relerr_percent']:.3f} % (gain {100 * pr['relative_gain']:.1f} %, "
+                          f"p = {pr['p_value']:.2g})", line)
+            self.assertEqual(line.endswith(" significant"), pr["significant"])
+
     def test_without_a_visible_gain_no_pair_is_tested(self):
         # the pair's share alone, each cause gaining nothing by itself: no pair is tried
         w = self.use(World({("offset", "position_gradient"): ("j",)}, {"j": 0.3}))
@@ -552,6 +577,33 @@ class SwapTest(WorldTest):
             self.assertEqual(c.base_relerr, fit.relerr(w.prep, w.TEST))
             self.assertEqual(set(c.fit.causes), (set(fit.causes) - {c.out}) | {c.cause})
         self.assertEqual([(c.out, c.cause) for c in sw if c.significant], [("asymmetric_friction", "offset")])
+
+    def test_swap_message_and_refits(self):
+        w = self.use(World(self.STAND_IN, {"m": 1.0, "a": 0.15, "g": 0.6, "k": 0.4}))
+        msgs = []
+        d = selection.diagnose(w.prep, msgs.append)
+        sw, = d.swapped
+        line, = [m for m in msgs if m.startswith("swapped ")]
+        self.assertIn(f"held-out relerr {sw['base_relerr_percent']:.3f} % -> {sw['relerr_percent']:.3f} % "
+                      f"(gain {100 * sw['relative_gain']:.1f} %, p = {sw['p_value']:.2g}), refitted: "
+                      f"{d.extended.relerr(w.prep, w.TEST):.3f} %", line)
+        # each swapped model is refitted with the shape (one round) before it is measured
+        w.calls.clear()
+        fit = w.Fit(("asymmetric_friction", "position_gradient"))
+        selection.swaps(w.prep, fit, ["offset"])
+        for out in fit.causes:
+            new = tuple(c for c in fit.causes if c != out) + ("offset",)
+            self.assertIn(("refine", new, 1), w.calls)
+
+    def test_a_cause_that_cannot_be_fitted_is_no_swap(self):
+        w = self.use(World(self.STAND_IN, {"m": 1.0, "a": 0.15, "g": 0.6, "k": 0.4}))
+        add = w.model.add_cause
+        w.model.add_cause = lambda prep, base, cause: None if cause == "actuator_delay" else add(prep, base, cause)
+        fit = w.Fit(("asymmetric_friction", "position_gradient"))
+        sw = selection.swaps(w.prep, fit, ["actuator_delay", "offset", "position_ripple"])
+        # the one that cannot be fitted is left out; the others are all still tried
+        self.assertEqual([(c.out, c.cause) for c in sw],
+                         [(o, r) for o in fit.causes for r in ("offset", "position_ripple")])
 
     def test_a_swap_that_gains_too_little_is_not_made(self):
         # k no larger than the stand-in's own share a: the swap gains nothing, none is made

@@ -174,13 +174,8 @@ def test_pair(prep, base, pair):
 def pairs_to_test(cands, remaining):
     """Each cause that gains MIN_REL_GAIN alone (not significantly) with each
     other remaining cause, every pair once, in the order of `remaining`."""
-    seeds = [c.cause for c in cands if c.rel_gain >= MIN_REL_GAIN]
-    out = []
-    for a in remaining:
-        for b in remaining:
-            if a != b and (a in seeds or b in seeds) and remaining.index(a) < remaining.index(b):
-                out.append((a, b))
-    return out
+    seeds = {c.cause for c in cands if c.rel_gain >= MIN_REL_GAIN}
+    return [(a, b) for i, a in enumerate(remaining) for b in remaining[i + 1:] if a in seeds or b in seeds]
 
 
 class Diagnosis:
@@ -255,10 +250,9 @@ def diagnose(prep, progress=None):
     base = nominal
     remaining = list(causes_.NAMES)
     findings, rounds, dropped, pairs, swapped = [], [], [], [], []
-    # every round adds a cause, two, or swaps one for a cause not tested again: bounded
-    for _ in range(2 * len(causes_.NAMES)):
-        if not remaining:
-            break
+    # every round that does not end the loop takes one or two causes out of
+    # `remaining` (a finding, a pair, a cause swapped in): at most len(NAMES) rounds
+    while remaining:
         cands = [c for c in (test(prep, base, cause) for cause in remaining) if c is not None]
         rounds.append([c.summary() for c in cands])
         for c in cands:
