@@ -418,6 +418,10 @@ class DiagnoseBackwardStepTest(WorldTest):
         # higher, and not better in the blocks: worse
         self.assertGreater(none.relerr(w.prep, w.TEST), off.relerr(w.prep, w.TEST))
         self.assertTrue(selection.worse_than(w.prep, none, off))
+        # lower, though worse in nine blocks of ten (better by far in one): never worse
+        self.assertGreater(selection.block_p_value(w.prep, off.residual(w.prep), rip.residual(w.prep)),
+                           selection.P_REMOVE)
+        self.assertFalse(selection.worse_than(w.prep, rip, off))
         # higher (the one block r*), but better in nine blocks of ten: not worse
         self.assertGreater(off.relerr(w.prep, w.TEST), rip.relerr(w.prep, w.TEST))
         self.assertLess(selection.block_p_value(w.prep, rip.residual(w.prep), off.residual(w.prep)),
@@ -518,6 +522,16 @@ class PairTest(WorldTest):
         self.assertFalse(selection.PairCandidate(("offset", "position_gradient"), None, 1.0, 0.99, 1e-6, both)
                          .significant)
 
+    def test_a_pair_is_refitted_once_with_the_shape(self):
+        w = self.use(World(self.HIDING, self.SIZES))
+        base = w.Fit(())
+        c = selection.test_pair(w.prep, base, ("offset", "position_gradient"))
+        self.assertEqual(c.pair, ("offset", "position_gradient"))
+        self.assertEqual(c.cause, "offset+position_gradient")
+        self.assertEqual(w.calls[0], ("refine", ("offset", "position_gradient"), 1))
+        # the members' need: each left out of the pair's model (solved, then refitted)
+        self.assertEqual(c.needed, {"offset": True, "position_gradient": True})
+
     def test_pair_messages(self):
         w = self.use(World(self.HIDING, self.SIZES))
         msgs = []
@@ -594,6 +608,16 @@ class SwapTest(WorldTest):
         for out in fit.causes:
             new = tuple(c for c in fit.causes if c != out) + ("offset",)
             self.assertIn(("refine", new, 1), w.calls)
+
+    def test_replace_finding(self):
+        fs = [(types.SimpleNamespace(cause=c), c.upper()) for c in ("offset", "asymmetric_friction", "position_ripple")]
+        new = (types.SimpleNamespace(cause="actuator_delay"), "NEW")
+        out = selection.replace_finding(fs, "offset", new)
+        # in its place; the others (sorting before or after it) untouched
+        self.assertEqual([f[0].cause for f in out], ["actuator_delay", "asymmetric_friction", "position_ripple"])
+        self.assertIs(out[0], new)
+        self.assertIs(out[1], fs[1])
+        self.assertIs(out[2], fs[2])
 
     def test_a_cause_that_cannot_be_fitted_is_no_swap(self):
         w = self.use(World(self.STAND_IN, {"m": 1.0, "a": 0.15, "g": 0.6, "k": 0.4}))

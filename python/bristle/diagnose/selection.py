@@ -135,7 +135,7 @@ class PairCandidate(Candidate):
     """base + two causes jointly, measured on the held-out part."""
 
     def __init__(self, pair, fit, base_relerr, relerr, p_value, needed=None):
-        super().__init__(pair[0], fit, base_relerr, relerr, p_value)
+        super().__init__("+".join(pair), fit, base_relerr, relerr, p_value)
         self.pair = tuple(pair)
         # each member needed in the pair's model (the backward step's level); a pair
         # with a member it does not need is that other cause alone, tested as such
@@ -243,6 +243,11 @@ def swaps(prep, fit, remaining):
     return out
 
 
+def replace_finding(findings, out, new):
+    """The findings with `out`'s entry replaced by `new`, in its place."""
+    return [new if f[0].cause == out else f for f in findings]
+
+
 def diagnose(prep, progress=None):
     say = progress or (lambda msg: None)
     nominal = model.fit_nominal(prep)
@@ -275,7 +280,7 @@ def diagnose(prep, progress=None):
             best = max(sw, key=lambda c: c.rel_gain)
             start = base
             refined = model.refine(prep, best.fit)
-            findings = [(best, refined) if f[0].cause == best.out else f for f in findings]   # in its place
+            findings = replace_finding(findings, best.out, (best, refined))
             remaining.remove(best.cause)
             swapped.append(dict(best.summary(), out=best.out, round=len(rounds)))
             say(f"swapped {best.out} for {best.cause}: held-out relerr {best.base_relerr:.3f} % -> "
