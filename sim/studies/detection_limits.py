@@ -42,6 +42,7 @@ Usage: detection_limits.py --simlog BIN --work DIR [--n N] [--n-verify M] [--n-n
                            [--md OUT.md] [--png OUT.png] [--json OUT.json]
 """
 import argparse
+import hashlib
 import json
 import math
 import multiprocessing as mp
@@ -122,7 +123,6 @@ SECONDS = {}   # key -> wall seconds of that log (br_simlog + diagnosis), this r
 def code_digest():
     """A digest of what decides a log's result: the diagnosis's Python sources
     and br_simlog's binary. A cached result of other code is never reused."""
-    import hashlib
     h = hashlib.sha256()
     root = os.path.join(REPO, "python", "bristle", "diagnose")
     for d, _, files in sorted(os.walk(root)):
@@ -140,7 +140,6 @@ def run(simlog, work, key, flags, sigma, seed):
     """One log: br_simlog, then the diagnosis. Returns (verdict, findings)."""
     if simlog not in DIGEST:
         with open(simlog, "rb") as fh:
-            import hashlib
             DIGEST[simlog] = code_digest() + hashlib.sha256(fh.read()).hexdigest()[:16]
     ck = f"{key}|{' '.join(flags)}|{sigma:.6g}|{seed}|{DIGEST[simlog]}"
     USED.add(ck)

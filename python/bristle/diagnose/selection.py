@@ -229,6 +229,7 @@ def swaps(prep, fit, remaining):
     in, with `.out` the finding it replaces."""
     out = []
     te = prep.test
+    fit_rel, fit_res = fit.relerr(prep, te), fit.residual(prep)   # what every swap is measured against
     for c in fit.causes:
         rest = without(prep, fit, c)
         for r in remaining:
@@ -236,8 +237,7 @@ def swaps(prep, fit, remaining):
             if f2 is None:
                 continue
             f2 = model.refine(prep, f2, rounds=1, max_nfev=REFINE_NFEV)
-            cand = Candidate(r, f2, fit.relerr(prep, te), f2.relerr(prep, te),
-                             block_p_value(prep, fit.residual(prep), f2.residual(prep)))
+            cand = Candidate(r, f2, fit_rel, f2.relerr(prep, te), block_p_value(prep, fit_res, f2.residual(prep)))
             cand.out = c
             out.append(cand)
     return out
