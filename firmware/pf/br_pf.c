@@ -14,23 +14,18 @@
 #include "br_math.h"
 #include "br_model_kernel.h"
 
-/* BR_PF_SIMD: the target has vector registers for float (x86-64 SSE2, Arm
- * NEON). There the weights' exponentials run in a loop of their own (vectorised)
- * and the in-place copy is branch-free; without (the Cortex-M7) one fused
- * weight loop and a copy that skips the particles staying put cost fewer
- * instructions. The results are the same either way. */
-#if defined(__SSE2__) || defined(__ARM_NEON)
-#define BR_PF_SIMD 1
-#else
-#define BR_PF_SIMD 0
-#endif
+/* BR_PF_SIMD (BR_FLOAT_SIMD, br_inline.h): with float SIMD the weights'
+ * exponentials run in a loop of their own (vectorised), the prediction loop
+ * and the in-place copy are branch-free; without (the Cortex-M7) one fused
+ * weight loop, a prediction loop that branches out to the fix-up and a copy
+ * that skips the particles staying put cost fewer instructions. The results
+ * are the same either way. */
+#define BR_PF_SIMD BR_FLOAT_SIMD
 
-/* f_nl (eqs. 3, 4) of a predicted particle: eq. 4 with its k_p = sigma0 L / g_p
- * (BR_PF_ONE_DIVISION) or divided by g_p, as the build selects */
-static inline float fnl_sel(const br_model_k_t *k, float om, float z, float gp, float kg)
+/* f_nl (eqs. 3, 4) of a predicted particle: eq. 4 with its k_p = sigma0 L / g_p */
+static inline float fnl_kp(const br_model_k_t *k, float om, float z, float kg)
 {
-    const float zd = BR_PF_ONE_DIVISION ? br_model_kp_zdot(k->L, kg, om, z) : br_model_k_zdot(k, om, z, gp);
-    return br_model_k_fnl(k, z, zd);
+    return br_model_k_fnl(k, z, br_model_kp_zdot(k->L, kg, om, z));
 }
 
 /* BR_PF_CLONES: on x86-64 hosts (GCC), the vectorised loops are also compiled
@@ -218,9 +213,7 @@ static void prime(br_pf_t *pf, const br_meas_t *y)
             pf->x[i][j] = mean[i] + pf->cfg.x0_std[i] * noise_at(pf, j, i);
         }
         pf->x[BR_X_GP][j] = br_clampf(pf->x[BR_X_GP][j], pf->cfg.est.gp_min_N, pf->cfg.est.gp_max_N);
-        if (BR_PF_ONE_DIVISION) {
-            pf->kgp[j] = br_model_kp_of(&pf->model, pf->x[BR_X_GP][j]);
-        }
+        pf->kgp[j] = br_model_kp_of(&pf->model, pf->x[BR_X_GP][j]);
     }
     noise_advance(pf);
     pf->origin_counts = y->counts;
@@ -372,9 +365,7 @@ static float resample_forward(br_pf_t *pf, float s[BR_NX])
         om[i] = om[src];
         zz[i] = zz[src];
         gg[i] = gg[src];
-        if (BR_PF_ONE_DIVISION) {
-            ia[i] = ia[src];
-        }
+        ia[i] = ia[src];
     }
     s[0] = s0;
     s[1] = s1;
@@ -405,7 +396,7 @@ static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
     uint32_t t = total / den, r = total % den;
     uint32_t j = 0u, c = W[0];
     float a0 = th[0], a1 = om[0], a2 = zz[0], a3 = gg[0], af = fnl[0];
-    float ai = BR_PF_ONE_DIVISION ? ia[0] : 0.0f;
+    float ai = ia[0];
     float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
     for (uint32_t i = 0; i < m; i++) {
         if (c <= t && j + 1u < m) {
@@ -418,9 +409,7 @@ static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
             a2 = zz[j];
             a3 = gg[j];
             af = fnl[j];
-            if (BR_PF_ONE_DIVISION) {
-                ai = ia[j];
-            }
+            ai = ia[j];
         }
         idx[i] = (uint16_t)j;
         s0 += a0;
@@ -433,9 +422,7 @@ static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
             om[i] = a1;
             zz[i] = a2;
             gg[i] = a3;
-            if (BR_PF_ONE_DIVISION) {
-                ia[i] = ai;
-            }
+            ia[i] = ai;
         }
         /* t_{i+1} = t_i + dq, plus 1 when the remainder carries */
         t += dq;
@@ -477,7 +464,7 @@ br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
 /* The constants of one prediction pass (steps 1 and 2), for every particle. */
 typedef struct {
     br_model_k_t mk;  /* the thesis model's kernel constants */
-    br_model_kp_t kp; /* the PF's RK4 constants (BR_PF_ONE_DIVISION) */
+    br_model_kp_t kp; /* the PF's prediction constants (br_model_kp_heun) */
     float s0L;        /* sigma0 L: k_p = s0L / g_p */
     br_model_kx_t mx; /* the extended model's (theta relative to the origin at its p0) */
     float q[BR_NX];   /* process noise standard deviations */
@@ -540,7 +527,7 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
     particle_get(pf, j, x);
     /* 1. predict: eq. 6 discretised as br_model_step (RK4, or the bounded scheme
      * beyond its a h limit); the particles are finite with g_p >= gp_min > 0 */
-    if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !(BR_PF_ONE_DIVISION ? br_model_kp_rk4(&c->kp, x, pf->kgp[j], xn) : br_model_k_rk4(&c->mk, x, c->u, xn))) {
+    if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_heun(&c->kp, x, pf->kgp[j], xn)) {
         if (ext) {
             br_model_bounded_step_x(&c->mx, x, c->u, xn);
         } else {
@@ -576,8 +563,8 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
     }
     const float z = xn[BR_X_Z] + c->q[2] * n[2];
     const float gp = clamp_sel(xn[BR_X_GP] + c->q[3] * n[3], c->gp_min, c->gp_max);
-    /* BR_PF_ONE_DIVISION: the particle's one division, k_p = sigma0 L / g_p for eq. 4 here and in the next step */
-    const float kg = BR_PF_ONE_DIVISION ? c->s0L / gp : 0.0f;
+    /* the particle's one division, k_p = sigma0 L / g_p for eq. 4 here and in the next step */
+    const float kg = c->s0L / gp;
     /* the force to compensate of the predicted particle: eq. 6's f_nl, or
      * the extended model's (at its position relative to the last origin) */
     float fnl;
@@ -585,7 +572,7 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
         const float xe[BR_NX] = {th_old, om, z, gp};
         fnl = br_model_kx_fcomp_N(&c->mx, xe);
     } else {
-        fnl = fnl_sel(&c->mk, om, z, gp, kg);
+        fnl = fnl_kp(&c->mk, om, z, kg);
     }
     /* Validity: x - x is 0 for finite x and NaN otherwise. g_p is finite after
      * the clamp; a non-finite omega or z makes f_nl non-finite (inf - inf,
@@ -595,9 +582,7 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
         pf->x[BR_X_OMEGA][j] = om;
         pf->x[BR_X_Z][j] = z;
         pf->x[BR_X_GP][j] = gp;
-        if (BR_PF_ONE_DIVISION) {
-            pf->kgp[j] = kg;
-        }
+        pf->kgp[j] = kg;
         pf->fnl[j] = fnl;
         /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R);
          * may be -inf for a particle far from y: still valid (NaN marks invalid) */
@@ -635,12 +620,8 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
                                          lsum_t *ls)
 {
     const br_model_k_t mk = c->mk;
-#if BR_PF_ONE_DIVISION
     const br_model_kp_t kp = c->kp;
     const float s0L = c->s0L;
-#else
-    const float u = c->u;
-#endif
     const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
     const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
     const float shift = c->shift, y_rel = c->y_rel;
@@ -648,9 +629,7 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     float *BR_RESTRICT om = pf->x[BR_X_OMEGA] + j0;
     float *BR_RESTRICT zz = pf->x[BR_X_Z] + j0;
     float *BR_RESTRICT gg = pf->x[BR_X_GP] + j0;
-#if BR_PF_ONE_DIVISION
     float *BR_RESTRICT ka = pf->kgp + j0;
-#endif
     float *BR_RESTRICT fo = pf->fnl + j0;
     float *BR_RESTRICT lo = pf->l + j0;
     const float *BR_RESTRICT nn = nz;
@@ -661,40 +640,52 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     for (size_t j = 0; j < n; j++) {
         const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
         float xn[BR_NX];
-        /* 1. predict (RK4 of eq. 6; ok_rk = 0 where the bounded scheme is needed) */
-#if BR_PF_ONE_DIVISION
+        /* 1. predict (Heun's step of eq. 6; ok_rk = 0 where the bounded scheme is needed) */
         const float kg0 = ka[j];
-        const int ok_rk = br_model_kp_rk4(&kp, x, kg0, xn);
-#else
-        const int ok_rk = br_model_k_rk4(&mk, x, u, xn);
-#endif
+        const int ok_rk = br_model_kp_heun(&kp, x, kg0, xn);
         /* process noise sqrt(Q) n */
         const float t = (xn[BR_X_THETA] + q0 * nn[BR_NX * j]) - shift;
         const float w = xn[BR_X_OMEGA] + q1 * nn[BR_NX * j + 1u];
         const float z = xn[BR_X_Z] + q2 * nn[BR_NX * j + 2u];
         const float g = clamp_sel(xn[BR_X_GP] + q3 * nn[BR_NX * j + 3u], gp_min, gp_max);
-        /* BR_PF_ONE_DIVISION: the particle's one division */
-#if BR_PF_ONE_DIVISION
+        /* the particle's one division */
         const float kg = s0L / g;
-#else
-        const float kg = 0.0f;
-#endif
         /* f_nl of the predicted particle (eqs. 3, 4) */
-        const float f = fnl_sel(&mk, w, z, g, kg);
-        /* validity as particle_one's */
-        const int ok = ok_rk & ((t - t) + (f - f) == 0.0f);
+        const float f = fnl_kp(&mk, w, z, kg);
         /* 2. log-likelihood */
         const float e = t - y_rel;
         const float l = -(e * e) * inv_2r;
         s1 += e;
         s2 += e * e;
+#if !BR_PF_SIMD
+        /* without float SIMD (the Cortex-M7) nothing is gained by a
+         * branch-free body: a particle for the fix-up (the bounded scheme, or
+         * not valid as particle_one's) branches out, keeping its state in
+         * place (f_nl = 0, l = NaN), and the valid ones store without selects */
+        if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
+            fo[j] = 0.0f;
+            lo[j] = NAN;
+            continue;
+        }
+        th[j] = t;
+        om[j] = w;
+        zz[j] = z;
+        gg[j] = g;
+        ka[j] = kg;
+        fo[j] = f;
+        lo[j] = l;
+        int32_t key;
+        memcpy(&key, &l, sizeof key);
+        kmin = (key < kmin) ? key : kmin;
+        n_ok++;
+#else
+        /* validity as particle_one's */
+        const int ok = ok_rk & ((t - t) + (f - f) == 0.0f);
         th[j] = ok ? t : x[BR_X_THETA];
         om[j] = ok ? w : x[BR_X_OMEGA];
         zz[j] = ok ? z : x[BR_X_Z];
         gg[j] = ok ? g : x[BR_X_GP];
-#if BR_PF_ONE_DIVISION
         ka[j] = ok ? kg : kg0;
-#endif
         fo[j] = ok ? f : 0.0f;
         const float lk = ok ? l : NAN;
         lo[j] = lk;
@@ -703,6 +694,7 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         memcpy(&key, &lk, sizeof key);
         kmin = (key < kmin) ? key : kmin;
         n_ok += (uint32_t)ok;
+#endif
     }
     ls->s1 = s1;
     ls->s2 = s2;
@@ -879,9 +871,7 @@ static void copy_backward(br_pf_t *pf)
         om[i] = om[s];
         zz[i] = zz[s];
         gg[i] = gg[s];
-        if (BR_PF_ONE_DIVISION) {
-            ia[i] = ia[s];
-        }
+        ia[i] = ia[s];
     }
 }
 
@@ -900,9 +890,7 @@ static void copy_back(br_pf_t *pf)
             om[i] = om[k];
             zz[i] = zz[k];
             gg[i] = gg[k];
-            if (BR_PF_ONE_DIVISION) {
-                ia[i] = ia[k];
-            }
+            ia[i] = ia[k];
         }
     }
 }

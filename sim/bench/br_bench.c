@@ -416,9 +416,9 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
     json_f4(f, c->x0_std);
     fprintf(f,
             ", \"gp_min_N\": %.9g, \"gp_max_N\": %.9g, \"outlier_sigma\": %.9g, \"reanchor_after\": %u, "
-            "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"one_division\": %d, \"noise_fnv1a64\": \"%016llx\"}",
+            "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"noise_fnv1a64\": \"%016llx\"}",
             (double)c->est.gp_min_N, (double)c->est.gp_max_N, (double)c->est.outlier_sigma, (unsigned)c->est.reanchor_after,
-            (double)c->est.rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip, (int)BR_PF_ONE_DIVISION,
+            (double)c->est.rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip,
             (unsigned long long)fnv1a(c->noise, (size_t)c->noise_len * sizeof *c->noise));
 }
 
@@ -657,7 +657,7 @@ int main(int argc, char **argv)
 
     const double load1 = loadavg1();
     /* 3. memory (host sizes; see docs/bench.md for the Cortex-M7 ones) */
-    const size_t per_particle = (sizeof(((br_pf_t *)0)->x) + (BR_PF_ONE_DIVISION ? sizeof(((br_pf_t *)0)->kgp) : 0u) +
+    const size_t per_particle = (sizeof(((br_pf_t *)0)->x) + sizeof(((br_pf_t *)0)->kgp) +
                                  sizeof(((br_pf_t *)0)->fnl) + sizeof(((br_pf_t *)0)->l) +
                                  sizeof(((br_pf_t *)0)->W) + sizeof(((br_pf_t *)0)->idx)) /
                                 BR_PF_MAX_PARTICLES;

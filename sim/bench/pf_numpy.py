@@ -5,8 +5,9 @@ in numpy, vectorised over the particles, timed on the recording br_bench made
 (br_bench --record FILE), and compared with the C filter.
 
 Same model and algorithm as br_pf.c, in float32 throughout (as the firmware):
-  predict   eq. 6 by RK4 on every particle, then, per particle (a mask on the
-            a h <= 2 test at both ends of the step), the bounded
+  predict   eq. 6 by Heun's step (br_model_kp_heun) on every particle,
+            then, per particle (a mask on the a h <= 2 test at both ends of
+            the step), the bounded
             displacement-exact scheme with 3 fixed-point passes (br_model.c),
             evaluated on the masked particles only and scattered back (as C
             computes it only where needed); process noise from the same ROM table
@@ -74,7 +75,7 @@ def seqsum(a):
 
 
 def exp_neg(x):
-    """br_exp_neg (firmware/math/br_math.c) on a float32 array: e^x for x <= 0,
+    """br_exp_neg (firmware/private/br_math.h) on a float32 array: e^x for x <= 0,
     2^n times a degree-6 Taylor polynomial, 0 below -87 and for NaN."""
     zero = ~(x > F(-87.0))
     x = np.where(zero, F(0.0), np.minimum(x, F(0.0)))
@@ -108,10 +109,9 @@ class NumpyPf:
         self.inv_jeff = F(1.0) / (J + self.L * self.L * M)   # br_model_init
         self.visc = self.L * self.L * s2
         self.s0L = self.s0 * self.L
-        # BR_PF_ONE_DIVISION builds: the PF's RK4 form (br_model_kp_rk4): each
+        # the PF's prediction (br_model_kp_heun): each
         # particle's k_p = sigma0 L / g_p (recomputed here from g_p: the same
         # float the C filter carries) and folded constants
-        self.one_div = bool(cfg.get("one_division", 0))
         self.kp_cw = self.visc * self.inv_jeff
         self.kp_cz = (self.L * self.s0) * self.inv_jeff
         self.kp_czd = (self.L * self.s1) * self.inv_jeff
@@ -149,8 +149,8 @@ class NumpyPf:
         return n
 
     def _fnl(self, om, z, gp, div=False):
-        """f_nl (eqs. 3, 4): divided by g_p, or with k_p as the C filter's prediction in a one-division build"""
-        if self.one_div and not div:
+        """f_nl (eqs. 3, 4): divided by g_p (div, br_model_fcomp_N), or with k_p as the C filter's prediction"""
+        if not div:
             zdot = self.L * om - (self.s0L / gp * np.abs(om)) * z
         else:
             v = self.L * om
@@ -158,9 +158,8 @@ class NumpyPf:
         return self.s0 * z + self.s1 * zdot
 
     def _model_step_kp(self, th, om, z, gp, u):
-        """br_model_kp_rk4 on every particle, the bounded scheme where a h > 2"""
+        """br_model_kp_heun on every particle, the bounded scheme where a h > 2"""
         L, h, hh = self.L, self.h, F(0.5) * self.h
-        h6, h3 = h / F(6.0), h / F(3.0)
         a, cw, cz, czd = u * self.inv_jeff, self.kp_cw, self.kp_cz, self.kp_czd
         kp = self.s0L / gp
 
@@ -170,44 +169,12 @@ class NumpyPf:
             return ((a - cw * w) - cz * zz) - czd * zd, zd, kw
 
         k1w, k1z, kw1 = stage(om, z)
-        om2, z2 = om + hh * k1w, z + hh * k1z
+        om2, z2 = om + h * k1w, z + h * k1z
         k2w, k2z, _ = stage(om2, z2)
-        om3, z3 = om + hh * k2w, z + hh * k2z
-        k3w, k3z, _ = stage(om3, z3)
-        om4, z4 = om + h * k3w, z + h * k3z
-        k4w, k4z, _ = stage(om4, z4)
-        th1 = th + (h6 * (om + om4) + h3 * (om2 + om3))
-        om1 = om + (h6 * (k1w + k4w) + h3 * (k2w + k3w))
-        z1 = z + (h6 * (k1z + k4z) + h3 * (k2z + k3z))
+        th1 = th + hh * (om + om2)
+        om1 = om + hh * (k1w + k2w)
+        z1 = z + hh * (k1z + k2z)
         rk4 = (kw1 <= self.ah_lim) & (kp * np.abs(om1) <= self.ah_lim)
-        b = np.flatnonzero(~rk4)
-        if b.size:
-            th1[b], om1[b], z1[b] = self._bounded(th[b], om[b], z[b], gp[b], u)
-        return th1, om1, z1
-
-    def _deriv(self, om, z, gp, u):
-        """eq. 6: (domega/dt, dz/dt); dtheta/dt = omega, dg_p/dt = 0."""
-        v = self.L * om
-        zdot = v - self.s0 * np.abs(v) * z / gp
-        fnl = self.s0 * z + self.s1 * zdot
-        return (u - self.visc * om - self.L * fnl) * self.inv_jeff, zdot
-
-    def _model_step(self, th, om, z, gp, u):
-        """br_model_step on every particle: RK4, the bounded scheme where a h > 2."""
-        h, hh = self.h, F(0.5) * self.h
-        k1w, k1z = self._deriv(om, z, gp, u)
-        om2 = om + hh * k1w
-        k2w, k2z = self._deriv(om2, z + hh * k1z, gp, u)
-        om3 = om + hh * k2w
-        k3w, k3z = self._deriv(om3, z + hh * k2z, gp, u)
-        om4 = om + h * k3w
-        k4w, k4z = self._deriv(om4, z + h * k3z, gp, u)
-        h6 = h / F(6.0)
-        th1 = th + h6 * (om + F(2.0) * om2 + F(2.0) * om3 + om4)
-        om1 = om + h6 * (k1w + F(2.0) * k2w + F(2.0) * k3w + k4w)
-        z1 = z + h6 * (k1z + F(2.0) * k2z + F(2.0) * k3z + k4z)
-        # RK4 only where a h = sigma0 L |omega| h / g_p <= 2 at both ends of the step
-        rk4 = (self.s0L * np.abs(om) * h / gp <= RK4_AH_MAX) & (self.s0L * np.abs(om1) * h / gp <= RK4_AH_MAX)
         b = np.flatnonzero(~rk4)
         if b.size:
             th1[b], om1[b], z1[b] = self._bounded(th[b], om[b], z[b], gp[b], u)
@@ -255,8 +222,7 @@ class NumpyPf:
         y_rel = frac * rpc
         x = self.x
         # 1. predict
-        step = self._model_step_kp if self.one_div else self._model_step
-        th, om, z = step(x[0], x[1], x[2], x[3], u)
+        th, om, z = self._model_step_kp(x[0], x[1], x[2], x[3], u)
         n = self._noise()
         th = th + self.q_std[0] * n[0]
         om = om + self.q_std[1] * n[1]

@@ -220,9 +220,7 @@ static void resample_forced(br_pf_t *pf, const br_pf_t *pred, const uint16_t *id
             pf->x[i][j] = pred->x[i][idx[j]];
             s[i] += pf->x[i][j];
         }
-        if (BR_PF_ONE_DIVISION) {
-            pf->kgp[j] = pred->kgp[idx[j]];
-        }
+        pf->kgp[j] = pred->kgp[idx[j]];
         sf += pf->fnl[idx[j]];
         pf->idx[j] = idx[j];
     }
@@ -535,10 +533,8 @@ static void test_pf_forced_run(void **state)
                     br_errstat_add(&e_x[i], &g.x, xrow, (double)pf->x[i][j], ref, dr.d[i]);
                     pf->x[i][j] = (float)ref;
                 }
-                if (BR_PF_ONE_DIVISION) {
-                    pf->kgp[j] = (pf->cfg.est.model.lugre.sigma0_Npm * pf->cfg.est.model.lead_mprad) /
-                                  pf->x[BR_X_GP][j]; /* the filter carries sigma0 L / g_p with g_p */
-                }
+                pf->kgp[j] = (pf->cfg.est.model.lugre.sigma0_Npm * pf->cfg.est.model.lead_mprad) /
+                              pf->x[BR_X_GP][j]; /* the filter carries sigma0 L / g_p with g_p */
             }
             step_scales(&c, xm, xm, 0.0, 0.0, S);
             drift_seed(&dr, S);

@@ -336,11 +336,35 @@ static void test_tracks_plant_friction(void **st)
     free(pf);
 }
 
-/* The PF's inline prediction (RK4 kernel, bounded fallback) is br_model_step bit
- * for bit: without process noise, every predicted particle equals br_model_step
- * of its parent shifted to the new origin, at circle speeds and beyond the RK4
- * a h limit (the bounded scheme). */
-static void predict_is_model_step(uint32_t scalar_path)
+/* eq. 6's right-hand side in double with g_p held: (omega', z') */
+static void deriv_d(const br_model_cfg_t *mc, double w, double z, double gp, double u, double *wd, double *zd)
+{
+    const double L = mc->lead_mprad, v = L * w;
+    *zd = v - mc->lugre.sigma0_Npm * fabs(v) * z / gp;
+    const double f = mc->lugre.sigma0_Npm * z + mc->lugre.sigma1_Nspm * *zd;
+    *wd = (u - L * (mc->sigma2_Nspm * v + f)) / (mc->J_kgm2 + L * L * mc->M_kg);
+}
+
+/* Heun's step of eq. 6 in double: x + h/2 (f(x) + f(x + h f(x))) */
+static void heun_d(const br_model_cfg_t *mc, const float x[BR_NX], double u, double out[BR_NX])
+{
+    const double h = mc->dt_s, w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z], gp = x[BR_X_GP];
+    double wd1, zd1, wd2, zd2;
+    deriv_d(mc, w0, z0, gp, u, &wd1, &zd1);
+    const double w2 = w0 + h * wd1, z2 = z0 + h * zd1;
+    deriv_d(mc, w2, z2, gp, u, &wd2, &zd2);
+    out[BR_X_THETA] = (double)x[BR_X_THETA] + 0.5 * h * (w0 + w2);
+    out[BR_X_OMEGA] = w0 + 0.5 * h * (wd1 + wd2);
+    out[BR_X_Z] = z0 + 0.5 * h * (zd1 + zd2);
+    out[BR_X_GP] = gp;
+}
+
+/* The PF's inline prediction (Heun's step, bounded fallback): without process
+ * noise, every predicted particle equals Heun's step of its parent (computed
+ * here in double) to a float32 rounding tolerance at circle speeds, and
+ * br_model_step's bounded scheme bit for bit beyond the a h limit, on both
+ * paths (the vector path fixes the bounded particles up in scalar). */
+static void predict_is_heun_step(uint32_t scalar_path)
 {
     br_pf_t *pf = calloc(1, sizeof *pf);
     assert_non_null(pf);
@@ -369,18 +393,21 @@ static void predict_is_model_step(uint32_t scalar_path)
     const float u = 0.05f;
     /* predict only: the set is the predicted set (no resampling), in place */
     assert_int_equal(br_pf_predict(pf, u), BR_OK);
+    int n_heun = 0;
     for (uint32_t j = 0; j < 64; j++) {
-        float xn[BR_NX];
-        assert_int_equal(br_model_step(&pf->model, parent[j], u, xn), BR_OK);
+        float xb[BR_NX];
+        double xn[BR_NX];
+        assert_int_equal(br_model_step(&pf->model, parent[j], u, xb), BR_OK);
+        heun_d(&c.est.model, parent[j], u, xn);
         const float ah = c.est.model.lugre.sigma0_Npm * c.est.model.lead_mprad * fabsf(parent[j][BR_X_OMEGA]) *
                          c.est.model.dt_s / parent[j][BR_X_GP];
-        /* RK4 steps: the PF's own RK4 form (k_p = sigma0 L / g_p, folded
-         * constants) rounds differently from br_model_step's (an ulp or so per
-         * operation, relative to the size of each term of eqs. 4 and 6, which
-         * may cancel): equal to 1e-5 of the step's change plus 1e-5 of the
-         * step's terms taken in absolute value (s[]: h |omega| + h^2 |eq. 6|,
-         * h |eq. 6|, h |eq. 4|) plus 2 ulp; the bounded scheme (both use it as
-         * is): bit for bit */
+        /* Heun's steps: the PF's float32 form (k_p = sigma0 L / g_p, folded
+         * constants) against the double one (an ulp or so per operation,
+         * relative to the size of each term of eqs. 4 and 6, which may
+         * cancel): equal to 1e-5 of the step's change plus 1e-5 of the step's
+         * terms taken in absolute value (s[]: h |omega| + h^2 |eq. 6|,
+         * h |eq. 6|, h |eq. 4|) plus 2 ulp; the bounded scheme (both use
+         * br_model_step's as is): bit for bit */
         const br_model_cfg_t *mc = &c.est.model;
         const double L = mc->lead_mprad, h = mc->dt_s, w = fabs((double)parent[j][BR_X_OMEGA]);
         const double zabs = fabs((double)parent[j][BR_X_Z]), v = L * w;
@@ -393,31 +420,31 @@ static void predict_is_model_step(uint32_t scalar_path)
             continue; /* near the limit either scheme may be taken at the step's end */
         }
         const int bounded = ah >= 1.1f * BR_MODEL_RK4_AH_MAX;
+        n_heun += !bounded;
         for (int i = 0; i < BR_NX; i++) {
-            const double d = fabs((double)pf->x[i][j] - (double)xn[i]);
-            const double tol = (bounded || !BR_PF_ONE_DIVISION) ? 0.0
-                                       : 1e-5 * (fabs((double)xn[i] - (double)parent[j][i]) + s[i]) +
-                                             2.0 * (double)FLT_EPSILON * fabs((double)xn[i]);
+            const double ref = bounded ? (double)xb[i] : xn[i];
+            const double d = fabs((double)pf->x[i][j] - ref);
+            const double tol = bounded ? 0.0
+                                       : 1e-5 * (fabs(ref - (double)parent[j][i]) + s[i]) +
+                                             2.0 * (double)FLT_EPSILON * fabs(ref);
             if (!(d <= tol)) {
-                fail_msg("path %u particle %u state %d: PF %.9g, br_model_step %.9g", (unsigned)scalar_path,
-                         (unsigned)j, i, (double)pf->x[i][j], (double)xn[i]);
+                fail_msg("path %u particle %u state %d: PF %.9g, %s %.9g", (unsigned)scalar_path, (unsigned)j, i,
+                         (double)pf->x[i][j], bounded ? "br_model_step" : "Heun (double)", ref);
             }
         }
         assert_true(pf->l[j] > -INFINITY);
     }
+    assert_true(n_heun >= 10); /* both schemes are compared */
     free(pf);
 }
 
-/* The prediction is br_model_step's bit for bit (RK4, and the bounded scheme
- * beyond the a h limit), on both paths (the vector path fixes the bounded
- * particles up in scalar); in a BR_PF_ONE_DIVISION build (the default: the
- * PF's own RK4 form, br_model_kp_rk4)
- * RK4 to an ulp-level tolerance. */
-static void test_predict_is_model_step(void **st)
+/* The prediction is Heun's step (to float32 rounding), and br_model_step's
+ * bounded scheme bit for bit beyond the a h limit, on both paths. */
+static void test_predict_is_heun_step(void **st)
 {
     (void)st;
-    predict_is_model_step(0u);
-    predict_is_model_step(1u);
+    predict_is_heun_step(0u);
+    predict_is_heun_step(1u);
 }
 
 /* The vector path and the scalar reference path give identical particles,
@@ -843,7 +870,7 @@ int main(void)
         cmocka_unit_test(test_gate_quantisation),
         cmocka_unit_test(test_all_invalid_keeps_previous), cmocka_unit_test(test_weights_survive_underflow),
         cmocka_unit_test(test_ess_reported),         cmocka_unit_test(test_tracks_plant_friction),
-        cmocka_unit_test(test_predict_is_model_step),
+        cmocka_unit_test(test_predict_is_heun_step),
         cmocka_unit_test(test_vector_path_is_scalar_path),
         cmocka_unit_test(test_gp_stays_in_range),
         cmocka_unit_test(test_one_invalid_particle),

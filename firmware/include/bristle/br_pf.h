@@ -24,17 +24,6 @@
 #ifndef BR_PF_MAX_PARTICLES
 #define BR_PF_MAX_PARTICLES 2048u
 #endif
-/* BR_PF_ONE_DIVISION (build option, CMake BR_PF_ONE_DIVISION, default 1):
- * 1 = each particle carries k_p = sigma0 L / g_p (kgp), one division per
- * particle-step where the RK4 stages and f_nl would divide by g_p five times
- * (the Cortex-M7's vdiv.f32 takes 14 cycles), and predicts with the RK4 form
- * of br_model_kp_rk4 (constants folded); 0 = br_model_step's RK4. They round
- * differently, so the tuned variances and the demo's figures belong to the
- * default, 1 (docs/modules/pf.md). */
-#ifndef BR_PF_ONE_DIVISION
-#define BR_PF_ONE_DIVISION 1
-#endif
-
 /* weight quantisation: W in [0, 2^16]; the resampling works on 2 C_m <= 2^17 m,
  * which fits uint32 for m < 2^15 (and the indices fit uint16) */
 #define BR_PF_W_BITS 16u
@@ -125,8 +114,8 @@ typedef struct {
     /* particles as a structure of arrays: x[i][j] is state i of particle j.
      * One set, predicted and resampled in place (docs/modules/pf.md). */
     float x[BR_NX][BR_PF_MAX_PARTICLES];
-    float kgp[BR_PF_ONE_DIVISION ? BR_PF_MAX_PARTICLES : 1u]; /* sigma0 L / g_p of each particle, 1/rad
-                                                                  (BR_PF_ONE_DIVISION builds only) */
+    float kgp[BR_PF_MAX_PARTICLES];   /* k_p = sigma0 L / g_p of each particle, 1/rad: the
+                                          particle-step's one division (docs/modules/pf.md) */
     float fnl[BR_PF_MAX_PARTICLES];   /* f_nl of the predicted particles (by predicted index) */
     float l[BR_PF_MAX_PARTICLES];     /* log-weights; NaN marks an invalid particle */
     uint32_t W[BR_PF_MAX_PARTICLES];  /* quantised weights */
