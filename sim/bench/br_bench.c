@@ -416,10 +416,12 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
     json_f4(f, c->x0_std);
     fprintf(f,
             ", \"gp_min_N\": %.9g, \"gp_max_N\": %.9g, \"outlier_sigma\": %.9g, \"reanchor_after\": %u, "
-            "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"noise_fnv1a64\": \"%016llx\"}",
+            "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"noise_fnv1a64\": \"%016llx\", "
+            "\"adapt\": {\"nis_ref\": %.9g, \"alpha\": %.9g, \"max_scale\": %.9g}}",
             (double)c->est.gp_min_N, (double)c->est.gp_max_N, (double)c->est.outlier_sigma, (unsigned)c->est.reanchor_after,
             (double)c->est.rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip,
-            (unsigned long long)fnv1a(c->noise, (size_t)c->noise_len * sizeof *c->noise));
+            (unsigned long long)fnv1a(c->noise, (size_t)c->noise_len * sizeof *c->noise), (double)c->adapt.nis_ref,
+            (double)c->adapt.alpha, (double)c->adapt.max_scale);
 }
 
 static int write_record(const char *path, const br_pf_cfg_t *cfg, const rec_t *rec, const float *fhat)

@@ -117,6 +117,14 @@ class NumpyPf:
         self.kp_czd = (self.L * self.s1) * self.inv_jeff
         self.ah_lim = RK4_AH_MAX / self.h
         self.q_std = np.sqrt(np.array(cfg["q_var"], dtype=F)).reshape(4, 1)
+        # cfg.adapt, the innovation-driven noise of z and g_p (adapt_update)
+        ad = cfg.get("adapt", {})
+        self.nis_ref = F(ad.get("nis_ref", 0.0))
+        self.alpha, self.max_scale = F(ad.get("alpha", 0.0)), F(ad.get("max_scale", 1.0))
+        self.r_gate = F(cfg["r_var_rad2"]) + F(cfg["rad_per_count"]) * F(cfg["rad_per_count"]) * F(1.0 / 12.0)
+        self.nis_max = F(cfg["outlier_sigma"]) * F(cfg["outlier_sigma"])
+        self.nis_avg = F(0.0)
+        self.q_scale = F(1.0)
         self.inv_2r = F(0.5) / F(cfg["r_var_rad2"])
         # the gate with the encoder's quantisation: -g^2 (R + rpc^2 / 12) / (2 R), as br_pf_init
         rpc = F(cfg["rad_per_count"])
@@ -212,6 +220,19 @@ class NumpyPf:
         self.ess = F(self.m)
         return BR_OK
 
+    def _adapt(self, d, n_valid):
+        """adapt_update: the NIS of the predicted cloud from the sums of d_j =
+        theta_j - y (0 for an invalid particle) and d_j^2 in particle order"""
+        n = F(n_valid)
+        s1, s2 = seqsum(d), seqsum(d * d)
+        mean = s1 / n
+        var = s2 / n - mean * mean
+        nis = (mean * mean) / ((var if var > F(0.0) else F(0.0)) + self.r_gate)
+        nis = nis if nis <= self.nis_max else self.nis_max
+        self.nis_avg = self.nis_avg + self.alpha * (nis - self.nis_avg)
+        sc = self.nis_avg / self.nis_ref
+        self.q_scale = np.sqrt(sc if sc < self.max_scale else self.max_scale) if sc > F(1.0) else F(1.0)
+
     def step(self, counts, frac, u):
         """br_pf_step; counts a Python int, frac and u np.float32. Returns the status."""
         if not self.primed:
@@ -226,8 +247,8 @@ class NumpyPf:
         n = self._noise()
         th = th + self.q_std[0] * n[0]
         om = om + self.q_std[1] * n[1]
-        z = z + self.q_std[2] * n[2]
-        gp = np.fmin(np.fmax(x[3] + self.q_std[3] * n[3], self.gp_min), self.gp_max)
+        z = z + (self.q_std[2] * self.q_scale) * n[2]
+        gp = np.fmin(np.fmax(x[3] + (self.q_std[3] * self.q_scale) * n[3], self.gp_min), self.gp_max)
         th = th - shift
         fnl = self._fnl(om, z, gp)
         valid = np.isfinite(th) & np.isfinite(om) & np.isfinite(z) & np.isfinite(gp) & np.isfinite(fnl)
@@ -242,6 +263,8 @@ class NumpyPf:
             l = np.where(valid, l, F(-np.inf))
         if n_valid == 0:
             return BR_E_NUMERIC
+        if self.nis_ref > F(0.0):
+            self._adapt(e * valid.astype(F), n_valid)
         lmax = l.max()
         outlier = lmax < self.outlier_l
         # 3. weights, quantised

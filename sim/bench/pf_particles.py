@@ -105,6 +105,9 @@ def replay(cfg, rec, seed, n_steps=None):
     """A fresh SMC over the recording; returns (F_hat per step, wall ns of each
     step t >= 1, thread CPU ns of steps 1.. together)."""
     model = pf_numpy.NumpyPf(cfg, np.zeros(1, dtype=np.float32))  # its constants and kernels (no noise table)
+    # the library's systematic resampling draws its offset from numpy's global
+    # generator: seeded too, so that a replay is the same on every run
+    np.random.seed(seed)
     rpc = float(cfg["rad_per_count"])
     y = (rec["counts"] + rec["frac"]) * rpc
     n = len(y) if n_steps is None else n_steps

@@ -94,9 +94,10 @@ grep -v '^long_ops ' <<<"$prof"
 # counts per particle-step come from the profile run.
 read -r dps sps dpp spp < <(sed -n 's/^long_ops per_particle_step_div=\([0-9.]*\) per_particle_step_sqrt=\([0-9.]*\) per_period_div=\([0-9.]*\) per_period_sqrt=\([0-9.]*\)/\1 \2 \3 \4/p' <<<"$prof")
 awk -v mh="$m_hi" -v ml="$m_lo" -v ah="${mean[$m_hi]}" -v al="${mean[$m_lo]}" -v ih="${ipt[$m_hi]}" -v il="${ipt[$m_lo]}" \
-    -v dps="$dps" -v sps="$sps" -v dpp="$dpp" -v spp="$spp" '
+    -v dps="$dps" -v sps="$sps" -v dpp="$dpp" -v spp="$spp" -v mhz="$mhz" '
 BEGIN {
   extra = 13
+  P = mhz * 1500  # cycles in the 1.5 ms period
   slope = (ah * ih - al * il) / (mh - ml); fixed = al * il - ml * slope
   cps = slope + extra * (dps + sps)
   dfix = dpp + spp - (dps + sps) * mh; if (dfix < 0) dfix = 0
@@ -105,9 +106,9 @@ BEGIN {
   printf "  cycle estimate (1 cycle per instruction + 13 per vdiv.f32/vsqrt.f32, 14-cycle latency each):\n"
   printf "    divisions per particle-step %.3f, square roots %.3f (profile run)\n", dps, sps
   printf "    per particle-step: %.1f cycles   (instructions %.1f; goal <= 200 instructions)\n", cps, slope
-  printf "    per period at m = %d: %.0f cycles = %.3f ms at 480 MHz = %.1f%% of the 1.5 ms period (goal <= 50%%)\n", mh, cper, cper / 480e3, 100 * cper / 720e3
-  m50 = int((0.5 * 720e3 - cfix) / cps); m80 = int((0.8 * 720e3 - cfix) / cps); m80x2 = int((0.8 * 720e3 - 2 * cfix) / (2 * cps))
-  printf "    largest m within 50%% of 480 MHz x 1.5 ms: %d; one axis within 80%%: %d; two axes on one core within 80%%: %d per axis\n", m50, m80, m80x2
+  printf "    per period at m = %d: %.0f cycles = %.3f ms at %d MHz = %.1f%% of the 1.5 ms period (goal <= 50%%)\n", mh, cper, cper / (mhz * 1e3), mhz, 100 * cper / P
+  m50 = int((0.5 * P - cfix) / cps); m80 = int((0.8 * P - cfix) / cps); m80x2 = int((0.8 * P - 2 * cfix) / (2 * cps))
+  printf "    largest m within 50%% of %d MHz x 1.5 ms: %d; one axis within 80%%: %d; two axes on one core within 80%%: %d per axis\n", mhz, m50, m80, m80x2
   printf "long_ops_summary cycles_per_particle_step=%.2f cycles_fixed=%.0f cycles_period=%.0f m_two_axes_80=%d\n", cps, cfix, cper, m80x2
 }' | tee "$out/cycles.txt" | grep -v '^long_ops_summary'
 
@@ -119,7 +120,7 @@ m2=$(sed -n 's/^long_ops_summary .* m_two_axes_80=\([0-9]*\)/\1/p' "$out/cycles.
 # run_xy M: prints "M mean_instructions max_instructions cycles_mean cycles_max periods"
 run_xy() {
   local m=$1 log ci ct nxy axy xxy
-  log=$("$qemu" -M mps2-an500 -nographic -monitor none -serial none -icount shift=0 \
+  log=$("$qemu" -M "$machine" -nographic -monitor none -serial none -icount shift=0 \
     -semihosting-config "enable=on,target=native,arg=replay,arg=$out/stream_xy.bin,arg=$out/target_xy.bin,arg=$m" \
     -kernel "$image" 2>&1)
   echo "$log" > "$out/qemu_xy_m$m.log"
@@ -129,17 +130,18 @@ run_xy() {
     ipt = i / t; printf "%d %.0f %.0f %.0f %.0f %d\n", m, a * ipt, x * ipt, a * ipt + 13 * dps * 2 * m, x * ipt + 13 * dps * 2 * m, n - 1 }'
 }
 read -r mx ins insx cyc cycx nper < <(run_xy "$m2")
+period=$((mhz * 1500))  # cycles in the 1.5 ms period
 for _ in 1 2 3 4; do
-  awk -v c="$cycx" 'BEGIN { exit !(c > 0.8 * 720e3) }' || break
+  awk -v c="$cycx" -v P="$period" 'BEGIN { exit !(c > 0.8 * P) }' || break
   # the estimate's m overshoots (two fixed parts, and the second axis's own
   # cost): scale it down by the measured worst period (at least by one
   # particle) and measure again, until the worst period is within 80 %
-  m2=$(awk -v m="$m2" -v c="$cycx" 'BEGIN { n = int(m * 0.8 * 720e3 / c); if (n >= m) n = m - 1; printf "%d", n }')
+  m2=$(awk -v m="$m2" -v c="$cycx" -v P="$period" 'BEGIN { n = int(m * 0.8 * P / c); if (n >= m) n = m - 1; printf "%d", n }')
   read -r mx ins insx cyc cycx nper < <(run_xy "$m2")
 done
 printf "  two axes on one core (the replay of both axes of the X-Y table, %d periods, m = %d per axis):\n" "$nper" "$mx"
-awk -v ins="$ins" -v insx="$insx" -v cyc="$cyc" -v cycx="$cycx" 'BEGIN {
-  printf "    instructions per period: mean %.0f, max %.0f; cycle estimate mean %.0f = %.1f%% of 480 MHz x 1.5 ms, worst period %.1f%% (goal <= 80%%)\n", ins, insx, cyc, 100 * cyc / 720e3, 100 * cycx / 720e3 }'
+awk -v ins="$ins" -v insx="$insx" -v cyc="$cyc" -v cycx="$cycx" -v mhz="$mhz" -v P="$period" 'BEGIN {
+  printf "    instructions per period: mean %.0f, max %.0f; cycle estimate mean %.0f = %.1f%% of %d MHz x 1.5 ms, worst period %.1f%% (goal <= 80%%)\n", ins, insx, cyc, 100 * cyc / P, mhz, 100 * cycx / P }'
 
 
 # Memory from the map file: output sections in CODE (0x0...) and RAM (0x2...).
