@@ -525,8 +525,9 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
 {
     float x[BR_NX], xn[BR_NX];
     particle_get(pf, j, x);
-    /* 1. predict: eq. 6 discretised as br_model_step (RK4, or the bounded scheme
-     * beyond its a h limit); the particles are finite with g_p >= gp_min > 0 */
+    /* 1. predict: eq. 6 by Heun's step (the extended model: its RK4), or the
+     * bounded scheme beyond the a h limit; the particles are finite with
+     * g_p >= gp_min > 0 */
     if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_heun(&c->kp, x, pf->kgp[j], xn)) {
         if (ext) {
             br_model_bounded_step_x(&c->mx, x, c->u, xn);
