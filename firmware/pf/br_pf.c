@@ -474,7 +474,7 @@ br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
 /* The constants of one prediction pass (steps 1 and 2), for every particle. */
 typedef struct {
     br_model_k_t mk;  /* the thesis model's kernel constants */
-    br_model_kp_t kp; /* the PF's prediction constants (br_model_kp_heun) */
+    br_model_kp_t kp; /* the PF's RK4 constants (br_model_kp_rk4) */
     float s0L;        /* sigma0 L: k_p = s0L / g_p */
     br_model_kx_t mx; /* the extended model's (theta relative to the origin at its p0) */
     float q[BR_NX];   /* process noise standard deviations */
@@ -535,10 +535,10 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
 {
     float x[BR_NX], xn[BR_NX];
     particle_get(pf, j, x);
-    /* 1. predict: eq. 6 by Heun's step (the extended model: its RK4), or the
-     * bounded scheme beyond the a h limit; the particles are finite with
-     * g_p >= gp_min > 0 */
-    if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_heun(&c->kp, x, pf->kgp[j], xn)) {
+    /* 1. predict: eq. 6 by RK4 (the PF's form with k_p, or the extended
+     * model's), or the bounded scheme beyond the a h limit; the particles are
+     * finite with g_p >= gp_min > 0 */
+    if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_rk4(&c->kp, x, pf->kgp[j], xn)) {
         if (ext) {
             br_model_bounded_step_x(&c->mx, x, c->u, xn);
         } else {
@@ -651,9 +651,9 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     for (size_t j = 0; j < n; j++) {
         const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
         float xn[BR_NX];
-        /* 1. predict (Heun's step of eq. 6; ok_rk = 0 where the bounded scheme is needed) */
+        /* 1. predict (RK4 of eq. 6; ok_rk = 0 where the bounded scheme is needed) */
         const float kg0 = ka[j];
-        const int ok_rk = br_model_kp_heun(&kp, x, kg0, xn);
+        const int ok_rk = br_model_kp_rk4(&kp, x, kg0, xn);
         /* process noise sqrt(Q) n */
         const float t = (xn[BR_X_THETA] + q0 * nn[BR_NX * j]) - shift;
         const float w = xn[BR_X_OMEGA] + q1 * nn[BR_NX * j + 1u];

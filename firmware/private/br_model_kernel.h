@@ -101,30 +101,24 @@ BR_INLINE int br_model_k_rk4(const br_model_k_t *k, const float x[BR_NX], float 
     return br_model_k_rk4_ok(k, w0, gp) & br_model_k_rk4_ok(k, out[BR_X_OMEGA], gp);
 }
 
-/* ---- The particle filter's prediction: Heun's step with k_p ----
- * Eq. 6 over h with u held by Heun's two-stage Runge-Kutta scheme (the
- * explicit trapezoid), in the form with the fewest operations per stage: each
- * particle carries k_p = sigma0 L / g_p (its one division, made when g_p
- * changes), and the constants are folded:
+/* ---- The particle filter's RK4 with k_p ----
+ * The same classic RK4 of eq. 6 over h with u held, in the form with the
+ * fewest operations per stage: each particle carries k_p = sigma0 L / g_p
+ * (its one division, made when g_p changes), and the constants are folded:
  *   eq. 4:          dz/dt     = L omega - k_p |omega| z            (L > 0)
  *   eqs. 3, 6:      domega/dt = u/Jeff - (L^2 sigma2/Jeff) omega
  *                               - (L sigma0/Jeff) z - (L sigma1/Jeff) dz/dt
- *   stages:         k1 = f(x),  k2 = f(x + h k1)
- *   combination:    x + h/2 (k1 + k2)
- *   limit:          a h = k_p |omega| h <= 2  <=>  k_p |omega| <= 2 / h,
- * at both ends of the step, as br_model_step's RK4: [-2, 0] is Heun's
- * stability interval on the real axis (the bristle's decay a). Two stages
- * where RK4 has four: about 45 instructions per particle-step fewer on the
- * Cortex-M7; the local error it adds is far below the process noise
- * (docs/modules/pf.md, "Prediction"), and the PF's tuned variances belong to
- * it. br_model_step (the UKF, the plant) keeps RK4. */
+ *   combination:    x + (h/6 (k1 + k4) + h/3 (k2 + k3))
+ *   RK4 limit:      a h = k_p |omega| h <= 2  <=>  k_p |omega| <= 2 / h.
+ * It rounds differently from br_model_k_rk4 (an ulp or so per operation), so
+ * the PF's tuned variances belong to it (docs/modules/pf.md). */
 typedef struct {
     float L;      /* lead, m/rad */
     float a;      /* u / Jeff */
     float cw;     /* L^2 sigma2 / Jeff */
     float cz;     /* L sigma0 / Jeff */
     float czd;    /* L sigma1 / Jeff */
-    float h, h_half;
+    float h, h_half, h_6, h_3;
     float ah_lim; /* BR_MODEL_RK4_AH_MAX / h */
 } br_model_kp_t;
 
@@ -139,6 +133,8 @@ static inline br_model_kp_t br_model_kp(const br_model_t *m, float u)
                              (L * m->cfg.lugre.sigma1_Nspm) * ij,
                              h,
                              0.5f * h,
+                             h / 6.0f,
+                             h / 3.0f,
                              BR_MODEL_RK4_AH_MAX / h};
     return k;
 }
@@ -155,30 +151,38 @@ static inline float br_model_kp_zdot(float L, float kp, float omega, float z)
     return L * omega - (kp * fabsf(omega)) * z;
 }
 
-/* Heun's step of the particle (theta, omega, z, g_p) with its k_p; returns 1
- * when a h is inside the limit at both ends of the step (as br_model_k_rk4),
- * 0 when the caller must use the bounded scheme instead */
-BR_INLINE int br_model_kp_heun(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX])
+/* RK4 of the particle (theta, omega, z, g_p) with its k_p; returns 1 when
+ * a h is inside the RK4 limit at both ends of the step (as br_model_k_rk4) */
+BR_INLINE int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX])
 {
-    const float L = k->L, h = k->h, hh = k->h_half;
+    const float L = k->L, hh = k->h_half;
     const float w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z];
     /* stage 1 at x */
     const float kw1 = kp * fabsf(w0);
     const float zd1 = L * w0 - kw1 * z0;
     const float wd1 = ((k->a - k->cw * w0) - k->cz * z0) - k->czd * zd1;
-    /* stage 2 at x + h k1 */
-    const float w2 = w0 + h * wd1, z2 = z0 + h * zd1;
+    /* stage 2 at x + h/2 k1 */
+    const float w2 = w0 + hh * wd1, z2 = z0 + hh * zd1;
     const float zd2 = br_model_kp_zdot(L, kp, w2, z2);
     const float wd2 = ((k->a - k->cw * w2) - k->cz * z2) - k->czd * zd2;
-    /* x + h/2 (k1 + k2) */
-    out[BR_X_THETA] = x[BR_X_THETA] + hh * (w0 + w2);
-    out[BR_X_OMEGA] = w0 + hh * (wd1 + wd2);
-    out[BR_X_Z] = z0 + hh * (zd1 + zd2);
+    /* stage 3 at x + h/2 k2 */
+    const float w3 = w0 + hh * wd2, z3 = z0 + hh * zd2;
+    const float zd3 = br_model_kp_zdot(L, kp, w3, z3);
+    const float wd3 = ((k->a - k->cw * w3) - k->cz * z3) - k->czd * zd3;
+    /* stage 4 at x + h k3 */
+    const float w4 = w0 + k->h * wd3, z4 = z0 + k->h * zd3;
+    const float zd4 = br_model_kp_zdot(L, kp, w4, z4);
+    const float wd4 = ((k->a - k->cw * w4) - k->cz * z4) - k->czd * zd4;
+    /* x + (h/6 (k1 + k4) + h/3 (k2 + k3)) */
+    out[BR_X_THETA] = x[BR_X_THETA] + (k->h_6 * (w0 + w4) + k->h_3 * (w2 + w3));
+    out[BR_X_OMEGA] = w0 + (k->h_6 * (wd1 + wd4) + k->h_3 * (wd2 + wd3));
+    out[BR_X_Z] = z0 + (k->h_6 * (zd1 + zd4) + k->h_3 * (zd2 + zd3));
     out[BR_X_GP] = x[BR_X_GP];
 #if BR_FLOAT_SIMD
     /* & rather than &&: no branch, so that a loop over particles vectorises */
     return (kw1 <= k->ah_lim) & (kp * fabsf(out[BR_X_OMEGA]) <= k->ah_lim);
 #else
+    /* without float SIMD a branch is cheaper than the flags (BR_FLOAT_SIMD) */
     return (kw1 <= k->ah_lim) && (kp * fabsf(out[BR_X_OMEGA]) <= k->ah_lim);
 #endif
 }

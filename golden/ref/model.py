@@ -79,15 +79,6 @@ def rk4(p, x, u, h):
     return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
-def heun(p, x, u, h):
-    """Heun's two-stage Runge-Kutta step of eq. 6 with u held (the particle
-    filter's prediction, docs/modules/pf.md)."""
-    x = np.asarray(x, dtype=np.float64)
-    k1 = deriv(p, x, u)
-    k2 = deriv(p, x + h * k1, u)
-    return x + (h / 2.0) * (k1 + k2)
-
-
 def bounded(p, x, u, h):
     """B2: displacement-exact bristle update + trapezoidal rigid body.
 
@@ -136,19 +127,6 @@ def step(p, x, u, h):
     x1 = rk4(p, x, u, h)
     # RK4 only while a h <= 2 at the start and at the RK4 end point
     # (a NaN end point compares false and falls to the bounded scheme).
-    if ah(p, x[1], x[3], h) <= RK4_AH_MAX and ah(p, x1[1], x[3], h) <= RK4_AH_MAX:
-        return BR_OK, x1, BRANCH_RK4
-    return BR_OK, bounded(p, x, u, h), BRANCH_BOUNDED
-
-
-def step_pf(p, x, u, h):
-    """The particle filter's discretisation of eq. 6: step's, with Heun's
-    scheme in place of RK4, within the same a h limit of 2 at both ends
-    (where Heun's real-axis stability interval [-2, 0] ends; docs/modules/pf.md)."""
-    x = np.asarray(x, dtype=np.float64)
-    if not (np.all(np.isfinite(x)) and math.isfinite(u)) or not x[3] > 0.0:
-        return BR_E_INPUT, x.copy(), BRANCH_INVALID
-    x1 = heun(p, x, u, h)
     if ah(p, x[1], x[3], h) <= RK4_AH_MAX and ah(p, x1[1], x[3], h) <= RK4_AH_MAX:
         return BR_OK, x1, BRANCH_RK4
     return BR_OK, bounded(p, x, u, h), BRANCH_BOUNDED

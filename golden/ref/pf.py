@@ -164,7 +164,7 @@ class Pf:
         y = frac * rpc
         xp, fn, l = [], [], []
         for j in range(c.m):
-            st, xn, _ = rmodel.step_pf(c.model, self.x[j], u, c.dt)
+            st, xn, _ = rmodel.step(c.model, self.x[j], u, c.dt)
             xn = np.array([xn[i] + self.q_std[i] * self._n(j, i) for i in range(NX)])
             xn[3] = self._clamp_gp(xn[3])
             xn[0] -= shift

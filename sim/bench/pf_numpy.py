@@ -5,7 +5,7 @@ in numpy, vectorised over the particles, timed on the recording br_bench made
 (br_bench --record FILE), and compared with the C filter.
 
 Same model and algorithm as br_pf.c, in float32 throughout (as the firmware):
-  predict   eq. 6 by Heun's step (br_model_kp_heun) on every particle,
+  predict   eq. 6 by the PF's RK4 (br_model_kp_rk4) on every particle,
             then, per particle (a mask on the a h <= 2 test at both ends of
             the step), the bounded
             displacement-exact scheme with 3 fixed-point passes (br_model.c),
@@ -109,7 +109,7 @@ class NumpyPf:
         self.inv_jeff = F(1.0) / (J + self.L * self.L * M)   # br_model_init
         self.visc = self.L * self.L * s2
         self.s0L = self.s0 * self.L
-        # the PF's prediction (br_model_kp_heun): each
+        # the PF's RK4 form (br_model_kp_rk4): each
         # particle's k_p = sigma0 L / g_p (recomputed here from g_p: the same
         # float the C filter carries) and folded constants
         self.kp_cw = self.visc * self.inv_jeff
@@ -166,8 +166,9 @@ class NumpyPf:
         return self.s0 * z + self.s1 * zdot
 
     def _model_step_kp(self, th, om, z, gp, u):
-        """br_model_kp_heun on every particle, the bounded scheme where a h > 2"""
+        """br_model_kp_rk4 on every particle, the bounded scheme where a h > 2"""
         L, h, hh = self.L, self.h, F(0.5) * self.h
+        h6, h3 = h / F(6.0), h / F(3.0)
         a, cw, cz, czd = u * self.inv_jeff, self.kp_cw, self.kp_cz, self.kp_czd
         kp = self.s0L / gp
 
@@ -177,11 +178,15 @@ class NumpyPf:
             return ((a - cw * w) - cz * zz) - czd * zd, zd, kw
 
         k1w, k1z, kw1 = stage(om, z)
-        om2, z2 = om + h * k1w, z + h * k1z
+        om2, z2 = om + hh * k1w, z + hh * k1z
         k2w, k2z, _ = stage(om2, z2)
-        th1 = th + hh * (om + om2)
-        om1 = om + hh * (k1w + k2w)
-        z1 = z + hh * (k1z + k2z)
+        om3, z3 = om + hh * k2w, z + hh * k2z
+        k3w, k3z, _ = stage(om3, z3)
+        om4, z4 = om + h * k3w, z + h * k3z
+        k4w, k4z, _ = stage(om4, z4)
+        th1 = th + (h6 * (om + om4) + h3 * (om2 + om3))
+        om1 = om + (h6 * (k1w + k4w) + h3 * (k2w + k3w))
+        z1 = z + (h6 * (k1z + k4z) + h3 * (k2z + k3z))
         rk4 = (kw1 <= self.ah_lim) & (kp * np.abs(om1) <= self.ah_lim)
         b = np.flatnonzero(~rk4)
         if b.size:

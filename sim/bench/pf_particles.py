@@ -5,12 +5,12 @@ on the same recorded input, run by Nicolas Chopin's `particles` library
 (Sequential Monte Carlo in Python, `particles.SMC` over `ssm.Bootstrap`),
 timed per particle-step like br_bench and pf_numpy.py.
 
-The model is pf_numpy.py's (NumpyPf: the PF's Heun step of eq. 6 with k_p = sigma0
+The model is pf_numpy.py's (NumpyPf: the PF's RK4 of eq. 6 with k_p = sigma0
 L / g_p, the bounded scheme where a h > 2, f_nl of eqs. 3-4), evaluated in
 float64 (the library's dtype) on the particles as an (m, 4) array
 [theta, omega, z, g_p], theta absolute (no integer origin):
   PX0       N([y_0, 0, 0, gp0], diag(x0_std^2)), g_p clamped to [gp_min, gp_max]
-  PX(t, xp) Heun step of each particle with the recorded torque u_t, plus
+  PX(t, xp) RK4 step of each particle with the recorded torque u_t, plus
             N(0, Q) process noise (numpy's generator), g_p clamped
   PY(t, x)  N(theta, R): the measurement y_t = (counts_t + frac_t) rpc
   SMC       N = m, systematic resampling at every step (ESSrmin = 1),

@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-"""One-step error of the PF's prediction scheme (docs/modules/pf.md,
-"Prediction: Heun's step").
+"""One-step error of a two-stage prediction for the PF (docs/modules/pf.md,
+"Heun's step: measured, not adopted").
 
 On the plant states of the golden circle trace (golden/traces/est_input.csv:
 the x axis of the thesis circle at 1.5 ms, plant state and applied torque per
 step), each state x_k = (0, omega_k, z_k, g(v_k)) (g_p = the plant's Stribeck
 level) is stepped over h with the torque of the next period by RK4 and by
-Heun's step (golden/ref/model.py, float64), and by RK4 with 64 substeps as
+Heun's step (heun() below), in float64 (golden/ref/model.py's eq. 6), and
+by RK4 with 64 substeps as
 the reference. Prints the error of f_nl (eq. 3) of each scheme against the
 reference: median, p90, p99 and max over the steps, and the step of the max.
 
@@ -28,6 +29,13 @@ SUBSTEPS = 64
 COL_U, COL_OMEGA, COL_Z = 4, 8, 9  # est_input.csv: k,t,counts,frac,u_prev_Nm,fault,ref_counts,theta,omega,z,...
 
 
+def heun(p, x, u, h):
+    """Heun's two-stage step of eq. 6 with u held: x + h/2 (f(x) + f(x + h f(x)))"""
+    k1 = rm.deriv(p, x, u)
+    k2 = rm.deriv(p, x + h * k1, u)
+    return x + (h / 2.0) * (k1 + k2)
+
+
 def main():
     m = gen_traces.load_machine()
     p = gen_est_traces.model_params_f32(m, gen_traces.f32)
@@ -46,7 +54,7 @@ def main():
             ref = rm.rk4(p, ref, u, h / SUBSTEPS)
         f_ref = rm.fnl(p, ref)
         err["RK4"].append(abs(rm.fnl(p, rm.rk4(p, x, u, h)) - f_ref))
-        err["Heun"].append(abs(rm.fnl(p, rm.heun(p, x, u, h)) - f_ref))
+        err["Heun"].append(abs(rm.fnl(p, heun(p, x, u, h)) - f_ref))
     print("one-step error of f_nl against RK4 with %d substeps, %d plant states of %s, h = %.4g s"
           % (SUBSTEPS, len(rows) - 1, os.path.relpath(path, ROOT), h))
     for name, e in err.items():
