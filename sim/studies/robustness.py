@@ -359,6 +359,7 @@ def main():
         with open(a.from_summary) as f:
             old = json.load(f)
         a.n, a.seed, a.jobs = old["n_plants"], old["seed"], old["jobs"]
+        os.makedirs(a.out, exist_ok=True)
         return finish(a, old["plants"], [], time.time() - old["wall_s"])
     if not (1 <= a.n <= 100000) or a.jobs < 1:
         ap.error("--n in 1..100000, --jobs >= 1")
