@@ -149,13 +149,15 @@ def main():
     load0 = os.getloadavg()[0]
     with np.errstate(all="ignore"):
         replay(cfg, rec, a.seed, n_steps=min(200, n))  # warm-up
-        per_rep, per_rep_cpu, fh = [], [], None
+        per_rep, per_rep_cpu, errs = [], [], []
+        true = rec["fnl_true_N"]
         for r in range(a.reps):
             fh, ns, cpu = replay(cfg, rec, a.seed + r)
             per_rep.append(float(ns.sum()) / ((n - 1) * m))
             per_rep_cpu.append(cpu / ((n - 1) * m))
-    true = rec["fnl_true_N"]
-    err = float(np.sqrt(np.mean(np.square(fh[1:] - true[1:]))))
+            errs.append(float(np.sqrt(np.mean(np.square(fh[1:] - true[1:])))))
+    # every replay must track: the largest error is the one reported and checked
+    err = max(errs)
     err_c = float(np.sqrt(np.mean(np.square(rec["fhat_c_N"][1:] - true[1:]))))
     res = {
         "library": "particles %s" % version("particles"),
@@ -173,6 +175,7 @@ def main():
         "cpu_ns_per_particle_step": {"median": statistics.median(per_rep_cpu), "min": min(per_rep_cpu),
                                      "max": max(per_rep_cpu)},
         "fhat_rms_err_N": err,
+        "fhat_rms_err_N_per_rep": errs,
         "fhat_c_rms_err_N": err_c,
     }
     c = res["cpu_ns_per_particle_step"]
@@ -180,7 +183,8 @@ def main():
           "steps; min %.1f, max %.1f); thread CPU %.1f (min %.1f, max %.1f)"
           % (res["library"], res["ns_per_particle_step"]["median"], a.reps, n - 1, min(per_rep), max(per_rep),
              c["median"], c["min"], c["max"]))
-    print("    tracks: F_hat RMS error vs true friction %.4f N (C: %.4f N)" % (err, err_c))
+    print("    tracks: F_hat RMS error vs true friction %.4f N, the largest of the replays' (C: %.4f N)"
+          % (err, err_c))
     ok = bool(np.isfinite(err)) and err < 2.0 * err_c + 0.05
     if not ok:
         print("pf_particles: the particles-library PF does not track like the C one", file=sys.stderr)
