@@ -14,15 +14,13 @@
 #include "br_math.h"
 #include "br_model_kernel.h"
 
-/* BR_PF_SIMD (BR_FLOAT_SIMD, br_inline.h): with float SIMD the weights'
- * exponentials run in a loop of their own (vectorised), the prediction loop
- * is branch-free and the resampling counts (resample_count,
- * resample_forward); without (the Cortex-M7) one fused weight loop, a
- * prediction loop that branches out to the fix-up and one resampling loop
- * (resample_fused) cost fewer instructions. Both copy in place with
- * branches that skip the particles staying put. The results are the same
- * either way. */
-#define BR_PF_SIMD BR_FLOAT_SIMD
+/* BR_FLOAT_SIMD (br_inline.h): with float SIMD the weights' exponentials
+ * run in a loop of their own (vectorised), the prediction loop is
+ * branch-free and the resampling counts (resample_count, resample_forward);
+ * without (the Cortex-M7) one fused weight loop, a prediction loop that
+ * branches out to the fix-up and one resampling loop (resample_fused) cost
+ * fewer instructions. Both copy in place with branches that skip the
+ * particles staying put. The results are the same either way. */
 
 /* f_nl (eqs. 3, 4) of a predicted particle: eq. 4 with its k_p = sigma0 L / g_p */
 static inline float fnl_kp(const br_model_k_t *k, float om, float z, float kg)
@@ -668,30 +666,21 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         const float l = -(e * e) * inv_2r;
         s1 += e;
         s2 += e * e;
-#if !BR_PF_SIMD
+        /* validity as particle_one's */
+#if BR_FLOAT_SIMD
+        const int ok = ok_rk & ((t - t) + (f - f) == 0.0f);
+#else
         /* without float SIMD (the Cortex-M7) nothing is gained by a
          * branch-free body: a particle for the fix-up (the bounded scheme, or
-         * not valid as particle_one's) branches out, keeping its state in
-         * place (f_nl = 0, l = NaN), and the valid ones store without selects */
+         * not valid) branches out, keeping its state in place (f_nl = 0,
+         * l = NaN), and the selects below fold away for the valid ones */
         if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
             fo[j] = 0.0f;
             lo[j] = NAN;
             continue;
         }
-        th[j] = t;
-        om[j] = w;
-        zz[j] = z;
-        gg[j] = g;
-        ka[j] = kg;
-        fo[j] = f;
-        lo[j] = l;
-        int32_t key;
-        memcpy(&key, &l, sizeof key);
-        kmin = (key < kmin) ? key : kmin;
-        n_ok++;
-#else
-        /* validity as particle_one's */
-        const int ok = ok_rk & ((t - t) + (f - f) == 0.0f);
+        const int ok = 1;
+#endif
         th[j] = ok ? t : x[BR_X_THETA];
         om[j] = ok ? w : x[BR_X_OMEGA];
         zz[j] = ok ? z : x[BR_X_Z];
@@ -705,7 +694,6 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         memcpy(&key, &lk, sizeof key);
         kmin = (key < kmin) ? key : kmin;
         n_ok += (uint32_t)ok;
-#endif
     }
     ls->s1 = s1;
     ls->s2 = s2;
@@ -974,7 +962,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
      * the best valid particle has W = 2^16) */
     /* 5. estimate over the resampled set: particle mean and the mean of f_nl (eq. 6) */
     float sw, sw2, s[BR_NX], sf;
-    if (BR_PF_SIMD && !pf->cfg.scalar_path) {
+    if (BR_FLOAT_SIMD && !pf->cfg.scalar_path) {
         if (verdict == BR_W_OUTLIER) {
             const uint32_t total = quantise_weights(pf, lmax, 1, &sw, &sw2);
             resample_count(pf->W, m, total, pf->idx, 0, &sw, &sw2);

@@ -11,6 +11,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "br_inline.h"
+
 /* e^x for x <= 0: 2^n * p(f), n = round(x log2 e), |f| <= 1/2, p the degree-6
  * Taylor polynomial of e^(f ln 2); relative error < 5e-6 over [-87, 0], set by
  * the rounding of x log2 e (measured in tests/unit/test_math.c); 0 below x = -87
@@ -34,7 +36,7 @@ static inline float br_exp2_parts(int32_t n, float f)
     return p * scale;
 }
 
-#if defined(__SSE2__) || defined(__ARM_NEON)
+#if BR_FLOAT_SIMD
 /* with float SIMD: branch-free, so that a loop over particles vectorises; the
  * range tests are integer masks rather than selects, which the compiler could
  * turn back into branches (GCC 12 does for SSE4.1 and up). The same result
