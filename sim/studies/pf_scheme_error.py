@@ -8,12 +8,10 @@ the x axis of the thesis circle at 1.5 ms, plant state and applied torque per
 step), each state x_k = (0, omega_k, z_k, g(v_k)) (g_p = the plant's Stribeck
 level) is stepped over h with the torque of the next period by RK4 and by
 Heun's step (heun() below), in float64 (golden/ref/model.py's eq. 6), and
-by RK4 with 64 substeps as
-the reference. Prints the error of f_nl (eq. 3) of each scheme against the
+by RK4 with 64 substeps as the reference. Prints the error of f_nl (eq. 3) of each scheme against the
 reference: median, p90, p99 and max over the steps, and the step of the max.
 
 Usage: pf_scheme_error.py"""
-import math
 import os
 import sys
 
@@ -23,6 +21,7 @@ ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 sys.path.insert(0, os.path.join(ROOT, "golden"))
 import gen_est_traces  # noqa: E402
 import gen_traces  # noqa: E402
+from ref import lugre as rl  # noqa: E402
 from ref import model as rm  # noqa: E402
 
 SUBSTEPS = 64
@@ -43,11 +42,10 @@ def main():
     path = os.path.join(ROOT, "golden", "traces", "est_input.csv")
     with open(path) as f:
         rows = np.array([[float(v) for v in line.split(",")] for line in f if line[0].isdigit()])
-    lp = p.lugre
     err = {"RK4": [], "Heun": []}
     for k in range(len(rows) - 1):
         w, z, u = rows[k, COL_OMEGA], rows[k, COL_Z], rows[k + 1, COL_U]
-        gp = lp.Fc + (lp.Fs - lp.Fc) * math.exp(-abs(p.L * w) / lp.vs)  # eq. 5
+        gp = rl.g(p.lugre, p.L * w)  # eq. 5
         x = np.array([0.0, w, z, gp])
         ref = x.copy()
         for _ in range(SUBSTEPS):

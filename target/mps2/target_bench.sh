@@ -21,6 +21,7 @@ qemu=${BR_QEMU:-qemu-system-arm}
 machine=${BR_QEMU_MACHINE:-mps2-an500}
 cpu=${BR_BENCH_CPU:-Cortex-M7}
 mhz=${BR_BENCH_MHZ:-480}
+period=$((mhz * 1500))  # cycles in the 1.5 ms control period
 image=$cm7/target/mps2/br_replay_mps2.elf
 map=$cm7/target/mps2/br_replay_mps2.map
 m_hi=${BR_BENCH_M_HI:-1500}
@@ -94,10 +95,9 @@ grep -v '^long_ops ' <<<"$prof"
 # counts per particle-step come from the profile run.
 read -r dps sps dpp spp < <(sed -n 's/^long_ops per_particle_step_div=\([0-9.]*\) per_particle_step_sqrt=\([0-9.]*\) per_period_div=\([0-9.]*\) per_period_sqrt=\([0-9.]*\)/\1 \2 \3 \4/p' <<<"$prof")
 awk -v mh="$m_hi" -v ml="$m_lo" -v ah="${mean[$m_hi]}" -v al="${mean[$m_lo]}" -v ih="${ipt[$m_hi]}" -v il="${ipt[$m_lo]}" \
-    -v dps="$dps" -v sps="$sps" -v dpp="$dpp" -v spp="$spp" -v mhz="$mhz" '
+    -v dps="$dps" -v sps="$sps" -v dpp="$dpp" -v spp="$spp" -v mhz="$mhz" -v P="$period" '
 BEGIN {
   extra = 13
-  P = mhz * 1500  # cycles in the 1.5 ms period
   slope = (ah * ih - al * il) / (mh - ml); fixed = al * il - ml * slope
   cps = slope + extra * (dps + sps)
   dfix = dpp + spp - (dps + sps) * mh; if (dfix < 0) dfix = 0
@@ -130,7 +130,6 @@ run_xy() {
     ipt = i / t; printf "%d %.0f %.0f %.0f %.0f %d\n", m, a * ipt, x * ipt, a * ipt + 13 * dps * 2 * m, x * ipt + 13 * dps * 2 * m, n - 1 }'
 }
 read -r mx ins insx cyc cycx nper < <(run_xy "$m2")
-period=$((mhz * 1500))  # cycles in the 1.5 ms period
 for _ in 1 2 3 4; do
   awk -v c="$cycx" -v P="$period" 'BEGIN { exit !(c > 0.8 * P) }' || break
   # the estimate's m overshoots (two fixed parts, and the second axis's own
