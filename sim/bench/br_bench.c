@@ -424,14 +424,15 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
             (double)c->adapt.alpha, (double)c->adapt.max_scale);
 }
 
-static int write_record(const char *path, const br_pf_cfg_t *cfg, const rec_t *rec, const float *fhat)
+static int write_record(const char *path, const char *plant, const br_pf_cfg_t *cfg, const rec_t *rec, const float *fhat)
 {
     FILE *f = fopen(path, "w");
     if (!f) {
         fprintf(stderr, "br_bench: cannot write %s\n", path);
         return -1;
     }
-    fprintf(f, "# br_bench PF recording: x axis of the thesis circle, H-inf + PF in closed loop\n# pf_cfg ");
+    fprintf(f, "# br_bench PF recording: x axis of the thesis circle on the %s plant, H-inf + PF in closed loop\n# pf_cfg ",
+            plant);
     json_pf_cfg(f, cfg);
     fprintf(f, "\nk,counts,frac,u_prev_Nm,fnl_true_N,fhat_c_N,status\n");
     for (long k = 0; k < rec->n; k++) {
@@ -510,11 +511,13 @@ static void json_timing_pf(FILE *f, const char *key, const br_circle_cfg_t *cpf,
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N]\n" BR_ARGS_COMMON_USAGE
+            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N] [--plant thesis|realistic]\n" BR_ARGS_COMMON_USAGE
             "  --json FILE         the figures as JSON (make bench: out/bench/bench.json)\n"
             "  --record FILE       the replayed stream's per-step record (CSV)\n"
             "  --reps N            repetitions of each PF timing, 1 .. 256 (default 7)\n"
-            "  --ukf-reps N        repetitions of each UKF timing, 1 .. 256 (default 21)\n",
+            "  --ukf-reps N        repetitions of each UKF timing, 1 .. 256 (default 21)\n"
+            "  --plant P           the recorded closed loop's plant: thesis (the estimators' own model,\n"
+            "                      default) or realistic (the demo's realistic plant, docs/demo.md)\n",
             argv0, argv0);
     return 2;
 }
@@ -522,11 +525,12 @@ static int usage(const char *argv0, FILE *to)
 int main(int argc, char **argv)
 {
     const char *json_path = NULL, *rec_path = NULL;
-    int reps = 7, ukf_reps = 21;
+    int reps = 7, ukf_reps = 21, realistic = 0;
     static const struct option opts[] = {{"json", required_argument, NULL, 'j'},
                                          {"record", required_argument, NULL, 'r'},
                                          {"reps", required_argument, NULL, 'n'},
                                          {"ukf-reps", required_argument, NULL, 'u'},
+                                         {"plant", required_argument, NULL, 'p'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -544,6 +548,13 @@ int main(int argc, char **argv)
         case 'u':
             bad = br_arg_long(TOOL, p.opt, v, 1, 256, &n);
             if (!bad) ukf_reps = (int)n;
+            break;
+        case 'p':
+            realistic = strcmp(v, "realistic") == 0;
+            if (!realistic && strcmp(v, "thesis") != 0) {
+                fprintf(stderr, "%s: --plant: '%s' is neither thesis nor realistic\n", TOOL, v);
+                bad = 1;
+            }
             break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
@@ -568,8 +579,10 @@ int main(int argc, char **argv)
     if (!pf || !ukf) goto done;
 
     /* 1. recordings */
-    const br_circle_cfg_t cpf = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
-    const br_circle_cfg_t cukf = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
+    const char *const plant = realistic ? "realistic" : "thesis";
+    const br_circle_cfg_t cpf = realistic ? br_circle_cfg_realistic(BR_CTRL_HINF_PF) : br_circle_cfg_thesis(BR_CTRL_HINF_PF);
+    const br_circle_cfg_t cukf =
+        realistic ? br_circle_cfg_realistic(BR_CTRL_HINF_UKF) : br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
     if (br_pf_init(pf, &cpf.pf) != BR_OK || br_ukf_init(ukf, &cukf.ukf) != BR_OK) {
         fprintf(stderr, "br_bench: filter init failed\n");
         goto done;
@@ -619,8 +632,8 @@ int main(int argc, char **argv)
         if (demo_cpu_s(i, &demo_s[i]) != 0) goto done;
     }
 
-    printf("PF recording: x axis of the thesis circle, H-inf + PF in closed loop, dt %.1f ms, %ld steps\n",
-           cpf.dt_s * 1e3, rpf.n);
+    printf("PF recording: x axis of the thesis circle on the %s plant, H-inf + PF in closed loop, dt %.1f ms, %ld steps\n",
+           plant, cpf.dt_s * 1e3, rpf.n);
     printf("PF  m = %u: %.1f ns per particle-step (median of %d replays of %ld steps; min %.1f, max %.1f)\n", m, pf_med,
            reps, tpf.steps_timed, pf_min, pf_max);
     printf("    in thread CPU time: %.1f ns per particle-step (min %.1f, max %.1f)\n", pf_cmed, pf_cmin, pf_cmax);
@@ -672,14 +685,14 @@ int main(int argc, char **argv)
     printf("     br_ukf_t %zu bytes\n", sizeof(br_ukf_t));
     printf("ROM: br_noise_table %zu bytes (%u float32 samples)\n", sizeof br_noise_table, (unsigned)BR_NOISE_LEN);
 
-    if (rec_path && write_record(rec_path, &cpf.pf, &rpf, fhat_pf) != 0) goto done;
+    if (rec_path && write_record(rec_path, plant, &cpf.pf, &rpf, fhat_pf) != 0) goto done;
     if (json_path) {
         FILE *f = fopen(json_path, "w");
         if (!f) {
             fprintf(stderr, "br_bench: cannot write %s\n", json_path);
             goto done;
         }
-        fprintf(f, "{\n  \"machine\": {\"cpu_model\": ");
+        fprintf(f, "{\n  \"plant\": \"%s\",\n  \"machine\": {\"cpu_model\": ", plant);
         json_str(f, cpu);
         fprintf(f, ", \"cpus_online\": %ld, \"compiler\": ", ncpu);
         json_str(f, "gcc " __VERSION__);
