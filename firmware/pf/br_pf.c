@@ -390,7 +390,11 @@ static float resample_forward(br_pf_t *pf, float s[BR_NX])
  * takes j's state now when j > i: a later i' reads only j' >= j > i, and a
  * position j' is read (when j reaches it) before it is written (at i = j',
  * which needs idx_j' > j'). The backward pass (idx_i < i) follows in
- * copy_back. The same indices, states and sums as the three loops. */
+ * copy_back. The same indices, states and sums as the three loops.
+ * total is the sum of W[0 .. m - 1] (quantise_weights' return), so every
+ * t_i = floor((2 i + 1) total / (2 m)) <= floor(total - total / (2 m)) is
+ * below C_{m-1} = total: the search for j stops by j = m - 1 without a test
+ * of j (resample(), for any W, tests it). */
 static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
 {
     const uint32_t m = pf->cfg.n_particles;
@@ -401,17 +405,21 @@ static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
     const float *const fnl = pf->fnl;
     const uint32_t den = 2u * m;
     const uint32_t dq = (2u * total) / den, dr = (2u * total) % den;
-    uint32_t t = total / den, r = total % den;
+    uint32_t t = total / den;
+    /* t_i's remainder less den, in [-den, 0): its sign is the carry below
+     * (the M7's add sets the flag; no compare with den) */
+    int32_t rn = (int32_t)(total % den) - (int32_t)den;
     uint32_t j = 0u, c = W[0];
     float a0 = th[0], a1 = om[0], a2 = zz[0], a3 = gg[0], af = fnl[0];
     float ai = ia[0];
     float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
     for (uint32_t i = 0; i < m; i++) {
-        if (c <= t && j + 1u < m) {
+        /* no j + 1 < m test: t_i < C_{m-1} (above), so the search stops by j = m - 1 */
+        if (c <= t) {
             do {
                 j++;
                 c += W[j];
-            } while (c <= t && j + 1u < m);
+            } while (c <= t);
             a0 = th[j];
             a1 = om[j];
             a2 = zz[j];
@@ -434,10 +442,10 @@ static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
         }
         /* t_{i+1} = t_i + dq, plus 1 when the remainder carries */
         t += dq;
-        r += dr;
-        if (r >= den) {
+        rn += (int32_t)dr;
+        if (rn >= 0) {
             t++;
-            r -= den;
+            rn -= (int32_t)den;
         }
     }
     s[0] = s0;
@@ -835,9 +843,11 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
             s2 += w * w;
         }
     } else {
-        /* (the vector path's weights: exp_vec, quant_total and resample_count) */
+        /* (the vector path's weights: exp_vec, quant_total and resample_count);
+         * br_exp_neg's constants taken once, held in registers over the loop */
+        const br_exp_k_t k = br_exp_k();
         for (uint32_t j = 0; j < m; j++) {
-            const float w = br_exp_neg(l[j] - lmax);
+            const float w = br_exp_neg_k(l[j] - lmax, k);
             W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
             total += W[j];
             s1 += w;
@@ -856,23 +866,33 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
  * was left alone by the forward pass); a particle with idx_i = i copies
  * itself. The backward pass alone, skipping the particles that stay (after
  * resample_fused or resample_forward, which made the forward pass; on hosts
- * too: the branch predicts well, see resample_forward). */
-static void copy_back(br_pf_t *pf)
+ * too: the branch predicts well, see resample_forward); from i = m - 1 down
+ * to 1 (i = 0 has no earlier particle). The arrays are parameters of a
+ * function of its own and each value is copied as its bit pattern (memcpy):
+ * the Cortex-M7 then holds the five arrays in registers and addresses them
+ * by index (integer loads and stores take a register offset, float ones do
+ * not), where with pf->x it formed the 8 KiB-apart addresses anew for every
+ * particle (docs/target.md). */
+BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om, float *zz,
+                               float *gg, float *ia)
 {
-    const uint32_t m = pf->cfg.n_particles;
-    const uint16_t *BR_RESTRICT idx = pf->idx;
-    float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA];
-    float *const zz = pf->x[BR_X_Z], *const gg = pf->x[BR_X_GP], *const ia = pf->kgp;
-    for (uint32_t i = m; i-- > 0u;) {
+    for (uint32_t i = m - 1u; i > 0u; i--) {
         const uint32_t k = idx[i];
         if (k < i) {
-            th[i] = th[k];
-            om[i] = om[k];
-            zz[i] = zz[k];
-            gg[i] = gg[k];
-            ia[i] = ia[k];
+            memcpy(&th[i], &th[k], sizeof th[i]);
+            memcpy(&om[i], &om[k], sizeof om[i]);
+            memcpy(&zz[i], &zz[k], sizeof zz[i]);
+            memcpy(&gg[i], &gg[k], sizeof gg[i]);
+            memcpy(&ia[i], &ia[k], sizeof ia[i]);
         }
     }
+}
+
+/* copy_back_soa on pf's particles */
+static void copy_back(br_pf_t *pf)
+{
+    copy_back_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
+                  pf->x[BR_X_GP], pf->kgp);
 }
 
 /* Step 5's sums over the set, in particle order: s gets the sums of the

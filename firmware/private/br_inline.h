@@ -12,6 +12,30 @@
 #define BR_INLINE static inline
 #endif
 
+/* BR_NOINLINE: a function the compiler must not inline (private to the
+ * firmware): a hot loop that gets the registers of a function of its own
+ * instead of sharing them with its caller's live values. */
+#if defined(__GNUC__)
+#define BR_NOINLINE static __attribute__((noinline))
+#else
+#define BR_NOINLINE static
+#endif
+
+/* BR_HOLD_F(v), BR_HOLD_U(v): the float or uint32_t variable v keeps its
+ * value, but the compiler no longer knows it (GCC on 32-bit Arm with an FPU: an
+ * empty asm that takes v and gives it back in a register; elsewhere
+ * nothing). Before a loop, for the loop's constants: GCC 12 for the
+ * Cortex-M7 makes a constant it can encode in an instruction (0.5f, 1.0f,
+ * 0x7FFFFFFF) or load from the literal pool afresh in every iteration, even
+ * with registers free; an unknown value it keeps in a register instead. */
+#if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
+#define BR_HOLD_F(v) __asm__("" : "+t"(v))
+#define BR_HOLD_U(v) __asm__("" : "+r"(v))
+#else
+#define BR_HOLD_F(v) ((void)0)
+#define BR_HOLD_U(v) ((void)0)
+#endif
+
 /* BR_FLOAT_SIMD: the target has vector registers for float (x86-64 SSE2,
  * Arm NEON). There the particle filter's loops are written branch-free, so
  * that the compiler vectorises them; without (the Cortex-M7) a branch costs

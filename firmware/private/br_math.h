@@ -13,12 +13,31 @@
 
 #include "br_inline.h"
 
-/* e^x for x <= 0: 2^n * p(f), n = round(x log2 e), |f| <= 1/2, p the degree-6
- * Taylor polynomial of e^(f ln 2); relative error < 5e-6 over [-87, 0], set by
- * the rounding of x log2 e (measured in tests/unit/test_math.c); 0 below x = -87
- * (and for NaN). */
+/* The constants br_exp_neg makes: 0.5, 1 and (without float SIMD) the
+ * range test's two words. br_exp_neg_k takes them as values, so that a loop
+ * over particles can take them once before it (br_exp_k) and keep them in
+ * registers (BR_HOLD_F, BR_HOLD_U: the Cortex-M7's loop made them afresh
+ * for every particle, 5 instructions); br_exp_neg(x) is
+ * br_exp_neg_k(x, br_exp_k()). */
+typedef struct {
+    float half, one;   /* 0.5f, 1.0f */
+    uint32_t lo, span; /* -87 < x < 0 <=> xb - lo < span for x's bit pattern xb (below) */
+} br_exp_k_t;
+
+static inline br_exp_k_t br_exp_k(void)
+{
+    br_exp_k_t k = {0.5f, 1.0f, 0x80000001u, 0xC2AE0000u - 0x80000001u};
+#if !BR_FLOAT_SIMD
+    BR_HOLD_F(k.half);
+    BR_HOLD_F(k.one);
+    BR_HOLD_U(k.lo);
+    BR_HOLD_U(k.span);
+#endif
+    return k;
+}
+
 /* 2^n e^(f ln 2) for n >= -126, |f| <= 1/2: both forms of br_exp_neg end here */
-static inline float br_exp2_parts(int32_t n, float f)
+static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k)
 {
     /* e^y, y = f ln 2 in [-0.347, 0.347]: Taylor to degree 6 (Horner) */
     const float y = f * 0.693147181f;
@@ -26,9 +45,9 @@ static inline float br_exp2_parts(int32_t n, float f)
     p = p * y + 1.0f / 120.0f;
     p = p * y + 1.0f / 24.0f;
     p = p * y + 1.0f / 6.0f;
-    p = p * y + 0.5f;
-    p = p * y + 1.0f;
-    p = p * y + 1.0f;
+    p = p * y + k->half;
+    p = p * y + k->one;
+    p = p * y + k->one;
     /* 2^n by building the exponent field */
     const uint32_t bits = (uint32_t)(n + 127) << 23;
     float scale;
@@ -42,7 +61,7 @@ static inline float br_exp2_parts(int32_t n, float f)
  * turn back into branches (GCC 12 does for SSE4.1 and up). The same result
  * as the branchy form below for every one of the 2^32 inputs (checked
  * exhaustively once, docs/modules/pf.md). */
-static inline float br_exp_neg(float x)
+static inline float br_exp_neg_k(float x, br_exp_k_t k)
 {
     const int in_range = x > -87.0f;
     /* x clamped to (-87, 0] by integer masks (no select the compiler could
@@ -55,12 +74,12 @@ static inline float br_exp_neg(float x)
     memcpy(&xc, &xcb, sizeof xc);
     /* x log2(e) = n + f, n = round-half-down, f in [-1/2, 1/2] */
     const float t = xc * 1.44269504f;
-    const int32_t n0 = (int32_t)(t - 0.5f); /* truncation toward zero of t - 1/2, t <= 0 */
+    const int32_t n0 = (int32_t)(t - k.half); /* truncation toward zero of t - 1/2, t <= 0 */
     const float f0 = t - (float)n0;
-    const int up = f0 > 0.5f;
+    const int up = f0 > k.half;
     const int32_t n = n0 + up;
     const float f = f0 - (float)up; /* f0 - 0 = f0 exactly */
-    const float r = br_exp2_parts(n, f);
+    const float r = br_exp2_parts(n, f, &k);
     /* 0 below the normal range and for NaN */
     uint32_t rb;
     memcpy(&rb, &r, sizeof rb);
@@ -72,28 +91,35 @@ static inline float br_exp_neg(float x)
 #else
 /* without (the Cortex-M7): the same operations with branches, fewer
  * instructions there; the same result for every x */
-static inline float br_exp_neg(float x)
+static inline float br_exp_neg_k(float x, br_exp_k_t k)
 {
     /* the range -87 < x < 0 as a test on the bit pattern (negative
-     * floats from -0 0x80000000 up to -87 0xC2AE0000); outside it: e^x = 1
-     * for x >= 0 (+0 .. +inf, and -0), as the polynomial gives at 0; 0 for
-     * x <= -87 and NaN. No fminf: on the Cortex-M4 a library call with two
-     * __fpclassifyf. */
+     * floats from -0 0x80000000 up to -87 0xC2AE0000, exclusive: one
+     * unsigned compare, xb - 0x80000001 < 0xC2AE0000 - 0x80000001); outside
+     * it: e^x = 1 for x >= 0 (+0 .. +inf, and -0), as the polynomial gives
+     * at 0; 0 for x <= -87 and NaN. No fminf: on the Cortex-M4 a library
+     * call with two __fpclassifyf. */
     uint32_t xb;
     memcpy(&xb, &x, sizeof xb);
-    if (!(xb > 0x80000000u && xb < 0xC2AE0000u)) { /* the compiler makes it one compare */
-        return (xb <= 0x7F800000u || xb == 0x80000000u) ? 1.0f : 0.0f;
+    if (!(xb - k.lo < k.span)) {
+        return (xb <= 0x7F800000u || xb == 0x80000000u) ? k.one : 0.0f;
     }
     /* x log2(e) = n + f, n = round-half-down, f in [-1/2, 1/2] */
     const float t = x * 1.44269504f;
-    int32_t n = (int32_t)(t - 0.5f); /* truncation toward zero of t - 1/2, t <= 0 */
+    int32_t n = (int32_t)(t - k.half); /* truncation toward zero of t - 1/2, t <= 0 */
     float f = t - (float)n;
-    if (f > 0.5f) {
+    if (f > k.half) {
         n += 1;
-        f -= 1.0f;
+        f -= k.one;
     }
-    return br_exp2_parts(n, f);
+    return br_exp2_parts(n, f, &k);
 }
 #endif
+
+/* e^x for x <= 0: 2^n * p(f), n = round(x log2 e), |f| <= 1/2, p the degree-6
+ * Taylor polynomial of e^(f ln 2); relative error < 5e-6 over [-87, 0], set by
+ * the rounding of x log2 e (measured in tests/unit/test_math.c); 0 below x = -87
+ * (and for NaN). */
+static inline float br_exp_neg(float x) { return br_exp_neg_k(x, br_exp_k()); }
 
 #endif
