@@ -5,6 +5,7 @@
  *
  * Usage: br_tune_est --est pf|ukf --out HEADER [--log CSV] [--max-fev N]
  *                    [--plants P1.json,P2.json,... [--stat median|p90]] [--guard-noise F]
+ *                    [--guard-outliers K]
  * --plants: the robust objective (docs/robustness.md, "Robust tuning"): the
  * penalised contour RMS on each plant (model.json files, e.g. the robustness
  * study's plant.json), and its median or 90th percentile (nearest rank) over
@@ -12,7 +13,9 @@
  * Prints a progress line per iteration; writes the tuned variances as a
  * generated header (used by sim/circle/br_circle_est.c) and, with --log, the
  * progress (iteration, evaluations, best contour RMS, parameters) for Fig. 1.
- * The objective is penalised by the outlier steps (lost lock). The start is
+ * The objective is penalised by the outlier steps (lost lock); with
+ * --guard-outliers K (PF) also by those on the guard plants (docs/tuning.md,
+ * "A noise-aware objective"). The start is
  * the hand-tuned default of the machine file's estimator section; each log-variance may move 3 decades
  * either way (bounds by the change of variables of br_nm). The outputs are
  * written beside their names and renamed once the tuning succeeded
@@ -44,6 +47,7 @@ typedef struct {
     br_plant_cfg_t plants[MAX_PLANTS];
     int p90;                /* 1: the 90th percentile over the plants, 0: the median */
     double guard_noise_N;   /* the PF's second guard plant's force noise (--guard-noise) */
+    double guard_outliers;  /* the PF's objective x (1 + this x the guard plants' outlier steps) */
     /* the searches before this one (several starts): their iterations,
      * evaluations, best value and point, so that the log runs on monotonically */
     int iter0, nfev0;
@@ -107,9 +111,13 @@ static int cmp_double(const void *a, const void *b)
  * contour RMS a tuning that passes could have (H-inf only's is 2.3e-6 m), and
  * falling the later the stops come, so that the search can leave such a region */
 #define BR_TUNE_GUARD_PENALTY_M 1.0e-5
+/* --guard-outliers' upper bound: one outlier step then counts as 1000 times
+ * the contour RMS */
+#define BR_TUNE_GUARD_OUTLIERS_MAX 1000.0
 
 /* The PF's guard plants, each without a safe stop: 0 when all pass, otherwise
- * BR_TUNE_GUARD_PENALTY_M times (failed guards + the share of the run lost).
+ * BR_TUNE_GUARD_PENALTY_M times (failed guards + the share of the run lost);
+ * *outliers gets the outlier steps of the three runs together.
  * 1. the demo's realistic plant (docs/demo.md): a tuning that only the exact
  *    model tolerates is none (make demo runs both plants);
  * 2. the same with the largest force noise of the robustness study's plants
@@ -118,10 +126,11 @@ static int cmp_double(const void *a, const void *b)
  * 3. the same with bristles at the top of the study's stiffness and damping
  *    range (a factor 2 on the reference's): a tuning that holds lock only on
  *    soft bristles is none either. */
-static double guard_penalty(const br_circle_cfg_t *c, double noise_N)
+static double guard_penalty(const br_circle_cfg_t *c, double noise_N, double *outliers)
 {
     const br_circle_cfg_t ref = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     double failed = 0.0;
+    *outliers = 0.0;
     for (int k = 0; k < 3; k++) {
         br_circle_cfg_t cr = br_circle_cfg_realistic(BR_CTRL_HINF_PF);
         cr.pf = c->pf;
@@ -133,6 +142,7 @@ static double guard_penalty(const br_circle_cfg_t *c, double noise_N)
         br_circle_result_t r;
         /* 1: a safe stop (br_circle_run), its time in r.fault_t_s */
         if (br_circle_run(&cr, NULL, NULL, &r) < 0) return INFINITY;
+        *outliers += (double)r.outlier_steps;
         if (r.fault_status != 0) {
             const double T = cr.duration_s;
             failed += 1.0 + (T - r.fault_t_s) / T;
@@ -149,8 +159,12 @@ static double objective(void *user, const double *x, int n)
     if (t->n_plants == 0) {
         const double f = one_plant(&c, 0);
         if (t->pf && isfinite(f)) {
-            const double g = guard_penalty(&c, t->guard_noise_N);
+            double outliers;
+            const double g = guard_penalty(&c, t->guard_noise_N, &outliers);
             if (g > 0.0) return g;
+            /* --guard-outliers: a filter that loses lock on the guard plants
+             * now and then counts too (0: make tune's objective) */
+            return f * (1.0 + t->guard_outliers * outliers);
         }
         return f;
     }
@@ -196,8 +210,11 @@ static int usage(const char *argv0, FILE *to)
             "  --plants LIST       model.json files, comma-separated: tune for a set of plants (robust objective)\n"
             "  --stat median|p90   the set's statistic the objective takes (default median)\n"
             "  --guard-noise F     PF: the force noise of the noisy guard plant, N (default %g)\n"
-            "bounds: --max-fev 1 .. %d (docs/tools.md), at most %d plants, --guard-noise 0 .. %g\n",
-            argv0, argv0, BR_TUNE_GUARD_FORCE_NOISE_N, BR_TOOL_MAX_FEV, MAX_PLANTS, BR_TUNE_GUARD_NOISE_MAX_N);
+            "  --guard-outliers K  PF: the objective x (1 + K x the guard plants' outlier steps) (default 0)\n"
+            "bounds: --max-fev 1 .. %d (docs/tools.md), at most %d plants, --guard-noise 0 .. %g,\n"
+            "        --guard-outliers 0 .. %g\n",
+            argv0, argv0, BR_TUNE_GUARD_FORCE_NOISE_N, BR_TOOL_MAX_FEV, MAX_PLANTS, BR_TUNE_GUARD_NOISE_MAX_N,
+            BR_TUNE_GUARD_OUTLIERS_MAX);
     return 2;
 }
 
@@ -205,7 +222,7 @@ int main(int argc, char **argv)
 {
     const char *est = NULL, *out = NULL, *log_path = NULL, *plants = NULL, *stat = "median";
     long max_fev = 0;
-    double guard_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N;
+    double guard_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N, guard_outliers = 0.0;
     static const struct option opts[] = {{"est", required_argument, NULL, 'e'},
                                          {"out", required_argument, NULL, 'o'},
                                          {"log", required_argument, NULL, 'l'},
@@ -213,6 +230,7 @@ int main(int argc, char **argv)
                                          {"plants", required_argument, NULL, 'p'},
                                          {"stat", required_argument, NULL, 's'},
                                          {"guard-noise", required_argument, NULL, 'g'},
+                                         {"guard-outliers", required_argument, NULL, 'k'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -226,6 +244,7 @@ int main(int argc, char **argv)
         case 'n': bad = br_arg_long(TOOL, p.opt, v, 1, BR_TOOL_MAX_FEV, &max_fev); break;
         case 'p': plants = v; break;
         case 'g': bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_TUNE_GUARD_NOISE_MAX_N, &guard_noise_N); break;
+        case 'k': bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_TUNE_GUARD_OUTLIERS_MAX, &guard_outliers); break;
         case 's':
             if (strcmp(v, "median") == 0 || strcmp(v, "p90") == 0) {
                 stat = v;
@@ -254,6 +273,7 @@ int main(int argc, char **argv)
     t.pf = strcmp(est, "pf") == 0;
     t.p90 = strcmp(stat, "p90") == 0;
     t.guard_noise_N = guard_noise_N;
+    t.guard_outliers = guard_outliers;
     t.n_plants = 0;
     if (plants) {
         const br_plant_cfg_t ref = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY).plant;
@@ -379,6 +399,9 @@ int main(int argc, char **argv)
     fprintf(h, "/* Nelder-Mead on the H-inf + %s circle: contour RMS %.4e m (start %.4e m), %d evaluations%s */\n",
             E, r.f, f_win, r.nfev, r.converged ? "" : ", budget reached");
     if (t.n_plants > 0) fprintf(h, "/* robust objective: the %s over %d plants (--plants) */\n", stat, t.n_plants);
+    if (t.pf && t.n_plants == 0 && guard_outliers > 0.0) {
+        fprintf(h, "/* objective x (1 + %g x the guard plants' outlier steps) (--guard-outliers) */\n", guard_outliers);
+    }
     fprintf(h, "#ifndef BR_%s_TUNED_H\n#define BR_%s_TUNED_H\n\n", E, E);
     for (int i = 0; i < n; i++) {
         fprintf(h, "#define BR_%s_TUNED_%s (%.9ef)\n", E, param_name(t.pf, i), (double)(float)exp(r.x[i]));

@@ -1,0 +1,62 @@
+# SPDX-License-Identifier: Apache-2.0
+"""br_tune_est --guard-outliers K (docs/tuning.md, "A noise-aware
+objective"): the PF's objective is the nominal one times (1 + K x the outlier
+steps of the guard plants' runs). From the tuner's second start (where the
+guard plants' runs have outlier steps with the committed machine) the
+printed start value with K must be the one without K times 1 + K n for a
+whole number n >= 1; the header names the objective only with K; a K out
+of its bounds is refused. Run with a release build of the tuner.
+
+Usage: test_tune_guard_outliers.py --tuner BIN --work DIR"""
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+K = 0.1
+
+
+def start2(tuner, out, extra):
+    r = subprocess.run([tuner, "--est", "pf", "--out", out, "--max-fev", "5"] + extra, capture_output=True, text=True)
+    m = re.search(r"start 2, contour RMS (\S+) m", r.stdout)
+    if r.returncode != 0 or not m:
+        sys.exit("br_tune_est %s: exit %d, no start-2 line:\n%s%s" % (" ".join(extra), r.returncode, r.stdout, r.stderr))
+    return float(m.group(1))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--tuner", required=True)
+    ap.add_argument("--work", required=True)
+    a = ap.parse_args()
+    shutil.rmtree(a.work, ignore_errors=True)
+    os.makedirs(a.work)
+    fails = []
+    h0, hk = os.path.join(a.work, "k0.h"), os.path.join(a.work, "k.h")
+    f0 = start2(a.tuner, h0, [])
+    fk = start2(a.tuner, hk, ["--guard-outliers", str(K)])
+    n = (fk / f0 - 1.0) / K
+    print("start 2: %.4e m without, %.4e m with --guard-outliers %g: %.3f outlier steps" % (f0, fk, K, n))
+    # the printed values have 5 significant digits
+    if not (n >= 0.5 and abs(n - round(n)) <= 1e-3 * max(1.0, n)):
+        fails.append("the ratio %.6g is not 1 + %g n for a whole n >= 1" % (fk / f0, K))
+    with open(h0) as f:
+        t0 = f.read()
+    with open(hk) as f:
+        tk = f.read()
+    if "--guard-outliers" in t0 or "(1 + %g x the guard plants' outlier steps)" % K not in tk:
+        fails.append("the header does not name the objective (only) with --guard-outliers")
+    for bad in ("-1", "1001", "nan"):
+        r = subprocess.run([a.tuner, "--est", "pf", "--out", os.path.join(a.work, "bad.h"), "--guard-outliers", bad],
+                           capture_output=True, text=True)
+        if r.returncode == 0 or "guard-outliers" not in r.stderr or os.path.exists(os.path.join(a.work, "bad.h")):
+            fails.append("--guard-outliers %s: exit %d, not refused by name (or a header written)" % (bad, r.returncode))
+    for msg in fails:
+        print("FAIL:", msg)
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
