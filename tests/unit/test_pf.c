@@ -575,6 +575,42 @@ static void test_one_invalid_particle(void **st)
     free(pf);
 }
 
+/* Only the last particle valid (every other one's f_nl overflows): the
+ * whole weight is W_{m-1}, so every index of the resampled set is m - 1 on
+ * both paths; the scalar path's search (resample_fused) has no j < m bound
+ * of its own and must stop there because t_i < C_{m-1} = total. */
+static void only_last_valid(uint32_t scalar_path)
+{
+    const uint32_t m = 100;
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t c = cfg(m);
+    c.scalar_path = scalar_path;
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    for (uint32_t j = 0; j + 1u < m; j++) pf->x[BR_X_Z][j] = 3.0e38f; /* f_nl overflows */
+    const br_status_t s = br_pf_step(pf, &y, 0.0f);
+    assert_true(s == BR_OK || s == BR_W_OUTLIER);
+    assert_true(pf->W[m - 1u] > 0u);
+    for (uint32_t j = 0; j + 1u < m; j++) assert_int_equal(pf->W[j], 0u);
+    for (uint32_t j = 0; j < m; j++) {
+        assert_int_equal(pf->idx[j], m - 1u);
+        for (int i = 0; i < BR_NX; i++) assert_true(pf->x[i][j] == pf->x[i][m - 1u]);
+    }
+    assert_true(all_finite(pf));
+    assert_true(isfinite(br_pf_estimate(pf)->F_hat_N));
+    free(pf);
+}
+
+static void test_only_last_particle_valid(void **st)
+{
+    (void)st;
+    only_last_valid(0u);
+    only_last_valid(1u);
+}
+
 /* theta finite, f_nl not: particles whose deflection makes the bristle rate
  * overflow (sigma0 |v| z / g_p) while theta stays finite must get weight 0;
  * the estimate must stay finite. */
@@ -847,6 +883,7 @@ int main(void)
         cmocka_unit_test(test_gp_stays_in_range),
         cmocka_unit_test(test_one_invalid_particle),
         cmocka_unit_test(test_fnl_overflow_is_invalid),
+        cmocka_unit_test(test_only_last_particle_valid),
         cmocka_unit_test(test_likelihood_scale),
         cmocka_unit_test(test_proposal_matches_equations),
         cmocka_unit_test(test_proposal_adapt_takes_the_prior_draw),
