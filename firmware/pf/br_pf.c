@@ -493,11 +493,17 @@ typedef struct {
 } pred_t;
 
 /* g_p limited to [lo, hi] with selects (fmaxf/fminf are library calls on
- * some hosts): br_clampf's result for every input, lo > 0 */
+ * some hosts): br_clampf's result for every input, lo > 0; with
+ * BR_FPU_MAXNM (br_inline.h) fmaxf and fminf themselves, one instruction
+ * each (the same result: lo and hi are finite, 0 < lo < hi, br_est.c) */
 static inline float clamp_sel(float v, float lo, float hi)
 {
+#if BR_FPU_MAXNM
+    return fminf(fmaxf(v, lo), hi);
+#else
     const float a = (v > lo) ? v : lo; /* a NaN gives lo, as fmaxf */
     return (a < hi) ? a : hi;
+#endif
 }
 
 /* Largest log-weight so far and the count of valid particles. l <= -0 for a
@@ -636,8 +642,10 @@ static void noise_wrapped(const br_pf_t *pf, uint32_t j, float n[BR_NX])
 BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t j0, uint32_t j1, const float *nz,
                                          lsum_t *ls)
 {
-    const br_model_k_t mk = c->mk;
     const br_model_kp_t kp = c->kp;
+    /* f_nl's L taken from kp (the same value): one constant fewer in the loop */
+    br_model_k_t mk = c->mk;
+    mk.L = kp.L;
     const float s0L = c->s0L;
     const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
     const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
@@ -651,8 +659,16 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     float *BR_RESTRICT lo = pf->l + j0;
     const float *BR_RESTRICT nn = nz;
     const size_t n = j1 - j0;
+#if BR_FPU_MAXNM
+    float lm = -INFINITY; /* the largest valid l by fmaxf (one instruction there) instead of the keys */
+#else
     int32_t kmin = INT32_MAX;
+#endif
+#if BR_FLOAT_SIMD
     uint32_t n_ok = 0u;
+#else
+    uint32_t n_ok = (uint32_t)n; /* less one for each particle that branches out */
+#endif
     float s1 = ls->s1, s2 = ls->s2;
     for (size_t j = 0; j < n; j++) {
         const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
@@ -685,6 +701,7 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
             fo[j] = 0.0f;
             lo[j] = NAN;
+            n_ok--;
             continue;
         }
         const int ok = 1;
@@ -697,17 +714,25 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         fo[j] = ok ? f : 0.0f;
         const float lk = ok ? l : NAN;
         lo[j] = lk;
+#if BR_FPU_MAXNM
+        lm = fmaxf(lm, lk); /* fmaxf passes over a NaN */
+#else
         /* NAN is a positive NaN: its key is above every valid one */
         int32_t key;
         memcpy(&key, &lk, sizeof key);
         kmin = (key < kmin) ? key : kmin;
+#endif
+#if BR_FLOAT_SIMD
         n_ok += (uint32_t)ok;
+#endif
     }
     ls->s1 = s1;
     ls->s2 = s2;
     if (n_ok > 0u) {
+#if !BR_FPU_MAXNM
         float lm;
         memcpy(&lm, &kmin, sizeof lm);
+#endif
         ls->lmax = (lm > ls->lmax) ? lm : ls->lmax;
         ls->n_valid += n_ok;
     }

@@ -47,6 +47,14 @@
 #define BR_FLOAT_SIMD 0
 #endif
 
+/* BR_FPU_MAXNM: the FPU has vmaxnm / vminnm (the Cortex-M7's FPv5), so
+ * that fmaxf and fminf are one instruction each (the Cortex-M4's FPv4 has
+ * neither: a library call). GCC predefines the same macros for both FPUs;
+ * firmware/CMakeLists.txt sets it for the toolchain's cortex-m7. */
+#ifndef BR_FPU_MAXNM
+#define BR_FPU_MAXNM 0
+#endif
+
 /* BR_RESTRICT: C99 restrict, for the particle filter's structure-of-arrays
  * loops (its arrays never overlap), so that the compiler vectorises them */
 #define BR_RESTRICT restrict
