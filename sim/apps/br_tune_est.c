@@ -223,6 +223,7 @@ int main(int argc, char **argv)
     const char *est = NULL, *out = NULL, *log_path = NULL, *plants = NULL, *stat = "median";
     long max_fev = 0;
     double guard_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N, guard_outliers = 0.0;
+    int guard_opt = 0; /* --guard-noise or --guard-outliers given */
     static const struct option opts[] = {{"est", required_argument, NULL, 'e'},
                                          {"out", required_argument, NULL, 'o'},
                                          {"log", required_argument, NULL, 'l'},
@@ -243,8 +244,14 @@ int main(int argc, char **argv)
         case 'l': log_path = v; break;
         case 'n': bad = br_arg_long(TOOL, p.opt, v, 1, BR_TOOL_MAX_FEV, &max_fev); break;
         case 'p': plants = v; break;
-        case 'g': bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_TUNE_GUARD_NOISE_MAX_N, &guard_noise_N); break;
-        case 'k': bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_TUNE_GUARD_OUTLIERS_MAX, &guard_outliers); break;
+        case 'g':
+            bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_TUNE_GUARD_NOISE_MAX_N, &guard_noise_N);
+            guard_opt = 1;
+            break;
+        case 'k':
+            bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_TUNE_GUARD_OUTLIERS_MAX, &guard_outliers);
+            guard_opt = 1;
+            break;
         case 's':
             if (strcmp(v, "median") == 0 || strcmp(v, "p90") == 0) {
                 stat = v;
@@ -258,6 +265,11 @@ int main(int argc, char **argv)
         if (bad) return usage(argv[0], stderr);
     }
     if (!est || !out || (strcmp(est, "pf") != 0 && strcmp(est, "ukf") != 0)) return usage(argv[0], stderr);
+    /* the guard plants belong to the PF's nominal objective: elsewhere the options would do nothing */
+    if (guard_opt && (strcmp(est, "pf") != 0 || plants)) {
+        fprintf(stderr, "%s: --guard-noise and --guard-outliers need --est pf without --plants\n", TOOL);
+        return 2;
+    }
     if (log_path && strcmp(log_path, out) == 0) {
         fprintf(stderr, "%s: --log and --out name the same file\n", TOOL);
         return 2;

@@ -222,8 +222,14 @@ class ToolsTest(unittest.TestCase):
         r = run("br_tune_est", "--est", "pf", "--out", header, "--plants", os.path.join(self.w, "none.json"))
         self.assert_refused(r, 1, "cannot open")
         self.assertNotIn("tuning", r.stdout)
-        for bad in (["--guard-noise", "-0.1"], ["--guard-noise", "11"], ["--guard-noise", "nan"]):
+        for bad in (["--guard-noise", "-0.1"], ["--guard-noise", "11"], ["--guard-noise", "nan"],
+                    ["--guard-outliers", "-1"], ["--guard-outliers", "1001"], ["--guard-outliers", "nan"]):
             self.assert_refused(run("br_tune_est", "--est", "pf", "--out", header, *bad), 2)
+        # the guard plants' options only where they act: the PF's nominal objective
+        for est, extra in (("ukf", ["--guard-outliers", "0.1"]), ("ukf", ["--guard-noise", "0.3"]),
+                           ("pf", ["--guard-outliers", "0.1", "--plants", os.path.join(self.w, "none.json")])):
+            r = run("br_tune_est", "--est", est, "--out", header, "--max-fev", "6", *extra)
+            self.assert_refused(r, 2, "--guard-noise and --guard-outliers")
         self.assert_untouched(header, log)
 
 

@@ -4,8 +4,9 @@ objective"): the PF's objective is the nominal one times (1 + K x the outlier
 steps of the guard plants' runs). From the tuner's second start (where the
 guard plants' runs have outlier steps with the committed machine) the
 printed start value with K must be the one without K times 1 + K n for a
-whole number n >= 1; the header names the objective only with K; a K out
-of its bounds is refused. Run with a release build of the tuner.
+whole number n >= 1; the header names the objective only with K (its
+bounds and where it is refused: test_tools.py). Run with a release build of
+the tuner.
 
 Usage: test_tune_guard_outliers.py --tuner BIN --work DIR"""
 import argparse
@@ -48,11 +49,6 @@ def main():
         tk = f.read()
     if "--guard-outliers" in t0 or "(1 + %g x the guard plants' outlier steps)" % K not in tk:
         fails.append("the header does not name the objective (only) with --guard-outliers")
-    for bad in ("-1", "1001", "nan"):
-        r = subprocess.run([a.tuner, "--est", "pf", "--out", os.path.join(a.work, "bad.h"), "--guard-outliers", bad],
-                           capture_output=True, text=True)
-        if r.returncode == 0 or "guard-outliers" not in r.stderr or os.path.exists(os.path.join(a.work, "bad.h")):
-            fails.append("--guard-outliers %s: exit %d, not refused by name (or a header written)" % (bad, r.returncode))
     for msg in fails:
         print("FAIL:", msg)
     return 1 if fails else 0
