@@ -209,6 +209,13 @@ class ToolsTest(unittest.TestCase):
                     ["--budget", "0.5"], ["--bogus", "1"], ["--seeds"]):
             self.assert_refused(run("br_dt_study", *bad), 2)
 
+    def test_bench_plant_named(self):
+        # br_bench --plant: thesis or realistic, anything else refused by name before any run
+        for bad in ("nominal", "", "Realistic"):
+            r = run("bench/br_bench", "--plant", bad)
+            self.assert_refused(r, 2, "--plant")
+            self.assertNotIn("PF recording", r.stdout)
+
     def test_tune_outputs_checked_before_the_tuning(self):
         header, log = self.existing("tuned.h"), self.existing("tune.csv")
         r = run("br_tune_est", "--est", "pf", "--out", header, "--log", os.path.join(self.w, "no", "l.csv"))
