@@ -9,12 +9,12 @@ the C filter's. The test also requires that the recording reaches both paths
 Run with a release br_bench (a sanitised one is slow).
 
 Usage: test_bench_numpy.py --bench BIN --work DIR"""
-import argparse
 import json
 import os
-import shutil
 import subprocess
 import sys
+
+import tool_check
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -25,19 +25,13 @@ def run(cmd):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--bench", required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    shutil.rmtree(a.work, ignore_errors=True)
-    os.makedirs(a.work)
+    bench, work = tool_check.start("bench")
     fails = []
-
-    rec = os.path.join(a.work, "pf_input.csv")
-    rc, out = run([a.bench, "--plant", "realistic", "--reps", "1", "--ukf-reps", "1", "--record", rec])
+    rec = os.path.join(work, "pf_input.csv")
+    rc, out = run([bench, "--plant", "realistic", "--reps", "1", "--ukf-reps", "1", "--record", rec])
     if rc != 0:
         sys.exit("br_bench --plant realistic failed (exit %d):\n%s" % (rc, out))
-    res = os.path.join(a.work, "numpy.json")
+    res = os.path.join(work, "numpy.json")
     rc, out = run([sys.executable, os.path.join(ROOT, "sim", "bench", "pf_numpy.py"), rec, "--reps", "1", "--check",
                    "--out", res])
     print(out)
@@ -50,9 +44,7 @@ def main():
             fails.append("the recording never raises cfg.adapt's noise factor: the adapt path is not compared")
         if r["reanchor_steps"] == 0:
             fails.append("the recording never re-anchors the cloud: that path is not compared")
-    for msg in fails:
-        print("FAIL:", msg)
-    return 1 if fails else 0
+    return tool_check.finish(fails)
 
 
 if __name__ == "__main__":

@@ -9,12 +9,12 @@ bounds and where it is refused: test_tools.py). Run with a release build of
 the tuner.
 
 Usage: test_tune_guard_outliers.py --tuner BIN --work DIR"""
-import argparse
 import os
 import re
-import shutil
 import subprocess
 import sys
+
+import tool_check
 
 K = 0.1
 
@@ -28,16 +28,11 @@ def start2(tuner, out, extra):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--tuner", required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    shutil.rmtree(a.work, ignore_errors=True)
-    os.makedirs(a.work)
+    tuner, work = tool_check.start("tuner")
     fails = []
-    h0, hk = os.path.join(a.work, "k0.h"), os.path.join(a.work, "k.h")
-    f0 = start2(a.tuner, h0, [])
-    fk = start2(a.tuner, hk, ["--guard-outliers", str(K)])
+    h0, hk = os.path.join(work, "k0.h"), os.path.join(work, "k.h")
+    f0 = start2(tuner, h0, [])
+    fk = start2(tuner, hk, ["--guard-outliers", str(K)])
     n = (fk / f0 - 1.0) / K
     print("start 2: %.4e m without, %.4e m with --guard-outliers %g: %.3f outlier steps" % (f0, fk, K, n))
     # the printed values have 5 significant digits
@@ -49,9 +44,7 @@ def main():
         tk = f.read()
     if "--guard-outliers" in t0 or "(1 + %g x the guard plants' outlier steps)" % K not in tk:
         fails.append("the header does not name the objective (only) with --guard-outliers")
-    for msg in fails:
-        print("FAIL:", msg)
-    return 1 if fails else 0
+    return tool_check.finish(fails)
 
 
 if __name__ == "__main__":

@@ -8,27 +8,22 @@ temporary file left. Run with a release build of the tuner (a sanitised one
 takes minutes for the dozen closed-loop circles).
 
 Usage: test_tune_refusal.py --tuner BIN --work DIR"""
-import argparse
 import os
-import shutil
 import subprocess
 import sys
+
+import tool_check
 
 OLD = b"an existing file\n"
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--tuner", required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    shutil.rmtree(a.work, ignore_errors=True)
-    os.makedirs(a.work)
-    header, log = os.path.join(a.work, "tuned.h"), os.path.join(a.work, "tune.csv")
+    tuner, work = tool_check.start("tuner")
+    header, log = os.path.join(work, "tuned.h"), os.path.join(work, "tune.csv")
     for p in (header, log):
         with open(p, "wb") as f:
             f.write(OLD)
-    r = subprocess.run([a.tuner, "--est", "pf", "--out", header, "--log", log, "--max-fev", "6",
+    r = subprocess.run([tuner, "--est", "pf", "--out", header, "--log", log, "--max-fev", "6",
                         "--guard-noise", "5"], capture_output=True, text=True, timeout=900)
     fails = []
     if r.returncode != 1:
@@ -42,12 +37,10 @@ def main():
         with open(p, "rb") as f:
             if f.read() != OLD:
                 fails.append(f"{p} was changed")
-    if sorted(os.listdir(a.work)) != ["tune.csv", "tuned.h"]:
-        fails.append(f"files left: {sorted(os.listdir(a.work))}")
-    for f in fails:
-        print("FAIL: " + f, file=sys.stderr)
+    if sorted(os.listdir(work)) != ["tune.csv", "tuned.h"]:
+        fails.append(f"files left: {sorted(os.listdir(work))}")
     print(r.stdout + r.stderr)
-    return 1 if fails else 0
+    return tool_check.finish(fails)
 
 
 if __name__ == "__main__":
