@@ -150,7 +150,9 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     pf->primed = 0;
     pf->n_outliers = 0u;
     pf->n_predicted = 0u;
-    pf->est = (br_pf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N}, 0, 0.0f, (float)cfg->n_particles};
+    pf->est = (br_pf_est_t){0, 0.0f};
+    pf->weighed = BR_PF_WEIGHED_EQUAL;
+    pf->lmax = 0.0f;
     pf->ready = 1;
     return BR_OK;
 }
@@ -180,27 +182,20 @@ static void particle_get(const br_pf_t *pf, uint32_t j, float x[BR_NX])
     }
 }
 
-/* Estimate of the freshly drawn set: means and the mean of f_nl (eq. 6). */
-static void estimate_current(br_pf_t *pf, float ess)
+/* Estimate of the freshly drawn set: the mean of f_nl (eq. 6); its weights all alike. */
+static void estimate_current(br_pf_t *pf)
 {
     const uint32_t m = pf->cfg.n_particles;
-    float s[BR_NX] = {0.0f, 0.0f, 0.0f, 0.0f}, sf = 0.0f;
+    float sf = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
         float xj[BR_NX];
         particle_get(pf, j, xj);
-        for (int i = 0; i < BR_NX; i++) {
-            s[i] += xj[i];
-        }
         /* thesis estimate: the mean of f_nl (eq. 6) over the particles */
         sf += br_model_fcomp_N(&pf->model, xj, origin_pos_m(pf));
     }
-    const float inv_m = 1.0f / (float)m;
-    for (int i = 0; i < BR_NX; i++) {
-        pf->est.mean[i] = s[i] * inv_m;
-    }
-    pf->est.F_hat_N = sf * inv_m;
+    pf->est.F_hat_N = sf * (1.0f / (float)m);
     pf->est.origin_counts = pf->origin_counts;
-    pf->est.ess = ess;
+    pf->weighed = BR_PF_WEIGHED_EQUAL;
 }
 
 /* First measurement: particles drawn around [y, 0, 0, gp0]. */
@@ -219,7 +214,7 @@ static void prime(br_pf_t *pf, const br_meas_t *y)
     pf->origin_counts = y->counts;
     pf->prev_frac = y->frac;
     pf->primed = 1;
-    estimate_current(pf, (float)m);
+    estimate_current(pf);
 }
 
 /* Systematic resampling on integer weights with a known total, 0 < total and
@@ -290,11 +285,10 @@ BR_PF_CLONES static uint32_t quant_total(const uint32_t *BR_RESTRICT W, uint32_t
 
 /* The counting resampling's writes: idx[N(C_{j-1})] = j for every j with
  * copies, 0 elsewhere. floats != 0: W holds the w_j as bit patterns
- * (exp_vec), quantised here in place; the sums of w and w^2 (for the ESS) in
- * order, as quantise_weights makes them, into *sw and *sw2. Otherwise W
- * holds the integer weights already. total: the sum of the W_j. */
+ * (exp_vec), quantised here in place. Otherwise W holds the integer
+ * weights already. total: the sum of the W_j. */
 static void resample_count(uint32_t *BR_RESTRICT W, uint32_t m, uint32_t total, uint16_t *BR_RESTRICT idx,
-                           const int floats, float *sw, float *sw2)
+                           const int floats)
 {
     const uint64_t two_m = 2u * (uint64_t)m, cm = total;
     const float m_over_cm = (float)m / (float)total;
@@ -304,7 +298,6 @@ static void resample_count(uint32_t *BR_RESTRICT W, uint32_t m, uint32_t total, 
     }
     uint32_t c = 0u;
     if (floats) {
-        float s1 = 0.0f, s2 = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
             const uint32_t n = n_below(c, two_m, cm, m_over_cm);
             uint16_t *const dst = (n < m) ? &idx[n] : &spare;
@@ -313,12 +306,8 @@ static void resample_count(uint32_t *BR_RESTRICT W, uint32_t m, uint32_t total, 
             memcpy(&w, &W[j], sizeof w);
             const uint32_t q = (uint32_t)(w * (float)BR_PF_W_ONE);
             W[j] = q;
-            s1 += w;
-            s2 += w * w;
             c += q;
         }
-        *sw = s1;
-        *sw2 = s2;
     } else {
         for (uint32_t j = 0; j < m; j++) {
             const uint32_t n = n_below(c, two_m, cm, m_over_cm);
@@ -331,7 +320,7 @@ static void resample_count(uint32_t *BR_RESTRICT W, uint32_t m, uint32_t total, 
 
 /* After resample_count: the running maximum that makes idx, fused with the
  * forward pass of the in-place copy (copy_back follows) and with step
- * 5's sums over the resampled set in particle order (particle i is the
+ * 5's sum of f_nl over the resampled set in particle order (particle i is the
  * predicted particle k = idx_i). Reading x[k] at i gives the predicted
  * value: for k >= i, position k is written only at i' = k (after this read
  * when k = i); for k < i it is never written in this pass (idx_k <= k, the
@@ -341,8 +330,8 @@ static void resample_count(uint32_t *BR_RESTRICT W, uint32_t m, uint32_t total, 
  * forward, 50 % backward, yet only 53 % of the blocks of 8 hold a backward
  * copy), so the branch predicts well and half the loads and stores of a
  * branch-free copy go.
- * The same indices, states and sums (in the same order) as resample_fused. */
-static float resample_forward(br_pf_t *pf, float s[BR_NX])
+ * The same indices, states and sum (in the same order) as resample_fused. */
+static float resample_forward(br_pf_t *pf)
 {
     const uint32_t m = pf->cfg.n_particles;
     uint16_t *BR_RESTRICT idx = pf->idx;
@@ -352,20 +341,16 @@ static float resample_forward(br_pf_t *pf, float s[BR_NX])
     float *BR_RESTRICT gg = pf->x[BR_X_GP];
     float *BR_RESTRICT ia = pf->kgp;
     const float *BR_RESTRICT fnl = pf->fnl;
-    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
+    float sf = 0.0f;
     uint32_t run = 0u;
     for (uint32_t i = 0; i < m; i++) {
         const uint32_t w = idx[i];
         const uint32_t k = (w > run) ? w : run;
         run = k;
         idx[i] = (uint16_t)k;
-        /* x[k], read once for the sums and the copy (held in registers:
-         * GCC reloads them after the first store otherwise) */
+        /* x[k], read once for the copy (held in registers: GCC reloads
+         * them after the first store otherwise) */
         const float a0 = th[k], a1 = om[k], a2 = zz[k], a3 = gg[k];
-        s0 += a0;
-        s1 += a1;
-        s2 += a2;
-        s3 += a3;
         sf += fnl[k];
         if (k > i) {
             th[i] = a0;
@@ -375,27 +360,24 @@ static float resample_forward(br_pf_t *pf, float s[BR_NX])
             ia[i] = ia[k];
         }
     }
-    s[0] = s0;
-    s[1] = s1;
-    s[2] = s2;
-    s[3] = s3;
     return sf;
 }
 
 /* resample()'s indices, fused with the forward pass of the in-place copy
- * (copy_resampled) and with step 5's sums (sum_set), for targets without
- * float SIMD (one loop instead of three): particle i is the predicted
- * particle j = idx_i, so the sums over the resampled set, in particle order,
- * add the predicted j's values, held in registers while j stays. Particle i
+ * (copy_resampled) and with step 5's sum of f_nl (sum_set), for targets
+ * without float SIMD (one loop instead of three): particle i is the
+ * predicted particle j = idx_i, so the sum over the resampled set, in
+ * particle order, adds the predicted j's f_nl, held in a register while j
+ * stays. Particle i
  * takes j's state now when j > i: a later i' reads only j' >= j > i, and a
  * position j' is read (when j reaches it) before it is written (at i = j',
  * which needs idx_j' > j'). The backward pass (idx_i < i) follows in
- * copy_back. The same indices, states and sums as the three loops.
+ * copy_back. The same indices, states and sum as the three loops.
  * total is the sum of W[0 .. m - 1] (quantise_weights' return), so every
  * t_i = floor((2 i + 1) total / (2 m)) <= floor(total - total / (2 m)) is
  * below C_{m-1} = total: the search for j stops by j = m - 1 without a test
  * of j (resample(), for any W, tests it). */
-static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
+static float resample_fused(br_pf_t *pf, uint32_t total)
 {
     const uint32_t m = pf->cfg.n_particles;
     const uint32_t *BR_RESTRICT W = pf->W;
@@ -412,7 +394,7 @@ static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
     uint32_t j = 0u, c = W[0];
     float a0 = th[0], a1 = om[0], a2 = zz[0], a3 = gg[0], af = fnl[0];
     float ai = ia[0];
-    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
+    float sf = 0.0f;
     for (uint32_t i = 0; i < m; i++) {
         /* no j + 1 < m test: t_i < C_{m-1} (above), so the search stops by j = m - 1 */
         if (c <= t) {
@@ -428,10 +410,6 @@ static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
             ai = ia[j];
         }
         idx[i] = (uint16_t)j;
-        s0 += a0;
-        s1 += a1;
-        s2 += a2;
-        s3 += a3;
         sf += af;
         if (j > i) {
             th[i] = a0;
@@ -448,10 +426,6 @@ static float resample_fused(br_pf_t *pf, uint32_t total, float s[BR_NX])
             rn -= (int32_t)den;
         }
     }
-    s[0] = s0;
-    s[1] = s1;
-    s[2] = s2;
-    s[3] = s3;
     return sf;
 }
 
@@ -850,22 +824,19 @@ BR_PF_CLONES static void exp_vec(const float *BR_RESTRICT l, uint32_t *BR_RESTRI
 
 /* Step 3: max-shifted weights w_j = e^(l_j - lmax), quantised to W_j (an invalid
  * particle has l_j = NaN and br_exp_neg gives 0 for it); on an outlier every
- * valid particle (l_j not NaN, even -inf when its residual overflowed) gets w = 1.
- * Returns the total of W; *sw and *sw2 get the sums of w and w^2 (for the ESS). */
-static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw, float *sw2)
+ * valid particle (l_j not NaN, even -inf when its residual overflowed) gets w = 1
+ * (step_weight: these w_j, for br_pf_stats). Returns the total of W. */
+static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier)
 {
     const uint32_t m = pf->cfg.n_particles;
     const float *BR_RESTRICT l = pf->l;
     uint32_t *BR_RESTRICT W = pf->W;
     uint32_t total = 0u;
-    float s1 = 0.0f, s2 = 0.0f;
     if (outlier) {
         for (uint32_t j = 0; j < m; j++) {
             const float w = (l[j] == l[j]) ? 1.0f : 0.0f; /* valid: not NaN */
             W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
             total += W[j];
-            s1 += w;
-            s2 += w * w;
         }
     } else {
         /* (the vector path's weights: exp_vec, quant_total and resample_count);
@@ -875,13 +846,20 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier, float *sw
             const float w = br_exp_neg_k(l[j] - lmax, k);
             W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
             total += W[j];
-            s1 += w;
-            s2 += w * w;
         }
     }
-    *sw = s1;
-    *sw2 = s2;
     return total;
+}
+
+/* w_j of the last step's weighing (quantise_weights' and exp_vec's: the same
+ * value, br_math.h), from the log-weight it left */
+static float step_weight(const br_pf_t *pf, uint32_t j)
+{
+    const float l = pf->l[j];
+    if (pf->weighed == BR_PF_WEIGHED_VALID) {
+        return (l == l) ? 1.0f : 0.0f;
+    }
+    return br_exp_neg(l - pf->lmax);
 }
 
 /* Step 4's copy, in place: particle i becomes the predicted particle idx_i.
@@ -920,29 +898,31 @@ static void copy_back(br_pf_t *pf)
                   pf->x[BR_X_GP], pf->kgp);
 }
 
-/* Step 5's sums over the set, in particle order: s gets the sums of the
- * states, the return value the sum of f_nl of the set's predicted
+/* Step 5's sum over the set, in particle order: f_nl of the set's predicted
  * particles idx_j. */
-static float sum_set(const br_pf_t *pf, float s[BR_NX])
+static float sum_set(const br_pf_t *pf)
 {
     const uint32_t m = pf->cfg.n_particles;
     const uint16_t *const idx = pf->idx;
-    const float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA];
-    const float *const zz = pf->x[BR_X_Z], *const gg = pf->x[BR_X_GP];
     const float *const fnl = pf->fnl;
-    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f, s3 = 0.0f, sf = 0.0f;
+    float sf = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
-        s0 += th[j];
-        s1 += om[j];
-        s2 += zz[j];
-        s3 += gg[j];
         sf += fnl[idx[j]];
     }
-    s[0] = s0;
-    s[1] = s1;
-    s[2] = s2;
-    s[3] = s3;
     return sf;
+}
+
+/* The sum of state i over the set, in particle order (br_pf_stats' mean; the
+ * re-anchoring's theta and omega) */
+static float sum_state(const br_pf_t *pf, int i)
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const float *const x = pf->x[i];
+    float s = 0.0f;
+    for (uint32_t j = 0; j < m; j++) {
+        s += x[j];
+    }
+    return s;
 }
 
 /* cfg.adapt: the normalised innovation squared of the predicted cloud,
@@ -993,6 +973,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     const uint32_t n_valid = predict_and_weigh(pf, u_a, shift, y_rel, 1, &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
+        pf->weighed = BR_PF_WEIGHED_NONE;
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
     }
     /* an outlier also when every valid particle's log-weight overflowed to -inf
@@ -1005,27 +986,30 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     /* 3. max-shifted weights, quantised; an outlier gives every valid particle weight 1 */
     /* 4. deterministic systematic resampling on the integer weights (total >= 2^16:
      * the best valid particle has W = 2^16) */
-    /* 5. estimate over the resampled set: particle mean and the mean of f_nl (eq. 6) */
-    float sw, sw2, s[BR_NX], sf;
+    /* 5. estimate over the resampled set: the mean of f_nl (eq. 6); the
+     * particle mean and the ESS on request (br_pf_stats, from the set and l) */
+    pf->weighed = (verdict == BR_W_OUTLIER) ? BR_PF_WEIGHED_VALID : BR_PF_WEIGHED_LOG;
+    pf->lmax = lmax;
+    float sf;
     if (BR_FLOAT_SIMD && !pf->cfg.scalar_path) {
         if (verdict == BR_W_OUTLIER) {
-            const uint32_t total = quantise_weights(pf, lmax, 1, &sw, &sw2);
-            resample_count(pf->W, m, total, pf->idx, 0, &sw, &sw2);
+            const uint32_t total = quantise_weights(pf, lmax, 1);
+            resample_count(pf->W, m, total, pf->idx, 0);
         } else {
             /* the exponentials in a loop of their own (vectorised), w parked
              * in W's storage as its bit pattern; the total of the quantised
-             * weights (vectorised); then the quantisation in place and the
-             * sums of w and w^2 in order, in the counting loop */
+             * weights (vectorised); then the quantisation in place, in the
+             * counting loop */
             exp_vec(pf->l, pf->W, lmax, m);
             const uint32_t total = quant_total(pf->W, m);
-            resample_count(pf->W, m, total, pf->idx, 1, &sw, &sw2);
+            resample_count(pf->W, m, total, pf->idx, 1);
         }
-        sf = resample_forward(pf, s);
+        sf = resample_forward(pf);
         copy_back(pf);
     } else {
-        const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER, &sw, &sw2);
-        /* one loop for the indices, the forward copy and the sums, then the backward copy */
-        sf = resample_fused(pf, total, s);
+        const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER);
+        /* one loop for the indices, the forward copy and the sum, then the backward copy */
+        sf = resample_fused(pf, total);
         copy_back(pf);
     }
     const float inv_m = 1.0f / (float)m;
@@ -1035,7 +1019,8 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
          * theta's mean moves to y, omega's mean to the measured velocity */
         const float periods = (float)pf->n_predicted + 1.0f;
         const float omega_meas = (shift + (y->frac - pf->prev_frac) * rpc) / (periods * pf->cfg.est.model.dt_s);
-        const float d_th = y_rel - s[BR_X_THETA] * inv_m, d_om = omega_meas - s[BR_X_OMEGA] * inv_m;
+        const float d_th = y_rel - sum_state(pf, BR_X_THETA) * inv_m;
+        const float d_om = omega_meas - sum_state(pf, BR_X_OMEGA) * inv_m;
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
             pf->x[BR_X_THETA][j] += d_th;
@@ -1045,19 +1030,12 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
             particle_get(pf, j, xj);
             sf += br_model_fcomp_N(&pf->model, xj, (float)y->counts * pf->m_per_count);
         }
-        s[BR_X_THETA] += d_th * (float)m;
-        s[BR_X_OMEGA] += d_om * (float)m;
     }
     pf->origin_counts = y->counts;
     pf->prev_frac = y->frac;
     pf->n_predicted = 0u;
-    for (int i = 0; i < BR_NX; i++) {
-        pf->est.mean[i] = s[i] * inv_m;
-    }
     pf->est.F_hat_N = sf * inv_m;
     pf->est.origin_counts = y->counts;
-    /* effective sample size of the weights, (sum w)^2 / sum w^2 */
-    pf->est.ess = sw * sw / sw2;
     return verdict;
 }
 
@@ -1079,20 +1057,15 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
                                                sums);
     noise_advance(pf);
     if (n_valid == 0u) {
+        pf->weighed = BR_PF_WEIGHED_NONE;
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
     }
     /* every particle moves on unweighted (an invalid one kept its state) */
     for (uint32_t j = 0; j < m; j++) {
         pf->idx[j] = (uint16_t)j;
     }
-    float s[BR_NX];
-    const float sf = sum_set(pf, s);
-    const float inv_m = 1.0f / (float)m;
-    for (int i = 0; i < BR_NX; i++) {
-        pf->est.mean[i] = s[i] * inv_m;
-    }
-    pf->est.F_hat_N = sf * inv_m;
-    pf->est.ess = (float)m;
+    pf->est.F_hat_N = sum_set(pf) * (1.0f / (float)m);
+    pf->weighed = BR_PF_WEIGHED_EQUAL;
     if (pf->n_predicted < UINT32_MAX) {
         pf->n_predicted++;
     }
@@ -1100,6 +1073,37 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
 }
 
 const br_pf_est_t *br_pf_estimate(const br_pf_t *pf) { return (pf != NULL) ? &pf->est : NULL; }
+
+br_status_t br_pf_stats(const br_pf_t *pf, br_pf_stats_t *out)
+{
+    if (pf == NULL || out == NULL) {
+        return BR_E_NULL;
+    }
+    if (!pf->ready || !pf->primed) {
+        return BR_E_STATE; /* no set before the first measurement */
+    }
+    const uint32_t m = pf->cfg.n_particles;
+    const float inv_m = 1.0f / (float)m;
+    for (int i = 0; i < BR_NX; i++) {
+        out->mean[i] = sum_state(pf, i) * inv_m;
+    }
+    if (pf->weighed == BR_PF_WEIGHED_EQUAL) {
+        out->ess = (float)m;
+    } else if (pf->weighed == BR_PF_WEIGHED_NONE) {
+        out->ess = 0.0f;
+    } else {
+        /* effective sample size of the step's weights, (sum w)^2 / sum w^2,
+         * the sums in particle order; sum w >= 1 (the best valid particle has w = 1) */
+        float sw = 0.0f, sw2 = 0.0f;
+        for (uint32_t j = 0; j < m; j++) {
+            const float w = step_weight(pf, j);
+            sw += w;
+            sw2 += w * w;
+        }
+        out->ess = sw * sw / sw2;
+    }
+    return BR_OK;
+}
 
 br_status_t br_pf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
 {

@@ -253,7 +253,12 @@ void br_circle_csv_sink(void *user, const br_circle_sample_t *s)
             s->pos_m[0], s->pos_m[1], s->radial_err_m, s->duty[0], s->duty[1], s->fnl_N[0], s->fnl_N[1],
             s->F_hat_N[0], s->F_hat_N[1]);
     for (int i = 0; i < 2; i++) {
-        if (s->pf[i]) fprintf(f, ",%.6f", (double)br_pf_estimate(s->pf[i])->mean[BR_X_GP]);
+        br_pf_stats_t ps;
+        if (s->pf[i]) {
+            /* g_p's particle mean (gp0 before the first measurement) */
+            const float gp = (br_pf_stats(s->pf[i], &ps) == BR_OK) ? ps.mean[BR_X_GP] : s->pf[i]->cfg.est.gp0_N;
+            fprintf(f, ",%.6f", (double)gp);
+        }
         else if (s->ukf[i]) fprintf(f, ",%.6f", (double)br_ukf_estimate(s->ukf[i])->mean[BR_X_GP]);
         else fprintf(f, ",");
     }

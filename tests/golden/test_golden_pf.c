@@ -209,23 +209,20 @@ static void test_pf_resample_identical(void **state)
     assert_int_equal(bad_steps, 0);
 }
 
-/* the estimate of the current set as br_pf.h defines it: particle means, mean
- * of f_nl over the resampled set (float32, as the filter) */
+/* the set resampled with the reference's indices, and its estimate as br_pf.h
+ * defines it: the mean of f_nl over the resampled set (float32, as the
+ * filter; br_pf_stats makes the particle means from the set) */
 static void resample_forced(br_pf_t *pf, const br_pf_t *pred, const uint16_t *idx)
 {
     const uint32_t m = pf->cfg.n_particles;
-    float s[BR_NX] = {0.0f, 0.0f, 0.0f, 0.0f}, sf = 0.0f;
+    float sf = 0.0f;
     for (uint32_t j = 0; j < m; j++) {
         for (int i = 0; i < BR_NX; i++) {
             pf->x[i][j] = pred->x[i][idx[j]];
-            s[i] += pf->x[i][j];
         }
         pf->kgp[j] = pred->kgp[idx[j]];
         sf += pf->fnl[idx[j]];
         pf->idx[j] = idx[j];
-    }
-    for (int i = 0; i < BR_NX; i++) {
-        pf->est.mean[i] = s[i] / (float)m;
     }
     pf->est.F_hat_N = sf / (float)m;
 }
@@ -467,7 +464,9 @@ static void test_pf_forced_run(void **state)
                 dB += (2.0 * rho + rho * rho) * w * w;
             }
             const double ess_t = br_trace_get(&g.pf, k, c_ess);
-            br_errstat_add(&e_ess, &g.pf, k, (double)pf->est.ess, ess_t,
+            br_pf_stats_t ps;
+            assert_int_equal(br_pf_stats(pf, &ps), BR_OK);
+            br_errstat_add(&e_ess, &g.pf, k, (double)ps.ess, ess_t,
                            ess_t * (2.0 * dA / A + dB / B + C_SUM * (double)m * U32));
             /* (c) the filter's own indices */
             int own_diff = 0;
@@ -507,8 +506,10 @@ static void test_pf_forced_run(void **state)
             dr.d[1] += 2.0 * (double)m * U32 * xmax[1];
         }
         /* estimate: the particles' bound plus the rounding of the sum */
+        br_pf_stats_t ps;
+        assert_int_equal(br_pf_stats(pf, &ps), BR_OK);
         for (int i = 0; i < BR_NX; i++) {
-            br_errstat_add(&e_mean[i], &g.pf, k, (double)pf->est.mean[i], xm[i],
+            br_errstat_add(&e_mean[i], &g.pf, k, (double)ps.mean[i], xm[i],
                            dr.d[i] + C_SUM * (double)m * U32 * xmax[i]);
         }
         const double F_t = br_trace_get(&g.pf, k, c_F);

@@ -51,6 +51,14 @@ static br_pf_t *new_pf(uint32_t m)
     return pf;
 }
 
+/* br_pf_stats of a primed filter */
+static br_pf_stats_t stats(const br_pf_t *pf)
+{
+    br_pf_stats_t s;
+    assert_int_equal(br_pf_stats(pf, &s), BR_OK);
+    return s;
+}
+
 static int all_finite(const br_pf_t *pf)
 {
     for (uint32_t j = 0; j < pf->cfg.n_particles; j++)
@@ -192,10 +200,12 @@ static void test_outlier_100_sigma(void **st)
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
     assert_true(all_finite(pf));
     assert_true(isfinite(br_pf_estimate(pf)->F_hat_N));
+    /* an outlier step weighs every valid particle alike (all 300 here) */
+    BR_ASSERT_NEAR(stats(pf).ess, 300.0, 0.0);
     /* a single glitch: the measurement returns and tracking resumes */
     y.counts = 0;
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    BR_ASSERT_NEAR(br_pf_estimate(pf)->mean[0] / RPC, 0.5, 1.0);
+    BR_ASSERT_NEAR(stats(pf).mean[0] / RPC, 0.5, 1.0);
     /* a lasting jump (the filter lost lock): re-anchored after 3 outliers */
     y.counts = 100;
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
@@ -203,7 +213,7 @@ static void test_outlier_100_sigma(void **st)
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
     assert_true(all_finite(pf));
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    BR_ASSERT_NEAR(br_pf_estimate(pf)->mean[0] / RPC, 0.5, 1.0);
+    BR_ASSERT_NEAR(stats(pf).mean[0] / RPC, 0.5, 1.0);
     free(pf);
 }
 
@@ -259,6 +269,15 @@ static void test_all_invalid_keeps_previous(void **st)
     assert_int_equal(br_pf_step(pf, &y, 3.0e38f), BR_E_NUMERIC);
     assert_true(all_finite(pf));
     assert_true(pf->x[0][3] == th && pf->origin_counts == origin);
+    /* no usable weight in this step: an ESS of 0, not the 0/0 of its NaN log-weights */
+    assert_true(stats(pf).ess == 0.0f);
+    /* the same for a predict-only step after a predict-only step (which weighs all alike) */
+    assert_int_equal(br_pf_predict(pf, 0.0f), BR_OK);
+    assert_true(stats(pf).ess == 100.0f);
+    th = pf->x[0][3];
+    assert_int_equal(br_pf_predict(pf, 3.0e38f), BR_E_NUMERIC);
+    assert_true(pf->x[0][3] == th);
+    assert_true(stats(pf).ess == 0.0f);
     free(pf);
 }
 
@@ -279,22 +298,50 @@ static void test_weights_survive_underflow(void **st)
     for (uint32_t j = 0; j < 100; j++) wmax = pf->W[j] > wmax ? pf->W[j] : wmax;
     assert_int_equal(wmax, 1u << BR_PF_W_BITS);
     assert_true(all_finite(pf));
-    assert_true(br_pf_estimate(pf)->ess >= 1.0f);
+    assert_true(stats(pf).ess >= 1.0f);
     free(pf);
 }
 
+/* br_pf_stats: the mean of the set and the ESS of the last step's weights,
+ * against the same made here in double from the set and the log-weights; m
+ * after the first measurement and after a predict-only step */
 static void test_ess_reported(void **st)
 {
     (void)st;
-    br_pf_t *pf = new_pf(500);
+    const uint32_t m = 500u;
+    br_pf_t *pf = new_pf(m);
+    br_pf_stats_t s;
+    assert_int_equal(br_pf_stats(pf, &s), BR_E_STATE); /* no set before the first measurement */
+    assert_int_equal(br_pf_stats(NULL, &s), BR_E_NULL);
+    assert_int_equal(br_pf_stats(pf, NULL), BR_E_NULL);
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    BR_ASSERT_NEAR(br_pf_estimate(pf)->ess, 500.0, 0.0); /* freshly drawn: uniform */
+    BR_ASSERT_NEAR(stats(pf).ess, 500.0, 0.0); /* freshly drawn: uniform */
+    double ess_min = (double)m;
     for (int k = 0; k < 20; k++) {
+        y.frac = (k % 2) ? 0.3f : 0.7f; /* a measurement that moves: weights far from uniform */
         assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-        float ess = br_pf_estimate(pf)->ess;
-        assert_true(ess >= 1.0f && ess <= 500.0f);
+        s = stats(pf);
+        assert_true(s.ess >= 1.0f && s.ess <= 500.0f);
+        double lmax = -INFINITY, sw = 0.0, sw2 = 0.0, mean[BR_NX] = {0.0, 0.0, 0.0, 0.0};
+        for (uint32_t j = 0; j < m; j++) lmax = fmax(lmax, (double)pf->l[j]);
+        for (uint32_t j = 0; j < m; j++) {
+            const double w = exp((double)pf->l[j] - lmax);
+            sw += w;
+            sw2 += w * w;
+            for (int i = 0; i < BR_NX; i++) mean[i] += (double)pf->x[i][j] / (double)m;
+        }
+        BR_ASSERT_NEAR(s.ess, sw * sw / sw2, 1e-4 * sw * sw / sw2);
+        for (int i = 0; i < BR_NX; i++) {
+            double xmax = 0.0;
+            for (uint32_t j = 0; j < m; j++) xmax = fmax(xmax, fabs((double)pf->x[i][j]));
+            BR_ASSERT_NEAR(s.mean[i], mean[i], 1e-5 * xmax);
+        }
+        ess_min = fmin(ess_min, (double)s.ess);
     }
+    assert_true(ess_min < 0.9 * (double)m); /* the check above saw weights that are not all alike */
+    assert_int_equal(br_pf_predict(pf, 0.0f), BR_OK);
+    BR_ASSERT_NEAR(stats(pf).ess, 500.0, 0.0); /* a predict-only step does not weigh */
     free(pf);
 }
 
@@ -488,6 +535,8 @@ static void test_vector_path_is_scalar_path(void **st)
         assert_memory_equal(a->W, b->W, sizeof a->W);
         assert_memory_equal(a->idx, b->idx, sizeof a->idx);
         assert_memory_equal(&a->est, &b->est, sizeof a->est);
+        const br_pf_stats_t ta = stats(a), tb = stats(b);
+        assert_memory_equal(&ta, &tb, sizeof ta);
         assert_int_equal(a->noise_pos, b->noise_pos);
         assert_memory_equal(&a->nis_avg, &b->nis_avg, sizeof a->nis_avg);
         assert_memory_equal(&a->q_scale_std, &b->q_scale_std, sizeof a->q_scale_std);

@@ -8,7 +8,8 @@
  *   3. quantise   W_j = floor(w_j 2^16) (the best particle has W = 2^16 > 0)
  *   4. resample   xi_i = (i + 1/2) / m; particle i copies the j with
  *                 C_{j-1} <= xi_i C_m < C_j, C_j = W_0 + ... + W_j, in integers
- *   5. estimate   mean of the particles, F_hat = mean of f_nl(x_j) (eq. 6)
+ *   5. estimate   F_hat = mean of f_nl(x_j) (eq. 6); the particle mean and the
+ *                 ESS on request (br_pf_stats), not in the step
  * theta is stored relative to the latest measured count (an integer origin),
  * so float32 keeps sub-nanometre resolution at any travel.
  * See docs/modules/pf.md. */
@@ -81,12 +82,27 @@ typedef struct {
     uint32_t proposal;       /* BR_PF_PROPOSAL_*: 0 (default) the thesis's bootstrap filter */
 } br_pf_cfg_t;
 
+/* What each step makes: the force to compensate and theta's origin. */
 typedef struct {
-    float mean[BR_NX];       /* particle mean; theta relative to origin_counts */
     int32_t origin_counts;   /* integer origin of theta */
     float F_hat_N;           /* mean f_nl over particles */
-    float ess;               /* effective sample size of the step's weights, 1..m */
 } br_pf_est_t;
+
+/* Diagnostics made on request by br_pf_stats from the filter's state (the
+ * control loop does not need them; docs/modules/pf.md, "Statistics on
+ * request"). */
+typedef struct {
+    float mean[BR_NX];       /* particle mean; theta relative to br_pf_est_t.origin_counts */
+    float ess;               /* effective sample size of the last step's weights, 1..m;
+                                m after the first measurement and a predict-only step;
+                                0 after a step that had no usable particle (BR_E_NUMERIC) */
+} br_pf_stats_t;
+
+/* how the last step weighed the particles (br_pf_stats' ESS) */
+#define BR_PF_WEIGHED_EQUAL 0u   /* all alike: ESS = m */
+#define BR_PF_WEIGHED_LOG 1u     /* w_j = e^(l_j - lmax) */
+#define BR_PF_WEIGHED_VALID 2u   /* an outlier step: w_j = 1 for a valid particle, 0 otherwise */
+#define BR_PF_WEIGHED_NONE 3u    /* no usable particle: ESS = 0 */
 
 typedef struct {
     br_pf_cfg_t cfg;
@@ -121,6 +137,8 @@ typedef struct {
     uint32_t W[BR_PF_MAX_PARTICLES];  /* quantised weights */
     uint16_t idx[BR_PF_MAX_PARTICLES];/* resampling indices of the last step */
     br_pf_est_t est;
+    uint32_t weighed;             /* BR_PF_WEIGHED_*: the last step's weights, for br_pf_stats */
+    float lmax;                   /* the last step's largest log-weight (BR_PF_WEIGHED_LOG) */
     int ready;
 } br_pf_t;
 
@@ -155,6 +173,13 @@ br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx);
 
 /* The last step's estimate. */
 const br_pf_est_t *br_pf_estimate(const br_pf_t *pf);
+
+/* The particle mean and the ESS of the last step, made now from the set and
+ * the log-weights the step left (one pass over the particles; the same
+ * values, bit for bit, as sums made inside the step). Call it before the next
+ * step. BR_E_NULL for a NULL argument, BR_E_STATE before the first
+ * measurement (no set yet). */
+br_status_t br_pf_stats(const br_pf_t *pf, br_pf_stats_t *out);
 
 /* br_est_t binding: ctx is a br_pf_t *. */
 br_status_t br_pf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
