@@ -14,7 +14,11 @@
 # every run. Two particle counts separate the per-particle slope from the
 # fixed per-period cost. A third, short run (20 periods, m_hi) with QEMU's
 # translation-block log gives the profile: instructions per particle-step by
-# function and by block (target/mps2/tb_profile.py).
+# function and by block (target/mps2/tb_profile.py). The cycle estimate's
+# divisions and square roots per particle-step and per period (k >= 1) come
+# from such traces at m_hi and m_lo, each less a trace of the priming period
+# alone. With two axes, each period's cost is the axes' br_app_step only
+# (br_replay_run makes their outputs after the last axis has stepped).
 set -euo pipefail
 host=$1 cm7=$2 out=$3
 qemu=${BR_QEMU:-qemu-system-arm}
@@ -78,22 +82,53 @@ awk -v n="$un" -v s="$usum" -v mx="$umax" -v ci="$uci" -v ct="$uct" -v sz="$usz"
   printf "    at 1 instruction/cycle and %d MHz: %.1f%% of the 1 ms period; br_ukf_t %d bytes\n", mhz, 100 * mean / (mhz * 1e3), sz
 }'
 
-# Profile: a 0.03 s stream (20 periods), one execution trace, then the log is deleted.
+# Profile: a 0.03 s stream (20 periods after the priming period k = 0), one
+# execution trace at m_hi, then the log is deleted.
+# Long instructions (the cycle estimate's): the executed vdiv.f32 / vsqrt.f32
+# of the periods k >= 1 are a trace's count less that of a replay of the same
+# stream's priming period alone (the recorder's first step of the same
+# closed loop, a prefix of the 20-period stream); per period k >= 1 that is at
+# m_hi and at m_lo, whose slope is the count per particle-step and whose
+# intercept the fixed part's, as for the instructions above.
 "$host/tests/target/br_replay_record" --out "$out/stream_prof.bin" --duration 0.03 >/dev/null
-"$qemu" -M "$machine" -nographic -monitor none -serial none -icount shift=0 \
-  -semihosting-config "enable=on,target=native,arg=replay,arg=$out/stream_prof.bin,arg=$out/target_prof.bin,arg=$m_hi" \
-  -kernel "$image" -d in_asm,exec,nochain -D "$out/qemu_prof.log" >/dev/null 2>&1
-read -r n_prof _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_prof.bin")
-prof=$("${BR_PYTHON:-python3}" "$(dirname "$0")/tb_profile.py" "$out/qemu_prof.log" "$image" \
-  --particle-steps $(( (n_prof - 1) * m_hi )) --periods "$n_prof" --skip main)  # main: the calibration loop
-rm -f "$out/qemu_prof.log"
-grep -v '^long_ops ' <<<"$prof"
+"$host/tests/target/br_replay_record" --out "$out/stream_prime.bin" --duration 0.0001 >/dev/null  # k = 0 only
+# trace STREAM M NAME: runs the image on STREAM at m = M with the block log $out/qemu_NAME.log
+trace() {
+  "$qemu" -M "$machine" -nographic -monitor none -serial none -icount shift=0 \
+    -semihosting-config "enable=on,target=native,arg=replay,arg=$1,arg=$out/target_$3.bin,arg=$2" \
+    -kernel "$image" -d in_asm,exec,nochain -D "$out/qemu_$3.log" >/dev/null 2>&1
+}
+# long_ops PROFILE_OUTPUT: prints "divisions square_roots" of its long_ops line
+long_ops() { sed -n 's/^long_ops div=\(-*[0-9]*\) sqrt=\(-*[0-9]*\)$/\1 \2/p' <<<"$1"; }
+declare -A ldiv lsqrt
+for m in "$m_hi" "$m_lo"; do
+  trace "$out/stream_prime.bin" "$m" "prime_m$m"
+  trace "$out/stream_prof.bin" "$m" "prof_m$m"
+  read -r np _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_prof_m$m.bin")
+  if [[ $m == "$m_hi" ]]; then
+    n_prof=$np
+    prof=$("${BR_PYTHON:-python3}" "$(dirname "$0")/tb_profile.py" "$out/qemu_prof_m$m.log" "$image" \
+      --particle-steps $(( (n_prof - 1) * m )) --base "$out/qemu_prime_m$m.log" --skip main)  # main: the calibration loop
+    grep -v '^long_ops ' <<<"$prof"
+  else
+    [[ $np == "$n_prof" ]] || { echo "target-bench: profile runs of $n_prof and $np periods" >&2; exit 1; }
+    prof=$("${BR_PYTHON:-python3}" "$(dirname "$0")/tb_profile.py" "$out/qemu_prof_m$m.log" "$image" \
+      --particle-steps $(( (n_prof - 1) * m )) --base "$out/qemu_prime_m$m.log" --skip main --long-ops-only)
+  fi
+  rm -f "$out/qemu_prof_m$m.log" "$out/qemu_prime_m$m.log"
+  read -r ldiv[$m] lsqrt[$m] < <(long_ops "$prof")
+  [[ -n ${ldiv[$m]:-} && -n ${lsqrt[$m]:-} ]] || { echo "target-bench: no long_ops count at m = $m" >&2; exit 1; }
+done
 
 # Cycle estimate (docs/target.md): one cycle per instruction, plus the latency
 # of the long FPU instructions the instruction count takes as one: vdiv.f32
 # and vsqrt.f32 take 14 cycles on the Cortex-M7 (13 more than counted). The
-# counts per particle-step come from the profile run.
-read -r dps sps dpp spp < <(sed -n 's/^long_ops per_particle_step_div=\([0-9.]*\) per_particle_step_sqrt=\([0-9.]*\) per_period_div=\([0-9.]*\) per_period_sqrt=\([0-9.]*\)/\1 \2 \3 \4/p' <<<"$prof")
+# counts per particle-step (dps, sps) are the slope of the profile runs'
+# counts per period k >= 1 between m_hi and m_lo; dpp, spp are those per
+# period at m_hi (per particle-step x m_hi + the intercept).
+read -r dps sps dpp spp < <(awk -v n="$((n_prof - 1))" -v mh="$m_hi" -v ml="$m_lo" \
+  -v dh="${ldiv[$m_hi]}" -v dl="${ldiv[$m_lo]}" -v sh="${lsqrt[$m_hi]}" -v sl="${lsqrt[$m_lo]}" 'BEGIN {
+  printf "%.6f %.6f %.4f %.4f\n", (dh - dl) / n / (mh - ml), (sh - sl) / n / (mh - ml), dh / n, sh / n }')
 awk -v mh="$m_hi" -v ml="$m_lo" -v ah="${mean[$m_hi]}" -v al="${mean[$m_lo]}" -v ih="${ipt[$m_hi]}" -v il="${ipt[$m_lo]}" \
     -v dps="$dps" -v sps="$sps" -v dpp="$dpp" -v spp="$spp" -v mhz="$mhz" -v P="$period" '
 BEGIN {
@@ -104,18 +139,20 @@ BEGIN {
   cfix = fixed + extra * dfix
   cper = cps * mh + cfix
   printf "  cycle estimate (1 cycle per instruction + 13 per vdiv.f32/vsqrt.f32, 14-cycle latency each):\n"
-  printf "    divisions per particle-step %.3f, square roots %.3f (profile run)\n", dps, sps
+  printf "    divisions per particle-step %.3f, square roots %.3f; per period at m = %d: %.1f divisions, %.1f square roots, of which fixed %.1f\n", dps, sps, mh, dpp, spp, dpp + spp - (dps + sps) * mh
+  printf "      (periods k >= 1 of the profile runs at m = %d and %d: each run less its priming period; slope and intercept)\n", mh, ml
   printf "    per particle-step: %.1f cycles   (instructions %.1f; goal <= 200 instructions)\n", cps, slope
   printf "    per period at m = %d: %.0f cycles = %.3f ms at %d MHz = %.1f%% of the 1.5 ms period (goal <= 50%%)\n", mh, cper, cper / (mhz * 1e3), mhz, 100 * cper / P
   m50 = int((0.5 * P - cfix) / cps); m80 = int((0.8 * P - cfix) / cps); m80x2 = int((0.8 * P - 2 * cfix) / (2 * cps))
   printf "    largest m within 50%% of %d MHz x 1.5 ms: %d; one axis within 80%%: %d; two axes on one core within 80%%: %d per axis\n", mhz, m50, m80, m80x2
-  printf "long_ops_summary cycles_per_particle_step=%.2f cycles_fixed=%.0f cycles_period=%.0f m_two_axes_80=%d\n", cps, cfix, cper, m80x2
+  printf "long_ops_summary cycles_per_particle_step=%.2f cycles_fixed=%.0f cycles_period=%.0f m_two_axes_80=%d long_fixed=%.4f\n", cps, cfix, cper, m80x2, dfix
 }' | tee "$out/cycles.txt" | grep -v '^long_ops_summary'
 
 # Two axes on one MCU: the replay image runs both axes of the X-Y table every
 # period (stream version 2) at the estimate's largest m per axis within 80 %;
 # measured instructions per period, charged as above.
-m2=$(sed -n 's/^long_ops_summary .* m_two_axes_80=\([0-9]*\)/\1/p' "$out/cycles.txt")
+m2=$(sed -n 's/^long_ops_summary .* m_two_axes_80=\([0-9]*\) .*/\1/p' "$out/cycles.txt")
+lfix=$(sed -n 's/^long_ops_summary .* long_fixed=\([0-9.]*\)$/\1/p' "$out/cycles.txt")  # fixed long instructions per axis and period
 "$host/tests/target/br_replay_record" --out "$out/stream_xy.bin" --duration 1.0 --axes 2 >/dev/null
 # run_xy M: prints "M mean_instructions max_instructions cycles_mean cycles_max periods"
 run_xy() {
@@ -126,8 +163,9 @@ run_xy() {
   echo "$log" > "$out/qemu_xy_m$m.log"
   read -r ci ct < <(sed -n 's/^calib insns=\([0-9]*\) ticks=\([0-9]*\).*/\1 \2/p' <<<"$log")
   read -r nxy axy _ _ xxy _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_xy.bin")
-  awk -v m="$m" -v a="$axy" -v x="$xxy" -v i="$ci" -v t="$ct" -v dps="$dps" -v n="$nxy" 'BEGIN {
-    ipt = i / t; printf "%d %.0f %.0f %.0f %.0f %d\n", m, a * ipt, x * ipt, a * ipt + 13 * dps * 2 * m, x * ipt + 13 * dps * 2 * m, n - 1 }'
+  awk -v m="$m" -v a="$axy" -v x="$xxy" -v i="$ci" -v t="$ct" -v ps="$dps" -v ss="$sps" -v lf="$lfix" -v n="$nxy" 'BEGIN {
+    ipt = i / t; l = 13 * 2 * ((ps + ss) * m + lf)  # two axes: per period each (per particle-step x m + fixed)
+    printf "%d %.0f %.0f %.0f %.0f %d\n", m, a * ipt, x * ipt, a * ipt + l, x * ipt + l, n - 1 }'
 }
 read -r mx ins insx cyc cycx nper < <(run_xy "$m2")
 for _ in 1 2 3 4; do

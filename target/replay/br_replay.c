@@ -164,24 +164,38 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
     for (uint32_t k = 0u; k < r->cfg.n_steps; ++k) {
         uint32_t in[BR_REPLAY_MAX_AXES][BR_REPLAY_STEP_WORDS];
         if (io->read(io->ctx, in, (uint32_t)(na * sizeof in[0])) != 0) return -1;
-        /* the axes one after the other in the period, as on one MCU */
+        /* the axes one after the other in the period, as on one MCU; each
+         * axis's end is stamped as it ends, and the outputs (index hash,
+         * write) of all axes are made after the last has stepped, so that
+         * the period's cost holds the axes' br_app_step only (the inputs are
+         * unpacked before the period's first stamp) */
+        br_ref_t ref[BR_REPLAY_MAX_AXES];
+        br_status_t st[BR_REPLAY_MAX_AXES];
+        uint32_t t1[BR_REPLAY_MAX_AXES];
+        for (uint32_t a = 0u; a < na; ++a) {
+            r->ax[a].enc_counts = (int32_t)in[a][0];
+            ref[a] = (br_ref_t){(int32_t)in[a][1], w2f(in[a][2]), w2f(in[a][3])};
+        }
+        uint32_t n_run = 0u; /* axes stepped: a failed step ends the period, as it ends the replay */
         const uint32_t t0 = io->stamp ? io->stamp(io->ctx) : 0u;
         for (uint32_t a = 0u; a < na; ++a) {
-            br_replay_axis_t *x = &r->ax[a];
+            st[a] = br_app_step(&r->ax[a].app, &ref[a]);
+            t1[a] = io->stamp ? io->stamp(io->ctx) : 0u;
+            n_run = a + 1u;
+            if (BR_FAILED(st[a])) break;
+        }
+        for (uint32_t a = 0u; a < n_run; ++a) {
+            const br_replay_axis_t *x = &r->ax[a];
             uint32_t out[BR_REPLAY_OUT_WORDS];
-            x->enc_counts = (int32_t)in[a][0];
-            const br_ref_t ref = {(int32_t)in[a][1], w2f(in[a][2]), w2f(in[a][3])};
-            const br_status_t st = br_app_step(&x->app, &ref);
-            const uint32_t t1 = io->stamp ? io->stamp(io->ctx) : 0u;
             out[0] = k;
-            out[1] = (uint32_t)(int32_t)st;
+            out[1] = (uint32_t)(int32_t)st[a];
             out[2] = br_replay_idx_hash(x->pf.idx, r->cfg.pf.n_particles);
             out[3] = f2w(x->app.axis.F_hat_N);
             out[4] = f2w(x->duty);
-            out[5] = t1 - t0;
+            out[5] = t1[a] - t0;
             if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;
-            if (BR_FAILED(st)) return -4;
         }
+        if (BR_FAILED(st[n_run - 1u])) return -4;
     }
     return 0;
 }

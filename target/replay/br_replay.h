@@ -20,7 +20,8 @@
  *   F_hat (float bits), duty (float bits), cost (stamp difference from the
  *   start of the period to the end of this axis's br_app_step, so the last
  *   axis's record holds the whole period; 0 when the I/O has no stamp; not
- *   compared).
+ *   compared). A period's records (index hashes, writes) are made after its
+ *   last axis has stepped, so that its cost is the axes' br_app_step only.
  * The PF's noise table is the firmware's br_noise_table; noise_len must match. */
 #ifndef BR_REPLAY_H
 #define BR_REPLAY_H
@@ -82,8 +83,9 @@ uint32_t br_replay_idx_hash(const uint16_t *idx, uint32_t m);
  * writes the output records. n_particles_override != 0 replaces the stream's m;
  * scalar_path selects the PF's scalar reference path (br_pf_cfg_t.scalar_path).
  * Returns 0, or a negative code: -1 I/O, -2 bad header, -3 init failed,
- * -4 a step failed with a status other than BR_OK / a warning (its record
- * is written first). */
+ * -4 a step failed with a status other than BR_OK / a warning (the later
+ * axes of that period are not stepped; the records of the axes that were,
+ * the failed one's last, are written first). */
 int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles_override, uint32_t scalar_path);
 
 #endif
