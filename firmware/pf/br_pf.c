@@ -649,7 +649,21 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         float xn[BR_NX];
         /* 1. predict (RK4 of eq. 6; ok_rk = 0 where the bounded scheme is needed) */
         const float kg0 = ka[j];
+#if BR_FPU_MAXNM
+        /* the a h test as one compare of the larger product (vmaxnm): the
+         * start's, k_p |omega_0|, is finite (a finite particle, k_p > 0), so
+         * the larger is NaN never, and it is <= the limit exactly when both
+         * are, unless the end's is NaN (fmaxf passes over it): then the
+         * predicted omega is NaN, so is f_nl (eq. 4 propagates it), and the
+         * validity test below sends the particle to the fix-up, whose
+         * particle_one makes the test of both (br_model_kp_rk4). The same
+         * particles reach the fix-up either way. */
+        float ah0, ah1;
+        br_model_kp_rk4_step(&kp, x, kg0, xn, &ah0, &ah1);
+        const int ok_rk = fmaxf(ah0, ah1) <= kp.ah_lim;
+#else
         const int ok_rk = br_model_kp_rk4(&kp, x, kg0, xn);
+#endif
         /* process noise sqrt(Q) n */
         const float t = (xn[BR_X_THETA] + q0 * nn[BR_NX * j]) - shift;
         const float w = xn[BR_X_OMEGA] + q1 * nn[BR_NX * j + 1u];

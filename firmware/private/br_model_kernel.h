@@ -151,9 +151,11 @@ static inline float br_model_kp_zdot(float L, float kp, float omega, float z)
     return L * omega - (kp * fabsf(omega)) * z;
 }
 
-/* RK4 of the particle (theta, omega, z, g_p) with its k_p; returns 1 when
- * a h is inside the RK4 limit at both ends of the step (as br_model_k_rk4) */
-BR_INLINE int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX])
+/* RK4 of the particle (theta, omega, z, g_p) with its k_p, without the
+ * a h test: *ah0, *ah1 get k_p |omega| at both ends of the step (the test's
+ * products, a h / h; br_model_kp_rk4 makes the test) */
+BR_INLINE void br_model_kp_rk4_step(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX],
+                                    float *ah0, float *ah1)
 {
     const float L = k->L, hh = k->h_half;
     const float w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z];
@@ -178,12 +180,22 @@ BR_INLINE int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], floa
     out[BR_X_OMEGA] = w0 + (k->h_6 * (wd1 + wd4) + k->h_3 * (wd2 + wd3));
     out[BR_X_Z] = z0 + (k->h_6 * (zd1 + zd4) + k->h_3 * (zd2 + zd3));
     out[BR_X_GP] = x[BR_X_GP];
+    *ah0 = kw1;
+    *ah1 = kp * fabsf(out[BR_X_OMEGA]);
+}
+
+/* RK4 of the particle (theta, omega, z, g_p) with its k_p; returns 1 when
+ * a h is inside the RK4 limit at both ends of the step (as br_model_k_rk4) */
+BR_INLINE int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX])
+{
+    float ah0, ah1;
+    br_model_kp_rk4_step(k, x, kp, out, &ah0, &ah1);
 #if BR_FLOAT_SIMD
     /* & rather than &&: no branch, so that a loop over particles vectorises */
-    return (kw1 <= k->ah_lim) & (kp * fabsf(out[BR_X_OMEGA]) <= k->ah_lim);
+    return (ah0 <= k->ah_lim) & (ah1 <= k->ah_lim);
 #else
     /* without float SIMD a branch is cheaper than the flags (BR_FLOAT_SIMD) */
-    return (kw1 <= k->ah_lim) && (kp * fabsf(out[BR_X_OMEGA]) <= k->ah_lim);
+    return (ah0 <= k->ah_lim) && (ah1 <= k->ah_lim);
 #endif
 }
 
