@@ -182,7 +182,8 @@ static void particle_get(const br_pf_t *pf, uint32_t j, float x[BR_NX])
     }
 }
 
-/* Estimate of the freshly drawn set: the mean of f_nl (eq. 6); its weights all alike. */
+/* Estimate of the freshly drawn set: the mean of f_nl (eq. 6) (its weights
+ * all alike: pf->weighed as init left it) */
 static void estimate_current(br_pf_t *pf)
 {
     const uint32_t m = pf->cfg.n_particles;
@@ -195,7 +196,6 @@ static void estimate_current(br_pf_t *pf)
     }
     pf->est.F_hat_N = sf * (1.0f / (float)m);
     pf->est.origin_counts = pf->origin_counts;
-    pf->weighed = BR_PF_WEIGHED_EQUAL;
 }
 
 /* First measurement: particles drawn around [y, 0, 0, gp0]. */
@@ -1094,7 +1094,7 @@ br_status_t br_pf_stats(const br_pf_t *pf, br_pf_stats_t *out)
         return BR_E_NULL;
     }
     if (!pf->ready || !pf->primed) {
-        return BR_E_STATE; /* no set before the first measurement */
+        return BR_E_STATE; /* no set: before the first measurement, or after a failed init */
     }
     const uint32_t m = pf->cfg.n_particles;
     const float inv_m = 1.0f / (float)m;

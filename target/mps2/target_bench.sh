@@ -139,7 +139,7 @@ BEGIN {
   cfix = fixed + extra * dfix
   cper = cps * mh + cfix
   printf "  cycle estimate (1 cycle per instruction + 13 per vdiv.f32/vsqrt.f32, 14-cycle latency each):\n"
-  printf "    divisions per particle-step %.3f, square roots %.3f; per period at m = %d: %.1f divisions, %.1f square roots, of which fixed %.1f\n", dps, sps, mh, dpp, spp, dpp + spp - (dps + sps) * mh
+  printf "    divisions per particle-step %.3f, square roots %.3f; per period at m = %d: %.1f divisions, %.1f square roots, of which fixed %.1f (as charged)\n", dps, sps, mh, dpp, spp, dfix
   printf "      (periods k >= 1 of the profile runs at m = %d and %d: each run less its priming period; slope and intercept)\n", mh, ml
   printf "    per particle-step: %.1f cycles   (instructions %.1f; goal <= 200 instructions)\n", cps, slope
   printf "    per period at m = %d: %.0f cycles = %.3f ms at %d MHz = %.1f%% of the 1.5 ms period (goal <= 50%%)\n", mh, cper, cper / (mhz * 1e3), mhz, 100 * cper / P

@@ -342,6 +342,11 @@ static void test_ess_reported(void **st)
     assert_true(ess_min < 0.9 * (double)m); /* the check above saw weights that are not all alike */
     assert_int_equal(br_pf_predict(pf, 0.0f), BR_OK);
     BR_ASSERT_NEAR(stats(pf).ess, 500.0, 0.0); /* a predict-only step does not weigh */
+    /* a failed re-init leaves the filter unusable, its set included */
+    br_pf_cfg_t bad = cfg(m);
+    bad.n_particles = 0u;
+    assert_int_equal(br_pf_init(pf, &bad), BR_E_PARAM);
+    assert_int_equal(br_pf_stats(pf, &s), BR_E_STATE);
     free(pf);
 }
 

@@ -175,10 +175,12 @@ br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx);
 const br_pf_est_t *br_pf_estimate(const br_pf_t *pf);
 
 /* The particle mean and the ESS of the last step, made now from the set and
- * the log-weights the step left (one pass over the particles; the same
- * values, bit for bit, as sums made inside the step). Call it before the next
- * step. BR_E_NULL for a NULL argument, BR_E_STATE before the first
- * measurement (no set yet). */
+ * the log-weights the step left (a pass over the particles per state and
+ * one over the weights: the same values, bit for bit, as the sums the step
+ * made itself before 2026-11-24, except the mean on a re-anchoring step,
+ * now the sum of the moved particles; docs/modules/pf.md). Call it before
+ * the next step. BR_E_NULL for a NULL argument, BR_E_STATE before the
+ * first measurement or after a failed init (no set). */
 br_status_t br_pf_stats(const br_pf_t *pf, br_pf_stats_t *out);
 
 /* br_est_t binding: ctx is a br_pf_t *. */
