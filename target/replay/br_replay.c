@@ -195,7 +195,7 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
             out[5] = t1[a] - t0;
             if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;
         }
-        if (BR_FAILED(st[n_run - 1u])) return -4;
+        if (n_run > 0u && BR_FAILED(st[n_run - 1u])) return -4; /* n_run >= 1: the header has 1..BR_REPLAY_MAX_AXES axes */
     }
     return 0;
 }
