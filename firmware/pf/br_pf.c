@@ -18,8 +18,9 @@
  * run in a loop of their own (vectorised), the prediction loop is
  * branch-free and the resampling counts (resample_count, resample_forward);
  * without (the Cortex-M7) one fused weight loop, a prediction loop that
- * branches out to the fix-up and one resampling loop (resample_fused) cost
- * fewer instructions. Both copy in place with branches that skip the
+ * branches out to the fix-up and one resampling loop (resample_fused, the
+ * indices and F_hat's sum) before the copy's two passes cost fewer
+ * instructions. Both copy in place with branches that skip the
  * particles staying put. The results are the same either way. */
 
 /* f_nl (eqs. 3, 4) of a predicted particle: eq. 4 with its k_p = sigma0 L / g_p */
@@ -363,16 +364,12 @@ static float resample_forward(br_pf_t *pf)
     return sf;
 }
 
-/* resample()'s indices, fused with the forward pass of the in-place copy
- * (copy_resampled) and with step 5's sum of f_nl (sum_set), for targets
- * without float SIMD (one loop instead of three): particle i is the
+/* resample()'s indices, fused with step 5's sum of f_nl (sum_set), for
+ * targets without float SIMD (one loop instead of two): particle i is the
  * predicted particle j = idx_i, so the sum over the resampled set, in
  * particle order, adds the predicted j's f_nl, held in a register while j
- * stays. Particle i
- * takes j's state now when j > i: a later i' reads only j' >= j > i, and a
- * position j' is read (when j reaches it) before it is written (at i = j',
- * which needs idx_j' > j'). The backward pass (idx_i < i) follows in
- * copy_back. The same indices, states and sum as the three loops.
+ * stays. The in-place copy follows (copy_fwd_soa, copy_back_soa). The same
+ * indices and sum as the two loops.
  * total is the sum of W[0 .. m - 1] (quantise_weights' return), so every
  * t_i = floor((2 i + 1) total / (2 m)) <= floor(total - total / (2 m)) is
  * below C_{m-1} = total: the search for j stops by j = m - 1 without a test
@@ -382,8 +379,6 @@ static float resample_fused(br_pf_t *pf, uint32_t total)
     const uint32_t m = pf->cfg.n_particles;
     const uint32_t *BR_RESTRICT W = pf->W;
     uint16_t *BR_RESTRICT idx = pf->idx;
-    float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA];
-    float *const zz = pf->x[BR_X_Z], *const gg = pf->x[BR_X_GP], *const ia = pf->kgp;
     const float *const fnl = pf->fnl;
     const uint32_t den = 2u * m;
     const uint32_t dq = (2u * total) / den, dr = (2u * total) % den;
@@ -392,8 +387,7 @@ static float resample_fused(br_pf_t *pf, uint32_t total)
      * (the M7's add sets the flag; no compare with den) */
     int32_t rn = (int32_t)(total % den) - (int32_t)den;
     uint32_t j = 0u, c = W[0];
-    float a0 = th[0], a1 = om[0], a2 = zz[0], a3 = gg[0], af = fnl[0];
-    float ai = ia[0];
+    float af = fnl[0];
     float sf = 0.0f;
     for (uint32_t i = 0; i < m; i++) {
         /* no j + 1 < m test: t_i < C_{m-1} (above), so the search stops by j = m - 1 */
@@ -402,22 +396,10 @@ static float resample_fused(br_pf_t *pf, uint32_t total)
                 j++;
                 c += W[j];
             } while (c <= t);
-            a0 = th[j];
-            a1 = om[j];
-            a2 = zz[j];
-            a3 = gg[j];
             af = fnl[j];
-            ai = ia[j];
         }
         idx[i] = (uint16_t)j;
         sf += af;
-        if (j > i) {
-            th[i] = a0;
-            om[i] = a1;
-            zz[i] = a2;
-            gg[i] = a3;
-            ia[i] = ai;
-        }
         /* t_{i+1} = t_i + dq, plus 1 when the remainder carries */
         t += dq;
         rn += (int32_t)dr;
@@ -881,15 +863,32 @@ static float step_weight(const br_pf_t *pf, uint32_t j)
  * take every particle from a later one (not yet overwritten) and a backward
  * pass every particle from an earlier one (idx_k <= k there, so its source
  * was left alone by the forward pass); a particle with idx_i = i copies
- * itself. The backward pass alone, skipping the particles that stay (after
- * resample_fused or resample_forward, which made the forward pass; on hosts
- * too: the branch predicts well, see resample_forward); from i = m - 1 down
- * to 1 (i = 0 has no earlier particle). The arrays are parameters of a
- * function of its own and each value is copied as its bit pattern (memcpy):
- * the Cortex-M7 then holds the five arrays in registers and addresses them
- * by index (integer loads and stores take a register offset, float ones do
- * not), where with pf->x it formed the 8 KiB-apart addresses anew for every
- * particle (docs/target.md). */
+ * itself. Each pass skips the particles that stay (on hosts too: the
+ * branch predicts well, see resample_forward). The arrays are parameters
+ * of a function of its own and each value is copied as its bit pattern
+ * (memcpy): the Cortex-M7 then holds the five arrays in registers and
+ * addresses them by index (integer loads and stores take a register offset,
+ * float ones do not), where with pf->x it formed the 8 KiB-apart addresses
+ * anew for every particle (docs/target.md).
+ * The forward pass, after resample_fused (the host's vector path makes it in
+ * resample_forward): from i = 0 up to m - 2 (particle m - 1 has no later one). */
+BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om, float *zz,
+                              float *gg, float *ia)
+{
+    for (uint32_t i = 0u; i + 1u < m; i++) {
+        const uint32_t k = idx[i];
+        if (k > i) {
+            memcpy(&th[i], &th[k], sizeof th[i]);
+            memcpy(&om[i], &om[k], sizeof om[i]);
+            memcpy(&zz[i], &zz[k], sizeof zz[i]);
+            memcpy(&gg[i], &gg[k], sizeof gg[i]);
+            memcpy(&ia[i], &ia[k], sizeof ia[i]);
+        }
+    }
+}
+
+/* The backward pass, after copy_fwd_soa or resample_forward: from i = m - 1
+ * down to 1 (particle 0 has no earlier one). */
 BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om, float *zz,
                                float *gg, float *ia)
 {
@@ -1022,8 +1021,9 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         copy_back(pf);
     } else {
         const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER);
-        /* one loop for the indices, the forward copy and the sum, then the backward copy */
+        /* one loop for the indices and the sum, then the copy's forward and backward passes */
         sf = resample_fused(pf, total);
+        copy_fwd_soa(pf->idx, m, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z], pf->x[BR_X_GP], pf->kgp);
         copy_back(pf);
     }
     const float inv_m = 1.0f / (float)m;
