@@ -839,8 +839,8 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier)
          * br_exp_neg's constants taken once, held in registers over the loop */
         const br_exp_k_t k = br_exp_k();
         for (uint32_t j = 0; j < m; j++) {
-            const float w = br_exp_neg_k(l[j] - lmax, k);
-            W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
+            /* W_j = floor(w_j 2^16), the scale in the exponent (br_exp_neg_w16_k) */
+            W[j] = (uint32_t)br_exp_neg_w16_k(l[j] - lmax, k);
             total += W[j];
         }
     }

@@ -36,8 +36,10 @@ static inline br_exp_k_t br_exp_k(void)
     return k;
 }
 
-/* 2^n e^(f ln 2) for n >= -126, |f| <= 1/2: both forms of br_exp_neg end here */
-static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k)
+/* 2^(n + s) e^(f ln 2) for n >= -126, |f| <= 1/2, with ebias = 127 + s
+ * (0 <= s <= 16): both forms of br_exp_neg end here (s = 0; s = 16 for
+ * br_exp_neg_w) */
+static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k, int32_t ebias)
 {
     /* e^y, y = f ln 2 in [-0.347, 0.347]: Taylor to degree 6 (Horner) */
     const float y = f * 0.693147181f;
@@ -48,8 +50,8 @@ static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k)
     p = p * y + k->half;
     p = p * y + k->one;
     p = p * y + k->one;
-    /* 2^n by building the exponent field */
-    const uint32_t bits = (uint32_t)(n + 127) << 23;
+    /* 2^(n + s) by building the exponent field */
+    const uint32_t bits = (uint32_t)(n + ebias) << 23;
     float scale;
     memcpy(&scale, &bits, sizeof scale);
     return p * scale;
@@ -61,8 +63,9 @@ static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k)
  * turn back into branches (GCC 12 does for SSE4.1 and up). The same result
  * as the branchy form below for every one of the 2^32 inputs (checked
  * exhaustively once, docs/modules/pf.md). */
-static inline float br_exp_neg_k(float x, br_exp_k_t k)
+static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float top)
 {
+    (void)top; /* e^0 2^s comes out of the polynomial */
     const int in_range = x > -87.0f;
     /* x clamped to (-87, 0] by integer masks (no select the compiler could
      * turn into a branch): xc = x where -87 < x < 0, else +0 */
@@ -79,7 +82,7 @@ static inline float br_exp_neg_k(float x, br_exp_k_t k)
     const int up = f0 > k.half;
     const int32_t n = n0 + up;
     const float f = f0 - (float)up; /* f0 - 0 = f0 exactly */
-    const float r = br_exp2_parts(n, f, &k);
+    const float r = br_exp2_parts(n, f, &k, ebias);
     /* 0 below the normal range and for NaN */
     uint32_t rb;
     memcpy(&rb, &r, sizeof rb);
@@ -91,7 +94,7 @@ static inline float br_exp_neg_k(float x, br_exp_k_t k)
 #else
 /* without (the Cortex-M7): the same operations with branches, fewer
  * instructions there; the same result for every x */
-static inline float br_exp_neg_k(float x, br_exp_k_t k)
+static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float top)
 {
     /* the range -87 < x < 0 as a test on the bit pattern (negative
      * floats from -0 0x80000000 up to -87 0xC2AE0000, exclusive: one
@@ -102,7 +105,7 @@ static inline float br_exp_neg_k(float x, br_exp_k_t k)
     uint32_t xb;
     memcpy(&xb, &x, sizeof xb);
     if (!(xb - k.lo < k.span)) {
-        return (xb <= 0x7F800000u || xb == 0x80000000u) ? k.one : 0.0f;
+        return (xb <= 0x7F800000u || xb == 0x80000000u) ? top : 0.0f;
     }
     /* x log2(e) = n + f, n = round-half-down, f in [-1/2, 1/2] */
     const float t = x * 1.44269504f;
@@ -112,9 +115,20 @@ static inline float br_exp_neg_k(float x, br_exp_k_t k)
         n += 1;
         f -= k.one;
     }
-    return br_exp2_parts(n, f, &k);
+    return br_exp2_parts(n, f, &k, ebias);
 }
 #endif
+
+/* e^x for x <= 0 with the constants k (br_exp_k) */
+static inline float br_exp_neg_k(float x, br_exp_k_t k) { return br_exp_neg_kb(x, k, 127, k.one); }
+
+/* e^x 2^16 for x <= 0, the particle filter's quantisation scale built into
+ * the exponent field (one multiplication fewer): (uint32_t) of it equals
+ * (uint32_t)(br_exp_neg_k(x, k) * 65536.0f) for every x. Where 2^n e^y is
+ * normal, both products by powers of two are exact; where it is subnormal
+ * (n = -126) both are below 2^-109 and truncate to 0; x >= 0 gives 2^16
+ * and x <= -87 or NaN 0 in both (checked over all 2^32 inputs, docs/modules/pf.md). */
+static inline float br_exp_neg_w16_k(float x, br_exp_k_t k) { return br_exp_neg_kb(x, k, 127 + 16, 65536.0f); }
 
 /* e^x for x <= 0: 2^n * p(f), n = round(x log2 e), |f| <= 1/2, p the degree-6
  * Taylor polynomial of e^(f ln 2); relative error < 5e-6 over [-87, 0], set by

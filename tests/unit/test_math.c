@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* br_exp_neg (br_math.h): accuracy over its range against double exp, the
- * edges (underflow, NaN, -inf, positive input), monotonicity. */
+ * edges (underflow, NaN, -inf, positive input), monotonicity; the PF's
+ * quantised form br_exp_neg_w16_k against the product it replaces. */
 #include "br_test.h"
 
 #include "br_math.h"
@@ -48,6 +49,35 @@ static void test_edges(void **st)
 }
 
 /* Weights must not reorder particles: e^x is non-decreasing over a sweep. */
+/* br_exp_neg_w16_k: the PF's quantised weight (uint32_t)(e^x 2^16) with the
+ * scale in the exponent equals the product's, on every float of (-88, -85]
+ * (where 2^n e^y turns subnormal), a sweep of (-85, 0], the edges */
+static void test_w16_is_quantised_product(void **st)
+{
+    (void)st;
+    const br_exp_k_t k = br_exp_k();
+    long n = 0, bad = 0;
+    float x = -88.0f;
+    while (x <= -85.0f) {
+        bad += (uint32_t)br_exp_neg_w16_k(x, k) != (uint32_t)(br_exp_neg_k(x, k) * 65536.0f);
+        x = nextafterf(x, 0.0f);
+        n++;
+    }
+    for (int i = 0; i <= 1000000; i++) {
+        const float y = -85.0f * (float)i / 1.0e6f;
+        bad += (uint32_t)br_exp_neg_w16_k(y, k) != (uint32_t)(br_exp_neg_k(y, k) * 65536.0f);
+        n++;
+    }
+    const float edge[] = {0.0f, -0.0f, 2.5f, INFINITY, -INFINITY, NAN, -87.0f, -1.0e-30f};
+    for (size_t i = 0; i < sizeof edge / sizeof edge[0]; i++) {
+        bad += (uint32_t)br_exp_neg_w16_k(edge[i], k) != (uint32_t)(br_exp_neg_k(edge[i], k) * 65536.0f);
+        n++;
+    }
+    assert_true(br_exp_neg_w16_k(0.0f, k) == 65536.0f); /* the best particle: W = 2^16 */
+    print_message("br_exp_neg_w16_k: %ld inputs, %ld differ from the product\n", n, bad);
+    assert_int_equal(bad, 0);
+}
+
 static void test_monotone(void **st)
 {
     (void)st;
@@ -92,6 +122,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_accuracy),
         cmocka_unit_test(test_edges),
+        cmocka_unit_test(test_w16_is_quantised_product),
         cmocka_unit_test(test_monotone),
         cmocka_unit_test(test_lk_move_over_series),
     };
