@@ -177,12 +177,13 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
             ref[a] = (br_ref_t){(int32_t)in[a][1], w2f(in[a][2]), w2f(in[a][3])};
         }
         uint32_t n_run = 0u; /* axes stepped: a failed step ends the period, as it ends the replay */
+        int failed = 0;
         const uint32_t t0 = io->stamp ? io->stamp(io->ctx) : 0u;
-        for (uint32_t a = 0u; a < na; ++a) {
+        for (uint32_t a = 0u; a < na && !failed; ++a) {
             st[a] = br_app_step(&r->ax[a].app, &ref[a]);
             t1[a] = io->stamp ? io->stamp(io->ctx) : 0u;
             n_run = a + 1u;
-            if (BR_FAILED(st[a])) break;
+            failed = BR_FAILED(st[a]);
         }
         for (uint32_t a = 0u; a < n_run; ++a) {
             const br_replay_axis_t *x = &r->ax[a];
@@ -195,7 +196,7 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
             out[5] = t1[a] - t0;
             if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;
         }
-        if (n_run > 0u && BR_FAILED(st[n_run - 1u])) return -4; /* n_run >= 1: the header has 1..BR_REPLAY_MAX_AXES axes */
+        if (failed) return -4;
     }
     return 0;
 }
