@@ -40,6 +40,9 @@ static inline float fnl_kp(const br_model_k_t *k, float om, float z, float kg)
 #define BR_PF_CLONES
 #endif
 
+/* 1 for a valid particle (its log-weight l is not NaN), 0 for one kept at its state */
+static inline float valid_weight(float l) { return (l == l) ? 1.0f : 0.0f; }
+
 /* W of a particle of weight 1 (the best one after the max-shift) */
 #define BR_PF_W_ONE (1u << BR_PF_W_BITS)
 
@@ -718,7 +721,7 @@ static void adapt_sums(const br_pf_t *pf, float y_rel, uint32_t k0, uint32_t k1,
     const float *const th = pf->x[BR_X_THETA], *const l = pf->l;
     float s1 = ls->s1, s2 = ls->s2;
     for (uint32_t k = k0; k < k1; k++) {
-        const float v = (l[k] == l[k]) ? 1.0f : 0.0f; /* valid: not NaN */
+        const float v = valid_weight(l[k]);
         const float d = (th[k] - y_rel) * v;
         s1 += d;
         s2 += d * d;
@@ -830,7 +833,7 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier)
     uint32_t total = 0u;
     if (outlier) {
         for (uint32_t j = 0; j < m; j++) {
-            const float w = (l[j] == l[j]) ? 1.0f : 0.0f; /* valid: not NaN */
+            const float w = valid_weight(l[j]);
             W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
             total += W[j];
         }
@@ -852,10 +855,7 @@ static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier)
 static float step_weight(const br_pf_t *pf, uint32_t j)
 {
     const float l = pf->l[j];
-    if (pf->weighed == BR_PF_WEIGHED_VALID) {
-        return (l == l) ? 1.0f : 0.0f;
-    }
-    return br_exp_neg(l - pf->lmax);
+    return (pf->weighed == BR_PF_WEIGHED_VALID) ? valid_weight(l) : br_exp_neg(l - pf->lmax);
 }
 
 /* Step 4's copy, in place: particle i becomes the predicted particle idx_i.
@@ -872,17 +872,22 @@ static float step_weight(const br_pf_t *pf, uint32_t j)
  * anew for every particle (docs/target.md).
  * The forward pass, after resample_fused (the host's vector path makes it in
  * resample_forward): from i = 0 up to m - 2 (particle m - 1 has no later one). */
+static inline void move_particle(uint32_t i, uint32_t k, float *th, float *om, float *zz, float *gg, float *ia)
+{
+    memcpy(&th[i], &th[k], sizeof th[i]);
+    memcpy(&om[i], &om[k], sizeof om[i]);
+    memcpy(&zz[i], &zz[k], sizeof zz[i]);
+    memcpy(&gg[i], &gg[k], sizeof gg[i]);
+    memcpy(&ia[i], &ia[k], sizeof ia[i]);
+}
+
 BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om, float *zz,
                               float *gg, float *ia)
 {
     for (uint32_t i = 0u; i + 1u < m; i++) {
         const uint32_t k = idx[i];
         if (k > i) {
-            memcpy(&th[i], &th[k], sizeof th[i]);
-            memcpy(&om[i], &om[k], sizeof om[i]);
-            memcpy(&zz[i], &zz[k], sizeof zz[i]);
-            memcpy(&gg[i], &gg[k], sizeof gg[i]);
-            memcpy(&ia[i], &ia[k], sizeof ia[i]);
+            move_particle(i, k, th, om, zz, gg, ia);
         }
     }
 }
@@ -895,16 +900,18 @@ BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, floa
     for (uint32_t i = m - 1u; i > 0u; i--) {
         const uint32_t k = idx[i];
         if (k < i) {
-            memcpy(&th[i], &th[k], sizeof th[i]);
-            memcpy(&om[i], &om[k], sizeof om[i]);
-            memcpy(&zz[i], &zz[k], sizeof zz[i]);
-            memcpy(&gg[i], &gg[k], sizeof gg[i]);
-            memcpy(&ia[i], &ia[k], sizeof ia[i]);
+            move_particle(i, k, th, om, zz, gg, ia);
         }
     }
 }
 
-/* copy_back_soa on pf's particles */
+/* copy_fwd_soa and copy_back_soa on pf's particles */
+static void copy_fwd(br_pf_t *pf)
+{
+    copy_fwd_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
+                 pf->x[BR_X_GP], pf->kgp);
+}
+
 static void copy_back(br_pf_t *pf)
 {
     copy_back_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
@@ -1023,7 +1030,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER);
         /* one loop for the indices and the sum, then the copy's forward and backward passes */
         sf = resample_fused(pf, total);
-        copy_fwd_soa(pf->idx, m, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z], pf->x[BR_X_GP], pf->kgp);
+        copy_fwd(pf);
         copy_back(pf);
     }
     const float inv_m = 1.0f / (float)m;
