@@ -105,16 +105,12 @@ for m in "$m_hi" "$m_lo"; do
   trace "$out/stream_prime.bin" "$m" "prime_m$m"
   trace "$out/stream_prof.bin" "$m" "prof_m$m"
   read -r np _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_prof_m$m.bin")
-  if [[ $m == "$m_hi" ]]; then
-    n_prof=$np
-    prof=$("${BR_PYTHON:-python3}" "$(dirname "$0")/tb_profile.py" "$out/qemu_prof_m$m.log" "$image" \
-      --particle-steps $(( (n_prof - 1) * m )) --base "$out/qemu_prime_m$m.log" --skip main)  # main: the calibration loop
-    grep -v '^long_ops ' <<<"$prof"
-  else
-    [[ $np == "$n_prof" ]] || { echo "target-bench: profile runs of $n_prof and $np periods" >&2; exit 1; }
-    prof=$("${BR_PYTHON:-python3}" "$(dirname "$0")/tb_profile.py" "$out/qemu_prof_m$m.log" "$image" \
-      --particle-steps $(( (n_prof - 1) * m )) --base "$out/qemu_prime_m$m.log" --skip main --long-ops-only)
-  fi
+  only=()  # the instruction profile at m_hi; at m_lo the long instructions only
+  if [[ $m == "$m_hi" ]]; then n_prof=$np; else only=(--long-ops-only); fi
+  [[ $np == "$n_prof" ]] || { echo "target-bench: profile runs of $n_prof and $np periods" >&2; exit 1; }
+  prof=$("${BR_PYTHON:-python3}" "$(dirname "$0")/tb_profile.py" "$out/qemu_prof_m$m.log" "$image" \
+    --particle-steps $(( (n_prof - 1) * m )) --base "$out/qemu_prime_m$m.log" --skip main "${only[@]}")  # main: the calibration loop
+  if [[ $m == "$m_hi" ]]; then grep -v '^long_ops ' <<<"$prof"; fi
   rm -f "$out/qemu_prof_m$m.log" "$out/qemu_prime_m$m.log"
   read -r ldiv[$m] lsqrt[$m] < <(long_ops "$prof")
   [[ -n ${ldiv[$m]:-} && -n ${lsqrt[$m]:-} ]] || { echo "target-bench: no long_ops count at m = $m" >&2; exit 1; }
