@@ -108,7 +108,9 @@ def gate_fields(E, e):
             ("BR_EST_%s_GP_MIN_N" % E, e["gp_min_N"], "g_p range"),
             ("BR_EST_%s_GP_MAX_N" % E, e["gp_max_N"], ""),
             ("BR_EST_%s_OUTLIER_SIGMA" % E, e["outlier_gate_sigma"], "outlier gate, standard deviations"),
-            ("BR_EST_%s_REANCHOR_AFTER" % E, e["reanchor_after"], "consecutive outliers before re-anchoring")]
+            ("BR_EST_%s_REANCHOR_AFTER" % E, e["reanchor_after"], "consecutive outliers before re-anchoring"),
+            ("BR_EST_%s_COMP_AHEAD_PERIODS" % E, e["comp_ahead_periods"],
+             "compensation lead beyond the actuator delay, periods (0: the filtered estimate)")]
 
 
 def render_defines(fields):

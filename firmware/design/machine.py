@@ -30,6 +30,8 @@ GEN_DIR = os.path.join(REPO_ROOT, "firmware", "gen")
 FORMAT_VERSION = 1
 # BR_PF_MAX_PARTICLES of firmware/include/bristle/br_pf.h
 PF_MAX_PARTICLES = 2048
+# BR_EST_AHEAD_MAX_PERIODS of firmware/include/bristle/br_est.h
+EST_AHEAD_MAX_PERIODS = 2.0
 
 
 class MachineError(Exception):
@@ -144,6 +146,9 @@ def _gates():
         "outlier_gate_sigma": Num(0.0, 1.0e4, "a measurement further than this many standard deviations "
                                   "is an outlier", lo_open=True),
         "reanchor_after": Int(1, 1000, "consecutive outliers before the filter is re-anchored on the measurement"),
+        "comp_ahead_periods": Num(0.0, EST_AHEAD_MAX_PERIODS, "0: compensate the filtered estimate (the thesis); "
+                                  "> 0: the force predicted over the actuator delay and this many periods "
+                                  "beyond it (docs/modules/est.md)"),
     }
 
 

@@ -33,6 +33,9 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
     if (!(cfg->model.causes.delay_s <= (float)(BR_EST_DELAY_HIST - 2u) * cfg->model.dt_s)) {
         return BR_E_PARAM;
     }
+    if (!(cfg->comp_ahead_periods >= 0.0f && cfg->comp_ahead_periods <= BR_EST_AHEAD_MAX_PERIODS)) {
+        return BR_E_PARAM;
+    }
     for (int i = 0; i < BR_NX; i++) {
         if (!br_est_var_ok(cfg->q_var[i], 1)) {
             return BR_E_PARAM;
@@ -88,4 +91,52 @@ float br_est_delay_apply(br_est_delay_t *d, float u_prev_Nm)
     }
     /* u_a = (1 - f) u[k-1-m] + f u[k-2-m] */
     return (1.0f - d->f) * cmd_ago(d, d->m) + d->f * cmd_ago(d, d->m + 1u);
+}
+
+/* u[k + i], the command of period k + i (u[k - 1] = u_prev, the newest):
+ * from the history for i < -1, u_prev for the ones not yet computed (i >= -1) */
+static float cmd_at(const br_est_delay_t *d, int32_t i, float u_prev_Nm)
+{
+    return (i >= -1) ? u_prev_Nm : cmd_ago(d, (uint32_t)(-i - 1));
+}
+
+float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_delay_t *d,
+                    const float x[BR_NX], float p0_m, float u_prev_Nm, float F_hat_N)
+{
+    const float lambda = cfg->comp_ahead_periods;
+    if (!(lambda > 0.0f)) {
+        return F_hat_N;
+    }
+    /* H = delay / dt + lambda = (dm + df) + lambda periods: n whole ones and fr of the next;
+     * n <= BR_EST_DELAY_HIST - 2 + BR_EST_AHEAD_MAX_PERIODS (br_est_cfg_check) */
+    const float h = (d->on ? (float)d->m + d->f : 0.0f) + lambda;
+    const uint32_t n = (uint32_t)h;
+    const float fr = h - (float)n;
+    const int32_t dm = d->on ? (int32_t)d->m : 0;
+    const float df = d->on ? d->f : 0.0f;
+    float cur[BR_NX], nxt[BR_NX];
+    for (int i = 0; i < BR_NX; i++) {
+        cur[i] = x[i];
+    }
+    for (uint32_t j = 0; j <= n; j++) {
+        /* the torque reaching the axis over period k + j: (1 - f) u[k+j-m] + f u[k+j-m-1] */
+        const int32_t a = (int32_t)j - dm;
+        const float u = (1.0f - df) * cmd_at(d, a, u_prev_Nm) + df * cmd_at(d, a - 1, u_prev_Nm);
+        if (br_model_step_at(m, cur, p0_m, u, nxt) != BR_OK) {
+            return F_hat_N;
+        }
+        if (j < n) {
+            for (int i = 0; i < BR_NX; i++) {
+                cur[i] = nxt[i];
+            }
+        }
+    }
+    /* f_c at t (x passed the model's checks in the first step) and at t + H dt,
+     * between the ends of the last period at fr of it */
+    const float f0 = br_model_fcomp_N(m, x, p0_m);
+    const float fc = br_model_fcomp_N(m, cur, p0_m);
+    const float fh = fc + fr * (br_model_fcomp_N(m, nxt, p0_m) - fc);
+    /* F_comp = F_hat + f_c(x(t + H dt)) - f_c(x) (finite states: each step checked them;
+     * the controller's range check on the compensation stands behind it, br_ctrl) */
+    return F_hat_N + (fh - f0);
 }

@@ -1093,6 +1093,16 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     return BR_OK;
 }
 
+/* The particle mean of the set (equal weights after every step), each state
+ * summed in particle order */
+static void set_mean(const br_pf_t *pf, float mean[BR_NX])
+{
+    const float inv_m = 1.0f / (float)pf->cfg.n_particles;
+    for (int i = 0; i < BR_NX; i++) {
+        mean[i] = sum_state(pf, i) * inv_m;
+    }
+}
+
 const br_pf_est_t *br_pf_estimate(const br_pf_t *pf) { return (pf != NULL) ? &pf->est : NULL; }
 
 br_status_t br_pf_stats(const br_pf_t *pf, br_pf_stats_t *out)
@@ -1104,10 +1114,7 @@ br_status_t br_pf_stats(const br_pf_t *pf, br_pf_stats_t *out)
         return BR_E_STATE; /* no set: before the first measurement, or after a failed init */
     }
     const uint32_t m = pf->cfg.n_particles;
-    const float inv_m = 1.0f / (float)m;
-    for (int i = 0; i < BR_NX; i++) {
-        out->mean[i] = sum_state(pf, i) * inv_m;
-    }
+    set_mean(pf, out->mean);
     if (pf->weighed == BR_PF_WEIGHED_EQUAL) {
         out->ess = (float)m;
     } else if (pf->weighed == BR_PF_WEIGHED_NONE) {
@@ -1134,7 +1141,15 @@ br_status_t br_pf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float
     }
     br_status_t st = br_pf_step(pf, y, u_prev_Nm);
     if (!BR_FAILED(st)) { /* an outlier step still predicts */
+        /* the compensation: F_hat, or the force predicted ahead from the
+         * particle mean (cfg.est.comp_ahead_periods) */
         *F_hat_N = pf->est.F_hat_N;
+        if (pf->cfg.est.comp_ahead_periods > 0.0f) {
+            float mean[BR_NX];
+            set_mean(pf, mean);
+            *F_hat_N = br_est_comp_N(&pf->cfg.est, &pf->model, &pf->delay, mean, origin_pos_m(pf), u_prev_Nm,
+                                     pf->est.F_hat_N);
+        }
     }
     return st;
 }

@@ -482,7 +482,9 @@ br_status_t br_ukf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, floa
     }
     const br_status_t st = br_ukf_step(ukf, y, u_prev_Nm);
     if (!BR_FAILED(st)) { /* an outlier step still predicts */
-        *F_hat_N = ukf->est.F_hat_N;
+        /* the compensation: F_hat, or the force predicted ahead (cfg.est.comp_ahead_periods) */
+        *F_hat_N = br_est_comp_N(&ukf->cfg.est, &ukf->model, &ukf->delay, ukf->x,
+                                 (float)ukf->origin_counts * ukf->m_per_count, u_prev_Nm, ukf->est.F_hat_N);
     }
     return st;
 }

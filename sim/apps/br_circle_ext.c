@@ -6,7 +6,7 @@
  * diagnosis saved (model.json): the firmware's own extended model, its
  * br_model_cfg_t.causes set from the model's. docs/diagnose.md.
  *
- * Usage: br_circle_ext [--model MODEL.json] [--est ukf|pf] [--json OUT] [cause options]
+ * Usage: br_circle_ext [--model MODEL.json] [--est ukf|pf] [--ahead P] [--json OUT] [cause options]
  * Prints one line per run and, with --json, writes them (to a temporary file
  * renamed at the end, br_outfile.h: a failed run writes nothing). */
 #define _POSIX_C_SOURCE 200809L
@@ -26,10 +26,12 @@
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s [--model MODEL.json] [--est ukf|pf] [--json OUT] [--offset F] [--asym DFC,DFV]\n"
+            "usage: %s [--model MODEL.json] [--est ukf|pf] [--ahead P] [--json OUT] [--offset F] [--asym DFC,DFV]\n"
             "       [--ripple A,P[,PH]] [--gradient S] [--delay D] [--drift R]\n" BR_ARGS_COMMON_USAGE
             "  --model MODEL.json  a diagnosis's saved model: adds the extended-model run\n"
             "  --est ukf|pf        the estimator beside H-inf (default ukf)\n"
+            "  --ahead P           the estimator's compensation lead, periods beyond the delay\n"
+            "                      (est.comp_ahead_periods; default the machine file's)\n"
             "  --json OUT          write the runs' figures to OUT as well\n"
             "  cause options       switch causes on in the plant (docs/simlog.md)\n",
             argv0, argv0);
@@ -39,10 +41,12 @@ static int usage(const char *argv0, FILE *to)
 int main(int argc, char **argv)
 {
     const char *model = NULL, *json = NULL, *est = "ukf";
+    double ahead = -1.0; /* < 0: the machine file's */
     br_plant_cfg_t plant = br_plant_cfg_reference();
     static const struct option opts[] = {{"model", required_argument, NULL, 'm'},
                                          {"json", required_argument, NULL, 'j'},
                                          {"est", required_argument, NULL, 'e'},
+                                         {"ahead", required_argument, NULL, 'a'},
                                          BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -52,6 +56,9 @@ int main(int argc, char **argv)
             if (br_cause_arg(p.opt, val, &plant) < 0) return 2;
         } else if (c == 'm') model = val;
         else if (c == 'j') json = val;
+        else if (c == 'a') {
+            if (br_arg_double(TOOL, "--ahead", val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &ahead) != 0) return 2;
+        }
         else if (c == 'e' && (strcmp(val, "ukf") == 0 || strcmp(val, "pf") == 0)) est = val;
         else {
             if (c == 'e') fprintf(stderr, "%s: --est %s: must be ukf or pf\n", TOOL, val);
@@ -77,12 +84,22 @@ int main(int argc, char **argv)
     br_outfile_t js = {0}; /* a temporary file until every run succeeded (br_outfile.h) */
     if (json) {
         if (br_outfile_open(&js, TOOL, json) != 0) return 1;
-        fprintf(js.f, "{\n  \"generator\": \"br_circle_ext (sim/apps/br_circle_ext.c)\",\n  \"estimator\": \"%s\"",
-                est);
+        const br_circle_cfg_t c0 = br_circle_cfg_thesis(ctrl);
+        const double lead = (ahead >= 0.0) ? ahead
+                                           : (double)(use_pf ? c0.pf.est.comp_ahead_periods
+                                                             : c0.ukf.est.comp_ahead_periods);
+        fprintf(js.f,
+                "{\n  \"generator\": \"br_circle_ext (sim/apps/br_circle_ext.c)\",\n  \"estimator\": \"%s\",\n"
+                "  \"comp_ahead_periods\": %.9g",
+                est, lead);
     }
     for (int r = 0; r < (model ? 4 : 3); r++) {
         br_circle_cfg_t c = br_circle_cfg_thesis(runs[r].ctrl);
         c.plant = plant;
+        if (ahead >= 0.0) { /* every estimator run, nominal and extended, with the same lead */
+            c.pf.est.comp_ahead_periods = (float)ahead;
+            c.ukf.est.comp_ahead_periods = (float)ahead;
+        }
         if (runs[r].extended) {
             /* the estimator predicts and compensates with the diagnosed causes */
             const br_causes_t causes = br_causes_from_model(&saved);

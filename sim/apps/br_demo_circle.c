@@ -117,12 +117,14 @@ typedef struct {
     double dt;
     long nsub;
     long pf_prop; /* -1: the machine's */
+    double ahead; /* < 0: the machine's */
 } opts_t;
 
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n" BR_ARGS_COMMON_USAGE
+            "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
+            "       [--ahead P]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
             "  --gains K0,K1,K2    the H-inf gains instead of the generated ones\n"
@@ -130,8 +132,10 @@ static int usage(const char *argv0, FILE *to)
             "  --nsub N            plant substeps per period\n"
             "  --pf-proposal K     the PF's proposal: 0 the prior (thesis), 1 optimal for theta, 2 with omega's\n"
             "                      noise held over the period (docs/modules/pf.md)\n"
+            "  --ahead P           the estimators' compensation lead, periods past the delay\n"
+            "                      (est.comp_ahead_periods, 0 .. %g; docs/modules/est.md)\n"
             "bounds: --dt %g .. %g s, --nsub 1 .. %d, |gain| <= %g (docs/tools.md)\n",
-            argv0, argv0, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX, BR_TOOL_GAIN_MAX);
+            argv0, argv0, (double)BR_EST_AHEAD_MAX_PERIODS, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX, BR_TOOL_GAIN_MAX);
     return 2;
 }
 
@@ -153,6 +157,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"dt", required_argument, NULL, 'd'},
                                          {"nsub", required_argument, NULL, 'n'},
                                          {"pf-proposal", required_argument, NULL, 'p'},
+                                         {"ahead", required_argument, NULL, 'a'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     const int st = br_args_begin(&p, TOOL, argc, argv);
@@ -172,6 +177,7 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'd': bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, &o->dt); break;
         case 'n': bad = br_arg_long(TOOL, p.opt, val, 1, BR_TOOL_NSUB_MAX, &o->nsub); break;
         case 'p': bad = br_arg_long(TOOL, p.opt, val, 0, (long)BR_PF_PROPOSAL_OPT_HELD, &o->pf_prop); break;
+        case 'a': bad = br_arg_double(TOOL, p.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &o->ahead); break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
@@ -198,7 +204,7 @@ static int finite_result(const br_circle_result_t *r)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1};
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -275,6 +281,10 @@ int main(int argc, char **argv)
             }
             if (opt.nsub > 0) cfg.plant.n_sub = (int)opt.nsub;
             if (opt.pf_prop >= 0) cfg.pf.proposal = (uint32_t)opt.pf_prop;
+            if (opt.ahead >= 0.0) {
+                cfg.pf.est.comp_ahead_periods = (float)opt.ahead;
+                cfg.ukf.est.comp_ahead_periods = (float)opt.ahead;
+            }
             sinks_t k = {o.trace[pl][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl].f : NULL};
             br_circle_csv_header(k.trace);
             if (k.hist)

@@ -7,14 +7,18 @@ diagnosis names the cause and saves an extended model (model.json); the
 thesis circle then runs on that machine with H-inf only, with H-inf + the
 estimator on the nominal model (the firmware's, as configured), and with
 H-inf + the same estimator on the extended model (br_circle_ext). The
-contour RMS of each goes into a table.
+contour RMS of each goes into a table. Both estimator runs compensate the
+force predicted AHEAD periods past the actuator delay
+(est.comp_ahead_periods, docs/modules/est.md; --ahead 0 for the filtered
+estimate, the thesis's compensation).
 
 Usage:
-  diagnose_control.py --bin BUILD/sim --work DIR [--md OUT.md] [--est ukf,pf] [--only CAUSE] [--check]
+  diagnose_control.py --bin BUILD/sim --work DIR [--md OUT.md] [--est ukf,pf] [--ahead P] [--only CAUSE] [--check]
 --check fails (exit 1) unless, for every cause run, the diagnosis names it
 and the extended estimator is better than the nominal one: it runs without a
 fault, and its contour RMS is below the nominal one's (or the nominal one
-faulted).
+faulted); and, with a lead, the extended estimator with it is not worse than
+with the filtered estimate (both within NOT_WORSE).
 """
 import argparse
 import json
@@ -42,12 +46,22 @@ CASES = (
 # docs/diagnose-control.md)
 NOT_WORSE = 1.05
 
+# the study's compensation lead (est.comp_ahead_periods): the command computed
+# now is held over the next period, after the actuator delay; half a period
+# past the delay is the centre of that hold (docs/modules/est.md)
+AHEAD = 0.5
+
 
 def run(cmd, **kw):
     r = subprocess.run(cmd, capture_output=True, text=True, **kw)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{r.stderr}")
     return r.stdout
+
+
+def fault_t(run_):
+    """the time the firmware stopped the axis safe, None without a fault"""
+    return run_["fault_t_s"] if run_["fault_status"] else None
 
 
 def fault_note(t_s):
@@ -66,6 +80,8 @@ def main():
     ap.add_argument("--work", required=True)
     ap.add_argument("--md")
     ap.add_argument("--est", default="ukf", help="ukf, pf or both: ukf,pf")
+    ap.add_argument("--ahead", type=float, default=AHEAD,
+                    help="every estimator run's compensation lead, periods past the delay (default %(default)s)")
     ap.add_argument("--only")
     ap.add_argument("--check", action="store_true")
     a = ap.parse_args()
@@ -90,23 +106,39 @@ def main():
         if rep["verdict"] != cause:
             fails.append(f"{cause}: verdict {rep['verdict']}")
         for est in ests:
-            cj = os.path.join(d, f"circle_{est}.json")
-            run([os.path.join(a.bin, "br_circle_ext"), "--model", os.path.join(out, "model.json"), "--est", est,
-                 "--json", cj] + flags)
-            with open(cj) as f:
-                c = json.load(f)
+            # the study's lead, and the filtered estimate (lead 0) beside it
+            runs_ = {}
+            for tag, lead in (("", a.ahead), ("_filtered", 0.0)):
+                if tag and a.ahead == 0.0:
+                    continue
+                cj = os.path.join(d, f"circle_{est}{tag}.json")
+                run([os.path.join(a.bin, "br_circle_ext"), "--model", os.path.join(out, "model.json"), "--est", est,
+                     "--ahead", repr(lead), "--json", cj] + flags)
+                with open(cj) as f:
+                    runs_[tag] = json.load(f)
+            c = runs_[""]
             row = {"cause": cause, "what": what, "verdict": rep["verdict"],
                    **{k: c[k]["contour_rms_m"] for k in ("hinf_only", "hinf_true", "est_nominal", "est_extended")},
                    "outliers_nominal": c["est_nominal"]["outlier_steps"],
                    "outliers_extended": c["est_extended"]["outlier_steps"],
                    # a fault: the firmware stopped the axis safe (zero duty) at that time
-                   "fault_nominal": c["est_nominal"]["fault_t_s"] if c["est_nominal"]["fault_status"] else None,
-                   "fault_extended": c["est_extended"]["fault_t_s"] if c["est_extended"]["fault_status"] else None}
+                   "fault_nominal": fault_t(c["est_nominal"]),
+                   "fault_extended": fault_t(c["est_extended"])}
+            if "_filtered" in runs_:
+                c0 = runs_["_filtered"]
+                row.update({"filtered_nominal": c0["est_nominal"]["contour_rms_m"],
+                            "filtered_extended": c0["est_extended"]["contour_rms_m"],
+                            "filtered_outliers_nominal": c0["est_nominal"]["outlier_steps"],
+                            "filtered_fault_nominal": fault_t(c0["est_nominal"]),
+                            "filtered_fault_extended": fault_t(c0["est_extended"])})
             rows[est].append(row)
             E = est.upper()
             print(f"{cause:20s} verdict {row['verdict']:20s} contour RMS: H-inf only {row['hinf_only']:.3e} m, "
                   f"{E} nominal {row['est_nominal']:.3e} m{fault_note(row['fault_nominal'])}, "
-                  f"{E} extended {row['est_extended']:.3e} m{fault_note(row['fault_extended'])}", flush=True)
+                  f"{E} extended {row['est_extended']:.3e} m{fault_note(row['fault_extended'])}"
+                  + (f", extended with the filtered estimate {row['filtered_extended']:.3e} m"
+                     f"{fault_note(row['filtered_fault_extended'])}" if "filtered_extended" in row else ""),
+                  flush=True)
             # a cause the circle barely feels (a gradient over its 0.2 mm) moves the
             # result by the filter's path-to-path spread only: NOT_WORSE allows that
             better = row["fault_extended"] is None and (row["fault_nominal"] is not None
@@ -115,6 +147,13 @@ def main():
                 fails.append(f"{cause}, {E}: extended {row['est_extended']:.3e} m"
                              f"{fault_note(row['fault_extended'])} is worse than nominal "
                              f"{row['est_nominal']:.3e} m{fault_note(row['fault_nominal'])}")
+            # the lead is for a model that is right: on the extended model it may not
+            # lose against the filtered estimate
+            if "filtered_extended" in row and row["filtered_fault_extended"] is None and not (
+                    row["fault_extended"] is None and row["est_extended"] < NOT_WORSE * row["filtered_extended"]):
+                fails.append(f"{cause}, {E}: extended with the lead {row['est_extended']:.3e} m"
+                             f"{fault_note(row['fault_extended'])} is worse than with the filtered estimate "
+                             f"{row['filtered_extended']:.3e} m")
     if a.md:
         L = ["<!-- generated by sim/studies/diagnose_control.py (make diagnose-control); do not edit -->", "",
              "# A diagnosis in control terms: the circle with the estimator on the nominal and on the extended model",
@@ -129,19 +168,32 @@ def main():
              "before it. \"Oracle\": H-inf compensating the plant's own force of the last period (friction, "
              "offset, ripple and the viscous terms beyond the nominal one; br_plant_comp_force_N), one period "
              "late like every estimator: a reference, not a bound (an estimator predicts the next period's force "
-             "and can beat it).", ""]
+             "and can beat it). "
+             f"\"Nominal\" and \"extended model\" compensate the force their model predicts {a.ahead:g} "
+             "period(s) past the actuator delay in the model (est.comp_ahead_periods; 0.5: the centre of the "
+             "period the next command is held over; carried with the commands already sent; "
+             "[modules/est.md](modules/est.md)); the last column is the extended model with the filtered "
+             "estimate (lead 0, the thesis's compensation and the machine files' default). The oracle has no "
+             "lead. The lead pays where the model is right; on plants whose parameters are off and with force "
+             "noise it loses (the robustness study, modules/est.md).", ""]
         for est in ests:
             E = est.upper()
-            L += [f"## H-inf + {E}", "",
-                  f"| hidden cause | verdict | contour RMS, H-inf only | H-inf + oracle | H-inf + {E}, nominal model | "
-                  f"H-inf + {E}, extended model | change |", "|---|---|---|---|---|---|---|"]
+            both = any("filtered_extended" in r for r in rows[est])
+            head = (f"| hidden cause | verdict | contour RMS, H-inf only | H-inf + oracle | H-inf + {E}, nominal model | "
+                    f"H-inf + {E}, extended model | change |")
+            if both:
+                head += " extended model, filtered estimate (lead 0) |"
+            L += [f"## H-inf + {E}", "", head, "|---|---|---|---|---|---|---|" + ("---|" if both else "")]
             for r in rows[est]:
                 faulted = r["fault_nominal"] is not None or r["fault_extended"] is not None
                 ch = "—" if faulted else f"{100.0 * (r['est_extended'] / r['est_nominal'] - 1.0):+.0f} %"
                 note = run_note(r["outliers_nominal"], r["fault_nominal"])
                 note_e = run_note(r["outliers_extended"], r["fault_extended"])
-                L.append(f"| {r['cause']}: {r['what']} | {r['verdict']} | {r['hinf_only']:.3e} m | {r['hinf_true']:.3e} m | "
-                         f"{r['est_nominal']:.3e} m{note} | {r['est_extended']:.3e} m{note_e} | {ch} |")
+                line = (f"| {r['cause']}: {r['what']} | {r['verdict']} | {r['hinf_only']:.3e} m | {r['hinf_true']:.3e} m | "
+                        f"{r['est_nominal']:.3e} m{note} | {r['est_extended']:.3e} m{note_e} | {ch} |")
+                if both:
+                    line += f" {r['filtered_extended']:.3e} m{run_note(0, r['filtered_fault_extended'])} |"
+                L.append(line)
             L.append("")
         with open(a.md, "w") as f:
             f.write("\n".join(L))

@@ -60,6 +60,8 @@ void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WOR
     w[i++] = f2w(c->pf.adapt.nis_ref);
     w[i++] = f2w(c->pf.adapt.alpha);
     w[i++] = f2w(c->pf.adapt.max_scale);
+    /* cfg.est.comp_ahead_periods (zero in a stream without it: the filtered estimate) */
+    w[i++] = f2w(c->pf.est.comp_ahead_periods);
     while (i < BR_REPLAY_HDR_WORDS) w[i++] = 0u;
 }
 
@@ -104,6 +106,7 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
     c->pf.adapt.nis_ref = w2f(w[i++]);
     c->pf.adapt.alpha = w2f(w[i++]);
     c->pf.adapt.max_scale = w2f(w[i++]);
+    c->pf.est.comp_ahead_periods = w2f(w[i++]);
     if (c->pf.noise_len != BR_NOISE_LEN) return BR_E_PARAM;
     c->pf.noise = br_noise_table;
     return BR_OK;

@@ -8,7 +8,8 @@
  *           controller configuration (8 floats) and the PF configuration
  *           (model 10 floats, m, q_var[4], r, gp0, x0_std[4], gp_min, gp_max,
  *           outlier_sigma, reanchor_after, rad_per_count, noise_len, noise_skip,
- *           adapt.nis_ref, adapt.alpha, adapt.max_scale; zeros there: adapt off),
+ *           adapt.nis_ref, adapt.alpha, adapt.max_scale; zeros there: adapt off;
+ *           est.comp_ahead_periods; zero there: no lead),
  *           floats as their bit patterns, so every value is exact;
  *   steps   n_steps records of 4 words per axis: encoder counts (int32),
  *           reference counts (int32), reference fraction (float), reference

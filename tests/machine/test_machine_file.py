@@ -12,6 +12,7 @@ import copy
 import glob
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -89,9 +90,18 @@ def main():
     bad["friction"]["Fc_N"] = 0.0
     bad["encoder"]["counter_bits"] = "32"
     bad["estimator"]["pf"]["n_particles"] = machine.PF_MAX_PARTICLES + 1
+    bad["estimator"]["ukf"]["comp_ahead_periods"] = 2.5
     expect_errors(work, "range.json", bad, ["field friction.Fc_N: 0 is outside (0, 100000]",
                                             "field encoder.counter_bits: expected an integer, got a string",
-                                            "field estimator.pf.n_particles: 2049 is outside [1, 2048]"])
+                                            "field estimator.pf.n_particles: 2049 is outside [1, 2048]",
+                                            "field estimator.ukf.comp_ahead_periods: 2.5 is outside [0, 2]"])
+    # the schema's firmware limits are the firmware headers' (one home each: the headers)
+    for header, name, value in (("br_pf.h", "BR_PF_MAX_PARTICLES", machine.PF_MAX_PARTICLES),
+                                ("br_est.h", "BR_EST_AHEAD_MAX_PERIODS", machine.EST_AHEAD_MAX_PERIODS)):
+        with open(os.path.join(REPO, "firmware", "include", "bristle", header)) as f:
+            m = re.search(r"#define\s+%s\s+([0-9.]+)u?f?\b" % name, f.read())
+        check(m is not None and float(m.group(1)) == float(value),
+              "%s: %s is %s, the machine schema's %s" % (header, name, m and m.group(1), value))
     bad = copy.deepcopy(good)
     bad["friction"]["Fs_N"] = 0.5 * bad["friction"]["Fc_N"]
     bad["control"]["torque_limit_Nm"] = 2.0 * bad["amplifier"]["torque_per_duty_Nm"]

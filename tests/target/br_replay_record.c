@@ -6,7 +6,8 @@
  * writes the closed loop's own (F_hat, duty) per step and axis as float bits,
  * which the host replay must reproduce.
  *
- *   br_replay_record --out stream.bin [--expect expect.bin] [--duration 1.0] [--axes 1|2] */
+ *   br_replay_record --out stream.bin [--expect expect.bin] [--duration 1.0] [--axes 1|2] [--ahead L]
+ * --ahead: the PF's est.comp_ahead_periods (docs/modules/est.md), in the circle and the stream. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -65,22 +66,26 @@ int main(int argc, char **argv)
     const char *out = NULL, *expect = NULL;
     double duration = 1.0;
     uint32_t n_axes = 1u;
+    double ahead = 0.0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
         else if (!strcmp(argv[i], "--expect") && i + 1 < argc) expect = argv[++i];
         else if (!strcmp(argv[i], "--duration") && i + 1 < argc) duration = atof(argv[++i]);
         else if (!strcmp(argv[i], "--axes") && i + 1 < argc) n_axes = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--ahead") && i + 1 < argc) ahead = atof(argv[++i]);
         else {
-            fprintf(stderr, "usage: br_replay_record --out FILE [--expect FILE] [--duration S] [--axes 1|2]\n");
+            fprintf(stderr, "usage: br_replay_record --out FILE [--expect FILE] [--duration S] [--axes 1|2] "
+                            "[--ahead L]\n");
             return 2;
         }
     }
-    if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u) {
-        fprintf(stderr, "br_replay_record: --out is required, duration > 0, axes 1 or 2\n");
+    if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u || !(ahead >= 0.0 && ahead <= 2.0)) {
+        fprintf(stderr, "br_replay_record: --out is required, duration > 0, axes 1 or 2, ahead in [0, 2]\n");
         return 2;
     }
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     c.duration_s = duration;
+    c.pf.est.comp_ahead_periods = (float)ahead;
     rec_t r = {&c, tmpfile(), NULL, 0u, n_axes};
     if (r.steps == NULL) return 1;
     if (expect && (r.expect = fopen(expect, "wb")) == NULL) {

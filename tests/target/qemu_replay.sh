@@ -10,6 +10,8 @@
 #   qemu_replay.sh RECORD HOST_REPLAY CMP IMAGE WORKDIR
 # BR_QEMU_MACHINE: the emulated board (default mps2-an500, the M7; mps2-an386:
 # the Cortex-M4 image of the cm4-release preset, target_qemu_replay_m4).
+# BR_REPLAY_RECORD_ARGS: more br_replay_record options (target_qemu_replay_ahead:
+# --ahead 0.5); BR_REPLAY_PATHS: the image's PF paths to run (default "0 1").
 set -euo pipefail
 record=$1 host=$2 cmp=$3 image=$4 work=$5
 qemu=${BR_QEMU:-qemu-system-arm}
@@ -17,12 +19,12 @@ command -v "$qemu" >/dev/null || { echo "FAIL: $qemu not found (make deps instal
 [[ -f $image ]] || { echo "FAIL: no replay image at $image (build the cm7-release preset: make test / make firmware)" >&2; exit 1; }
 mkdir -p "$work"
 rm -f "$work"/{stream,expect,host,target}.bin
-"$record" --out "$work/stream.bin" --expect "$work/expect.bin" --duration 1.0 --axes 2
+"$record" --out "$work/stream.bin" --expect "$work/expect.bin" --duration 1.0 --axes 2 ${BR_REPLAY_RECORD_ARGS:-}
 "$host" "$work/stream.bin" "$work/host.bin"
 # Under QEMU the image's I/O paths are the host's (semihosting, target=native).
 # The image runs the PF's vector path (the default) and its scalar reference
 # path; both must equal the host's vector path, which must equal the closed loop.
-for sp in 0 1; do
+for sp in ${BR_REPLAY_PATHS:-0 1}; do
   timeout 600 "$qemu" -M "${BR_QEMU_MACHINE:-mps2-an500}" -nographic -monitor none -serial none \
     -semihosting-config "enable=on,target=native,arg=replay,arg=$work/stream.bin,arg=$work/target.bin,arg=0,arg=$sp" \
     -kernel "$image"

@@ -22,6 +22,10 @@
  * is far below any quantised encoder's noise (1/12 count^2), and it keeps
  * 1 / (2 R) and the log-weights finite. */
 #define BR_EST_R_MIN_COUNTS2 1.0e-6f
+/* Longest compensation lead beyond the actuator delay, in periods
+ * (comp_ahead_periods): two periods carry the model further than any
+ * zero-order hold needs (half a period is its centre). */
+#define BR_EST_AHEAD_MAX_PERIODS 2.0f
 
 /* The configuration the PF and the UKF share (each embeds it as `est`). */
 typedef struct {
@@ -35,6 +39,9 @@ typedef struct {
                                 whole estimate is an outlier, > 0 (each filter says which deviation) */
     uint32_t reanchor_after; /* consecutive outliers before the filter is re-anchored on y, >= 1 */
     float rad_per_count;     /* encoder resolution, > 0 */
+    float comp_ahead_periods; /* 0: the compensation is the filtered estimate (the thesis);
+                                 > 0: the force predicted over the actuator delay and this many
+                                 periods beyond it (br_est_comp_N), <= BR_EST_AHEAD_MAX_PERIODS */
 } br_est_cfg_t;
 
 /* Checks the shared configuration: the model (br_model_init's checks, the
@@ -43,7 +50,8 @@ typedef struct {
  * BR_EST_VAR_MAX (no subnormals), R from BR_EST_R_MIN_COUNTS2 counts^2 up to
  * BR_EST_VAR_MAX, 0 < gp_min < gp_max with gp0 inside, an outlier gate in
  * (0, BR_EST_GATE_MAX_SIGMA], at
- * least one outlier before re-anchoring. BR_OK, BR_E_NULL or BR_E_PARAM. */
+ * least one outlier before re-anchoring, a compensation lead in
+ * [0, BR_EST_AHEAD_MAX_PERIODS]. BR_OK, BR_E_NULL or BR_E_PARAM. */
 br_status_t br_est_cfg_check(const br_est_cfg_t *cfg);
 
 /* 1 when v is a usable variance: a normal float in [FLT_MIN, BR_EST_VAR_MAX],
@@ -73,6 +81,20 @@ void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg);
 /* Keeps u_prev_Nm, the command held over the last period, and returns the
  * torque that reached the axis over it. */
 float br_est_delay_apply(br_est_delay_t *d, float u_prev_Nm);
+
+/* The force to compensate (docs/modules/est.md, "Compensating ahead").
+ * With cfg->comp_ahead_periods = lambda = 0 it is F_hat_N itself. Otherwise
+ * the estimate x (theta relative to p0_m) is carried by the model over
+ * H = delay / dt + lambda periods, each period with the torque that will
+ * reach the axis over it (from d's history; u_prev_Nm, the newest command,
+ * stands in for the ones not yet computed), and
+ *   F_comp = F_hat + f_c(x(t + H dt)) - f_c(x)
+ * with f_c(x(t + H dt)) interpolated linearly inside its last period. A step
+ * the model refuses (a state out of its range) gives F_hat_N, no lead; the
+ * controller refuses a compensation out of range (br_ctrl). Call after the
+ * estimator's step (d then holds u_prev_Nm). */
+float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_delay_t *d,
+                    const float x[BR_NX], float p0_m, float u_prev_Nm, float F_hat_N);
 
 /* Encoder measurement: position = (counts + frac) counts. For a plain
  * quadrature encoder (floor quantisation) pass frac = 0.5, the centre of the

@@ -49,7 +49,8 @@
                 .gp_max_N = BR_EST_PF_GP_MAX_N_F,                                                  \
                 .outlier_sigma = BR_EST_PF_OUTLIER_SIGMA_F,                                        \
                 .reanchor_after = BR_EST_PF_REANCHOR_AFTER,                                        \
-                .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F},                                      \
+                .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,                                   \
+                .comp_ahead_periods = BR_EST_PF_COMP_AHEAD_PERIODS_F},                         \
         .n_particles = BR_EST_PF_N_PARTICLES,                                                      \
         .x0_std = {BR_EST_PF_X0_STD_THETA_COUNTS_F * BR_MACHINE_RAD_PER_COUNT_F,                   \
                    BR_EST_PF_X0_STD_OMEGA_RADPS_F, BR_EST_PF_X0_STD_Z_M_F, BR_EST_PF_X0_STD_GP_N_F}, \
@@ -78,7 +79,8 @@
                 .gp_max_N = BR_EST_UKF_GP_MAX_N_F,                                                 \
                 .outlier_sigma = BR_EST_UKF_OUTLIER_SIGMA_F,                                       \
                 .reanchor_after = BR_EST_UKF_REANCHOR_AFTER,                                       \
-                .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F},                                      \
+                .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,                                   \
+                .comp_ahead_periods = BR_EST_UKF_COMP_AHEAD_PERIODS_F},                        \
         .p0_var = {BR_EST_UKF_P0_THETA_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F *                    \
                        BR_MACHINE_RAD_PER_COUNT_F,                                                 \
                    BR_EST_UKF_P0_OMEGA_RAD2PS2_F, BR_EST_UKF_P0_Z_M2_F, BR_EST_UKF_P0_GP_N2_F},    \

@@ -54,6 +54,9 @@
 #define BR_EST_PF_OUTLIER_SIGMA_F (8.000000000e+00f)
 /* consecutive outliers before re-anchoring */
 #define BR_EST_PF_REANCHOR_AFTER 3u
+/* compensation lead beyond the actuator delay, periods (0: the filtered estimate) */
+#define BR_EST_PF_COMP_AHEAD_PERIODS (0.0)
+#define BR_EST_PF_COMP_AHEAD_PERIODS_F (0.000000000e+00f)
 /* extra noise-table advance per step */
 #define BR_EST_PF_NOISE_SKIP 1u
 /* innovation-driven noise of z and g_p (0: off) */
@@ -105,6 +108,9 @@
 #define BR_EST_UKF_OUTLIER_SIGMA_F (8.000000000e+00f)
 /* consecutive outliers before re-anchoring */
 #define BR_EST_UKF_REANCHOR_AFTER 3u
+/* compensation lead beyond the actuator delay, periods (0: the filtered estimate) */
+#define BR_EST_UKF_COMP_AHEAD_PERIODS (0.0)
+#define BR_EST_UKF_COMP_AHEAD_PERIODS_F (0.000000000e+00f)
 /* sigma-point spread */
 #define BR_EST_UKF_ALPHA (1.0)
 #define BR_EST_UKF_ALPHA_F (1.000000000e+00f)

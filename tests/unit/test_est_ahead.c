@@ -1,0 +1,214 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Compensating ahead (br_est_comp_N, docs/modules/est.md): the lead is
+ * checked at init; a lead of 0 is the filtered estimate itself, bit for bit;
+ * a lead carries the estimate by the model with the torque that reaches the
+ * axis in each period (the delayed commands from the history, the newest
+ * standing in for those not yet computed), interpolated in the last period;
+ * a carry that fails gives the filtered estimate, never a NaN. The expected
+ * values here step br_model themselves with the commands the test sent. */
+#include "br_test.h"
+
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "circle/br_circle_est.h"
+#include "bristle/br_est.h"
+#include "bristle/br_model.h"
+#include "bristle/br_pf.h"
+#include "bristle/br_ukf.h"
+
+#define UKF_DT_S 1.0e-3f
+#define PF_DT_S 1.5e-3f
+#define N_STEPS 60
+
+/* a moving axis: 20 counts a period, and commands that alternate in sign so
+ * that a wrong command in the carry changes the force */
+static int32_t counts_at(int k) { return 20 * k; }
+static float cmd_at(int k) { return ((k % 2) != 0 ? 0.3f : -0.2f) + 0.001f * (float)k; }
+
+static void test_ahead_bounds(void **st)
+{
+    (void)st;
+    const br_est_cfg_t ok = br_circle_ukf_cfg_tuned(UKF_DT_S).est;
+    br_est_cfg_t c = ok;
+    c.comp_ahead_periods = 0.0f;                     assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    c.comp_ahead_periods = BR_EST_AHEAD_MAX_PERIODS; assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    c.comp_ahead_periods = nextafterf(BR_EST_AHEAD_MAX_PERIODS, INFINITY);
+    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c.comp_ahead_periods = -1.0e-6f;                 assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c.comp_ahead_periods = NAN;                      assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c.comp_ahead_periods = INFINITY;                 assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    /* both filters refuse it at init */
+    br_ukf_t u;
+    br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
+    cu.est.comp_ahead_periods = NAN;
+    assert_int_equal(br_ukf_init(&u, &cu), BR_E_PARAM);
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
+    cp.est.comp_ahead_periods = -0.5f;
+    assert_int_equal(br_pf_init(pf, &cp), BR_E_PARAM);
+    free(pf);
+}
+
+/* lead 0: what the step returns is the filtered F_hat, bit for bit */
+static void test_no_lead_is_the_estimate(void **st)
+{
+    (void)st;
+    br_ukf_t u;
+    br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
+    cu.est.comp_ahead_periods = 0.0f;
+    assert_int_equal(br_ukf_init(&u, &cu), BR_OK);
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
+    cp.n_particles = 200u;
+    cp.est.comp_ahead_periods = 0.0f;
+    assert_int_equal(br_pf_init(pf, &cp), BR_OK);
+    for (int k = 0; k < N_STEPS; k++) {
+        const br_meas_t y = {counts_at(k), 0.5f};
+        float Fu = NAN, Fp = NAN;
+        assert_false(BR_FAILED(br_ukf_est_step(&u, &y, cmd_at(k), &Fu)));
+        assert_false(BR_FAILED(br_pf_est_step(pf, &y, cmd_at(k), &Fp)));
+        assert_memory_equal(&Fu, &br_ukf_estimate(&u)->F_hat_N, sizeof Fu);
+        assert_memory_equal(&Fp, &br_pf_estimate(pf)->F_hat_N, sizeof Fp);
+    }
+    free(pf);
+}
+
+/* the torque reaching the axis over the j-th period after step k, with the
+ * delay dm + df periods: sent[i] was held over the period that ended at step
+ * i, so the command of the period starting at step k + j is sent[k + 1 + j]
+ * (sent[k] is the newest; those not yet computed take its value) */
+static float reaching(const float *sent, int k, int j, uint32_t dm, float df)
+{
+    const int a = k + 1 + j - (int)dm; /* sent[a] and sent[a - 1] */
+    const float ua = (a > k) ? sent[k] : ((a >= 0) ? sent[a] : 0.0f);
+    const float ub = (a - 1 > k) ? sent[k] : ((a - 1 >= 0) ? sent[a - 1] : 0.0f);
+    return (1.0f - df) * ua + df * ub;
+}
+
+/* the UKF on a model with a delay of 2.5 periods and a lead of 0.75: the
+ * compensation is F_hat plus the change of f_c over 3.25 periods of the
+ * model, driven by the commands that reach the axis in them */
+static void run_carry_case(float delay_periods, float lead)
+{
+    br_ukf_t u;
+    br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
+    cu.est.model.causes.delay_s = delay_periods * UKF_DT_S;
+    cu.est.comp_ahead_periods = lead;
+    assert_int_equal(br_ukf_init(&u, &cu), BR_OK);
+    br_model_t m;
+    assert_int_equal(br_model_init(&m, &cu.est.model), BR_OK);
+    float sent[N_STEPS];
+    float worst = 0.0f, moved = 0.0f;
+    for (int k = 0; k < N_STEPS; k++) {
+        const br_meas_t y = {counts_at(k), 0.5f};
+        sent[k] = cmd_at(k);
+        float F = NAN;
+        assert_false(BR_FAILED(br_ukf_est_step(&u, &y, sent[k], &F)));
+        const float F_hat = br_ukf_estimate(&u)->F_hat_N;
+        const float p0 = (float)u.origin_counts * u.m_per_count;
+        const uint32_t dm = u.delay.on ? u.delay.m : 0u;
+        const float df = u.delay.on ? u.delay.f : 0.0f;
+        const float h = (float)dm + df + lead;
+        const int n = (int)floorf(h);
+        float cur[BR_NX], nxt[BR_NX];
+        memcpy(cur, u.x, sizeof cur);
+        const float f0 = br_model_fcomp_N(&m, u.x, p0);
+        for (int j = 0; j < n; j++) {
+            assert_int_equal(br_model_step_at(&m, cur, p0, reaching(sent, k, j, dm, df), nxt), BR_OK);
+            memcpy(cur, nxt, sizeof cur);
+        }
+        assert_int_equal(br_model_step_at(&m, cur, p0, reaching(sent, k, n, dm, df), nxt), BR_OK);
+        const float fa = br_model_fcomp_N(&m, cur, p0), fb = br_model_fcomp_N(&m, nxt, p0);
+        const float want = F_hat + (fa + (h - (float)n) * (fb - fa) - f0);
+        assert_true(isfinite(F));
+        worst = fmaxf(worst, fabsf(F - want));
+        moved = fmaxf(moved, fabsf(want - F_hat));
+    }
+    /* float rounding of the same sums only; the lead itself moves F by far more */
+    assert_true(worst <= 1.0e-5f);
+    assert_true(moved > 1.0e-2f);
+}
+
+static void test_lead_without_delay(void **st)
+{
+    (void)st;
+    run_carry_case(0.0f, 0.5f);
+    run_carry_case(0.0f, 1.0f);
+}
+
+static void test_lead_over_a_delay(void **st)
+{
+    (void)st;
+    run_carry_case(2.5f, 0.75f);
+    run_carry_case(3.0f, 0.5f);
+}
+
+/* the PF's lead starts from the particle mean (br_pf_stats' mean) */
+static void test_pf_lead_from_the_mean(void **st)
+{
+    (void)st;
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
+    cp.n_particles = 200u;
+    cp.est.comp_ahead_periods = 1.0f;
+    assert_int_equal(br_pf_init(pf, &cp), BR_OK);
+    br_model_t m;
+    assert_int_equal(br_model_init(&m, &cp.est.model), BR_OK);
+    for (int k = 0; k < N_STEPS; k++) {
+        const br_meas_t y = {counts_at(k), 0.5f};
+        float F = NAN;
+        assert_false(BR_FAILED(br_pf_est_step(pf, &y, cmd_at(k), &F)));
+        br_pf_stats_t s;
+        assert_int_equal(br_pf_stats(pf, &s), BR_OK);
+        const float p0 = (float)br_pf_estimate(pf)->origin_counts * pf->m_per_count;
+        float nxt[BR_NX];
+        assert_int_equal(br_model_step_at(&m, s.mean, p0, cmd_at(k), nxt), BR_OK);
+        const float want = br_pf_estimate(pf)->F_hat_N +
+                           (br_model_fcomp_N(&m, nxt, p0) - br_model_fcomp_N(&m, s.mean, p0));
+        BR_ASSERT_NEAR(F, want, 1.0e-5);
+    }
+    free(pf);
+}
+
+/* a carry the model refuses (a state out of its range) gives F_hat itself */
+static void test_failed_carry_gives_the_estimate(void **st)
+{
+    (void)st;
+    br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
+    cu.est.comp_ahead_periods = 0.5f;
+    br_model_t m;
+    assert_int_equal(br_model_init(&m, &cu.est.model), BR_OK);
+    br_est_delay_t d;
+    br_est_delay_init(&d, &cu.est);
+    const float F_hat = 3.25f;
+    const float bad_gp[BR_NX] = {0.0f, 1.0f, 0.0f, 0.0f}; /* g_p = 0: outside the model */
+    assert_true(br_est_comp_N(&cu.est, &m, &d, bad_gp, 0.0f, 0.1f, F_hat) == F_hat);
+    const float nan_x[BR_NX] = {0.0f, NAN, 0.0f, 5.0f};
+    assert_true(br_est_comp_N(&cu.est, &m, &d, nan_x, 0.0f, 0.1f, F_hat) == F_hat);
+    /* finite steps whose force is not: a speed whose viscous force overflows */
+    const float fast[BR_NX] = {0.0f, 3.0e38f, 0.0f, 5.0f};
+    const float F = br_est_comp_N(&cu.est, &m, &d, fast, 0.0f, 0.1f, F_hat);
+    assert_true(F == F_hat);
+    /* and a sane state moves it */
+    const float ok[BR_NX] = {0.0f, 1.0f, 0.0f, 5.0f};
+    const float lead = br_est_comp_N(&cu.est, &m, &d, ok, 0.0f, 0.1f, 0.0f);
+    assert_true(isfinite(lead) && lead != 0.0f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ahead_bounds),
+        cmocka_unit_test(test_no_lead_is_the_estimate),
+        cmocka_unit_test(test_lead_without_delay),
+        cmocka_unit_test(test_lead_over_a_delay),
+        cmocka_unit_test(test_pf_lead_from_the_mean),
+        cmocka_unit_test(test_failed_carry_gives_the_estimate),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
