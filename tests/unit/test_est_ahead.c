@@ -52,6 +52,18 @@ static void test_ahead_bounds(void **st)
     free(pf);
 }
 
+/* a PF of 200 particles with the lead given (the caller frees it) */
+static br_pf_t *pf_with_lead(float lead, br_pf_cfg_t *cp)
+{
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    *cp = br_circle_pf_cfg_tuned(PF_DT_S);
+    cp->n_particles = 200u;
+    cp->est.comp_ahead_periods = lead;
+    assert_int_equal(br_pf_init(pf, cp), BR_OK);
+    return pf;
+}
+
 /* lead 0: what the step returns is the filtered F_hat, bit for bit */
 static void test_no_lead_is_the_estimate(void **st)
 {
@@ -60,12 +72,8 @@ static void test_no_lead_is_the_estimate(void **st)
     br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
     cu.est.comp_ahead_periods = 0.0f;
     assert_int_equal(br_ukf_init(&u, &cu), BR_OK);
-    br_pf_t *pf = calloc(1, sizeof *pf);
-    assert_non_null(pf);
-    br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
-    cp.n_particles = 200u;
-    cp.est.comp_ahead_periods = 0.0f;
-    assert_int_equal(br_pf_init(pf, &cp), BR_OK);
+    br_pf_cfg_t cp;
+    br_pf_t *pf = pf_with_lead(0.0f, &cp);
     for (int k = 0; k < N_STEPS; k++) {
         const br_meas_t y = {counts_at(k), 0.5f};
         float Fu = NAN, Fp = NAN;
@@ -151,12 +159,8 @@ static void test_lead_over_a_delay(void **st)
 static void test_pf_lead_from_the_mean(void **st)
 {
     (void)st;
-    br_pf_t *pf = calloc(1, sizeof *pf);
-    assert_non_null(pf);
-    br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
-    cp.n_particles = 200u;
-    cp.est.comp_ahead_periods = 1.0f;
-    assert_int_equal(br_pf_init(pf, &cp), BR_OK);
+    br_pf_cfg_t cp;
+    br_pf_t *pf = pf_with_lead(1.0f, &cp);
     br_model_t m;
     assert_int_equal(br_model_init(&m, &cp.est.model), BR_OK);
     for (int k = 0; k < N_STEPS; k++) {
