@@ -104,11 +104,13 @@ float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_d
                     const float x[BR_NX], float p0_m, float u_prev_Nm, float F_hat_N)
 {
     const float lambda = cfg->comp_ahead_periods;
-    if (!(lambda > 0.0f)) {
+    /* no lead; and, for a caller whose configuration br_est_cfg_check did not see,
+     * no carry beyond the bounds that keep the loop below bounded */
+    if (!(lambda > 0.0f && lambda <= BR_EST_AHEAD_MAX_PERIODS) || (d->on && d->m > BR_EST_DELAY_HIST - 2u)) {
         return F_hat_N;
     }
-    /* H = delay / dt + lambda = (dm + df) + lambda periods: n whole ones and fr of the next;
-     * n <= BR_EST_DELAY_HIST - 2 + BR_EST_AHEAD_MAX_PERIODS (br_est_cfg_check) */
+    /* (ahead 1) H = delay / dt + lambda = (dm + df) + lambda periods: n whole ones and fr of
+     * the next; n <= BR_EST_DELAY_HIST - 2 + 1 + BR_EST_AHEAD_MAX_PERIODS */
     const float h = (d->on ? (float)d->m + d->f : 0.0f) + lambda;
     const uint32_t n = (uint32_t)h;
     const float fr = h - (float)n;
@@ -118,8 +120,11 @@ float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_d
     for (int i = 0; i < BR_NX; i++) {
         cur[i] = x[i];
     }
-    for (uint32_t j = 0; j <= n; j++) {
-        /* the torque reaching the axis over period k + j: (1 - f) u[k+j-m] + f u[k+j-m-1] */
+    /* (ahead 2) the whole periods, then the part-period's end when fr > 0 (at least one
+     * step: H > 0; the first checks x) */
+    const uint32_t steps = n + ((fr > 0.0f) ? 1u : 0u);
+    for (uint32_t j = 0; j < steps; j++) {
+        /* (ahead 3) the torque reaching the axis over period k + j: (1 - f) u[k+j-m] + f u[k+j-m-1] */
         const int32_t a = (int32_t)j - dm;
         const float u = (1.0f - df) * cmd_at(d, a, u_prev_Nm) + df * cmd_at(d, a - 1, u_prev_Nm);
         if (br_model_step_at(m, cur, p0_m, u, nxt) != BR_OK) {
@@ -131,12 +136,12 @@ float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_d
             }
         }
     }
-    /* f_c at t (x passed the model's checks in the first step) and at t + H dt,
-     * between the ends of the last period at fr of it */
+    /* (ahead 4) f_c at t + H dt, between the ends of the last period at fr of it */
     const float f0 = br_model_fcomp_N(m, x, p0_m);
     const float fc = br_model_fcomp_N(m, cur, p0_m);
-    const float fh = fc + fr * (br_model_fcomp_N(m, nxt, p0_m) - fc);
-    /* F_comp = F_hat + f_c(x(t + H dt)) - f_c(x) (finite states: each step checked them;
-     * the controller's range check on the compensation stands behind it, br_ctrl) */
-    return F_hat_N + (fh - f0);
+    const float fh = (fr > 0.0f) ? fc + fr * (br_model_fcomp_N(m, nxt, p0_m) - fc) : fc;
+    /* (ahead 5) F_comp = F_hat + f_H - f_c(x); a force beyond float range (finite states
+     * at speeds far beyond any axis'): the filtered estimate */
+    const float F = F_hat_N + (fh - f0);
+    return isfinite(F) ? F : F_hat_N;
 }

@@ -5,7 +5,7 @@ For each cause: the reference machine with the cause switched on (hidden
 from the diagnosis) runs the identification trajectory (br_simlog); the
 diagnosis names the cause and saves an extended model (model.json); the
 thesis circle then runs on that machine with H-inf only, with H-inf + the
-estimator on the nominal model (the firmware's, as configured), and with
+estimator on the nominal model (the firmware's, the machine file's model), and with
 H-inf + the same estimator on the extended model (br_circle_ext). The
 contour RMS of each goes into a table. Both estimator runs compensate the
 force predicted AHEAD periods past the actuator delay
@@ -161,7 +161,8 @@ def main():
              "Each row: the reference machine with one cause switched on; br_simlog's identification run "
              "(0.1 N force noise); the diagnosis's verdict and its extended model (model.json); the thesis circle "
              "(radius 0.1 mm, 8 s; 1 ms for the UKF, 1.5 ms and 1500 particles for the PF) on that machine. "
-             "\"Nominal model\": the firmware's estimator as configured; \"extended model\": the same estimator "
+             "\"Nominal model\": the firmware's estimator on the machine file's nominal model; \"extended model\": "
+             "the same estimator "
              "with the causes of model.json in its own model (br_model_cfg_t.causes: the firmware's extended "
              "model). \"Safe stop\": the firmware faulted (its estimate out of range, or it lost lock: "
              "br_app's lock monitor) and zeroed the drive at that time; the contour RMS is that of the run "

@@ -79,7 +79,7 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u || !(ahead >= 0.0 && ahead <= 2.0)) {
+    if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u || !(ahead >= 0.0 && ahead <= (double)BR_EST_AHEAD_MAX_PERIODS)) {
         fprintf(stderr, "br_replay_record: --out is required, duration > 0, axes 1 or 2, ahead in [0, 2]\n");
         return 2;
     }

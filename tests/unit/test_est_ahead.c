@@ -22,10 +22,21 @@
 #define PF_DT_S 1.5e-3f
 #define N_STEPS 60
 
-/* a moving axis: 20 counts a period, and commands that alternate in sign so
- * that a wrong command in the carry changes the force */
-static int32_t counts_at(int k) { return 20 * k; }
+/* a moving axis, 2 mm from the encoder's zero (where the extended model's
+ * position terms differ from theirs at 0): 20 counts a period, and commands
+ * that alternate in sign so that a wrong command in the carry changes the force */
+#define COUNTS_0 260000
+static int32_t counts_at(int k) { return COUNTS_0 + 20 * k; }
 static float cmd_at(int k) { return ((k % 2) != 0 ? 0.3f : -0.2f) + 0.001f * (float)k; }
+
+/* position terms of the extended model: a ripple and a friction gradient */
+static void with_position_causes(br_model_cfg_t *mc)
+{
+    mc->causes.ripple_amp_N = 1.0f;
+    mc->causes.ripple_period_m = 4.0e-3f;
+    mc->causes.ripple_phase_rad = 0.5f;
+    mc->causes.grad_per_m = 4.0f;
+}
 
 static void test_ahead_bounds(void **st)
 {
@@ -52,14 +63,18 @@ static void test_ahead_bounds(void **st)
     free(pf);
 }
 
-/* a PF of 200 particles with the lead given (the caller frees it) */
-static br_pf_t *pf_with_lead(float lead, br_pf_cfg_t *cp)
+/* a PF of 200 particles with the lead given, on the extended model with
+ * position terms when extended (the caller frees it) */
+static br_pf_t *pf_with_lead(float lead, int extended, br_pf_cfg_t *cp)
 {
     br_pf_t *pf = calloc(1, sizeof *pf);
     assert_non_null(pf);
     *cp = br_circle_pf_cfg_tuned(PF_DT_S);
     cp->n_particles = 200u;
     cp->est.comp_ahead_periods = lead;
+    if (extended) {
+        with_position_causes(&cp->est.model);
+    }
     assert_int_equal(br_pf_init(pf, cp), BR_OK);
     return pf;
 }
@@ -73,7 +88,7 @@ static void test_no_lead_is_the_estimate(void **st)
     cu.est.comp_ahead_periods = 0.0f;
     assert_int_equal(br_ukf_init(&u, &cu), BR_OK);
     br_pf_cfg_t cp;
-    br_pf_t *pf = pf_with_lead(0.0f, &cp);
+    br_pf_t *pf = pf_with_lead(0.0f, 0, &cp);
     for (int k = 0; k < N_STEPS; k++) {
         const br_meas_t y = {counts_at(k), 0.5f};
         float Fu = NAN, Fp = NAN;
@@ -97,18 +112,25 @@ static float reaching(const float *sent, int k, int j, uint32_t dm, float df)
     return (1.0f - df) * ua + df * ub;
 }
 
-/* the UKF on a model with a delay of 2.5 periods and a lead of 0.75: the
- * compensation is F_hat plus the change of f_c over 3.25 periods of the
- * model, driven by the commands that reach the axis in them */
-static void run_carry_case(float delay_periods, float lead)
+/* the UKF with a delay of delay_periods and a lead (on the extended model
+ * with position terms when extended): the compensation is F_hat plus the
+ * change of f_c over delay + lead periods of the model, driven by the
+ * commands that reach the axis in them */
+static void run_carry_case(float delay_periods, float lead, int extended)
 {
     br_ukf_t u;
     br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
     cu.est.model.causes.delay_s = delay_periods * UKF_DT_S;
+    if (extended) {
+        with_position_causes(&cu.est.model);
+    }
     cu.est.comp_ahead_periods = lead;
     assert_int_equal(br_ukf_init(&u, &cu), BR_OK);
     br_model_t m;
     assert_int_equal(br_model_init(&m, &cu.est.model), BR_OK);
+    /* the delay's own history, fed the same commands: the anchor of reaching() */
+    br_est_delay_t dd;
+    br_est_delay_init(&dd, &cu.est);
     float sent[N_STEPS];
     float worst = 0.0f, moved = 0.0f;
     for (int k = 0; k < N_STEPS; k++) {
@@ -120,6 +142,13 @@ static void run_carry_case(float delay_periods, float lead)
         const float p0 = (float)u.origin_counts * u.m_per_count;
         const uint32_t dm = u.delay.on ? u.delay.m : 0u;
         const float df = u.delay.on ? u.delay.f : 0.0f;
+        /* reaching() for the period that ended at step k is what the estimator's
+         * delay took (br_est_delay_apply); with a delay of a period or more,
+         * where no stand-in enters it */
+        const float ua = br_est_delay_apply(&dd, sent[k]);
+        if (k >= 1 && dm >= 1u) {
+            BR_ASSERT_NEAR(ua, reaching(sent, k - 1, 0, dm, df), 1e-7);
+        }
         const float h = (float)dm + df + lead;
         const int n = (int)floorf(h);
         float cur[BR_NX], nxt[BR_NX];
@@ -144,25 +173,35 @@ static void run_carry_case(float delay_periods, float lead)
 static void test_lead_without_delay(void **st)
 {
     (void)st;
-    run_carry_case(0.0f, 0.5f);
-    run_carry_case(0.0f, 1.0f);
+    run_carry_case(0.0f, 0.5f, 0);
+    run_carry_case(0.0f, 1.0f, 0);
 }
 
 static void test_lead_over_a_delay(void **st)
 {
     (void)st;
-    run_carry_case(2.5f, 0.75f);
-    run_carry_case(3.0f, 0.5f);
+    run_carry_case(2.5f, 0.75f, 0);
+    run_carry_case(3.0f, 0.5f, 0);
 }
 
-/* the PF's lead starts from the particle mean (br_pf_stats' mean) */
-static void test_pf_lead_from_the_mean(void **st)
+/* the extended model carries theta relative to the estimator's origin: its
+ * ripple and gradient see the position p0 + L theta */
+static void test_lead_on_the_extended_model(void **st)
 {
     (void)st;
+    run_carry_case(0.0f, 0.5f, 1);
+    run_carry_case(2.5f, 0.75f, 1);
+}
+
+/* the PF's lead starts from the particle mean (br_pf_stats' mean), theta
+ * relative to its origin */
+static void run_pf_case(int extended)
+{
     br_pf_cfg_t cp;
-    br_pf_t *pf = pf_with_lead(1.0f, &cp);
+    br_pf_t *pf = pf_with_lead(1.0f, extended, &cp);
     br_model_t m;
     assert_int_equal(br_model_init(&m, &cp.est.model), BR_OK);
+    float moved = 0.0f;
     for (int k = 0; k < N_STEPS; k++) {
         const br_meas_t y = {counts_at(k), 0.5f};
         float F = NAN;
@@ -175,11 +214,21 @@ static void test_pf_lead_from_the_mean(void **st)
         const float want = br_pf_estimate(pf)->F_hat_N +
                            (br_model_fcomp_N(&m, nxt, p0) - br_model_fcomp_N(&m, s.mean, p0));
         BR_ASSERT_NEAR(F, want, 1.0e-5);
+        moved = fmaxf(moved, fabsf(F - br_pf_estimate(pf)->F_hat_N));
     }
+    assert_true(moved > 1.0e-2f);
     free(pf);
 }
 
-/* a carry the model refuses (a state out of its range) gives F_hat itself */
+static void test_pf_lead_from_the_mean(void **st)
+{
+    (void)st;
+    run_pf_case(0);
+    run_pf_case(1);
+}
+
+/* a carry the model refuses (a state out of its range), a force beyond float
+ * range, or a lead or delay no check has seen give F_hat itself */
 static void test_failed_carry_gives_the_estimate(void **st)
 {
     (void)st;
@@ -194,14 +243,32 @@ static void test_failed_carry_gives_the_estimate(void **st)
     assert_true(br_est_comp_N(&cu.est, &m, &d, bad_gp, 0.0f, 0.1f, F_hat) == F_hat);
     const float nan_x[BR_NX] = {0.0f, NAN, 0.0f, 5.0f};
     assert_true(br_est_comp_N(&cu.est, &m, &d, nan_x, 0.0f, 0.1f, F_hat) == F_hat);
-    /* finite steps whose force is not: a speed whose viscous force overflows */
-    const float fast[BR_NX] = {0.0f, 3.0e38f, 0.0f, 5.0f};
-    const float F = br_est_comp_N(&cu.est, &m, &d, fast, 0.0f, 0.1f, F_hat);
-    assert_true(F == F_hat);
-    /* and a sane state moves it */
+    /* a speed the model's step refuses */
+    const float faster[BR_NX] = {0.0f, 3.0e38f, 0.0f, 5.0f};
+    assert_true(br_est_comp_N(&cu.est, &m, &d, faster, 0.0f, 0.1f, F_hat) == F_hat);
+    /* finite steps whose force is not (1e36 rad/s: f_c is infinite or NaN) */
+    const float fast[BR_NX] = {0.0f, 1.0e36f, 0.0f, 5.0f};
+    float x1[BR_NX];
+    assert_int_equal(br_model_step_at(&m, fast, 0.0f, 0.1f, x1), BR_OK);
+    assert_true(br_est_comp_N(&cu.est, &m, &d, fast, 0.0f, 0.1f, F_hat) == F_hat);
+    /* a sane state moves it */
     const float ok[BR_NX] = {0.0f, 1.0f, 0.0f, 5.0f};
     const float lead = br_est_comp_N(&cu.est, &m, &d, ok, 0.0f, 0.1f, 0.0f);
     assert_true(isfinite(lead) && lead != 0.0f);
+    /* a lead no check has seen: none at all, not a loop of 2^32 steps */
+    br_est_cfg_t wild = cu.est;
+    wild.comp_ahead_periods = INFINITY;
+    assert_true(br_est_comp_N(&wild, &m, &d, ok, 0.0f, 0.1f, F_hat) == F_hat);
+    wild.comp_ahead_periods = 2.5f;
+    assert_true(br_est_comp_N(&wild, &m, &d, ok, 0.0f, 0.1f, F_hat) == F_hat);
+    /* nor a delay longer than the history */
+    br_est_delay_t far = d;
+    far.on = 1;
+    far.m = BR_EST_DELAY_HIST - 1u;
+    far.f = 0.0f;
+    assert_true(br_est_comp_N(&cu.est, &m, &far, ok, 0.0f, 0.1f, F_hat) == F_hat);
+    far.m = BR_EST_DELAY_HIST - 2u; /* the longest one: carried */
+    assert_true(br_est_comp_N(&cu.est, &m, &far, ok, 0.0f, 0.1f, F_hat) != F_hat);
 }
 
 int main(void)
@@ -210,6 +277,7 @@ int main(void)
         cmocka_unit_test(test_ahead_bounds),
         cmocka_unit_test(test_no_lead_is_the_estimate),
         cmocka_unit_test(test_lead_without_delay),
+        cmocka_unit_test(test_lead_on_the_extended_model),
         cmocka_unit_test(test_lead_over_a_delay),
         cmocka_unit_test(test_pf_lead_from_the_mean),
         cmocka_unit_test(test_failed_carry_gives_the_estimate),
