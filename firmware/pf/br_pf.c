@@ -609,6 +609,10 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
     const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
     const float shift = c->shift, y_rel = c->y_rel;
+#if BR_FPU_MAXNM && !BR_FLOAT_SIMD
+    uint32_t ah_lim_bits;
+    memcpy(&ah_lim_bits, &kp.ah_lim, sizeof ah_lim_bits);
+#endif
     float *BR_RESTRICT th = pf->x[BR_X_THETA] + j0;
     float *BR_RESTRICT om = pf->x[BR_X_OMEGA] + j0;
     float *BR_RESTRICT zz = pf->x[BR_X_Z] + j0;
@@ -645,7 +649,10 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
          * particles reach the fix-up either way. */
         float ah0, ah1;
         br_model_kp_rk4_step(&kp, x, kg0, xn, &ah0, &ah1);
-        const int ok_rk = fmaxf(ah0, ah1) <= kp.ah_lim;
+        const float ahm = fmaxf(ah0, ah1);
+#if BR_FLOAT_SIMD
+        const int ok_rk = ahm <= kp.ah_lim;
+#endif
 #else
         const int ok_rk = br_model_kp_rk4(&kp, x, kg0, xn);
 #endif
@@ -671,7 +678,25 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
          * branch-free body: a particle for the fix-up (the bounded scheme, or
          * not valid) branches out, keeping its state in place (f_nl = 0,
          * l = NaN), and the selects below fold away for the valid ones */
+#if BR_FPU_MAXNM
+        /* the a h test and the validity test as one compare, on the bit
+         * patterns: v - v with v = t + f is +0 when t and f are finite (and
+         * v does not overflow), NaN otherwise, so c_ah = ahm + (v - v) is
+         * ahm (>= +0: k_p > 0) or a NaN. As unsigned integers the patterns
+         * of floats >= +0 order as the floats do and every NaN's, of either
+         * sign, lies above the limit's, so c_bits <= ah_lim_bits exactly
+         * when the particle is inside the RK4 limit and valid; the limit
+         * sits in an integer register, one float register more for the
+         * loop's constants. An overflow of t + f alone (both finite) sends
+         * a valid particle to the fix-up, which makes the same prediction
+         * (particle_one): the same results either way. */
+        const float v = t + f, c_ah = ahm + (v - v);
+        uint32_t c_bits;
+        memcpy(&c_bits, &c_ah, sizeof c_bits);
+        if (!(c_bits <= ah_lim_bits)) {
+#else
         if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
+#endif
             fo[j] = 0.0f;
             lo[j] = NAN;
             n_ok--;
