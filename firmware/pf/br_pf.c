@@ -894,7 +894,9 @@ static float step_weight(const br_pf_t *pf, uint32_t j)
  * (memcpy): the Cortex-M7 then holds the five arrays in registers and
  * addresses them by index (integer loads and stores take a register offset,
  * float ones do not), where with pf->x it formed the 8 KiB-apart addresses
- * anew for every particle (docs/target.md).
+ * anew for every particle (docs/target.md). Both passes are compiled
+ * without GCC's induction variable optimisation (BR_NO_IVOPTS): each
+ * access then takes the index i itself as its register offset.
  * The forward pass, after resample_fused (the host's vector path makes it in
  * resample_forward): from i = 0 up to m - 2 (particle m - 1 has no later one). */
 static inline void move_particle(uint32_t i, uint32_t k, float *th, float *om, float *zz, float *gg, float *ia)
@@ -906,10 +908,11 @@ static inline void move_particle(uint32_t i, uint32_t k, float *th, float *om, f
     memcpy(&ia[i], &ia[k], sizeof ia[i]);
 }
 
-BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om, float *zz,
-                              float *gg, float *ia)
+BR_NO_IVOPTS BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
+                                           float *zz, float *gg, float *ia)
 {
-    for (uint32_t i = 0u; i + 1u < m; i++) {
+    const uint32_t last = m - 1u; /* m >= 1; the bound once, not i + 1 < m per particle */
+    for (uint32_t i = 0u; i < last; i++) {
         const uint32_t k = idx[i];
         if (k > i) {
             move_particle(i, k, th, om, zz, gg, ia);
@@ -919,8 +922,8 @@ BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float
 
 /* The backward pass, after copy_fwd_soa or resample_forward: from i = m - 1
  * down to 1 (particle 0 has no earlier one). */
-BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om, float *zz,
-                               float *gg, float *ia)
+BR_NO_IVOPTS BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
+                                            float *zz, float *gg, float *ia)
 {
     for (uint32_t i = m - 1u; i > 0u; i--) {
         const uint32_t k = idx[i];
