@@ -633,6 +633,9 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     uint32_t n_ok = (uint32_t)n; /* less one for each particle that branches out */
 #endif
     float s1 = ls->s1, s2 = ls->s2;
+#if !BR_FLOAT_SIMD
+    const float *np = nn; /* particle j's samples, BR_NX = 4 of them */
+#endif
     for (size_t j = 0; j < n; j++) {
         const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
         float xn[BR_NX];
@@ -657,10 +660,16 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         const int ok_rk = br_model_kp_rk4(&kp, x, kg0, xn);
 #endif
         /* process noise sqrt(Q) n */
-        const float t = (xn[BR_X_THETA] + q0 * nn[BR_NX * j]) - shift;
-        const float w = xn[BR_X_OMEGA] + q1 * nn[BR_NX * j + 1u];
-        const float z = xn[BR_X_Z] + q2 * nn[BR_NX * j + 2u];
-        const float g = clamp_sel(xn[BR_X_GP] + q3 * nn[BR_NX * j + 3u], gp_min, gp_max);
+#if BR_FLOAT_SIMD
+        const float *const nj = nn + BR_NX * j;
+#else
+        float nj[BR_NX];
+        br_load4_f(&np, nj); /* the M7: one vldmia for the four samples */
+#endif
+        const float t = (xn[BR_X_THETA] + q0 * nj[0]) - shift;
+        const float w = xn[BR_X_OMEGA] + q1 * nj[1];
+        const float z = xn[BR_X_Z] + q2 * nj[2];
+        const float g = clamp_sel(xn[BR_X_GP] + q3 * nj[3], gp_min, gp_max);
         /* the particle's one division */
         const float kg = s0L / g;
         /* f_nl of the predicted particle (eqs. 3, 4) */

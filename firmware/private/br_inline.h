@@ -47,6 +47,38 @@
 #define BR_HOLD_U(v) ((void)0)
 #endif
 
+/* br_load4_f(&p, n): n[0..3] = p[0..3] and p += 4. On 32-bit Arm with an
+ * FPU one vldmia into four consecutive float registers (s12-s15; the
+ * compiler moves them on where it needs those registers) where GCC makes
+ * four loads and an add; elsewhere the four loads. The same values. */
+#if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
+typedef struct {
+    float v[4];
+} br_f4_t; /* the four floats the vldmia reads, for its memory operand */
+BR_INLINE void br_load4_f(const float **p, float n[4])
+{
+    register float n0 __asm__("s12");
+    register float n1 __asm__("s13");
+    register float n2 __asm__("s14");
+    register float n3 __asm__("s15");
+    __asm__("vldmia %4!, {s12-s15}" : "=t"(n0), "=t"(n1), "=t"(n2), "=t"(n3), "+r"(*p) : "m"(*(const br_f4_t *)*p));
+    n[0] = n0;
+    n[1] = n1;
+    n[2] = n2;
+    n[3] = n3;
+}
+#else
+BR_INLINE void br_load4_f(const float **p, float n[4])
+{
+    const float *const q = *p;
+    n[0] = q[0];
+    n[1] = q[1];
+    n[2] = q[2];
+    n[3] = q[3];
+    *p = q + 4;
+}
+#endif
+
 /* BR_FLOAT_SIMD: the target has vector registers for float (x86-64 SSE2,
  * Arm NEON). There the particle filter's loops are written branch-free, so
  * that the compiler vectorises them; without (the Cortex-M7) a branch costs
