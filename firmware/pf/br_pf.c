@@ -635,6 +635,7 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     float s1 = ls->s1, s2 = ls->s2;
 #if !BR_FLOAT_SIMD
     const float *np = nn; /* particle j's samples, BR_NX = 4 of them */
+    float *fp = fo, *lp = lo; /* f_nl and l stored by br_store_f_inc (vstmia with write-back) */
 #endif
     for (size_t j = 0; j < n; j++) {
         const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
@@ -706,8 +707,8 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
 #else
         if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
 #endif
-            fo[j] = 0.0f;
-            lo[j] = NAN;
+            br_store_f_inc(&fp, 0.0f);
+            br_store_f_inc(&lp, NAN);
             n_ok--;
             continue;
         }
@@ -718,9 +719,14 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         zz[j] = ok ? z : x[BR_X_Z];
         gg[j] = ok ? g : x[BR_X_GP];
         ka[j] = ok ? kg : kg0;
-        fo[j] = ok ? f : 0.0f;
         const float lk = ok ? l : NAN;
+#if BR_FLOAT_SIMD
+        fo[j] = ok ? f : 0.0f;
         lo[j] = lk;
+#else
+        br_store_f_inc(&fp, f);
+        br_store_f_inc(&lp, lk);
+#endif
 #if BR_FPU_MAXNM
         lm = fmaxf(lm, lk); /* fmaxf passes over a NaN */
 #else

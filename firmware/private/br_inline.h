@@ -47,10 +47,14 @@
 #define BR_HOLD_U(v) ((void)0)
 #endif
 
-/* br_load4_f(&p, n): n[0..3] = p[0..3] and p += 4. On 32-bit Arm with an
- * FPU one vldmia into four consecutive float registers (s12-s15; the
- * compiler moves them on where it needs those registers) where GCC makes
- * four loads and an add; elsewhere the four loads. The same values. */
+/* br_load4_f(&p, n): n[0..3] = p[0..3] and p += 4. br_store_f_inc(&p, v):
+ * *p = v and p += 1. On 32-bit Arm with an FPU one vldmia into four
+ * consecutive float registers (s12-s15; the compiler moves them on where it
+ * needs those registers) where GCC makes four loads and an add, and one
+ * vstmia with the pointer written back where GCC makes a store and an add
+ * (the PF's prediction loop without float SIMD: the noise samples, and
+ * f_nl and l, the two arrays the loop stores but does not load);
+ * elsewhere the plain loads and stores. The same values. */
 #if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
 typedef struct {
     float v[4];
@@ -67,7 +71,16 @@ BR_INLINE void br_load4_f(const float **p, float n[4])
     n[2] = n2;
     n[3] = n3;
 }
+BR_INLINE void br_store_f_inc(float **p, float v)
+{
+    __asm__("vstmia %0!, {%2}" : "+r"(*p), "=m"(**p) : "t"(v));
+}
 #else
+BR_INLINE void br_store_f_inc(float **p, float v)
+{
+    **p = v;
+    *p += 1;
+}
 BR_INLINE void br_load4_f(const float **p, float n[4])
 {
     const float *const q = *p;
