@@ -125,9 +125,16 @@ static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float to
     /* 2^(n + s): the exponent field (n + ebias) << 23 as the conversion of
      * r + ebias to fixed point with 23 fraction bits (vcvt #23, in the FPU;
      * every step exact: 1 <= n + ebias <= 143) */
+#if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
+    /* as an asm on the register itself: GCC's own vcvt #23 (the C form
+     * below) first copied its operand to another register */
+    float scale = r + (float)ebias;
+    __asm__("vcvt.s32.f32 %0, %0, #23" : "+t"(scale));
+#else
     const int32_t bits = (int32_t)((r + (float)ebias) * 8388608.0f);
     float scale;
     memcpy(&scale, &bits, sizeof scale);
+#endif
     return br_exp2_poly(f, &k) * scale;
 #else
     int32_t n = (int32_t)(t - k.half); /* truncation toward zero of t - 1/2, t <= 0 */
