@@ -609,6 +609,10 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
     const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
     const float shift = c->shift, y_rel = c->y_rel;
+#if BR_FPU_MAXNM && !BR_FLOAT_SIMD
+    uint32_t ah_lim_bits;
+    memcpy(&ah_lim_bits, &kp.ah_lim, sizeof ah_lim_bits);
+#endif
     float *BR_RESTRICT th = pf->x[BR_X_THETA] + j0;
     float *BR_RESTRICT om = pf->x[BR_X_OMEGA] + j0;
     float *BR_RESTRICT zz = pf->x[BR_X_Z] + j0;
@@ -629,6 +633,10 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
     uint32_t n_ok = (uint32_t)n; /* less one for each particle that branches out */
 #endif
     float s1 = ls->s1, s2 = ls->s2;
+#if !BR_FLOAT_SIMD
+    const float *np = nn; /* particle j's samples, BR_NX = 4 of them */
+    float *fp = fo, *lp = lo; /* f_nl and l stored by br_store_f_inc (vstmia with write-back) */
+#endif
     for (size_t j = 0; j < n; j++) {
         const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
         float xn[BR_NX];
@@ -645,15 +653,24 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
          * particles reach the fix-up either way. */
         float ah0, ah1;
         br_model_kp_rk4_step(&kp, x, kg0, xn, &ah0, &ah1);
-        const int ok_rk = fmaxf(ah0, ah1) <= kp.ah_lim;
+        const float ahm = fmaxf(ah0, ah1);
+#if BR_FLOAT_SIMD
+        const int ok_rk = ahm <= kp.ah_lim;
+#endif
 #else
         const int ok_rk = br_model_kp_rk4(&kp, x, kg0, xn);
 #endif
         /* process noise sqrt(Q) n */
-        const float t = (xn[BR_X_THETA] + q0 * nn[BR_NX * j]) - shift;
-        const float w = xn[BR_X_OMEGA] + q1 * nn[BR_NX * j + 1u];
-        const float z = xn[BR_X_Z] + q2 * nn[BR_NX * j + 2u];
-        const float g = clamp_sel(xn[BR_X_GP] + q3 * nn[BR_NX * j + 3u], gp_min, gp_max);
+#if BR_FLOAT_SIMD
+        const float *const nj = nn + BR_NX * j;
+#else
+        float nj[BR_NX];
+        br_load4_f(&np, nj); /* the M7: one vldmia for the four samples */
+#endif
+        const float t = (xn[BR_X_THETA] + q0 * nj[0]) - shift;
+        const float w = xn[BR_X_OMEGA] + q1 * nj[1];
+        const float z = xn[BR_X_Z] + q2 * nj[2];
+        const float g = clamp_sel(xn[BR_X_GP] + q3 * nj[3], gp_min, gp_max);
         /* the particle's one division */
         const float kg = s0L / g;
         /* f_nl of the predicted particle (eqs. 3, 4) */
@@ -671,9 +688,27 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
          * branch-free body: a particle for the fix-up (the bounded scheme, or
          * not valid) branches out, keeping its state in place (f_nl = 0,
          * l = NaN), and the selects below fold away for the valid ones */
+#if BR_FPU_MAXNM
+        /* the a h test and the validity test as one compare, on the bit
+         * patterns: v - v with v = t + f is +0 when t and f are finite (and
+         * v does not overflow), NaN otherwise, so c_ah = ahm + (v - v) is
+         * ahm (>= +0: k_p > 0) or a NaN. As unsigned integers the patterns
+         * of floats >= +0 order as the floats do and every NaN's, of either
+         * sign, lies above the limit's, so c_bits <= ah_lim_bits exactly
+         * when the particle is inside the RK4 limit and valid; the limit
+         * sits in an integer register, one float register more for the
+         * loop's constants. An overflow of t + f alone (both finite) sends
+         * a valid particle to the fix-up, which makes the same prediction
+         * (particle_one): the same results either way. */
+        const float v = t + f, c_ah = ahm + (v - v);
+        uint32_t c_bits;
+        memcpy(&c_bits, &c_ah, sizeof c_bits);
+        if (!(c_bits <= ah_lim_bits)) {
+#else
         if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
-            fo[j] = 0.0f;
-            lo[j] = NAN;
+#endif
+            br_store_f_inc(&fp, 0.0f);
+            br_store_f_inc(&lp, NAN);
             n_ok--;
             continue;
         }
@@ -684,9 +719,14 @@ BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t 
         zz[j] = ok ? z : x[BR_X_Z];
         gg[j] = ok ? g : x[BR_X_GP];
         ka[j] = ok ? kg : kg0;
-        fo[j] = ok ? f : 0.0f;
         const float lk = ok ? l : NAN;
+#if BR_FLOAT_SIMD
+        fo[j] = ok ? f : 0.0f;
         lo[j] = lk;
+#else
+        br_store_f_inc(&fp, f);
+        br_store_f_inc(&lp, lk);
+#endif
 #if BR_FPU_MAXNM
         lm = fmaxf(lm, lk); /* fmaxf passes over a NaN */
 #else
@@ -869,7 +909,9 @@ static float step_weight(const br_pf_t *pf, uint32_t j)
  * (memcpy): the Cortex-M7 then holds the five arrays in registers and
  * addresses them by index (integer loads and stores take a register offset,
  * float ones do not), where with pf->x it formed the 8 KiB-apart addresses
- * anew for every particle (docs/target.md).
+ * anew for every particle (docs/target.md). Both passes are compiled
+ * without GCC's induction variable optimisation (BR_NO_IVOPTS): each
+ * access then takes the index i itself as its register offset.
  * The forward pass, after resample_fused (the host's vector path makes it in
  * resample_forward): from i = 0 up to m - 2 (particle m - 1 has no later one). */
 static inline void move_particle(uint32_t i, uint32_t k, float *th, float *om, float *zz, float *gg, float *ia)
@@ -881,10 +923,11 @@ static inline void move_particle(uint32_t i, uint32_t k, float *th, float *om, f
     memcpy(&ia[i], &ia[k], sizeof ia[i]);
 }
 
-BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om, float *zz,
-                              float *gg, float *ia)
+BR_NO_IVOPTS BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
+                                           float *zz, float *gg, float *ia)
 {
-    for (uint32_t i = 0u; i + 1u < m; i++) {
+    const uint32_t last = m - 1u; /* m >= 1; the bound once, not i + 1 < m per particle */
+    for (uint32_t i = 0u; i < last; i++) {
         const uint32_t k = idx[i];
         if (k > i) {
             move_particle(i, k, th, om, zz, gg, ia);
@@ -894,8 +937,8 @@ BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float
 
 /* The backward pass, after copy_fwd_soa or resample_forward: from i = m - 1
  * down to 1 (particle 0 has no earlier one). */
-BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om, float *zz,
-                               float *gg, float *ia)
+BR_NO_IVOPTS BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
+                                            float *zz, float *gg, float *ia)
 {
     for (uint32_t i = m - 1u; i > 0u; i--) {
         const uint32_t k = idx[i];

@@ -21,6 +21,17 @@
 #define BR_NOINLINE static
 #endif
 
+/* BR_NO_IVOPTS: a function whose loops GCC compiles without its induction
+ * variable optimisation (elsewhere nothing). For the PF's in-place copy
+ * loops on the Cortex-M7: with it every access is addressed by the loop's
+ * own index (a register offset, shifted), one register and one add fewer
+ * per particle than the byte offset GCC otherwise keeps beside it. */
+#if defined(__GNUC__) && !defined(__clang__)
+#define BR_NO_IVOPTS __attribute__((optimize("no-ivopts")))
+#else
+#define BR_NO_IVOPTS
+#endif
+
 /* BR_HOLD_F(v), BR_HOLD_U(v): the float or uint32_t variable v keeps its
  * value, but the compiler no longer knows it (GCC on 32-bit Arm with an FPU: an
  * empty asm that takes v and gives it back in a register; elsewhere
@@ -34,6 +45,51 @@
 #else
 #define BR_HOLD_F(v) ((void)0)
 #define BR_HOLD_U(v) ((void)0)
+#endif
+
+/* br_load4_f(&p, n): n[0..3] = p[0..3] and p += 4. br_store_f_inc(&p, v):
+ * *p = v and p += 1. On 32-bit Arm with an FPU one vldmia into four
+ * consecutive float registers (s12-s15; the compiler moves them on where it
+ * needs those registers) where GCC makes four loads and an add, and one
+ * vstmia with the pointer written back where GCC makes a store and an add
+ * (the PF's prediction loop without float SIMD: the noise samples, and
+ * f_nl and l, the two arrays the loop stores but does not load);
+ * elsewhere the plain loads and stores. The same values. */
+#if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
+typedef struct {
+    float v[4];
+} br_f4_t; /* the four floats the vldmia reads, for its memory operand */
+BR_INLINE void br_load4_f(const float **p, float n[4])
+{
+    register float n0 __asm__("s12");
+    register float n1 __asm__("s13");
+    register float n2 __asm__("s14");
+    register float n3 __asm__("s15");
+    __asm__("vldmia %4!, {s12-s15}" : "=t"(n0), "=t"(n1), "=t"(n2), "=t"(n3), "+r"(*p) : "m"(*(const br_f4_t *)*p));
+    n[0] = n0;
+    n[1] = n1;
+    n[2] = n2;
+    n[3] = n3;
+}
+BR_INLINE void br_store_f_inc(float **p, float v)
+{
+    __asm__("vstmia %0!, {%2}" : "+r"(*p), "=m"(**p) : "t"(v));
+}
+#else
+BR_INLINE void br_store_f_inc(float **p, float v)
+{
+    **p = v;
+    *p += 1;
+}
+BR_INLINE void br_load4_f(const float **p, float n[4])
+{
+    const float *const q = *p;
+    n[0] = q[0];
+    n[1] = q[1];
+    n[2] = q[2];
+    n[3] = q[3];
+    *p = q + 4;
+}
 #endif
 
 /* BR_FLOAT_SIMD: the target has vector registers for float (x86-64 SSE2,

@@ -36,10 +36,8 @@ static inline br_exp_k_t br_exp_k(void)
     return k;
 }
 
-/* 2^(n + s) e^(f ln 2) for n >= -126, |f| <= 1/2, with ebias = 127 + s
- * (0 <= s <= 16): both forms of br_exp_neg end here (s = 0; s = 16 for
- * br_exp_neg_w) */
-static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k, int32_t ebias)
+/* e^(f ln 2) for |f| <= 1/2 */
+static inline float br_exp2_poly(float f, const br_exp_k_t *k)
 {
     /* e^y, y = f ln 2 in [-0.347, 0.347]: Taylor to degree 6 (Horner) */
     const float y = f * 0.693147181f;
@@ -50,11 +48,20 @@ static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k, int32
     p = p * y + k->half;
     p = p * y + k->one;
     p = p * y + k->one;
+    return p;
+}
+
+/* 2^(n + s) e^(f ln 2) for n >= -126, |f| <= 1/2, with ebias = 127 + s
+ * (0 <= s <= 16): both forms of br_exp_neg end here (s = 0; s = 16 for
+ * br_exp_neg_w), but the Cortex-M7's (BR_FPU_MAXNM), which makes the
+ * same 2^(n + s) in the FPU */
+static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k, int32_t ebias)
+{
     /* 2^(n + s) by building the exponent field */
     const uint32_t bits = (uint32_t)(n + ebias) << 23;
     float scale;
     memcpy(&scale, &bits, sizeof scale);
-    return p * scale;
+    return br_exp2_poly(f, k) * scale;
 }
 
 #if BR_FLOAT_SIMD
@@ -109,6 +116,27 @@ static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float to
     }
     /* x log2(e) = n + f, n = round-half-down, f in [-1/2, 1/2] */
     const float t = x * 1.44269504f;
+#if BR_FPU_MAXNM
+    /* FPv5's vrinta (roundf): t's nearest integer, ties away from zero,
+     * which for t < 0 is round-half-down; f = t - n is exact. The (n, f)
+     * of the branches below for every t < 0 (docs/modules/pf.md) */
+    const float r = roundf(t);
+    const float f = t - r;
+    /* 2^(n + s): the exponent field (n + ebias) << 23 as the conversion of
+     * r + ebias to fixed point with 23 fraction bits (vcvt #23, in the FPU;
+     * every step exact: 1 <= n + ebias <= 143) */
+#if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
+    /* as an asm on the register itself: GCC's own vcvt #23 (the C form
+     * below) first copied its operand to another register */
+    float scale = r + (float)ebias;
+    __asm__("vcvt.s32.f32 %0, %0, #23" : "+t"(scale));
+#else
+    const int32_t bits = (int32_t)((r + (float)ebias) * 8388608.0f);
+    float scale;
+    memcpy(&scale, &bits, sizeof scale);
+#endif
+    return br_exp2_poly(f, &k) * scale;
+#else
     int32_t n = (int32_t)(t - k.half); /* truncation toward zero of t - 1/2, t <= 0 */
     float f = t - (float)n;
     if (f > k.half) {
@@ -116,6 +144,7 @@ static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float to
         f -= k.one;
     }
     return br_exp2_parts(n, f, &k, ebias);
+#endif
 }
 #endif
 
