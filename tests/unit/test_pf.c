@@ -629,6 +629,31 @@ static void test_one_invalid_particle(void **st)
     free(pf);
 }
 
+/* theta not finite, the rest of the particle sane (velocity, deflection and
+ * g_p inside the RK4 limit): only the validity test can catch it, not the a h
+ * test; it must reach the fix-up, keep f_nl = 0 and weight 0, and never be
+ * resampled (the M7's combined compare: test_pf_m7_paths). */
+static void test_theta_nan_particle(void **st)
+{
+    (void)st;
+    br_pf_t *pf = new_pf(100);
+    br_meas_t y = {0, 0.5f};
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    const uint32_t bad = 9u;
+    pf->x[BR_X_THETA][bad] = NAN;
+    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    assert_true(isnan(pf->l[bad]));
+    assert_int_equal(pf->W[bad], 0u);
+    assert_true(pf->fnl[bad] == 0.0f);
+    for (uint32_t j = 0; j < 100; j++) {
+        assert_true(pf->idx[j] != bad);
+    }
+    assert_true(all_finite(pf));
+    assert_true(isfinite(br_pf_estimate(pf)->F_hat_N));
+    free(pf);
+}
+
 /* Only the last particle valid (every other one's f_nl overflows): the
  * whole weight is W_{m-1}, so every index of the resampled set is m - 1 on
  * both paths; the scalar path's search (resample_fused) has no j < m bound
@@ -936,6 +961,7 @@ int main(void)
         cmocka_unit_test(test_vector_path_is_scalar_path),
         cmocka_unit_test(test_gp_stays_in_range),
         cmocka_unit_test(test_one_invalid_particle),
+        cmocka_unit_test(test_theta_nan_particle),
         cmocka_unit_test(test_fnl_overflow_is_invalid),
         cmocka_unit_test(test_only_last_particle_valid),
         cmocka_unit_test(test_likelihood_scale),
