@@ -25,7 +25,10 @@
  * variable optimisation (elsewhere nothing). For the PF's in-place copy
  * loops on the Cortex-M7: with it every access is addressed by the loop's
  * own index (a register offset, shifted), one register and one add fewer
- * per particle than the byte offset GCC otherwise keeps beside it. */
+ * per particle than the byte offset GCC otherwise keeps beside it. GCC's
+ * manual meant the optimize attribute for debugging; here it holds two
+ * loops of integer loads and stores, and the replays' bit-identity
+ * (target_qemu_replay, _m4) checks what they compile to. */
 #if defined(__GNUC__) && !defined(__clang__)
 #define BR_NO_IVOPTS __attribute__((optimize("no-ivopts")))
 #else

@@ -119,7 +119,9 @@ static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float to
 #if BR_FPU_MAXNM
     /* FPv5's vrinta (roundf): t's nearest integer, ties away from zero,
      * which for t < 0 is round-half-down; f = t - n is exact. The (n, f)
-     * of the branches below for every t < 0 (docs/modules/pf.md) */
+     * of the branches below for every t = x log2(e) that occurs (one t < 0
+     * that no float x gives, -0x1.fffffep-2, differs), so the same float
+     * for all 2^32 x (docs/modules/pf.md) */
     const float r = roundf(t);
     const float f = t - r;
     /* 2^(n + s): the exponent field (n + ebias) << 23 as the conversion of
