@@ -151,7 +151,8 @@ class ToolsTest(unittest.TestCase):
             f.write(OLD)
         for bad in (["--dt", "5"], ["--dt", "0"], ["--dt", "inf"], ["--nsub", "0"], ["--nsub", "1001"],
                     ["--gains", "1,2"], ["--gains", "1,2,inf"], ["--gains", "1,2,3x"], ["--only", "nope"],
-                    ["--pf-proposal", "3"], ["--pf-proposal", "-1"], ["--bogus", "1"]):
+                    ["--pf-proposal", "3"], ["--pf-proposal", "-1"], ["--ahead", "2.5"], ["--ahead", "-0.1"],
+                    ["--ahead", "nan"], ["--bogus", "1"]):
             r = run("br_demo_circle", "--out", d, *bad)
             self.assert_refused(r, 2)
             with open(summary, "rb") as f:
@@ -171,7 +172,7 @@ class ToolsTest(unittest.TestCase):
     def test_robust_run_bad_options_touch_nothing(self):
         keep = self.existing("robust.json")
         for bad in (["--drift", "0.6"], ["--drift", "nan"], ["--force-noise", "-1"], ["--enc-noise", "1.5"],
-                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
+                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
                     ["--bogus", "1"], ["--drift"]):
             r = run("br_robust_run", "--json", keep, *bad)
             self.assert_refused(r, 2)
@@ -190,6 +191,9 @@ class ToolsTest(unittest.TestCase):
         self.assertNotIn("contour RMS", r.stdout)
         r = run("br_circle_ext", "--json", keep, "--delay", "1")
         self.assert_refused(r, 2, "delay_s")
+        for bad in ("2.5", "-0.1", "nan"):  # the lead's bounds, 0 .. BR_EST_AHEAD_MAX_PERIODS
+            r = run("br_circle_ext", "--json", keep, "--ahead", bad)
+            self.assert_refused(r, 2, "--ahead")
         r = run("br_circle_ext", "--json", keep, "--model", os.path.join(self.w, "none.json"))
         self.assert_refused(r, 1, "cannot open")
         self.assert_untouched(keep)
