@@ -84,10 +84,9 @@ int main(int argc, char **argv)
     br_outfile_t js = {0}; /* a temporary file until every run succeeded (br_outfile.h) */
     if (json) {
         if (br_outfile_open(&js, TOOL, json) != 0) return 1;
-        const br_circle_cfg_t c0 = br_circle_cfg_thesis(ctrl);
-        const double lead = (ahead >= 0.0) ? ahead
-                                           : (double)(use_pf ? c0.pf.est.comp_ahead_periods
-                                                             : c0.ukf.est.comp_ahead_periods);
+        br_circle_cfg_t c0 = br_circle_cfg_thesis(ctrl);
+        br_circle_use_ahead(&c0, ahead); /* the lead the runs below take */
+        const double lead = (double)(use_pf ? c0.pf.est.comp_ahead_periods : c0.ukf.est.comp_ahead_periods);
         fprintf(js.f,
                 "{\n  \"generator\": \"br_circle_ext (sim/apps/br_circle_ext.c)\",\n  \"estimator\": \"%s\",\n"
                 "  \"comp_ahead_periods\": %.9g",
@@ -96,10 +95,7 @@ int main(int argc, char **argv)
     for (int r = 0; r < (model ? 4 : 3); r++) {
         br_circle_cfg_t c = br_circle_cfg_thesis(runs[r].ctrl);
         c.plant = plant;
-        if (ahead >= 0.0) { /* every estimator run, nominal and extended, with the same lead */
-            c.pf.est.comp_ahead_periods = (float)ahead;
-            c.ukf.est.comp_ahead_periods = (float)ahead;
-        }
+        br_circle_use_ahead(&c, ahead); /* every estimator run, nominal and extended, with the same lead */
         if (runs[r].extended) {
             /* the estimator predicts and compensates with the diagnosed causes */
             const br_causes_t causes = br_causes_from_model(&saved);

@@ -281,10 +281,7 @@ int main(int argc, char **argv)
             }
             if (opt.nsub > 0) cfg.plant.n_sub = (int)opt.nsub;
             if (opt.pf_prop >= 0) cfg.pf.proposal = (uint32_t)opt.pf_prop;
-            if (opt.ahead >= 0.0) {
-                cfg.pf.est.comp_ahead_periods = (float)opt.ahead;
-                cfg.ukf.est.comp_ahead_periods = (float)opt.ahead;
-            }
+            br_circle_use_ahead(&cfg, opt.ahead);
             sinks_t k = {o.trace[pl][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl].f : NULL};
             br_circle_csv_header(k.trace);
             if (k.hist)

@@ -218,10 +218,7 @@ int main(int argc, char **argv)
         }
         if (pf_n > 0) c.pf.n_particles = (uint32_t)pf_n;
         if (pf_prop >= 0) c.pf.proposal = (uint32_t)pf_prop;
-        if (ahead >= 0.0) {
-            c.pf.est.comp_ahead_periods = (float)ahead;
-            c.ukf.est.comp_ahead_periods = (float)ahead;
-        }
+        br_circle_use_ahead(&c, ahead);
         if (runs[r].identified) br_circle_use_model(&c, &model);
         br_outfile_t tr = {0}, hi = {0};
         sinks_t k = {NULL, NULL};

@@ -67,6 +67,14 @@ br_circle_cfg_t br_circle_cfg_realistic(br_circle_ctrl_t controller)
     return c;
 }
 
+void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods)
+{
+    if (lead_periods >= 0.0) {
+        c->pf.est.comp_ahead_periods = (float)lead_periods;
+        c->ukf.est.comp_ahead_periods = (float)lead_periods;
+    }
+}
+
 void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *m)
 {
     br_model_cfg_t *ms[2] = {&c->pf.est.model, &c->ukf.est.model};

@@ -82,6 +82,11 @@ br_circle_cfg_t br_circle_cfg_realistic(br_circle_ctrl_t controller);
  * and viscous parameters and its causes (br_causes_from_model). */
 void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *model);
 
+/* The tools' --ahead: both estimators' compensation lead
+ * (est.comp_ahead_periods, docs/modules/est.md); lead < 0 leaves the
+ * machine file's. */
+void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods);
+
 /* The firmware's controller configuration of one axis of cfg: its gains and
  * period, the machine's torque limit, the plant's amplifier, encoder and lead
  * (also what sim/apps/br_track.c runs). */
