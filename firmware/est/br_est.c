@@ -109,13 +109,14 @@ float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_d
     if (!(lambda > 0.0f && lambda <= BR_EST_AHEAD_MAX_PERIODS) || (d->on && d->m > BR_EST_DELAY_HIST - 2u)) {
         return F_hat_N;
     }
-    /* (ahead 1) H = delay / dt + lambda = (dm + df) + lambda periods: n whole ones and fr of
-     * the next; n <= BR_EST_DELAY_HIST - 2 + 1 + BR_EST_AHEAD_MAX_PERIODS */
-    const float h = (d->on ? (float)d->m + d->f : 0.0f) + lambda;
-    const uint32_t n = (uint32_t)h;
-    const float fr = h - (float)n;
+    /* the delay dm + df periods (none when off) */
     const int32_t dm = d->on ? (int32_t)d->m : 0;
     const float df = d->on ? d->f : 0.0f;
+    /* (ahead 1) H = delay / dt + lambda = (dm + df) + lambda periods: n whole ones and fr of
+     * the next; n <= BR_EST_DELAY_HIST - 2 + 1 + BR_EST_AHEAD_MAX_PERIODS */
+    const float h = ((float)dm + df) + lambda;
+    const uint32_t n = (uint32_t)h;
+    const float fr = h - (float)n;
     float cur[BR_NX], nxt[BR_NX];
     for (int i = 0; i < BR_NX; i++) {
         cur[i] = x[i];
