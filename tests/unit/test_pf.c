@@ -51,6 +51,15 @@ static br_pf_t *new_pf(uint32_t m)
     return pf;
 }
 
+/* A PF of m particles after two steps at rest at y (the priming one and one more) */
+static br_pf_t *pf_at_rest(uint32_t m, const br_meas_t *y)
+{
+    br_pf_t *pf = new_pf(m);
+    assert_int_equal(br_pf_step(pf, y, 0.0f), BR_OK);
+    assert_int_equal(br_pf_step(pf, y, 0.0f), BR_OK);
+    return pf;
+}
+
 /* br_pf_stats of a primed filter */
 static br_pf_stats_t stats(const br_pf_t *pf)
 {
@@ -258,10 +267,8 @@ static void test_gate_quantisation(void **st)
 static void test_all_invalid_keeps_previous(void **st)
 {
     (void)st;
-    br_pf_t *pf = new_pf(100);
     br_meas_t y = {0, 0.5f};
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    br_pf_t *pf = pf_at_rest(100, &y);
     float th = pf->x[0][3];
     int32_t origin = pf->origin_counts;
     /* a torque that overflows every particle's velocity: no particle is usable */
@@ -595,10 +602,8 @@ static void test_gp_stays_in_range(void **st)
 static void test_one_invalid_particle(void **st)
 {
     (void)st;
-    br_pf_t *pf = new_pf(100);
-    br_meas_t y = {0, 0.5f};
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    const br_meas_t y = {0, 0.5f};
+    br_pf_t *pf = pf_at_rest(100, &y);
     const int bad[3] = {5, 6, 7};
     pf->x[BR_X_Z][5] = 3.0e38f;     /* f_nl overflows */
     pf->x[BR_X_OMEGA][6] = 3.0e38f; /* the velocity overflows */
@@ -636,10 +641,8 @@ static void test_one_invalid_particle(void **st)
 static void test_theta_nan_particle(void **st)
 {
     (void)st;
-    br_pf_t *pf = new_pf(100);
-    br_meas_t y = {0, 0.5f};
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+    const br_meas_t y = {0, 0.5f};
+    br_pf_t *pf = pf_at_rest(100, &y);
     const uint32_t bad = 9u;
     pf->x[BR_X_THETA][bad] = NAN;
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
