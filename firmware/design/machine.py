@@ -32,6 +32,11 @@ FORMAT_VERSION = 1
 PF_MAX_PARTICLES = 2048
 # BR_EST_AHEAD_MAX_PERIODS of firmware/include/bristle/br_est.h
 EST_AHEAD_MAX_PERIODS = 2.0
+# BR_DLYID_MAX_CAND of firmware/include/bristle/br_dlyid.h
+DLYID_MAX_CAND = 8
+# BR_EST_DELAY_HIST - 2 of firmware/include/bristle/br_est.h: the longest delay, in periods, an
+# estimator's command history holds
+EST_DELAY_MAX_PERIODS = 62
 
 
 class MachineError(Exception):
@@ -229,10 +234,10 @@ SCHEMA = {
             },
             "noise_skip": Int(0, 1024, "extra ROM noise-table advance per step (docs/modules/pf.md)"),
             "adapt": {
-                "nis_ref": Num(0.0, 1.0e6, "innovation-driven noise of z and g_p: the smoothed NIS above which "
+                "nis_ref": Num(0.0, 1.0e6, "innovation-driven noise of omega, z and g_p: the smoothed NIS above which "
                                "it grows; 0 = off (the thesis filter; docs/modules/pf.md)"),
                 "alpha": Num(0.0, 1.0, "smoothing of the NIS per measured step", lo_open=True),
-                "max_scale": Num(1.0, 1.0e12, "largest factor on the variances of z and g_p"),
+                "max_scale": Num(1.0, 1.0e12, "largest factor on the variances of omega, z and g_p"),
             },
         }, **_gates()),
         "ukf": dict({
@@ -248,6 +253,18 @@ SCHEMA = {
             "beta": Num(0.0, 10.0, "prior-distribution weight (2 for a Gaussian)"),
             "kappa": Num(-3.0, 100.0, "secondary scaling (n + kappa > 0, n = 4)", lo_open=True),
         }, **_gates()),
+        # actuator-delay identification while the axis runs, both estimators (docs/modules/dlyid.md);
+        # absent = off
+        "delay_id": Optional({
+            "candidates": Int(2, DLYID_MAX_CAND, "candidate delays 0, step_s, ..., (candidates - 1) step_s"),
+            "step_s": Num(0.0, 0.1, "their spacing", lo_open=True),
+            "q_force_N2_per_s": Num(0.0, 1.0e12, "the identifying filters' friction random walk, "
+                                    "variance per second", lo_open=True),
+            "memory_s": Num(0.0, 100.0, "time constant of the innovations' forgotten sums", lo_open=True),
+            "warmup_s": Num(0.0, 100.0, "no switch before this time after the first measurement"),
+            "switch_ratio": Num(0.0, 1.0, "switch when the best candidate's sum is below this times the sum "
+                                "of the delay in use", lo_open=True, hi_open=True),
+        }),
     },
     "limits": {
         "max_speed_mps": Num(0.0, 100.0, "largest table speed the axis is used at", lo_open=True),
@@ -334,6 +351,13 @@ def _cross_checks(m, errors):
         need([e + "gp_min_N", e + "gp_max_N", e + "gp0_N"],
              lambda: get(e + "gp_min_N") <= get(e + "gp0_N") <= get(e + "gp_max_N"),
              e + "gp0_N", "must lie in [%sgp_min_N, %sgp_max_N]" % (e, e))
+    periods = [("estimator.pf.period_s", get("estimator.pf.period_s")),
+               ("control.period_s", get("control.period_s"))]
+    d = "estimator.delay_id."
+    for name, T in periods:
+        need([d + "candidates", d + "step_s", name],
+             lambda: (get(d + "candidates") - 1) * get(d + "step_s") <= EST_DELAY_MAX_PERIODS * T,
+             d + "step_s", "(candidates - 1) * step_s must be <= %d periods of %s" % (EST_DELAY_MAX_PERIODS, name))
     need(["estimator.pf.adapt.nis_ref"],
          lambda: get("estimator.pf.adapt.nis_ref") == 0.0 or get("estimator.pf.adapt.nis_ref") >= 1.0e-6,
          "estimator.pf.adapt.nis_ref", "must be 0 (off) or >= 1e-6")

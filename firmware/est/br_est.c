@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "br_check.h"
+#include "br_dlyid_check.h"
 
 int br_est_var_ok(float v, int zero_ok)
 {
@@ -34,6 +35,9 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
         return BR_E_PARAM;
     }
     if (!(cfg->comp_ahead_periods >= 0.0f && cfg->comp_ahead_periods <= BR_EST_AHEAD_MAX_PERIODS)) {
+        return BR_E_PARAM;
+    }
+    if (!br_dlyid_cfg_ok(cfg)) {
         return BR_E_PARAM;
     }
     for (int i = 0; i < BR_NX; i++) {
@@ -65,7 +69,7 @@ void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg)
     const float q = cfg->model.causes.delay_s / cfg->model.dt_s;
     d->m = (uint32_t)q;
     d->f = q - (float)d->m;
-    d->on = cfg->model.causes.delay_s > 0.0f;
+    d->on = cfg->model.causes.delay_s > 0.0f || cfg->delay_id.n_cand > 0u;
     d->head = 0u;
     d->n = 0u;
     for (uint32_t i = 0; i < BR_EST_DELAY_HIST; i++) {
@@ -89,8 +93,13 @@ float br_est_delay_apply(br_est_delay_t *d, float u_prev_Nm)
     if (d->n < BR_EST_DELAY_HIST) {
         d->n++;
     }
+    return br_est_delay_torque(d, d->m, d->f);
+}
+
+float br_est_delay_torque(const br_est_delay_t *d, uint32_t m, float f)
+{
     /* u_a = (1 - f) u[k-1-m] + f u[k-2-m] */
-    return (1.0f - d->f) * cmd_ago(d, d->m) + d->f * cmd_ago(d, d->m + 1u);
+    return (1.0f - f) * cmd_ago(d, m) + f * cmd_ago(d, m + 1u);
 }
 
 /* u[k + i], the command of period k + i (u[k - 1] = u_prev, the newest):

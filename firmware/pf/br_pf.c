@@ -139,6 +139,7 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     pf->inv_2r = 0.5f / cfg->est.r_var_rad2;
     pf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
     br_est_delay_init(&pf->delay, &cfg->est);
+    br_est_dlyid_init(&pf->dlyid, &cfg->est);
     /* gate (docs/modules/pf.md): outlier when min_j e_j^2 > g^2 (R + rpc^2 / 12), R with
      * the encoder's quantisation; in log-weights l = -e^2 / (2 R): max_j l_j < -g^2 (R + rpc^2 / 12) / (2 R) */
     pf->outlier_l = -0.5f * cfg->est.outlier_sigma * cfg->est.outlier_sigma *
@@ -790,7 +791,12 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     for (int i = 0; i < BR_NX; i++) {
         c.q[i] = pf->q_std[i];
     }
-    /* cfg.adapt: z's and g_p's noise scaled (by exactly 1 while the smoothed NIS stays below its reference) */
+    /* cfg.adapt: omega's, z's and g_p's noise scaled (by exactly 1 while the smoothed NIS stays
+     * below its reference); omega's only for the bootstrap draw: cfg.proposal draws omega from
+     * its own constants (proposal_init), with which its held theta term stays consistent */
+    if (pf->cfg.proposal == BR_PF_PROPOSAL_PRIOR) {
+        c.q[BR_X_OMEGA] *= pf->q_scale_std;
+    }
     c.q[BR_X_Z] *= pf->q_scale_std;
     c.q[BR_X_GP] *= pf->q_scale_std;
     c.gp_min = pf->cfg.est.gp_min_N;
@@ -992,8 +998,8 @@ static float sum_state(const br_pf_t *pf, int i)
  * (y - mean theta_j)^2 / (var theta_j + R + rpc^2 / 12) over the n valid
  * particles (theta relative to the new origin; d_j = theta_j - y, whose
  * sums s1, s2 predict_and_weigh makes), limited to outlier_sigma^2 (also
- * for a NaN or an overflow); then E and the factor on z's and g_p's noise
- * std for the next predictions. */
+ * for a NaN or an overflow); then E and the factor on omega's, z's and g_p's
+ * noise std for the next predictions. */
 static void adapt_update(br_pf_t *pf, float s1, float s2, uint32_t n_valid)
 {
     const float n = (float)n_valid; /* exact: n_valid <= BR_PF_MAX_PARTICLES */
@@ -1023,6 +1029,9 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     }
     /* the torque that reached the axis over the last period (the command itself without a delay) */
     const float u_a = br_est_delay_apply(&pf->delay, u_prev_Nm);
+    /* the delay's identification (off unless cfg.est.delay_id.n_cand): from the next period on,
+     * the torque with the delay it finds */
+    (void)br_est_dlyid_step(&pf->dlyid, &pf->cfg.est, y, &pf->delay);
     if (!pf->primed) {
         prime(pf, y);
         return BR_OK;
@@ -1117,6 +1126,8 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     const uint32_t m = pf->cfg.n_particles;
     /* step 1 only: the log-weights against a dummy measurement are not used */
     float lmax, sums[2];
+    /* no measurement: the delay's identification starts again at the next one */
+    pf->dlyid.primed = 0;
     const uint32_t n_valid = predict_and_weigh(pf, br_est_delay_apply(&pf->delay, u_prev_Nm), 0.0f, 0.0f, 0, &lmax,
                                                sums);
     noise_advance(pf);

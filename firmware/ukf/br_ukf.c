@@ -78,6 +78,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->quant_var_rad2 = cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f);
     ukf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
     br_est_delay_init(&ukf->delay, &cfg->est);
+    br_est_dlyid_init(&ukf->dlyid, &cfg->est);
     for (int i = 0; i < BR_NX; i++) {
         ukf->x[i] = 0.0f;
         for (int j = 0; j < BR_NX; j++) {
@@ -344,6 +345,9 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     }
     /* the torque that reached the axis over the last period (the command itself without a delay) */
     const float u_a = br_est_delay_apply(&ukf->delay, u_prev_Nm);
+    /* the delay's identification (off unless cfg.est.delay_id.n_cand): from the next period on,
+     * the torque with the delay it finds */
+    (void)br_est_dlyid_step(&ukf->dlyid, &ukf->cfg.est, y, &ukf->delay);
     if (!ukf->primed) {
         return prime(ukf, y);
     }
@@ -456,6 +460,8 @@ br_status_t br_ukf_predict(br_ukf_t *ukf, float u_prev_Nm)
     }
     float xm[BR_NX], Pm[BR_NX][BR_NX];
     int chol_reset;
+    /* no measurement: the delay's identification starts again at the next one */
+    ukf->dlyid.primed = 0;
     if (!predict(ukf, br_est_delay_apply(&ukf->delay, u_prev_Nm), xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }

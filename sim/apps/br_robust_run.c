@@ -12,12 +12,14 @@
  *
  * Usage: br_robust_run [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N]
  *                      [--enc-noise P] [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT]
- *                      [--pf-dt S] [--pf-n M] [--pf-proposal K] [--ahead P]
+ *                      [--pf-dt S] [--pf-n M] [--pf-proposal K] [--ahead P] [--delay-id 0|1]
  * --pf-dt, --pf-n: the PF runs at another period / with another particle
  * count (docs/robustness.md, "PF variants"; the tuned variances per step kept).
  * --pf-proposal: the PF's br_pf_cfg_t.proposal (0 the thesis's, 1 OPT, 2
  * OPT_HELD; docs/modules/pf.md).
  * --ahead: every estimator's est.comp_ahead_periods (docs/modules/est.md).
+ * --delay-id 0: the estimators without the machine's delay identification
+ * (est.delay_id, docs/modules/dlyid.md); 1: with it (the default).
  * --dir writes trace_<name>.csv per run and gp_hist_<name>.csv per PF run
  * (the demo's formats). The JSON is written to a temporary file renamed at
  * the end (br_outfile.h): a failed run writes nothing. Exit 0, 1 (a run or a
@@ -57,7 +59,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N] [--enc-noise P]\n"
             "       [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT] [--pf-dt S] [--pf-n M]\n"
-            "       [--pf-proposal K] [--ahead P]\n"
+            "       [--pf-proposal K] [--ahead P] [--delay-id 0|1]\n"
             BR_ARGS_COMMON_USAGE
             "  --plant PLANT.json  the simulated plant (a model.json; default the reference machine)\n"
             "  --model MODEL.json  the identified model the *_id runs' estimators and feedforward use\n"
@@ -74,6 +76,7 @@ static int usage(const char *argv0, FILE *to)
             "  --pf-proposal K     the PF runs' proposal: 0 the prior (thesis), 1 optimal for theta, 2 with omega's\n"
             "                      noise held over the period (docs/modules/pf.md)\n"
             "  --ahead P           the estimators' compensation lead, periods past the delay (docs/modules/est.md)\n"
+            "  --delay-id 0|1      the estimators' delay identification off / as the machine has it (docs/modules/dlyid.md)\n"
             "runs:", argv0, argv0);
     for (unsigned r = 0; r < N_RUNS; r++) fprintf(to, " %s", runs[r].name);
     fprintf(to, " (the *_id ones need --model)\n");
@@ -130,7 +133,7 @@ int main(int argc, char **argv)
     const char *plant_path = NULL, *model_path = NULL, *json = NULL, *only = NULL, *dir = NULL;
     br_circle_real_t real = {0.0, 0.0, 0.0, 0u};
     double veps = -1.0, pf_dt = -1.0, ahead = -1.0;
-    long pf_n = 0, pf_prop = -1;
+    long pf_n = 0, pf_prop = -1, delay_id = -1;
     static const struct option opts[] = {
         {"plant", required_argument, NULL, 'P'},  {"model", required_argument, NULL, 'm'},
         {"json", required_argument, NULL, 'j'},   {"only", required_argument, NULL, 'o'},
@@ -139,7 +142,7 @@ int main(int argc, char **argv)
         {"ff-veps", required_argument, NULL, 'v'}, {"pf-dt", required_argument, NULL, 't'},
         {"pf-n", required_argument, NULL, 'n'},   {"seed", required_argument, NULL, 's'},
         {"pf-proposal", required_argument, NULL, 'p'}, {"ahead", required_argument, NULL, 'a'},
-        {NULL, 0, NULL, 0}};
+        {"delay-id", required_argument, NULL, 'i'}, {NULL, 0, NULL, 0}};
     br_args_t ap;
     if (br_args_start(&ap, TOOL, argc, argv, usage)) return 0;
     const char *val;
@@ -160,6 +163,7 @@ int main(int argc, char **argv)
         case 'n': bad = br_arg_long(TOOL, ap.opt, val, 1, BR_TOOL_PARTICLES_MAX, &pf_n); break;
         case 'p': bad = br_arg_long(TOOL, ap.opt, val, 0, (long)BR_PF_PROPOSAL_OPT_HELD, &pf_prop); break;
         case 'a': bad = br_arg_double(TOOL, ap.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &ahead); break;
+        case 'i': bad = br_arg_long(TOOL, ap.opt, val, 0, 1, &delay_id); break;
         case 's':
             bad = br_arg_long(TOOL, ap.opt, val, 0, 2147483647L, &seed);
             real.seed = (unsigned long long)seed;
@@ -219,6 +223,7 @@ int main(int argc, char **argv)
         if (pf_n > 0) c.pf.n_particles = (uint32_t)pf_n;
         if (pf_prop >= 0) c.pf.proposal = (uint32_t)pf_prop;
         br_circle_use_ahead(&c, ahead);
+        br_circle_use_delay_id(&c, delay_id);
         if (runs[r].identified) br_circle_use_model(&c, &model);
         br_outfile_t tr = {0}, hi = {0};
         sinks_t k = {NULL, NULL};

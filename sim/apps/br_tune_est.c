@@ -14,8 +14,9 @@
  * generated header (used by sim/circle/br_circle_est.c) and, with --log, the
  * progress (iteration, evaluations, best contour RMS, parameters) for Fig. 1.
  * The objective is penalised by the outlier steps (lost lock); with
- * --guard-outliers K (PF) also by those on the guard plants (docs/tuning.md,
- * "A noise-aware objective"). The start is
+ * --guard-outliers K (PF; default BR_TUNE_GUARD_OUTLIERS_PF, what `make tune`
+ * runs) also by those on the guard plants (docs/tuning.md, "A noise-aware
+ * objective"). The start is
  * the hand-tuned default of the machine file's estimator section; each log-variance may move 3 decades
  * either way (bounds by the change of variables of br_nm). The outputs are
  * written beside their names and renamed once the tuning succeeded
@@ -114,6 +115,10 @@ static int cmp_double(const void *a, const void *b)
 /* --guard-outliers' upper bound: one outlier step then counts as 1000 times
  * the contour RMS */
 #define BR_TUNE_GUARD_OUTLIERS_MAX 1000.0
+/* --guard-outliers' default, the PF's `make tune`: a tuning that keeps lock on
+ * the noisy guard plants (the robustness set loses no plant with it, against
+ * 10 with the nominal objective alone; docs/tuning.md) */
+#define BR_TUNE_GUARD_OUTLIERS_PF 0.01
 
 /* The PF's guard plants, each without a safe stop: 0 when all pass, otherwise
  * BR_TUNE_GUARD_PENALTY_M times (failed guards + the share of the run lost);
@@ -210,10 +215,10 @@ static int usage(const char *argv0, FILE *to)
             "  --plants LIST       model.json files, comma-separated: tune for a set of plants (robust objective)\n"
             "  --stat median|p90   the set's statistic the objective takes (default median)\n"
             "  --guard-noise F     PF: the force noise of the noisy guard plant, N (default %g)\n"
-            "  --guard-outliers K  PF: the objective x (1 + K x the guard plants' outlier steps) (default 0)\n"
+            "  --guard-outliers K  PF: the objective x (1 + K x the guard plants' outlier steps) (default %g)\n"
             "bounds: --max-fev 1 .. %d (docs/tools.md), at most %d plants, --guard-noise 0 .. %g,\n"
             "        --guard-outliers 0 .. %g\n",
-            argv0, argv0, BR_TUNE_GUARD_FORCE_NOISE_N, BR_TOOL_MAX_FEV, MAX_PLANTS, BR_TUNE_GUARD_NOISE_MAX_N,
+            argv0, argv0, BR_TUNE_GUARD_FORCE_NOISE_N, BR_TUNE_GUARD_OUTLIERS_PF, BR_TOOL_MAX_FEV, MAX_PLANTS, BR_TUNE_GUARD_NOISE_MAX_N,
             BR_TUNE_GUARD_OUTLIERS_MAX);
     return 2;
 }
@@ -222,7 +227,7 @@ int main(int argc, char **argv)
 {
     const char *est = NULL, *out = NULL, *log_path = NULL, *plants = NULL, *stat = "median";
     long max_fev = 0;
-    double guard_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N, guard_outliers = 0.0;
+    double guard_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N, guard_outliers = BR_TUNE_GUARD_OUTLIERS_PF;
     int guard_opt = 0; /* --guard-noise or --guard-outliers given */
     static const struct option opts[] = {{"est", required_argument, NULL, 'e'},
                                          {"out", required_argument, NULL, 'o'},

@@ -117,7 +117,7 @@ class NumpyPf:
         self.kp_czd = (self.L * self.s1) * self.inv_jeff
         self.ah_lim = RK4_AH_MAX / self.h
         self.q_std = np.sqrt(np.array(cfg["q_var"], dtype=F)).reshape(4, 1)
-        # cfg.adapt, the innovation-driven noise of z and g_p (adapt_update)
+        # cfg.adapt, the innovation-driven noise of omega, z and g_p (adapt_update)
         ad = cfg.get("adapt", {})
         self.nis_ref = F(ad.get("nis_ref", 0.0))
         self.alpha, self.max_scale = F(ad.get("alpha", 0.0)), F(ad.get("max_scale", 1.0))
@@ -252,7 +252,7 @@ class NumpyPf:
         th, om, z = self._model_step_kp(x[0], x[1], x[2], x[3], u)
         n = self._noise()
         th = th + self.q_std[0] * n[0]
-        om = om + self.q_std[1] * n[1]
+        om = om + (self.q_std[1] * self.q_scale) * n[1]
         z = z + (self.q_std[2] * self.q_scale) * n[2]
         gp = np.fmin(np.fmax(x[3] + (self.q_std[3] * self.q_scale) * n[3], self.gp_min), self.gp_max)
         th = th - shift

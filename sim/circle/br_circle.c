@@ -75,6 +75,14 @@ void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods)
     }
 }
 
+void br_circle_use_delay_id(br_circle_cfg_t *c, long on)
+{
+    if (on == 0) {
+        c->pf.est.delay_id.n_cand = 0u;
+        c->ukf.est.delay_id.n_cand = 0u;
+    }
+}
+
 void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *m)
 {
     br_model_cfg_t *ms[2] = {&c->pf.est.model, &c->ukf.est.model};

@@ -87,6 +87,10 @@ void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *model);
  * machine file's. */
 void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods);
 
+/* The tools' --delay-id: 0 turns both estimators' delay identification off
+ * (est.delay_id, docs/modules/dlyid.md); any other value leaves the machine's. */
+void br_circle_use_delay_id(br_circle_cfg_t *c, long on);
+
 /* The firmware's controller configuration of one axis of cfg: its gains and
  * period, the machine's torque limit, the plant's amplifier, encoder and lead
  * (also what sim/apps/br_track.c runs). */

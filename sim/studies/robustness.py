@@ -94,7 +94,7 @@ def run(cmd, env=None):
 
 
 def one_plant(job):
-    i, seed, binp, out, diagnose, only, pf_proposal, ahead = job
+    i, seed, binp, out, diagnose, only, pf_proposal, ahead, delay_id = job
     ref = reference()
     p = draw(seed, ref)
     d = os.path.join(out, "plants", f"{i:04d}")
@@ -134,6 +134,8 @@ def one_plant(job):
         cmd += ["--pf-proposal", str(pf_proposal)]
     if ahead is not None:
         cmd += ["--ahead", repr(ahead)]
+    if delay_id is not None:
+        cmd += ["--delay-id", str(delay_id)]
     rc, _, err = run(cmd)
     if rc != 0:
         rec["error"] = err.strip()
@@ -356,6 +358,9 @@ def main():
                     help="the PF runs' proposal (br_robust_run --pf-proposal; docs/modules/pf.md)")
     ap.add_argument("--ahead", type=float,
                     help="the estimators' compensation lead (br_robust_run --ahead; docs/modules/est.md)")
+    ap.add_argument("--delay-id", type=int, choices=(0, 1),
+                    help="0: the estimators without the machine's delay identification (br_robust_run "
+                         "--delay-id; docs/modules/dlyid.md)")
     ap.add_argument("--only", help="the controllers to run, comma-separated (br_robust_run's --only; "
                     "hinf_only always runs: the statistics compare with it)")
     a = ap.parse_args()
@@ -381,7 +386,7 @@ def main():
         if bad_names:
             ap.error(f"--only: unknown controllers {bad_names}")
         only = ",".join(["hinf_only"] + [k for k in names if k != "hinf_only"])
-    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only, a.pf_proposal, a.ahead) for i in range(a.n)]
+    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only, a.pf_proposal, a.ahead, a.delay_id) for i in range(a.n)]
     recs, t0 = [], time.time()
     progress(0, a.n, t0)
     with Pool(a.jobs) as pool:

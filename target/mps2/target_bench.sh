@@ -33,7 +33,9 @@ m_lo=${BR_BENCH_M_LO:-100}
 command -v "$qemu" >/dev/null || { echo "target-bench: $qemu not found (make deps)" >&2; exit 1; }
 [[ -f $image && -f $map ]] || { echo "target-bench: no image/map at $image" >&2; exit 1; }
 mkdir -p "$out"
-"$host/tests/target/br_replay_record" --out "$out/stream.bin" --duration 1.0 >/dev/null
+# the PF's scaling: streams without the delay identification (docs/modules/dlyid.md), replayed at
+# other m than recorded; its own cost per period is measured at m_hi on a stream with it, below
+"$host/tests/target/br_replay_record" --out "$out/stream.bin" --duration 1.0 --delay-id 0 >/dev/null
 
 declare -A mean med min max p99 ipt
 for m in "$m_hi" "$m_lo"; do
@@ -90,8 +92,8 @@ awk -v n="$un" -v s="$usum" -v mx="$umax" -v ci="$uci" -v ct="$uct" -v sz="$usz"
 # closed loop, a prefix of the 20-period stream); per period k >= 1 that is at
 # m_hi and at m_lo, whose slope is the count per particle-step and whose
 # intercept the fixed part's, as for the instructions above.
-"$host/tests/target/br_replay_record" --out "$out/stream_prof.bin" --duration 0.03 >/dev/null
-"$host/tests/target/br_replay_record" --out "$out/stream_prime.bin" --duration 0.0001 >/dev/null  # k = 0 only
+"$host/tests/target/br_replay_record" --out "$out/stream_prof.bin" --duration 0.03 --delay-id 0 >/dev/null
+"$host/tests/target/br_replay_record" --out "$out/stream_prime.bin" --duration 0.0001 --delay-id 0 >/dev/null  # k = 0 only
 # trace STREAM M NAME: runs the image on STREAM at m = M with the block log $out/qemu_NAME.log
 trace() {
   "$qemu" -M "$machine" -nographic -monitor none -serial none -icount shift=0 \
@@ -144,12 +146,29 @@ BEGIN {
   printf "long_ops_summary cycles_per_particle_step=%.2f cycles_fixed=%.0f cycles_period=%.0f m_two_axes_80=%d long_fixed=%.4f\n", cps, cfix, cper, m80x2, dfix
 }' | tee "$out/cycles.txt" | grep -v '^long_ops_summary'
 
+# The machine's delay identification (docs/modules/dlyid.md) on: one run at m_hi on a stream
+# recorded with it (the closed loop's own commands, so the replay is that loop); its cost per
+# period is the difference of the means, instructions, against the run without it above.
+"$host/tests/target/br_replay_record" --out "$out/stream_id.bin" --duration 1.0 >/dev/null
+log=$("$qemu" -M "$machine" -nographic -monitor none -serial none -icount shift=0 \
+  -semihosting-config "enable=on,target=native,arg=replay,arg=$out/stream_id.bin,arg=$out/target_id.bin,arg=$m_hi" \
+  -kernel "$image" 2>&1)
+echo "$log" > "$out/qemu_id.log"
+read -r ci ct < <(sed -n 's/^calib insns=\([0-9]*\) ticks=\([0-9]*\).*/\1 \2/p' <<<"$log")
+[[ -n ${ct:-} && $ct -gt 0 ]] || { echo "target-bench: calibration failed: $log" >&2; exit 1; }
+read -r _ mean_id _ _ max_id _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_id.bin")
+awk -v m="$m_hi" -v a="$mean_id" -v x="$max_id" -v i="$ci" -v t="$ct" -v a0="${mean[$m_hi]}" -v i0="${ipt[$m_hi]}" \
+    -v mhz="$mhz" -v P="$period" 'BEGIN {
+  d = a * i / t - a0 * i0
+  printf "  with the delay identification (the machine'"'"'s, on its own stream): m = %d: mean %.0f  max %.0f instructions per period; its cost %+.0f instructions per period (%.2f%% of the period at %d MHz, one cycle each)\n", m, a * i / t, x * i / t, d, 100 * d / P, mhz
+}' | tee -a "$out/cycles.txt"
+
 # Two axes on one MCU: the replay image runs both axes of the X-Y table every
 # period (stream version 2) at the estimate's largest m per axis within 80 %;
 # measured instructions per period, charged as above.
 m2=$(sed -n 's/^long_ops_summary .* m_two_axes_80=\([0-9]*\) .*/\1/p' "$out/cycles.txt")
 lfix=$(sed -n 's/^long_ops_summary .* long_fixed=\([0-9.]*\)$/\1/p' "$out/cycles.txt")  # fixed long instructions per axis and period
-"$host/tests/target/br_replay_record" --out "$out/stream_xy.bin" --duration 1.0 --axes 2 >/dev/null
+"$host/tests/target/br_replay_record" --out "$out/stream_xy.bin" --duration 1.0 --axes 2 --delay-id 0 >/dev/null
 # run_xy M: prints "M mean_instructions max_instructions cycles_mean cycles_max periods"
 run_xy() {
   local m=$1 log ci ct nxy axy xxy

@@ -62,6 +62,13 @@ void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WOR
     w[i++] = f2w(c->pf.adapt.max_scale);
     /* cfg.est.comp_ahead_periods (zero in a stream without it: the filtered estimate) */
     w[i++] = f2w(c->pf.est.comp_ahead_periods);
+    /* cfg.est.delay_id (zeros in a stream without them: off) */
+    w[i++] = c->pf.est.delay_id.n_cand;
+    w[i++] = f2w(c->pf.est.delay_id.step_s);
+    w[i++] = f2w(c->pf.est.delay_id.q_force_N2ps);
+    w[i++] = f2w(c->pf.est.delay_id.memory_s);
+    w[i++] = f2w(c->pf.est.delay_id.warmup_s);
+    w[i++] = f2w(c->pf.est.delay_id.switch_ratio);
     while (i < BR_REPLAY_HDR_WORDS) w[i++] = 0u;
 }
 
@@ -107,6 +114,12 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
     c->pf.adapt.alpha = w2f(w[i++]);
     c->pf.adapt.max_scale = w2f(w[i++]);
     c->pf.est.comp_ahead_periods = w2f(w[i++]);
+    c->pf.est.delay_id.n_cand = w[i++];
+    c->pf.est.delay_id.step_s = w2f(w[i++]);
+    c->pf.est.delay_id.q_force_N2ps = w2f(w[i++]);
+    c->pf.est.delay_id.memory_s = w2f(w[i++]);
+    c->pf.est.delay_id.warmup_s = w2f(w[i++]);
+    c->pf.est.delay_id.switch_ratio = w2f(w[i++]);
     if (c->pf.noise_len != BR_NOISE_LEN) return BR_E_PARAM;
     c->pf.noise = br_noise_table;
     return BR_OK;

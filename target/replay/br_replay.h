@@ -9,7 +9,9 @@
  *           (model 10 floats, m, q_var[4], r, gp0, x0_std[4], gp_min, gp_max,
  *           outlier_sigma, reanchor_after, rad_per_count, noise_len, noise_skip,
  *           adapt.nis_ref, adapt.alpha, adapt.max_scale; zeros there: adapt off;
- *           est.comp_ahead_periods; zero there: no lead),
+ *           est.comp_ahead_periods; zero there: no lead; est.delay_id's
+ *           n_cand, step_s, q_force_N2ps, memory_s, warmup_s, switch_ratio;
+ *           zeros there: off),
  *           floats as their bit patterns, so every value is exact;
  *   steps   n_steps records of 4 words per axis: encoder counts (int32),
  *           reference counts (int32), reference fraction (float), reference
@@ -35,7 +37,7 @@
 #define BR_REPLAY_VERSION 1u   /* one axis */
 #define BR_REPLAY_VERSION_XY 2u /* two axes */
 #define BR_REPLAY_MAX_AXES 2u
-#define BR_REPLAY_HDR_WORDS 44u
+#define BR_REPLAY_HDR_WORDS 52u
 #define BR_REPLAY_STEP_WORDS 4u
 #define BR_REPLAY_OUT_WORDS 6u
 #define BR_REPLAY_FNV_OFFSET 2166136261u

@@ -327,6 +327,8 @@ br_est_cfg_t br_trace_est_cfg(const br_trace_t *t)
 {
     br_est_cfg_t e;
     double q[4];
+    /* what the trace does not name is off: no compensation lead, no delay identification */
+    memset(&e, 0, sizeof e);
     e.model = br_trace_model_cfg(t);
     br_trace_meta_nums(t, "q_var", q, 4);
     for (int i = 0; i < 4; i++) e.q_var[i] = (float)q[i];

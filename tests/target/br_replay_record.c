@@ -7,7 +7,13 @@
  * which the host replay must reproduce.
  *
  *   br_replay_record --out stream.bin [--expect expect.bin] [--duration 1.0] [--axes 1|2] [--ahead L]
- * --ahead: the PF's est.comp_ahead_periods (docs/modules/est.md), in the circle and the stream. */
+ *                    [--delay-id 0|1]
+ * --ahead: the PF's est.comp_ahead_periods (docs/modules/est.md), in the circle and the stream.
+ * --delay-id 0: the PF without the machine's delay identification (est.delay_id,
+ * docs/modules/dlyid.md), in the circle and the stream; 1 (default): the machine's. A stream
+ * replayed at another m than it was recorded at is no closed loop (the commands change, the
+ * counts do not), which the identification may take for a delay: the bench's scaling runs
+ * take it off. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -67,25 +73,29 @@ int main(int argc, char **argv)
     double duration = 1.0;
     uint32_t n_axes = 1u;
     double ahead = 0.0;
+    int delay_id = 1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
         else if (!strcmp(argv[i], "--expect") && i + 1 < argc) expect = argv[++i];
         else if (!strcmp(argv[i], "--duration") && i + 1 < argc) duration = atof(argv[++i]);
         else if (!strcmp(argv[i], "--axes") && i + 1 < argc) n_axes = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--ahead") && i + 1 < argc) ahead = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--delay-id") && i + 1 < argc) delay_id = atoi(argv[++i]);
         else {
             fprintf(stderr, "usage: br_replay_record --out FILE [--expect FILE] [--duration S] [--axes 1|2] "
-                            "[--ahead L]\n");
+                            "[--ahead L] [--delay-id 0|1]\n");
             return 2;
         }
     }
-    if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u || !(ahead >= 0.0 && ahead <= (double)BR_EST_AHEAD_MAX_PERIODS)) {
-        fprintf(stderr, "br_replay_record: --out is required, duration > 0, axes 1 or 2, ahead in [0, 2]\n");
+    if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u || !(ahead >= 0.0 && ahead <= (double)BR_EST_AHEAD_MAX_PERIODS) ||
+        (delay_id != 0 && delay_id != 1)) {
+        fprintf(stderr, "br_replay_record: --out is required, duration > 0, axes 1 or 2, ahead in [0, 2], delay-id 0 or 1\n");
         return 2;
     }
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     c.duration_s = duration;
     c.pf.est.comp_ahead_periods = (float)ahead;
+    br_circle_use_delay_id(&c, delay_id);
     rec_t r = {&c, tmpfile(), NULL, 0u, n_axes};
     if (r.steps == NULL) return 1;
     if (expect && (r.expect = fopen(expect, "wb")) == NULL) {

@@ -13,10 +13,13 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 rm -rf "$work" && mkdir -p "$work"
 "$record" --out "$work/stream.bin" --duration 0.03 --axes 2 >/dev/null || fail "recording"
 K=10
-python3 - "$work/stream.bin" "$work/bad.bin" "$K" <<'PY' || fail "no stream to corrupt"
-import struct, sys
+hdr_h=$(dirname "$0")/../../target/replay/br_replay.h
+python3 - "$work/stream.bin" "$work/bad.bin" "$K" "$hdr_h" <<'PY' || fail "no stream to corrupt"
+import re, struct, sys
 d = bytearray(open(sys.argv[1], "rb").read())
-hdr, words, axes, k = 44, 4, 2, int(sys.argv[3])  # br_replay.h: header words, words per period and axis
+h = open(sys.argv[4]).read()  # br_replay.h: header words, words per period and axis
+hdr, words = (int(re.search(r"#define %s (\d+)u" % n, h).group(1)) for n in ("BR_REPLAY_HDR_WORDS", "BR_REPLAY_STEP_WORDS"))
+axes, k = 2, int(sys.argv[3])
 off = 4 * (hdr + words * axes * k)  # period k, axis 0: its counts
 struct.pack_into("<i", d, off, struct.unpack_from("<i", d, off)[0] + 1000000)
 open(sys.argv[2], "wb").write(d)

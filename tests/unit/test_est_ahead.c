@@ -71,6 +71,7 @@ static br_pf_t *pf_with_lead(float lead, int extended, br_pf_cfg_t *cp)
     assert_non_null(pf);
     *cp = br_circle_pf_cfg_tuned(PF_DT_S);
     cp->n_particles = 200u;
+    cp->est.delay_id.n_cand = 0u; /* the test's made-up motion is no axis: no delay to identify */
     cp->est.comp_ahead_periods = lead;
     if (extended) {
         with_position_causes(&cp->est.model);
@@ -86,6 +87,7 @@ static void test_no_lead_is_the_estimate(void **st)
     br_ukf_t u;
     br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
     cu.est.comp_ahead_periods = 0.0f;
+    cu.est.delay_id.n_cand = 0u; /* as the PF's */
     assert_int_equal(br_ukf_init(&u, &cu), BR_OK);
     br_pf_cfg_t cp;
     br_pf_t *pf = pf_with_lead(0.0f, 0, &cp);
@@ -121,6 +123,7 @@ static void run_carry_case(float delay_periods, float lead, int extended)
     br_ukf_t u;
     br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
     cu.est.model.causes.delay_s = delay_periods * UKF_DT_S;
+    cu.est.delay_id.n_cand = 0u; /* the delay is the test's, not identified */
     if (extended) {
         with_position_causes(&cu.est.model);
     }

@@ -124,7 +124,8 @@ static void test_init_guards(void **st)
      * so long that (h/2)^2 Q_omega overflows is refused with OPT_HELD only) */
     c = cfg(100); c.proposal = BR_PF_PROPOSAL_OPT_HELD + 1u; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg(100); c.proposal = BR_PF_PROPOSAL_OPT_HELD;   assert_int_equal(br_pf_init(pf, &c), BR_OK);
-    c = cfg(100); c.est.model.dt_s = 1e20f;               assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    /* (the delay identification's constants overflow at such a period: off here, test_dlyid) */
+    c = cfg(100); c.est.model.dt_s = 1e20f; c.est.delay_id.n_cand = 0u; assert_int_equal(br_pf_init(pf, &c), BR_OK);
     c.proposal = BR_PF_PROPOSAL_OPT;                      assert_int_equal(br_pf_init(pf, &c), BR_OK);
     c.proposal = BR_PF_PROPOSAL_OPT_HELD;                 assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     br_meas_t y = {0, 0.5f};
@@ -863,7 +864,7 @@ static void test_proposal_matches_equations(void **st)
  * stays at or below nis_ref: a PF with it and one without, on the same
  * measurements of a slow move (innovations within the cloud), hold the same
  * particles bit for bit; a jump of 20 gate sigmas raises E above nis_ref
- * and the filters part (z's and g_p's noise scaled by q_scale_std > 1). */
+ * and the filters part (omega's, z's and g_p's noise scaled by q_scale_std > 1). */
 static void test_adapt_is_thesis_filter_below_ref(void **st)
 {
     (void)st;
@@ -925,10 +926,12 @@ static br_circle_cfg_t robust_plant0(br_circle_ctrl_t ctrl, float nis_ref)
 
 /* The innovation-driven process noise (cfg.adapt, docs/modules/pf.md,
  * "Keeping lock"): on plant 0 the thesis filter's cloud misses the axis at
- * reversals (its bristles and friction level are not the model's) and the
- * lock monitor stops the axis (LOST_LOCK, measured at 4.08 s); with the
- * machine file's adapt the filter keeps lock, outliers below 1 % of the
- * axis-periods, and the contour stays better than with H-inf only. */
+ * reversals (its bristles and friction level are not the model's). With the
+ * tuning of 2026-11-23 the lock monitor then stopped the axis (at 4.08 s);
+ * with today's noise-aware tuning it runs on with 63 outlier steps
+ * (2026-11-24). With the machine file's adapt the filter keeps lock: a fifth
+ * of those outliers or fewer (3 measured), below 1 % of the axis-periods,
+ * a contour error below the thesis filter's and below H-inf only's. */
 static void test_adapt_keeps_lock_under_force_noise(void **st)
 {
     (void)st;
@@ -936,17 +939,19 @@ static void test_adapt_keeps_lock_under_force_noise(void **st)
     assert_true(base.pf.adapt.nis_ref > 0.0f); /* the reference machine's file has it on */
     br_circle_result_t r_off, r_on, r_hinf;
     br_circle_cfg_t c = robust_plant0(BR_CTRL_HINF_PF, 0.0f);
-    assert_int_equal(br_circle_run(&c, NULL, NULL, &r_off), 1); /* off: the thesis filter stops the axis */
-    assert_true(r_off.fault_status != 0);
+    (void)br_circle_run(&c, NULL, NULL, &r_off); /* off: the thesis filter */
     c = robust_plant0(BR_CTRL_HINF_PF, base.pf.adapt.nis_ref);
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r_on), 0);
     assert_int_equal(r_on.fault_status, 0);
     assert_true((double)r_on.outlier_steps < 0.01 * 2.0 * (double)r_on.n_samples);
+    /* the thesis filter stopped, or ran with at least five times the outliers and a larger error */
+    assert_true(r_off.fault_status != 0 ||
+                (5 * r_on.outlier_steps < r_off.outlier_steps && r_on.contour_rms_m < r_off.contour_rms_m));
     c = robust_plant0(BR_CTRL_HINF_ONLY, 0.0f);
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r_hinf), 0);
-    print_message("plant 0: adapt off: fault %d at %.3f s, %d outliers; on: %.3e m, %d outliers of %ld periods; "
-                  "H-inf only %.3e m\n", r_off.fault_status, r_off.fault_t_s, r_off.outlier_steps, r_on.contour_rms_m,
-                  r_on.outlier_steps, r_on.n_samples, r_hinf.contour_rms_m);
+    print_message("plant 0: adapt off: fault %d at %.3f s, %.3e m, %d outliers; on: %.3e m, %d outliers of %ld "
+                  "periods; H-inf only %.3e m\n", r_off.fault_status, r_off.fault_t_s, r_off.contour_rms_m,
+                  r_off.outlier_steps, r_on.contour_rms_m, r_on.outlier_steps, r_on.n_samples, r_hinf.contour_rms_m);
     assert_true(r_on.contour_rms_m < r_hinf.contour_rms_m);
 }
 

@@ -7,6 +7,7 @@
 
 #include <stdint.h>
 
+#include "bristle/br_dlyid.h"
 #include "bristle/br_model.h"
 #include "bristle/br_status.h"
 
@@ -42,6 +43,7 @@ typedef struct {
     float comp_ahead_periods; /* 0: the compensation is the filtered estimate (the thesis);
                                  > 0: the force predicted over the actuator delay and this many
                                  periods beyond it (br_est_comp_N), <= BR_EST_AHEAD_MAX_PERIODS */
+    br_dlyid_cfg_t delay_id;  /* actuator-delay identification while running; n_cand = 0: off */
 } br_est_cfg_t;
 
 /* Checks the shared configuration: the model (br_model_init's checks, the
@@ -51,7 +53,9 @@ typedef struct {
  * BR_EST_VAR_MAX, 0 < gp_min < gp_max with gp0 inside, an outlier gate in
  * (0, BR_EST_GATE_MAX_SIGMA], at
  * least one outlier before re-anchoring, a compensation lead in
- * [0, BR_EST_AHEAD_MAX_PERIODS]. BR_OK, BR_E_NULL or BR_E_PARAM. */
+ * [0, BR_EST_AHEAD_MAX_PERIODS], and the delay identification off or within
+ * br_dlyid_cfg_t's ranges (its largest candidate within the command history).
+ * BR_OK, BR_E_NULL or BR_E_PARAM. */
 br_status_t br_est_cfg_check(const br_est_cfg_t *cfg);
 
 /* 1 when v is a usable variance: a normal float in [FLT_MIN, BR_EST_VAR_MAX],
@@ -72,7 +76,7 @@ typedef struct {
     uint32_t n;                 /* commands kept, <= BR_EST_DELAY_HIST */
     uint32_t m;                 /* whole periods of the delay */
     float f;                    /* its fraction of a period */
-    int on;                     /* delay_s > 0 */
+    int on;                     /* delay_s > 0, or the delay identification on: the history is kept */
 } br_est_delay_t;
 
 /* Empties the history for the configuration's delay (checked by br_est_cfg_check). */
@@ -81,6 +85,12 @@ void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg);
 /* Keeps u_prev_Nm, the command held over the last period, and returns the
  * torque that reached the axis over it. */
 float br_est_delay_apply(br_est_delay_t *d, float u_prev_Nm);
+
+/* The torque that reached the axis over the last period for a delay of m + f
+ * periods (0 <= f < 1, m <= BR_EST_DELAY_HIST - 2), from d's history (call
+ * after br_est_delay_apply): (1 - f) u[k-1-m] + f u[k-2-m]. */
+float br_est_delay_torque(const br_est_delay_t *d, uint32_t m, float f);
+
 
 /* The force to compensate (docs/modules/est.md, "Compensating ahead").
  * With cfg->comp_ahead_periods = lambda = 0 it is F_hat_N itself. Otherwise
@@ -103,6 +113,20 @@ typedef struct {
     int32_t counts;  /* free-running, wraps modulo 2^32 */
     float frac;      /* finite, in [0, 1] */
 } br_meas_t;
+
+/* Actuator-delay identification (br_dlyid.h, docs/modules/dlyid.md).
+ * init: candidate j's delay j step_s in periods, its filters unprimed, the
+ * candidate standing for the configured delay the nearest to it. */
+void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg);
+
+/* One period, after br_est_delay_apply has kept the last command: every
+ * candidate's filter predicts with its delay's torque and takes y. Once past
+ * the warm-up, when the best candidate's forgotten sum of squared innovations
+ * is below switch_ratio times that of the candidate in use, d's delay becomes
+ * the best one's and 1 is returned (else 0). A filter that is not finite
+ * restarts the bank at the next measurement, nothing switched. Off
+ * (n_cand = 0): nothing, 0. */
+int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d);
 
 /* One estimator step: y is the measurement at t_k, u_prev_Nm the torque that
  * was applied over [t_{k-1}, t_k]. Unless the status is an error (negative),

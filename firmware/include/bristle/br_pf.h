@@ -42,7 +42,7 @@
  *   NIS = (y - mean theta_j)^2 / (var theta_j + R + rpc^2 / 12),
  * limited to est.outlier_sigma^2 (a glitch counts as much as a step at the
  * gate), smooths it, E <- E + alpha (NIS - E), and the next predictions draw the
- * process noise of z and g_p with the variances times
+ * process noise of omega, z and g_p with the variances times
  *   s = min(max(E / nis_ref, 1), max_scale)
  * (standard deviations times sqrt(s)). While E <= nis_ref, s = 1 and the
  * arithmetic is the thesis filter's bit for bit. */
@@ -78,7 +78,7 @@ typedef struct {
     uint32_t scalar_path;    /* 1: the scalar reference path (one particle at a time, with branches);
                                 0 (default): the structure-of-arrays loops the compiler vectorises,
                                 the rare cases fixed up in scalar; both give identical results */
-    br_pf_adapt_t adapt;     /* innovation-driven process noise of z and g_p (all 0: off) */
+    br_pf_adapt_t adapt;     /* innovation-driven process noise of omega, z and g_p (all 0: off) */
     uint32_t proposal;       /* BR_PF_PROPOSAL_*: 0 (default) the thesis's bootstrap filter */
 } br_pf_cfg_t;
 
@@ -111,6 +111,7 @@ typedef struct {
     float inv_2r;                 /* 1 / (2 R) */
     float m_per_count;            /* L rpc: load position per encoder count */
     br_est_delay_t delay;         /* commands for the actuator delay (model.causes.delay_s) */
+    br_dlyid_t dlyid;             /* the delay's identification (cfg.est.delay_id) */
     float outlier_l;              /* -outlier_sigma^2 (R + rpc^2 / 12) / (2 R): log-weight threshold */
     uint32_t noise_pos;           /* table position, advances every step */
     int32_t origin_counts;
@@ -119,7 +120,7 @@ typedef struct {
     uint32_t n_predicted;         /* predict-only steps since the last measurement */
     float r_gate;                 /* R + rpc^2 / 12, rad^2 */
     float nis_avg;                /* cfg.adapt: the smoothed NIS, E */
-    float q_scale_std;            /* cfg.adapt: sqrt(s), the factor on z's and g_p's noise std (1: the thesis filter) */
+    float q_scale_std;            /* cfg.adapt: sqrt(s), the factor on omega's, z's and g_p's noise std (1: the thesis filter) */
     /* cfg.proposal (constants of the step, from Q, R and h at init): the gains
      * of theta and omega on the predicted residual, the Cholesky factor
      * [l00 0; l10 l11] of their covariance given y, 1 / (2 S) with

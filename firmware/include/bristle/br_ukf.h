@@ -63,6 +63,7 @@ typedef struct {
     float quant_var_rad2;            /* rpc^2 / 12: the encoder's quantisation variance, in the gate */
     float m_per_count;               /* L rpc: load position per encoder count */
     br_est_delay_t delay;            /* commands for the actuator delay (model.causes.delay_s) */
+    br_dlyid_t dlyid;             /* the delay's identification (cfg.est.delay_id) */
     float x[BR_NX];                  /* mean; theta relative to origin_counts */
     float P[BR_NX][BR_NX];           /* covariance, symmetric positive definite */
     float S[BR_NX][BR_NX];           /* scratch: Cholesky factor of the last factorised P (lower) */

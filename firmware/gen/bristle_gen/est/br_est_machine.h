@@ -59,7 +59,7 @@
 #define BR_EST_PF_COMP_AHEAD_PERIODS_F (0.000000000e+00f)
 /* extra noise-table advance per step */
 #define BR_EST_PF_NOISE_SKIP 1u
-/* innovation-driven noise of z and g_p (0: off) */
+/* innovation-driven noise of omega, z and g_p (0: off) */
 #define BR_EST_PF_ADAPT_NIS_REF (0.25)
 #define BR_EST_PF_ADAPT_NIS_REF_F (2.500000000e-01f)
 /* its NIS smoothing per step */
@@ -68,6 +68,23 @@
 /* its largest variance factor */
 #define BR_EST_PF_ADAPT_MAX_SCALE (100.0)
 #define BR_EST_PF_ADAPT_MAX_SCALE_F (1.000000000e+02f)
+/* delay identification: candidates (0: off) */
+#define BR_EST_DELAY_ID_CANDIDATES 8u
+/* their spacing */
+#define BR_EST_DELAY_ID_STEP_S (0.0005)
+#define BR_EST_DELAY_ID_STEP_S_F (5.000000237e-04f)
+/* friction random walk per second */
+#define BR_EST_DELAY_ID_Q_FORCE_N2PS (1000.0)
+#define BR_EST_DELAY_ID_Q_FORCE_N2PS_F (1.000000000e+03f)
+/* forgetting time constant */
+#define BR_EST_DELAY_ID_MEMORY_S (0.02)
+#define BR_EST_DELAY_ID_MEMORY_S_F (1.999999955e-02f)
+/* no switch before */
+#define BR_EST_DELAY_ID_WARMUP_S (0.02)
+#define BR_EST_DELAY_ID_WARMUP_S_F (1.999999955e-02f)
+/* switch below this ratio */
+#define BR_EST_DELAY_ID_SWITCH_RATIO (0.5)
+#define BR_EST_DELAY_ID_SWITCH_RATIO_F (5.000000000e-01f)
 /* process noise variance per step */
 #define BR_EST_UKF_Q_THETA_RAD2 (1e-14)
 #define BR_EST_UKF_Q_THETA_RAD2_F (9.999999825e-15f)

@@ -1,0 +1,219 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Actuator-delay identification while the axis runs. See br_dlyid.h, br_est.h
+ * and docs/modules/dlyid.md (equations dly1-dly6). */
+#include <math.h>
+#include <stddef.h>
+
+#include "bristle/br_encoder.h"
+#include "bristle/br_est.h"
+#include "br_check.h"
+#include "br_dlyid_check.h"
+
+/* Longest warm-up, in periods: far beyond any start-up, and a uint32 */
+#define BR_DLYID_WARMUP_MAX_PERIODS 1.0e9f
+
+/* (dly1) the period's transition and input, omega' = (u - L F) / J_eff held over T:
+ * theta += T omega + T^2/2 (u - L F) / J_eff, omega += T (u - L F) / J_eff; the forgetting
+ * e^(-T / memory_s); R + rpc^2 / 12; the friction's variance per period. Returns 1 when
+ * every one is finite (a period or mass far out of range overflows them). */
+static int constants(br_dlyid_t *id, const br_est_cfg_t *cfg)
+{
+    const br_dlyid_cfg_t *c = &cfg->delay_id;
+    const br_model_cfg_t *mc = &cfg->model;
+    const float T = mc->dt_s;
+    const float L = mc->lead_mprad;
+    const float inv_J = 1.0f / (mc->J_kgm2 + L * L * mc->M_kg);
+    id->a01 = T;
+    id->b0 = 0.5f * T * T * inv_J;
+    id->b1 = T * inv_J;
+    id->a02 = -L * id->b0;
+    id->a12 = -L * id->b1;
+    id->q_force_N2 = c->q_force_N2ps * T;
+    const float rpc = cfg->rad_per_count;
+    id->r_rad2 = cfg->r_var_rad2 + rpc * rpc * (1.0f / 12.0f);
+    id->forget = expf(-T / c->memory_s);
+    /* b0, b1 are finite when L b0, L b1 are (L > 0 finite, br_model_init) */
+    return isfinite(id->a02) && isfinite(id->a12) && isfinite(id->q_force_N2) && isfinite(id->r_rad2) &&
+           id->forget < 1.0f;
+}
+
+int br_dlyid_cfg_ok(const br_est_cfg_t *cfg)
+{
+    const br_dlyid_cfg_t *c = &cfg->delay_id;
+    const float dt = cfg->model.dt_s;
+    if (c->n_cand == 0u) {
+        return 1;
+    }
+    if (c->n_cand < 2u || c->n_cand > BR_DLYID_MAX_CAND || !br_finite_pos(c->step_s) ||
+        !br_finite_pos(c->q_force_N2ps) || !br_finite_pos(c->memory_s) || !br_finite_nonneg(c->warmup_s) ||
+        !(c->warmup_s / dt <= BR_DLYID_WARMUP_MAX_PERIODS) || !(c->switch_ratio > 0.0f && c->switch_ratio < 1.0f)) {
+        return 0;
+    }
+    /* the largest candidate within the command history (br_est_delay_torque's m <= HIST - 2) */
+    const float largest = (float)(c->n_cand - 1u) * c->step_s;
+    if (!(largest <= (float)(BR_EST_DELAY_HIST - 2u) * dt)) {
+        return 0;
+    }
+    br_dlyid_t scratch;
+    return constants(&scratch, cfg);
+}
+
+void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg)
+{
+    const br_dlyid_cfg_t *c = &cfg->delay_id;
+    const br_model_cfg_t *mc = &cfg->model;
+    const float T = mc->dt_s;
+    id->n_switch = 0u;
+    id->primed = 0;
+    id->k = 0u;
+    id->cur = 0u;
+    id->warmup = 0u;
+    const uint32_t n = c->n_cand;
+    if (n == 0u || n > BR_DLYID_MAX_CAND) {
+        return; /* off (br_est_dlyid_step does nothing), or a configuration no check has seen */
+    }
+    (void)constants(id, cfg); /* finite: checked by br_est_cfg_check */
+    id->warmup = (uint32_t)(c->warmup_s / T);
+    for (uint32_t j = 0; j < n; j++) {
+        const float q = (float)j * c->step_s / T;
+        id->cm[j] = (uint32_t)q;
+        id->cf[j] = q - (float)id->cm[j];
+    }
+    /* the candidate standing for the configured delay: the nearest */
+    const float near = mc->causes.delay_s / c->step_s + 0.5f;
+    id->cur = (near < (float)n) ? (uint32_t)near : n - 1u;
+}
+
+/* (dly2) the first measurement: every filter at theta = frac rpc, at rest, F = 0, P0 */
+static void prime(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, uint32_t n)
+{
+    const float rpc = cfg->rad_per_count;
+    const float T = cfg->model.dt_s;
+    for (uint32_t j = 0; j < n; j++) {
+        id->x[j][0] = y->frac * rpc;
+        id->x[j][1] = 0.0f;
+        id->x[j][2] = 0.0f;
+        id->J[j] = 0.0f;
+    }
+    for (int i = 0; i < BR_DLYID_NX; i++) {
+        for (int j = 0; j < BR_DLYID_NX; j++) {
+            id->P[i][j] = 0.0f;
+        }
+    }
+    /* theta within the measurement noise, omega within a count per period, F within g_p's range */
+    id->P[0][0] = id->r_rad2;
+    id->P[1][1] = (rpc / T) * (rpc / T);
+    id->P[2][2] = cfg->gp_max_N * cfg->gp_max_N;
+    id->origin_counts = y->counts;
+    id->k = 0u;
+    id->primed = 1;
+}
+
+/* (dly3) P- = A P A^T + diag(0, 0, q_F), A = [1 a01 a02; 0 1 a12; 0 0 1]; then the gain
+ * K = P-[:,0] / S, S = P-_00 + R, and P+ = P- - K P-[0,:]. Returns S. */
+static float covariance(br_dlyid_t *id, float K[BR_DLYID_NX])
+{
+    const float A[BR_DLYID_NX][BR_DLYID_NX] = {{1.0f, id->a01, id->a02}, {0.0f, 1.0f, id->a12}, {0.0f, 0.0f, 1.0f}};
+    float AP[BR_DLYID_NX][BR_DLYID_NX], Pm[BR_DLYID_NX][BR_DLYID_NX];
+    for (int i = 0; i < BR_DLYID_NX; i++) {
+        for (int j = 0; j < BR_DLYID_NX; j++) {
+            float s = 0.0f;
+            for (int l = 0; l < BR_DLYID_NX; l++) {
+                s += A[i][l] * id->P[l][j];
+            }
+            AP[i][j] = s;
+        }
+    }
+    for (int i = 0; i < BR_DLYID_NX; i++) {
+        for (int j = 0; j < BR_DLYID_NX; j++) {
+            float s = 0.0f;
+            for (int l = 0; l < BR_DLYID_NX; l++) {
+                s += AP[i][l] * A[j][l];
+            }
+            Pm[i][j] = s;
+        }
+    }
+    Pm[2][2] += id->q_force_N2;
+    const float S = Pm[0][0] + id->r_rad2;
+    for (int i = 0; i < BR_DLYID_NX; i++) {
+        K[i] = Pm[i][0] / S;
+    }
+    for (int i = 0; i < BR_DLYID_NX; i++) {
+        for (int j = 0; j < BR_DLYID_NX; j++) {
+            id->P[i][j] = Pm[i][j] - K[i] * Pm[0][j];
+        }
+    }
+    /* P+ <- (P+ + P+^T) / 2 */
+    for (int i = 0; i < BR_DLYID_NX; i++) {
+        for (int j = i + 1; j < BR_DLYID_NX; j++) {
+            const float m = 0.5f * (id->P[i][j] + id->P[j][i]);
+            id->P[i][j] = m;
+            id->P[j][i] = m;
+        }
+    }
+    return S;
+}
+
+int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d)
+{
+    const uint32_t n = cfg->delay_id.n_cand;
+    if (n == 0u || n > BR_DLYID_MAX_CAND) {
+        return 0;
+    }
+    if (!id->primed) {
+        prime(id, cfg, y, n);
+        return 0;
+    }
+    const float rpc = cfg->rad_per_count;
+    float K[BR_DLYID_NX];
+    const float S = covariance(id, K);
+    /* theta re-expressed relative to the new count (wrap-safe), the measurement frac rpc */
+    const float shift = (float)br_counts_delta(y->counts, id->origin_counts) * rpc;
+    const float y_rel = y->frac * rpc;
+    int finite = br_finite_pos(S);
+    for (uint32_t j = 0; j < n; j++) {
+        float *x = id->x[j];
+        /* (dly4) candidate j's prediction with the torque its delay brings: u_j = (1 - f_j)
+         * u[k-1-m_j] + f_j u[k-2-m_j] */
+        const float u = br_est_delay_torque(d, id->cm[j], id->cf[j]);
+        const float th = x[0] + id->a01 * x[1] + id->a02 * x[2] + id->b0 * u - shift;
+        const float om = x[1] + id->a12 * x[2] + id->b1 * u;
+        /* (dly5) innovation nu_j = y - theta-_j, update x+ = x- + K nu_j, J_j <- forget J_j + nu_j^2 */
+        const float nu = y_rel - th;
+        x[0] = th + K[0] * nu;
+        x[1] = om + K[1] * nu;
+        x[2] = x[2] + K[2] * nu;
+        id->J[j] = id->forget * id->J[j] + nu * nu;
+        finite = finite && isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(id->J[j]);
+    }
+    id->origin_counts = y->counts;
+    if (!finite) {
+        id->primed = 0; /* the bank restarts at the next measurement */
+        return 0;
+    }
+    if (id->k < UINT32_MAX) {
+        id->k++;
+    }
+    if (id->k < id->warmup) {
+        return 0;
+    }
+    /* (dly6) the best candidate takes over when its sum is below switch_ratio times the
+     * sum of the one in use */
+    uint32_t best = id->cur;
+    for (uint32_t j = 0; j < n; j++) {
+        if (id->J[j] < id->J[best]) {
+            best = j;
+        }
+    }
+    if (best == id->cur || !(id->J[best] < cfg->delay_id.switch_ratio * id->J[id->cur])) {
+        return 0;
+    }
+    id->cur = best;
+    d->m = id->cm[best];
+    d->f = id->cf[best];
+    d->on = 1;
+    if (id->n_switch < UINT32_MAX) {
+        id->n_switch++;
+    }
+    return 1;
+}

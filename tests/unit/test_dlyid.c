@@ -1,0 +1,317 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The actuator-delay identification (br_est_dlyid_*, docs/modules/dlyid.md):
+ * its configuration is checked at init; on an axis of the test's own (a rigid
+ * body with a smooth Coulomb and a viscous friction, integrated finely in
+ * double, the torque delayed to the instant) it finds the delay the axis has
+ * and keeps the one the estimator already models; a bank that overflows
+ * starts again and still finds it; a step without a measurement restarts it;
+ * with no switch the estimators are bit for bit those without it. The
+ * machine's settings are read from the machine's configuration. */
+#include "br_test.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "circle/br_circle_est.h"
+#include "bristle/br_est.h"
+#include "bristle/br_pf.h"
+#include "bristle/br_ukf.h"
+
+#define UKF_DT_S 1.0e-3f
+#define PF_DT_S 1.5e-3f
+#define SUBSTEPS 20
+#define TWO_PI 6.283185307179586
+
+/* The test's axis: J_eff omega' = u(t - delay) - L (Fc tanh(v / v0) + sigma2 v), v = L omega,
+ * with the estimator model's mass, lead and levels; commands held over each period. */
+typedef struct {
+    double th, om, t;
+    double J, L, Fc, s2, delay, dt;
+    double u[256]; /* commands, u[k] over [k dt, (k + 1) dt) */
+    int k;
+} axis_t;
+
+static void axis_init(axis_t *a, const br_est_cfg_t *c, double delay_s)
+{
+    memset(a, 0, sizeof *a);
+    const br_model_cfg_t *m = &c->model;
+    a->L = m->lead_mprad;
+    a->J = (double)m->J_kgm2 + a->L * a->L * (double)m->M_kg;
+    a->Fc = m->lugre.Fc_N;
+    a->s2 = m->sigma2_Nspm;
+    a->delay = delay_s;
+    a->dt = m->dt_s;
+}
+
+/* the command of period k: two tones and a slow sweep, in units of the machine's Coulomb
+ * torque L Fc (the reference machine's: 8.9e-3 N m) */
+static float command(const axis_t *a, int k)
+{
+    const double t = k * a->dt, lfc = a->L * a->Fc;
+    return (float)(lfc * (2.25 * sin(TWO_PI * 3.0 * t) + 0.9 * sin(TWO_PI * 37.0 * t) +
+                          0.45 * sin(TWO_PI * (10.0 + 20.0 * t) * t)));
+}
+
+/* one period with command u (kept), then the measurement: the count below theta, frac 0.5 */
+static br_meas_t axis_step(axis_t *a, float u, double rpc)
+{
+    a->u[a->k % 256] = u;
+    const double h = a->dt / SUBSTEPS;
+    for (int s = 0; s < SUBSTEPS; s++) {
+        const double tm = a->t + 0.5 * h - a->delay; /* the command reaching the axis mid-substep */
+        const long j = (long)floor(tm / a->dt + 1e-9);
+        const double ua = (j < 0 || a->k - j >= 256) ? 0.0 : a->u[j % 256];
+        const double v = a->L * a->om;
+        const double F = a->Fc * tanh(v / 1.0e-4) + a->s2 * v;
+        const double acc = (ua - a->L * F) / a->J;
+        a->th += h * a->om + 0.5 * h * h * acc;
+        a->om += h * acc;
+        a->t += h;
+    }
+    a->k++;
+    const br_meas_t y = {(int32_t)floor(a->th / rpc), 0.5f};
+    return y;
+}
+
+/* runs the bank on the test's axis for n periods; returns the switches */
+static uint32_t run_bank(const br_est_cfg_t *c, double delay_s, int n, br_est_delay_t *d, br_dlyid_t *id)
+{
+    axis_t a;
+    axis_init(&a, c, delay_s);
+    br_est_delay_init(d, c);
+    br_est_dlyid_init(id, c);
+    float u_prev = 0.0f;
+    for (int k = 0; k < n; k++) {
+        const br_meas_t y = axis_step(&a, u_prev, c->rad_per_count);
+        (void)br_est_delay_apply(d, u_prev);
+        (void)br_est_dlyid_step(id, c, &y, d);
+        u_prev = command(&a, k + 1);
+    }
+    return id->n_switch;
+}
+
+/* the delay the estimator now models, in seconds */
+static double modelled_s(const br_est_delay_t *d, const br_est_cfg_t *c)
+{
+    return ((double)d->m + (double)d->f) * (double)c->model.dt_s;
+}
+
+static br_est_cfg_t machine_ukf(void) { return br_circle_ukf_cfg_tuned(UKF_DT_S).est; }
+
+static void test_dlyid_bounds(void **st)
+{
+    (void)st;
+    const br_est_cfg_t ok = machine_ukf();
+    assert_true(ok.delay_id.n_cand >= 2u); /* the machine has it on */
+    assert_int_equal(br_est_cfg_check(&ok), BR_OK);
+    br_est_cfg_t c = ok;
+    const float dt = ok.model.dt_s;
+#define REFUSED(field, v)                                                                          \
+    do {                                                                                           \
+        c = ok;                                                                                    \
+        c.delay_id.field = (v);                                                                    \
+        assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);                                        \
+    } while (0)
+    REFUSED(n_cand, 1u);
+    REFUSED(n_cand, BR_DLYID_MAX_CAND + 1u);
+    REFUSED(step_s, 0.0f);
+    REFUSED(step_s, NAN);
+    REFUSED(step_s, INFINITY);
+    REFUSED(q_force_N2ps, 0.0f);
+    REFUSED(q_force_N2ps, NAN);
+    REFUSED(q_force_N2ps, INFINITY);
+    REFUSED(memory_s, 0.0f);
+    REFUSED(memory_s, 1.0e12f * dt); /* e^(-dt / memory) rounds to 1: the sums would never forget */
+    REFUSED(memory_s, NAN);
+    REFUSED(memory_s, INFINITY);
+    REFUSED(warmup_s, -1.0e-6f);
+    REFUSED(warmup_s, NAN);
+    REFUSED(warmup_s, 2.0e9f * dt);
+    REFUSED(switch_ratio, 0.0f);
+    REFUSED(switch_ratio, 1.0f);
+    REFUSED(switch_ratio, NAN);
+#undef REFUSED
+    /* the largest candidate at the command history's end: kept; beyond it: refused */
+    c = ok;
+    c.delay_id.n_cand = BR_DLYID_MAX_CAND;
+    c.delay_id.step_s = (float)(BR_EST_DELAY_HIST - 2u) * dt / (float)(BR_DLYID_MAX_CAND - 1u);
+    c.delay_id.step_s = nextafterf(c.delay_id.step_s, 0.0f);
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    c.delay_id.step_s = 1.01f * (float)(BR_EST_DELAY_HIST - 2u) * dt / (float)(BR_DLYID_MAX_CAND - 1u);
+    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    /* a period so long that the bank's constants overflow (T^2 / J_eff) */
+    c = ok;
+    c.model.dt_s = 1.0e20f;
+    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c.delay_id.n_cand = 0u;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    /* off: the other fields are not looked at */
+    c = ok;
+    c.delay_id.n_cand = 0u;
+    c.delay_id.step_s = NAN;
+    c.delay_id.switch_ratio = 7.0f;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    /* both filters refuse a bad one at init */
+    br_ukf_t u;
+    br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
+    cu.est.delay_id.switch_ratio = 1.5f;
+    assert_int_equal(br_ukf_init(&u, &cu), BR_E_PARAM);
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
+    cp.est.delay_id.n_cand = 1u;
+    assert_int_equal(br_pf_init(pf, &cp), BR_E_PARAM);
+    free(pf);
+}
+
+/* An axis 1.5 ms late: the bank moves the estimator's delay to the candidate nearest
+ * 1.5 ms within the first second, and an axis on time never moves it. */
+static void test_dlyid_finds_delay(void **st)
+{
+    (void)st;
+    const br_est_cfg_t c = machine_ukf();
+    br_est_delay_t d;
+    br_dlyid_t id;
+    const double step = c.delay_id.step_s;
+    assert_true(run_bank(&c, 1.5e-3, 1000, &d, &id) >= 1u);
+    assert_true(fabs(modelled_s(&d, &c) - 1.5e-3) <= 0.5 * step + 1e-9);
+    assert_int_equal(d.on, 1);
+    /* in time: no switch in 3 s, the estimator's torque the command itself */
+    assert_int_equal(run_bank(&c, 0.0, 3000, &d, &id), 0u);
+    assert_int_equal(d.m, 0u);
+    assert_true(d.f == 0.0f);
+}
+
+/* The estimator already models the axis's 1 ms: the bank keeps it. */
+static void test_dlyid_keeps_the_modelled_delay(void **st)
+{
+    (void)st;
+    br_est_cfg_t c = machine_ukf();
+    c.model.causes.delay_s = 1.0e-3f;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    br_est_delay_t d;
+    br_dlyid_t id;
+    assert_int_equal(run_bank(&c, 1.0e-3, 3000, &d, &id), 0u);
+    assert_true(fabs(modelled_s(&d, &c) - 1.0e-3) < 1e-9);
+}
+
+/* A command that overflows the bank's filters (finite, near FLT_MAX): the bank starts again
+ * at the next measurement, switches nothing meanwhile, and still finds the delay after. */
+static void test_dlyid_overflow_restarts(void **st)
+{
+    (void)st;
+    const br_est_cfg_t c = machine_ukf();
+    br_est_delay_t d;
+    br_dlyid_t id;
+    br_est_delay_init(&d, &c);
+    br_est_dlyid_init(&id, &c);
+    axis_t a;
+    axis_init(&a, &c, 1.5e-3);
+    float u_prev = 0.0f;
+    for (int k = 0; k < 1500; k++) {
+        const br_meas_t y = axis_step(&a, (k == 5) ? 0.0f : u_prev, c.rad_per_count);
+        /* period 5: the estimator is told of a torque the axis never got */
+        const float told = (k == 5) ? 3.0e38f : u_prev;
+        (void)br_est_delay_apply(&d, told);
+        const int sw = br_est_dlyid_step(&id, &c, &y, &d);
+        if (k >= 5 && k <= 10) {
+            assert_int_equal(sw, 0);
+        }
+        if (k == 5) {
+            assert_int_equal(id.primed, 0); /* the bank starts again */
+        }
+        for (uint32_t j = 0; j < c.delay_id.n_cand; j++) {
+            assert_true(isfinite(id.J[j]) || !id.primed);
+        }
+        u_prev = command(&a, k + 1);
+    }
+    assert_true(id.n_switch >= 1u);
+    assert_true(fabs(modelled_s(&d, &c) - 1.5e-3) <= 0.5 * (double)c.delay_id.step_s + 1e-9);
+}
+
+/* A period without a measurement restarts the bank (its filters would miss a step). */
+static void test_dlyid_predict_restarts(void **st)
+{
+    (void)st;
+    br_ukf_t u;
+    const br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
+    assert_int_equal(br_ukf_init(&u, &cu), BR_OK);
+    const br_meas_t y0 = {100, 0.5f}, y1 = {101, 0.5f};
+    assert_false(BR_FAILED(br_ukf_step(&u, &y0, 0.0f)));
+    assert_false(BR_FAILED(br_ukf_step(&u, &y1, 0.001f)));
+    assert_int_equal(u.dlyid.primed, 1);
+    assert_false(BR_FAILED(br_ukf_predict(&u, 0.001f)));
+    assert_int_equal(u.dlyid.primed, 0);
+
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
+    cp.n_particles = 100u;
+    assert_int_equal(br_pf_init(pf, &cp), BR_OK);
+    assert_false(BR_FAILED(br_pf_step(pf, &y0, 0.0f)));
+    assert_false(BR_FAILED(br_pf_step(pf, &y1, 0.001f)));
+    assert_int_equal(pf->dlyid.primed, 1);
+    assert_false(BR_FAILED(br_pf_predict(pf, 0.001f)));
+    assert_int_equal(pf->dlyid.primed, 0);
+    free(pf);
+}
+
+/* Without a switch the identification changes nothing: the UKF and the PF on the test's
+ * axis (on time) give the same estimates, bit for bit, with it on and off. */
+static void test_dlyid_on_without_switch_is_off(void **st)
+{
+    (void)st;
+    br_ukf_cfg_t on = br_circle_ukf_cfg_tuned(UKF_DT_S), off = on;
+    off.est.delay_id.n_cand = 0u;
+    br_ukf_t a, b;
+    assert_int_equal(br_ukf_init(&a, &on), BR_OK);
+    assert_int_equal(br_ukf_init(&b, &off), BR_OK);
+    assert_int_equal(a.delay.on, 1);
+    assert_int_equal(b.delay.on, 0);
+    br_pf_t *pa = calloc(1, sizeof *pa), *pb = calloc(1, sizeof *pb);
+    assert_non_null(pa);
+    assert_non_null(pb);
+    br_pf_cfg_t pon = br_circle_pf_cfg_tuned(PF_DT_S), poff = pon;
+    pon.n_particles = poff.n_particles = 200u;
+    poff.est.delay_id.n_cand = 0u;
+    assert_int_equal(br_pf_init(pa, &pon), BR_OK);
+    assert_int_equal(br_pf_init(pb, &poff), BR_OK);
+    axis_t ax;
+    axis_init(&ax, &on.est, 0.0);
+    float u_prev = 0.0f;
+    for (int k = 0; k < 600; k++) {
+        const br_meas_t y = axis_step(&ax, u_prev, on.est.rad_per_count);
+        float fa, fb;
+        assert_int_equal(br_ukf_est_step(&a, &y, u_prev, &fa), br_ukf_est_step(&b, &y, u_prev, &fb));
+        assert_memory_equal(&fa, &fb, sizeof fa);
+        u_prev = command(&ax, k + 1);
+    }
+    axis_init(&ax, &pon.est, 0.0); /* the PF's own period */
+    u_prev = 0.0f;
+    for (int k = 0; k < 400; k++) {
+        const br_meas_t y = axis_step(&ax, u_prev, pon.est.rad_per_count);
+        float fa, fb;
+        assert_int_equal(br_pf_est_step(pa, &y, u_prev, &fa), br_pf_est_step(pb, &y, u_prev, &fb));
+        assert_memory_equal(&fa, &fb, sizeof fa);
+        u_prev = command(&ax, k + 1);
+    }
+    assert_int_equal(pa->dlyid.n_switch, 0u);
+    assert_int_equal(a.dlyid.n_switch, 0u);
+    free(pa);
+    free(pb);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_dlyid_bounds),
+        cmocka_unit_test(test_dlyid_finds_delay),
+        cmocka_unit_test(test_dlyid_keeps_the_modelled_delay),
+        cmocka_unit_test(test_dlyid_overflow_restarts),
+        cmocka_unit_test(test_dlyid_predict_restarts),
+        cmocka_unit_test(test_dlyid_on_without_switch_is_off),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
