@@ -89,7 +89,6 @@ def est_fields(m):
     out += [("BR_EST_PF_ADAPT_NIS_REF", pf["adapt"]["nis_ref"], "innovation-driven noise of omega, z and g_p (0: off)"),
             ("BR_EST_PF_ADAPT_ALPHA", pf["adapt"]["alpha"], "its NIS smoothing per step"),
             ("BR_EST_PF_ADAPT_MAX_SCALE", pf["adapt"]["max_scale"], "its largest variance factor")]
-    out += delay_id_fields(m)
     for k, c in (("theta_rad2", "Q_THETA_RAD2"), ("omega_rad2_per_s2", "Q_OMEGA_RAD2PS2"),
                  ("z_m2", "Q_Z_M2"), ("gp_N2", "Q_GP_N2")):
         out.append(("BR_EST_UKF_" + c, ukf["q_var"][k], "process noise variance per step"))
@@ -104,15 +103,16 @@ def est_fields(m):
     return out
 
 
-def delay_id_fields(m):
-    """The delay identification both estimators share (absent: off, 0 candidates)."""
-    d = m["estimator"].get("delay_id") or {}
-    return [("BR_EST_DELAY_ID_CANDIDATES", d.get("candidates", 0), "delay identification: candidates (0: off)"),
-            ("BR_EST_DELAY_ID_STEP_S", d.get("step_s", 0.0), "their spacing"),
-            ("BR_EST_DELAY_ID_Q_FORCE_N2PS", d.get("q_force_N2_per_s", 0.0), "friction random walk per second"),
-            ("BR_EST_DELAY_ID_MEMORY_S", d.get("memory_s", 0.0), "forgetting time constant"),
-            ("BR_EST_DELAY_ID_WARMUP_S", d.get("warmup_s", 0.0), "no switch before"),
-            ("BR_EST_DELAY_ID_SWITCH_RATIO", d.get("switch_ratio", 0.0), "switch below this ratio")]
+def delay_id_fields(E, e):
+    """An estimator's delay identification (absent: off, 0 candidates)."""
+    d = e.get("delay_id") or {}
+    P = "BR_EST_%s_DELAY_ID_" % E
+    return [(P + "CANDIDATES", d.get("candidates", 0), "delay identification: candidates (0: off)"),
+            (P + "STEP_S", d.get("step_s", 0.0), "their spacing"),
+            (P + "Q_FORCE_N2PS", d.get("q_force_N2_per_s", 0.0), "friction random walk per second"),
+            (P + "MEMORY_S", d.get("memory_s", 0.0), "forgetting time constant"),
+            (P + "WARMUP_S", d.get("warmup_s", 0.0), "no switch before"),
+            (P + "SWITCH_RATIO", d.get("switch_ratio", 0.0), "switch below this ratio")]
 
 
 def gate_fields(E, e):
@@ -122,7 +122,7 @@ def gate_fields(E, e):
             ("BR_EST_%s_OUTLIER_SIGMA" % E, e["outlier_gate_sigma"], "outlier gate, standard deviations"),
             ("BR_EST_%s_REANCHOR_AFTER" % E, e["reanchor_after"], "consecutive outliers before re-anchoring"),
             ("BR_EST_%s_COMP_AHEAD_PERIODS" % E, e["comp_ahead_periods"],
-             "compensation lead beyond the actuator delay, periods (0: the filtered estimate)")]
+             "compensation lead beyond the actuator delay, periods (0: the filtered estimate)")] + delay_id_fields(E, e)
 
 
 def render_defines(fields):

@@ -154,6 +154,17 @@ def _gates():
         "comp_ahead_periods": Num(0.0, EST_AHEAD_MAX_PERIODS, "0: compensate the filtered estimate (the thesis); "
                                   "> 0: the force predicted over the actuator delay and this many periods "
                                   "beyond it (docs/modules/est.md)"),
+        # actuator-delay identification while the axis runs (docs/modules/dlyid.md); absent = off
+        "delay_id": Optional({
+            "candidates": Int(2, DLYID_MAX_CAND, "candidate delays 0, step_s, ..., (candidates - 1) step_s"),
+            "step_s": Num(0.0, 0.1, "their spacing", lo_open=True),
+            "q_force_N2_per_s": Num(0.0, 1.0e12, "the identifying filters' friction random walk, "
+                                    "variance per second", lo_open=True),
+            "memory_s": Num(0.0, 100.0, "time constant of the innovations' forgotten sums", lo_open=True),
+            "warmup_s": Num(0.0, 100.0, "no switch before this time after the first measurement"),
+            "switch_ratio": Num(0.0, 1.0, "switch when the best candidate's sum is below this times the sum "
+                                "of the delay in use", lo_open=True, hi_open=True),
+        }),
     }
 
 
@@ -253,18 +264,6 @@ SCHEMA = {
             "beta": Num(0.0, 10.0, "prior-distribution weight (2 for a Gaussian)"),
             "kappa": Num(-3.0, 100.0, "secondary scaling (n + kappa > 0, n = 4)", lo_open=True),
         }, **_gates()),
-        # actuator-delay identification while the axis runs, both estimators (docs/modules/dlyid.md);
-        # absent = off
-        "delay_id": Optional({
-            "candidates": Int(2, DLYID_MAX_CAND, "candidate delays 0, step_s, ..., (candidates - 1) step_s"),
-            "step_s": Num(0.0, 0.1, "their spacing", lo_open=True),
-            "q_force_N2_per_s": Num(0.0, 1.0e12, "the identifying filters' friction random walk, "
-                                    "variance per second", lo_open=True),
-            "memory_s": Num(0.0, 100.0, "time constant of the innovations' forgotten sums", lo_open=True),
-            "warmup_s": Num(0.0, 100.0, "no switch before this time after the first measurement"),
-            "switch_ratio": Num(0.0, 1.0, "switch when the best candidate's sum is below this times the sum "
-                                "of the delay in use", lo_open=True, hi_open=True),
-        }),
     },
     "limits": {
         "max_speed_mps": Num(0.0, 100.0, "largest table speed the axis is used at", lo_open=True),
@@ -351,12 +350,11 @@ def _cross_checks(m, errors):
         need([e + "gp_min_N", e + "gp_max_N", e + "gp0_N"],
              lambda: get(e + "gp_min_N") <= get(e + "gp0_N") <= get(e + "gp_max_N"),
              e + "gp0_N", "must lie in [%sgp_min_N, %sgp_max_N]" % (e, e))
-    periods = [("estimator.pf.period_s", get("estimator.pf.period_s")),
-               ("control.period_s", get("control.period_s"))]
-    d = "estimator.delay_id."
-    for name, T in periods:
+    # each estimator's delay identification: its largest candidate within its command history
+    for est, name in (("pf", "estimator.pf.period_s"), ("ukf", "control.period_s")):
+        d = "estimator.%s.delay_id." % est
         need([d + "candidates", d + "step_s", name],
-             lambda: (get(d + "candidates") - 1) * get(d + "step_s") <= EST_DELAY_MAX_PERIODS * T,
+             lambda: (get(d + "candidates") - 1) * get(d + "step_s") <= EST_DELAY_MAX_PERIODS * get(name),
              d + "step_s", "(candidates - 1) * step_s must be <= %d periods of %s" % (EST_DELAY_MAX_PERIODS, name))
     need(["estimator.pf.adapt.nis_ref"],
          lambda: get("estimator.pf.adapt.nis_ref") == 0.0 or get("estimator.pf.adapt.nis_ref") >= 1.0e-6,

@@ -32,9 +32,9 @@ static int constants(br_dlyid_t *id, const br_est_cfg_t *cfg)
     const float rpc = cfg->rad_per_count;
     id->r_rad2 = cfg->r_var_rad2 + rpc * rpc * (1.0f / 12.0f);
     id->forget = expf(-T / c->memory_s);
-    /* b0, b1 are finite when L b0, L b1 are (L > 0 finite, br_model_init) */
-    return isfinite(id->a02) && isfinite(id->a12) && isfinite(id->q_force_N2) && isfinite(id->r_rad2) &&
-           id->forget < 1.0f;
+    /* b0 and b1 are finite when L b0 and L b1 are (L > 0, br_model_init); R' is finite
+     * where br_est_cfg_check accepts R and rpc */
+    return isfinite(id->a02) && isfinite(id->a12) && isfinite(id->q_force_N2) && id->forget < 1.0f;
 }
 
 int br_dlyid_cfg_ok(const br_est_cfg_t *cfg)
@@ -68,20 +68,21 @@ void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg)
     id->k = 0u;
     id->cur = 0u;
     id->warmup = 0u;
+    /* off, or unchecked: nothing below is read (br_est_dlyid_step returns first) */
     const uint32_t n = c->n_cand;
     if (n == 0u || n > BR_DLYID_MAX_CAND) {
         return; /* off (br_est_dlyid_step does nothing), or a configuration no check has seen */
     }
     (void)constants(id, cfg); /* finite: checked by br_est_cfg_check */
-    id->warmup = (uint32_t)(c->warmup_s / T);
-    for (uint32_t j = 0; j < n; j++) {
-        const float q = (float)j * c->step_s / T;
+    id->warmup = (uint32_t)(c->warmup_s / T + 0.5f);
+    for (uint32_t j = 0; j <= n; j++) {
+        /* the candidates j step_s; slot n the configured delay, where the estimator starts
+         * (br_est_delay_init's m and f) */
+        const float q = (j < n) ? (float)j * c->step_s / T : mc->causes.delay_s / T;
         id->cm[j] = (uint32_t)q;
         id->cf[j] = q - (float)id->cm[j];
     }
-    /* the candidate standing for the configured delay: the nearest */
-    const float near = mc->causes.delay_s / c->step_s + 0.5f;
-    id->cur = (near < (float)n) ? (uint32_t)near : n - 1u;
+    id->cur = n;
 }
 
 /* (dly2) the first measurement: every filter at theta = frac rpc, at rest, F = 0, P0 */
@@ -89,7 +90,7 @@ static void prime(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, u
 {
     const float rpc = cfg->rad_per_count;
     const float T = cfg->model.dt_s;
-    for (uint32_t j = 0; j < n; j++) {
+    for (uint32_t j = 0; j <= n; j++) {
         id->x[j][0] = y->frac * rpc;
         id->x[j][1] = 0.0f;
         id->x[j][2] = 0.0f;
@@ -110,8 +111,10 @@ static void prime(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, u
 }
 
 /* (dly3) P- = A P A^T + diag(0, 0, q_F), A = [1 a01 a02; 0 1 a12; 0 0 1]; then the gain
- * K = P-[:,0] / S, S = P-_00 + R, and P+ = P- - K P-[0,:]. Returns S. */
-static float covariance(br_dlyid_t *id, float K[BR_DLYID_NX])
+ * K = P-[:,0] / S, S = P-_00 + R, and P+ = P- - K P-[0,:]. P does not depend on the
+ * data: with the finite constants br_est_cfg_check requires it is the Riccati recursion
+ * of an observable system (theta measured), bounded. */
+static void covariance(br_dlyid_t *id, float K[BR_DLYID_NX])
 {
     const float A[BR_DLYID_NX][BR_DLYID_NX] = {{1.0f, id->a01, id->a02}, {0.0f, 1.0f, id->a12}, {0.0f, 0.0f, 1.0f}};
     float AP[BR_DLYID_NX][BR_DLYID_NX], Pm[BR_DLYID_NX][BR_DLYID_NX];
@@ -151,7 +154,6 @@ static float covariance(br_dlyid_t *id, float K[BR_DLYID_NX])
             id->P[j][i] = m;
         }
     }
-    return S;
 }
 
 int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d)
@@ -166,12 +168,13 @@ int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *
     }
     const float rpc = cfg->rad_per_count;
     float K[BR_DLYID_NX];
-    const float S = covariance(id, K);
+    covariance(id, K);
     /* theta re-expressed relative to the new count (wrap-safe), the measurement frac rpc */
     const float shift = (float)br_counts_delta(y->counts, id->origin_counts) * rpc;
     const float y_rel = y->frac * rpc;
-    int finite = br_finite_pos(S);
-    for (uint32_t j = 0; j < n; j++) {
+    int finite = 1;
+    /* the candidates and the configured delay's slot n */
+    for (uint32_t j = 0; j <= n; j++) {
         float *x = id->x[j];
         /* (dly4) candidate j's prediction with the torque its delay brings: u_j = (1 - f_j)
          * u[k-1-m_j] + f_j u[k-2-m_j] */
@@ -200,7 +203,7 @@ int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *
     /* (dly6) the best candidate takes over when its sum is below switch_ratio times the
      * sum of the one in use */
     uint32_t best = id->cur;
-    for (uint32_t j = 0; j < n; j++) {
+    for (uint32_t j = 0; j <= n; j++) {
         if (id->J[j] < id->J[best]) {
             best = j;
         }

@@ -91,14 +91,14 @@ def main():
     bad["encoder"]["counter_bits"] = "32"
     bad["estimator"]["pf"]["n_particles"] = machine.PF_MAX_PARTICLES + 1
     bad["estimator"]["ukf"]["comp_ahead_periods"] = 2.5
-    bad["estimator"]["delay_id"]["candidates"] = machine.DLYID_MAX_CAND + 1
-    bad["estimator"]["delay_id"]["switch_ratio"] = 1.0
+    bad["estimator"]["ukf"]["delay_id"]["candidates"] = machine.DLYID_MAX_CAND + 1
+    bad["estimator"]["pf"]["delay_id"]["switch_ratio"] = 1.0
     expect_errors(work, "range.json", bad, ["field friction.Fc_N: 0 is outside (0, 100000]",
                                             "field encoder.counter_bits: expected an integer, got a string",
                                             "field estimator.pf.n_particles: 2049 is outside [1, 2048]",
                                             "field estimator.ukf.comp_ahead_periods: 2.5 is outside [0, 2]",
-                                            "field estimator.delay_id.candidates: 9 is outside [2, 8]",
-                                            "field estimator.delay_id.switch_ratio: 1 is outside (0, 1)"])
+                                            "field estimator.ukf.delay_id.candidates: 9 is outside [2, 8]",
+                                            "field estimator.pf.delay_id.switch_ratio: 1 is outside (0, 1)"])
     # the schema's firmware limits are the firmware headers' (one home each: the headers)
     for header, name, value in (("br_pf.h", "BR_PF_MAX_PARTICLES", machine.PF_MAX_PARTICLES),
                                 ("br_est.h", "BR_EST_AHEAD_MAX_PERIODS", machine.EST_AHEAD_MAX_PERIODS),
@@ -112,15 +112,16 @@ def main():
     bad["friction"]["Fs_N"] = 0.5 * bad["friction"]["Fc_N"]
     bad["control"]["torque_limit_Nm"] = 2.0 * bad["amplifier"]["torque_per_duty_Nm"]
     bad["estimator"]["ukf"]["gp0_N"] = 2.0 * bad["estimator"]["ukf"]["gp_max_N"]
-    bad["estimator"]["delay_id"]["step_s"] = 0.1  # 7 x 0.1 s: beyond 62 periods of either estimator
+    for est in ("pf", "ukf"):
+        bad["estimator"][est]["delay_id"]["step_s"] = 0.1  # 7 x 0.1 s: beyond 62 periods of either period
     expect_errors(work, "cross.json", bad, ["field friction.Fs_N: must be >= friction.Fc_N (7 N)",
                                             "field control.torque_limit_Nm: must be <= amplifier.duty_limit * "
                                             "amplifier.torque_per_duty_Nm",
                                             "field estimator.ukf.gp0_N: must lie in [estimator.ukf.gp_min_N, "
                                             "estimator.ukf.gp_max_N]",
-                                            "field estimator.delay_id.step_s: (candidates - 1) * step_s must be "
+                                            "field estimator.pf.delay_id.step_s: (candidates - 1) * step_s must be "
                                             "<= %d periods of estimator.pf.period_s" % machine.EST_DELAY_MAX_PERIODS,
-                                            "field estimator.delay_id.step_s: (candidates - 1) * step_s must be "
+                                            "field estimator.ukf.delay_id.step_s: (candidates - 1) * step_s must be "
                                             "<= %d periods of control.period_s" % machine.EST_DELAY_MAX_PERIODS])
     bad = copy.deepcopy(good)
     bad["provenance"] = {"friction.Fc_N": "identified", "mechanics.mass_kg": "given",

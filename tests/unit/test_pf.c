@@ -855,6 +855,65 @@ static void test_proposal_matches_equations(void **st)
     proposal_matches_equations(BR_PF_PROPOSAL_OPT_HELD);
 }
 
+/* cfg.adapt's factor on the noise (docs/modules/pf.md, "omega too"): one
+ * prediction from the same set with the factor s = 1, 2 and 4 moves each
+ * particle's omega, z and g_p by s times its noise sample, so that
+ * x(4) - x(2) = 2 (x(2) - x(1)) per particle (g_p away from its clamps),
+ * theta's noise unscaled (theta(4) - theta(2) from omega's scaled step only
+ * through the next prediction: here, the same). With cfg.proposal omega's
+ * draw keeps its constants: omega(4) = omega(1), bit for bit. */
+static void scaled_predictions(uint32_t proposal, float out[3][BR_NX][64])
+{
+    const float scales[3] = {1.0f, 2.0f, 4.0f};
+    for (int s = 0; s < 3; s++) {
+        br_pf_t *pf = calloc(1, sizeof *pf);
+        assert_non_null(pf);
+        br_pf_cfg_t c = cfg(64);
+        c.proposal = proposal;
+        assert_int_equal(br_pf_init(pf, &c), BR_OK);
+        const br_meas_t y = {100, 0.5f};
+        assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+        pf->q_scale_std = scales[s];
+        assert_int_equal(br_pf_predict(pf, 0.01f), BR_OK);
+        for (int i = 0; i < BR_NX; i++) {
+            for (uint32_t j = 0; j < 64u; j++) {
+                out[s][i][j] = pf->x[i][j];
+            }
+        }
+        free(pf);
+    }
+}
+
+static void test_adapt_scales_omega(void **st)
+{
+    (void)st;
+    static float x[3][BR_NX][64];
+    scaled_predictions(BR_PF_PROPOSAL_PRIOR, x);
+    int moved = 0;
+    for (uint32_t j = 0; j < 64u; j++) {
+        for (int i = BR_X_OMEGA; i < BR_NX; i++) {
+            const double d1 = (double)x[1][i][j] - (double)x[0][i][j];
+            const double d2 = (double)x[2][i][j] - (double)x[1][i][j];
+            if (i == BR_X_GP && (x[2][i][j] <= cfg(64).est.gp_min_N || x[2][i][j] >= cfg(64).est.gp_max_N)) {
+                continue; /* a clamp */
+            }
+            BR_ASSERT_NEAR(d2, 2.0 * d1, 1e-5 * fabs(d2) + 1e-6 * fabs((double)x[0][i][j]) + 1e-30);
+            moved += (i == BR_X_OMEGA) && (d1 != 0.0);
+        }
+        /* theta: the same noise sample, unscaled */
+        assert_memory_equal(&x[0][BR_X_THETA][j], &x[2][BR_X_THETA][j], sizeof(float));
+    }
+    assert_true(moved > 32); /* omega moved on most particles */
+    /* the predict-only step under OPT_HELD: omega's noise its own, unscaled */
+    scaled_predictions(BR_PF_PROPOSAL_OPT_HELD, x);
+    assert_memory_equal(x[0][BR_X_OMEGA], x[2][BR_X_OMEGA], sizeof x[0][BR_X_OMEGA]);
+    int zmoved = 0;
+    for (uint32_t j = 0; j < 64u; j++) {
+        zmoved += x[0][BR_X_Z][j] != x[2][BR_X_Z][j];
+    }
+    assert_true(zmoved > 32); /* z's noise is scaled there too */
+}
+
 /* The adapt tests need the reference machine: its file switches adapt on
  * (heavy and emps keep it off) and plant 0 is drawn around it. They are
  * built only in the reference machine's configuration (BR_TEST_THESIS_MACHINE,
@@ -975,6 +1034,7 @@ int main(void)
         cmocka_unit_test(test_likelihood_scale),
         cmocka_unit_test(test_proposal_matches_equations),
         cmocka_unit_test(test_proposal_adapt_takes_the_prior_draw),
+        cmocka_unit_test(test_adapt_scales_omega),
 #ifdef BR_TEST_THESIS_MACHINE
         cmocka_unit_test(test_adapt_is_thesis_filter_below_ref),
         cmocka_unit_test(test_adapt_keeps_lock_under_force_noise),

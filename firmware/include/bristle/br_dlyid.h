@@ -26,20 +26,25 @@ typedef struct {
                                use, in (0, 1) */
 } br_dlyid_cfg_t;
 
+/* Filters of the bank: the n_cand candidates, then one for the configured
+ * delay (model.causes.delay_s, on the grid or not), slot n_cand. */
+#define BR_DLYID_MAX_SLOTS (BR_DLYID_MAX_CAND + 1u)
+
 typedef struct {
-    float x[BR_DLYID_MAX_CAND][BR_DLYID_NX]; /* each candidate's filter mean */
+    float x[BR_DLYID_MAX_SLOTS][BR_DLYID_NX]; /* each slot's filter mean */
     float P[BR_DLYID_NX][BR_DLYID_NX];       /* their common covariance (the delay moves only the input) */
-    float J[BR_DLYID_MAX_CAND];              /* forgotten sums of squared innovations, rad^2 */
+    float J[BR_DLYID_MAX_SLOTS];             /* forgotten sums of squared innovations, rad^2 */
     float forget;                            /* e^(-dt / memory_s) */
     float q_force_N2;                        /* per period */
     float r_rad2;                            /* R + rpc^2 / 12 */
     float a01, a02, a12, b0, b1;             /* the period's transition and input (ZOH) */
-    uint32_t cm[BR_DLYID_MAX_CAND];          /* candidate j's delay: cm[j] whole periods */
-    float cf[BR_DLYID_MAX_CAND];             /* and cf[j] of the next */
+    uint32_t cm[BR_DLYID_MAX_SLOTS];         /* slot j's delay: cm[j] whole periods */
+    float cf[BR_DLYID_MAX_SLOTS];            /* and cf[j] of the next */
     int32_t origin_counts;                   /* the last measurement's count */
     uint32_t k;                              /* periods since the first measurement */
     uint32_t warmup;                         /* periods */
-    uint32_t cur;                            /* the candidate standing for the delay in use */
+    uint32_t cur;                            /* the slot of the delay in use (n_cand at the start:
+                                                the configured delay) */
     uint32_t n_switch;                       /* switches so far */
     int primed;
 } br_dlyid_t;

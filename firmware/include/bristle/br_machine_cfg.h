@@ -23,12 +23,13 @@
 #include "bristle_gen/est/br_ukf_tuned.h"
 #include "bristle_gen/machine/br_machine.h"
 
-/* the delay identification both estimators share (docs/modules/dlyid.md; 0 candidates: off) */
-#define BR_MACHINE_DELAY_ID_CFG                                                                    \
+/* an estimator's delay identification (E: PF or UKF; docs/modules/dlyid.md; 0 candidates: off) */
+#define BR_MACHINE_DELAY_ID_CFG(E)                                                                 \
     {                                                                                              \
-        .n_cand = BR_EST_DELAY_ID_CANDIDATES, .step_s = BR_EST_DELAY_ID_STEP_S_F,                  \
-        .q_force_N2ps = BR_EST_DELAY_ID_Q_FORCE_N2PS_F, .memory_s = BR_EST_DELAY_ID_MEMORY_S_F,    \
-        .warmup_s = BR_EST_DELAY_ID_WARMUP_S_F, .switch_ratio = BR_EST_DELAY_ID_SWITCH_RATIO_F     \
+        .n_cand = BR_EST_##E##_DELAY_ID_CANDIDATES, .step_s = BR_EST_##E##_DELAY_ID_STEP_S_F,      \
+        .q_force_N2ps = BR_EST_##E##_DELAY_ID_Q_FORCE_N2PS_F,                                      \
+        .memory_s = BR_EST_##E##_DELAY_ID_MEMORY_S_F, .warmup_s = BR_EST_##E##_DELAY_ID_WARMUP_S_F, \
+        .switch_ratio = BR_EST_##E##_DELAY_ID_SWITCH_RATIO_F                                       \
     }
 
 /* the eq. 6 estimation model of the machine at period dt (float) */
@@ -59,7 +60,7 @@
                 .reanchor_after = BR_EST_PF_REANCHOR_AFTER,                                        \
                 .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,                                   \
                 .comp_ahead_periods = BR_EST_PF_COMP_AHEAD_PERIODS_F,                          \
-                .delay_id = BR_MACHINE_DELAY_ID_CFG},                                          \
+                .delay_id = BR_MACHINE_DELAY_ID_CFG(PF)},                                          \
         .n_particles = BR_EST_PF_N_PARTICLES,                                                      \
         .x0_std = {BR_EST_PF_X0_STD_THETA_COUNTS_F * BR_MACHINE_RAD_PER_COUNT_F,                   \
                    BR_EST_PF_X0_STD_OMEGA_RADPS_F, BR_EST_PF_X0_STD_Z_M_F, BR_EST_PF_X0_STD_GP_N_F}, \
@@ -90,7 +91,7 @@
                 .reanchor_after = BR_EST_UKF_REANCHOR_AFTER,                                       \
                 .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,                                   \
                 .comp_ahead_periods = BR_EST_UKF_COMP_AHEAD_PERIODS_F,                         \
-                .delay_id = BR_MACHINE_DELAY_ID_CFG},                                          \
+                .delay_id = BR_MACHINE_DELAY_ID_CFG(UKF)},                                          \
         .p0_var = {BR_EST_UKF_P0_THETA_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F *                    \
                        BR_MACHINE_RAD_PER_COUNT_F,                                                 \
                    BR_EST_UKF_P0_OMEGA_RAD2PS2_F, BR_EST_UKF_P0_Z_M2_F, BR_EST_UKF_P0_GP_N2_F},    \

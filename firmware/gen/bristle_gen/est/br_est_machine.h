@@ -57,6 +57,23 @@
 /* compensation lead beyond the actuator delay, periods (0: the filtered estimate) */
 #define BR_EST_PF_COMP_AHEAD_PERIODS (0.0)
 #define BR_EST_PF_COMP_AHEAD_PERIODS_F (0.000000000e+00f)
+/* delay identification: candidates (0: off) */
+#define BR_EST_PF_DELAY_ID_CANDIDATES 8u
+/* their spacing */
+#define BR_EST_PF_DELAY_ID_STEP_S (0.0005)
+#define BR_EST_PF_DELAY_ID_STEP_S_F (5.000000237e-04f)
+/* friction random walk per second */
+#define BR_EST_PF_DELAY_ID_Q_FORCE_N2PS (1000.0)
+#define BR_EST_PF_DELAY_ID_Q_FORCE_N2PS_F (1.000000000e+03f)
+/* forgetting time constant */
+#define BR_EST_PF_DELAY_ID_MEMORY_S (0.01)
+#define BR_EST_PF_DELAY_ID_MEMORY_S_F (9.999999776e-03f)
+/* no switch before */
+#define BR_EST_PF_DELAY_ID_WARMUP_S (0.005)
+#define BR_EST_PF_DELAY_ID_WARMUP_S_F (4.999999888e-03f)
+/* switch below this ratio */
+#define BR_EST_PF_DELAY_ID_SWITCH_RATIO (0.6)
+#define BR_EST_PF_DELAY_ID_SWITCH_RATIO_F (6.000000238e-01f)
 /* extra noise-table advance per step */
 #define BR_EST_PF_NOISE_SKIP 1u
 /* innovation-driven noise of omega, z and g_p (0: off) */
@@ -68,23 +85,6 @@
 /* its largest variance factor */
 #define BR_EST_PF_ADAPT_MAX_SCALE (100.0)
 #define BR_EST_PF_ADAPT_MAX_SCALE_F (1.000000000e+02f)
-/* delay identification: candidates (0: off) */
-#define BR_EST_DELAY_ID_CANDIDATES 8u
-/* their spacing */
-#define BR_EST_DELAY_ID_STEP_S (0.0005)
-#define BR_EST_DELAY_ID_STEP_S_F (5.000000237e-04f)
-/* friction random walk per second */
-#define BR_EST_DELAY_ID_Q_FORCE_N2PS (1000.0)
-#define BR_EST_DELAY_ID_Q_FORCE_N2PS_F (1.000000000e+03f)
-/* forgetting time constant */
-#define BR_EST_DELAY_ID_MEMORY_S (0.02)
-#define BR_EST_DELAY_ID_MEMORY_S_F (1.999999955e-02f)
-/* no switch before */
-#define BR_EST_DELAY_ID_WARMUP_S (0.02)
-#define BR_EST_DELAY_ID_WARMUP_S_F (1.999999955e-02f)
-/* switch below this ratio */
-#define BR_EST_DELAY_ID_SWITCH_RATIO (0.5)
-#define BR_EST_DELAY_ID_SWITCH_RATIO_F (5.000000000e-01f)
 /* process noise variance per step */
 #define BR_EST_UKF_Q_THETA_RAD2 (1e-14)
 #define BR_EST_UKF_Q_THETA_RAD2_F (9.999999825e-15f)
@@ -128,6 +128,23 @@
 /* compensation lead beyond the actuator delay, periods (0: the filtered estimate) */
 #define BR_EST_UKF_COMP_AHEAD_PERIODS (0.0)
 #define BR_EST_UKF_COMP_AHEAD_PERIODS_F (0.000000000e+00f)
+/* delay identification: candidates (0: off) */
+#define BR_EST_UKF_DELAY_ID_CANDIDATES 8u
+/* their spacing */
+#define BR_EST_UKF_DELAY_ID_STEP_S (0.0005)
+#define BR_EST_UKF_DELAY_ID_STEP_S_F (5.000000237e-04f)
+/* friction random walk per second */
+#define BR_EST_UKF_DELAY_ID_Q_FORCE_N2PS (1000.0)
+#define BR_EST_UKF_DELAY_ID_Q_FORCE_N2PS_F (1.000000000e+03f)
+/* forgetting time constant */
+#define BR_EST_UKF_DELAY_ID_MEMORY_S (0.02)
+#define BR_EST_UKF_DELAY_ID_MEMORY_S_F (1.999999955e-02f)
+/* no switch before */
+#define BR_EST_UKF_DELAY_ID_WARMUP_S (0.02)
+#define BR_EST_UKF_DELAY_ID_WARMUP_S_F (1.999999955e-02f)
+/* switch below this ratio */
+#define BR_EST_UKF_DELAY_ID_SWITCH_RATIO (0.5)
+#define BR_EST_UKF_DELAY_ID_SWITCH_RATIO_F (5.000000000e-01f)
 /* sigma-point spread */
 #define BR_EST_UKF_ALPHA (1.0)
 #define BR_EST_UKF_ALPHA_F (1.000000000e+00f)
