@@ -37,14 +37,20 @@ mkdir -p "$out"
 # other m than recorded; its own cost per period is measured at m_hi on a stream with it, below
 "$host/tests/target/br_replay_record" --out "$out/stream.bin" --duration 1.0 --delay-id 0 >/dev/null
 
-declare -A mean med min max p99 ipt
-for m in "$m_hi" "$m_lo"; do
+# qemu_replay STREAM OUT M NAME: the image replays STREAM at m = M into OUT; the log is kept
+# as $out/qemu_NAME.log, and log, ci, ct (its calibration: instructions, SysTick ticks) are set
+qemu_replay() {
   log=$("$qemu" -M "$machine" -nographic -monitor none -serial none -icount shift=0 \
-    -semihosting-config "enable=on,target=native,arg=replay,arg=$out/stream.bin,arg=$out/target_m$m.bin,arg=$m" \
+    -semihosting-config "enable=on,target=native,arg=replay,arg=$1,arg=$2,arg=$3" \
     -kernel "$image" 2>&1)
-  echo "$log" > "$out/qemu_m$m.log"
+  echo "$log" > "$out/qemu_$4.log"
   read -r ci ct < <(sed -n 's/^calib insns=\([0-9]*\) ticks=\([0-9]*\).*/\1 \2/p' <<<"$log")
   [[ -n ${ct:-} && $ct -gt 0 ]] || { echo "target-bench: calibration failed: $log" >&2; exit 1; }
+}
+
+declare -A mean med min max p99 ipt
+for m in "$m_hi" "$m_lo"; do
+  qemu_replay "$out/stream.bin" "$out/target_m$m.bin" "$m" "m$m"
   ipt[$m]=$(awk -v i="$ci" -v t="$ct" 'BEGIN { printf "%.6f", i / t }')
   read -r n mean[$m] med[$m] min[$m] max[$m] p99[$m] < <("$host/tests/target/br_replay_cmp" --cost "$out/target_m$m.bin")
   sizes=$(sed -n 's/.*sizeof_replay=\([0-9]*\) .*sizeof_pf=\([0-9]*\).*/\1 \2/p' <<<"$log")
@@ -150,12 +156,7 @@ BEGIN {
 # recorded with it (the closed loop's own commands, so the replay is that loop); its cost per
 # period is the difference of the means, instructions, against the run without it above.
 "$host/tests/target/br_replay_record" --out "$out/stream_id.bin" --duration 1.0 >/dev/null
-log=$("$qemu" -M "$machine" -nographic -monitor none -serial none -icount shift=0 \
-  -semihosting-config "enable=on,target=native,arg=replay,arg=$out/stream_id.bin,arg=$out/target_id.bin,arg=$m_hi" \
-  -kernel "$image" 2>&1)
-echo "$log" > "$out/qemu_id.log"
-read -r ci ct < <(sed -n 's/^calib insns=\([0-9]*\) ticks=\([0-9]*\).*/\1 \2/p' <<<"$log")
-[[ -n ${ct:-} && $ct -gt 0 ]] || { echo "target-bench: calibration failed: $log" >&2; exit 1; }
+qemu_replay "$out/stream_id.bin" "$out/target_id.bin" "$m_hi" id
 read -r _ mean_id _ _ max_id _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_id.bin")
 awk -v m="$m_hi" -v a="$mean_id" -v x="$max_id" -v i="$ci" -v t="$ct" -v a0="${mean[$m_hi]}" -v i0="${ipt[$m_hi]}" \
     -v mhz="$mhz" -v P="$period" 'BEGIN {

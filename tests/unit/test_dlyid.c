@@ -103,6 +103,14 @@ static double modelled_s(const br_est_delay_t *d, const br_est_cfg_t *c)
 
 static br_est_cfg_t machine_ukf(void) { return br_circle_ukf_cfg_tuned(UKF_DT_S).est; }
 
+/* c is refused, and the same configuration with the bank off is not */
+static void refused_only_with_the_bank(br_est_cfg_t c)
+{
+    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c.delay_id.n_cand = 0u;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+}
+
 static void test_dlyid_bounds(void **st)
 {
     (void)st;
@@ -147,18 +155,14 @@ static void test_dlyid_bounds(void **st)
     /* a period so long that the bank's constants overflow (T^2 / J_eff) */
     c = ok;
     c.model.dt_s = 1.0e20f;
-    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
-    c.delay_id.n_cand = 0u;
-    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    refused_only_with_the_bank(c);
     /* a lead and an inertia at which L T / J_eff overflows, L T^2 / (2 J_eff) not */
     c = ok;
     c.model.lead_mprad = 1.8e19f;
     c.model.M_kg = 0.0f;
     c.model.J_kgm2 = 1.0e-23f;
     assert_true(isfinite(-c.model.lead_mprad * (0.5f * c.model.dt_s * c.model.dt_s / c.model.J_kgm2)));
-    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
-    c.delay_id.n_cand = 0u;
-    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    refused_only_with_the_bank(c);
     /* the friction's variance per period q T beyond float range, at a 100 s period */
     c = ok;
     c.model.dt_s = 100.0f;
