@@ -23,7 +23,6 @@ static int constants(br_dlyid_t *id, const br_est_cfg_t *cfg)
     const float T = mc->dt_s;
     const float L = mc->lead_mprad;
     const float inv_J = 1.0f / (mc->J_kgm2 + L * L * mc->M_kg);
-    id->a01 = T;
     id->b0 = 0.5f * T * T * inv_J;
     id->b1 = T * inv_J;
     id->a02 = -L * id->b0;
@@ -50,8 +49,7 @@ int br_dlyid_cfg_ok(const br_est_cfg_t *cfg)
         return 0;
     }
     /* the largest candidate within the command history (br_est_delay_torque's m <= HIST - 2) */
-    const float largest = (float)(c->n_cand - 1u) * c->step_s;
-    if (!(largest <= (float)(BR_EST_DELAY_HIST - 2u) * dt)) {
+    if (!br_est_delay_fits((float)(c->n_cand - 1u) * c->step_s, dt)) {
         return 0;
     }
     br_dlyid_t scratch;
@@ -78,9 +76,7 @@ void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg)
     for (uint32_t j = 0; j <= n; j++) {
         /* the candidates j step_s; slot n the configured delay, where the estimator starts
          * (br_est_delay_init's m and f) */
-        const float q = (j < n) ? (float)j * c->step_s / T : mc->causes.delay_s / T;
-        id->cm[j] = (uint32_t)q;
-        id->cf[j] = q - (float)id->cm[j];
+        br_est_delay_periods((j < n) ? (float)j * c->step_s : mc->causes.delay_s, T, &id->cm[j], &id->cf[j]);
     }
     id->cur = n;
 }
@@ -110,13 +106,13 @@ static void prime(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, u
     id->primed = 1;
 }
 
-/* (dly3) P- = A P A^T + diag(0, 0, q_F), A = [1 a01 a02; 0 1 a12; 0 0 1]; then the gain
+/* (dly3) P- = A P A^T + diag(0, 0, q_F), A = [1 T a02; 0 1 a12; 0 0 1]; then the gain
  * K = P-[:,0] / S, S = P-_00 + R, and P+ = P- - K P-[0,:]. P does not depend on the
  * data: with the finite constants br_est_cfg_check requires it is the Riccati recursion
  * of an observable system (theta measured), bounded. */
-static void covariance(br_dlyid_t *id, float K[BR_DLYID_NX])
+static void covariance(br_dlyid_t *id, float T, float K[BR_DLYID_NX])
 {
-    const float A[BR_DLYID_NX][BR_DLYID_NX] = {{1.0f, id->a01, id->a02}, {0.0f, 1.0f, id->a12}, {0.0f, 0.0f, 1.0f}};
+    const float A[BR_DLYID_NX][BR_DLYID_NX] = {{1.0f, T, id->a02}, {0.0f, 1.0f, id->a12}, {0.0f, 0.0f, 1.0f}};
     float AP[BR_DLYID_NX][BR_DLYID_NX], Pm[BR_DLYID_NX][BR_DLYID_NX];
     for (int i = 0; i < BR_DLYID_NX; i++) {
         for (int j = 0; j < BR_DLYID_NX; j++) {
@@ -156,19 +152,20 @@ static void covariance(br_dlyid_t *id, float K[BR_DLYID_NX])
     }
 }
 
-int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d)
+void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d)
 {
     const uint32_t n = cfg->delay_id.n_cand;
     if (n == 0u || n > BR_DLYID_MAX_CAND) {
-        return 0;
+        return;
     }
     if (!id->primed) {
         prime(id, cfg, y, n);
-        return 0;
+        return;
     }
     const float rpc = cfg->rad_per_count;
     float K[BR_DLYID_NX];
-    covariance(id, K);
+    const float T = cfg->model.dt_s;
+    covariance(id, T, K);
     /* theta re-expressed relative to the new count (wrap-safe), the measurement frac rpc */
     const float shift = (float)br_counts_delta(y->counts, id->origin_counts) * rpc;
     const float y_rel = y->frac * rpc;
@@ -179,7 +176,7 @@ int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *
         /* (dly4) candidate j's prediction with the torque its delay brings: u_j = (1 - f_j)
          * u[k-1-m_j] + f_j u[k-2-m_j] */
         const float u = br_est_delay_torque(d, id->cm[j], id->cf[j]);
-        const float th = x[0] + id->a01 * x[1] + id->a02 * x[2] + id->b0 * u - shift;
+        const float th = x[0] + T * x[1] + id->a02 * x[2] + id->b0 * u - shift;
         const float om = x[1] + id->a12 * x[2] + id->b1 * u;
         /* (dly5) innovation nu_j = y - theta-_j, update x+ = x- + K nu_j, J_j <- forget J_j + nu_j^2 */
         const float nu = y_rel - th;
@@ -192,13 +189,13 @@ int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *
     id->origin_counts = y->counts;
     if (!finite) {
         id->primed = 0; /* the bank restarts at the next measurement */
-        return 0;
+        return;
     }
     if (id->k < UINT32_MAX) {
         id->k++;
     }
     if (id->k < id->warmup) {
-        return 0;
+        return;
     }
     /* (dly6) the best candidate takes over when its sum is below switch_ratio times the
      * sum of the one in use */
@@ -209,14 +206,12 @@ int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *
         }
     }
     if (best == id->cur || !(id->J[best] < cfg->delay_id.switch_ratio * id->J[id->cur])) {
-        return 0;
+        return;
     }
     id->cur = best;
     d->m = id->cm[best];
-    d->f = id->cf[best];
-    d->on = 1;
+    d->f = id->cf[best]; /* d->on: set by br_est_delay_init for the bank */
     if (id->n_switch < UINT32_MAX) {
         id->n_switch++;
     }
-    return 1;
 }

@@ -31,7 +31,7 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
         cfg->outlier_sigma > BR_EST_GATE_MAX_SIGMA || cfg->reanchor_after < 1u) {
         return BR_E_PARAM;
     }
-    if (!(cfg->model.causes.delay_s <= (float)(BR_EST_DELAY_HIST - 2u) * cfg->model.dt_s)) {
+    if (!br_est_delay_fits(cfg->model.causes.delay_s, cfg->model.dt_s)) {
         return BR_E_PARAM;
     }
     if (!(cfg->comp_ahead_periods >= 0.0f && cfg->comp_ahead_periods <= BR_EST_AHEAD_MAX_PERIODS)) {
@@ -64,11 +64,21 @@ br_status_t br_est_check_step(const br_meas_t *y, float u_prev_Nm)
     return BR_OK;
 }
 
+int br_est_delay_fits(float delay_s, float dt_s)
+{
+    return delay_s <= (float)(BR_EST_DELAY_HIST - 2u) * dt_s;
+}
+
+void br_est_delay_periods(float delay_s, float dt_s, uint32_t *m, float *f)
+{
+    const float q = delay_s / dt_s;
+    *m = (uint32_t)q;
+    *f = q - (float)*m;
+}
+
 void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg)
 {
-    const float q = cfg->model.causes.delay_s / cfg->model.dt_s;
-    d->m = (uint32_t)q;
-    d->f = q - (float)d->m;
+    br_est_delay_periods(cfg->model.causes.delay_s, cfg->model.dt_s, &d->m, &d->f);
     d->on = cfg->model.causes.delay_s > 0.0f || cfg->delay_id.n_cand > 0u;
     d->head = 0u;
     d->n = 0u;

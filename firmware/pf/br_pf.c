@@ -1031,7 +1031,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     const float u_a = br_est_delay_apply(&pf->delay, u_prev_Nm);
     /* the delay's identification (off unless cfg.est.delay_id.n_cand): from the next period on,
      * the torque with the delay it finds */
-    (void)br_est_dlyid_step(&pf->dlyid, &pf->cfg.est, y, &pf->delay);
+    br_est_dlyid_step(&pf->dlyid, &pf->cfg.est, y, &pf->delay);
     if (!pf->primed) {
         prime(pf, y);
         return BR_OK;

@@ -347,7 +347,7 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     const float u_a = br_est_delay_apply(&ukf->delay, u_prev_Nm);
     /* the delay's identification (off unless cfg.est.delay_id.n_cand): from the next period on,
      * the torque with the delay it finds */
-    (void)br_est_dlyid_step(&ukf->dlyid, &ukf->cfg.est, y, &ukf->delay);
+    br_est_dlyid_step(&ukf->dlyid, &ukf->cfg.est, y, &ukf->delay);
     if (!ukf->primed) {
         return prime(ukf, y);
     }

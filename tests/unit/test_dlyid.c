@@ -89,7 +89,7 @@ static uint32_t run_bank(const br_est_cfg_t *c, double delay_s, int n, br_est_de
     for (int k = 0; k < n; k++) {
         const br_meas_t y = axis_step(&a, u_prev, c->rad_per_count);
         (void)br_est_delay_apply(d, u_prev);
-        (void)br_est_dlyid_step(id, c, &y, d);
+        br_est_dlyid_step(id, c, &y, d);
         u_prev = command(&a, k + 1);
     }
     return id->n_switch;
@@ -238,7 +238,7 @@ static void test_dlyid_overflow_restarts(void **st)
         /* period 5: the estimator is told of a torque the axis never got */
         const float told = (k == 5) ? 3.0e38f : u_prev;
         (void)br_est_delay_apply(&d, told);
-        (void)br_est_dlyid_step(&id, &c, &y, &d);
+        br_est_dlyid_step(&id, &c, &y, &d);
         if (k == 5) {
             assert_int_equal(id.primed, 0); /* the bank starts again */
             assert_int_equal(id.n_switch, 0u);

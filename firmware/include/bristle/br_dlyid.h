@@ -37,7 +37,7 @@ typedef struct {
     float forget;                            /* e^(-dt / memory_s) */
     float q_force_N2;                        /* per period */
     float r_rad2;                            /* R + rpc^2 / 12 */
-    float a01, a02, a12, b0, b1;             /* the period's transition and input (ZOH) */
+    float a02, a12, b0, b1;                  /* the period's transition and input (ZOH; a01 = dt) */
     uint32_t cm[BR_DLYID_MAX_SLOTS];         /* slot j's delay: cm[j] whole periods */
     float cf[BR_DLYID_MAX_SLOTS];            /* and cf[j] of the next */
     int32_t origin_counts;                   /* the last measurement's count */

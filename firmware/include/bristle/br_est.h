@@ -79,6 +79,14 @@ typedef struct {
     int on;                     /* delay_s > 0, or the delay identification on: the history is kept */
 } br_est_delay_t;
 
+/* 1 when a delay of delay_s at the period dt_s lies within the history:
+ * delay_s <= (BR_EST_DELAY_HIST - 2) dt_s (NaN: 0). */
+int br_est_delay_fits(float delay_s, float dt_s);
+
+/* A delay of delay_s (checked by br_est_delay_fits) at the period dt_s as *m
+ * whole periods and the fraction *f of the next, 0 <= f < 1. */
+void br_est_delay_periods(float delay_s, float dt_s, uint32_t *m, float *f);
+
 /* Empties the history for the configuration's delay (checked by br_est_cfg_check). */
 void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg);
 
@@ -123,10 +131,10 @@ void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg);
  * candidate's filter predicts with its delay's torque and takes y. Once past
  * the warm-up, when the best candidate's forgotten sum of squared innovations
  * is below switch_ratio times that of the candidate in use, d's delay becomes
- * the best one's and 1 is returned (else 0). A filter that is not finite
- * restarts the bank at the next measurement, nothing switched. Off
- * (n_cand = 0): nothing, 0. */
-int br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d);
+ * the best one's (id->n_switch counts the switches). A filter that is not
+ * finite restarts the bank at the next measurement, nothing switched. Off
+ * (n_cand = 0): nothing. */
+void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d);
 
 /* One estimator step: y is the measurement at t_k, u_prev_Nm the torque that
  * was applied over [t_{k-1}, t_k]. Unless the status is an error (negative),
