@@ -94,7 +94,7 @@ int main(int argc, char **argv)
     }
     br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     c.duration_s = duration;
-    c.pf.est.comp_ahead_periods = (float)ahead;
+    br_circle_use_ahead(&c, ahead);
     br_circle_use_delay_id(&c, delay_id);
     rec_t r = {&c, tmpfile(), NULL, 0u, n_axes};
     if (r.steps == NULL) return 1;

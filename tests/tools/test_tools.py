@@ -172,7 +172,7 @@ class ToolsTest(unittest.TestCase):
     def test_robust_run_bad_options_touch_nothing(self):
         keep = self.existing("robust.json")
         for bad in (["--drift", "0.6"], ["--drift", "nan"], ["--force-noise", "-1"], ["--enc-noise", "1.5"],
-                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
+                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--delay-id", "2"], ["--delay-id", "-1"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
                     ["--bogus", "1"], ["--drift"]):
             r = run("br_robust_run", "--json", keep, *bad)
             self.assert_refused(r, 2)
