@@ -31,9 +31,13 @@ static int constants(br_dlyid_t *id, const br_est_cfg_t *cfg)
     const float rpc = cfg->rad_per_count;
     id->r_rad2 = cfg->r_var_rad2 + rpc * rpc * (1.0f / 12.0f);
     id->forget = expf(-T / c->memory_s);
+    /* (dly7) the travel over which LuGre's bristles carry the friction's jump at a reversal,
+     * in rad at the motor */
+    id->settle_rad = BR_DLYID_SETTLE_LENGTHS * cfg->gp_max_N / (mc->lugre.sigma0_Npm * L);
     /* b0 and b1 are finite when L b0 and L b1 are (L > 0, br_model_init); R' is finite
      * where br_est_cfg_check accepts R and rpc */
-    return isfinite(id->a02) && isfinite(id->a12) && isfinite(id->q_force_N2) && id->forget < 1.0f;
+    return isfinite(id->a02) && isfinite(id->a12) && isfinite(id->q_force_N2) && id->forget < 1.0f &&
+           isfinite(id->settle_rad);
 }
 
 int br_dlyid_cfg_ok(const br_est_cfg_t *cfg)
@@ -103,6 +107,9 @@ static void prime(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, u
     id->P[2][2] = cfg->gp_max_N * cfg->gp_max_N;
     id->origin_counts = y->counts;
     id->k = 0u;
+    id->dir = 0;
+    id->settle_left_rad = 0.0f;
+    id->run_rad = 0.0f;
     id->primed = 1;
 }
 
@@ -152,6 +159,33 @@ static void covariance(br_dlyid_t *id, float T, float K[BR_DLYID_NX])
     }
 }
 
+/* (dly7) a velocity reversal after a run of at least settle_rad: the friction jumps
+ * by up to 2 g_p,max over a few presliding lengths, which no candidate's random walk
+ * follows, and the innovations then favour whichever delay happens to match the
+ * controller's reaction to the jump. From such a change of the sign of the filter in
+ * use's velocity (beyond one count per period, w_min, so that rest does not count)
+ * the innovations are not scored until the axis has travelled settle_rad. A reversal
+ * after a shorter run (an oscillation, a dither) is not one: the bristles never left
+ * presliding, where the friction is a spring and does not jump. */
+static void reversal(br_dlyid_t *id, float w_min, float T)
+{
+    const float w = id->x[id->cur][1];
+    const int32_t s = (w > w_min) ? 1 : ((w < -w_min) ? -1 : 0);
+    const float step = fabsf(w) * T;
+    if (s != 0 && id->dir != 0 && s != id->dir) {
+        if (id->run_rad >= id->settle_rad) {
+            id->settle_left_rad = id->settle_rad;
+        }
+        id->run_rad = 0.0f;
+    } else {
+        id->settle_left_rad -= step;
+        id->run_rad += step;
+    }
+    if (s != 0) {
+        id->dir = s;
+    }
+}
+
 void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d)
 {
     const uint32_t n = cfg->delay_id.n_cand;
@@ -165,6 +199,8 @@ void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t 
     const float rpc = cfg->rad_per_count;
     float K[BR_DLYID_NX];
     const float T = cfg->model.dt_s;
+    reversal(id, rpc / T, T);
+    const int scored = !(id->settle_left_rad > 0.0f);
     covariance(id, T, K);
     /* theta re-expressed relative to the new count (wrap-safe), the measurement frac rpc */
     const float shift = (float)br_counts_delta(y->counts, id->origin_counts) * rpc;
@@ -183,7 +219,9 @@ void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t 
         x[0] = th + K[0] * nu;
         x[1] = om + K[1] * nu;
         x[2] = x[2] + K[2] * nu;
-        id->J[j] = id->forget * id->J[j] + nu * nu;
+        if (scored) {
+            id->J[j] = id->forget * id->J[j] + nu * nu;
+        }
         finite = finite && isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(id->J[j]);
     }
     id->origin_counts = y->counts;
@@ -194,18 +232,21 @@ void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t 
     if (id->k < UINT32_MAX) {
         id->k++;
     }
-    if (id->k < id->warmup) {
-        return;
+    if (id->k < id->warmup || !scored) {
+        return; /* no decision on a period that brought no evidence */
     }
     /* (dly6) the best candidate takes over when its sum is below switch_ratio times the
-     * sum of the one in use */
+     * sum of the one in use ... */
     uint32_t best = id->cur;
     for (uint32_t j = 0; j <= n; j++) {
         if (id->J[j] < id->J[best]) {
             best = j;
         }
     }
-    if (best == id->cur || !(id->J[best] < cfg->delay_id.switch_ratio * id->J[id->cur])) {
+    /* ... and the one in use explains the motion worse than the noise allows */
+    const float J_noise = BR_DLYID_NOISE_FACTOR * (id->r_rad2 + id->P[0][0]) / (1.0f - id->forget);
+    if (best == id->cur || !(id->J[best] < cfg->delay_id.switch_ratio * id->J[id->cur]) ||
+        !(id->J[id->cur] > J_noise)) {
         return;
     }
     id->cur = best;

@@ -31,7 +31,7 @@
  * with the estimator model's mass, lead and levels; commands held over each period. */
 typedef struct {
     double th, om, t;
-    double J, L, Fc, s2, delay, dt;
+    double J, L, Fc, v0, s2, delay, dt;
     double u[256]; /* commands, u[k] over [k dt, (k + 1) dt) */
     int k;
 } axis_t;
@@ -43,6 +43,7 @@ static void axis_init(axis_t *a, const br_est_cfg_t *c, double delay_s)
     a->L = m->lead_mprad;
     a->J = (double)m->J_kgm2 + a->L * a->L * (double)m->M_kg;
     a->Fc = m->lugre.Fc_N;
+    a->v0 = 1.0e-4;
     a->s2 = m->sigma2_Nspm;
     a->delay = delay_s;
     a->dt = m->dt_s;
@@ -67,7 +68,7 @@ static br_meas_t axis_step(axis_t *a, float u, double rpc)
         const long j = (long)floor(tm / a->dt + 1e-9);
         const double ua = (j < 0 || a->k - j >= 256) ? 0.0 : a->u[j % 256];
         const double v = a->L * a->om;
-        const double F = a->Fc * tanh(v / 1.0e-4) + a->s2 * v;
+        const double F = a->Fc * tanh(v / a->v0) + a->s2 * v;
         const double acc = (ua - a->L * F) / a->J;
         a->th += h * a->om + 0.5 * h * h * acc;
         a->om += h * acc;
@@ -78,11 +79,10 @@ static br_meas_t axis_step(axis_t *a, float u, double rpc)
     return y;
 }
 
-/* runs the bank on the test's axis for n periods; returns the switches */
-static uint32_t run_bank(const br_est_cfg_t *c, double delay_s, int n, br_est_delay_t *d, br_dlyid_t *id)
+/* runs the bank on axis a for n periods; returns the switches */
+static uint32_t run_bank_on(axis_t *a0, const br_est_cfg_t *c, int n, br_est_delay_t *d, br_dlyid_t *id)
 {
-    axis_t a;
-    axis_init(&a, c, delay_s);
+    axis_t a = *a0;
     br_est_delay_init(d, c);
     br_est_dlyid_init(id, c);
     float u_prev = 0.0f;
@@ -95,6 +95,14 @@ static uint32_t run_bank(const br_est_cfg_t *c, double delay_s, int n, br_est_de
     return id->n_switch;
 }
 
+/* runs the bank on the test's axis for n periods; returns the switches */
+static uint32_t run_bank(const br_est_cfg_t *c, double delay_s, int n, br_est_delay_t *d, br_dlyid_t *id)
+{
+    axis_t a;
+    axis_init(&a, c, delay_s);
+    return run_bank_on(&a, c, n, d, id);
+}
+
 /* the delay the estimator now models, in seconds */
 static double modelled_s(const br_est_delay_t *d, const br_est_cfg_t *c)
 {
@@ -102,6 +110,7 @@ static double modelled_s(const br_est_delay_t *d, const br_est_cfg_t *c)
 }
 
 static br_est_cfg_t machine_ukf(void) { return br_circle_ukf_cfg_tuned(UKF_DT_S).est; }
+static br_est_cfg_t machine_pf(void) { return br_circle_pf_cfg_tuned(PF_DT_S).est; }
 
 /* c is refused, and the same configuration with the bank off is not */
 static void refused_only_with_the_bank(br_est_cfg_t c)
@@ -327,8 +336,8 @@ static void test_dlyid_on_without_switch_is_off(void **st)
     assert_non_null(pb);
     br_pf_cfg_t pon = br_circle_pf_cfg_tuned(PF_DT_S), poff = pon;
     pon.n_particles = poff.n_particles = 200u;
-    /* the PF's machine setting decides fast and switches on this axis too (docs/modules/dlyid.md,
-     * "false switches"): a ratio no candidate reaches keeps the bank running without a switch */
+    /* the PF's machine setting decides fast and switches at this axis's start (docs/modules/dlyid.md,
+     * "False switches"): a ratio no candidate reaches keeps the bank running without a switch */
     pon.est.delay_id.switch_ratio = 1.0e-30f;
     poff.est.delay_id.n_cand = 0u;
     assert_int_equal(br_pf_init(pa, &pon), BR_OK);
@@ -358,6 +367,70 @@ static void test_dlyid_on_without_switch_is_off(void **st)
     free(pb);
 }
 
+/* The PF's setting (the faster one: 10 ms memory, ratio 0.6) on an axis on time. Sums at
+ * the noise floor, whose ratio wanders below 0.6, and one period's event (a command step, the
+ * friction's jump at a reversal) favour a wrong delay for a period or two: the bank keeps the
+ * delay in use unless its sum is above the noise's and a candidate stays decisively best
+ * (dly6; the EMPS chain's switch to 0.5 ms at an acceleration step and its lost lock). No
+ * switch, with the smooth friction of the other tests and with one that jumps by 2 Fs within
+ * 1 um/s; an axis 1.5 ms late with the sharp friction is still found. */
+/* runs the bank on a for n periods and returns the switches after the first n0 (the
+ * start, where the bank's filters converge from rest and a candidate may win a period or two
+ * before the delay in use takes over again); the delay at the end is 0 */
+static uint32_t switches_after(axis_t *a, const br_est_cfg_t *c, int n0, int n)
+{
+    br_est_delay_t d;
+    br_dlyid_t id;
+    const uint32_t s0 = run_bank_on(a, c, n0, &d, &id);
+    const uint32_t s = run_bank_on(a, c, n, &d, &id);
+    assert_true(s >= s0); /* the same run, longer: the start's switches are its first */
+    assert_int_equal(d.m, 0u);
+    assert_true(d.f == 0.0f);
+    return s - s0;
+}
+
+/* the PF's setting, an axis on time with the smooth friction of the other tests: no switch
+ * after the first 0.1 s */
+static void test_dlyid_no_false_switch(void **st)
+{
+    (void)st;
+    const br_est_cfg_t c = machine_pf();
+    axis_t a;
+    axis_init(&a, &c, 0.0);
+    assert_int_equal(switches_after(&a, &c, (int)(0.1 / PF_DT_S), 6000), 0u);
+}
+
+/* the test's axis with a friction that jumps by 2 Fs within 1 um/s at each reversal */
+static axis_t sharp_axis(const br_est_cfg_t *c, double delay_s)
+{
+    axis_t a;
+    axis_init(&a, c, delay_s);
+    a.Fc = c->model.lugre.Fs_N;
+    a.v0 = 1.0e-6;
+    return a;
+}
+
+/* the PF's setting on it, on time: no switch after the first 0.1 s */
+static void test_dlyid_no_switch_at_reversals(void **st)
+{
+    (void)st;
+    const br_est_cfg_t c = machine_pf();
+    axis_t a = sharp_axis(&c, 0.0);
+    assert_int_equal(switches_after(&a, &c, (int)(0.1 / PF_DT_S), 6000), 0u);
+}
+
+/* and 1.5 ms late: found */
+static void test_dlyid_finds_delay_at_reversals(void **st)
+{
+    (void)st;
+    const br_est_cfg_t c = machine_pf();
+    br_est_delay_t d;
+    br_dlyid_t id;
+    axis_t a = sharp_axis(&c, 1.5e-3);
+    assert_true(run_bank_on(&a, &c, 2000, &d, &id) >= 1u);
+    assert_true(fabs(modelled_s(&d, &c) - 1.5e-3) <= 0.5 * (double)c.delay_id.step_s + 1e-9);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -369,6 +442,9 @@ int main(void)
         cmocka_unit_test(test_dlyid_unchecked_count_is_off),
         cmocka_unit_test(test_dlyid_predict_restarts),
         cmocka_unit_test(test_dlyid_on_without_switch_is_off),
+        cmocka_unit_test(test_dlyid_no_false_switch),
+        cmocka_unit_test(test_dlyid_no_switch_at_reversals),
+        cmocka_unit_test(test_dlyid_finds_delay_at_reversals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

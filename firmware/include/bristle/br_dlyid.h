@@ -15,6 +15,18 @@
 /* The filters' state: theta (rad, relative to the last measurement's count),
  * omega (rad/s), the whole friction F (load side, N, a random walk). */
 #define BR_DLYID_NX 3
+/* After a velocity reversal that ended a run of at least this many
+ * presliding lengths g_p,max / sigma0, the innovations are not scored until
+ * the axis has travelled as far again (dly7): LuGre's bristle state settles
+ * with the e-folding distance g(v) / sigma0 <= g_p,max / sigma0, so after
+ * three lengths 95 % of the friction's jump is through. */
+#define BR_DLYID_SETTLE_LENGTHS 3.0f
+/* A candidate is taken only when the delay in use explains the motion worse
+ * than the noise allows (dly6): its forgotten sum above this factor times
+ * (R' + P+_00) / (1 - e^(-T / memory_s)), the encoder's noise and the filtered
+ * position's own uncertainty over the sums' memory. Chosen on measured runs:
+ * docs/modules/dlyid.md, "False switches". */
+#define BR_DLYID_NOISE_FACTOR 2.0f
 
 typedef struct {
     uint32_t n_cand;        /* candidates 0, step_s, ..., (n_cand - 1) step_s; 0: off, else 2..BR_DLYID_MAX_CAND */
@@ -37,6 +49,11 @@ typedef struct {
     float forget;                            /* e^(-dt / memory_s) */
     float q_force_N2;                        /* per period */
     float r_rad2;                            /* R + rpc^2 / 12 */
+    float settle_rad;                        /* BR_DLYID_SETTLE_LENGTHS g_p,max / (sigma0 L), rad */
+    float settle_left_rad;                   /* travel left before the innovations are scored again */
+    float run_rad;                           /* travel since the last reversal */
+    int32_t dir;                             /* the sign of the velocity in use's filter: -1, +1; 0 at rest
+                                                since the start */
     float a02, a12, b0, b1;                  /* the period's transition and input (ZOH; a01 = dt) */
     uint32_t cm[BR_DLYID_MAX_SLOTS];         /* slot j's delay: cm[j] whole periods */
     float cf[BR_DLYID_MAX_SLOTS];            /* and cf[j] of the next */
