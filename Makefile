@@ -261,7 +261,7 @@ emps: deps
 	$(Q)$(PYTHON) sim/studies/machine_chain.py --src . --work $(EMPS_OUT) --given machines/emps.json --log $(EMPS_LOG) \
 	  --controller python/bristle/diagnose/machines/emps.json --cross --cross-dir build/cm7-release-emps --track --circle \
 	  --md docs/machines/emps.md > $(EMPS_OUT)/chain.log || { cat $(EMPS_OUT)/chain.log; exit 1; }
-	$(Q)grep -E "tracking RMS|^image|^circle" $(EMPS_OUT)/chain.log
+	$(Q)grep -E "tracking RMS|FAULT|^image|^circle" $(EMPS_OUT)/chain.log
 
 # Everything generated from machines/reference.json (docs/machine-file.md):
 # after editing it, `make regen` then `make test` needs no hand edits.

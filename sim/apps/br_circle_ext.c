@@ -20,6 +20,7 @@
 #include "simlog/br_cause_args.h"
 #include "tools/br_args.h"
 #include "tools/br_outfile.h"
+#include "tools/br_run_report.h"
 
 #define TOOL "br_circle_ext"
 
@@ -111,16 +112,15 @@ int main(int argc, char **argv)
             br_outfile_discard(&js);
             return 1;
         }
-        printf("%-14s contour RMS %.4e m, max %.4e m, outlier steps %d", runs[r].name, res.contour_rms_m,
-               res.max_err_m, res.outlier_steps);
-        if (res.fault_status != 0) printf(", fault (status %d) at %.4f s", res.fault_status, res.fault_t_s);
-        printf("\n");
-        if (js.f)
-            fprintf(js.f,
-                    ",\n  \"%s\": {\"contour_rms_m\": %.6e, \"max_err_m\": %.6e, \"outlier_steps\": %d, "
-                    "\"fault_status\": %d, \"fault_t_s\": %.6g}",
-                    runs[r].name, res.contour_rms_m, res.max_err_m, res.outlier_steps, res.fault_status,
-                    res.fault_t_s);
+        /* a faulted run is a fault (time, cause), never an RMS beside full runs (br_run_report.h) */
+        const br_run_report_t rep = {res.contour_rms_m, res.max_err_m, res.fault_status, res.fault_cause,
+                                     res.fault_t_s};
+        br_run_print(stdout, runs[r].name, "contour", &rep);
+        if (js.f) {
+            fprintf(js.f, ",\n  \"%s\": {", runs[r].name);
+            br_run_json(js.f, "contour_rms_m", "max_err_m", &rep);
+            fprintf(js.f, ", \"outlier_steps\": %d}", res.outlier_steps);
+        }
     }
     if (js.f) {
         fprintf(js.f, "\n}\n");

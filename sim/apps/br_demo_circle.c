@@ -25,6 +25,7 @@
 #include "circle/br_circle.h"
 #include "tools/br_args.h"
 #include "tools/br_outfile.h"
+#include "tools/br_run_report.h"
 #include "tools/br_tool_limits.h"
 
 #define TOOL "br_demo_circle"
@@ -295,6 +296,13 @@ int main(int argc, char **argv)
             }
             if (!finite_result(&res)) {
                 fprintf(stderr, "%s: run %s gave a non-finite result; nothing written\n", TOOL, name);
+                discard_all(&o);
+                return 1;
+            }
+            if (res.fault_status != 0) {
+                /* the demo's runs go to the end: a faulted run is no result (docs/tools.md) */
+                fprintf(stderr, "%s: run %s faulted at %.4f s (%s, status %d): no result; nothing written\n", TOOL,
+                        name, res.fault_t_s, br_run_fault_name(res.fault_cause), res.fault_status);
                 discard_all(&o);
                 return 1;
             }

@@ -35,6 +35,7 @@
 #include "plant/br_plant_json.h"
 #include "tools/br_args.h"
 #include "tools/br_outfile.h"
+#include "tools/br_run_report.h"
 #include "tools/br_tool_limits.h"
 
 #define TOOL "br_robust_run"
@@ -260,17 +261,17 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
-        printf("%-12s contour RMS %.4e m, max %.4e m, outlier steps %d", runs[r].name, res.contour_rms_m,
-               res.max_err_m, res.outlier_steps);
-        if (res.fault_status != 0) printf(", fault (status %d) at %.4f s", res.fault_status, res.fault_t_s);
-        printf("\n");
-        if (js.f)
-            fprintf(js.f,
-                    "%s\n    \"%s\": {\"contour_rms_m\": %.6e, \"max_err_m\": %.6e, \"fhat_rms_err_N\": %.6e, "
-                    "\"outlier_steps\": %d, \"last_outlier_t_s\": %.6g, \"fault_status\": %d, \"fault_t_s\": %.6g, "
-                    "\"n_samples\": %ld}",
-                    first ? "" : ",", runs[r].name, res.contour_rms_m, res.max_err_m, res.fhat_rms_err_N,
-                    res.outlier_steps, res.last_outlier_t_s, res.fault_status, res.fault_t_s, res.n_samples);
+        /* a faulted run is a fault (time, cause), never an RMS beside full runs (br_run_report.h) */
+        const br_run_report_t rep = {res.contour_rms_m, res.max_err_m, res.fault_status, res.fault_cause,
+                                     res.fault_t_s};
+        br_run_print(stdout, runs[r].name, "contour", &rep);
+        if (js.f) {
+            fprintf(js.f, "%s\n    \"%s\": {", first ? "" : ",", runs[r].name);
+            br_run_json(js.f, "contour_rms_m", "max_err_m", &rep);
+            fprintf(js.f, ", \"fhat_rms_err_N\": %.6e, \"outlier_steps\": %d, \"last_outlier_t_s\": %.6g, "
+                          "\"n_samples\": %ld}",
+                    res.fhat_rms_err_N, res.outlier_steps, res.last_outlier_t_s, res.n_samples);
+        }
         first = 0;
     }
     if (rc != 0) {

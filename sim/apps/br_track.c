@@ -44,6 +44,8 @@
 #include "plant/br_plant_json.h"
 #include "simlog/br_cause_args.h"
 #include "tools/br_args.h"
+#include "tools/br_outfile.h"
+#include "tools/br_run_report.h"
 
 #define BR_PI 3.14159265358979323846
 
@@ -208,7 +210,7 @@ static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, f
  * BR_CTRL_HINF_FF), 2 the estimator (ctrl BR_CTRL_HINF_PF: the PF; BR_CTRL_HINF_TRUE:
  * the oracle) plus the feedforward's inertia term */
 static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int extended, int ff, err_t *e,
-                  int *fault, double *fault_t)
+                  br_run_report_t *rep)
 {
     br_circle_cfg_t c = br_circle_cfg_thesis(ctrl);
     c.plant = *pc;
@@ -272,7 +274,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     }
     const double L = pc->lead_mprad, rpc = 2.0 * BR_PI / pc->counts_per_rev;
     const long n = lround((double)(tr->n - 1) * tr->dt / c.dt_s);
-    *fault = 0;
+    rep->fault_status = 0;
     for (long k = 0; k <= n; k++) {
         const double t = (double)k * c.dt_s;
         uint32_t tick;
@@ -286,8 +288,9 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
         const double pos = br_plant_pos_m(&p);
         st = br_app_step(&app, &r);
         if (st != BR_OK && st != BR_W_OUTLIER) {
-            *fault = (int)st;
-            *fault_t = t;
+            rep->fault_status = (int)st;
+            rep->fault_cause = (int)app.fault;
+            rep->fault_t_s = t;
             break;
         }
         err_add(e, t, x_ref, pos, (double)app.axis.last.duty * pc->tau_per_duty_Nm / L);
@@ -362,11 +365,13 @@ int main(int argc, char **argv)
     }
     traj_t tr;
     if (read_traj(ref, &tr) != 0) return 1;
-    FILE *js = NULL;
-    if (json && (js = fopen(json, "w")) == NULL) {
-        fprintf(stderr, "br_track: cannot write %s: %s\n", json, strerror(errno));
+    /* written to a temporary file, renamed onto --json only when every run succeeded */
+    br_outfile_t out = {0};
+    if (json && br_outfile_open(&out, TOOL, json) != 0) {
+        free(tr.ref);
         return 1;
     }
+    FILE *js = out.f;
     if (js)
         fprintf(js, "{\n  \"generator\": \"br_track (sim/apps/br_track.c); generated, do not edit\",\n"
                     "  \"duration_s\": %.6g", (double)(tr.n - 1) * tr.dt);
@@ -390,8 +395,7 @@ int main(int argc, char **argv)
             }
             fprintf(e.trace, "t,ref,pos,err,force\n");
         }
-        int fault = 0;
-        double fault_t = 0.0;
+        br_run_report_t rep = {0.0, 0.0, 0, 0, 0.0};
         if (w == 0) {
             if (!have_pd) {
                 fprintf(stderr, "br_track: the pd controller needs --pd KP,KV,GAIN,UMAX\n");
@@ -401,21 +405,24 @@ int main(int argc, char **argv)
             const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : (w == 4 || w == 8) ? BR_CTRL_HINF_TRUE
                                           : w == 5 ? BR_CTRL_HINF_FF : BR_CTRL_HINF_PF;
             const int ff = w == 5 ? 1 : w >= 6 ? 2 : 0;
-            if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &fault, &fault_t) != 0) rc = 1;
+            if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &rep) != 0) rc = 1;
         }
         if (e.trace && fclose(e.trace) != 0) rc = 1;
         if (rc != 0) break;
-        const double rms = e.n > 0 ? sqrt(e.sum2 / (double)e.n) : 0.0;
-        printf("%-12s tracking RMS %.4e m, max %.4e m", names[w], rms, e.emax);
-        if (fault) printf(", fault (status %d) at %.4f s", fault, fault_t);
-        printf("\n");
-        if (js)
-            fprintf(js, ",\n  \"%s\": {\"rms_m\": %.6e, \"max_m\": %.6e, \"fault_status\": %d, \"fault_t_s\": %.6g}",
-                    names[w], rms, e.emax, fault, fault_t);
+        rep.rms_m = e.n > 0 ? sqrt(e.sum2 / (double)e.n) : 0.0;
+        rep.max_m = e.emax;
+        /* a faulted run is a fault (time, cause), never an RMS beside full runs */
+        br_run_print(stdout, names[w], "tracking", &rep);
+        if (js) {
+            fprintf(js, ",\n  \"%s\": {", names[w]);
+            br_run_json(js, "rms_m", "max_m", &rep);
+            fprintf(js, "}");
+        }
     }
     if (js) {
         fprintf(js, "\n}\n");
-        if (fclose(js) != 0) rc = 1;
+        if (rc != 0) br_outfile_discard(&out);
+        else if (br_outfile_commit(&out, TOOL) != 0) rc = 1;
     }
     free(tr.ref);
     return rc;

@@ -68,10 +68,17 @@ def fault_note(t_s):
     return "" if t_s is None else f" (safe stop at {t_s:.3f} s)"
 
 
-def run_note(outliers, fault_t_s):
-    parts = ([f"{outliers} outlier steps"] if outliers else []) + \
-        ([f"safe stop at {fault_t_s:.3f} s"] if fault_t_s is not None else [])
-    return f" ({', '.join(parts)})" if parts else ""
+def fig(v):
+    """a run's contour RMS; None (a faulted run's: no result, docs/tools.md) as a dash"""
+    return "—" if v is None else f"{v:.3e} m"
+
+
+def cell(v, outliers, run_):
+    """a table cell: the RMS of a run that went to the end (with its outlier steps), or the
+    fault's time and cause in its place: a faulted run is never an RMS beside full runs"""
+    if run_["fault_status"]:
+        return f"safe stop at {run_['fault_t_s']:.3f} s ({run_.get('fault_cause', 'unknown')})"
+    return f"{v:.3e} m" + (f" ({outliers} outlier steps)" if outliers else "")
 
 
 def main():
@@ -123,37 +130,43 @@ def main():
                    "outliers_extended": c["est_extended"]["outlier_steps"],
                    # a fault: the firmware stopped the axis safe (zero duty) at that time
                    "fault_nominal": fault_t(c["est_nominal"]),
-                   "fault_extended": fault_t(c["est_extended"])}
+                   "fault_extended": fault_t(c["est_extended"]),
+                   "run_nominal": c["est_nominal"], "run_extended": c["est_extended"]}
             if "_filtered" in runs_:
                 c0 = runs_["_filtered"]
                 row.update({"filtered_nominal": c0["est_nominal"]["contour_rms_m"],
                             "filtered_extended": c0["est_extended"]["contour_rms_m"],
                             "filtered_outliers_nominal": c0["est_nominal"]["outlier_steps"],
                             "filtered_fault_nominal": fault_t(c0["est_nominal"]),
-                            "filtered_fault_extended": fault_t(c0["est_extended"])})
+                            "filtered_fault_extended": fault_t(c0["est_extended"]),
+                            "run_filtered_extended": c0["est_extended"]})
             rows[est].append(row)
             E = est.upper()
-            print(f"{cause:20s} verdict {row['verdict']:20s} contour RMS: H-inf only {row['hinf_only']:.3e} m, "
-                  f"{E} nominal {row['est_nominal']:.3e} m{fault_note(row['fault_nominal'])}, "
-                  f"{E} extended {row['est_extended']:.3e} m{fault_note(row['fault_extended'])}"
-                  + (f", extended with the filtered estimate {row['filtered_extended']:.3e} m"
+            print(f"{cause:20s} verdict {row['verdict']:20s} contour RMS: H-inf only {fig(row['hinf_only'])}, "
+                  f"{E} nominal {fig(row['est_nominal'])}{fault_note(row['fault_nominal'])}, "
+                  f"{E} extended {fig(row['est_extended'])}{fault_note(row['fault_extended'])}"
+                  + (f", extended with the filtered estimate {fig(row['filtered_extended'])}"
                      f"{fault_note(row['filtered_fault_extended'])}" if "filtered_extended" in row else ""),
                   flush=True)
+            for k in ("hinf_only", "hinf_true"):
+                if c[k]["fault_status"]:
+                    fails.append(f"{cause}, {E}: {k} faulted at {c[k]['fault_t_s']:.3f} s "
+                                 f"({c[k].get('fault_cause', 'unknown')}): not a result")
             # a cause the circle barely feels (a gradient over its 0.2 mm) moves the
             # result by the filter's path-to-path spread only: NOT_WORSE allows that
             better = row["fault_extended"] is None and (row["fault_nominal"] is not None
                                                         or row["est_extended"] < NOT_WORSE * row["est_nominal"])
             if not better:
-                fails.append(f"{cause}, {E}: extended {row['est_extended']:.3e} m"
+                fails.append(f"{cause}, {E}: extended {fig(row['est_extended'])}"
                              f"{fault_note(row['fault_extended'])} is worse than nominal "
-                             f"{row['est_nominal']:.3e} m{fault_note(row['fault_nominal'])}")
+                             f"{fig(row['est_nominal'])}{fault_note(row['fault_nominal'])}")
             # the lead is for a model that is right: on the extended model it may not
             # lose against the filtered estimate
             if "filtered_extended" in row and row["filtered_fault_extended"] is None and not (
                     row["fault_extended"] is None and row["est_extended"] < NOT_WORSE * row["filtered_extended"]):
-                fails.append(f"{cause}, {E}: extended with the lead {row['est_extended']:.3e} m"
+                fails.append(f"{cause}, {E}: extended with the lead {fig(row['est_extended'])}"
                              f"{fault_note(row['fault_extended'])} is worse than with the filtered estimate "
-                             f"{row['filtered_extended']:.3e} m")
+                             f"{fig(row['filtered_extended'])}")
     if a.md:
         L = ["<!-- generated by sim/studies/diagnose_control.py (make diagnose-control); do not edit -->", "",
              "# A diagnosis in control terms: the circle with the estimator on the nominal and on the extended model",
@@ -165,8 +178,8 @@ def main():
              "the same estimator "
              "with the causes of model.json in its own model (br_model_cfg_t.causes: the firmware's extended "
              "model). \"Safe stop\": the firmware faulted (its estimate out of range, or it lost lock: "
-             "br_app's lock monitor) and zeroed the drive at that time; the contour RMS is that of the run "
-             "before it. \"Oracle\": H-inf compensating the plant's own force of the last period (friction, "
+             "br_app's lock monitor) and zeroed the drive at that time; the run ended there, so its cell gives the "
+             "time and the cause, not a contour RMS. \"Oracle\": H-inf compensating the plant's own force of the last period (friction, "
              "offset, ripple and the viscous terms beyond the nominal one; br_plant_comp_force_N), one period "
              "late like every estimator: a reference, not a bound (an estimator predicts the next period's force "
              "and can beat it). "
@@ -188,12 +201,11 @@ def main():
             for r in rows[est]:
                 faulted = r["fault_nominal"] is not None or r["fault_extended"] is not None
                 ch = "—" if faulted else f"{100.0 * (r['est_extended'] / r['est_nominal'] - 1.0):+.0f} %"
-                note = run_note(r["outliers_nominal"], r["fault_nominal"])
-                note_e = run_note(r["outliers_extended"], r["fault_extended"])
-                line = (f"| {r['cause']}: {r['what']} | {r['verdict']} | {r['hinf_only']:.3e} m | {r['hinf_true']:.3e} m | "
-                        f"{r['est_nominal']:.3e} m{note} | {r['est_extended']:.3e} m{note_e} | {ch} |")
+                line = (f"| {r['cause']}: {r['what']} | {r['verdict']} | {fig(r['hinf_only'])} | {fig(r['hinf_true'])} | "
+                        f"{cell(r['est_nominal'], r['outliers_nominal'], r['run_nominal'])} | "
+                        f"{cell(r['est_extended'], r['outliers_extended'], r['run_extended'])} | {ch} |")
                 if both:
-                    line += f" {r['filtered_extended']:.3e} m{run_note(0, r['filtered_fault_extended'])} |"
+                    line += f" {cell(r['filtered_extended'], 0, r['run_filtered_extended'])} |"
                 L.append(line)
             L.append("")
         with open(a.md, "w") as f:

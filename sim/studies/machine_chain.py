@@ -17,17 +17,20 @@ circle (br_circle_ext), H-infinity only against H-infinity + PF.
 --diagnose   python -m bristle.diagnose on the log with --machine given -> WORK/diagnose/
 --cross      the image for WORK/diagnose/machine.json in WORK/cm7 (or --cross-dir):
              flash and RAM against the part's, the PF's entry points linked
---track      br_track on the log's reference (the identified plant of model.json)
+--track      br_track on the log's reference (the identified plant of model.json);
+             --track-ctrl LIST: its controllers (br_track --ctrl)
 --circle     br_circle_ext --est pf with the firmware of machine.json on the
              plant of the given machine (the truth of a simulated log), or of
              the diagnosis's model.json (a measured log)
 --md DOC     the track table into DOC between "<!-- chain:begin -->" and "<!-- chain:end -->"
 --check-ratio R  exit 1 unless H-inf + PF (nominal model) / H-inf only < R on the circle,
              and the image links the PF within the part's memory
-Prints each figure; WORK/summary.json holds them."""
+--expect-fault NAMES  runs (track or circle names, comma-separated) allowed to fault
+Prints each figure; WORK/summary.json holds them. A run the firmware stopped
+(a fault) is shown as a fault with its time and cause, never as an RMS; any
+other faulted run makes the script exit 1 (after writing the page, which shows it)."""
 import argparse
 import json
-import math
 import os
 import subprocess
 import sys
@@ -130,22 +133,52 @@ def plot_track(work, names, path):
     fig.savefig(path, dpi=110)
 
 
+def faulted(r):
+    """the firmware stopped the axis: the run ended early, its figures are no result (docs/tools.md)"""
+    return r.get("fault_status", 0) != 0
+
+
+def cells(r, rms_key, max_key, ref):
+    """the row's figures, or the fault (time, cause) in their place"""
+    if faulted(r):
+        return "fault at %.3f s (%s) | — | —" % (r["fault_t_s"], r.get("fault_cause", "unknown"))
+    ratio = "%.3f" % (r[rms_key] / ref) if ref else "—"
+    return "%.3e m | %.3e m | %s" % (r[rms_key], r[max_key], ratio)
+
+
+def faults(s):
+    """every tabulated run that faulted: (where, name, time, cause)"""
+    out = []
+    for where, key in (("track", "track"), ("circle", "circle")):
+        for name, r in s.get(key, {}).items():
+            if isinstance(r, dict) and faulted(r):
+                out.append((where, name, r["fault_t_s"], r.get("fault_cause", "unknown")))
+    return out
+
+
+def unexpected_faults(s, expect=""):
+    """a message per faulted run not named in expect (comma-separated run names)"""
+    expected = {n for n in expect.split(",") if n}
+    return ["%s run %s faulted at %.3f s (%s): not a result" % f for f in faults(s) if f[1] not in expected]
+
+
 def write_md(doc, s):
     rows = ["The log's reference trajectory (24.8 s) on the identified plant (model.json):", "",
             "| controller | tracking RMS | max error | against H-inf only |", "|---|---|---|---|"]
-    ref = s["track"]["hinf_only"]["rms_m"]
+    h = s["track"]["hinf_only"]
+    ref = None if faulted(h) else h["rms_m"]
     for name, label in TRACK:
         r = s["track"].get(name)
         if r:
-            rows.append("| %s | %.3e m | %.3e m | %.3f |" % (label, r["rms_m"], r["max_m"], r["rms_m"] / ref))
+            rows.append("| %s | %s |" % (label, cells(r, "rms_m", "max_m", ref)))
     if "circle" in s:
-        c, ref = s["circle"], s["circle"]["hinf_only"]["contour_rms_m"]
+        c = s["circle"]
+        ref = None if faulted(c["hinf_only"]) else c["hinf_only"]["contour_rms_m"]
         rows += ["", "The thesis circle (radius 0.1 mm, 8 s) on the same plant, the firmware built for machine.json:", "",
                  "| controller | contour RMS | max error | against H-inf only |", "|---|---|---|---|"]
         for name, label in (("hinf_only", "H-infinity only"), ("est_nominal", "H-infinity + PF, nominal model"),
                             ("est_extended", "H-infinity + PF, extended model")):
-            rows.append("| %s | %.3e m | %.3e m | %.3f |" % (label, c[name]["contour_rms_m"], c[name]["max_err_m"],
-                                                            c[name]["contour_rms_m"] / ref))
+            rows.append("| %s | %s |" % (label, cells(c[name], "contour_rms_m", "max_err_m", ref)))
     if "image" in s:
         im = s["image"]
         rows += ["", "Image (`make firmware MACHINE=out/emps-chain/diagnose/machine.json`): flash %d B of %d KiB, "
@@ -175,6 +208,8 @@ def main():
     ap.add_argument("--circle", action="store_true")
     ap.add_argument("--md")
     ap.add_argument("--check-ratio", type=float)
+    ap.add_argument("--expect-fault", default="", help="run names allowed to fault, comma-separated")
+    ap.add_argument("--track-ctrl", help="br_track's --ctrl list (default: its own; with --controller the log's PD first)")
     a = ap.parse_args()
     a.src = os.path.abspath(a.src)
     os.makedirs(a.work, exist_ok=True)
@@ -210,6 +245,8 @@ def main():
             with open(a.controller, encoding="utf-8") as f:
                 c = json.load(f)["controller"]
             cmd += ["--pd", "%r,%r,%r,%r" % (c["kp_1ps"], c["kv"], c["gain_N"], c["u_max"])]
+        if a.track_ctrl:
+            cmd += ["--ctrl", a.track_ctrl]
         run(cmd)
         with open(os.path.join(a.work, "track.json"), encoding="utf-8") as f:
             s["track"] = {k: v for k, v in json.load(f).items() if isinstance(v, dict)}
@@ -224,20 +261,26 @@ def main():
         with open(os.path.join(a.work, "circle.json"), encoding="utf-8") as f:
             s["circle"] = {k: v for k, v in json.load(f).items() if isinstance(v, dict)}
         c = s["circle"]
-        s["circle_ratio_pf_nominal"] = c["est_nominal"]["contour_rms_m"] / c["hinf_only"]["contour_rms_m"]
-        print("circle: H-inf only %.3e m, H-inf + PF %.3e m (ratio %.4f), extended model %.3e m"
-              % (c["hinf_only"]["contour_rms_m"], c["est_nominal"]["contour_rms_m"], s["circle_ratio_pf_nominal"],
-                 c["est_extended"]["contour_rms_m"]))
+        s["circle_ratio_pf_nominal"] = (None if faulted(c["est_nominal"]) or faulted(c["hinf_only"])
+                                        else c["est_nominal"]["contour_rms_m"] / c["hinf_only"]["contour_rms_m"])
+        for name in ("hinf_only", "est_nominal", "est_extended"):
+            print("circle %s: %s" % (name, cells(c[name], "contour_rms_m", "max_err_m", None).split(" | ")[0]))
     if a.md:
         write_md(a.md, s)
     with open(os.path.join(a.work, "summary.json"), "w", encoding="utf-8") as f:
         json.dump(s, f, indent=2)
         f.write("\n")
+    unexpected = unexpected_faults(s, a.expect_fault)
+    for msg in unexpected:
+        print("machine_chain: %s%s" % (msg, "; the page shows the fault" if a.md else ""), file=sys.stderr)
+    if unexpected:
+        return 1
     if a.check_ratio is not None:
         bad = []
-        if not (s.get("circle_ratio_pf_nominal", math.inf) < a.check_ratio):
-            bad.append("circle contour RMS H-inf + PF / H-inf only = %.4g, not below %g"
-                       % (s.get("circle_ratio_pf_nominal", math.nan), a.check_ratio))
+        ratio = s.get("circle_ratio_pf_nominal")
+        if ratio is None or not ratio < a.check_ratio:
+            bad.append("circle contour RMS H-inf + PF / H-inf only = %s, not below %g"
+                       % ("%.4g" % ratio if ratio is not None else "none (a run faulted)", a.check_ratio))
         im = s.get("image")
         if im is not None:
             if "br_pf_est_step" not in im["estimator_symbols"]:

@@ -80,20 +80,25 @@ def main():
          "|---|---|---|---|---|"]
 
     def cell(r):
+        # a faulted run is its fault (time, cause), never an RMS beside full runs (docs/tools.md)
+        if r["fault_status"]:
+            return f"safe stop at {r['fault_t_s']:.3f} s ({r.get('fault_cause', 'unknown')})"
         s = f"{r['contour_rms_m']:.3e} m"
-        notes = ([f"{r['outlier_steps']} outlier steps"] if r["outlier_steps"] else []) + \
-            ([f"safe stop at {r['fault_t_s']:.3f} s"] if r["fault_status"] else [])
-        return s + (f" ({', '.join(notes)})" if notes else "")
+        return s + (f" ({r['outlier_steps']} outlier steps)" if r["outlier_steps"] else "")
+
+    def ratio_of(r):
+        pf, ukf = r["hinf_pf"], r["hinf_ukf"]
+        return None if pf["fault_status"] or ukf["fault_status"] else pf["contour_rms_m"] / ukf["contour_rms_m"]
     for r in rows:
         if "error" in r:
             L.append(f"| {r['name']} | error: {r['error']} | | | |")
             continue
-        ratio = r["hinf_pf"]["contour_rms_m"] / r["hinf_ukf"]["contour_rms_m"]
+        ratio = ratio_of(r)
         L.append(f"| {r['name']} | {cell(r['hinf_only'])} | {cell(r['hinf_ukf'])} | {cell(r['hinf_pf'])} | "
-                 f"{ratio:.2f} |")
+                 f"{'—' if ratio is None else f'{ratio:.2f}'} |")
     # the case most favourable to the PF, run again with its traces: Figs. 5-8 (g_p histograms)
-    ok = [(k, r) for k, r in enumerate(rows) if "error" not in r]
-    k, best = min(ok, key=lambda kr: kr[1]["hinf_pf"]["contour_rms_m"] / kr[1]["hinf_ukf"]["contour_rms_m"])
+    ok = [(k, r) for k, r in enumerate(rows) if "error" not in r and ratio_of(r) is not None]
+    k, best = min(ok, key=lambda kr: ratio_of(kr[1]))
     opts = [o for kv in CASES[k][2].items() for o in (kv[0], repr(kv[1]))] + ["--seed", str(k + 1)]
     fig = run_figures(a.bin, os.path.join(a.out, f"{k:02d}", "plant.json"), opts, os.path.join(a.out, "pf_best"))
     L += ["", f"Figures of the case most favourable to the PF ({best['name']}): {fig.get('dir', fig)}"]

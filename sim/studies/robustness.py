@@ -160,14 +160,14 @@ def lost(run_, hinf):
 
 def harmful(run_, hinf_m):
     """an estimator run that went on (no safe stop) with a contour RMS above H-inf only's hinf_m"""
-    return run_["fault_status"] == 0 and run_["contour_rms_m"] > hinf_m
+    return run_["fault_status"] == 0 and hinf_m is not None and run_["contour_rms_m"] > hinf_m
 
 
 def safety_failures(good):
     """--check-safe's list: each estimator run that left the axis worse than H-inf only on its plant
     without a safe stop"""
     return [f"{k}: worse than H-inf only without a safe stop on plant {r['i']}" for r in good
-            for k in ESTIMATORS if k in r["runs"] and harmful(r["runs"][k], r["runs"]["hinf_only"]["contour_rms_m"])]
+            for k in ESTIMATORS if k in r["runs"] and harmful(r["runs"][k], r["runs"]["hinf_only"].get("contour_rms_m"))]
 
 
 def wilcoxon(a, b):
@@ -183,24 +183,37 @@ def wilcoxon(a, b):
             "p_value": float(res.pvalue), "statistic": float(res.statistic)}
 
 
+def completed(run_):
+    """a run that went to the end: a faulted run (the firmware stopped the axis) is a fault with its
+    time and cause, never an RMS beside full runs (its contour_rms_m is null, docs/tools.md)"""
+    return run_.get("fault_status", 0) == 0 and run_.get("contour_rms_m") is not None
+
+
 def summarise(recs):
     ctl = {}
     for name in CONTROLLERS:
-        vals, lost_ids, reasons = [], [], {}
+        vals, lost_ids, reasons, faults, n = [], [], {}, [], 0
         for r in recs:
             if name not in r["runs"]:
                 continue
+            n += 1
             run_ = r["runs"][name]
-            vals.append(run_["contour_rms_m"])
-            why = lost(run_, None if name == "hinf_only" else r["runs"]["hinf_only"]["contour_rms_m"])
+            if completed(run_):
+                vals.append(run_["contour_rms_m"])
+            else:
+                faults.append({"plant": r["i"], "t_s": run_["fault_t_s"], "cause": run_.get("fault_cause", "unknown")})
+            hinf = r["runs"]["hinf_only"]
+            why = lost(run_, None if name == "hinf_only" or not completed(hinf) else hinf["contour_rms_m"])
             if why:
                 lost_ids.append(r["i"])
                 reasons[why] = reasons.get(why, 0) + 1
-        if not vals:
+        if not n:
             continue
-        v = np.array(vals)
-        ctl[name] = {"n": len(vals), "median_m": float(np.median(v)), "p90_m": float(np.percentile(v, 90)),
-                     "max_m": float(v.max()), "lost": len(lost_ids), "lost_reasons": reasons, "lost_plants": lost_ids,
+        # the statistics of the runs that went to the end; the faulted ones are counted and listed
+        v = np.array(vals) if vals else np.array([np.nan])
+        ctl[name] = {"n": n, "n_completed": len(vals), "median_m": float(np.median(v)),
+                     "p90_m": float(np.percentile(v, 90)), "max_m": float(v.max()), "lost": len(lost_ids),
+                     "lost_reasons": reasons, "lost_plants": lost_ids, "faults": faults,
                      "runs_with_outliers": int(sum(1 for r in recs if name in r["runs"]
                                                    and r["runs"][name]["outlier_steps"] > 0))}
     pairs = {}
@@ -208,7 +221,8 @@ def summarise(recs):
                  ("hinf_pf", "hinf_ff"), ("hinf_ff", "hinf_only"), ("hinf_ukf_id", "hinf_ukf"),
                  ("hinf_pf_id", "hinf_pf"), ("hinf_ff_id", "hinf_ff"), ("hinf_ukf_id", "hinf_ff_id"),
                  ("hinf_pf_id", "hinf_ff_id")):
-        rs = [r for r in recs if a in r["runs"] and b in r["runs"]]
+        rs = [r for r in recs if a in r["runs"] and b in r["runs"]
+              and completed(r["runs"][a]) and completed(r["runs"][b])]
         t = wilcoxon([r["runs"][a]["contour_rms_m"] for r in rs], [r["runs"][b]["contour_rms_m"] for r in rs])
         if t:
             pairs[f"{a}_vs_{b}"] = t
@@ -218,7 +232,8 @@ def summarise(recs):
 def regime(recs):
     """where the PF beats the UKF: log(PF / UKF) against each drawn quantity (Spearman), and by cause"""
     from scipy.stats import spearmanr
-    rs = [r for r in recs if "hinf_pf" in r["runs"] and "hinf_ukf" in r["runs"]]
+    rs = [r for r in recs if "hinf_pf" in r["runs"] and "hinf_ukf" in r["runs"]
+          and completed(r["runs"]["hinf_pf"]) and completed(r["runs"]["hinf_ukf"])]
     if not rs:
         return {}
     y = np.log([r["runs"]["hinf_pf"]["contour_rms_m"] / r["runs"]["hinf_ukf"]["contour_rms_m"] for r in rs])
@@ -248,11 +263,15 @@ def cdf_plot(recs, path):
               "hinf_pf": ("tab:red", "-"), "hinf_true": ("tab:gray", ":"), "hinf_ff_id": ("tab:brown", "--"),
               "hinf_ukf_id": ("tab:blue", "--"), "hinf_pf_id": ("tab:red", "--")}
     for name in CONTROLLERS:
-        v = np.sort([r["runs"][name]["contour_rms_m"] for r in recs if name in r["runs"]])
+        n = sum(1 for r in recs if name in r["runs"])
+        # faulted runs never reach the curve: it ends below 1 by their share
+        v = np.sort([r["runs"][name]["contour_rms_m"] for r in recs if name in r["runs"]
+                     and completed(r["runs"][name])])
         if len(v) == 0:
             continue
         c, ls = styles[name]
-        ax.step(v, np.arange(1, len(v) + 1) / len(v), where="post", color=c, ls=ls, label=f"{name} ({len(v)})")
+        ax.step(v, np.arange(1, len(v) + 1) / n, where="post", color=c, ls=ls,
+                label=f"{name} ({len(v)} of {n}{'' if len(v) == n else ', the rest faulted'})")
     ax.set_xscale("log")
     ax.set_xlabel("contour RMS [m]")
     ax.set_ylabel("fraction of plants")
@@ -282,7 +301,7 @@ def run_figures(binp, plant_json, opts, d):
     plot_demo.fig5(d, traces)
     plot_demo.fig6(d, traces)
     plot_demo.fig7_8(d, traces)
-    return {"dir": d, **{k: v["contour_rms_m"] for k, v in res.items()}}
+    return {"dir": d, **{k: v["contour_rms_m"] for k, v in res.items()}}  # null for a faulted run
 
 
 def pf_best_figures(a, i):
@@ -321,6 +340,11 @@ def write_md(path, summ, command):
         why = ", ".join(f"{a}: {b}" for a, b in v["lost_reasons"].items()) or "—"
         L.append(f"| {k} | {v['n']} | {fmt(v['median_m'])} m | {fmt(v['p90_m'])} m | {fmt(v['max_m'])} m | "
                  f"{v['lost']} | {why} | {v['runs_with_outliers']} |")
+    faults = [(k, f) for k, v in c.items() for f in v["faults"]]
+    if faults:
+        L += ["", "Runs the firmware stopped (a fault; not in the RMS columns, which cover the runs that went to the "
+              "end):", "", "| controller | plant | fault at | cause |", "|---|---|---|---|"]
+        L += [f"| {k} | {f['plant']} | {f['t_s']:.3f} s | {f['cause']} |" for k, f in faults]
     L += ["", "Paired comparisons (Wilcoxon signed-rank on log(a / b), two-sided; median ratio a / b):", "",
           "| a vs b | pairs | median a / b | a better | p |", "|---|---|---|---|---|"]
     for k, v in pr.items():
@@ -351,6 +375,9 @@ def main():
     ap.add_argument("--md")
     ap.add_argument("--command", default="make robustness")
     ap.add_argument("--check", action="store_true")
+    ap.add_argument("--expect-faults", action="store_true",
+                    help="a run the firmware stopped is an expected outcome (listed, exit 0); without it a page "
+                         "written with --md is still written, and the study exits 1")
     ap.add_argument("--check-safe", action="store_true",
                     help="exit 1 when an estimator makes the axis worse than H-inf only without a safe stop (the CI check)")
     ap.add_argument("--from-summary", help="recompute the statistics from an earlier summary.json's plants")
@@ -425,6 +452,11 @@ def finish(a, good, bad, t0):
               f"Wilcoxon p {v['p_value']:.2g}")
     print(f"wrote {a.out}/summary.json, {a.out}/cdf.png")
     if bad:
+        return 1
+    n_faults = sum(len(v["faults"]) for v in ctl.values())
+    if n_faults and a.md and not a.expect_faults:
+        print(f"robustness: {n_faults} runs faulted (listed in {a.md} with time and cause); "
+              "--expect-faults accepts them", file=sys.stderr)
         return 1
     if a.check or a.check_safe:
         if a.check:

@@ -17,7 +17,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from robustness import wilcoxon  # noqa: E402
+from robustness import completed, wilcoxon  # noqa: E402
 
 # the force noise that splits the plants (N per period): about the median of
 # robustness.py's draw, and where docs/robustness.md finds the PF / UKF order turning
@@ -37,13 +37,14 @@ def pair(a, b):
     names = sorted(set.intersection(*[set(p["runs"]) for p in list(a.values()) + list(b.values())]))
     out = {}
     for k in names:
-        ids = sorted(a)
+        # the pairs where both runs went to the end (a faulted run has no RMS, docs/tools.md)
+        ids = [i for i in sorted(a) if completed(a[i]["runs"][k]) and completed(b[i]["runs"][k])]
         ra = np.array([a[i]["runs"][k]["contour_rms_m"] for i in ids])
         rb = np.array([b[i]["runs"][k]["contour_rms_m"] for i in ids])
         noise = np.array([a[i]["real"]["force_noise_N"] for i in ids])
         t = None if np.all(rb == ra) else wilcoxon(rb, ra)  # identical runs: no test to make
         ratio = rb / ra
-        row = {"n": len(ids), "b_better": int(np.sum(rb < ra)), "median_ratio_b_over_a": float(np.median(ratio)),
+        row = {"n": len(ids), "n_faulted": len(a) - len(ids), "b_better": int(np.sum(rb < ra)), "median_ratio_b_over_a": float(np.median(ratio)),
                "wilcoxon_p": t["p_value"] if t else None}
         for tag, sel in (("below", noise < SPLIT_N), ("above", noise >= SPLIT_N)):
             row[f"noise_{tag}_{SPLIT_N:g}N"] = {"n": int(sel.sum()),

@@ -1,0 +1,34 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* How a host tool reports one closed-loop run (docs/tools.md, "A faulted run
+ * is not a result"). A run the firmware stopped (a latched fault: lost lock,
+ * an encoder guard, ...) ended early: its RMS covers the periods before the
+ * stop and is not comparable with a run that went to the end. So a faulted
+ * run is printed and written as a fault, with its time and cause, and its
+ * figures are null in the JSON; only a run that went to the end has them. */
+#ifndef BR_RUN_REPORT_H
+#define BR_RUN_REPORT_H
+
+#include <stdio.h>
+
+typedef struct {
+    double rms_m;   /* contour or tracking RMS over the run */
+    double max_m;   /* largest error */
+    int fault_status; /* 0: ran to the end; else the firmware's negative status */
+    int fault_cause;  /* br_app_fault_t of the latched fault (0 unknown) */
+    double fault_t_s; /* when the firmware stopped the axis */
+} br_run_report_t;
+
+/* "lost_lock", "enc_jump", ...: the name of a br_app_fault_t (docs/reliability.md),
+ * "unknown" for a value outside the enum. */
+const char *br_run_fault_name(int cause);
+
+/* One line: "<name> <what> RMS %.4e m, max %.4e m" for a run that went to the end,
+ * "<name> FAULT at %.4f s (<cause>, status %d): no result" for a faulted one. */
+void br_run_print(FILE *f, const char *name, const char *what, const br_run_report_t *r);
+
+/* The run's JSON members, without braces: "<rms_key>": x, "<max_key>": y, "faulted": false,
+ * or "<rms_key>": null, "<max_key>": null, "faulted": true, "fault_status": s,
+ * "fault_cause": "...", "fault_t_s": t. */
+void br_run_json(FILE *f, const char *rms_key, const char *max_key, const br_run_report_t *r);
+
+#endif
