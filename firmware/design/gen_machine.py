@@ -25,6 +25,12 @@ import numpy as np
 import machine
 
 # (C name, value in the file or derived, comment); floats get a double and an _F float literal
+def est_rank(m, name):
+    """name's place in control.estimator (1 first), 0 when it is not listed"""
+    order = [e for e in m["control"]["estimator"].split(",")]
+    return order.index(name) + 1 if name in order else 0
+
+
 def machine_fields(m, p):
     ctl, lim = m["control"], m["limits"]
     return [
@@ -45,6 +51,10 @@ def machine_fields(m, p):
         ("BR_MACHINE_CTRL_PERIOD_S", ctl["period_s"], "control period (H-inf only, H-inf + UKF)"),
         ("BR_MACHINE_CTRL_PERIOD_NS", int(round(ctl["period_s"] * 1e9)), "the same in whole nanoseconds (an MCU tick)"),
         ("BR_MACHINE_TORQUE_LIMIT_NM", ctl["torque_limit_Nm"], "controller torque saturation"),
+        ("BR_MACHINE_EST_RANK_PF", est_rank(m, "pf"), "control.estimator: the image's order of preference,\n"
+         " * 1 first, 0 not listed; each board runs the first it can (hal/<board>/image/main.c): the PF"),
+        ("BR_MACHINE_EST_RANK_UKF", est_rank(m, "ukf"), "the UKF"),
+        ("BR_MACHINE_EST_RANK_NONE", est_rank(m, "none"), "none: H-infinity only"),
         ("BR_MACHINE_MAX_SPEED_MPS", lim["max_speed_mps"], "largest table speed the axis is used at"),
         ("BR_MACHINE_MAX_SPEED_COUNTS_PER_S", lim["max_speed_mps"] / (p["L_mprad"] * p["rad_per_count"]),
          "that speed in encoder counts per second (max_speed / (L rad_per_count)); times the period:\n"

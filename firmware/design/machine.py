@@ -221,6 +221,9 @@ SCHEMA = {
     },
     "control": {
         "period_s": Num(1.0e-5, 0.1, "control period (H-inf only, UKF)"),
+        "estimator": Str(r"(pf|ukf|none)(,(pf|ukf|none))*", "the estimators the firmware image may run, in the "
+                         "order of preference, comma-separated: the image runs the first its board can (pf in a loop "
+                         "at estimator.pf.period_s, ukf or none at period_s; docs/configure.md)"),
         "torque_limit_Nm": Num(0.0, 1.0e3, "controller torque saturation, <= duty_limit * torque_per_duty_Nm; "
                                "also the H-inf design's torque scale (Dz = 1/torque_limit_Nm)", lo_open=True),
         "hinf": {
@@ -343,6 +346,9 @@ def _cross_checks(m, errors):
     need(["control.torque_limit_Nm", "amplifier.duty_limit", "amplifier.torque_per_duty_Nm"],
          lambda: get("control.torque_limit_Nm") <= get("amplifier.duty_limit") * get("amplifier.torque_per_duty_Nm"),
          "control.torque_limit_Nm", "must be <= amplifier.duty_limit * amplifier.torque_per_duty_Nm")
+    need(["control.estimator"],
+         lambda: len(set(get("control.estimator").split(","))) == len(get("control.estimator").split(",")),
+         "control.estimator", "names an estimator twice")
     for est in ("pf", "ukf"):
         e = "estimator.%s." % est
         need([e + "gp_min_N", e + "gp_max_N"], lambda: get(e + "gp_min_N") < get(e + "gp_max_N"),

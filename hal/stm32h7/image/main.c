@@ -2,10 +2,11 @@
 /* The bristle firmware image for the STM32H743: one axis tracking a
  * sinusoidal (circle-test) reference with the H-infinity gains of
  * firmware/gen/bristle_gen/ctrl/br_hinf_gains.h and the friction compensation
- * of the configured estimator: the particle filter of the machine file
- * (1500 particles for the reference machine) at its period (1.5 ms), as the
- * simulator's H-inf + PF circle runs it (bristle/br_machine_cfg.h: the same
- * generated headers, one home).
+ * of the machine file's estimator (control.estimator): the particle filter
+ * (1500 particles for the reference machine) in a loop at its period (1.5 ms),
+ * as the simulator's H-inf + PF circle runs it, or the UKF or H-infinity only
+ * at the control period (bristle/br_machine_cfg.h: the same generated
+ * headers, one home).
  *
  * main: board bring-up (hal/stm32h7/board: 480 MHz, outputs off) -> after a
  * watchdog reset, park with the outputs off -> IWDG1 started -> br_app_init
@@ -34,9 +35,27 @@
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 
-/* The loop runs at the PF's period (as the simulator's H-inf + PF circle). */
+/* The estimator is the first of the machine file's control.estimator (the H743
+ * runs each): the PF in a loop at its own period (estimator.pf.period_s), the
+ * UKF and H-infinity only at control.period_s (bristle_gen/machine/br_machine.h). */
+#if BR_MACHINE_EST_RANK_PF == 1
+#define BR_IMAGE_USES_PF 1
+#define BR_IMAGE_USES_UKF 0
+#define BR_IMAGE_EST BR_APP_EST_PF
 #define BR_IMAGE_DT_S BR_EST_PF_PERIOD_S_F
 #define BR_IMAGE_PERIOD_NS BR_EST_PF_PERIOD_NS
+#else
+#define BR_IMAGE_USES_PF 0
+#if BR_MACHINE_EST_RANK_UKF == 1
+#define BR_IMAGE_USES_UKF 1
+#define BR_IMAGE_EST BR_APP_EST_UKF
+#else
+#define BR_IMAGE_USES_UKF 0
+#define BR_IMAGE_EST BR_APP_EST_NONE
+#endif
+#define BR_IMAGE_DT_S BR_MACHINE_CTRL_PERIOD_S_F
+#define BR_IMAGE_PERIOD_NS BR_MACHINE_CTRL_PERIOD_NS
+#endif
 
 /* Reference: circle of radius 5 mm in 2 s, this axis is the sine. */
 #define BR_IMAGE_REF_AMPLITUDE_M 5.0e-3f
@@ -55,7 +74,11 @@ static const br_ctrl_cfg_t br_image_ctrl = {
     .lead_mprad = BR_MACHINE_LEAD_MPRAD_F,
 };
 
+#if BR_IMAGE_USES_PF
 static const br_pf_cfg_t br_image_pf_cfg = BR_MACHINE_PF_CFG_TUNED(BR_IMAGE_DT_S);
+#elif BR_IMAGE_USES_UKF
+static const br_ukf_cfg_t br_image_ukf_cfg = BR_MACHINE_UKF_CFG_TUNED(BR_IMAGE_DT_S);
+#endif
 
 static const br_refgen_cfg_t br_image_ref = {
     .amplitude_m = BR_IMAGE_REF_AMPLITUDE_M,
@@ -66,8 +89,10 @@ static const br_refgen_cfg_t br_image_ref = {
     .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,
 };
 
+#if BR_IMAGE_USES_PF
 /* The documented exception: the PF's state, in AXI SRAM (see above). */
 static br_pf_t br_image_pf __attribute__((section(".axisram")));
+#endif
 
 int main(void)
 {
@@ -77,13 +102,26 @@ int main(void)
     br_refgen_t refgen = {0};
     br_ref_t ref = {0};
     uint32_t tick = 0u;
+#if BR_IMAGE_USES_UKF
+    br_ukf_t ukf = {0};
+#endif
     const br_app_cfg_t app_cfg = {
         .ctrl = &br_image_ctrl,
-        .est = BR_APP_EST_PF,
+        .est = BR_IMAGE_EST,
+#if BR_IMAGE_USES_PF
         .pf = &br_image_pf_cfg,
+#elif BR_IMAGE_USES_UKF
+        .ukf = &br_image_ukf_cfg,
+#endif
         .guard = br_app_guard_cfg(BR_IMAGE_DT_S, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F),
     };
+#if BR_IMAGE_USES_PF
     const br_app_mem_t mem = {.pf = &br_image_pf};
+#elif BR_IMAGE_USES_UKF
+    const br_app_mem_t mem = {.ukf = &ukf};
+#else
+    const br_app_mem_t mem = {0};
+#endif
 
     if (br_stm32h7_board_init(&port, BR_IMAGE_PERIOD_NS, &hal) != BR_OK || br_stm32h7_board_reset_by_watchdog() ||
         br_stm32h7_board_watchdog_start() != BR_OK || br_app_init(&app, &app_cfg, &hal, &mem) != BR_OK ||

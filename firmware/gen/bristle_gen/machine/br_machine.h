@@ -57,6 +57,13 @@
 /* controller torque saturation */
 #define BR_MACHINE_TORQUE_LIMIT_NM (0.64)
 #define BR_MACHINE_TORQUE_LIMIT_NM_F (6.399999857e-01f)
+/* control.estimator: the image's order of preference,
+ * 1 first, 0 not listed; each board runs the first it can (hal/<board>/image/main.c): the PF */
+#define BR_MACHINE_EST_RANK_PF 1u
+/* the UKF */
+#define BR_MACHINE_EST_RANK_UKF 2u
+/* none: H-infinity only */
+#define BR_MACHINE_EST_RANK_NONE 0u
 /* largest table speed the axis is used at */
 #define BR_MACHINE_MAX_SPEED_MPS (0.1)
 #define BR_MACHINE_MAX_SPEED_MPS_F (1.000000015e-01f)

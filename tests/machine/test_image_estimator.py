@@ -1,0 +1,61 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The image follows the machine file's control.estimator (docs/configure.md,
+"The image's estimator"): a machine file that lists only pf is refused for the
+STM32G474 with the reason, and one that puts ukf first builds an STM32H743
+image that runs the UKF at control.period_s (its PF state, 94 KB of AXI SRAM,
+is not linked). Cross builds into WORK, never the source tree.
+
+Usage: test_image_estimator.py --src REPO --work DIR"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+
+def build(src, work, name, machine, preset, target):
+    d = os.path.join(work, name)
+    path = os.path.join(work, name + ".json")
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(machine, f, indent=1)
+    r = subprocess.run(["cmake", "--preset", preset, "-B", d, "-DBR_MACHINE=" + path, "-DBR_PYTHON=" + sys.executable],
+                       cwd=src, capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit("configure %s failed:\n%s%s" % (name, r.stdout, r.stderr))
+    r = subprocess.run(["cmake", "--build", d, "--target", target], capture_output=True, text=True)
+    return r, d
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--src", required=True)
+    ap.add_argument("--work", required=True)
+    a = ap.parse_args()
+    os.makedirs(a.work, exist_ok=True)
+    with open(os.path.join(a.src, "machines", "reference.json"), encoding="utf-8") as f:
+        ref = json.load(f)
+    fails = []
+    pf_only = dict(ref, name="pfonly", control=dict(ref["control"], estimator="pf"))
+    r, _ = build(a.src, a.work, "pfonly", pf_only, "cm4-release", "br_image_stm32g4")
+    out = r.stdout + r.stderr
+    if r.returncode == 0 or "cannot run the PF" not in out:
+        fails.append("STM32G474 with control.estimator = pf: expected a refusal naming the PF, got exit %d:\n%s"
+                     % (r.returncode, out[-2000:]))
+    ukf_first = dict(ref, name="ukffirst", control=dict(ref["control"], estimator="ukf,pf"))
+    r, d = build(a.src, a.work, "ukffirst", ukf_first, "cm7-release", "br_image_stm32h7")
+    if r.returncode != 0:
+        fails.append("STM32H743 with control.estimator = ukf,pf: build failed:\n" + (r.stdout + r.stderr)[-2000:])
+    else:
+        img = os.path.join(d, "hal", "stm32h7", "br_image_stm32h7.elf")
+        sec = subprocess.run(["arm-none-eabi-size", "-A", img], capture_output=True, text=True, check=True).stdout
+        axi = [ln.split() for ln in sec.splitlines() if ln.startswith(".axisram")]
+        if axi and int(axi[0][1]) != 0:
+            fails.append("the UKF image still holds the PF's state: .axisram %s bytes" % axi[0][1])
+    for f_ in fails:
+        print("FAIL: " + f_, file=sys.stderr)
+    print("image estimator: %d failures" % len(fails))
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
