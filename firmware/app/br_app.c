@@ -288,12 +288,16 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
         counts = app->last_counts;
         est_st = est_predict(app);
     } else {
+        /* the periods since the last good read: this one and the held ones */
+        const uint64_t periods = (uint64_t)app->n_stale + 1u;
         app->n_stale = 0u;
         if (app->have_counts) {
             const int32_t d = br_counts_delta(counts, app->last_counts);
             /* |d| as unsigned: INT32_MIN included */
             const uint32_t mag = (d < 0) ? (uint32_t)0u - (uint32_t)d : (uint32_t)d;
-            if (mag > app->guard.enc_max_delta_counts) {
+            /* the largest delta of one period, times the periods the delta spans (after
+             * held reads the axis moved for all of them; <= 2^30 (1000 + 1), no overflow) */
+            if ((uint64_t)mag > (uint64_t)app->guard.enc_max_delta_counts * periods) {
                 return latch(app, BR_APP_FAULT_ENC_JUMP);
             }
             if (mag == 0u && fabsf(a->last.duty) >= app->guard.frozen_duty) {

@@ -458,6 +458,39 @@ static void test_encoder_jump_latches(void **st)
     assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_JUMP);
 }
 
+/* k held reads, then a good one at delta: the step's status */
+static br_status_t held_then(rig_t *g, uint32_t k, int32_t delta)
+{
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    rig_init(g, 0);
+    assert_int_equal(br_app_step(&g->app, &r), BR_OK);
+    g->f.enc_st = BR_E_INPUT;
+    for (uint32_t i = 0u; i < k; i++) {
+        assert_int_equal(br_app_step(&g->app, &r), BR_OK);
+    }
+    g->f.enc_st = BR_OK;
+    g->f.counts += delta;
+    return br_app_step(&g->app, &r);
+}
+
+/* After k held reads the first good one spans k + 1 periods: at the speed limit (100
+ * counts a period) the axis moved 100 (k + 1) counts, which is no jump; one count more is.
+ * (The limit of one period latched ENC_JUMP after a single held read at speed.) */
+static void test_encoder_jump_after_held_reads(void **st)
+{
+    (void)st;
+    rig_t g;
+    for (uint32_t k = 1u; k <= 3u; k++) {
+        assert_int_equal(held_then(&g, k, (int32_t)(100u * (k + 1u))), BR_OK);
+        assert_int_equal(held_then(&g, k, -(int32_t)(100u * (k + 1u))), BR_OK);
+        assert_int_equal(held_then(&g, k, (int32_t)(100u * (k + 1u) + 1u)), BR_E_FAULT);
+        assert_latched(&g, BR_APP_FAULT_ENC_JUMP);
+    }
+    /* and a good read right after a good one is held to one period again */
+    assert_int_equal(held_then(&g, 0u, 101), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_JUMP);
+}
+
 static void test_encoder_stale_holds_then_latches(void **st)
 {
     (void)st;
@@ -654,6 +687,7 @@ int main(void)
         cmocka_unit_test(test_hal_error_latches),
         cmocka_unit_test(test_encoder_jump_latches),
         cmocka_unit_test(test_encoder_stale_holds_then_latches),
+        cmocka_unit_test(test_encoder_jump_after_held_reads),
         cmocka_unit_test(test_encoder_frozen_latches),
         cmocka_unit_test(test_external_fault_latches),
         cmocka_unit_test(test_guard_config),
