@@ -234,6 +234,8 @@ detection-limits: deps
 	  --json out/detection-limits/summary.json
 
 firmware: deps
+	$(Q)echo "== image for $(BOARD): the estimator the machine file's control.estimator gives"
+	$(Q)$(PYTHON) firmware/design/image_info.py "$(if $(MACHINE),$(MACHINE),machines/reference.json)" "$(BOARD)"
 ifeq ($(MACHINE),)
 	$(call configure,$(BOARD_PRESET))
 	$(call build,$(BOARD_PRESET))

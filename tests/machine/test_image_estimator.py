@@ -51,6 +51,16 @@ def main():
         axi = [ln.split() for ln in sec.splitlines() if ln.startswith(".axisram")]
         if axi and int(axi[0][1]) != 0:
             fails.append("the UKF image still holds the PF's state: .axisram %s bytes" % axi[0][1])
+    # make firmware's line (firmware/design/image_info.py) says what the images run
+    info = os.path.join(a.src, "firmware", "design", "image_info.py")
+    r = subprocess.run([sys.executable, info, os.path.join(a.work, "ukffirst.json"), "stm32h7"],
+                       capture_output=True, text=True)
+    if r.returncode != 0 or "estimator: ukf at 1 ms" not in r.stdout:
+        fails.append("image_info.py on the UKF-first file: %r %r" % (r.stdout, r.stderr))
+    r = subprocess.run([sys.executable, info, os.path.join(a.work, "pfonly.json"), "stm32g4"],
+                       capture_output=True, text=True)
+    if r.returncode == 0 or "the stm32g4 image runs ukf, none" not in r.stderr:
+        fails.append("image_info.py on the PF-only file for the G474: %r %r" % (r.stdout, r.stderr))
     for f_ in fails:
         print("FAIL: " + f_, file=sys.stderr)
     print("image estimator: %d failures" % len(fails))

@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""What a board's firmware image runs for a machine file (docs/configure.md,
+"The image's estimator"): the estimator (the first of control.estimator the
+board can run, the rule of hal/<board>/image/main.c), its loop period, and its
+share of the period from the costs make target-bench measured
+(target/mps2/measured_cost.json).
+
+  image_info.py MACHINE.json BOARD      (BOARD: stm32h7 | stm32g4)
+Exit 1 (with the reason) when the board runs none of the listed estimators."""
+import json
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import machine  # noqa: E402
+
+# what each board's image can run (hal/<board>/image/main.c) and its core
+BOARDS = {"stm32h7": (("pf", "ukf", "none"), "cortex_m7"), "stm32g4": (("ukf", "none"), "cortex_m4")}
+COST = os.path.join(HERE, "..", "..", "target", "mps2", "measured_cost.json")
+
+
+def image(m, board):
+    """(estimator, period_s) of board's image for machine m, or (None, reason)"""
+    can, _ = BOARDS[board]
+    listed = m["control"]["estimator"].split(",")
+    for e in listed:
+        if e in can:
+            return e, (m["estimator"]["pf"]["period_s"] if e == "pf" else m["control"]["period_s"])
+    return None, "control.estimator lists %s; the %s image runs %s" % (",".join(listed), board, ", ".join(can))
+
+
+def share(m, board, est, period_s):
+    """instructions per period and the share of the period, or None where not measured"""
+    with open(COST, encoding="utf-8") as f:
+        cost = json.load(f)[BOARDS[board][1]]
+    if est == "pf" and "pf_fixed_per_period" in cost:
+        pf = m["estimator"]["pf"]
+        n = cost["pf_per_particle_step"] * pf["n_particles"] + cost["pf_fixed_per_period"]
+        if "delay_id" in pf:
+            n += cost["pf_delay_id_per_period"]
+        return n, n / (cost["mhz"] * 1e6 * period_s)
+    if est == "ukf" and "ukf_app_per_period" in cost:
+        n = cost["ukf_app_per_period"]
+        return n, n / (cost["mhz"] * 1e6 * period_s)
+    return None
+
+
+def main():
+    if len(sys.argv) != 3 or sys.argv[2] not in BOARDS:
+        sys.exit("usage: image_info.py MACHINE.json stm32h7|stm32g4")
+    m = machine.load_or_exit(sys.argv[1])
+    est, period = image(m, sys.argv[2])
+    if est is None:
+        sys.exit("%s: %s" % (sys.argv[1], period))
+    s = share(m, sys.argv[2], est, period)
+    cost = ("%.0f instructions per period, %.1f %% of it at 1 instruction per cycle (make target-bench's costs, "
+            "target/mps2/measured_cost.json)" % (s[0], 100.0 * s[1])) if s else "its cost on this core not measured"
+    print("  estimator: %s at %g ms; %s" % (est, period * 1e3, cost))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
