@@ -272,6 +272,24 @@ class ToolsTest(unittest.TestCase):
         self.assertEqual((s["experiment"]["direction"], s["hinf_only"]["trace"]), ("ccw", "trace_hinf_only.csv"))
         self.assertNotIn("ccw", s)
 
+    def test_make_demo_passes_the_circle_quoted(self):
+        # make demo RADIUS_M=... FEED=... DIR=...: each value one argument of br_demo_circle, whatever it holds
+        import shlex
+        root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+        env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MAKELEVEL", "MFLAGS", "DIR")}
+        evil = "1e-4'; touch pwned; '"
+        r = subprocess.run(["make", "-n", "-C", root, "demo", "RADIUS_M=" + evil, "FEED=300 x", "DIR=both"],
+                           capture_output=True, text=True, env=env, timeout=120)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        line = next(ln for ln in r.stdout.splitlines() if "br_demo_circle --out" in ln)
+        argv = shlex.split(line)
+        self.assertEqual(argv[argv.index("--radius-m") + 1], evil)
+        self.assertEqual(argv[argv.index("--feed-mm-min") + 1], "300 x")
+        self.assertEqual(argv[argv.index("--dir") + 1], "both")
+        r = subprocess.run(["make", "-n", "-C", root, "demo"], capture_output=True, text=True, env=env, timeout=120)
+        line = next(ln for ln in r.stdout.splitlines() if "br_demo_circle --out" in ln)
+        self.assertEqual(shlex.split(line)[1:], ["--out", "out/demo"])  # without them: the thesis's circle
+
     def test_pf_study_bounds(self):
         table = os.path.join(self.w, "t.bin")
         with open(table, "wb") as f:
