@@ -78,7 +78,7 @@ help:
 	@echo "  make deps      install Debian packages and the pinned .venv (cmake/setup-deps.sh)"
 	@echo "  make build     configure + build host-debug (ASan + UBSan)"
 	@echo "  make test      host-debug build + ctest, then the firmware image and its size"
-	@echo "  make demo      host-release build, run the circle demo into $(DEMO_OUT), plot it"
+	@echo "  make demo [RADIUS_M=m] [FEED=mm/min] [DIR=cw|ccw|both]  host-release build, run the circle demo into $(DEMO_OUT), its ISO 230-4 figures, plot it"
 	@echo "  make bench     host-release build, time the PF (C and numpy) and the UKF, memory -> $(BENCH_OUT)/bench.json"
 	@echo "  make diagnose LOG=<csv> OUT=<dir> [MACHINE=<json>]  what the model gets wrong in a measured log (docs/diagnose.md)"
 	@echo "  make validate MODEL=<model.json> LOG=<csv>          a saved model's relerr on another log"
@@ -121,12 +121,19 @@ test: deps
 	$(print_size)
 	$(Q)$(MAKE) firmware BOARD=stm32g4
 
+# The circle (docs/circle-test.md): `make demo RADIUS_M=<m> FEED=<mm/min> DIR=cw|ccw|both`
+# (br_demo_circle --radius-m, --feed-mm-min, --dir; each passed only when set,
+# single-quoted for the shell); then the ISO 230-4 figures into summary.json.
+squote = '$(subst ','\'',$(1))'
+DEMO_ARGS = $(if $(RADIUS_M),--radius-m $(call squote,$(RADIUS_M))) $(if $(FEED),--feed-mm-min $(call squote,$(FEED))) \
+  $(if $(DIR),--dir $(call squote,$(DIR)))
 demo: deps
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)echo "== demo -> $(DEMO_OUT)"
 	$(Q)mkdir -p $(DEMO_OUT)
-	$(Q)build/host-release/sim/br_demo_circle --out $(DEMO_OUT)
+	$(Q)build/host-release/sim/br_demo_circle --out $(DEMO_OUT) $(DEMO_ARGS)
+	$(Q)$(PYTHON) sim/plots/iso230_4.py $(DEMO_OUT)
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_demo.py $(DEMO_OUT)
 
 # Nelder-Mead tuning of the PF's and the UKF's noise variances on the circle

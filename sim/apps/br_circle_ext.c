@@ -7,6 +7,8 @@
  * br_model_cfg_t.causes set from the model's. docs/diagnose.md.
  *
  * Usage: br_circle_ext [--model MODEL.json] [--est ukf|pf] [--ahead P] [--json OUT] [cause options]
+ *                      [--radius-m R] [--feed-mm-min F] [--dir cw|ccw]
+ * (the circle: br_circle_args.h, default the thesis's)
  * Prints one line per run and, with --json, writes them (to a temporary file
  * renamed at the end, br_outfile.h: a failed run writes nothing). */
 #define _POSIX_C_SOURCE 200809L
@@ -15,6 +17,7 @@
 #include <string.h>
 
 #include "circle/br_circle.h"
+#include "circle/br_circle_args.h"
 #include "plant/br_model_params.h"
 #include "plant/br_plant_json.h"
 #include "simlog/br_cause_args.h"
@@ -28,13 +31,15 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s [--model MODEL.json] [--est ukf|pf] [--ahead P] [--json OUT] [--offset F] [--asym DFC,DFV]\n"
-            "       [--ripple A,P[,PH]] [--gradient S] [--delay D] [--drift R]\n" BR_ARGS_COMMON_USAGE
+            "       [--ripple A,P[,PH]] [--gradient S] [--delay D] [--drift R] [--radius-m R] [--feed-mm-min F]\n"
+            "       [--dir cw|ccw]\n" BR_ARGS_COMMON_USAGE
             "  --model MODEL.json  a diagnosis's saved model: adds the extended-model run\n"
             "  --est ukf|pf        the estimator beside H-inf (default ukf)\n"
             "  --ahead P           the estimator's compensation lead, periods beyond the delay\n"
             "                      (est.comp_ahead_periods; default the machine file's)\n"
             "  --json OUT          write the runs' figures to OUT as well\n"
-            "  cause options       switch causes on in the plant (docs/simlog.md)\n",
+            "  cause options       switch causes on in the plant (docs/simlog.md)\n"
+            BR_CIRCLE_USAGE("--dir cw|ccw       "),
             argv0, argv0);
     return 2;
 }
@@ -44,17 +49,20 @@ int main(int argc, char **argv)
     const char *model = NULL, *json = NULL, *est = "ukf";
     double ahead = -1.0; /* < 0: the machine file's */
     br_plant_cfg_t plant = br_plant_cfg_reference();
+    br_circle_path_t path = BR_CIRCLE_PATH_DEFAULT;
     static const struct option opts[] = {{"model", required_argument, NULL, 'm'},
                                          {"json", required_argument, NULL, 'j'},
                                          {"est", required_argument, NULL, 'e'},
                                          {"ahead", required_argument, NULL, 'a'},
-                                         BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
+                                         BR_CAUSE_LONGOPTS BR_CIRCLE_LONGOPTS BR_CIRCLE_LONGOPT_DIR{NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
     const char *val;
     for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
         if (c == BR_CAUSE_OPT) {
             if (br_cause_arg(p.opt, val, &plant) < 0) return 2;
+        } else if (c == BR_CIRCLE_OPT) {
+            if (br_circle_arg(TOOL, p.opt, val, 0, &path) != 0) return usage(argv[0], stderr);
         } else if (c == 'm') model = val;
         else if (c == 'j') json = val;
         else if (c == 'a') {
@@ -65,6 +73,10 @@ int main(int argc, char **argv)
             if (c == 'e') fprintf(stderr, "%s: --est %s: must be ukf or pf\n", TOOL, val);
             return usage(argv[0], stderr);
         }
+    }
+    {
+        const br_circle_cfg_t thesis = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
+        if (br_circle_path_check(TOOL, &path, &thesis) != 0) return usage(argv[0], stderr);
     }
     const int use_pf = strcmp(est, "pf") == 0;
     br_plant_cfg_t saved;
@@ -87,15 +99,19 @@ int main(int argc, char **argv)
         if (br_outfile_open(&js, TOOL, json) != 0) return 1;
         br_circle_cfg_t c0 = br_circle_cfg_thesis(ctrl);
         br_circle_use_ahead(&c0, ahead); /* the lead the runs below take */
+        br_circle_use_path(&c0, path.radius_m, path.feed_mps, path.dir == BR_CIRCLE_DIR_CCW);
         const double lead = (double)(use_pf ? c0.pf.est.comp_ahead_periods : c0.ukf.est.comp_ahead_periods);
         fprintf(js.f,
                 "{\n  \"generator\": \"br_circle_ext (sim/apps/br_circle_ext.c)\",\n  \"estimator\": \"%s\",\n"
                 "  \"comp_ahead_periods\": %.9g",
                 est, lead);
+        fprintf(js.f, ",\n  \"circle\": {\"radius_m\": %.9g, \"period_s\": %.9g, \"direction\": \"%s\"}", c0.radius_m,
+                c0.period_s, c0.dir < 0.0 ? "ccw" : "cw");
     }
     for (int r = 0; r < (model ? 4 : 3); r++) {
         br_circle_cfg_t c = br_circle_cfg_thesis(runs[r].ctrl);
         c.plant = plant;
+        br_circle_use_path(&c, path.radius_m, path.feed_mps, path.dir == BR_CIRCLE_DIR_CCW);
         br_circle_use_ahead(&c, ahead); /* every estimator run, nominal and extended, with the same lead */
         if (runs[r].extended) {
             /* the estimator predicts and compensates with the diagnosed causes */

@@ -6,10 +6,16 @@
  * parameters away from the model, drift and noise).
  *
  * Usage: br_demo_circle --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N]
+ *                       [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]
  * Writes DIR/trace_<name>.csv per controller, DIR/gp_hist_hinf_pf.csv (the PF's
  * g_p particle histogram per step), the same with the prefix real_ for the
  * realistic plant, and DIR/summary.json (the realistic plant's under
  * "realistic"); prints the tables.
+ * --radius-m, --feed-mm-min, --dir: the circle (br_circle_args.h; default the
+ * thesis's, clockwise); --dir both runs every controller clockwise, then
+ * counter-clockwise into trace_ccw_<name>.csv, trace_real_ccw_<name>.csv and
+ * summary.json's "ccw" (top level and under "realistic"): the pair of the
+ * ISO 230-4 bi-directional figures (docs/circle-test.md).
  * --gains, --dt and --nsub override the generated H-inf gains, the thesis
  * periods and the plant's substeps (design and accuracy studies), within the
  * bounds of br_tool_limits.h. Every option is checked before a file is
@@ -19,10 +25,12 @@
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
 #include "circle/br_circle.h"
+#include "circle/br_circle_args.h"
 #include "tools/br_args.h"
 #include "tools/br_outfile.h"
 #include "tools/br_run_report.h"
@@ -75,18 +83,23 @@ static void demo_sink(void *user, const br_circle_sample_t *s)
 /* the two plants: [0] the reference machine (the estimators' model), [1] the realistic one */
 #define N_PLANTS 2
 static const char *const plant_prefix[N_PLANTS] = {"", "real_"};
+/* the directions of a run: [0] the one --dir names (files unprefixed), [1] with
+ * --dir both the counter-clockwise one */
+#define N_DIRS 2
+static const char *const dir_prefix[N_DIRS] = {"", "ccw_"};
 
 typedef struct {
-    br_outfile_t summary, trace[N_PLANTS][N_ROWS], hist[N_PLANTS];
+    br_outfile_t summary, trace[N_PLANTS][N_DIRS][N_ROWS], hist[N_PLANTS][N_DIRS];
 } outputs_t;
 
 static void discard_all(outputs_t *o)
 {
     br_outfile_discard(&o->summary);
-    for (int pl = 0; pl < N_PLANTS; pl++) {
-        br_outfile_discard(&o->hist[pl]);
-        for (unsigned r = 0; r < N_ROWS; r++) br_outfile_discard(&o->trace[pl][r]);
-    }
+    for (int pl = 0; pl < N_PLANTS; pl++)
+        for (int d = 0; d < N_DIRS; d++) {
+            br_outfile_discard(&o->hist[pl][d]);
+            for (unsigned r = 0; r < N_ROWS; r++) br_outfile_discard(&o->trace[pl][d][r]);
+        }
 }
 
 static int open_in(br_outfile_t *f, const char *dir, const char *name)
@@ -99,14 +112,15 @@ static int open_in(br_outfile_t *f, const char *dir, const char *name)
     return br_outfile_open(f, TOOL, path);
 }
 
-static int commit_all(outputs_t *o, const int selected[N_ROWS], int pf_selected)
+static int commit_all(outputs_t *o, const int selected[N_ROWS], int pf_selected, int n_dirs)
 {
     int rc = 0;
-    for (int pl = 0; pl < N_PLANTS; pl++) {
-        for (unsigned r = 0; r < N_ROWS; r++)
-            if (selected[r] && rc == 0) rc = br_outfile_commit(&o->trace[pl][r], TOOL);
-        if (pf_selected && rc == 0) rc = br_outfile_commit(&o->hist[pl], TOOL);
-    }
+    for (int pl = 0; pl < N_PLANTS; pl++)
+        for (int d = 0; d < n_dirs; d++) {
+            for (unsigned r = 0; r < N_ROWS; r++)
+                if (selected[r] && rc == 0) rc = br_outfile_commit(&o->trace[pl][d][r], TOOL);
+            if (pf_selected && rc == 0) rc = br_outfile_commit(&o->hist[pl][d], TOOL);
+        }
     if (rc == 0) rc = br_outfile_commit(&o->summary, TOOL); /* last: its presence says the rest is there */
     return rc;
 }
@@ -119,13 +133,14 @@ typedef struct {
     long nsub;
     long pf_prop; /* -1: the machine's */
     double ahead; /* < 0: the machine's */
+    br_circle_path_t path; /* the circle (default the thesis's) */
 } opts_t;
 
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
-            "       [--ahead P]\n" BR_ARGS_COMMON_USAGE
+            "       [--ahead P] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
             "  --gains K0,K1,K2    the H-inf gains instead of the generated ones\n"
@@ -135,8 +150,12 @@ static int usage(const char *argv0, FILE *to)
             "                      noise held over the period (docs/modules/pf.md)\n"
             "  --ahead P           the estimators' compensation lead, periods past the delay\n"
             "                      (est.comp_ahead_periods, 0 .. %g; docs/modules/est.md)\n"
-            "bounds: --dt %g .. %g s, --nsub 1 .. %d, |gain| <= %g (docs/tools.md)\n",
-            argv0, argv0, (double)BR_EST_AHEAD_MAX_PERIODS, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX, BR_TOOL_GAIN_MAX);
+            BR_CIRCLE_USAGE("--dir cw|ccw|both  ") "                      (both: each controller both ways, the ISO 230-4 pair; --direction the same)\n"
+            "bounds: --dt %g .. %g s, --nsub 1 .. %d, |gain| <= %g, --radius-m %g .. %g m,\n"
+            "        --feed-mm-min %g .. %g, a revolution %g .. %g s (docs/tools.md)\n",
+            argv0, argv0, (double)BR_EST_AHEAD_MAX_PERIODS, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX,
+            BR_TOOL_GAIN_MAX, BR_TOOL_RADIUS_MIN_M, BR_TOOL_RADIUS_MAX_M, BR_TOOL_FEED_MIN_MM_MIN,
+            BR_TOOL_FEED_MAX_MM_MIN, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S);
     return 2;
 }
 
@@ -159,7 +178,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"nsub", required_argument, NULL, 'n'},
                                          {"pf-proposal", required_argument, NULL, 'p'},
                                          {"ahead", required_argument, NULL, 'a'},
-                                         {NULL, 0, NULL, 0}};
+                                         BR_CIRCLE_LONGOPTS BR_CIRCLE_LONGOPT_DIR{NULL, 0, NULL, 0}};
     br_args_t p;
     const int st = br_args_begin(&p, TOOL, argc, argv);
     if (st != BR_ARGS_RUN) return st == BR_ARGS_HELP ? 1 : 3;
@@ -179,6 +198,7 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'n': bad = br_arg_long(TOOL, p.opt, val, 1, BR_TOOL_NSUB_MAX, &o->nsub); break;
         case 'p': bad = br_arg_long(TOOL, p.opt, val, 0, (long)BR_PF_PROPOSAL_OPT_HELD, &o->pf_prop); break;
         case 'a': bad = br_arg_double(TOOL, p.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &o->ahead); break;
+        case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, p.opt, val, 1, &o->path); break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
@@ -187,6 +207,8 @@ static int parse(int argc, char **argv, opts_t *o)
         fprintf(stderr, "%s: --out is required\n", TOOL);
         return 2;
     }
+    const br_circle_cfg_t thesis = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
+    if (br_circle_path_check(TOOL, &o->path, &thesis) != 0) return 2;
     if (o->only) {
         unsigned r = 0;
         while (r < N_ROWS && strcmp(o->only, br_circle_ctrl_name(rows[r].ctrl)) != 0) r++;
@@ -203,9 +225,33 @@ static int finite_result(const br_circle_result_t *r)
     return isfinite(r->contour_rms_m) && isfinite(r->max_err_m) && isfinite(r->fhat_rms_err_N);
 }
 
+/* JSON numbers of the experiment: the shortest text that reads back as v, in
+ * exponent form ("1e-4", the thesis radius as summary.json always wrote it)
+ * or in %g form ("8") */
+static void json_exp(char *buf, size_t n, double v)
+{
+    char t[40];
+    for (int p = 0; p <= 16; p++) {
+        snprintf(t, sizeof t, "%.*e", p, v);
+        if (strtod(t, NULL) == v) break;
+    }
+    char *e = strchr(t, 'e');
+    const long ex = strtol(e + 1, NULL, 10);
+    *e = '\0';
+    snprintf(buf, n, "%se%ld", t, ex);
+}
+
+static void json_g(char *buf, size_t n, double v)
+{
+    for (int p = 1; p <= 17; p++) {
+        snprintf(buf, n, "%.*g", p, v);
+        if (strtod(buf, NULL) == v) return;
+    }
+}
+
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0};
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, BR_CIRCLE_PATH_DEFAULT};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -221,21 +267,26 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: cannot create %s: %s\n", TOOL, out, strerror(errno));
         return 1;
     }
+    /* the directions run: the one --dir names, or clockwise then counter-clockwise */
+    const int n_dirs = opt.path.dir == BR_CIRCLE_DIR_BOTH ? 2 : 1;
+    const int ccw_of[N_DIRS] = {opt.path.dir == BR_CIRCLE_DIR_CCW, 1};
     int selected[N_ROWS] = {0}, pf_selected = 0;
     static outputs_t o; /* zeroed: nothing open */
     int rc = open_in(&o.summary, out, "summary.json");
     for (int pl = 0; pl < N_PLANTS; pl++) {
-        for (unsigned r = 0; r < N_ROWS && rc == 0; r++) {
-            const char *name = br_circle_ctrl_name(rows[r].ctrl);
-            selected[r] = !opt.only || strcmp(opt.only, name) == 0;
-            if (!selected[r]) continue;
-            char fname[256];
-            snprintf(fname, sizeof fname, "trace_%s%s.csv", plant_prefix[pl], name);
-            rc = open_in(&o.trace[pl][r], out, fname);
-            if (rc == 0 && rows[r].ctrl == BR_CTRL_HINF_PF) {
-                pf_selected = 1;
-                snprintf(fname, sizeof fname, "gp_hist_%shinf_pf.csv", plant_prefix[pl]);
-                rc = open_in(&o.hist[pl], out, fname);
+        for (int d = 0; d < n_dirs; d++) {
+            for (unsigned r = 0; r < N_ROWS && rc == 0; r++) {
+                const char *name = br_circle_ctrl_name(rows[r].ctrl);
+                selected[r] = !opt.only || strcmp(opt.only, name) == 0;
+                if (!selected[r]) continue;
+                char fname[256];
+                snprintf(fname, sizeof fname, "trace_%s%s%s.csv", plant_prefix[pl], dir_prefix[d], name);
+                rc = open_in(&o.trace[pl][d][r], out, fname);
+                if (rc == 0 && rows[r].ctrl == BR_CTRL_HINF_PF) {
+                    pf_selected = 1;
+                    snprintf(fname, sizeof fname, "gp_hist_%s%shinf_pf.csv", plant_prefix[pl], dir_prefix[d]);
+                    rc = open_in(&o.hist[pl][d], out, fname);
+                }
             }
         }
     }
@@ -244,10 +295,25 @@ int main(int argc, char **argv)
         return 1;
     }
     FILE *js = o.summary.f;
-    fprintf(js, "{\n  \"experiment\": {\"radius_m\": 1e-4, \"period_s\": 8, \"duration_s\": 8}");
-    printf("X-Y circle, radius 1.0e-04 m, period 8 s, 8 s simulated\n");
+    br_circle_cfg_t ex = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
+    br_circle_use_path(&ex, opt.path.radius_m, opt.path.feed_mps, ccw_of[0]);
+    char jr[48], jp[48], jd[48], jf[48], pr[48];
+    json_exp(jr, sizeof jr, ex.radius_m);
+    json_g(jp, sizeof jp, ex.period_s);
+    json_g(jd, sizeof jd, ex.duration_s);
+    json_g(jf, sizeof jf, br_circle_feed_mps(&ex) * 60000.0);
+    for (int k = 1; k <= 6; k++) { /* the radius as printed: 1.0e-04 for the thesis's */
+        snprintf(pr, sizeof pr, "%.*e", k, ex.radius_m);
+        if (strtod(pr, NULL) == ex.radius_m) break;
+    }
+    const char *dir_name[2] = {"cw", "ccw"};
+    fprintf(js, "{\n  \"experiment\": {\"radius_m\": %s, \"period_s\": %s, \"duration_s\": %s", jr, jp, jd);
+    fprintf(js, ", \"feed_mm_min\": %s, \"direction\": \"%s\", \"directions\": [\"%s\"%s]}", jf,
+            dir_name[ccw_of[0]], dir_name[ccw_of[0]], n_dirs == 2 ? ", \"ccw\"" : "");
+    printf("X-Y circle, radius %s m, period %g s, %g s simulated\n", pr, ex.period_s, ex.duration_s);
+    printf("%s, feed %.4g mm/min%s\n", ccw_of[0] ? "counter-clockwise" : "clockwise (the thesis's)",
+           br_circle_feed_mps(&ex) * 60000.0, n_dirs == 2 ? "; then each counter-clockwise (--dir both)" : "");
     for (int pl = 0; pl < N_PLANTS; pl++) {
-        const char *ind = pl == 0 ? "  " : "    ";
         if (pl == 0) {
             printf("plant = the estimators' and the feedforward's model (the reference machine's numbers):"
                    " the best case, docs/demo.md\n");
@@ -267,68 +333,82 @@ int main(int argc, char **argv)
                     rp->sigma0_Npm, rp->sigma1_Nspm, rp->Fc_N, rp->Fs_N, rp->vs_mps, rp->sigma2_Nspm, rp->J_kgm2,
                     rp->M_kg, rc0.real.drift_frac, rc0.real.force_noise_N, rc0.real.enc_noise_p, rc0.real.seed);
         }
-        printf("%-14s %8s %16s %16s %16s %12s %12s\n", "controller", "dt [ms]", "contour RMS [m]", "max error [m]",
-               "thesis RMS [m]", "/ H-inf only", "F err [N]");
-        double rms_hinf = 0.0;
-        for (unsigned r = 0; r < N_ROWS; r++) {
-            if (!selected[r]) continue;
-            const char *name = br_circle_ctrl_name(rows[r].ctrl);
-            br_circle_cfg_t cfg = pl == 0 ? br_circle_cfg_thesis(rows[r].ctrl) : br_circle_cfg_realistic(rows[r].ctrl);
-            if (opt.have_gains) memcpy(cfg.K, opt.K, sizeof opt.K);
-            if (opt.dt > 0.0) {
-                cfg.dt_s = opt.dt;
-                cfg.pf.est.model.dt_s = (float)opt.dt;
-                cfg.ukf.est.model.dt_s = (float)opt.dt;
+        for (int d = 0; d < n_dirs; d++) {
+            /* the second direction's runs: an object "ccw" beside the first's */
+            const char *ind = d == 0 ? (pl == 0 ? "  " : "    ") : (pl == 0 ? "    " : "      ");
+            const char *sep = ",";
+            if (d == 1) {
+                printf("counter-clockwise (--dir both):\n");
+                fprintf(js, ",\n%s\"ccw\": {", pl == 0 ? "  " : "    ");
+                sep = "";
             }
-            if (opt.nsub > 0) cfg.plant.n_sub = (int)opt.nsub;
-            if (opt.pf_prop >= 0) cfg.pf.proposal = (uint32_t)opt.pf_prop;
-            br_circle_use_ahead(&cfg, opt.ahead);
-            sinks_t k = {o.trace[pl][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl].f : NULL};
-            br_circle_csv_header(k.trace);
-            if (k.hist)
-                fprintf(k.hist, "# g_p particle histogram per step: t,axis, then %d bins of %g N from 0 N\n",
-                        BR_HIST_BINS, BR_HIST_W_N);
-            br_circle_result_t res;
-            if (br_circle_run(&cfg, demo_sink, &k, &res) != 0) {
-                fprintf(stderr, "%s: run %s failed; nothing written\n", TOOL, name);
-                discard_all(&o);
-                return 1;
+            printf("%-14s %8s %16s %16s %16s %12s %12s\n", "controller", "dt [ms]", "contour RMS [m]",
+                   "max error [m]", "thesis RMS [m]", "/ H-inf only", "F err [N]");
+            double rms_hinf = 0.0;
+            for (unsigned r = 0; r < N_ROWS; r++) {
+                if (!selected[r]) continue;
+                const char *name = br_circle_ctrl_name(rows[r].ctrl);
+                br_circle_cfg_t cfg =
+                    pl == 0 ? br_circle_cfg_thesis(rows[r].ctrl) : br_circle_cfg_realistic(rows[r].ctrl);
+                br_circle_use_path(&cfg, opt.path.radius_m, opt.path.feed_mps, ccw_of[d]);
+                if (opt.have_gains) memcpy(cfg.K, opt.K, sizeof opt.K);
+                if (opt.dt > 0.0) {
+                    cfg.dt_s = opt.dt;
+                    cfg.pf.est.model.dt_s = (float)opt.dt;
+                    cfg.ukf.est.model.dt_s = (float)opt.dt;
+                }
+                if (opt.nsub > 0) cfg.plant.n_sub = (int)opt.nsub;
+                if (opt.pf_prop >= 0) cfg.pf.proposal = (uint32_t)opt.pf_prop;
+                br_circle_use_ahead(&cfg, opt.ahead);
+                sinks_t k = {o.trace[pl][d][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl][d].f : NULL};
+                br_circle_csv_header(k.trace);
+                if (k.hist)
+                    fprintf(k.hist, "# g_p particle histogram per step: t,axis, then %d bins of %g N from 0 N\n",
+                            BR_HIST_BINS, BR_HIST_W_N);
+                br_circle_result_t res;
+                if (br_circle_run(&cfg, demo_sink, &k, &res) != 0) {
+                    fprintf(stderr, "%s: run %s failed; nothing written\n", TOOL, name);
+                    discard_all(&o);
+                    return 1;
+                }
+                if (!finite_result(&res)) {
+                    fprintf(stderr, "%s: run %s gave a non-finite result; nothing written\n", TOOL, name);
+                    discard_all(&o);
+                    return 1;
+                }
+                if (res.fault_status != 0) {
+                    /* the demo's runs go to the end: a faulted run is no result (docs/tools.md) */
+                    fprintf(stderr, "%s: run %s faulted at %.4f s (%s, status %d): no result; nothing written\n",
+                            TOOL, name, res.fault_t_s, br_run_fault_name(res.fault_cause), res.fault_status);
+                    discard_all(&o);
+                    return 1;
+                }
+                if (rows[r].ctrl == BR_CTRL_HINF_ONLY) rms_hinf = res.contour_rms_m;
+                char thesis_js[32] = "null", thesis[32] = "-", ratio[32] = "-";
+                if (rows[r].thesis_rms_m > 0.0) {
+                    snprintf(thesis_js, sizeof thesis_js, "%.6e", rows[r].thesis_rms_m);
+                    snprintf(thesis, sizeof thesis, "%.3e", rows[r].thesis_rms_m);
+                }
+                char fname[256];
+                snprintf(fname, sizeof fname, "trace_%s%s%s.csv", plant_prefix[pl], dir_prefix[d], name);
+                fprintf(js,
+                        "%s\n%s\"%s\": {\"dt_s\": %.6g, \"contour_rms_m\": %.6e, \"max_err_m\": %.6e, "
+                        "\"thesis_contour_rms_m\": %s, \"fhat_rms_err_N\": %.6e, \"saturated_steps\": %d, "
+                        "\"outlier_steps\": %d, \"trace\": \"%s\"}",
+                        sep, ind, name, cfg.dt_s, res.contour_rms_m, res.max_err_m, thesis_js, res.fhat_rms_err_N,
+                        res.saturated_steps, res.outlier_steps, fname);
+                sep = ",";
+                if (rms_hinf > 0.0) snprintf(ratio, sizeof ratio, "%.3f", res.contour_rms_m / rms_hinf);
+                printf("%-14s %8.1f %16.3e %16.3e %16s %12s %12.3f\n", rows[r].label, cfg.dt_s * 1e3,
+                       res.contour_rms_m, res.max_err_m, thesis, ratio, res.fhat_rms_err_N);
+                fflush(stdout);
             }
-            if (!finite_result(&res)) {
-                fprintf(stderr, "%s: run %s gave a non-finite result; nothing written\n", TOOL, name);
-                discard_all(&o);
-                return 1;
-            }
-            if (res.fault_status != 0) {
-                /* the demo's runs go to the end: a faulted run is no result (docs/tools.md) */
-                fprintf(stderr, "%s: run %s faulted at %.4f s (%s, status %d): no result; nothing written\n", TOOL,
-                        name, res.fault_t_s, br_run_fault_name(res.fault_cause), res.fault_status);
-                discard_all(&o);
-                return 1;
-            }
-            if (rows[r].ctrl == BR_CTRL_HINF_ONLY) rms_hinf = res.contour_rms_m;
-            char thesis_js[32] = "null", thesis[32] = "-", ratio[32] = "-";
-            if (rows[r].thesis_rms_m > 0.0) {
-                snprintf(thesis_js, sizeof thesis_js, "%.6e", rows[r].thesis_rms_m);
-                snprintf(thesis, sizeof thesis, "%.3e", rows[r].thesis_rms_m);
-            }
-            char fname[256];
-            snprintf(fname, sizeof fname, "trace_%s%s.csv", plant_prefix[pl], name);
-            fprintf(js,
-                    ",\n%s\"%s\": {\"dt_s\": %.6g, \"contour_rms_m\": %.6e, \"max_err_m\": %.6e, "
-                    "\"thesis_contour_rms_m\": %s, \"fhat_rms_err_N\": %.6e, \"saturated_steps\": %d, "
-                    "\"outlier_steps\": %d, \"trace\": \"%s\"}",
-                    ind, name, cfg.dt_s, res.contour_rms_m, res.max_err_m, thesis_js, res.fhat_rms_err_N,
-                    res.saturated_steps, res.outlier_steps, fname);
-            if (rms_hinf > 0.0) snprintf(ratio, sizeof ratio, "%.3f", res.contour_rms_m / rms_hinf);
-            printf("%-14s %8.1f %16.3e %16.3e %16s %12s %12.3f\n", rows[r].label, cfg.dt_s * 1e3, res.contour_rms_m,
-                   res.max_err_m, thesis, ratio, res.fhat_rms_err_N);
-            fflush(stdout);
+            if (d == 1) fprintf(js, "\n%s}", pl == 0 ? "  " : "    ");
         }
         if (pl == 1) fprintf(js, "\n  }");
     }
     fprintf(js, "\n}\n");
-    if (commit_all(&o, selected, pf_selected) != 0) {
+    if (commit_all(&o, selected, pf_selected, n_dirs) != 0) {
         discard_all(&o);
         return 1;
     }

@@ -13,6 +13,9 @@
  * Usage: br_robust_run [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N]
  *                      [--enc-noise P] [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT]
  *                      [--pf-dt S] [--pf-n M] [--pf-proposal K] [--ahead P] [--delay-id 0|1]
+ *                      [--radius-m R] [--feed-mm-min F] [--direction cw|ccw]
+ * --radius-m, --feed-mm-min, --direction: the circle (br_circle_args.h;
+ * default the thesis's; --direction, since --dir is the trace folder).
  * --pf-dt, --pf-n: the PF runs at another period / with another particle
  * count (docs/robustness.md, "PF variants"; the tuned variances per step kept).
  * --pf-proposal: the PF's br_pf_cfg_t.proposal (0 the thesis's, 1 OPT, 2
@@ -32,6 +35,7 @@
 #include <sys/stat.h>
 
 #include "circle/br_circle.h"
+#include "circle/br_circle_args.h"
 #include "plant/br_plant_json.h"
 #include "tools/br_args.h"
 #include "tools/br_outfile.h"
@@ -60,7 +64,8 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N] [--enc-noise P]\n"
             "       [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT] [--pf-dt S] [--pf-n M]\n"
-            "       [--pf-proposal K] [--ahead P] [--delay-id 0|1]\n"
+            "       [--pf-proposal K] [--ahead P] [--delay-id 0|1] [--radius-m R] [--feed-mm-min F]\n"
+            "       [--direction cw|ccw]\n"
             BR_ARGS_COMMON_USAGE
             "  --plant PLANT.json  the simulated plant (a model.json; default the reference machine)\n"
             "  --model MODEL.json  the identified model the *_id runs' estimators and feedforward use\n"
@@ -78,6 +83,7 @@ static int usage(const char *argv0, FILE *to)
             "                      noise held over the period (docs/modules/pf.md)\n"
             "  --ahead P           the estimators' compensation lead, periods past the delay (docs/modules/est.md)\n"
             "  --delay-id 0|1      the estimators' delay identification off / as the machine has it (docs/modules/dlyid.md)\n"
+            BR_CIRCLE_USAGE("--direction cw|ccw ")
             "runs:", argv0, argv0);
     for (unsigned r = 0; r < N_RUNS; r++) fprintf(to, " %s", runs[r].name);
     fprintf(to, " (the *_id ones need --model)\n");
@@ -135,6 +141,7 @@ int main(int argc, char **argv)
     br_circle_real_t real = {0.0, 0.0, 0.0, 0u};
     double veps = -1.0, pf_dt = -1.0, ahead = -1.0;
     long pf_n = 0, pf_prop = -1, delay_id = -1;
+    br_circle_path_t path = BR_CIRCLE_PATH_DEFAULT;
     static const struct option opts[] = {
         {"plant", required_argument, NULL, 'P'},  {"model", required_argument, NULL, 'm'},
         {"json", required_argument, NULL, 'j'},   {"only", required_argument, NULL, 'o'},
@@ -143,7 +150,7 @@ int main(int argc, char **argv)
         {"ff-veps", required_argument, NULL, 'v'}, {"pf-dt", required_argument, NULL, 't'},
         {"pf-n", required_argument, NULL, 'n'},   {"seed", required_argument, NULL, 's'},
         {"pf-proposal", required_argument, NULL, 'p'}, {"ahead", required_argument, NULL, 'a'},
-        {"delay-id", required_argument, NULL, 'i'}, {NULL, 0, NULL, 0}};
+        {"delay-id", required_argument, NULL, 'i'}, BR_CIRCLE_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t ap;
     if (br_args_start(&ap, TOOL, argc, argv, usage)) return 0;
     const char *val;
@@ -165,6 +172,7 @@ int main(int argc, char **argv)
         case 'p': bad = br_arg_long(TOOL, ap.opt, val, 0, (long)BR_PF_PROPOSAL_OPT_HELD, &pf_prop); break;
         case 'a': bad = br_arg_double(TOOL, ap.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &ahead); break;
         case 'i': bad = br_arg_long(TOOL, ap.opt, val, 0, 1, &delay_id); break;
+        case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, ap.opt, val, 0, &path); break;
         case 's':
             bad = br_arg_long(TOOL, ap.opt, val, 0, 2147483647L, &seed);
             real.seed = (unsigned long long)seed;
@@ -191,6 +199,7 @@ int main(int argc, char **argv)
         }
     }
     const br_circle_cfg_t thesis = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
+    if (br_circle_path_check(TOOL, &path, &thesis) != 0) return usage(argv[0], stderr);
     br_plant_cfg_t plant = thesis.plant, model = thesis.plant;
     char msg[512];
     if (plant_path && br_plant_cfg_from_model_json(plant_path, &thesis.plant, &plant, msg, sizeof msg) != 0) {
@@ -208,7 +217,12 @@ int main(int argc, char **argv)
     br_outfile_t js = {0};
     if (json) {
         if (br_outfile_open(&js, TOOL, json) != 0) return 1;
-        fprintf(js.f, "{\n  \"generator\": \"br_robust_run (sim/apps/br_robust_run.c)\",\n  \"controllers\": {");
+        br_circle_cfg_t c0 = thesis;
+        br_circle_use_path(&c0, path.radius_m, path.feed_mps, path.dir == BR_CIRCLE_DIR_CCW);
+        fprintf(js.f, "{\n  \"generator\": \"br_robust_run (sim/apps/br_robust_run.c)\",\n");
+        fprintf(js.f, "  \"circle\": {\"radius_m\": %.9g, \"period_s\": %.9g, \"direction\": \"%s\"},\n", c0.radius_m,
+                c0.period_s, c0.dir < 0.0 ? "ccw" : "cw");
+        fprintf(js.f, "  \"controllers\": {");
     }
     int first = 1, rc = 0;
     for (unsigned r = 0; r < N_RUNS && rc == 0; r++) {
@@ -216,6 +230,7 @@ int main(int argc, char **argv)
         br_circle_cfg_t c = br_circle_cfg_thesis(runs[r].ctrl);
         c.plant = plant;
         c.real = real;
+        br_circle_use_path(&c, path.radius_m, path.feed_mps, path.dir == BR_CIRCLE_DIR_CCW);
         if (veps > 0.0) c.ff.v_eps_mps = (float)veps;
         if (runs[r].ctrl == BR_CTRL_HINF_PF && pf_dt > 0.0) {
             c.dt_s = pf_dt;

@@ -34,6 +34,7 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     static const float K[3] = BR_HINF_K;
     c.radius_m = 1.0e-4;
     c.period_s = 8.0;
+    c.dir = 1.0; /* clockwise */
     c.duration_s = 8.0;
     /* the machine's periods (thesis section 5: 1.5 ms for the PF, 1 ms for the others) */
     c.dt_s = (controller == BR_CTRL_HINF_PF) ? BR_EST_PF_PERIOD_S : BR_MACHINE_CTRL_PERIOD_S;
@@ -73,6 +74,34 @@ void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods)
         c->pf.est.comp_ahead_periods = (float)lead_periods;
         c->ukf.est.comp_ahead_periods = (float)lead_periods;
     }
+}
+
+double br_circle_feed_mps(const br_circle_cfg_t *c)
+{
+    return 2.0 * BR_PI * c->radius_m / c->period_s;
+}
+
+void br_circle_use_path(br_circle_cfg_t *c, double radius_m, double feed_mps, int ccw)
+{
+    if (radius_m > 0.0 || feed_mps > 0.0) {
+        const double revs = c->duration_s / c->period_s;
+        if (feed_mps > 0.0) {
+            if (radius_m > 0.0) c->radius_m = radius_m;
+            c->period_s = 2.0 * BR_PI * c->radius_m / feed_mps;
+        } else {
+            c->period_s *= radius_m / c->radius_m; /* the same feed */
+            c->radius_m = radius_m;
+        }
+        c->duration_s = revs * c->period_s;
+    }
+    c->dir = ccw ? -1.0 : 1.0;
+}
+
+/* the reference's angular velocity, signed by the direction, rad/s */
+static double circle_omega(const br_circle_cfg_t *c)
+{
+    const double w = 2.0 * BR_PI / c->period_s;
+    return c->dir < 0.0 ? -w : w;
 }
 
 void br_circle_use_delay_id(br_circle_cfg_t *c, long on)
@@ -174,7 +203,7 @@ static void axis_perturb(axis_sim_t *a)
 static br_ref_t axis_ref(const br_circle_cfg_t *c, double phase, double t, double *x_ref)
 {
     const double L = c->plant.lead_mprad, rpc = 2.0 * BR_PI / c->plant.counts_per_rev;
-    const double w = 2.0 * BR_PI / c->period_s;
+    const double w = circle_omega(c);
     *x_ref = c->radius_m * sin(w * t + phase);
     const double counts = *x_ref / L / rpc;
     const double whole = floor(counts);
@@ -287,6 +316,10 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
         fprintf(stderr, "br_circle: radius, period, duration and dt must be > 0\n");
         return -1;
     }
+    if (!(c->dir == 1.0 || c->dir == -1.0)) {
+        fprintf(stderr, "br_circle: dir must be +1 (clockwise) or -1 (counter-clockwise)\n");
+        return -1;
+    }
     const br_circle_real_t *rl = &c->real;
     if (!(isfinite(rl->drift_frac) && rl->drift_frac > -0.9 && rl->drift_frac < 10.0 && isfinite(rl->force_noise_N) &&
           rl->force_noise_N >= 0.0 && isfinite(rl->enc_noise_p) && rl->enc_noise_p >= 0.0 && rl->enc_noise_p <= 1.0)) {
@@ -322,7 +355,7 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
             if (c->controller == BR_CTRL_HINF_FF) {
                 /* the feedforward's reference at t_k, load side */
-                const double w = 2.0 * BR_PI / c->period_s, ph = w * t + ax[i].phase;
+                const double w = circle_omega(c), ph = w * t + ax[i].phase;
                 const br_ff_in_t in = {(float)(c->radius_m * w * cos(ph)), (float)(-c->radius_m * w * w * sin(ph)),
                                        (float)s.ref_m[i]};
                 br_ff_set_ref(&ax[i].ff, &in);

@@ -40,6 +40,8 @@ const char *br_circle_ctrl_name(br_circle_ctrl_t c);
 typedef struct {
     double radius_m;     /* A */
     double period_s;     /* T */
+    double dir;          /* +1: clockwise seen from +z (the thesis: x = A sin, y = A cos from (0, A)),
+                            -1: counter-clockwise from the same start (x = -A sin, y = A cos) */
     double duration_s;
     double dt_s;         /* control period */
     br_circle_ctrl_t controller;
@@ -90,6 +92,17 @@ void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods);
 /* The tools' --delay-id: 0 turns both estimators' delay identification off
  * (est.delay_id, docs/modules/dlyid.md); any other value leaves the machine's. */
 void br_circle_use_delay_id(br_circle_cfg_t *c, long on);
+
+/* The tools' circle (--radius-m, --feed-mm-min, --dir; docs/circle-test.md):
+ * radius_m > 0 sets the radius A, feed_mps > 0 the tangential feed v = 2 pi A / T;
+ * either one sets the period T = 2 pi A / v (a radius alone keeps c's feed,
+ * T scaled by the radius's ratio) and as many revolutions as c had (the
+ * thesis: one, duration = T). Neither (both <= 0): c's circle bit for bit.
+ * ccw != 0 runs it counter-clockwise (c->dir = -1), else clockwise. */
+void br_circle_use_path(br_circle_cfg_t *c, double radius_m, double feed_mps, int ccw);
+
+/* The tangential feed of c's circle, 2 pi A / T, m/s. */
+double br_circle_feed_mps(const br_circle_cfg_t *c);
 
 /* The firmware's controller configuration of one axis of cfg: its gains and
  * period, the machine's torque limit, the plant's amplifier, encoder and lead

@@ -13,6 +13,11 @@ Usage: plot_demo.py DIR
   fig7_gp.png                 the PF's mean g_p over time, both axes (Fig. 7)
   fig8_gp_hist.png            g_p particle histograms 30 ms before, at and after the
                               largest g_p transition at a reversal after start-up (Fig. 8)
+  iso230_4_polar.png          the circular test as a ballbar report draws it: per
+                              controller the nominal circle and the radial deviation
+                              about the least-squares centre, magnified (the scale
+                              printed), with G and the reversal spikes (iso230_4.py);
+                              with --dir both the counter-clockwise path overlaid
 The realistic plant's traces (summary.json "realistic", prefix real_) give the
 same figures with the prefix real_."""
 import json
@@ -24,6 +29,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+import iso230_4  # noqa: E402  (beside this script)
 
 LABELS = {"hinf_only": "H-inf only", "hinf_ukf": "H-inf + UKF", "hinf_pf": "H-inf + PF",
           "hinf_true": "true friction (limit)", "hinf_ff": "H-inf + feedforward"}
@@ -184,6 +191,72 @@ def fig7_8(d, traces, pre=""):
     plt.close(fig)
 
 
+def _nice(x):
+    """1, 2 or 5 times a power of ten, >= x"""
+    e = 10.0 ** np.floor(np.log10(x))
+    return next(m * e for m in (1, 2, 5, 10) if m * e >= x)
+
+
+def polar(d, sec, pre="", A=1e-4):
+    """iso230_4_polar.png: one polar panel per controller, as a ballbar report:
+    the nominal circle (radius 1 on the plot) and 1 + deviation / scale at the
+    actual polar angle about the least-squares centre, the rings labelled in
+    deviation; the counter-clockwise run overlaid when there is one."""
+    names = [n for n in LABELS if n in sec]
+    if not names:
+        return
+    ccw = sec.get("ccw") or {}
+    ncol = min(3, len(names))
+    nrow = (len(names) + ncol - 1) // ncol
+    fig = plt.figure(figsize=(4.6 * ncol, 4.9 * nrow))
+    for i, n in enumerate(names):
+        ax = fig.add_subplot(nrow, ncol, i + 1, projection="polar")
+        runs = [("main", sec[n])] + ([("ccw", ccw[n])] if n in ccw else [])
+        paths = []
+        for tag, obj in runs:
+            tr = load_trace(d, {"t": obj}, "t")
+            a, b, R = iso230_4.lsq_circle(tr["x"], tr["y"])
+            dev = iso230_4.deviation(tr["x"], tr["y"], (a, b), R)
+            phi = np.arctan2(tr["y"] - b, tr["x"] - a)
+            paths.append((tag, phi, dev, iso230_4.analyse_trace(tr)))
+        big = max(np.abs(p[2]).max() for p in paths)
+        step = _nice(big / 3.0)  # a ring every step of deviation
+        unit, f = ("nm", 1e9) if step < 1e-6 else ("um", 1e6)
+        per = step / 0.1  # deviation per unit of plot radius: a ring every 0.1 of the nominal radius
+        th = np.linspace(0, 2 * np.pi, 721)
+        ax.plot(th, np.ones_like(th), "k--", lw=0.8)
+        for k, (tag, phi, dev, fig_) in enumerate(paths):
+            lab = {"main": "cw" if len(paths) == 1 or tag == "main" else "ccw", "ccw": "ccw"}[tag]
+            if len(paths) == 1:
+                lab = None
+            ax.plot(phi, 1.0 + dev / per, lw=0.8, color="C%d" % (3 if tag == "ccw" else 0), label=lab)
+            for sp in fig_["reversal_spikes"]:
+                ang = np.radians(sp["peak_angle_deg"])
+                ax.plot([ang], [1.0 + (sp["height_m"] + sp["local_mean_m"]) / per], "v" if sp["height_m"] < 0 else "^",
+                        ms=4, color="C%d" % (3 if tag == "ccw" else 0))
+        ticks = np.arange(-4, 5)
+        ax.set_rticks(1.0 + 0.1 * ticks)
+        ax.set_yticklabels(["%+g" % (k * step * f) if k % 2 == 0 and k else "0" if k == 0 else "" for k in ticks],
+                           fontsize=6)
+        ax.set_rlim(0.45, 1.55)
+        ax.set_rlabel_position(100)
+        ax.tick_params(axis="x", labelsize=7)
+        fig0 = paths[0][3]
+        sub = "G %.3g %s" % (fig0["circular_deviation_m"] * f, unit)
+        bi = (sec[n].get("iso230_4") or {}).get("bidirectional")
+        if bi:
+            sub += ", H %.3g %s" % (bi["circular_hysteresis_m"] * f, unit)
+        ax.set_title("%s\n%s; rings %g %s apart\n(x%.3g against the radius)" %
+                     (LABELS[n], sub, step * f, unit, 0.1 * A / step), fontsize=8)
+        if len(paths) > 1:
+            ax.legend(fontsize=7, loc="lower right", bbox_to_anchor=(1.15, -0.1))
+    fig.suptitle("circular test (ISO 230-4): radial deviation about the least-squares centre, magnified; "
+                 "dashed: the nominal circle; markers: reversal spikes", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "%siso230_4_polar.png" % pre), dpi=120)
+    plt.close(fig)
+
+
 def main(d):
     s = json.load(open(os.path.join(d, "summary.json")))
     A = s["experiment"]["radius_m"]
@@ -196,6 +269,7 @@ def main(d):
         fig5(d, traces, pre)
         fig6(d, traces, pre)
         fig7_8(d, traces, pre)
+        polar(d, sec, pre, A)
     print("wrote plots to %s" % d)
 
 

@@ -35,6 +35,15 @@
 /* br_demo_circle --gains: magnitude of each H-inf gain */
 #define BR_TOOL_GAIN_MAX 1e9
 
+/* the circle (br_circle_args.h: --radius-m, --feed-mm-min): the radius up to half
+ * the reference machine's travel (0.3 m, the circle centred on the axes' zero),
+ * the feed up to half its top speed (0.1 m/s: the loop's overshoot stays under
+ * the speed guard); a revolution must last BR_TOOL_DURATION_MIN_S .. _MAX_S */
+#define BR_TOOL_RADIUS_MIN_M 1e-6
+#define BR_TOOL_RADIUS_MAX_M 0.15
+#define BR_TOOL_FEED_MIN_MM_MIN 0.01
+#define BR_TOOL_FEED_MAX_MM_MIN 3000.0
+
 /* br_simlog --force-noise: standard deviation, N */
 #define BR_TOOL_NOISE_MAX_N 1e4
 

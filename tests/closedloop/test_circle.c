@@ -161,6 +161,64 @@ static void test_rejects_bad_experiment(void **st)
     c = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
     c.ukf.est.r_var_rad2 = -1.0f;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+    /* a direction other than +1 (clockwise) or -1 */
+    c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
+    c.dir = 0.5;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+}
+
+/* The tools' circle (br_circle_use_path, docs/circle-test.md): nothing given
+ * keeps the thesis's bit for bit; a radius alone keeps the feed; a feed sets
+ * the revolution; counter-clockwise mirrors x from the same start (0, A). */
+#define assert_near(a, b, tol) assert_true(fabs((a) - (b)) <= (tol))
+
+typedef struct {
+    double t_s[3], ref_m[3][2];
+} refs_t;
+
+static void refs_sink(void *user, const br_circle_sample_t *s)
+{
+    refs_t *g = user;
+    for (int i = 0; i < 3; i++)
+        if (fabs(s->t_s - g->t_s[i]) < 1e-9) {
+            g->ref_m[i][0] = s->ref_m[0];
+            g->ref_m[i][1] = s->ref_m[1];
+        }
+}
+
+static void test_circle_path(void **st)
+{
+    (void)st;
+    const br_circle_cfg_t th = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
+    br_circle_cfg_t c = th;
+    br_circle_use_path(&c, 0.0, 0.0, 0);
+    assert_true(c.radius_m == th.radius_m && c.period_s == th.period_s && c.duration_s == th.duration_s);
+    assert_true(c.dir == 1.0);
+    br_circle_use_path(&c, 2.0 * th.radius_m, 0.0, 1); /* the thesis's feed on twice the radius */
+    assert_true(c.radius_m == 2.0 * th.radius_m && c.period_s == 2.0 * th.period_s && c.duration_s == c.period_s);
+    assert_true(c.dir == -1.0);
+    assert_near(br_circle_feed_mps(&c), br_circle_feed_mps(&th), 1e-18);
+    c = th;
+    br_circle_use_path(&c, 0.0, 0.005, 0); /* 300 mm/min on the thesis's radius */
+    assert_near(c.period_s, 2.0 * 3.14159265358979323846 * th.radius_m / 0.005, 1e-15);
+    assert_near(br_circle_feed_mps(&c), 0.005, 1e-15);
+    assert_true(c.duration_s == c.period_s && c.radius_m == th.radius_m);
+    /* both directions on a short circle: the same y, x mirrored, a similar contour error */
+    br_circle_result_t r[2];
+    refs_t g[2] = {{{0.01, 0.03, 0.05}, {{0}}}, {{0.01, 0.03, 0.05}, {{0}}}};
+    for (int d = 0; d < 2; d++) {
+        c = th;
+        br_circle_use_path(&c, 0.0, 0.005, d);
+        assert_int_equal(br_circle_run(&c, refs_sink, &g[d], &r[d]), 0);
+    }
+    for (int i = 0; i < 3; i++) {
+        assert_true(g[0].ref_m[i][0] > 0.0); /* clockwise from (0, A): x > 0 in the first half turn (T = 0.126 s) */
+        assert_near(g[1].ref_m[i][0], -g[0].ref_m[i][0], 1e-15);
+        assert_near(g[1].ref_m[i][1], g[0].ref_m[i][1], 1e-15);
+    }
+    print_message("300 mm/min: contour RMS %.3e m clockwise, %.3e m counter-clockwise\n", r[0].contour_rms_m,
+                  r[1].contour_rms_m);
+    assert_true(fabs(r[1].contour_rms_m / r[0].contour_rms_m - 1.0) < 0.2);
 }
 
 /* A fault stops the run safe: the UKF on the nominal model of a plant with a
@@ -262,6 +320,7 @@ int main(void)
                                        cmocka_unit_test(test_ukf_beats_thesis_ratio),
                                        cmocka_unit_test(test_pf_beats_thesis_ratio),
                                        cmocka_unit_test(test_rejects_bad_experiment),
+                                       cmocka_unit_test(test_circle_path),
                                        cmocka_unit_test(test_delay_identified)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

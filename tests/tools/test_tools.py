@@ -198,6 +198,98 @@ class ToolsTest(unittest.TestCase):
         self.assert_refused(r, 1, "cannot open")
         self.assert_untouched(keep)
 
+    # the circle's options (sim/circle/br_circle_args.h, docs/tools.md): each bound refused just beyond it,
+    # nothing written; the pair's bound (a revolution 0.1 .. 3600 s) likewise
+    CIRCLE_BAD = tuple((b, " ".join(b) + ": must be") for b in (
+        ["--radius-m", "0.9e-6"], ["--radius-m", "0.1501"], ["--radius-m", "0"], ["--radius-m", "nan"],
+        ["--radius-m", "1e-4x"], ["--feed-mm-min", "0.0099"], ["--feed-mm-min", "3000.1"], ["--feed-mm-min", "-1"],
+        ["--feed-mm-min", "inf"], ["--dir", "up"], ["--dir", "CW"], ["--direction", ""])) + (
+        # a revolution of 0.094 s (< 0.1 s), of 12000 s and of 37700 s (> 3600 s)
+        (["--radius-m", "1e-4", "--feed-mm-min", "400"], "lasts 0.0942478 s: must be 0.1 .. 3600 s"),
+        (["--radius-m", "0.15"], "lasts 12000 s"), (["--radius-m", "1e-3", "--feed-mm-min", "0.01"], "lasts 37699.1 s"))
+
+    def test_circle_options_bounds(self):
+        d = os.path.join(self.w, "demo")
+        os.makedirs(d)
+        summary = os.path.join(d, "summary.json")
+        with open(summary, "wb") as f:
+            f.write(OLD)
+        keep = self.existing("robust.json")
+        ext = self.existing("ext.json")
+        for bad, msg in self.CIRCLE_BAD:
+            for tool, out in (("br_demo_circle", ["--out", d]), ("br_circle_ext", ["--json", ext]),
+                              ("br_robust_run", ["--json", keep])):
+                if tool == "br_robust_run" and bad[0] == "--dir":  # its --dir is the trace folder
+                    bad, msg = ["--direction", *bad[1:]], msg.replace("--dir", "--direction")
+                r = run(tool, *out, *bad)
+                self.assert_refused(r, 2, msg)
+                self.assertNotIn("contour", r.stdout)
+            with open(summary, "rb") as f:
+                self.assertEqual(f.read(), OLD)
+            self.assertEqual(os.listdir(d), ["summary.json"])
+        shutil.rmtree(d)
+        # "both" only where both directions are run: the demo
+        for tool, opt, out in (("br_circle_ext", "--dir", ext), ("br_robust_run", "--direction", keep)):
+            self.assert_refused(run(tool, "--json", out, opt, "both"), 2, "must be cw or ccw\n")
+        self.assert_untouched(keep, ext)
+        # the bounds themselves are accepted (each checked against its own bound first: the message is the pair's)
+        for ok in (["--radius-m", "0.15"], ["--radius-m", "1e-6"], ["--feed-mm-min", "0.01"],
+                   ["--feed-mm-min", "3000"]):
+            r = run("br_circle_ext", "--json", ext, *ok)
+            self.assert_refused(r, 2, "a revolution of radius")
+
+    def test_demo_circle_options_run(self):
+        # 300 mm/min on the thesis radius (a revolution of 0.126 s), both directions: the ccw traces mirror x
+        d = os.path.join(self.w, "demo")
+        r = run("br_demo_circle", "--out", d, "--only", "hinf_only", "--feed-mm-min", "300", "--dir", "both")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        import json
+        with open(os.path.join(d, "summary.json")) as f:
+            s = json.load(f)
+        e = s["experiment"]
+        self.assertEqual((e["radius_m"], e["direction"], e["directions"]), (1e-4, "cw", ["cw", "ccw"]))
+        self.assertAlmostEqual(e["period_s"], 2 * 3.141592653589793 * 1e-4 / 0.005, places=12)
+        self.assertAlmostEqual(e["feed_mm_min"], 300.0, places=9)
+        self.assertEqual(e["duration_s"], e["period_s"])
+        self.assertEqual(s["ccw"]["hinf_only"]["trace"], "trace_ccw_hinf_only.csv")
+        self.assertEqual(s["realistic"]["ccw"]["hinf_only"]["trace"], "trace_real_ccw_hinf_only.csv")
+        rows = {}
+        for n in ("trace_hinf_only.csv", "trace_ccw_hinf_only.csv"):
+            with open(os.path.join(d, n)) as f:
+                rows[n] = [ln.split(",") for ln in f.read().splitlines()[1:]]
+        self.assertEqual(len(rows["trace_hinf_only.csv"]), 127)  # 0 .. 0.1257 s at 1 ms
+        for a, b in zip(rows["trace_hinf_only.csv"][1:60], rows["trace_ccw_hinf_only.csv"][1:60]):
+            self.assertGreater(float(a[1]), 0.0)  # clockwise from (0, A): x_ref > 0 in the first half turn
+            self.assertEqual(float(b[1]), -float(a[1]))
+            self.assertEqual(b[2], a[2])
+        # a radius alone keeps the thesis's feed: 1.5e-5 m, 1.2 s a revolution; --dir ccw alone: unprefixed traces
+        d2 = os.path.join(self.w, "demo2")
+        r = run("br_demo_circle", "--out", d2, "--only", "hinf_only", "--radius-m", "1.5e-5", "--dir", "ccw")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(d2, "summary.json")) as f:
+            s = json.load(f)
+        self.assertAlmostEqual(s["experiment"]["period_s"], 1.2, places=12)
+        self.assertEqual((s["experiment"]["direction"], s["hinf_only"]["trace"]), ("ccw", "trace_hinf_only.csv"))
+        self.assertNotIn("ccw", s)
+
+    def test_make_demo_passes_the_circle_quoted(self):
+        # make demo RADIUS_M=... FEED=... DIR=...: each value one argument of br_demo_circle, whatever it holds
+        import shlex
+        root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+        env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MAKELEVEL", "MFLAGS", "DIR")}
+        evil = "1e-4'; touch pwned; '"
+        r = subprocess.run(["make", "-n", "-C", root, "demo", "RADIUS_M=" + evil, "FEED=300 x", "DIR=both"],
+                           capture_output=True, text=True, env=env, timeout=120)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        line = next(ln for ln in r.stdout.splitlines() if "br_demo_circle --out" in ln)
+        argv = shlex.split(line)
+        self.assertEqual(argv[argv.index("--radius-m") + 1], evil)
+        self.assertEqual(argv[argv.index("--feed-mm-min") + 1], "300 x")
+        self.assertEqual(argv[argv.index("--dir") + 1], "both")
+        r = subprocess.run(["make", "-n", "-C", root, "demo"], capture_output=True, text=True, env=env, timeout=120)
+        line = next(ln for ln in r.stdout.splitlines() if "br_demo_circle --out" in ln)
+        self.assertEqual(shlex.split(line)[1:], ["--out", "out/demo"])  # without them: the thesis's circle
+
     def test_pf_study_bounds(self):
         table = os.path.join(self.w, "t.bin")
         with open(table, "wb") as f:
