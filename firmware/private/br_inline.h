@@ -95,28 +95,6 @@ BR_INLINE void br_load4_f(const float **p, float n[4])
 }
 #endif
 
-/* BR_FLOAT_SIMD: the target has vector registers for float (x86-64 SSE2,
- * Arm NEON). There the particle filter's loops are written branch-free, so
- * that the compiler vectorises them; without (the Cortex-M7) a branch costs
- * fewer instructions than the flags and selects a branch-free body needs.
- * The results are the same either way. */
-#ifndef BR_FLOAT_SIMD /* set to 0 on the host by the test of the M7's paths (test_pf_m7_paths) */
-#if defined(__SSE2__) || defined(__ARM_NEON)
-#define BR_FLOAT_SIMD 1
-#else
-#define BR_FLOAT_SIMD 0
-#endif
-#endif
-
-/* BR_FPU_MAXNM: the FPU has vmaxnm / vminnm (the Cortex-M7's FPv5), so
- * that fmaxf and fminf are one instruction each (the Cortex-M4's FPv4 has
- * neither: a library call). GCC predefines the same macros for both FPUs;
- * firmware/CMakeLists.txt sets it for the toolchain's cortex-m7 (and
- * tests/unit for test_pf_m7_paths). */
-#ifndef BR_FPU_MAXNM
-#define BR_FPU_MAXNM 0
-#endif
-
 /* BR_RESTRICT: C99 restrict, for the particle filter's structure-of-arrays
  * loops (its arrays never overlap), so that the compiler vectorises them */
 #define BR_RESTRICT restrict

@@ -190,13 +190,7 @@ BR_INLINE int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], floa
 {
     float ah0, ah1;
     br_model_kp_rk4_step(k, x, kp, out, &ah0, &ah1);
-#if BR_FLOAT_SIMD
-    /* & rather than &&: no branch, so that a loop over particles vectorises */
-    return (ah0 <= k->ah_lim) & (ah1 <= k->ah_lim);
-#else
-    /* without float SIMD a branch is cheaper than the flags (BR_FLOAT_SIMD) */
     return (ah0 <= k->ah_lim) && (ah1 <= k->ah_lim);
-#endif
 }
 
 /* ---- The extended model (causes on; docs/modules/model.md, "Extended model") ----
