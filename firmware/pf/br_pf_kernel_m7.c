@@ -116,11 +116,7 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
         const float *BR_RESTRICT l = pf->l;
         uint32_t *BR_RESTRICT W = pf->W;
         /* br_exp_neg's constants once, held in registers over the loop */
-        br_exp_k_t k = br_exp_k();
-        BR_HOLD_F(k.half);
-        BR_HOLD_F(k.one);
-        BR_HOLD_U(k.lo);
-        BR_HOLD_U(k.span);
+        const br_exp_k_t k = br_exp_k_opaque();
         total = 0u;
         for (uint32_t j = 0; j < m; j++) {
             /* W_j = floor(e^(l_j - lmax) 2^16), the scale in the exponent */

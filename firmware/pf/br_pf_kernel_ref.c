@@ -130,7 +130,7 @@ static inline void move_particle(uint32_t i, uint32_t k, float *th, float *om, f
 }
 
 /* the forward pass: i = 0 .. m - 2 (particle m - 1 has no later one) */
-BR_NO_IVOPTS BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
+BR_NO_IVOPTS static void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
                                            float *zz, float *gg, float *ia)
 {
     const uint32_t last = m - 1u; /* m >= 1 */
@@ -143,7 +143,7 @@ BR_NO_IVOPTS BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint
 }
 
 /* the backward pass: i = m - 1 down to 1 (particle 0 has no earlier one) */
-BR_NO_IVOPTS BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
+BR_NO_IVOPTS static void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
                                             float *zz, float *gg, float *ia)
 {
     for (uint32_t i = m - 1u; i > 0u; i--) {
