@@ -285,7 +285,7 @@ static inline void lsum_skip(br_pf_lsum_t *s, float th, float y_rel)
 }
 
 /* Steps 1 and 2 for particle j, one at a time: the scalar reference path,
- * and the fix-up of the vector loop's rare cases (the bounded scheme, an
+ * and the fix-up of the kernel's rare cases (the bounded scheme, an
  * invalid prediction). n: its BR_NX standard-normal samples. The particle is
  * overwritten by its prediction when that is valid and added to *ls
  * (lsum_add); otherwise it keeps its state, f_nl = 0, l = NaN (lsum_skip).
@@ -358,7 +358,7 @@ static void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j
         /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R);
          * may be -inf for a particle far from y: still valid (NaN marks invalid) */
         const float e = th - c->k.y_rel;
-        const float l = c->prop ? l_prop : -(e * e) * c->k.inv_2r;
+        const float l = c->prop ? l_prop : br_pf_loglik(e, c->k.inv_2r);
         pf->l[j] = l;
         /* cfg.adapt's sums take the prior's innovation (e itself without cfg.proposal) */
         lsum_add(ls, l, c->prop ? th_a - c->k.y_rel : e);
@@ -438,7 +438,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     float n[BR_NX];
     if (pf->model.extended || pf->cfg.scalar_path || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR) {
         /* one particle at a time (the extended model always: its kernel branches;
-         * cfg.proposal always: the vector loop draws from the prior) */
+         * cfg.proposal always: the kernels draw from the prior) */
         for (uint32_t j = 0; j < m; j++) {
             noise_wrapped(pf, j, n);
             if (pf->model.extended) {
@@ -464,7 +464,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             const float *const nz = pf->cfg.noise + p;
             const float s1 = ls.s1, s2 = ls.s2;
             if (br_pf_kernel_predict(pf, &c.k, j, j1, nz, &ls) > 0u) {
-                /* the fix-up: redo the particles the vector loop left (l = NaN) in scalar */
+                /* the fix-up: the particles the kernel left (l = NaN), one at a time */
                 for (uint32_t k = j; k < j1; k++) {
                     if (pf->l[k] != pf->l[k]) {
                         particle_one(pf, &c, 0, k, nz + BR_NX * (k - j), &ls);

@@ -60,7 +60,7 @@ uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uin
         const float f = br_pf_fnl_kp(&mk, w, z, kg);
         /* 2. Gaussian log-likelihood, l = -(theta - y)^2 / (2 R) */
         const float e = t - y_rel;
-        const float l = -(e * e) * inv_2r;
+        const float l = br_pf_loglik(e, inv_2r);
         s1 += e;
         s2 += e * e;
         /* validity as the reference's; a particle that fails branches out,

@@ -54,6 +54,14 @@ static inline float br_pf_fnl_kp(const br_model_k_t *k, float om, float z, float
     return br_model_k_fnl(k, z, br_model_kp_zdot(k->L, kg, om, z));
 }
 
+/* Step 2, the log-likelihood of the measurement y given particle j,
+ * Gaussian: l_j = -(theta_j - y)^2 / (2 R), e = theta_j - y. The one place it
+ * is written (every kernel and the per-particle step call it). A valid
+ * particle's l is <= -0 (-inf when e^2 overflows): the largest log-weight
+ * by integer keys (the SIMD and Cortex-M4 kernels) holds only while that is
+ * so (docs/modules/pf.md, "Changing the likelihood"). */
+static inline float br_pf_loglik(float e, float inv_2r) { return -(e * e) * inv_2r; }
+
 /* 1 for a valid particle (its log-weight l is not NaN), 0 for one kept at its state */
 static inline float br_pf_valid_weight(float l) { return (l == l) ? 1.0f : 0.0f; }
 
