@@ -2,12 +2,12 @@
 /* The particle filter's kernel for the Cortex-M4 (br_pf_kernel.h; FPv4
  * single precision: no vmaxnm / vminnm, no vrinta, so no fmaxf, fminf or
  * roundf, library calls there): the reference kernel's operations, with
- * what the M4 does in fewer instructions (docs/target.md, "The kernels"):
+ * what the M4 does in fewer instructions (docs/modules/pf.md, "Kernels"; docs/target.md, "What the kernels keep"):
  * the largest log-weight as an integer min, the four noise samples in one
  * load and f_nl and l stored with the pointer moved on, the exponential's
- * constants held in registers. Plain C but for those two helpers (their C
- * forms on the host: test_pf_kernels_m4). Same results as the reference,
- * bit for bit. */
+ * constants held in registers. Plain C but for br_inline.h's helpers of
+ * those (asm on Arm; their C forms on the host: test_pf_kernels_m4). Same
+ * results as the reference, bit for bit. */
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -107,8 +107,14 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
         const uint32_t m = pf->cfg.n_particles;
         const float *BR_RESTRICT l = pf->l;
         uint32_t *BR_RESTRICT W = pf->W;
-        /* br_exp_neg's constants once, held in registers over the loop */
-        const br_exp_k_t k = br_exp_k_opaque();
+        /* br_exp_neg's constants once, held in registers over the loop
+         * (BR_HOLD: GCC would make 0.5, 1 and the range words afresh for
+         * every particle) */
+        br_exp_k_t k = br_exp_k();
+        BR_HOLD_F(k.half);
+        BR_HOLD_F(k.one);
+        BR_HOLD_U(k.lo);
+        BR_HOLD_U(k.span);
         total = 0u;
         for (uint32_t j = 0; j < m; j++) {
             /* W_j = floor(e^(l_j - lmax) 2^16), the scale in the exponent */

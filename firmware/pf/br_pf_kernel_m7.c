@@ -1,12 +1,14 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The particle filter's kernel for the Cortex-M7 (br_pf_kernel.h; FPv5
  * single precision, no float SIMD): the reference kernel's operations, with
- * what the M7 does in fewer instructions (docs/target.md, "The kernels"):
+ * what the M7 does in fewer instructions (docs/modules/pf.md, "Kernels"; docs/target.md, "What the kernels keep"):
  * fmaxf / fminf (vmaxnm / vminnm) for the g_p clamp, the a h test and the
  * largest log-weight; the a h and validity tests as one unsigned compare;
- * the exponential's roundf form (br_exp_neg_kb_rinta). Plain C: the host
- * test runs it too (test_pf_kernels_m7). Same results as the reference, bit
- * for bit. */
+ * the exponential's roundf form (br_exp_neg_kb_rinta); the noise samples in
+ * one load, f_nl and l stored with the pointer moved on and the
+ * exponential's constants held in registers (br_inline.h's helpers: asm on
+ * Arm, C elsewhere). The host test runs its C form (test_pf_kernels_m7).
+ * Same results as the reference, bit for bit. */
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -115,8 +117,14 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
         const uint32_t m = pf->cfg.n_particles;
         const float *BR_RESTRICT l = pf->l;
         uint32_t *BR_RESTRICT W = pf->W;
-        /* br_exp_neg's constants once, held in registers over the loop */
-        const br_exp_k_t k = br_exp_k_opaque();
+        /* br_exp_neg's constants once, held in registers over the loop
+         * (BR_HOLD: GCC would make 0.5, 1 and the range words afresh for
+         * every particle) */
+        br_exp_k_t k = br_exp_k();
+        BR_HOLD_F(k.half);
+        BR_HOLD_F(k.one);
+        BR_HOLD_U(k.lo);
+        BR_HOLD_U(k.span);
         total = 0u;
         for (uint32_t j = 0; j < m; j++) {
             /* W_j = floor(e^(l_j - lmax) 2^16), the scale in the exponent */

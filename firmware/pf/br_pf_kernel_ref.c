@@ -112,8 +112,6 @@ uint32_t br_pf_kref_weights(br_pf_t *pf, float lmax, int outlier)
     return total;
 }
 
-float br_pf_kref_select(br_pf_t *pf, uint32_t total) { return br_pf_select(pf, total); }
-
 /* 4. the copy in place: particle i becomes the predicted particle idx_i. The
  * indices never decrease, so a forward pass takes every particle from a
  * later one (not yet overwritten) and a backward pass every particle from an
@@ -169,7 +167,7 @@ void br_pf_kref_copy_back(br_pf_t *pf)
 float br_pf_kref_resample(br_pf_t *pf, float lmax, int outlier)
 {
     const uint32_t total = br_pf_kref_weights(pf, lmax, outlier);
-    const float sf = br_pf_kref_select(pf, total);
+    const float sf = br_pf_select(pf, total);
     br_pf_kref_copy_fwd(pf);
     br_pf_kref_copy_back(pf);
     return sf;

@@ -23,6 +23,23 @@
 #define BR_NO_IVOPTS
 #endif
 
+/* BR_HOLD_F(v), BR_HOLD_U(v): the float or uint32_t variable v keeps its
+ * value, but the compiler no longer knows it (GCC on 32-bit Arm with an FPU:
+ * an empty asm that takes v and gives it back in a register; elsewhere
+ * nothing). Before a loop, for its constants: GCC 12 for the Cortex-M7 and
+ * -M4 makes a constant it can encode (0.5f, 1.0f) or load from the literal
+ * pool afresh in every iteration, even with registers free; an unknown value
+ * it keeps in a register. The exponential's constants in the M7 and M4
+ * kernels' weight loops: without it 2.0 and 5.0 instructions more per
+ * particle-step (docs/target.md, "What the kernels keep"). */
+#if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
+#define BR_HOLD_F(v) __asm__("" : "+t"(v))
+#define BR_HOLD_U(v) __asm__("" : "+r"(v))
+#else
+#define BR_HOLD_F(v) ((void)0)
+#define BR_HOLD_U(v) ((void)0)
+#endif
+
 /* br_load4_f(&p, n): n[0..3] = p[0..3] and p += 4. br_store_f_inc(&p, v):
  * *p = v and p += 1. On 32-bit Arm with an FPU one vldmia into four
  * consecutive float registers (s12-s15; the compiler moves them on where it

@@ -27,18 +27,6 @@ static inline br_exp_k_t br_exp_k(void)
     return k;
 }
 
-/* br_exp_k's values read from a volatile object: the compiler does not know
- * them, so a loop takes them once and keeps them in registers, where GCC 12
- * for the Cortex-M7 and -M4 made the ones it knows (0.5, 1, the range
- * words) afresh for every particle (docs/target.md, "What the kernels keep").
- * The object is const: nothing writes it. */
-static inline br_exp_k_t br_exp_k_opaque(void)
-{
-    static const volatile br_exp_k_t kv = {0.5f, 1.0f, 0x80000001u, 0xC2AE0000u - 0x80000001u};
-    const br_exp_k_t k = {kv.half, kv.one, kv.lo, kv.span};
-    return k;
-}
-
 /* e^(f ln 2) for |f| <= 1/2 */
 static inline float br_exp2_poly(float f, const br_exp_k_t *k)
 {

@@ -7,8 +7,9 @@
  *                                    always in the library (cfg.scalar_path)
  *   firmware/pf/br_pf_kernel_simd.c  br_pf_kernel_*: hosts with float SIMD
  *   firmware/pf/br_pf_kernel_m7.c    br_pf_kernel_*: the Cortex-M7
- *   firmware/pf/br_pf_kernel_port.c  br_pf_kernel_*: every other target (the
- *                                    Cortex-M4): the reference itself
+ *   firmware/pf/br_pf_kernel_m4.c    br_pf_kernel_*: the Cortex-M4
+ *   firmware/pf/br_pf_kernel_port.c  br_pf_kernel_*: every other target: the
+ *                                    reference itself
  *
  * firmware/CMakeLists.txt compiles exactly one of the br_pf_kernel_* files.
  * br_pf.c orchestrates: it calls br_pf_kernel_* (br_pf_kref_* on the scalar
@@ -132,11 +133,9 @@ float br_pf_kref_resample(br_pf_t *pf, float lmax, int outlier);
 float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier);
 
 /* Pieces of the reference that other kernels share (br_pf_kernel_ref.c):
- * the quantised weights, returning their total; the indices by search fused
- * with step 5's sum (total: the weights' sum); the copy's forward and
- * backward passes. */
+ * the quantised weights, returning their total; the copy's forward and
+ * backward passes (the search is br_pf_select, above). */
 uint32_t br_pf_kref_weights(br_pf_t *pf, float lmax, int outlier);
-float br_pf_kref_select(br_pf_t *pf, uint32_t total);
 void br_pf_kref_copy_fwd(br_pf_t *pf);
 void br_pf_kref_copy_back(br_pf_t *pf);
 
