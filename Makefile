@@ -89,7 +89,7 @@ help:
 	@echo "  make firmware [MACHINE=<json>] [BOARD=stm32g4]  cross build (cm7-release; BOARD=stm32g4: cm4-release; another machine: build/<preset>-<name>), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make emps      the EMPS drive through the chain: its log -> diagnose -> machine.json -> image -> tracking in the simulator -> $(EMPS_OUT), docs/machines/emps.md"
 	@echo "  make robustness [N=200] [DIAGNOSE_FIRST=K]  Monte Carlo over N plants around the reference machine -> $(ROBUST_OUT), docs/robustness-results.md"
-	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM"
+	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
 	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
@@ -171,7 +171,9 @@ bench: deps
 	  --particles-json $(BENCH_OUT)/particles.json --out $(BENCH_OUT)/bench.json
 
 # Instructions per PF particle-step and per control period on QEMU's emulated
-# Cortex-M7 (-icount), flash / RAM from the map file. docs/target.md.
+# Cortex-M7 (-icount), flash / RAM from the map file. docs/target.md. Fails
+# when a core's instructions per particle-step exceed its budget in
+# target/mps2/budget.txt (target_bench.sh exits 1).
 target-bench: deps
 	$(call configure,host-release)
 	$(call build,host-release)

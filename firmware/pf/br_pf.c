@@ -10,42 +10,16 @@
 
 #include "bristle/br_encoder.h"
 #include "br_check.h"
-#include "br_inline.h"
 #include "br_math.h"
 #include "br_model_kernel.h"
+#include "br_pf_kernel.h"
 
-/* BR_FLOAT_SIMD (br_inline.h): with float SIMD the weights' exponentials
- * run in a loop of their own (vectorised), the prediction loop is
- * branch-free and the resampling counts (resample_count, resample_forward);
- * without (the Cortex-M7) one fused weight loop, a prediction loop that
- * branches out to the fix-up and one resampling loop (resample_fused, the
- * indices and F_hat's sum) before the copy's two passes cost fewer
- * instructions. Both copy in place with branches that skip the
- * particles staying put. The results are the same either way. */
-
-/* f_nl (eqs. 3, 4) of a predicted particle: eq. 4 with its k_p = sigma0 L / g_p */
-static inline float fnl_kp(const br_model_k_t *k, float om, float z, float kg)
-{
-    return br_model_k_fnl(k, z, br_model_kp_zdot(k->L, kg, om, z));
-}
-
-/* BR_PF_CLONES: on x86-64 hosts (GCC), the vectorised loops are also compiled
- * for AVX-512F and AVX2 and picked at run time by the CPU (target_clones):
- * 16 or 8 lanes instead of SSE2's 4. The same IEEE operations lane by lane
- * (-ffp-contract=off holds in every clone: no FMA), so the results do not
- * depend on the clone. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__)
-#define BR_PF_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define BR_PF_CLONES
-#endif
-
-/* 1 for a valid particle (its log-weight l is not NaN), 0 for one kept at its state */
-static inline float valid_weight(float l) { return (l == l) ? 1.0f : 0.0f; }
-
-/* W of a particle of weight 1 (the best one after the max-shift) */
-#define BR_PF_W_ONE (1u << BR_PF_W_BITS)
-
+/* br_pf.c orchestrates one step; the hot loops of steps 1-5 are the kernel's
+ * (br_pf_kernel.h: br_pf_kernel_* of the target, chosen by
+ * firmware/CMakeLists.txt, or the reference br_pf_kref_* on the scalar
+ * reference path). particle_one, the per-particle step, is the reference of
+ * steps 1 and 2 for every model and proposal and the fix-up of the particles
+ * a kernel leaves (the bounded scheme, an invalid prediction). */
 
 /* cfg.proposal: the step's constants (docs/modules/pf.md, "A proposal that
  * uses the measurement"). The prior of (theta, omega) around the particle's
@@ -250,171 +224,6 @@ static void resample(const uint32_t *W, uint32_t m, uint32_t total, uint16_t *id
     }
 }
 
-/* The same resampling without a data-dependent inner loop (the vector path
- * on hosts with SIMD, where resample()'s inner loop mispredicts), made by
- * counting: for each particle j the number of points below its cumulative
- * weight C,
- *   N(C) = #{i < m : t_i < C} = floor(X + 1/2), X = m C / C_m,
- * one less when X + 1/2 is an integer (t_i < C <=> (2 i + 1) C_m < 2 m C
- * for integer C, i.e. i < X - 1/2). The float estimate
- *   e = trunc(fl(fl(C) fl(m / C_m)) + (1/2 - 2^-9))
- * has |error| <= 2^-11 in the product (four roundings of 2^-24 relative,
- * X <= m <= 2^11) and 2^-13 in the sum (< 2^12), less than 2^-9 in all, so
- * its argument lies in (X + 1/2 - 2^-8, X + 1/2) and e is N or N - 1;
- * one exact 64-bit comparison, t_e < C, makes it N (for e = m it is false:
- * C <= C_m). Particle i copies the j with N(C_{j-1}) <= i < N(C_j): j is
- * written at i = N(C_{j-1}) (the last j written there is the one with
- * copies) and carried forward by a running maximum (resample_forward).
- * Gives resample()'s indices exactly (test_vector_path_is_scalar_path, whose
- * tie fails without the comparison; the estimate checked once against the
- * exact count over 1.75e8 cases, docs/bench.md). */
-static inline uint32_t n_below(uint32_t c, uint64_t two_m, uint64_t cm, float m_over_cm)
-{
-    const float y = (float)(int32_t)c * m_over_cm + (0.5f - 1.0f / 512.0f);
-    const uint32_t e = (uint32_t)(int32_t)y;
-    return e + (uint32_t)((uint64_t)(2u * e + 1u) * cm < two_m * (uint64_t)c);
-}
-
-/* The quantised weights' total: W_j = floor(w_j 2^16) of the w_j parked in
- * W as bit patterns by exp_vec (any order: an integer sum) */
-BR_PF_CLONES static uint32_t quant_total(const uint32_t *BR_RESTRICT W, uint32_t m)
-{
-    uint32_t total = 0u;
-    for (uint32_t j = 0; j < m; j++) {
-        float w;
-        memcpy(&w, &W[j], sizeof w);
-        total += (uint32_t)(w * (float)BR_PF_W_ONE);
-    }
-    return total;
-}
-
-/* The counting resampling's writes: idx[N(C_{j-1})] = j for every j with
- * copies, 0 elsewhere. floats != 0: W holds the w_j as bit patterns
- * (exp_vec), quantised here in place. Otherwise W holds the integer
- * weights already. total: the sum of the W_j. */
-static void resample_count(uint32_t *BR_RESTRICT W, uint32_t m, uint32_t total, uint16_t *BR_RESTRICT idx,
-                           const int floats)
-{
-    const uint64_t two_m = 2u * (uint64_t)m, cm = total;
-    const float m_over_cm = (float)m / (float)total;
-    uint16_t spare = 0u; /* the write of a particle whose N(C_{j-1}) = m (no copies) */
-    for (uint32_t i = 0; i < m; i++) {
-        idx[i] = 0u;
-    }
-    uint32_t c = 0u;
-    if (floats) {
-        for (uint32_t j = 0; j < m; j++) {
-            const uint32_t n = n_below(c, two_m, cm, m_over_cm);
-            uint16_t *const dst = (n < m) ? &idx[n] : &spare;
-            *dst = (uint16_t)j;
-            float w;
-            memcpy(&w, &W[j], sizeof w);
-            const uint32_t q = (uint32_t)(w * (float)BR_PF_W_ONE);
-            W[j] = q;
-            c += q;
-        }
-    } else {
-        for (uint32_t j = 0; j < m; j++) {
-            const uint32_t n = n_below(c, two_m, cm, m_over_cm);
-            uint16_t *const dst = (n < m) ? &idx[n] : &spare;
-            *dst = (uint16_t)j;
-            c += W[j];
-        }
-    }
-}
-
-/* After resample_count: the running maximum that makes idx, fused with the
- * forward pass of the in-place copy (copy_back follows) and with step
- * 5's sum of f_nl over the resampled set in particle order (particle i is the
- * predicted particle k = idx_i). Reading x[k] at i gives the predicted
- * value: for k >= i, position k is written only at i' = k (after this read
- * when k = i); for k < i it is never written in this pass (idx_k <= k, the
- * indices never decrease). Particle i takes k now when k > i, an earlier
- * one in the backward pass. The copies branch: the sign of idx_i - i
- * changes in long runs (br_bench's recording: 49 % of the particles copy
- * forward, 50 % backward, yet only 53 % of the blocks of 8 hold a backward
- * copy), so the branch predicts well and half the loads and stores of a
- * branch-free copy go.
- * The same indices, states and sum (in the same order) as resample_fused. */
-static float resample_forward(br_pf_t *pf)
-{
-    const uint32_t m = pf->cfg.n_particles;
-    uint16_t *BR_RESTRICT idx = pf->idx;
-    float *BR_RESTRICT th = pf->x[BR_X_THETA];
-    float *BR_RESTRICT om = pf->x[BR_X_OMEGA];
-    float *BR_RESTRICT zz = pf->x[BR_X_Z];
-    float *BR_RESTRICT gg = pf->x[BR_X_GP];
-    float *BR_RESTRICT ia = pf->kgp;
-    const float *BR_RESTRICT fnl = pf->fnl;
-    float sf = 0.0f;
-    uint32_t run = 0u;
-    for (uint32_t i = 0; i < m; i++) {
-        const uint32_t w = idx[i];
-        const uint32_t k = (w > run) ? w : run;
-        run = k;
-        idx[i] = (uint16_t)k;
-        /* x[k], read once for the copy (held in registers: GCC reloads
-         * them after the first store otherwise) */
-        const float a0 = th[k], a1 = om[k], a2 = zz[k], a3 = gg[k];
-        sf += fnl[k];
-        if (k > i) {
-            th[i] = a0;
-            om[i] = a1;
-            zz[i] = a2;
-            gg[i] = a3;
-            ia[i] = ia[k];
-        }
-    }
-    return sf;
-}
-
-/* resample()'s indices, fused with step 5's sum of f_nl (sum_set), for
- * targets without float SIMD (one loop instead of two): particle i is the
- * predicted particle j = idx_i, so the sum over the resampled set, in
- * particle order, adds the predicted j's f_nl, held in a register while j
- * stays. The in-place copy follows (copy_fwd_soa, copy_back_soa). The same
- * indices and sum as the two loops.
- * total is the sum of W[0 .. m - 1] (quantise_weights' return), so every
- * t_i = floor((2 i + 1) total / (2 m)) <= floor(total - total / (2 m)) is
- * below C_{m-1} = total: the search for j stops by j = m - 1 without a test
- * of j (resample(), for any W, tests it). */
-static float resample_fused(br_pf_t *pf, uint32_t total)
-{
-    const uint32_t m = pf->cfg.n_particles;
-    const uint32_t *BR_RESTRICT W = pf->W;
-    uint16_t *BR_RESTRICT idx = pf->idx;
-    const float *const fnl = pf->fnl;
-    const uint32_t den = 2u * m;
-    const uint32_t dq = (2u * total) / den, dr = (2u * total) % den;
-    uint32_t t = total / den;
-    /* t_i's remainder less den, in [-den, 0): its sign is the carry below
-     * (the M7's add sets the flag; no compare with den) */
-    int32_t rn = (int32_t)(total % den) - (int32_t)den;
-    uint32_t j = 0u, c = W[0];
-    float af = fnl[0];
-    float sf = 0.0f;
-    for (uint32_t i = 0; i < m; i++) {
-        /* no j + 1 < m test: t_i < C_{m-1} (above), so the search stops by j = m - 1 */
-        if (c <= t) {
-            do {
-                j++;
-                c += W[j];
-            } while (c <= t);
-            af = fnl[j];
-        }
-        idx[i] = (uint16_t)j;
-        sf += af;
-        /* t_{i+1} = t_i + dq, plus 1 when the remainder carries */
-        t += dq;
-        rn += (int32_t)dr;
-        if (rn >= 0) {
-            t++;
-            rn -= (int32_t)den;
-        }
-    }
-    return sf;
-}
-
 br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
 {
     if (W == NULL || idx == NULL) {
@@ -437,50 +246,28 @@ br_status_t br_pf_resample_idx(const uint32_t *W, uint32_t m, uint16_t *idx)
     return BR_OK;
 }
 
-/* The constants of one prediction pass (steps 1 and 2), for every particle. */
+/* The constants of one prediction pass (steps 1 and 2), for every particle:
+ * the thesis model's (the kernels'), and what the per-particle step adds */
 typedef struct {
-    br_model_k_t mk;  /* the thesis model's kernel constants */
-    br_model_kp_t kp; /* the PF's RK4 constants (br_model_kp_rk4) */
-    float s0L;        /* sigma0 L: k_p = s0L / g_p */
+    br_pf_kc_t k;     /* the thesis model's pass: kernel constants, noise, g_p range, 1/(2R), origin, y */
     br_model_kx_t mx; /* the extended model's (theta relative to the origin at its p0) */
-    float q[BR_NX];   /* process noise standard deviations */
-    float gp_min, gp_max, inv_2r;
     float u;          /* torque over the period, N m */
-    float shift;      /* theta of the new origin relative to the old one, rad */
-    float y_rel;      /* the measurement relative to the new origin, rad */
     int prop;         /* cfg.proposal on a measured step: theta and omega drawn given y */
     float hold;       /* the prior's coupling of omega's sample into theta (OPT_HELD), else 0 */
 } pred_t;
 
-/* g_p limited to [lo, hi] with selects (fmaxf/fminf are library calls on
- * some hosts): br_clampf's result for every input, lo > 0; with
- * BR_FPU_MAXNM (br_inline.h) fmaxf and fminf themselves, one instruction
- * each (the same result: lo and hi are finite, 0 < lo < hi, br_est.c) */
+/* g_p limited to [lo, hi] by selects: br_clampf's result for every input,
+ * 0 < lo < hi finite (br_est.c); a NaN gives lo, as fmaxf */
 static inline float clamp_sel(float v, float lo, float hi)
 {
-#if BR_FPU_MAXNM
-    return fminf(fmaxf(v, lo), hi);
-#else
-    const float a = (v > lo) ? v : lo; /* a NaN gives lo, as fmaxf */
+    const float a = (v > lo) ? v : lo;
     return (a < hi) ? a : hi;
-#endif
 }
 
-/* Largest log-weight so far and the count of valid particles. l <= -0 for a
- * valid particle, so its bit pattern as int32 (its key) is negative and
- * orders the other way round: the largest l has the smallest key (the vector
- * loop reduces the keys with an integer min, which vectorises where fmaxf
- * does not). s1, s2: cfg.adapt's sums over the particles in their order, of
- * d_j = theta_j - y and of d_j^2, made from the innovation the log-weight
- * forms (adapt_update). */
-typedef struct {
-    float lmax;
-    uint32_t n_valid;
-    float s1, s2;
-} lsum_t;
-
-/* a valid particle: log-weight l, innovation e = theta_j - y (d_j = e 1 = e) */
-static inline void lsum_add(lsum_t *s, float l, float e)
+/* A valid particle's log-weight l and innovation e = theta_j - y added to
+ * the pass's sums (br_pf_lsum_t: the largest l, the count of valid particles,
+ * cfg.adapt's sums of d_j = e and d_j^2 in particle order) */
+static inline void lsum_add(br_pf_lsum_t *s, float l, float e)
 {
     s->lmax = (l > s->lmax) ? l : s->lmax; /* fmaxf for l not NaN */
     s->n_valid++;
@@ -490,7 +277,7 @@ static inline void lsum_add(lsum_t *s, float l, float e)
 
 /* an invalid particle (kept at theta_j): d_j = (theta_j - y) 0, as
  * adapt_sums adds it (it changes the sums only when theta_j - y is not finite) */
-static inline void lsum_skip(lsum_t *s, float th, float y_rel)
+static inline void lsum_skip(br_pf_lsum_t *s, float th, float y_rel)
 {
     const float d = (th - y_rel) * 0.0f;
     s->s1 += d;
@@ -498,19 +285,20 @@ static inline void lsum_skip(lsum_t *s, float th, float y_rel)
 }
 
 /* Steps 1 and 2 for particle j, one at a time: the scalar reference path,
- * and the fix-up of the vector loop's rare cases (the bounded scheme, an
+ * and the fix-up of the kernel's rare cases (the bounded scheme, an
  * invalid prediction). n: its BR_NX standard-normal samples. The particle is
  * overwritten by its prediction when that is valid and added to *ls
  * (lsum_add); otherwise it keeps its state, f_nl = 0, l = NaN (lsum_skip).
  * ext: the extended model's kernel (a constant at each call site). */
-BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j, const float n[BR_NX], lsum_t *ls)
+static void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j, const float n[BR_NX],
+                         br_pf_lsum_t *ls)
 {
     float x[BR_NX], xn[BR_NX];
     particle_get(pf, j, x);
     /* 1. predict: eq. 6 by RK4 (the PF's form with k_p, or the extended
      * model's), or the bounded scheme beyond the a h limit; the particles are
      * finite with g_p >= gp_min > 0 */
-    if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_rk4(&c->kp, x, pf->kgp[j], xn)) {
+    if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_rk4(&c->k.kp, x, pf->kgp[j], xn)) {
         if (ext) {
             br_model_bounded_step_x(&c->mx, x, c->u, xn);
         } else {
@@ -522,32 +310,32 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
         /* cfg.proposal, a measured step: (theta, omega) drawn from their Gaussian
          * given y around the noise-free prediction mu (proposal_init); the
          * weight is the predictive likelihood of y, -e^2 / (2 S), e = mu - y */
-        const float mu = xn[BR_X_THETA] - c->shift;
-        const float e = mu - c->y_rel;
+        const float mu = xn[BR_X_THETA] - c->k.shift;
+        const float e = mu - c->k.y_rel;
         th = (mu - pf->prop_k_th * e) + pf->prop_l00 * n[0];
-        th_old = th + c->shift;
+        th_old = th + c->k.shift;
         om = ((xn[BR_X_OMEGA] - pf->prop_k_om * e) + pf->prop_l10 * n[0]) + pf->prop_l11 * n[1];
         l_prop = -(e * e) * pf->prop_inv_2s;
         /* the prior's draw of theta with the same samples: cfg.adapt's
          * innovation of the predicted cloud is the prior's */
-        th_a = ((mu + c->q[0] * n[0]) + c->hold * n[1]);
+        th_a = ((mu + c->k.q[0] * n[0]) + c->hold * n[1]);
     } else if (c->hold != 0.0f) {
         /* OPT_HELD without a measurement: the prior, omega's sample moving theta by h/2 of it */
-        th_old = (xn[BR_X_THETA] + c->q[0] * n[0]) + c->hold * n[1];
-        th = th_old - c->shift;
-        om = xn[BR_X_OMEGA] + c->q[1] * n[1];
+        th_old = (xn[BR_X_THETA] + c->k.q[0] * n[0]) + c->hold * n[1];
+        th = th_old - c->k.shift;
+        om = xn[BR_X_OMEGA] + c->k.q[1] * n[1];
         th_a = th;
     } else {
         /* process noise sqrt(Q) n */
-        th_old = xn[BR_X_THETA] + c->q[0] * n[0]; /* relative to the last origin */
-        th = th_old - c->shift;
-        om = xn[BR_X_OMEGA] + c->q[1] * n[1];
+        th_old = xn[BR_X_THETA] + c->k.q[0] * n[0]; /* relative to the last origin */
+        th = th_old - c->k.shift;
+        om = xn[BR_X_OMEGA] + c->k.q[1] * n[1];
         th_a = th;
     }
-    const float z = xn[BR_X_Z] + c->q[2] * n[2];
-    const float gp = clamp_sel(xn[BR_X_GP] + c->q[3] * n[3], c->gp_min, c->gp_max);
+    const float z = xn[BR_X_Z] + c->k.q[2] * n[2];
+    const float gp = clamp_sel(xn[BR_X_GP] + c->k.q[3] * n[3], c->k.gp_min, c->k.gp_max);
     /* the particle's one division, k_p = sigma0 L / g_p for eq. 4 here and in the next step */
-    const float kg = c->s0L / gp;
+    const float kg = c->k.s0L / gp;
     /* the force to compensate of the predicted particle: eq. 6's f_nl, or
      * the extended model's (at its position relative to the last origin) */
     float fnl;
@@ -555,7 +343,7 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
         const float xe[BR_NX] = {th_old, om, z, gp};
         fnl = br_model_kx_fcomp_N(&c->mx, xe);
     } else {
-        fnl = fnl_kp(&c->mk, om, z, kg);
+        fnl = br_pf_fnl_kp(&c->k.mk, om, z, kg);
     }
     /* Validity: x - x is 0 for finite x and NaN otherwise. g_p is finite after
      * the clamp; a non-finite omega or z makes f_nl non-finite (inf - inf,
@@ -569,18 +357,18 @@ BR_INLINE void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_
         pf->fnl[j] = fnl;
         /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R);
          * may be -inf for a particle far from y: still valid (NaN marks invalid) */
-        const float e = th - c->y_rel;
-        const float l = c->prop ? l_prop : -(e * e) * c->inv_2r;
+        const float e = th - c->k.y_rel;
+        const float l = c->prop ? l_prop : br_pf_loglik(e, c->k.inv_2r);
         pf->l[j] = l;
         /* cfg.adapt's sums take the prior's innovation (e itself without cfg.proposal) */
-        lsum_add(ls, l, c->prop ? th_a - c->y_rel : e);
+        lsum_add(ls, l, c->prop ? th_a - c->k.y_rel : e);
         return;
     }
     /* unusable: the particle keeps its state and gets weight 0; its log-weight
      * is NaN, which no valid particle's can be */
     pf->fnl[j] = 0.0f;
     pf->l[j] = NAN;
-    lsum_skip(ls, x[BR_X_THETA], c->y_rel);
+    lsum_skip(ls, x[BR_X_THETA], c->k.y_rel);
 }
 
 /* the BR_NX samples of particle j, read round the end of the table */
@@ -591,178 +379,16 @@ static void noise_wrapped(const br_pf_t *pf, uint32_t j, float n[BR_NX])
     }
 }
 
-/* Steps 1 and 2, thesis model, particles j0 .. j1 - 1 whose noise samples
- * are the contiguous nz[BR_NX (j - j0) + i]: branch-free, so that the
- * compiler vectorises it. A particle that needs the bounded scheme or whose
- * prediction is not valid keeps its state here (l = NaN) and is redone by
- * particle_one afterwards. Adds its valid particles to *ls; returns the
- * number of particles left for the fix-up. cfg.adapt's sums take every
- * particle's innovation in order, so they hold only when no particle is
- * left (the caller makes them again after a fix-up). */
-BR_PF_CLONES static uint32_t predict_vec(br_pf_t *pf, const pred_t *c, uint32_t j0, uint32_t j1, const float *nz,
-                                         lsum_t *ls)
-{
-    const br_model_kp_t kp = c->kp;
-    /* f_nl's L taken from kp (the same value): one constant fewer in the loop */
-    br_model_k_t mk = c->mk;
-    mk.L = kp.L;
-    const float s0L = c->s0L;
-    const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
-    const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
-    const float shift = c->shift, y_rel = c->y_rel;
-#if BR_FPU_MAXNM && !BR_FLOAT_SIMD
-    uint32_t ah_lim_bits;
-    memcpy(&ah_lim_bits, &kp.ah_lim, sizeof ah_lim_bits);
-#endif
-    float *BR_RESTRICT th = pf->x[BR_X_THETA] + j0;
-    float *BR_RESTRICT om = pf->x[BR_X_OMEGA] + j0;
-    float *BR_RESTRICT zz = pf->x[BR_X_Z] + j0;
-    float *BR_RESTRICT gg = pf->x[BR_X_GP] + j0;
-    float *BR_RESTRICT ka = pf->kgp + j0;
-    float *BR_RESTRICT fo = pf->fnl + j0;
-    float *BR_RESTRICT lo = pf->l + j0;
-    const float *BR_RESTRICT nn = nz;
-    const size_t n = j1 - j0;
-#if BR_FPU_MAXNM
-    float lm = -INFINITY; /* the largest valid l by fmaxf (one instruction there) instead of the keys */
-#else
-    int32_t kmin = INT32_MAX;
-#endif
-#if BR_FLOAT_SIMD
-    uint32_t n_ok = 0u;
-#else
-    uint32_t n_ok = (uint32_t)n; /* less one for each particle that branches out */
-#endif
-    float s1 = ls->s1, s2 = ls->s2;
-#if !BR_FLOAT_SIMD
-    const float *np = nn; /* particle j's samples, BR_NX = 4 of them */
-    float *fp = fo, *lp = lo; /* f_nl and l stored by br_store_f_inc (vstmia with write-back) */
-#endif
-    for (size_t j = 0; j < n; j++) {
-        const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
-        float xn[BR_NX];
-        /* 1. predict (RK4 of eq. 6; ok_rk = 0 where the bounded scheme is needed) */
-        const float kg0 = ka[j];
-#if BR_FPU_MAXNM
-        /* the a h test as one compare of the larger product (vmaxnm): the
-         * start's, k_p |omega_0|, is finite (a finite particle, k_p > 0), so
-         * the larger is NaN never, and it is <= the limit exactly when both
-         * are, unless the end's is NaN (fmaxf passes over it): then the
-         * predicted omega is NaN, so is f_nl (eq. 4 propagates it), and the
-         * validity test below sends the particle to the fix-up, whose
-         * particle_one makes the test of both (br_model_kp_rk4). The same
-         * particles reach the fix-up either way. */
-        float ah0, ah1;
-        br_model_kp_rk4_step(&kp, x, kg0, xn, &ah0, &ah1);
-        const float ahm = fmaxf(ah0, ah1);
-#if BR_FLOAT_SIMD
-        const int ok_rk = ahm <= kp.ah_lim;
-#endif
-#else
-        const int ok_rk = br_model_kp_rk4(&kp, x, kg0, xn);
-#endif
-        /* process noise sqrt(Q) n */
-#if BR_FLOAT_SIMD
-        const float *const nj = nn + BR_NX * j;
-#else
-        float nj[BR_NX];
-        br_load4_f(&np, nj); /* the M7: one vldmia for the four samples */
-#endif
-        const float t = (xn[BR_X_THETA] + q0 * nj[0]) - shift;
-        const float w = xn[BR_X_OMEGA] + q1 * nj[1];
-        const float z = xn[BR_X_Z] + q2 * nj[2];
-        const float g = clamp_sel(xn[BR_X_GP] + q3 * nj[3], gp_min, gp_max);
-        /* the particle's one division */
-        const float kg = s0L / g;
-        /* f_nl of the predicted particle (eqs. 3, 4) */
-        const float f = fnl_kp(&mk, w, z, kg);
-        /* 2. log-likelihood */
-        const float e = t - y_rel;
-        const float l = -(e * e) * inv_2r;
-        s1 += e;
-        s2 += e * e;
-        /* validity as particle_one's */
-#if BR_FLOAT_SIMD
-        const int ok = ok_rk & ((t - t) + (f - f) == 0.0f);
-#else
-        /* without float SIMD (the Cortex-M7) nothing is gained by a
-         * branch-free body: a particle for the fix-up (the bounded scheme, or
-         * not valid) branches out, keeping its state in place (f_nl = 0,
-         * l = NaN), and the selects below fold away for the valid ones */
-#if BR_FPU_MAXNM
-        /* the a h test and the validity test as one compare, on the bit
-         * patterns: v - v with v = t + f is +0 when t and f are finite (and
-         * v does not overflow), NaN otherwise, so c_ah = ahm + (v - v) is
-         * ahm (>= +0: k_p > 0) or a NaN. As unsigned integers the patterns
-         * of floats >= +0 order as the floats do and every NaN's, of either
-         * sign, lies above the limit's, so c_bits <= ah_lim_bits exactly
-         * when the particle is inside the RK4 limit and valid; the limit
-         * sits in an integer register, one float register more for the
-         * loop's constants. An overflow of t + f alone (both finite) sends
-         * a valid particle to the fix-up, which makes the same prediction
-         * (particle_one): the same results either way. */
-        const float v = t + f, c_ah = ahm + (v - v);
-        uint32_t c_bits;
-        memcpy(&c_bits, &c_ah, sizeof c_bits);
-        if (!(c_bits <= ah_lim_bits)) {
-#else
-        if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
-#endif
-            br_store_f_inc(&fp, 0.0f);
-            br_store_f_inc(&lp, NAN);
-            n_ok--;
-            continue;
-        }
-        const int ok = 1;
-#endif
-        th[j] = ok ? t : x[BR_X_THETA];
-        om[j] = ok ? w : x[BR_X_OMEGA];
-        zz[j] = ok ? z : x[BR_X_Z];
-        gg[j] = ok ? g : x[BR_X_GP];
-        ka[j] = ok ? kg : kg0;
-        const float lk = ok ? l : NAN;
-#if BR_FLOAT_SIMD
-        fo[j] = ok ? f : 0.0f;
-        lo[j] = lk;
-#else
-        br_store_f_inc(&fp, f);
-        br_store_f_inc(&lp, lk);
-#endif
-#if BR_FPU_MAXNM
-        lm = fmaxf(lm, lk); /* fmaxf passes over a NaN */
-#else
-        /* NAN is a positive NaN: its key is above every valid one */
-        int32_t key;
-        memcpy(&key, &lk, sizeof key);
-        kmin = (key < kmin) ? key : kmin;
-#endif
-#if BR_FLOAT_SIMD
-        n_ok += (uint32_t)ok;
-#endif
-    }
-    ls->s1 = s1;
-    ls->s2 = s2;
-    if (n_ok > 0u) {
-#if !BR_FPU_MAXNM
-        float lm;
-        memcpy(&lm, &kmin, sizeof lm);
-#endif
-        ls->lmax = (lm > ls->lmax) ? lm : ls->lmax;
-        ls->n_valid += n_ok;
-    }
-    return (uint32_t)n - n_ok;
-}
-
 /* cfg.adapt's sums over particles k0 .. k1 - 1 in their order, from the
  * predicted set (the fix-up's runs): d = (theta_k - y) v with v = 1 for a
  * valid particle (l not NaN) and 0 for one kept at its state: the same
  * additions of the same values as lsum_add and lsum_skip (e 1 = e). */
-static void adapt_sums(const br_pf_t *pf, float y_rel, uint32_t k0, uint32_t k1, lsum_t *ls)
+static void adapt_sums(const br_pf_t *pf, float y_rel, uint32_t k0, uint32_t k1, br_pf_lsum_t *ls)
 {
     const float *const th = pf->x[BR_X_THETA], *const l = pf->l;
     float s1 = ls->s1, s2 = ls->s2;
     for (uint32_t k = k0; k < k1; k++) {
-        const float v = valid_weight(l[k]);
+        const float v = br_pf_valid_weight(l[k]);
         const float d = (th[k] - y_rel) * v;
         s1 += d;
         s2 += d * d;
@@ -783,36 +409,36 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     /* the model's clock moves on by one period (friction_drift) */
     br_model_tick(&pf->model);
     pred_t c;
-    c.mk = br_model_k(&pf->model);
-    c.kp = br_model_kp(&pf->model, u_prev_Nm);
-    c.s0L = pf->model.cfg.lugre.sigma0_Npm * pf->model.cfg.lead_mprad;
+    c.k.mk = br_model_k(&pf->model);
+    c.k.kp = br_model_kp(&pf->model, u_prev_Nm);
+    c.k.s0L = pf->model.cfg.lugre.sigma0_Npm * pf->model.cfg.lead_mprad;
     /* the extended kernel's constants (a few operations per step; unused by the thesis model) */
     c.mx = br_model_kx(&pf->model, origin_pos_m(pf));
     for (int i = 0; i < BR_NX; i++) {
-        c.q[i] = pf->q_std[i];
+        c.k.q[i] = pf->q_std[i];
     }
     /* cfg.adapt: omega's, z's and g_p's noise scaled (by exactly 1 while the smoothed NIS stays
      * below its reference); omega's only for the bootstrap draw: cfg.proposal draws omega from
      * its own constants (proposal_init), with which its held theta term stays consistent */
     if (pf->cfg.proposal == BR_PF_PROPOSAL_PRIOR) {
-        c.q[BR_X_OMEGA] *= pf->q_scale_std;
+        c.k.q[BR_X_OMEGA] *= pf->q_scale_std;
     }
-    c.q[BR_X_Z] *= pf->q_scale_std;
-    c.q[BR_X_GP] *= pf->q_scale_std;
-    c.gp_min = pf->cfg.est.gp_min_N;
-    c.gp_max = pf->cfg.est.gp_max_N;
-    c.inv_2r = pf->inv_2r;
+    c.k.q[BR_X_Z] *= pf->q_scale_std;
+    c.k.q[BR_X_GP] *= pf->q_scale_std;
+    c.k.gp_min = pf->cfg.est.gp_min_N;
+    c.k.gp_max = pf->cfg.est.gp_max_N;
+    c.k.inv_2r = pf->inv_2r;
     c.u = u_prev_Nm;
-    c.shift = shift;
-    c.y_rel = y_rel;
+    c.k.shift = shift;
+    c.k.y_rel = y_rel;
     c.prop = measured && pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR;
     c.hold = (pf->cfg.proposal == BR_PF_PROPOSAL_OPT_HELD) ? pf->prop_hold : 0.0f;
     const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
-    lsum_t ls = {-INFINITY, 0u, 0.0f, 0.0f};
+    br_pf_lsum_t ls = {-INFINITY, 0u, 0.0f, 0.0f};
     float n[BR_NX];
     if (pf->model.extended || pf->cfg.scalar_path || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR) {
         /* one particle at a time (the extended model always: its kernel branches;
-         * cfg.proposal always: the vector loop draws from the prior) */
+         * cfg.proposal always: the kernels draw from the prior) */
         for (uint32_t j = 0; j < m; j++) {
             noise_wrapped(pf, j, n);
             if (pf->model.extended) {
@@ -837,8 +463,8 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             const uint32_t j1 = (m - j < room) ? m : j + room;
             const float *const nz = pf->cfg.noise + p;
             const float s1 = ls.s1, s2 = ls.s2;
-            if (predict_vec(pf, &c, j, j1, nz, &ls) > 0u) {
-                /* the fix-up: redo the particles the vector loop left (l = NaN) in scalar */
+            if (br_pf_kernel_predict(pf, &c.k, j, j1, nz, &ls) > 0u) {
+                /* the fix-up: the particles the kernel left (l = NaN), one at a time */
                 for (uint32_t k = j; k < j1; k++) {
                     if (pf->l[k] != pf->l[k]) {
                         particle_one(pf, &c, 0, k, nz + BR_NX * (k - j), &ls);
@@ -858,113 +484,12 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     return ls.n_valid;
 }
 
-/* w_j = e^(l_j - lmax) for j < m, stored as their bit patterns in W */
-BR_PF_CLONES static void exp_vec(const float *BR_RESTRICT l, uint32_t *BR_RESTRICT W, float lmax, uint32_t m)
-{
-    for (uint32_t j = 0; j < m; j++) {
-        const float w = br_exp_neg(l[j] - lmax);
-        memcpy(&W[j], &w, sizeof w);
-    }
-}
-
-/* Step 3: max-shifted weights w_j = e^(l_j - lmax), quantised to W_j (an invalid
- * particle has l_j = NaN and br_exp_neg gives 0 for it); on an outlier every
- * valid particle (l_j not NaN, even -inf when its residual overflowed) gets w = 1
- * (step_weight: these w_j, for br_pf_stats). Returns the total of W. */
-static uint32_t quantise_weights(br_pf_t *pf, float lmax, int outlier)
-{
-    const uint32_t m = pf->cfg.n_particles;
-    const float *BR_RESTRICT l = pf->l;
-    uint32_t *BR_RESTRICT W = pf->W;
-    uint32_t total = 0u;
-    if (outlier) {
-        for (uint32_t j = 0; j < m; j++) {
-            const float w = valid_weight(l[j]);
-            W[j] = (uint32_t)(w * (float)BR_PF_W_ONE);
-            total += W[j];
-        }
-    } else {
-        /* (the vector path's weights: exp_vec, quant_total and resample_count);
-         * br_exp_neg's constants taken once, held in registers over the loop */
-        const br_exp_k_t k = br_exp_k();
-        for (uint32_t j = 0; j < m; j++) {
-            /* W_j = floor(w_j 2^16), the scale in the exponent (br_exp_neg_w16_k) */
-            W[j] = (uint32_t)br_exp_neg_w16_k(l[j] - lmax, k);
-            total += W[j];
-        }
-    }
-    return total;
-}
-
-/* w_j of the last step's weighing (quantise_weights' and exp_vec's: the same
- * value, br_math.h), from the log-weight it left */
+/* w_j of the last step's weighing (every kernel's: the same value, br_math.h),
+ * from the log-weight it left */
 static float step_weight(const br_pf_t *pf, uint32_t j)
 {
     const float l = pf->l[j];
-    return (pf->weighed == BR_PF_WEIGHED_VALID) ? valid_weight(l) : br_exp_neg(l - pf->lmax);
-}
-
-/* Step 4's copy, in place: particle i becomes the predicted particle idx_i.
- * The indices never decrease (systematic resampling), so a forward pass can
- * take every particle from a later one (not yet overwritten) and a backward
- * pass every particle from an earlier one (idx_k <= k there, so its source
- * was left alone by the forward pass); a particle with idx_i = i copies
- * itself. Each pass skips the particles that stay (on hosts too: the
- * branch predicts well, see resample_forward). The arrays are parameters
- * of a function of its own and each value is copied as its bit pattern
- * (memcpy): the Cortex-M7 then holds the five arrays in registers and
- * addresses them by index (integer loads and stores take a register offset,
- * float ones do not), where with pf->x it formed the 8 KiB-apart addresses
- * anew for every particle (docs/target.md). Both passes are compiled
- * without GCC's induction variable optimisation (BR_NO_IVOPTS): each
- * access then takes the index i itself as its register offset.
- * The forward pass, after resample_fused (the host's vector path makes it in
- * resample_forward): from i = 0 up to m - 2 (particle m - 1 has no later one). */
-static inline void move_particle(uint32_t i, uint32_t k, float *th, float *om, float *zz, float *gg, float *ia)
-{
-    memcpy(&th[i], &th[k], sizeof th[i]);
-    memcpy(&om[i], &om[k], sizeof om[i]);
-    memcpy(&zz[i], &zz[k], sizeof zz[i]);
-    memcpy(&gg[i], &gg[k], sizeof gg[i]);
-    memcpy(&ia[i], &ia[k], sizeof ia[i]);
-}
-
-BR_NO_IVOPTS BR_NOINLINE void copy_fwd_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
-                                           float *zz, float *gg, float *ia)
-{
-    const uint32_t last = m - 1u; /* m >= 1; the bound once, not i + 1 < m per particle */
-    for (uint32_t i = 0u; i < last; i++) {
-        const uint32_t k = idx[i];
-        if (k > i) {
-            move_particle(i, k, th, om, zz, gg, ia);
-        }
-    }
-}
-
-/* The backward pass, after copy_fwd_soa or resample_forward: from i = m - 1
- * down to 1 (particle 0 has no earlier one). */
-BR_NO_IVOPTS BR_NOINLINE void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t m, float *th, float *om,
-                                            float *zz, float *gg, float *ia)
-{
-    for (uint32_t i = m - 1u; i > 0u; i--) {
-        const uint32_t k = idx[i];
-        if (k < i) {
-            move_particle(i, k, th, om, zz, gg, ia);
-        }
-    }
-}
-
-/* copy_fwd_soa and copy_back_soa on pf's particles */
-static void copy_fwd(br_pf_t *pf)
-{
-    copy_fwd_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
-                 pf->x[BR_X_GP], pf->kgp);
-}
-
-static void copy_back(br_pf_t *pf)
-{
-    copy_back_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
-                  pf->x[BR_X_GP], pf->kgp);
+    return (pf->weighed == BR_PF_WEIGHED_VALID) ? br_pf_valid_weight(l) : br_exp_neg(l - pf->lmax);
 }
 
 /* Step 5's sum over the set, in particle order: f_nl of the set's predicted
@@ -1062,29 +587,9 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
      * particle mean and the ESS on request (br_pf_stats, from the set and l) */
     pf->weighed = (verdict == BR_W_OUTLIER) ? BR_PF_WEIGHED_VALID : BR_PF_WEIGHED_LOG;
     pf->lmax = lmax;
-    float sf;
-    if (BR_FLOAT_SIMD && !pf->cfg.scalar_path) {
-        if (verdict == BR_W_OUTLIER) {
-            const uint32_t total = quantise_weights(pf, lmax, 1);
-            resample_count(pf->W, m, total, pf->idx, 0);
-        } else {
-            /* the exponentials in a loop of their own (vectorised), w parked
-             * in W's storage as its bit pattern; the total of the quantised
-             * weights (vectorised); then the quantisation in place, in the
-             * counting loop */
-            exp_vec(pf->l, pf->W, lmax, m);
-            const uint32_t total = quant_total(pf->W, m);
-            resample_count(pf->W, m, total, pf->idx, 1);
-        }
-        sf = resample_forward(pf);
-        copy_back(pf);
-    } else {
-        const uint32_t total = quantise_weights(pf, lmax, verdict == BR_W_OUTLIER);
-        /* one loop for the indices and the sum, then the copy's forward and backward passes */
-        sf = resample_fused(pf, total);
-        copy_fwd(pf);
-        copy_back(pf);
-    }
+    /* the kernel's (the reference's on the scalar reference path) */
+    const int outlier = verdict == BR_W_OUTLIER;
+    float sf = pf->cfg.scalar_path ? br_pf_kref_resample(pf, lmax, outlier) : br_pf_kernel_resample(pf, lmax, outlier);
     const float inv_m = 1.0f / (float)m;
     pf->n_outliers = (verdict == BR_W_OUTLIER) ? pf->n_outliers + 1u : 0u;
     if (pf->n_outliers >= pf->cfg.est.reanchor_after) {

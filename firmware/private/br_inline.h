@@ -1,8 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* BR_INLINE: a function the compiler must inline (private to the firmware).
- * For a hot loop written once and specialised at its call sites by constant
- * arguments (the PF's prediction for the thesis model and for the extended
- * one), so that the common case carries no per-particle test of the other. */
+/* BR_INLINE: a function the compiler must inline (private to the firmware):
+ * br_model's RK4 kernel (br_model_kernel.h), inside br_model_step. */
 #ifndef BR_INLINE_H
 #define BR_INLINE_H
 
@@ -12,23 +10,13 @@
 #define BR_INLINE static inline
 #endif
 
-/* BR_NOINLINE: a function the compiler must not inline (private to the
- * firmware): a hot loop that gets the registers of a function of its own
- * instead of sharing them with its caller's live values. */
-#if defined(__GNUC__)
-#define BR_NOINLINE static __attribute__((noinline))
-#else
-#define BR_NOINLINE static
-#endif
-
 /* BR_NO_IVOPTS: a function whose loops GCC compiles without its induction
- * variable optimisation (elsewhere nothing). For the PF's in-place copy
- * loops on the Cortex-M7: with it every access is addressed by the loop's
- * own index (a register offset, shifted), one register and one add fewer
- * per particle than the byte offset GCC otherwise keeps beside it. GCC's
- * manual meant the optimize attribute for debugging; here it holds two
- * loops of integer loads and stores, and the replays' bit-identity
- * (target_qemu_replay, _m4) checks what they compile to. */
+ * variable optimisation (elsewhere nothing): the PF's in-place copy passes
+ * (br_pf_kernel_ref.c), with it every access addressed by the loop's own
+ * index as a register offset; without it 2.0 instructions more per
+ * particle-step on the Cortex-M7 and -M4 (make target-bench, docs/target.md,
+ * "What the kernels keep"). Two loops of integer loads and stores; the
+ * replays' bit-identity (target_qemu_replay, _m4) checks what they compile to. */
 #if defined(__GNUC__) && !defined(__clang__)
 #define BR_NO_IVOPTS __attribute__((optimize("no-ivopts")))
 #else
@@ -36,12 +24,14 @@
 #endif
 
 /* BR_HOLD_F(v), BR_HOLD_U(v): the float or uint32_t variable v keeps its
- * value, but the compiler no longer knows it (GCC on 32-bit Arm with an FPU: an
- * empty asm that takes v and gives it back in a register; elsewhere
- * nothing). Before a loop, for the loop's constants: GCC 12 for the
- * Cortex-M7 makes a constant it can encode in an instruction (0.5f, 1.0f,
- * 0x7FFFFFFF) or load from the literal pool afresh in every iteration, even
- * with registers free; an unknown value it keeps in a register instead. */
+ * value, but the compiler no longer knows it (GCC on 32-bit Arm with an FPU:
+ * an empty asm that takes v and gives it back in a register; elsewhere
+ * nothing). Before a loop, for its constants: GCC 12 for the Cortex-M7 and
+ * -M4 makes a constant it can encode (0.5f, 1.0f) or load from the literal
+ * pool afresh in every iteration, even with registers free; an unknown value
+ * it keeps in a register. The exponential's constants in the M7 and M4
+ * kernels' weight loops: without it 2.0 and 5.0 instructions more per
+ * particle-step (docs/target.md, "What the kernels keep"). */
 #if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
 #define BR_HOLD_F(v) __asm__("" : "+t"(v))
 #define BR_HOLD_U(v) __asm__("" : "+r"(v))
@@ -55,14 +45,16 @@
  * consecutive float registers (s12-s15; the compiler moves them on where it
  * needs those registers) where GCC makes four loads and an add, and one
  * vstmia with the pointer written back where GCC makes a store and an add
- * (the PF's prediction loop without float SIMD: the noise samples, and
- * f_nl and l, the two arrays the loop stores but does not load);
- * elsewhere the plain loads and stores. The same values. */
+ * (the prediction loops of the PF's Cortex-M7 and -M4 kernels: the noise
+ * samples, and f_nl and l, the two arrays the loop stores but does not load;
+ * without them 6.0 and 2.0 instructions more per particle-step on the M7,
+ * docs/target.md, "What the kernels keep"); elsewhere the plain loads and
+ * stores. The same values. */
 #if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
 typedef struct {
     float v[4];
 } br_f4_t; /* the four floats the vldmia reads, for its memory operand */
-BR_INLINE void br_load4_f(const float **p, float n[4])
+static inline void br_load4_f(const float **p, float n[4])
 {
     register float n0 __asm__("s12");
     register float n1 __asm__("s13");
@@ -74,17 +66,17 @@ BR_INLINE void br_load4_f(const float **p, float n[4])
     n[2] = n2;
     n[3] = n3;
 }
-BR_INLINE void br_store_f_inc(float **p, float v)
+static inline void br_store_f_inc(float **p, float v)
 {
     __asm__("vstmia %0!, {%2}" : "+r"(*p), "=m"(**p) : "t"(v));
 }
 #else
-BR_INLINE void br_store_f_inc(float **p, float v)
+static inline void br_store_f_inc(float **p, float v)
 {
     **p = v;
     *p += 1;
 }
-BR_INLINE void br_load4_f(const float **p, float n[4])
+static inline void br_load4_f(const float **p, float n[4])
 {
     const float *const q = *p;
     n[0] = q[0];
@@ -93,28 +85,6 @@ BR_INLINE void br_load4_f(const float **p, float n[4])
     n[3] = q[3];
     *p = q + 4;
 }
-#endif
-
-/* BR_FLOAT_SIMD: the target has vector registers for float (x86-64 SSE2,
- * Arm NEON). There the particle filter's loops are written branch-free, so
- * that the compiler vectorises them; without (the Cortex-M7) a branch costs
- * fewer instructions than the flags and selects a branch-free body needs.
- * The results are the same either way. */
-#ifndef BR_FLOAT_SIMD /* set to 0 on the host by the test of the M7's paths (test_pf_m7_paths) */
-#if defined(__SSE2__) || defined(__ARM_NEON)
-#define BR_FLOAT_SIMD 1
-#else
-#define BR_FLOAT_SIMD 0
-#endif
-#endif
-
-/* BR_FPU_MAXNM: the FPU has vmaxnm / vminnm (the Cortex-M7's FPv5), so
- * that fmaxf and fminf are one instruction each (the Cortex-M4's FPv4 has
- * neither: a library call). GCC predefines the same macros for both FPUs;
- * firmware/CMakeLists.txt sets it for the toolchain's cortex-m7 (and
- * tests/unit for test_pf_m7_paths). */
-#ifndef BR_FPU_MAXNM
-#define BR_FPU_MAXNM 0
 #endif
 
 /* BR_RESTRICT: C99 restrict, for the particle filter's structure-of-arrays

@@ -11,14 +11,11 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "br_inline.h"
 
-/* The constants br_exp_neg makes: 0.5, 1 and (without float SIMD) the
- * range test's two words. br_exp_neg_k takes them as values, so that a loop
- * over particles can take them once before it (br_exp_k) and keep them in
- * registers (BR_HOLD_F, BR_HOLD_U: the Cortex-M7's loop made them afresh
- * for every particle, 5 instructions); br_exp_neg(x) is
- * br_exp_neg_k(x, br_exp_k()). */
+/* The constants br_exp_neg makes: 0.5, 1 and the branching forms' range
+ * test's two words. br_exp_neg_k takes them as values, so that a loop over
+ * particles can take them once before it (br_exp_k) and keep them in
+ * registers; br_exp_neg(x) is br_exp_neg_k(x, br_exp_k()). */
 typedef struct {
     float half, one;   /* 0.5f, 1.0f */
     uint32_t lo, span; /* -87 < x < 0 <=> xb - lo < span for x's bit pattern xb (below) */
@@ -26,13 +23,7 @@ typedef struct {
 
 static inline br_exp_k_t br_exp_k(void)
 {
-    br_exp_k_t k = {0.5f, 1.0f, 0x80000001u, 0xC2AE0000u - 0x80000001u};
-#if !BR_FLOAT_SIMD
-    BR_HOLD_F(k.half);
-    BR_HOLD_F(k.one);
-    BR_HOLD_U(k.lo);
-    BR_HOLD_U(k.span);
-#endif
+    const br_exp_k_t k = {0.5f, 1.0f, 0x80000001u, 0xC2AE0000u - 0x80000001u};
     return k;
 }
 
@@ -52,9 +43,7 @@ static inline float br_exp2_poly(float f, const br_exp_k_t *k)
 }
 
 /* 2^(n + s) e^(f ln 2) for n >= -126, |f| <= 1/2, with ebias = 127 + s
- * (0 <= s <= 16): both forms of br_exp_neg end here (s = 0; s = 16 for
- * br_exp_neg_w), but the Cortex-M7's (BR_FPU_MAXNM), which makes the
- * same 2^(n + s) in the FPU */
+ * (0 <= s <= 16): the exponent field built as an integer */
 static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k, int32_t ebias)
 {
     /* 2^(n + s) by building the exponent field */
@@ -64,18 +53,45 @@ static inline float br_exp2_parts(int32_t n, float f, const br_exp_k_t *k, int32
     return br_exp2_poly(f, k) * scale;
 }
 
-#if BR_FLOAT_SIMD
-/* with float SIMD: branch-free, so that a loop over particles vectorises; the
- * range tests are integer masks rather than selects, which the compiler could
- * turn back into branches (GCC 12 does for SSE4.1 and up). The same result
- * as the branchy form below for every one of the 2^32 inputs (checked
- * exhaustively once, docs/modules/pf.md). */
+/* Three forms of e^x 2^s for x <= 0 (s = ebias - 127; top = 2^s, the value
+ * for x >= 0), the same float for every one of the 2^32 inputs
+ * (docs/modules/pf.md, "The exponential"; test_exp_forms):
+ *   br_exp_neg_kb         the reference: branches, plain C
+ *   br_exp_neg_kb_mask    branch-free, the range tests as integer masks (a
+ *                         loop over particles vectorises; br_pf_kernel_simd.c)
+ *   br_exp_neg_kb_rinta   x log2 e rounded by roundf, 2^(n + s) by a
+ *                         fixed-point conversion: one instruction each on an
+ *                         FPv5 FPU (br_pf_kernel_m7.c) */
+
+/* The reference. The range -87 < x < 0 as a test on the bit pattern
+ * (negative floats from -0 0x80000000 up to -87 0xC2AE0000, exclusive: one
+ * unsigned compare, xb - 0x80000001 < 0xC2AE0000 - 0x80000001); outside it:
+ * e^x = 1 for x >= 0 (+0 .. +inf, and -0), as the polynomial gives at 0; 0
+ * for x <= -87 and NaN. (No fminf: on the Cortex-M4 a library call.) */
 static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float top)
 {
-    (void)top; /* e^0 2^s comes out of the polynomial */
+    uint32_t xb;
+    memcpy(&xb, &x, sizeof xb);
+    if (!(xb - k.lo < k.span)) {
+        return (xb <= 0x7F800000u || xb == 0x80000000u) ? top : 0.0f;
+    }
+    /* x log2(e) = n + f, n = round-half-down, f in [-1/2, 1/2] */
+    const float t = x * 1.44269504f;
+    int32_t n = (int32_t)(t - k.half); /* truncation toward zero of t - 1/2, t <= 0 */
+    float f = t - (float)n;
+    if (f > k.half) {
+        n += 1;
+        f -= k.one;
+    }
+    return br_exp2_parts(n, f, &k, ebias);
+}
+
+/* Branch-free: x clamped to (-87, 0] by integer masks (no select the
+ * compiler could turn back into a branch: GCC 12 does for SSE4.1 and up) */
+static inline float br_exp_neg_kb_mask(float x, br_exp_k_t k, int32_t ebias)
+{
     const int in_range = x > -87.0f;
-    /* x clamped to (-87, 0] by integer masks (no select the compiler could
-     * turn into a branch): xc = x where -87 < x < 0, else +0 */
+    /* xc = x where -87 < x < 0, else +0 (e^0 2^s comes out of the polynomial) */
     uint32_t xb;
     memcpy(&xb, &x, sizeof xb);
     const uint32_t keep = (uint32_t)0u - (uint32_t)(in_range & (x < 0.0f));
@@ -98,38 +114,23 @@ static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float to
     memcpy(&o, &ob, sizeof o);
     return o;
 }
-#else
-/* without (the Cortex-M7): the same operations with branches, fewer
- * instructions there; the same result for every x */
-static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float top)
+
+/* roundf (vrinta on FPv5: ties away from zero, which for t < 0 is
+ * round-half-down) gives the reference's (n, f) for every t = x log2(e)
+ * that occurs, f = t - n exact; the exponent field (n + ebias) << 23 is the
+ * conversion of r + ebias to fixed point with 23 fraction bits (vcvt #23 on
+ * FPv5; every step exact: 1 <= n + ebias <= 143). */
+static inline float br_exp_neg_kb_rinta(float x, br_exp_k_t k, int32_t ebias, float top)
 {
-    /* the range -87 < x < 0 as a test on the bit pattern (negative
-     * floats from -0 0x80000000 up to -87 0xC2AE0000, exclusive: one
-     * unsigned compare, xb - 0x80000001 < 0xC2AE0000 - 0x80000001); outside
-     * it: e^x = 1 for x >= 0 (+0 .. +inf, and -0), as the polynomial gives
-     * at 0; 0 for x <= -87 and NaN. No fminf: on the Cortex-M4 a library
-     * call with two __fpclassifyf. */
     uint32_t xb;
     memcpy(&xb, &x, sizeof xb);
     if (!(xb - k.lo < k.span)) {
         return (xb <= 0x7F800000u || xb == 0x80000000u) ? top : 0.0f;
     }
-    /* x log2(e) = n + f, n = round-half-down, f in [-1/2, 1/2] */
     const float t = x * 1.44269504f;
-#if BR_FPU_MAXNM
-    /* FPv5's vrinta (roundf): t's nearest integer, ties away from zero,
-     * which for t < 0 is round-half-down; f = t - n is exact. The (n, f)
-     * of the branches below for every t = x log2(e) that occurs (one t < 0
-     * that no float x gives, -0x1.fffffep-2, differs), so the same float
-     * for all 2^32 x (docs/modules/pf.md) */
     const float r = roundf(t);
     const float f = t - r;
-    /* 2^(n + s): the exponent field (n + ebias) << 23 as the conversion of
-     * r + ebias to fixed point with 23 fraction bits (vcvt #23, in the FPU;
-     * every step exact: 1 <= n + ebias <= 143) */
 #if defined(__GNUC__) && defined(__arm__) && defined(__ARM_FP)
-    /* as an asm on the register itself: GCC's own vcvt #23 (the C form
-     * below) first copied its operand to another register */
     float scale = r + (float)ebias;
     __asm__("vcvt.s32.f32 %0, %0, #23" : "+t"(scale));
 #else
@@ -138,17 +139,7 @@ static inline float br_exp_neg_kb(float x, br_exp_k_t k, int32_t ebias, float to
     memcpy(&scale, &bits, sizeof scale);
 #endif
     return br_exp2_poly(f, &k) * scale;
-#else
-    int32_t n = (int32_t)(t - k.half); /* truncation toward zero of t - 1/2, t <= 0 */
-    float f = t - (float)n;
-    if (f > k.half) {
-        n += 1;
-        f -= k.one;
-    }
-    return br_exp2_parts(n, f, &k, ebias);
-#endif
 }
-#endif
 
 /* e^x for x <= 0 with the constants k (br_exp_k) */
 static inline float br_exp_neg_k(float x, br_exp_k_t k) { return br_exp_neg_kb(x, k, 127, k.one); }

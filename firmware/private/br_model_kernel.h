@@ -154,7 +154,7 @@ static inline float br_model_kp_zdot(float L, float kp, float omega, float z)
 /* RK4 of the particle (theta, omega, z, g_p) with its k_p, without the
  * a h test: *ah0, *ah1 get k_p |omega| at both ends of the step (the test's
  * products, a h / h; br_model_kp_rk4 makes the test) */
-BR_INLINE void br_model_kp_rk4_step(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX],
+static inline void br_model_kp_rk4_step(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX],
                                     float *ah0, float *ah1)
 {
     const float L = k->L, hh = k->h_half;
@@ -186,17 +186,11 @@ BR_INLINE void br_model_kp_rk4_step(const br_model_kp_t *k, const float x[BR_NX]
 
 /* RK4 of the particle (theta, omega, z, g_p) with its k_p; returns 1 when
  * a h is inside the RK4 limit at both ends of the step (as br_model_k_rk4) */
-BR_INLINE int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX])
+static inline int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX])
 {
     float ah0, ah1;
     br_model_kp_rk4_step(k, x, kp, out, &ah0, &ah1);
-#if BR_FLOAT_SIMD
-    /* & rather than &&: no branch, so that a loop over particles vectorises */
-    return (ah0 <= k->ah_lim) & (ah1 <= k->ah_lim);
-#else
-    /* without float SIMD a branch is cheaper than the flags (BR_FLOAT_SIMD) */
     return (ah0 <= k->ah_lim) && (ah1 <= k->ah_lim);
-#endif
 }
 
 /* ---- The extended model (causes on; docs/modules/model.md, "Extended model") ----

@@ -1,16 +1,20 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* br_math.h's three forms of the PF's exponentials give the same float:
- * the host's (float SIMD: masks), the Cortex-M4's (branches) and the
- * Cortex-M7's (vrinta's rounding of x log2 e, ties away from zero, and the
- * scale 2^(n + s) as a fixed-point conversion in the FPU). The rounding
- * differs from the branches' round-half-down only if ties were handled the
- * other way, so the test takes every float x near each tie
+/* br_math.h's three forms of the PF's exponentials give the same float
+ * (docs/modules/pf.md, "The exponential"): the reference (branches,
+ * br_exp_neg_kb), the float-SIMD kernel's (masks, br_exp_neg_kb_mask) and
+ * the Cortex-M7 kernel's (roundf's rounding of x log2 e, ties away from
+ * zero, and the scale 2^(n + s) as a fixed-point conversion,
+ * br_exp_neg_kb_rinta; its C form here, the M7's vcvt in the QEMU replay),
+ * each as e^x (s = 0) and as e^x 2^16 (the quantisation's, s = 16). The
+ * rounding differs from the branches' round-half-down only if ties were
+ * handled the other way, so the test takes every float x near each tie
  * x log2 e = k + 1/2 (k = -126 .. -1), where x log2 e rounds to the tie
  * itself for a few x, and a sweep of the range and its edges. */
 #include "br_test.h"
 
+#include <string.h>
+
 #include "br_math.h"
-#include "exp_forms.h"
 
 static int same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
 
@@ -19,8 +23,10 @@ static int forms_agree(float x)
 {
     const br_exp_k_t k = br_exp_k();
     const float w = br_exp_neg_w16_k(x, k), e = br_exp_neg_k(x, k);
-    return same_bits(w, exp_w16_m7(x)) && same_bits(w, exp_w16_m4(x)) && same_bits(e, exp_neg_m7(x)) &&
-           same_bits(e, exp_neg_m4(x));
+    /* the mask form has no top argument: its e^0 2^s comes from the polynomial */
+    return same_bits(w, br_exp_neg_kb_mask(x, k, 127 + 16)) &&
+           same_bits(w, br_exp_neg_kb_rinta(x, k, 127 + 16, 65536.0f)) && same_bits(e, br_exp_neg_kb_mask(x, k, 127)) &&
+           same_bits(e, br_exp_neg_kb_rinta(x, k, 127, k.one));
 }
 
 static void test_ties(void **st)

@@ -1,0 +1,142 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The particle filter's kernel interface (private to the firmware): the hot
+ * loops of one step, with one portable reference and one implementation per
+ * target, each a file of its own (docs/modules/pf.md, "Kernels"):
+ *
+ *   firmware/pf/br_pf_kernel_ref.c   br_pf_kref_*: the reference, plain C99,
+ *                                    always in the library (cfg.scalar_path)
+ *   firmware/pf/br_pf_kernel_simd.c  br_pf_kernel_*: hosts with float SIMD
+ *   firmware/pf/br_pf_kernel_m7.c    br_pf_kernel_*: the Cortex-M7
+ *   firmware/pf/br_pf_kernel_m4.c    br_pf_kernel_*: the Cortex-M4
+ *   firmware/pf/br_pf_kernel_port.c  br_pf_kernel_*: every other target: the
+ *                                    reference itself
+ *
+ * firmware/CMakeLists.txt compiles exactly one of the br_pf_kernel_* files.
+ * br_pf.c orchestrates: it calls br_pf_kernel_* (br_pf_kref_* on the scalar
+ * reference path) and redoes the particles a kernel leaves with its
+ * per-particle step (particle_one), which is the reference of steps 1 and 2
+ * for every particle and model. Every kernel gives the reference kernel's
+ * results bit for bit (test_pf_kernels). */
+#ifndef BR_PF_KERNEL_H
+#define BR_PF_KERNEL_H
+
+#include <stdint.h>
+
+#include "bristle/br_pf.h"
+#include "br_model_kernel.h"
+
+/* W of a particle of weight 1 (the best one after the max-shift) */
+#define BR_PF_W_ONE (1u << BR_PF_W_BITS)
+
+/* The constants of one prediction pass of the thesis model (steps 1 and 2,
+ * bootstrap proposal), the same for every particle. */
+typedef struct {
+    br_model_k_t mk;  /* the thesis model's kernel constants (f_nl) */
+    br_model_kp_t kp; /* the PF's RK4 constants (br_model_kp_rk4) */
+    float s0L;        /* sigma0 L: k_p = s0L / g_p */
+    float q[BR_NX];   /* process noise standard deviations */
+    float gp_min, gp_max, inv_2r;
+    float shift;      /* theta of the new origin relative to the old one, rad */
+    float y_rel;      /* the measurement relative to the new origin, rad */
+} br_pf_kc_t;
+
+/* What a prediction pass adds up: the largest log-weight of the valid
+ * particles and their count; cfg.adapt's sums of d_j = theta_j - y and d_j^2
+ * over the particles in their order. */
+typedef struct {
+    float lmax;
+    uint32_t n_valid;
+    float s1, s2;
+} br_pf_lsum_t;
+
+/* f_nl (eqs. 3, 4) of a predicted particle: eq. 4 with its k_p = sigma0 L / g_p */
+static inline float br_pf_fnl_kp(const br_model_k_t *k, float om, float z, float kg)
+{
+    return br_model_k_fnl(k, z, br_model_kp_zdot(k->L, kg, om, z));
+}
+
+/* Step 2, the log-likelihood of the measurement y given particle j,
+ * Gaussian: l_j = -(theta_j - y)^2 / (2 R), e = theta_j - y. The one place it
+ * is written (every kernel and the per-particle step call it). A valid
+ * particle's l is <= -0 (-inf when e^2 overflows): the largest log-weight
+ * by integer keys (the SIMD and Cortex-M4 kernels) holds only while that is
+ * so (docs/modules/pf.md, "Changing the likelihood"). */
+static inline float br_pf_loglik(float e, float inv_2r) { return -(e * e) * inv_2r; }
+
+/* 1 for a valid particle (its log-weight l is not NaN), 0 for one kept at its state */
+static inline float br_pf_valid_weight(float l) { return (l == l) ? 1.0f : 0.0f; }
+
+/* 4. systematic resampling's indices by search, fused with step 5's sum of
+ * f_nl over the resampled set in particle order (particle i is the predicted
+ * particle j = idx_i, its f_nl held while j stays).
+ * t_i = floor((2 i + 1) total / (2 m)), stepped as quotient and remainder
+ * (the remainder kept less 2 m: its sign is the carry); particle i takes the
+ * j with C_{j-1} <= t_i < C_j. total is the sum of the W_j, so
+ * t_i <= floor(total - total / (2 m)) < C_{m-1}: the search stops by
+ * j = m - 1 without a test of j. */
+static inline float br_pf_select(br_pf_t *pf, uint32_t total)
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const uint32_t *restrict W = pf->W;
+    uint16_t *restrict idx = pf->idx;
+    const float *const fnl = pf->fnl;
+    const uint32_t den = 2u * m;
+    const uint32_t dq = (2u * total) / den, dr = (2u * total) % den;
+    uint32_t t = total / den;
+    int32_t rn = (int32_t)(total % den) - (int32_t)den;
+    uint32_t j = 0u, c = W[0];
+    float af = fnl[0];
+    float sf = 0.0f;
+    for (uint32_t i = 0; i < m; i++) {
+        if (c <= t) {
+            do {
+                j++;
+                c += W[j];
+            } while (c <= t);
+            af = fnl[j];
+        }
+        idx[i] = (uint16_t)j;
+        sf += af;
+        /* t_{i+1} = t_i + dq, plus 1 when the remainder carries */
+        t += dq;
+        rn += (int32_t)dr;
+        if (rn >= 0) {
+            t++;
+            rn -= (int32_t)den;
+        }
+    }
+    return sf;
+}
+
+/* Steps 1 and 2 (docs/modules/pf.md) of the thesis model for particles
+ * j0 .. j1 - 1 of pf, whose standard-normal samples are nz[BR_NX (j - j0) + i]
+ * (contiguous: no wrap round the table). A particle inside the RK4 limit with
+ * a valid prediction is overwritten by it (state, k_p, f_nl, l) and added to
+ * ls (lmax, n_valid). Any other particle keeps its state, gets f_nl = 0 and
+ * l = NaN and is left for the caller's fix-up; a kernel may leave more
+ * particles than the reference does, never fewer, and only ones that the
+ * fix-up predicts as the reference would. ls's s1 and s2 hold the run's sums
+ * in particle order when nothing is left (the caller makes them again
+ * otherwise). Returns the number of particles left. */
+uint32_t br_pf_kref_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                            br_pf_lsum_t *ls);
+uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                              br_pf_lsum_t *ls);
+
+/* Steps 3, 4 and step 5's sum, over pf's m predicted particles with their
+ * log-weights pf->l (NaN: invalid) and lmax, the largest valid one (finite
+ * unless outlier): the weights W_j (outlier: 2^16 for every valid particle),
+ * systematic resampling's indices idx, the set copied in place (state and
+ * k_p), and the sum of f_nl over the resampled set in particle order, which
+ * it returns. */
+float br_pf_kref_resample(br_pf_t *pf, float lmax, int outlier);
+float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier);
+
+/* Pieces of the reference that other kernels share (br_pf_kernel_ref.c):
+ * the quantised weights, returning their total; the copy's forward and
+ * backward passes (the search is br_pf_select, above). */
+uint32_t br_pf_kref_weights(br_pf_t *pf, float lmax, int outlier);
+void br_pf_kref_copy_fwd(br_pf_t *pf);
+void br_pf_kref_copy_back(br_pf_t *pf);
+
+#endif
