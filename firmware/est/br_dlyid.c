@@ -33,7 +33,8 @@ static int constants(br_dlyid_t *id, const br_est_cfg_t *cfg)
     id->forget = expf(-T / c->memory_s);
     /* (dly7) the travel over which LuGre's bristles carry the friction's jump at a reversal,
      * in rad at the motor */
-    id->settle_rad = BR_DLYID_SETTLE_LENGTHS * cfg->gp_max_N / (mc->lugre.sigma0_Npm * L);
+    const float s0L = mc->lugre.sigma0_Npm * L; /* > 0 unless the product underflows: refused below */
+    id->settle_rad = (s0L > 0.0f) ? BR_DLYID_SETTLE_LENGTHS * cfg->gp_max_N / s0L : INFINITY;
     /* b0 and b1 are finite when L b0 and L b1 are (L > 0, br_model_init); R' is finite
      * where br_est_cfg_check accepts R and rpc */
     return isfinite(id->a02) && isfinite(id->a12) && isfinite(id->q_force_N2) && id->forget < 1.0f &&

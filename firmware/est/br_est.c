@@ -37,9 +37,6 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
     if (!(cfg->comp_ahead_periods >= 0.0f && cfg->comp_ahead_periods <= BR_EST_AHEAD_MAX_PERIODS)) {
         return BR_E_PARAM;
     }
-    if (!br_dlyid_cfg_ok(cfg)) {
-        return BR_E_PARAM;
-    }
     for (int i = 0; i < BR_NX; i++) {
         if (!br_est_var_ok(cfg->q_var[i], 1)) {
             return BR_E_PARAM;
@@ -51,6 +48,10 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
     }
     if (!br_finite_pos(cfg->gp_min_N) || !isfinite(cfg->gp_max_N) || !(cfg->gp_max_N > cfg->gp_min_N) ||
         !(cfg->gp0_N >= cfg->gp_min_N && cfg->gp0_N <= cfg->gp_max_N)) {
+        return BR_E_PARAM;
+    }
+    /* last: the bank's constants use g_p's range and the model's (checked above) */
+    if (!br_dlyid_cfg_ok(cfg)) {
         return BR_E_PARAM;
     }
     return BR_OK;

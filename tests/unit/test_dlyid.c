@@ -179,6 +179,12 @@ static void test_dlyid_bounds(void **st)
     assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
     c.delay_id.q_force_N2ps = 1.0e35f;
     assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    /* sigma0 L underflowing to 0 (the presliding length of dly7 would divide by it) */
+    c = ok;
+    c.model.lugre.sigma0_Npm = 1.0e-30f;
+    c.model.lead_mprad = 1.0e-20f;
+    assert_true(c.model.lugre.sigma0_Npm * c.model.lead_mprad == 0.0f);
+    refused_only_with_the_bank(c);
     /* off: the other fields are not looked at */
     c = ok;
     c.delay_id.n_cand = 0u;
