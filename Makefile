@@ -64,7 +64,7 @@ endif
 # its own cross build folder, build/<preset>-<name>-<hash> (firmware/design/build_dir.py:
 # the first 8 hex digits of the SHA-256 of the file's real path, so that two files
 # with the same "name" never share one), configured with -DBR_MACHINE, headers
-# generated there. The folder is found inside the recipe, never by $(shell).
+# generated there. The folder is found inside the recipe, never while make parses.
 # the cross preset of BOARD: stm32h7 (Cortex-M7) cm7-release, stm32g4 (Cortex-M4F) cm4-release
 BOARD_PRESET = $(if $(filter stm32g4,$(BOARD)),cm4-release,cm7-release)
 DEMO_OUT   := out/demo
