@@ -156,7 +156,7 @@ test: deps
 	$(call build,cm7-release)
 	$(Q)echo "== test host-debug"
 	$(Q)ctest --preset host-debug --output-on-failure -j$(JOBS)
-	$(call print_size,build/cm7-release)
+	$(call print_size,build/$(BOARD_PRESET))
 	$(Q)$(MAKE) firmware BOARD=stm32g4
 
 # The circle (docs/circle-test.md): `make demo RADIUS_M=<m> FEED=<mm/min> DIR=cw|ccw|both`
