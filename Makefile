@@ -8,8 +8,14 @@ SHELL := bash
 .SUFFIXES:
 MAKEFLAGS += --no-print-directory
 
+# User values (paths, names, numbers) never become shell or make text
+# (docs/tools.md, "Inputs that cannot inject"): each is taken as it was
+# given ($(value ...): a "$(...)" in it is not a make function), then
+# reaches the recipes only as an environment variable, BR_MK_<NAME>, which a
+# recipe quotes ("$$BR_MK_MACHINE"); BOARD and the counts must match what
+# they select. tests/machine/test_hostile_inputs.py holds the Makefile to it.
 V ?= 0
-ifeq ($(V),1)
+ifeq ($(value V),1)
   Q :=
   NINJA_QUIET :=
 else
@@ -19,20 +25,50 @@ endif
 
 JOBS       ?= 2
 PYTHON     := .venv/bin/python
+EMPS_LOG   ?= ../shared/data/emps/emps_estimation.csv
+N          ?= 200
+DL_N ?= 20
+DL_N_VERIFY ?= 59
+DL_N_NOMINAL ?= 150
+DL_JOBS ?= 1
+FUZZ_SECONDS ?= 600
+MUTANTS_BUDGET ?= 3600
+override MACHINE  := $(value MACHINE)
+override LOG      := $(value LOG)
+override OUT      := $(value OUT)
+override MODEL    := $(value MODEL)
+override EMPS_LOG := $(value EMPS_LOG)
+override RADIUS_M := $(value RADIUS_M)
+override FEED     := $(value FEED)
+override DIR      := $(value DIR)
+export BR_MK_MACHINE  := $(MACHINE)
+export BR_MK_LOG      := $(LOG)
+export BR_MK_OUT      := $(OUT)
+export BR_MK_MODEL    := $(MODEL)
+export BR_MK_EMPS_LOG := $(EMPS_LOG)
+export BR_MK_RADIUS_M := $(RADIUS_M)
+export BR_MK_FEED     := $(FEED)
+export BR_MK_DIR      := $(DIR)
+# the counts: digits only (they are written into recipes)
+_nodigits = $(subst 0,,$(subst 1,,$(subst 2,,$(subst 3,,$(subst 4,,$(subst 5,,$(subst 6,,$(subst 7,,$(subst 8,,$(subst 9,,$(1)))))))))))
+_check_count = $(if $(value $(1)),$(if $(or $(call _nodigits,$(value $(1))),$(filter-out 1,$(words $(value $(1))))),$(error $(1) must be a whole number)))
+$(foreach v,JOBS N DIAGNOSE_FIRST DL_N DL_N_VERIFY DL_N_NOMINAL DL_JOBS FUZZ_SECONDS MUTANTS_BUDGET,$(call _check_count,$(v)))
 # The board whose firmware image `make firmware` / `make test` build and size:
-# its CMakeLists (hal/<board>/) writes into BOARD_INFO the image's path, its
+# its CMakeLists (hal/<board>/) writes into <build>/board-<board>.txt the image's path, its
 # part's flash size (KiB) and its RAM regions (NAME:ORIGIN:KiB).
 BOARD      ?= stm32h7
+ifneq ($(filter-out stm32h7 stm32g4,$(value BOARD))$(filter-out 1,$(words $(value BOARD))),)
+  $(error BOARD must be stm32h7 or stm32g4)
+endif
 # `make firmware MACHINE=<file>` builds for another machine (docs/configure.md):
-# its own cross build folder, configured with -DBR_MACHINE, headers generated there.
-MACHINE_NAME = $(if $(MACHINE),$(shell $(PYTHON) -c 'import json, sys; print(json.load(open(sys.argv[1])).get("name", "x"))' "$(MACHINE)" 2>/dev/null || echo invalid))
+# its own cross build folder, build/<preset>-<name>-<hash> (firmware/design/build_dir.py:
+# the first 8 hex digits of the SHA-256 of the file's real path, so that two files
+# with the same "name" never share one), configured with -DBR_MACHINE, headers
+# generated there. The folder is found inside the recipe, never while make parses.
 # the cross preset of BOARD: stm32h7 (Cortex-M7) cm7-release, stm32g4 (Cortex-M4F) cm4-release
 BOARD_PRESET = $(if $(filter stm32g4,$(BOARD)),cm4-release,cm7-release)
-CM7_DIR     = build/$(BOARD_PRESET)$(if $(MACHINE),-$(MACHINE_NAME))
-BOARD_INFO  = $(CM7_DIR)/board-$(BOARD).txt
 DEMO_OUT   := out/demo
 ROBUST_OUT := out/robustness
-N          ?= 200
 HIDDEN_OUT := out/diagnose-hidden
 TUNE_OUT   := out/tune
 BENCH_OUT  := out/bench
@@ -53,13 +89,15 @@ define build
 	$(Q)cmake --build --preset $(1) $(NINJA_QUIET)
 endef
 
+# $(call print_size,<build folder, a shell word>)
 # Flash = text + data (the .data image is stored in flash); RAM per region
-# (BOARD_INFO: the image, the flash KiB, then NAME:ORIGIN:KiB per RAM region)
-# = the allocated sections whose address lies in it (.data, .bss, the reserved
-# stack, NOLOAD sections), from arm-none-eabi-size -A.
+# (the board file <build>/board-BOARD.txt: the image, the flash KiB, then
+# NAME:ORIGIN:KiB per RAM region) = the allocated sections whose address lies
+# in it (.data, .bss, the reserved stack, NOLOAD sections), from arm-none-eabi-size -A.
 define print_size
-	$(Q)test -f $(BOARD_INFO) || { echo "no board $(BOARD) in the cm7-release build ($(BOARD_INFO))" >&2; exit 1; }
-	$(Q)read -r img fk regions < $(BOARD_INFO); img=$$(realpath --relative-to=. "$$img"); \
+	$(Q)info=$(1)/board-$(BOARD).txt; \
+	test -f "$$info" || { echo "no board $(BOARD) in the $(BOARD_PRESET) build ($$info)" >&2; exit 1; }; \
+	read -r img fk regions < "$$info"; img=$$(realpath --relative-to=. "$$img"); \
 	test -f "$$img" || { echo "no firmware image at $$img" >&2; exit 1; }; \
 	arm-none-eabi-size "$$img" | awk 'NR == 2 { print $$1, $$2 }' | { read -r text data; \
 	  f=$$((text + data)); echo "firmware $$img"; \
@@ -86,7 +124,7 @@ help:
 	@echo "  make diagnose-control the circle with the estimator on the nominal / extended model -> docs/diagnose-control.md"
 	@echo "  make detection-limits smallest effect of each cause detected in 95 % of logs, false positives -> docs/detection-limits.md"
 	@echo "  make diagnose-bench   peak memory of a diagnosis of a 2e6-row log written by br_simlog (docs/diagnose.md, Memory)"
-	@echo "  make firmware [MACHINE=<json>] [BOARD=stm32g4]  cross build (cm7-release; BOARD=stm32g4: cm4-release; another machine: build/<preset>-<name>), print the image's flash / RAM use (BOARD=$(BOARD))"
+	@echo "  make firmware [MACHINE=<json>] [BOARD=stm32g4]  cross build (cm7-release; BOARD=stm32g4: cm4-release; another machine: build/<preset>-<name>-<hash>), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make emps      the EMPS drive through the chain: its log -> diagnose -> machine.json -> image -> tracking in the simulator -> $(EMPS_OUT), docs/machines/emps.md"
 	@echo "  make robustness [N=200] [DIAGNOSE_FIRST=K]  Monte Carlo over N plants around the reference machine -> $(ROBUST_OUT), docs/robustness-results.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
@@ -118,15 +156,14 @@ test: deps
 	$(call build,cm7-release)
 	$(Q)echo "== test host-debug"
 	$(Q)ctest --preset host-debug --output-on-failure -j$(JOBS)
-	$(print_size)
+	$(call print_size,build/$(BOARD_PRESET))
 	$(Q)$(MAKE) firmware BOARD=stm32g4
 
 # The circle (docs/circle-test.md): `make demo RADIUS_M=<m> FEED=<mm/min> DIR=cw|ccw|both`
 # (br_demo_circle --radius-m, --feed-mm-min, --dir; each passed only when set,
-# single-quoted for the shell); then the ISO 230-4 figures into summary.json.
-squote = '$(subst ','\'',$(1))'
-DEMO_ARGS = $(if $(RADIUS_M),--radius-m $(call squote,$(RADIUS_M))) $(if $(FEED),--feed-mm-min $(call squote,$(FEED))) \
-  $(if $(DIR),--dir $(call squote,$(DIR)))
+# as data: the environment's BR_MK_*); then the ISO 230-4 figures into summary.json.
+DEMO_ARGS = $${BR_MK_RADIUS_M:+"--radius-m=$$BR_MK_RADIUS_M"} $${BR_MK_FEED:+"--feed-mm-min=$$BR_MK_FEED"} \
+  $${BR_MK_DIR:+"--dir=$$BR_MK_DIR"}
 demo: deps
 	$(call configure,host-release)
 	$(call build,host-release)
@@ -190,12 +227,13 @@ target-bench: deps
 # Measured logs (docs/diagnose.md): diagnose one, validate a saved model on
 # another, and the hidden-cause suite that writes docs/diagnose-hidden.md.
 diagnose: deps
-	$(Q)test -n "$(LOG)" -a -n "$(OUT)" || { echo "usage: make diagnose LOG=<csv> OUT=<dir> [MACHINE=<json>]" >&2; exit 2; }
-	$(Q)PYTHONPATH=python MPLBACKEND=Agg $(PYTHON) -m bristle.diagnose diagnose --log "$(LOG)" --out "$(OUT)" $(if $(MACHINE),--machine "$(MACHINE)")
+	$(Q)test -n "$$BR_MK_LOG" -a -n "$$BR_MK_OUT" || { echo "usage: make diagnose LOG=<csv> OUT=<dir> [MACHINE=<json>]" >&2; exit 2; }
+	$(Q)PYTHONPATH=python MPLBACKEND=Agg $(PYTHON) -m bristle.diagnose diagnose "--log=$$BR_MK_LOG" "--out=$$BR_MK_OUT" \
+	  $${BR_MK_MACHINE:+"--machine=$$BR_MK_MACHINE"}
 
 validate: deps
-	$(Q)test -n "$(MODEL)" -a -n "$(LOG)" || { echo "usage: make validate MODEL=<model.json> LOG=<csv>" >&2; exit 2; }
-	$(Q)PYTHONPATH=python $(PYTHON) -m bristle.diagnose validate --model "$(MODEL)" --log "$(LOG)"
+	$(Q)test -n "$$BR_MK_MODEL" -a -n "$$BR_MK_LOG" || { echo "usage: make validate MODEL=<model.json> LOG=<csv>" >&2; exit 2; }
+	$(Q)PYTHONPATH=python $(PYTHON) -m bristle.diagnose validate "--model=$$BR_MK_MODEL" "--log=$$BR_MK_LOG"
 
 diagnose-control: deps
 	$(call configure,host-release)
@@ -229,10 +267,6 @@ diagnose-hidden: deps
 # detect the cause (59 of 59: a 95 % rate at 95 % confidence), and DL_N_NOMINAL nominal logs per
 # noise level, on DL_JOBS processes (default one core: over an hour with the defaults;
 # docs/detection-limits.md gives the wall time). DL_ prefix: N is the robustness study's.
-DL_N ?= 20
-DL_N_VERIFY ?= 59
-DL_N_NOMINAL ?= 150
-DL_JOBS ?= 1
 detection-limits: deps
 	$(call configure,host-release)
 	$(call build,host-release)
@@ -242,35 +276,41 @@ detection-limits: deps
 	  --n $(DL_N) --n-verify $(DL_N_VERIFY) --n-nominal $(DL_N_NOMINAL) --jobs $(DL_JOBS) --md docs/detection-limits.md --png docs/detection-limits.png \
 	  --json out/detection-limits/summary.json
 
+# MACHINE reaches the recipe only as "$$BR_MK_MACHINE"; its build folder comes
+# from build_dir.py (which validates the file first) inside the recipe.
+MACHINE_DIR = "$$($(PYTHON) firmware/design/build_dir.py $(BOARD_PRESET) "$$BR_MK_MACHINE")"
 firmware: deps
 	$(Q)echo "== image for $(BOARD): the estimator the machine file's control.estimator gives"
-	$(Q)$(PYTHON) firmware/design/image_info.py "$(if $(MACHINE),$(MACHINE),machines/reference.json)" "$(BOARD)"
+	$(Q)$(PYTHON) firmware/design/image_info.py "$${BR_MK_MACHINE:-machines/reference.json}" "$(BOARD)"
 ifeq ($(MACHINE),)
 	$(call configure,$(BOARD_PRESET))
 	$(call build,$(BOARD_PRESET))
+	$(call print_size,build/$(BOARD_PRESET))
 else
-	$(Q)$(PYTHON) firmware/design/machine.py "$(MACHINE)" > /dev/null
-	$(Q)echo "== H-infinity synthesis for $(MACHINE) ($(MACHINE_NAME))"
-	$(Q)mkdir -p $(CM7_DIR)/gen/bristle_gen/ctrl
-	$(Q)$(PYTHON) firmware/design/synth_hinf.py --machine "$(MACHINE)" --out $(CM7_DIR)/gen/bristle_gen/ctrl/br_hinf_gains.h
-	$(Q)echo "== configure $(CM7_DIR) (BR_MACHINE=$(abspath $(MACHINE)))"
-	$(Q)log="$$(cmake --preset $(BOARD_PRESET) -B $(CM7_DIR) -DBR_MACHINE=$(abspath $(MACHINE)) 2>&1)" || { echo "$$log"; echo "configure $(CM7_DIR) failed" >&2; exit 1; }
-	$(Q)echo "== build $(CM7_DIR)"
-	$(Q)cmake --build $(CM7_DIR) $(NINJA_QUIET)
+	$(Q)dir=$(MACHINE_DIR); abs="$$(realpath -- "$$BR_MK_MACHINE")"; \
+	echo "== H-infinity synthesis for $$BR_MK_MACHINE ($$dir)"; \
+	mkdir -p "$$dir/gen/bristle_gen/ctrl"; \
+	$(PYTHON) firmware/design/synth_hinf.py "--machine=$$abs" "--out=$$dir/gen/bristle_gen/ctrl/br_hinf_gains.h"; \
+	echo "== configure $$dir (BR_MACHINE=$$abs)"; \
+	log="$$(cmake --preset $(BOARD_PRESET) -B "$$dir" "-DBR_MACHINE=$$abs" 2>&1)" || { echo "$$log"; echo "configure $$dir failed" >&2; exit 1; }; \
+	echo "== build $$dir"; \
+	cmake --build "$$dir" $(NINJA_QUIET)
+	$(call print_size,$(MACHINE_DIR))
 endif
-	$(print_size)
 
 # A real machine through the whole chain (docs/machines/emps.md): the EMPS
 # log -> diagnosis -> machine.json -> its image -> its own reference
 # trajectory on the identified plant with the log's PD, H-inf, H-inf + PF.
-EMPS_LOG ?= ../shared/data/emps/emps_estimation.csv
+# EMPS_LOG (default ../shared/data/emps/emps_estimation.csv) reaches the
+# recipes as "$$BR_MK_EMPS_LOG"; the image's folder is build_dir.py's for machine.json.
 EMPS_OUT := out/emps-chain
 emps: deps
-	$(Q)$(MAKE) diagnose LOG=$(EMPS_LOG) OUT=$(EMPS_OUT)/diagnose MACHINE=machines/emps.json
+	$(Q)$(MAKE) diagnose "LOG=$$BR_MK_EMPS_LOG" OUT=$(EMPS_OUT)/diagnose MACHINE=machines/emps.json
 	$(Q)$(MAKE) firmware MACHINE=$(EMPS_OUT)/diagnose/machine.json
 	$(Q)echo "== tracking on the simulator -> $(EMPS_OUT), docs/machines/emps.md"
-	$(Q)$(PYTHON) sim/studies/machine_chain.py --src . --work $(EMPS_OUT) --given machines/emps.json --log $(EMPS_LOG) \
-	  --controller python/bristle/diagnose/machines/emps.json --cross --cross-dir build/cm7-release-emps --track --circle \
+	$(Q)dir="$$($(PYTHON) firmware/design/build_dir.py cm7-release $(EMPS_OUT)/diagnose/machine.json)"; \
+	$(PYTHON) sim/studies/machine_chain.py --src . --work $(EMPS_OUT) --given machines/emps.json "--log=$$BR_MK_EMPS_LOG" \
+	  --controller python/bristle/diagnose/machines/emps.json --cross "--cross-dir=$$dir" --track --circle \
 	  --md docs/machines/emps.md > $(EMPS_OUT)/chain.log || { cat $(EMPS_OUT)/chain.log; exit 1; }
 	$(Q)grep -E "tracking RMS|FAULT|^image|^circle" $(EMPS_OUT)/chain.log
 
@@ -291,7 +331,6 @@ regen: deps
 
 # The libFuzzer targets of tests/fuzz for longer than ctest's 20 s each,
 # corpora kept in out/fuzz (docs/reliability.md).
-FUZZ_SECONDS ?= 600
 fuzz: deps
 	$(call configure,fuzz)
 	$(call build,fuzz)
@@ -315,7 +354,6 @@ robustness: deps
 # The mutation check (docs/mutants.md): every mutant of tests/mutants/ in
 # scratch copies under build/mutants (the tree itself is never written),
 # $(JOBS) at a time, within MUTANTS_BUDGET seconds -> out/mutants/summary.json, report.md.
-MUTANTS_BUDGET ?= 3600
 .PHONY: mutants
 mutants: deps
 	$(Q)echo "== mutation check -> out/mutants (budget $(MUTANTS_BUDGET) s)"

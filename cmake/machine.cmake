@@ -23,6 +23,16 @@ elseif(NOT BR_PYTHON)
   set(BR_PYTHON "${_br_root}/.venv/bin/python")
 endif()
 
+# A newline or a carriage return in the path: no build rule can name the file
+# (Ninja's paths are one line); a ';' splits it (CMake's list separator).
+# Refused here with the reason, not at build time (docs/tools.md).
+string(FIND "${BR_MACHINE}" "\n" _br_nl)
+string(FIND "${BR_MACHINE}" "\r" _br_cr)
+string(FIND "${BR_MACHINE}" ";" _br_sc)
+if(NOT _br_nl EQUAL -1 OR NOT _br_cr EQUAL -1 OR NOT _br_sc EQUAL -1)
+  message(FATAL_ERROR "BR_MACHINE: the machine file's path holds a newline, a carriage return or a ';', "
+                      "which no build rule can name: move or rename the file (docs/tools.md)")
+endif()
 get_filename_component(BR_MACHINE_PATH "${BR_MACHINE}" REALPATH BASE_DIR "${_br_root}")
 get_filename_component(_br_reference "${_br_root}/machines/reference.json" REALPATH)
 if(NOT EXISTS "${BR_MACHINE_PATH}")

@@ -52,10 +52,9 @@ def main():
     if a.len < 2 or a.len & (a.len - 1):
         ap.error("--len must be a power of two >= 2")
     h, c = render(a.len)
-    with open(os.path.join(a.out_dir, "br_noise_table.h"), "w") as f:
-        f.write(h)
-    with open(os.path.join(a.out_dir, "br_noise_table.c"), "w") as f:
-        f.write(c)
+    # through temporary files and renames: a failed run leaves the old table
+    machine.write_atomic(os.path.join(a.out_dir, "br_noise_table.h"), h)
+    machine.write_atomic(os.path.join(a.out_dir, "br_noise_table.c"), c)
 
 
 if __name__ == "__main__":

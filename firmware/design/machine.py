@@ -437,6 +437,59 @@ def params(m):
     return p
 
 
+# --- text that generated C embeds (docs/tools.md, "Inputs that cannot inject") ---
+# A path or a field never goes into generated C as it is: into a comment only
+# its c_comment_text() form, into a string only its c_string_literal().
+_COMMENT_SAFE = re.compile(r"[A-Za-z0-9 ._+,:=@%~/-]")
+
+
+def c_comment_text(s):
+    """s for a C comment: every character outside [A-Za-z0-9 ._+,:=@%~/-]
+    (quotes, backslashes, '*', '?', newlines, control and non-ASCII characters)
+    replaced by '_', so it can neither end the comment ("*/"), splice a line
+    ("\\", the trigraph "??/") nor start a new one."""
+    return "".join(c if _COMMENT_SAFE.fullmatch(c) else "_" for c in s)
+
+
+def c_string_literal(s):
+    """s (UTF-8) as a C string literal, quotes included, that reads back as
+    exactly its bytes: '"', '\\' and '?' (trigraphs) escaped, every byte
+    outside printable ASCII as a three-digit octal escape."""
+    out = []
+    for b in s.encode("utf-8", "surrogateescape"):
+        c = chr(b)
+        if c in '"\\?':
+            out.append("\\" + c)
+        elif 0x20 <= b < 0x7F:
+            out.append(c)
+        else:
+            out.append("\\%03o" % b)
+    return '"' + "".join(out) + '"'
+
+
+def write_atomic(path, text):
+    """Writes text to path through a temporary file in its folder, renamed onto
+    it only when the whole text is written: a failed generation leaves the old
+    file as it was (and no temporary file)."""
+    import tempfile
+    d = os.path.dirname(os.path.abspath(path))
+    os.makedirs(d, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".tmp-", dir=d)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
 def c_float(x):
     """A C float literal that round-trips exactly to the float32 nearest x."""
     import numpy as np

@@ -273,22 +273,27 @@ class ToolsTest(unittest.TestCase):
         self.assertNotIn("ccw", s)
 
     def test_make_demo_passes_the_circle_quoted(self):
-        # make demo RADIUS_M=... FEED=... DIR=...: each value one argument of br_demo_circle, whatever it holds
-        import shlex
-        root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+        # make demo RADIUS_M=... FEED=... DIR=...: each value one argument of br_demo_circle, whatever it holds,
+        # passed as data (the environment's BR_MK_*), never recipe text (docs/tools.md, "Inputs that cannot inject")
+        root = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
         env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MAKELEVEL", "MFLAGS", "DIR")}
-        evil = "1e-4'; touch pwned; '"
-        r = subprocess.run(["make", "-n", "-C", root, "demo", "RADIUS_M=" + evil, "FEED=300 x", "DIR=both"],
-                           capture_output=True, text=True, env=env, timeout=120)
+        evil = "1e-4'; touch pwned-demo; '"
+        vals = ["RADIUS_M=" + evil, "FEED=300 x", "DIR=both"]
+        r = subprocess.run(["make", "-n", "-C", root, "demo"] + vals, capture_output=True, text=True, env=env,
+                           timeout=120)
         self.assertEqual(r.returncode, 0, r.stderr)
         line = next(ln for ln in r.stdout.splitlines() if "br_demo_circle --out" in ln)
-        argv = shlex.split(line)
-        self.assertEqual(argv[argv.index("--radius-m") + 1], evil)
-        self.assertEqual(argv[argv.index("--feed-mm-min") + 1], "300 x")
-        self.assertEqual(argv[argv.index("--dir") + 1], "both")
-        r = subprocess.run(["make", "-n", "-C", root, "demo"], capture_output=True, text=True, env=env, timeout=120)
-        line = next(ln for ln in r.stdout.splitlines() if "br_demo_circle --out" in ln)
-        self.assertEqual(shlex.split(line)[1:], ["--out", "out/demo"])  # without them: the thesis's circle
+        self.assertNotIn("pwned", line)
+        # the arguments the recipe's shell builds from DEMO_ARGS, one NUL-terminated each
+        argv_rule = "br-demo-argv: ; @for a in $(DEMO_ARGS); do printf '%s\\0' \"$$a\"; done"
+        r = subprocess.run(["make", "-s", "-C", root, "--eval", argv_rule, "br-demo-argv"] + vals, capture_output=True,
+                           text=True, env=env, timeout=120)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout.split("\0")[:-1], ["--radius-m=" + evil, "--feed-mm-min=300 x", "--dir=both"])
+        self.assertFalse(os.path.exists(os.path.join(root, "pwned-demo")))
+        r = subprocess.run(["make", "-s", "-C", root, "--eval", argv_rule, "br-demo-argv"], capture_output=True,
+                           text=True, env=env, timeout=120)
+        self.assertEqual(r.stdout, "")  # without them: the thesis's circle
 
     def test_pf_study_bounds(self):
         table = os.path.join(self.w, "t.bin")

@@ -6,8 +6,11 @@
 #ifndef BR_GEN_MACHINE_H
 #define BR_GEN_MACHINE_H
 
-/* the machine description these values come from */
+/* the machine description these values come from: its path (relative to the
+ * repository when inside it) as a C string, and the same with every character
+ * outside [A-Za-z0-9 ._+,:=@%~/-] replaced by _, for a generated comment */
 #define BR_MACHINE_FILE "machines/reference.json"
+#define BR_MACHINE_FILE_COMMENT "machines/reference.json"
 /* L = lead / (2 pi), m/rad */
 #define BR_MACHINE_LEAD_MPRAD (0.0012732395447351628)
 #define BR_MACHINE_LEAD_MPRAD_F (1.273239497e-03f)
