@@ -28,6 +28,9 @@ import sys
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from runs import fault_text, faulted  # noqa: E402
+
 # the hidden causes (br_simlog / br_circle_ext options) and what they stand for
 CASES = (
     ("offset", ["--offset", "2.5"], "2.5 N constant force (tilted axis)"),
@@ -61,7 +64,7 @@ def run(cmd, **kw):
 
 def fault_t(run_):
     """the time the firmware stopped the axis safe, None without a fault"""
-    return run_["fault_t_s"] if run_["fault_status"] else None
+    return run_["fault_t_s"] if faulted(run_) else None
 
 
 def fault_note(t_s):
@@ -76,8 +79,8 @@ def fig(v):
 def cell(v, outliers, run_):
     """a table cell: the RMS of a run that went to the end (with its outlier steps), or the
     fault's time and cause in its place: a faulted run is never an RMS beside full runs"""
-    if run_["fault_status"]:
-        return f"safe stop at {run_['fault_t_s']:.3f} s ({run_.get('fault_cause', 'unknown')})"
+    if faulted(run_):
+        return fault_text(run_)
     return f"{v:.3e} m" + (f" ({outliers} outlier steps)" if outliers else "")
 
 
@@ -149,9 +152,8 @@ def main():
                      f"{fault_note(row['filtered_fault_extended'])}" if "filtered_extended" in row else ""),
                   flush=True)
             for k in ("hinf_only", "hinf_true"):
-                if c[k]["fault_status"]:
-                    fails.append(f"{cause}, {E}: {k} faulted at {c[k]['fault_t_s']:.3f} s "
-                                 f"({c[k].get('fault_cause', 'unknown')}): not a result")
+                if faulted(c[k]):
+                    fails.append(f"{cause}, {E}: {k}: {fault_text(c[k])}, not a result")
             # a cause the circle barely feels (a gradient over its 0.2 mm) moves the
             # result by the filter's path-to-path spread only: NOT_WORSE allows that
             better = row["fault_extended"] is None and (row["fault_nominal"] is not None
@@ -199,8 +201,8 @@ def main():
                 head += " extended model, filtered estimate (lead 0) |"
             L += [f"## H-inf + {E}", "", head, "|---|---|---|---|---|---|---|" + ("---|" if both else "")]
             for r in rows[est]:
-                faulted = r["fault_nominal"] is not None or r["fault_extended"] is not None
-                ch = "—" if faulted else f"{100.0 * (r['est_extended'] / r['est_nominal'] - 1.0):+.0f} %"
+                any_fault = r["fault_nominal"] is not None or r["fault_extended"] is not None
+                ch = "—" if any_fault else f"{100.0 * (r['est_extended'] / r['est_nominal'] - 1.0):+.0f} %"
                 line = (f"| {r['cause']}: {r['what']} | {r['verdict']} | {fig(r['hinf_only'])} | {fig(r['hinf_true'])} | "
                         f"{cell(r['est_nominal'], r['outliers_nominal'], r['run_nominal'])} | "
                         f"{cell(r['est_extended'], r['outliers_extended'], r['run_extended'])} | {ch} |")

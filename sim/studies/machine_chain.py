@@ -36,6 +36,9 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from runs import fault_text, faulted  # noqa: E402
+
 BEGIN, END = "<!-- chain:begin -->", "<!-- chain:end -->"
 TRACK = (("pd", "the log's PD controller"), ("hinf_only", "H-infinity only"),
          ("hinf_pf", "H-infinity + PF, nominal model"), ("hinf_pf_ext", "H-infinity + PF, extended model"),
@@ -133,15 +136,10 @@ def plot_track(work, names, path):
     fig.savefig(path, dpi=110)
 
 
-def faulted(r):
-    """the firmware stopped the axis: the run ended early, its figures are no result (docs/tools.md)"""
-    return r.get("fault_status", 0) != 0
-
-
 def cells(r, rms_key, max_key, ref):
     """the row's figures, or the fault (time, cause) in their place"""
     if faulted(r):
-        return "fault at %.3f s (%s) | — | —" % (r["fault_t_s"], r.get("fault_cause", "unknown"))
+        return fault_text(r) + " | — | —"
     ratio = "%.3f" % (r[rms_key] / ref) if ref else "—"
     return "%.3e m | %.3e m | %s" % (r[rms_key], r[max_key], ratio)
 

@@ -16,6 +16,7 @@ from multiprocessing import Pool
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from robustness import reference, run_figures  # noqa: E402
+from runs import fault_text, faulted  # noqa: E402
 
 # (name, plant parameter changes (factor on the reference, or an added cause), run options)
 CASES = [
@@ -81,14 +82,14 @@ def main():
 
     def cell(r):
         # a faulted run is its fault (time, cause), never an RMS beside full runs (docs/tools.md)
-        if r["fault_status"]:
-            return f"safe stop at {r['fault_t_s']:.3f} s ({r.get('fault_cause', 'unknown')})"
+        if faulted(r):
+            return fault_text(r)
         s = f"{r['contour_rms_m']:.3e} m"
         return s + (f" ({r['outlier_steps']} outlier steps)" if r["outlier_steps"] else "")
 
     def ratio_of(r):
         pf, ukf = r["hinf_pf"], r["hinf_ukf"]
-        return None if pf["fault_status"] or ukf["fault_status"] else pf["contour_rms_m"] / ukf["contour_rms_m"]
+        return None if faulted(pf) or faulted(ukf) else pf["contour_rms_m"] / ukf["contour_rms_m"]
     for r in rows:
         if "error" in r:
             L.append(f"| {r['name']} | error: {r['error']} | | | |")

@@ -30,6 +30,9 @@ from multiprocessing import Pool
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from runs import faulted  # noqa: E402
+
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DURATION_S = 8.0           # the circle's length (br_circle_cfg_thesis)
 LOST_OUTLIER_FRAC = 0.01   # outlier steps above 1 % of the axis-periods: lock lost (re-anchoring over and over)
@@ -149,7 +152,7 @@ def one_plant(job):
 def lost(run_, hinf):
     """lock lost: a safe stop, outliers in more than LOST_OUTLIER_FRAC of the axis-periods (the
     filter re-anchors over and over), or a contour RMS worse than H-inf only's"""
-    if run_["fault_status"] != 0:
+    if faulted(run_):
         return "fault"
     if run_["outlier_steps"] > LOST_OUTLIER_FRAC * 2 * run_["n_samples"]:
         return "persistent_outliers"
@@ -160,7 +163,7 @@ def lost(run_, hinf):
 
 def harmful(run_, hinf_m):
     """an estimator run that went on (no safe stop) with a contour RMS above H-inf only's hinf_m"""
-    return run_["fault_status"] == 0 and hinf_m is not None and run_["contour_rms_m"] > hinf_m
+    return not faulted(run_) and hinf_m is not None and run_["contour_rms_m"] > hinf_m
 
 
 def safety_failures(good):
@@ -184,9 +187,8 @@ def wilcoxon(a, b):
 
 
 def completed(run_):
-    """a run that went to the end: a faulted run (the firmware stopped the axis) is a fault with its
-    time and cause, never an RMS beside full runs (its contour_rms_m is null, docs/tools.md)"""
-    return run_.get("fault_status", 0) == 0 and run_.get("contour_rms_m") is not None
+    """a run that went to the end (runs.faulted: a faulted run's contour_rms_m is null)"""
+    return not faulted(run_)
 
 
 def summarise(recs):
