@@ -233,8 +233,8 @@ void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t 
     if (id->k < UINT32_MAX) {
         id->k++;
     }
-    if (id->k < id->warmup || !scored) {
-        return; /* no decision on a period that brought no evidence */
+    if (id->k < id->warmup) {
+        return;
     }
     /* (dly6) the best candidate takes over when its sum is below switch_ratio times the
      * sum of the one in use ... */
