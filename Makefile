@@ -49,10 +49,11 @@ export BR_MK_EMPS_LOG := $(EMPS_LOG)
 export BR_MK_RADIUS_M := $(RADIUS_M)
 export BR_MK_FEED     := $(FEED)
 export BR_MK_DIR      := $(DIR)
+export BR_MK_MAX_FEV  := $(value MAX_FEV)
 # the counts: digits only (they are written into recipes)
 _nodigits = $(subst 0,,$(subst 1,,$(subst 2,,$(subst 3,,$(subst 4,,$(subst 5,,$(subst 6,,$(subst 7,,$(subst 8,,$(subst 9,,$(1)))))))))))
 _check_count = $(if $(value $(1)),$(if $(or $(call _nodigits,$(value $(1))),$(filter-out 1,$(words $(value $(1))))),$(error $(1) must be a whole number)))
-$(foreach v,JOBS N DIAGNOSE_FIRST DL_N DL_N_VERIFY DL_N_NOMINAL DL_JOBS FUZZ_SECONDS MUTANTS_BUDGET,$(call _check_count,$(v)))
+$(foreach v,JOBS N DIAGNOSE_FIRST DL_N DL_N_VERIFY DL_N_NOMINAL DL_JOBS FUZZ_SECONDS MUTANTS_BUDGET MAX_FEV,$(call _check_count,$(v)))
 # The board whose firmware image `make firmware` / `make test` build and size:
 # its CMakeLists (hal/<board>/) writes into <build>/board-<board>.txt the image's path, its
 # part's flash size (KiB) and its RAM regions (NAME:ORIGIN:KiB).
@@ -129,7 +130,7 @@ help:
 	@echo "  make robustness [N=200] [DIAGNOSE_FIRST=K]  Monte Carlo over N plants around the reference machine -> $(ROBUST_OUT), docs/robustness-results.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
-	@echo "  make tune      Nelder-Mead tuning of the PF and UKF noise (regenerates firmware/gen/bristle_gen/est/)"
+	@echo "  make tune [MACHINE=<json>] [MAX_FEV=n]  Nelder-Mead tuning of the PF and UKF noise (the reference: regenerates firmware/gen/bristle_gen/est/; another machine: its build folder's tune/, with tune/machine.json; docs/tuning.md)"
 	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
 	@echo "  make fuzz [FUZZ_SECONDS=600]  every libFuzzer target (clang, ASan + UBSan) for that long (ctest runs 20 s each)"
 	@echo "  make mutants [MUTANTS_BUDGET=s]  the mutation check: C set + cosmic-ray on the diagnosis -> out/mutants (docs/mutants.md)"
@@ -176,13 +177,29 @@ demo: deps
 # Nelder-Mead tuning of the PF's and the UKF's noise variances on the circle
 # (thesis section 3.2): regenerates firmware/gen/bristle_gen/est/br_{pf,ukf}_tuned.h, with the
 # progress logs and thesis Fig. 1 in $(TUNE_OUT). docs/tuning.md.
+# `make tune MACHINE=<file>` tunes another machine (docs/tuning.md, "Another
+# machine"): a host-release build for it in its build folder (build_dir.py),
+# the tuned headers, logs and a copy of the machine file with the tuned
+# settings (tuned_machine.py) in <folder>/tune/, nothing in the source tree.
 tune: deps
+ifeq ($(MACHINE),)
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)mkdir -p $(TUNE_OUT)
 	$(Q)build/host-release/sim/br_tune_est --est ukf --out firmware/gen/bristle_gen/est/br_ukf_tuned.h --log $(TUNE_OUT)/ukf.csv
 	$(Q)build/host-release/sim/br_tune_est --est pf --out firmware/gen/bristle_gen/est/br_pf_tuned.h --log $(TUNE_OUT)/pf.csv
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_tuning.py $(TUNE_OUT)/fig1_tuning.png $(TUNE_OUT)/pf.csv:"H-inf + PF" $(TUNE_OUT)/ukf.csv:"H-inf + UKF"
+else
+	$(Q)dir="$$($(PYTHON) firmware/design/build_dir.py host-release "$$BR_MK_MACHINE")"; abs="$$(realpath -- "$$BR_MK_MACHINE")"; \
+	echo "== configure $$dir (BR_MACHINE=$$abs)"; \
+	log="$$(cmake --preset host-release -B "$$dir" "-DBR_MACHINE=$$abs" 2>&1)" || { echo "$$log"; echo "configure $$dir failed" >&2; exit 1; }; \
+	cmake --build "$$dir" --target br_tune_est $(NINJA_QUIET); \
+	mkdir -p "$$dir/tune"; \
+	"$$dir/sim/br_tune_est" --est ukf --out "$$dir/tune/br_ukf_tuned.h" --log "$$dir/tune/ukf.csv" $${BR_MK_MAX_FEV:+--max-fev "$$BR_MK_MAX_FEV"}; \
+	"$$dir/sim/br_tune_est" --est pf --out "$$dir/tune/br_pf_tuned.h" --log "$$dir/tune/pf.csv" $${BR_MK_MAX_FEV:+--max-fev "$$BR_MK_MAX_FEV"}; \
+	$(PYTHON) firmware/design/tuned_machine.py --machine "$$abs" --pf "$$dir/tune/br_pf_tuned.h" \
+	  --ukf "$$dir/tune/br_ukf_tuned.h" --out "$$dir/tune/machine.json"
+endif
 
 # Thesis Figs. 1-8 into docs/figures/ and docs/results.md (about 12 min: the
 # tunings, the sampling-time study, the demo; progress is printed).

@@ -107,8 +107,11 @@ def model_meta(mp):
 
 
 def est_section(name):
-    """The machine file's estimator settings (estimator.pf or .ukf)."""
-    return machine_module().load_or_exit(MACHINE_JSON)["estimator"][name]
+    """The machine file's estimator settings (estimator.pf or .ukf) with their
+    per-step values (the loader's est_per_step: machine-file.md)."""
+    mm = machine_module()
+    mach = mm.load_or_exit(MACHINE_JSON)
+    return mach["estimator"][name], mm.est_per_step(mach, name)
 
 
 def pf_cfg(m, f32):
@@ -118,15 +121,14 @@ def pf_cfg(m, f32):
     1500-particle tuning loses lock every few steps at m = 128), fixed here,
     independent of later tuning of the demo. All values float32-exact."""
     rpc = m["rad_per_count"]
-    e = est_section("pf")
-    x0 = e["x0_std"]
+    e, ps = est_section("pf")
     table, crc = noise_table()
     cfg = rpf.PfCfg(
         model=model_params_f32(m, f32), dt=f32(EST_DT), m=PF_M,
         q_var=(f32(rpc * rpc), f32(5.0e-6), f32(1.0e-14), f32(1.0)),
-        r_var=f32(10.0 * rpc * rpc), gp0=f32(e["gp0_N"]),
-        x0_std=(f32(x0["theta_counts"] * rpc), f32(x0["omega_rad_per_s"]), f32(x0["z_m"]), f32(x0["gp_N"])),
-        gp_min=f32(e["gp_min_N"]), gp_max=f32(e["gp_max_N"]),
+        r_var=f32(10.0 * rpc * rpc), gp0=f32(ps["gp0_N"]),
+        x0_std=(f32(ps["x0_theta_counts"] * rpc), f32(ps["x0_omega_radps"]), f32(ps["x0_z_m"]), f32(ps["x0_gp_N"])),
+        gp_min=f32(ps["gp_min_N"]), gp_max=f32(ps["gp_max_N"]),
         outlier_sigma=f32(e["outlier_gate_sigma"]), reanchor_after=e["reanchor_after"],
         rad_per_count=f32(rpc), noise=table, noise_skip=e["noise_skip"])
     return cfg, crc
@@ -215,15 +217,14 @@ def ukf_cfg(m, f32):
     defaults of docs/modules/ukf.md) at the input's 1.5 ms. All values
     float32-exact."""
     rpc = f32(m["rad_per_count"])
-    e = est_section("ukf")
-    q, p0 = e["q_var"], e["p0_var"]
+    e, ps = est_section("ukf")
     return rukf.UkfCfg(
         model=model_params_f32(m, f32), dt=f32(EST_DT),
-        q_var=(f32(q["theta_rad2"]), f32(q["omega_rad2_per_s2"]), f32(q["z_m2"]), f32(q["gp_N2"])),
-        r_var=f32(e["r_var_counts2"] * rpc * rpc), gp0=f32(e["gp0_N"]),
-        p0_var=(f32(p0["theta_counts2"] * rpc * rpc), f32(p0["omega_rad2_per_s2"]), f32(p0["z_m2"]),
-                f32(p0["gp_N2"])),
-        gp_min=f32(e["gp_min_N"]), gp_max=f32(e["gp_max_N"]), outlier_sigma=f32(e["outlier_gate_sigma"]),
+        q_var=(f32(ps["q_theta_rad2"]), f32(ps["q_omega_rad2ps2"]), f32(ps["q_z_m2"]), f32(ps["q_gp_N2"])),
+        r_var=f32(ps["r_counts2"] * rpc * rpc), gp0=f32(ps["gp0_N"]),
+        p0_var=(f32(ps["p0_theta_counts2"] * rpc * rpc), f32(ps["p0_omega_rad2ps2"]), f32(ps["p0_z_m2"]),
+                f32(ps["p0_gp_N2"])),
+        gp_min=f32(ps["gp_min_N"]), gp_max=f32(ps["gp_max_N"]), outlier_sigma=f32(e["outlier_gate_sigma"]),
         reanchor_after=e["reanchor_after"], rad_per_count=rpc, alpha=f32(e["alpha"]), beta=f32(e["beta"]),
         kappa=f32(e["kappa"]))
 

@@ -83,56 +83,60 @@ def render_causes(m):
 
 
 def est_fields(m):
+    """The estimators' settings as the firmware takes them: per step, in its
+    state's units, from the file's physical ones (machine.est_per_step)."""
     pf, ukf = m["estimator"]["pf"], m["estimator"]["ukf"]
+    P, U = machine.est_per_step(m, "pf"), machine.est_per_step(m, "ukf")
     out = [("BR_EST_PF_PERIOD_S", pf["period_s"], "the PF's period (its loop runs at it)"),
            ("BR_EST_PF_PERIOD_NS", int(round(pf["period_s"] * 1e9)), "the same in whole nanoseconds (an MCU tick)"),
            ("BR_EST_PF_N_PARTICLES", pf["n_particles"], "particle count")]
-    for k, c in (("theta_counts2", "Q_THETA_COUNTS2"), ("omega_rad2_per_s2", "Q_OMEGA_RAD2PS2"),
-                 ("z_m2", "Q_Z_M2"), ("gp_N2", "Q_GP_N2")):
-        out.append(("BR_EST_PF_" + c, pf["q_var"][k], "process noise variance per step"))
-    out.append(("BR_EST_PF_R_COUNTS2", pf["r_var_counts2"], "measurement noise variance"))
-    for k, c in (("theta_counts", "X0_STD_THETA_COUNTS"), ("omega_rad_per_s", "X0_STD_OMEGA_RADPS"),
-                 ("z_m", "X0_STD_Z_M"), ("gp_N", "X0_STD_GP_N")):
-        out.append(("BR_EST_PF_" + c, pf["x0_std"][k], "initial spread"))
-    out += gate_fields("PF", pf)
+    for k, c in (("q_theta_counts2", "Q_THETA_COUNTS2"), ("q_omega_rad2ps2", "Q_OMEGA_RAD2PS2"),
+                 ("q_z_m2", "Q_Z_M2"), ("q_gp_N2", "Q_GP_N2")):
+        out.append(("BR_EST_PF_" + c, P[k], "process noise variance per step"))
+    out.append(("BR_EST_PF_R_COUNTS2", P["r_counts2"], "measurement noise variance (the quantisation's 1/12 and the rest)"))
+    for k, c in (("x0_theta_counts", "X0_STD_THETA_COUNTS"), ("x0_omega_radps", "X0_STD_OMEGA_RADPS"),
+                 ("x0_z_m", "X0_STD_Z_M"), ("x0_gp_N", "X0_STD_GP_N")):
+        out.append(("BR_EST_PF_" + c, P[k], "initial spread"))
+    out += gate_fields("PF", pf, P)
     out.append(("BR_EST_PF_NOISE_SKIP", pf["noise_skip"], "extra noise-table advance per step"))
     out += [("BR_EST_PF_ADAPT_NIS_REF", pf["adapt"]["nis_ref"], "innovation-driven noise of omega, z and g_p (0: off)"),
-            ("BR_EST_PF_ADAPT_ALPHA", pf["adapt"]["alpha"], "its NIS smoothing per step"),
+            ("BR_EST_PF_ADAPT_ALPHA", P["adapt_alpha"], "its NIS smoothing per step (period / tau_s)"),
             ("BR_EST_PF_ADAPT_MAX_SCALE", pf["adapt"]["max_scale"], "its largest variance factor")]
-    for k, c in (("theta_rad2", "Q_THETA_RAD2"), ("omega_rad2_per_s2", "Q_OMEGA_RAD2PS2"),
-                 ("z_m2", "Q_Z_M2"), ("gp_N2", "Q_GP_N2")):
-        out.append(("BR_EST_UKF_" + c, ukf["q_var"][k], "process noise variance per step"))
-    out.append(("BR_EST_UKF_R_COUNTS2", ukf["r_var_counts2"], "measurement noise variance"))
-    for k, c in (("theta_counts2", "P0_THETA_COUNTS2"), ("omega_rad2_per_s2", "P0_OMEGA_RAD2PS2"),
-                 ("z_m2", "P0_Z_M2"), ("gp_N2", "P0_GP_N2")):
-        out.append(("BR_EST_UKF_" + c, ukf["p0_var"][k], "initial (and recovery) variance"))
-    out += gate_fields("UKF", ukf)
+    for k, c in (("q_theta_rad2", "Q_THETA_RAD2"), ("q_omega_rad2ps2", "Q_OMEGA_RAD2PS2"),
+                 ("q_z_m2", "Q_Z_M2"), ("q_gp_N2", "Q_GP_N2")):
+        out.append(("BR_EST_UKF_" + c, U[k], "process noise variance per step"))
+    out.append(("BR_EST_UKF_R_COUNTS2", U["r_counts2"], "measurement noise variance (the quantisation's 1/12 and the rest)"))
+    for k, c in (("p0_theta_counts2", "P0_THETA_COUNTS2"), ("p0_omega_rad2ps2", "P0_OMEGA_RAD2PS2"),
+                 ("p0_z_m2", "P0_Z_M2"), ("p0_gp_N2", "P0_GP_N2")):
+        out.append(("BR_EST_UKF_" + c, U[k], "initial (and recovery) variance"))
+    out += gate_fields("UKF", ukf, U)
     out += [("BR_EST_UKF_ALPHA", ukf["alpha"], "sigma-point spread"),
             ("BR_EST_UKF_BETA", ukf["beta"], "prior-distribution weight"),
             ("BR_EST_UKF_KAPPA", ukf["kappa"], "secondary scaling")]
     return out
 
 
-def delay_id_fields(E, e):
+def delay_id_fields(E, e, per_step):
     """An estimator's delay identification (absent: off, 0 candidates)."""
     d = e.get("delay_id") or {}
     P = "BR_EST_%s_DELAY_ID_" % E
     return [(P + "CANDIDATES", d.get("candidates", 0), "delay identification: candidates (0: off)"),
             (P + "STEP_S", d.get("step_s", 0.0), "their spacing"),
-            (P + "Q_FORCE_N2PS", d.get("q_force_N2_per_s", 0.0), "friction random walk per second"),
+            (P + "Q_FORCE_N2PS", per_step["dlyid_q_force_N2ps"], "friction random walk per second"),
             (P + "MEMORY_S", d.get("memory_s", 0.0), "forgetting time constant"),
             (P + "WARMUP_S", d.get("warmup_s", 0.0), "no switch before"),
             (P + "SWITCH_RATIO", d.get("switch_ratio", 0.0), "switch below this ratio")]
 
 
-def gate_fields(E, e):
-    return [("BR_EST_%s_GP0_N" % E, e["gp0_N"], "initial g_p"),
-            ("BR_EST_%s_GP_MIN_N" % E, e["gp_min_N"], "g_p range"),
-            ("BR_EST_%s_GP_MAX_N" % E, e["gp_max_N"], ""),
+def gate_fields(E, e, per_step):
+    return [("BR_EST_%s_GP0_N" % E, per_step["gp0_N"], "initial g_p"),
+            ("BR_EST_%s_GP_MIN_N" % E, per_step["gp_min_N"], "g_p range"),
+            ("BR_EST_%s_GP_MAX_N" % E, per_step["gp_max_N"], ""),
             ("BR_EST_%s_OUTLIER_SIGMA" % E, e["outlier_gate_sigma"], "outlier gate, standard deviations"),
             ("BR_EST_%s_REANCHOR_AFTER" % E, e["reanchor_after"], "consecutive outliers before re-anchoring"),
             ("BR_EST_%s_COMP_AHEAD_PERIODS" % E, e["comp_ahead_periods"],
-             "compensation lead beyond the actuator delay, periods (0: the filtered estimate)")] + delay_id_fields(E, e)
+             "compensation lead beyond the actuator delay, periods (0: the filtered estimate)")] + \
+        delay_id_fields(E, e, per_step)
 
 
 def render_defines(fields):
@@ -175,6 +179,7 @@ def render_est(m):
         "/* generated by firmware/design/gen_machine.py from %s -- do not edit */" % machine.c_comment_text(m["file"]),
         "/* SPDX-License-Identifier: Apache-2.0 */",
         "/* The estimators' settings of the machine description (its \"estimator\" section):",
+        " * per step, converted from the file's physical units by machine.est_per_step:",
         " * double and exact float (_F) literals, counts as unsigned integers. Variances",
         " * in counts^2 and spreads in counts are multiplied by BR_MACHINE_RAD_PER_COUNT_F",
         " * (squared) where the configuration is built (sim/circle/br_circle_est.c). */",
@@ -192,14 +197,11 @@ def render_tuned(m, est):
     variances, in the units and float32 arithmetic of the configuration."""
     f32 = np.float32
     rpc = f32(machine.params(m)["rad_per_count"])
-    e = m["estimator"][est]
-    r = f32(e["r_var_counts2"]) * rpc * rpc
-    q = e["q_var"]
-    if est == "pf":
-        vals = [("q_omega", q["omega_rad2_per_s2"]), ("q_z", q["z_m2"]), ("q_gp", q["gp_N2"]), ("r", r)]
-    else:
-        vals = [("q_theta", q["theta_rad2"]), ("q_omega", q["omega_rad2_per_s2"]), ("q_z", q["z_m2"]),
-                ("q_gp", q["gp_N2"]), ("r", r)]
+    e = machine.est_per_step(m, est)
+    r = f32(e["r_counts2"]) * rpc * rpc
+    vals = [("q_omega", e["q_omega_rad2ps2"]), ("q_z", e["q_z_m2"]), ("q_gp", e["q_gp_N2"]), ("r", r)]
+    if est == "ukf":
+        vals = [("q_theta", e["q_theta_rad2"])] + vals
     E = est.upper()
     out = ["/* generated by firmware/design/gen_machine.py from %s -- do not edit */" % machine.c_comment_text(m["file"]),
            "/* SPDX-License-Identifier: Apache-2.0 */",

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Machine description (machines/*.json, format version 1): loader, validator
+"""Machine description (machines/*.json, format version 2): loader, validator
 and the values derived from it. Documented field by field in
 docs/machine-file.md; the reference machine is machines/reference.json.
 
@@ -14,6 +14,7 @@ import json
 import math
 import os
 import re
+import struct
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -27,7 +28,9 @@ REFERENCE_MACHINE = os.path.join(MACHINES_DIR, "reference.json")
 # generated headers: one root on the include path, one folder per kind below bristle_gen/
 GEN_DIR = os.path.join(REPO_ROOT, "firmware", "gen")
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+# format 1 held the estimators' settings per step and in encoder counts; upgrade_machine.py converts it
+FORMAT_UPGRADE = "python firmware/design/upgrade_machine.py OLD.json NEW.json"
 # BR_PF_MAX_PARTICLES of firmware/include/bristle/br_pf.h
 PF_MAX_PARTICLES = 2048
 # BR_EST_AHEAD_MAX_PERIODS of firmware/include/bristle/br_est.h
@@ -133,24 +136,32 @@ def _kind(v):
             type(None): "null"}.get(type(v), type(v).__name__)
 
 
-def _variances(doc_theta, theta_name, theta_rng):
-    """Process-noise variances per step of x = [theta, omega, z, g_p]."""
+def _process_noise():
+    """Process noise of x = [theta, omega, z, g_p], each a variance per second in
+    units that hold across machines (docs/machine-file.md, "Estimator settings in
+    physical units"); est_per_step() turns them into the per-step variances."""
     return {
-        theta_name: Num(theta_rng[0], theta_rng[1], doc_theta),
-        "omega_rad2_per_s2": Num(0.0, 1.0e3, "omega, per step"),
-        "z_m2": Num(0.0, 1.0e-6, "bristle deflection z, per step"),
-        "gp_N2": Num(0.0, 1.0e6, "g_p, per step"),
+        "theta_m2_per_s": Num(0.0, 1.0, "table position random walk, m^2 per second"),
+        "force_Fs2_s": Num(0.0, 1.0e6, "unmodelled force on the table, white, its density in Fs^2 s "
+                           "(Fs: friction.Fs_N): omega's process noise"),
+        "z_zs2_per_s": Num(0.0, 1.0e9, "bristle deflection random walk, in zs^2 per second "
+                           "(zs = Fs_N / sigma0_Npm, the deflection at breakaway)"),
+        "gp_Fs2_per_s": Num(0.0, 1.0e9, "g_p random walk, in Fs^2 per second"),
     }
 
 
 def _gates():
     return {
-        "gp0_N": Num(0.0, 1.0e5, "initial g_p (friction level the filter starts from)", lo_open=True),
-        "gp_min_N": Num(0.0, 1.0e5, "g_p is kept >= this", lo_open=True),
-        "gp_max_N": Num(0.0, 1.0e5, "g_p is kept <= this", lo_open=True),
+        "gp0_Fs": Num(0.0, 100.0, "initial g_p (the friction level the filter starts from), in Fs", lo_open=True),
+        "gp_min_Fc": Num(0.0, 100.0, "g_p is kept >= this, in Fc (friction.Fc_N)", lo_open=True),
+        "gp_max_Fs": Num(0.0, 100.0, "g_p is kept <= this, in Fs", lo_open=True),
+        "position_noise_m2": Num(0.0, 1.0, "measurement noise of the position beyond the encoder's quantisation "
+                                 "(interpolation and scale error, the model's position error over a period): "
+                                 "R = 1/12 count^2 + this"),
         "outlier_gate_sigma": Num(0.0, 1.0e4, "a measurement further than this many standard deviations "
                                   "is an outlier", lo_open=True),
-        "reanchor_after": Int(1, 1000, "consecutive outliers before the filter is re-anchored on the measurement"),
+        "reanchor_after": Int(1, 1000, "consecutive outliers before the filter is re-anchored on the measurement "
+                              "(a count: how unlikely that many in a row are by chance)"),
         "comp_ahead_periods": Num(0.0, EST_AHEAD_MAX_PERIODS, "0: compensate the filtered estimate (the thesis); "
                                   "> 0: the force predicted over the actuator delay and this many periods "
                                   "beyond it (docs/modules/est.md)"),
@@ -158,8 +169,8 @@ def _gates():
         "delay_id": Optional({
             "candidates": Int(2, DLYID_MAX_CAND, "candidate delays 0, step_s, ..., (candidates - 1) step_s"),
             "step_s": Num(0.0, 0.1, "their spacing", lo_open=True),
-            "q_force_N2_per_s": Num(0.0, 1.0e12, "the identifying filters' friction random walk, "
-                                    "variance per second", lo_open=True),
+            "q_force_Fs2_per_s": Num(0.0, 1.0e9, "the identifying filters' friction random walk, "
+                                     "variance per second, in Fs^2", lo_open=True),
             "memory_s": Num(0.0, 100.0, "time constant of the innovations' forgotten sums", lo_open=True),
             "warmup_s": Num(0.0, 100.0, "no switch before this time after the first measurement"),
             "switch_ratio": Num(0.0, 1.0, "switch when the best candidate's sum is below this times the sum "
@@ -237,31 +248,31 @@ SCHEMA = {
         "pf": dict({
             "period_s": Num(1.0e-5, 0.1, "the PF's (and its loop's) period"),
             "n_particles": Int(1, PF_MAX_PARTICLES, "particle count m"),
-            "q_var": _variances("theta, per step, in counts^2 (times rad_per_count^2)",
-                                "theta_counts2", (0.0, 1.0e6)),
-            "r_var_counts2": Num(0.0, 1.0e6, "measurement noise variance R", lo_open=True),
+            "process_noise": _process_noise(),
             "x0_std": {
-                "theta_counts": Num(0.0, 1.0e6, "initial spread of theta around the first measurement"),
-                "omega_rad_per_s": Num(0.0, 1.0e3, "of omega around 0"),
-                "z_m": Num(0.0, 1.0e-3, "of z around 0"),
-                "gp_N": Num(0.0, 1.0e5, "of g_p around gp0_N"),
+                "theta_m": Num(0.0, 1.0, "initial spread of theta around the first measurement beyond the "
+                               "count's quantisation: std = sqrt(1/12 count^2 + theta_m^2)"),
+                "speed_mps": Num(0.0, 100.0, "of the table speed around 0"),
+                "z_zs": Num(0.0, 1.0e3, "of z around 0, in zs"),
+                "gp_Fs": Num(0.0, 100.0, "of g_p around its initial value, in Fs"),
             },
             "noise_skip": Int(0, 1024, "extra ROM noise-table advance per step (docs/modules/pf.md)"),
             "adapt": {
                 "nis_ref": Num(0.0, 1.0e6, "innovation-driven noise of omega, z and g_p: the smoothed NIS above which "
                                "it grows; 0 = off (the thesis filter; docs/modules/pf.md)"),
-                "alpha": Num(0.0, 1.0, "smoothing of the NIS per measured step", lo_open=True),
+                "tau_s": Num(0.0, 100.0, "time constant of the NIS smoothing (per measured step "
+                             "alpha = period_s / tau_s)", lo_open=True),
                 "max_scale": Num(1.0, 1.0e12, "largest factor on the variances of omega, z and g_p"),
             },
         }, **_gates()),
         "ukf": dict({
-            "q_var": _variances("theta, per step", "theta_rad2", (0.0, 1.0)),
-            "r_var_counts2": Num(0.0, 1.0e6, "measurement noise variance R", lo_open=True),
+            "process_noise": _process_noise(),
             "p0_var": {
-                "theta_counts2": Num(0.0, 1.0e6, "initial (and recovery) variance of theta", lo_open=True),
-                "omega_rad2_per_s2": Num(0.0, 1.0e6, "of omega", lo_open=True),
-                "z_m2": Num(0.0, 1.0, "of z", lo_open=True),
-                "gp_N2": Num(0.0, 1.0e8, "of g_p", lo_open=True),
+                "theta_m2": Num(0.0, 1.0, "initial (and recovery) variance of theta beyond the count's "
+                                "quantisation: 1/12 count^2 + this"),
+                "speed_m2_per_s2": Num(0.0, 1.0e4, "of the table speed", lo_open=True),
+                "z_zs2": Num(0.0, 1.0e6, "of z, in zs^2", lo_open=True),
+                "gp_Fs2": Num(0.0, 1.0e4, "of g_p, in Fs^2", lo_open=True),
             },
             "alpha": Num(0.1, 1.0, "sigma-point spread"),
             "beta": Num(0.0, 10.0, "prior-distribution weight (2 for a Gaussian)"),
@@ -351,11 +362,17 @@ def _cross_checks(m, errors):
          "control.estimator", "names an estimator twice")
     for est in ("pf", "ukf"):
         e = "estimator.%s." % est
-        need([e + "gp_min_N", e + "gp_max_N"], lambda: get(e + "gp_min_N") < get(e + "gp_max_N"),
-             e + "gp_max_N", "must be > %sgp_min_N" % e)
-        need([e + "gp_min_N", e + "gp_max_N", e + "gp0_N"],
-             lambda: get(e + "gp_min_N") <= get(e + "gp0_N") <= get(e + "gp_max_N"),
-             e + "gp0_N", "must lie in [%sgp_min_N, %sgp_max_N]" % (e, e))
+        lvl = ["friction.Fc_N", "friction.Fs_N"]
+        need(lvl + [e + "gp_min_Fc", e + "gp_max_Fs"],
+             lambda: get(e + "gp_min_Fc") * get("friction.Fc_N") < get(e + "gp_max_Fs") * get("friction.Fs_N"),
+             e + "gp_max_Fs", "gp_max_Fs * Fs_N must be > %sgp_min_Fc * Fc_N" % e)
+        need(lvl + [e + "gp_min_Fc", e + "gp_max_Fs", e + "gp0_Fs"],
+             lambda: (get(e + "gp_min_Fc") * get("friction.Fc_N") <= get(e + "gp0_Fs") * get("friction.Fs_N")
+                      <= get(e + "gp_max_Fs") * get("friction.Fs_N")),
+             e + "gp0_Fs", "gp0_Fs * Fs_N must lie in [gp_min_Fc * Fc_N, gp_max_Fs * Fs_N]")
+    need(["estimator.pf.adapt.tau_s", "estimator.pf.period_s"],
+         lambda: get("estimator.pf.adapt.tau_s") >= get("estimator.pf.period_s"),
+         "estimator.pf.adapt.tau_s", "must be >= estimator.pf.period_s (alpha = period_s / tau_s <= 1)")
     # each estimator's delay identification: its largest candidate within its command history
     for est, name in (("pf", "estimator.pf.period_s"), ("ukf", "control.period_s")):
         d = "estimator.%s.delay_id." % est
@@ -392,11 +409,15 @@ def load(path=REFERENCE_MACHINE):
         raise MachineError(["%s: not valid JSON: line %d column %d: %s" % (name, e.lineno, e.colno, e.msg)])
     errors = []
     if isinstance(raw, dict) and "format_version" in raw and raw["format_version"] != FORMAT_VERSION:
-        raise MachineError(["%s: field format_version: %r is not a version this loader reads (%d)"
-                            % (name, raw["format_version"], FORMAT_VERSION)])
+        hint = ("; format 1's estimator settings were per step and in encoder counts: convert the file with "
+                + FORMAT_UPGRADE) if raw["format_version"] == 1 else ""
+        raise MachineError(["%s: field format_version: %r is not a version this loader reads (%d)%s"
+                            % (name, raw["format_version"], FORMAT_VERSION, hint)])
     m = _walk(SCHEMA, raw, "", errors)
     if not errors:
         _cross_checks(m, errors)
+    if not errors:
+        _per_step_checks(m, errors)
     if errors:
         raise MachineError(["%s: field %s: %s" % (name, p or "(top level)", problem) for p, problem in errors])
     m["file"] = name
@@ -436,6 +457,191 @@ def params(m):
     p["rad_per_count"] = 2.0 * math.pi / p["counts_per_rev"]
     return p
 
+
+
+# --- the estimators' settings per step (docs/machine-file.md, "Estimator settings in physical units") ---
+# The file states them per second, in metres, and relative to the machine's own
+# friction levels, so that one set holds across machines; the firmware takes
+# variances per step in its state's units (theta in rad; R, the initial spread
+# and the recovery variance of theta in counts, multiplied by rad_per_count
+# where the configuration is built: firmware/include/bristle/br_machine_cfg.h).
+# With T the estimator's period, L = lead / 2 pi, Jeff = J + L^2 M, mpc = L
+# rad_per_count (metres per count), zs = Fs / sigma0:
+#   q_theta  = theta_m2_per_s T / L^2                       (rad^2; the PF: / mpc^2 in counts^2)
+#   q_omega  = force_Fs2_s Fs^2 L^2 T / Jeff^2               (a white force on the table, eq. 6)
+#   q_z      = z_zs2_per_s zs^2 T,   q_gp = gp_Fs2_per_s Fs^2 T
+#   R        = 1/12 + position_noise_m2 / mpc^2              (counts^2: the quantisation plus the rest)
+#   g_p      = gp0_Fs Fs in [gp_min_Fc Fc, gp_max_Fs Fs]
+QUANT_COUNTS2 = 1.0 / 12.0  # variance of a uniform quantisation of one count
+
+
+def _scales(m, est):
+    p = params(m)
+    T = m["estimator"]["pf"]["period_s"] if est == "pf" else m["control"]["period_s"]
+    mpc = p["L_mprad"] * p["rad_per_count"]
+    zs = p["Fs_N"] / p["sigma0_Npm"]
+    return p, T, mpc, zs
+
+
+def est_per_step(m, est):
+    """Estimator est's ("pf" or "ukf") settings as the firmware takes them:
+    {"q_theta_counts2" (PF) or "q_theta_rad2" (UKF), "q_omega_rad2ps2", "q_z_m2",
+    "q_gp_N2", "r_counts2", "gp0_N", "gp_min_N", "gp_max_N", "dlyid_q_force_N2ps",
+    and the PF's "x0_theta_counts", "x0_omega_radps", "x0_z_m", "x0_gp_N",
+    "adapt_alpha", or the UKF's "p0_theta_counts2", "p0_omega_rad2ps2", "p0_z_m2",
+    "p0_gp_N2"} (float64)."""
+    p, T, mpc, zs = _scales(m, est)
+    e = m["estimator"][est]
+    L, Fs, Fc = p["L_mprad"], p["Fs_N"], p["Fc_N"]
+    q = e["process_noise"]
+    out = {
+        "q_omega_rad2ps2": q["force_Fs2_s"] * Fs * Fs * L * L * T / (p["Jeff_kgm2"] * p["Jeff_kgm2"]),
+        "q_z_m2": q["z_zs2_per_s"] * zs * zs * T,
+        "q_gp_N2": q["gp_Fs2_per_s"] * Fs * Fs * T,
+        "r_counts2": QUANT_COUNTS2 + e["position_noise_m2"] / (mpc * mpc),
+        "gp0_N": e["gp0_Fs"] * Fs, "gp_min_N": e["gp_min_Fc"] * Fc, "gp_max_N": e["gp_max_Fs"] * Fs,
+        "dlyid_q_force_N2ps": (e.get("delay_id") or {}).get("q_force_Fs2_per_s", 0.0) * Fs * Fs,
+    }
+    if est == "pf":
+        x0 = e["x0_std"]
+        out.update({
+            "q_theta_counts2": q["theta_m2_per_s"] * T / (mpc * mpc),
+            "x0_theta_counts": math.sqrt(QUANT_COUNTS2 + (x0["theta_m"] / mpc) ** 2),
+            "x0_omega_radps": x0["speed_mps"] / L, "x0_z_m": x0["z_zs"] * zs, "x0_gp_N": x0["gp_Fs"] * Fs,
+            "adapt_alpha": T / e["adapt"]["tau_s"],
+        })
+    else:
+        p0 = e["p0_var"]
+        out.update({
+            "q_theta_rad2": q["theta_m2_per_s"] * T / (L * L),
+            "p0_theta_counts2": QUANT_COUNTS2 + p0["theta_m2"] / (mpc * mpc),
+            "p0_omega_rad2ps2": p0["speed_m2_per_s2"] / (L * L), "p0_z_m2": p0["z_zs2"] * zs * zs,
+            "p0_gp_N2": p0["gp_Fs2"] * Fs * Fs,
+        })
+    return out
+
+
+def est_physical(m, est, per_step):
+    """The inverse of est_per_step for the values per_step holds: the machine
+    file's fields (dotted paths under estimator.<est>.) that give them on
+    machine m. Raises ValueError for a value the file cannot state (a variance
+    of theta below the quantisation's)."""
+    p, T, mpc, zs = _scales(m, est)
+    L, Fs, Fc = p["L_mprad"], p["Fs_N"], p["Fc_N"]
+    J2 = p["Jeff_kgm2"] * p["Jeff_kgm2"]
+
+    def above_quant(v, name):
+        if v < QUANT_COUNTS2:
+            raise ValueError("%s %.6g count^2 is below the quantisation's 1/12 count^2" % (name, v))
+        return (v - QUANT_COUNTS2) * mpc * mpc
+    inv = {
+        "q_theta_counts2": lambda v: v * mpc * mpc / T,
+        "q_theta_rad2": lambda v: v * L * L / T,
+        "q_omega_rad2ps2": lambda v: v * J2 / (Fs * Fs * L * L * T),
+        "q_z_m2": lambda v: v / (zs * zs * T),
+        "q_gp_N2": lambda v: v / (Fs * Fs * T),
+        "r_counts2": lambda v: above_quant(v, "R"),
+        "gp0_N": lambda v: v / Fs, "gp_min_N": lambda v: v / Fc,
+        "gp_max_N": lambda v: v / Fs,
+        "dlyid_q_force_N2ps": lambda v: v / (Fs * Fs),
+        "x0_theta_counts": lambda v: math.sqrt(above_quant(v * v, "the initial variance")),
+        "x0_omega_radps": lambda v: v * L, "x0_z_m": lambda v: v / zs,
+        "x0_gp_N": lambda v: v / Fs, "adapt_alpha": lambda v: T / v,
+        "p0_theta_counts2": lambda v: above_quant(v, "P0"),
+        "p0_omega_rad2ps2": lambda v: v * L * L,
+        "p0_z_m2": lambda v: v / (zs * zs), "p0_gp_N2": lambda v: v / (Fs * Fs),
+    }
+    return {PER_STEP_FIELD[k]: inv[k](v) for k, v in per_step.items()}
+
+
+# the file's field (under estimator.<est>.) each per-step value comes from
+PER_STEP_FIELD = {
+    "q_theta_counts2": "process_noise.theta_m2_per_s", "q_theta_rad2": "process_noise.theta_m2_per_s",
+    "q_omega_rad2ps2": "process_noise.force_Fs2_s", "q_z_m2": "process_noise.z_zs2_per_s",
+    "q_gp_N2": "process_noise.gp_Fs2_per_s", "r_counts2": "position_noise_m2", "gp0_N": "gp0_Fs",
+    "gp_min_N": "gp_min_Fc", "gp_max_N": "gp_max_Fs", "dlyid_q_force_N2ps": "delay_id.q_force_Fs2_per_s",
+    "x0_theta_counts": "x0_std.theta_m", "x0_omega_radps": "x0_std.speed_mps", "x0_z_m": "x0_std.z_zs",
+    "x0_gp_N": "x0_std.gp_Fs", "adapt_alpha": "adapt.tau_s", "p0_theta_counts2": "p0_var.theta_m2",
+    "p0_omega_rad2ps2": "p0_var.speed_m2_per_s2", "p0_z_m2": "p0_var.z_zs2", "p0_gp_N2": "p0_var.gp_Fs2",
+}
+
+
+def _put(d, dotted, v):
+    ks = dotted.split(".")
+    for k in ks[:-1]:
+        d = d.setdefault(k, {})
+    d[ks[-1]] = v
+
+
+def _get(d, dotted):
+    for k in dotted.split("."):
+        d = d[k]
+    return d
+
+
+def set_est_per_step(raw, est, per_step):
+    """Writes into raw (a file's dict, its machine fields complete) the
+    settings under estimator.<est> that give per_step's values, each with the
+    fewest significant digits that give the same float32 per-step value on
+    this machine (a readable file, the firmware's values unchanged). Returns
+    the dotted fields written; raises ValueError when a value cannot be
+    stated (est_physical) or does not come back."""
+    e = raw["estimator"][est]
+    phys = est_physical(raw, est, per_step)
+    for field, v in phys.items():
+        _put(e, field, v)
+    for key, target in per_step.items():
+        field = PER_STEP_FIELD[key]
+
+        def same(r):
+            _put(e, field, r)
+            return float32(est_per_step(raw, est)[key]) == float32(target)
+        full = _get(e, field)
+        for digits in range(1, 18):
+            if same(float("%.*g" % (digits, full))):
+                break
+        else:
+            if not same(full):
+                raise ValueError("estimator.%s.%s does not give %s back" % (est, field, key))
+    return ["estimator.%s.%s" % (est, f) for f in phys]
+
+
+def float32(v):
+    """v rounded to the nearest float32 (as the generated _F literals are)."""
+    return struct.unpack("f", struct.pack("f", v))[0]
+
+
+# the firmware's bounds on the per-step values (br_est_cfg_check, br_pf_init, br_ukf_init):
+# the per-step key, the file's field it comes from, lo, hi, 0 allowed
+_PER_STEP_BOUNDS = {
+    "pf": [("q_theta_counts2", "process_noise.theta_m2_per_s", 0.0, 1.0e6, True),
+           ("x0_theta_counts", "x0_std.theta_m", 0.0, 1.0e6, True),
+           ("x0_omega_radps", "x0_std.speed_mps", 0.0, 1.0e3, True),
+           ("x0_z_m", "x0_std.z_zs", 0.0, 1.0e-3, True), ("x0_gp_N", "x0_std.gp_Fs", 0.0, 1.0e5, True)],
+    "ukf": [("q_theta_rad2", "process_noise.theta_m2_per_s", 0.0, 1.0, True),
+            ("p0_theta_counts2", "p0_var.theta_m2", 0.0, 1.0e6, False),
+            ("p0_omega_rad2ps2", "p0_var.speed_m2_per_s2", 0.0, 1.0e6, False),
+            ("p0_z_m2", "p0_var.z_zs2", 0.0, 1.0, False), ("p0_gp_N2", "p0_var.gp_Fs2", 0.0, 1.0e8, False)],
+    "both": [("q_omega_rad2ps2", "process_noise.force_Fs2_s", 0.0, 1.0e3, True),
+             ("q_z_m2", "process_noise.z_zs2_per_s", 0.0, 1.0e-6, True),
+             ("q_gp_N2", "process_noise.gp_Fs2_per_s", 0.0, 1.0e6, True),
+             ("r_counts2", "position_noise_m2", 0.0, 1.0e6, False)],
+}
+FLOAT32_MIN_NORMAL = 1.1754943508222875e-38
+
+
+def _per_step_checks(m, errors):
+    """Each per-step value within the firmware's bounds, a normal float32 (no
+    subnormal) when not 0; a problem is named by the file's field it comes from."""
+    for est in ("pf", "ukf"):
+        v = est_per_step(m, est)
+        for key, field, lo, hi, zero_ok in _PER_STEP_BOUNDS[est] + _PER_STEP_BOUNDS["both"]:
+            x = v[key]
+            bad = (x == 0.0 and not zero_ok) or (x != 0.0 and not FLOAT32_MIN_NORMAL <= x <= hi) or x < lo
+            if bad:
+                errors.append(("estimator.%s.%s" % (est, field), "gives %s = %.6g per step on this machine, "
+                               "outside the firmware's %s[%g, %g]" % (key, x, "" if zero_ok else "(0 excluded) ",
+                                                                         lo, hi)))
 
 # --- text that generated C embeds (docs/tools.md, "Inputs that cannot inject") ---
 # A path or a field never goes into generated C as it is: into a comment only

@@ -38,10 +38,11 @@ COMPENSATED = ("hinf_ukf", "hinf_pf", "hinf_true")  # errors in nm: their own pa
 STARTUP_S = 1.0   # Fig. 8 looks for its transition after the start-up
 REVERSAL_WIN_S = 0.5  # ... within this of an axis reversal
 MAGNIFY = 10.0  # radial error magnification in the trajectory plot
-# the PF's g_p clamp (machines/reference.json, estimator.pf.gp_min_N / gp_max_N)
-with open(os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
-                       "machines", "reference.json")) as _f:
-    _pf = json.load(_f)["estimator"]["pf"]
+# the PF's g_p clamp (machines/reference.json, estimator.pf.gp_min_Fc / gp_max_Fs, in N)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                                "firmware", "design"))
+import machine  # noqa: E402
+_pf = machine.est_per_step(machine.load_or_exit(machine.REFERENCE_MACHINE), "pf")
 GP_CLAMPS_N = (_pf["gp_min_N"], _pf["gp_max_N"])
 
 

@@ -4,7 +4,7 @@
 paths and fields given to the Makefile and to the header generators are data,
 never shell, make or C text.
 
-- every make target that takes a path or a value (firmware MACHINE=, diagnose
+- every make target that takes a path or a value (firmware MACHINE=, tune MACHINE=, diagnose
   LOG= OUT= MACHINE=, validate MODEL= LOG=, emps EMPS_LOG=, demo RADIUS_M=
   FEED= DIR=) run as `make -n` with values that hold a double and a single
   quote, a backtick, $(...), make's $(shell ...), "*/" and a newline, each
@@ -89,7 +89,7 @@ def heavy_copy(folder, name=None):
 
 def check_make(markers):
     # what each target takes (a hostile value for each, one marker tag per variable)
-    cases = [("firmware", ["MACHINE"]), ("diagnose", ["LOG", "OUT", "MACHINE"]), ("validate", ["MODEL", "LOG"]),
+    cases = [("firmware", ["MACHINE"]), ("tune", ["MACHINE"]), ("diagnose", ["LOG", "OUT", "MACHINE"]), ("validate", ["MODEL", "LOG"]),
              ("emps", ["EMPS_LOG"]), ("demo", ["RADIUS_M", "FEED", "DIR"])]
     for target, names in cases:
         for extra in ([], ["BOARD=stm32g4"]) if target == "firmware" else ([],):

@@ -11,6 +11,7 @@ import argparse
 import copy
 import glob
 import json
+import math
 import os
 import re
 import subprocess
@@ -111,14 +112,16 @@ def main():
     bad = copy.deepcopy(good)
     bad["friction"]["Fs_N"] = 0.5 * bad["friction"]["Fc_N"]
     bad["control"]["torque_limit_Nm"] = 2.0 * bad["amplifier"]["torque_per_duty_Nm"]
-    bad["estimator"]["ukf"]["gp0_N"] = 2.0 * bad["estimator"]["ukf"]["gp_max_N"]
+    bad["estimator"]["ukf"]["gp0_Fs"] = 2.0 * bad["estimator"]["ukf"]["gp_max_Fs"]
+    bad["estimator"]["pf"]["adapt"]["tau_s"] = 0.5 * bad["estimator"]["pf"]["period_s"]
     for est in ("pf", "ukf"):
         bad["estimator"][est]["delay_id"]["step_s"] = 0.1  # 7 x 0.1 s: beyond 62 periods of either period
     expect_errors(work, "cross.json", bad, ["field friction.Fs_N: must be >= friction.Fc_N (7 N)",
                                             "field control.torque_limit_Nm: must be <= amplifier.duty_limit * "
                                             "amplifier.torque_per_duty_Nm",
-                                            "field estimator.ukf.gp0_N: must lie in [estimator.ukf.gp_min_N, "
-                                            "estimator.ukf.gp_max_N]",
+                                            "field estimator.ukf.gp0_Fs: gp0_Fs * Fs_N must lie in "
+                                            "[gp_min_Fc * Fc_N, gp_max_Fs * Fs_N]",
+                                            "field estimator.pf.adapt.tau_s: must be >= estimator.pf.period_s (alpha = period_s / tau_s <= 1)",
                                             "field estimator.pf.delay_id.step_s: (candidates - 1) * step_s must be "
                                             "<= %d periods of estimator.pf.period_s" % machine.EST_DELAY_MAX_PERIODS,
                                             "field estimator.ukf.delay_id.step_s: (candidates - 1) * step_s must be "
@@ -139,8 +142,24 @@ def main():
     check(machine.provenance(m, "friction.Fc_N") == "identified" and machine.provenance(m, "friction.Fs_N") == "given",
           "provenance: a listed field has its kind, an unlisted one is given")
     bad = copy.deepcopy(good)
-    bad["format_version"] = 2
-    expect_errors(work, "version.json", bad, ["field format_version: 2 is not a version this loader reads (1)"])
+    bad["format_version"] = 3
+    expect_errors(work, "version.json", bad, ["field format_version: 3 is not a version this loader reads (2)"])
+    bad["format_version"] = 1
+    expect_errors(work, "version1.json", bad, ["field format_version: 1 is not a version this loader reads (2); "
+                                               "format 1's estimator settings were per step and in encoder counts: "
+                                               "convert the file with " + machine.FORMAT_UPGRADE])
+    # a physical setting whose per-step value the firmware refuses is named by the file's field
+    bad = copy.deepcopy(good)
+    bad["estimator"]["pf"]["process_noise"]["z_zs2_per_s"] = 1.0e9
+    bad["estimator"]["ukf"]["p0_var"]["speed_m2_per_s2"] = 1.0e-60
+    fr, lead = good["friction"], good["mechanics"]["lead_m_per_rev"]
+    q_z = 1.0e9 * (fr["Fs_N"] / fr["sigma0_Npm"]) ** 2 * good["estimator"]["pf"]["period_s"]
+    p0_om = 1.0e-60 / (lead / (2.0 * math.pi)) ** 2
+    expect_errors(work, "per-step.json", bad, [
+        "field estimator.pf.process_noise.z_zs2_per_s: gives q_z_m2 = %.6g per step on this machine, outside the "
+        "firmware's [0, 1e-06]" % q_z,
+        "field estimator.ukf.p0_var.speed_m2_per_s2: gives p0_omega_rad2ps2 = %.6g per step on this machine, outside "
+        "the firmware's (0 excluded) [0, 1e+06]" % p0_om])
     path = write(work, "syntax.json", "{\n  \"name\": \"x\",\n}\n")
     rc, err = run("machine.py", path)
     check(rc == 1 and err.startswith("%s: not valid JSON: line 3" % machine.display_name(path))

@@ -196,7 +196,7 @@ def parser(prog="bristle-diagnose"):
     d.add_argument("--out", required=True, metavar="DIR",
                    help="output directory (created if needed; existing files in it are replaced)")
     d.add_argument("--machine", metavar="JSON",
-                   help="the log's controller file, or a firmware machine file (format 1) whose values "
+                   help="the log's controller file, or a firmware machine file (format 2) whose values "
                         "machine.json takes; default: <log>.machine.json beside the log, else a file of "
                         "bristle/diagnose/machines/ listing the log's name")
     d.add_argument("--fc", type=float, default=signals.FC_HZ, metavar="HZ",

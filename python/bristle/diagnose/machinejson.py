@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: Apache-2.0
-"""machine.json: the firmware machine file (firmware/design/machine.py, format 1) a
+"""machine.json: the firmware machine file (firmware/design/machine.py, format 2) a
 diagnosis writes beside model.json (docs/machine-file.md, "provenance";
 docs/configure.md).
 
 What a log identifies goes in from the extended model (model.json "params"
 and "causes"), what it cannot identify (lead or encoder, amplifier, control
 design, estimator settings, limits) from the given machine file (--machine,
-when it is a format-1 machine file), else from machines/reference.json and
+when it is a machine file), else from machines/reference.json and
 marked "assumed"; what follows from the log and the rest is "derived". The
 "provenance" block lists every value that is not "given":
 
@@ -23,8 +23,10 @@ marked "assumed"; what follows from the log and the rest is "derived". The
                    these keep the base's values ("assumed"; Fs_N scaled by the
                    base's Fs/Fc if the base's would be below Fc)
   causes           model.json's causes and their parameters, same names ("identified")
-  estimator g_p    the g_p settings scaled from the base by Fs / Fs_base
-                   (variances by its square): "derived"
+  estimator        the base's, as they are: format 2 states them in the
+                   machine's own units (per second, in metres, in Fs, Fc and
+                   Fs/sigma0), so they follow the identified friction and
+                   encoder by themselves (docs/machine-file.md)
 """
 import copy
 import importlib
@@ -57,7 +59,7 @@ def _loader():
 
 
 def is_machine_file(path):
-    """True when path is a format-1 machine file (it has "format_version"),
+    """True when path is a machine file (it has "format_version"),
     not the diagnosis's controller file (python/bristle/diagnose/machines/)."""
     try:
         with open(path, encoding="utf-8-sig") as f:
@@ -68,7 +70,7 @@ def is_machine_file(path):
 
 
 def given(path):
-    """path when it is a format-1 machine file, checked (ControllerError with
+    """path when it is a machine file, checked (ControllerError with
     the loader's "FILE: field ...: problem" lines when it is not valid); None
     when path is None or another file (the diagnosis's controller file)."""
     if path is None or not is_machine_file(path):
@@ -202,17 +204,6 @@ def build(prep, diag, given=None, log_path=None):
     for c in causes_.of(diag.extended.causes):
         for q in c.PARAMS:
             _set(m, "causes.%s.%s" % (c.NAME, q.name), p[q.name], prov, "identified")
-
-    # the estimators' friction-level settings follow the friction
-    s = fr["Fs_N"] / base_fr["Fs_N"]
-    if abs(s - 1.0) > 1e-9:
-        est = m["estimator"]
-        for e in ("pf", "ukf"):
-            for f in ("gp0_N", "gp_min_N", "gp_max_N"):
-                _set(m, "estimator.%s.%s" % (e, f), est[e][f] * s, prov, "derived")
-            _set(m, "estimator.%s.q_var.gp_N2" % e, est[e]["q_var"]["gp_N2"] * s * s, prov, "derived")
-        _set(m, "estimator.pf.x0_std.gp_N", est["pf"]["x0_std"]["gp_N"] * s, prov, "derived")
-        _set(m, "estimator.ukf.p0_var.gp_N2", est["ukf"]["p0_var"]["gp_N2"] * s * s, prov, "derived")
 
     log_name = os.path.basename(log_path or prep.path)
     if given is None:
