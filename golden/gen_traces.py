@@ -33,13 +33,16 @@ from ref import model as rmodel  # noqa: E402
 from ref import plant as rplant  # noqa: E402
 import gen_est_traces  # noqa: E402
 import gen_ext_traces  # noqa: E402
+import gen_gms_traces  # noqa: E402
 
 SEED = 20240611  # base seed; trace i uses SEED + i (recorded in each header)
 SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                # estimator traces (gen_est_traces.py): one recorded input, one seed
                "est_input": 6, "pf": 6, "pf_w": 6, "pf_x": 6, "ukf": 6,
                # the extended model (gen_ext_traces.py)
-               "model_ext": 7}
+               "model_ext": 7,
+               # the Maxwell-slip plant (gen_gms_traces.py)
+               "plant_gms": 8, "plant_gms_clamp": 9}
 
 DT = 1.0e-3
 INT32_MAX = 2**31 - 1
@@ -384,9 +387,8 @@ def run_plant(p, x0, duties):
     return rows
 
 
-def gen_plant(out_dir, m):
-    rng = np.random.default_rng(SEED + SEED_OFFSET["plant"])
-    p = rplant.PlantParams.from_machine(m, PLANT_NSUB)
+def plant_duties(m, rng):
+    """The plant traces' duty profile (float32-exact)."""
     L = m["L_mprad"]
     d_cruise = L * (m["sigma2_Nspm"] * 0.05 + m["Fc_N"]) / m["tau_per_duty_Nm"]
     d = []
@@ -402,7 +404,15 @@ def gen_plant(out_dir, m):
     d += [-d_cruise] * 150
     d += [0.0] * 300                                               # coast to rest
     d += [0.03 * rng.standard_normal() for _ in range(200)]        # dither
-    d = [f32(v) for v in d]
+    return [f32(v) for v in d]
+
+
+def gen_plant(out_dir, m):
+    rng = np.random.default_rng(SEED + SEED_OFFSET["plant"])
+    p = rplant.PlantParams.from_machine(m, PLANT_NSUB)
+    L = m["L_mprad"]
+    d_cruise = L * (m["sigma2_Nspm"] * 0.05 + m["Fc_N"]) / m["tau_per_duty_Nm"]
+    d = plant_duties(m, rng)
     x0 = (0.0, 0.0, 0.0)
     rows = run_plant(p, x0, d)
     out = [write_trace(out_dir, "plant", plant_meta(m, x0), PLANT_COLUMNS, rows, [
@@ -434,6 +444,7 @@ def main(argv=None):
     paths += gen_plant(args.out, m)
     paths += gen_est_traces.generate(args.out, m, sys.modules[__name__])
     paths.append(gen_ext_traces.generate(args.out, m, sys.modules[__name__]))
+    paths += gen_gms_traces.generate(args.out, m, sys.modules[__name__])
     for pth in paths:
         print("wrote", os.path.relpath(pth))
     return 0

@@ -3,14 +3,23 @@
  * controller of thesis section 5, the static friction feedforward and the
  * true-friction limit; first on the plant the estimators model exactly (the
  * reference machine), then on the realistic plant (br_circle_cfg_realistic:
- * parameters away from the model, drift and noise).
+ * parameters away from the model, drift and noise), then on the hardware-like
+ * plant (br_circle_cfg_hardware_like: Maxwell-slip presliding, a friction
+ * outside the estimators' model class).
  *
  * Usage: br_demo_circle --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N]
  *                       [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]
+ *                       [--hw-law slip|clamp] [--hw-c-mps C]
  * Writes DIR/trace_<name>.csv per controller, DIR/gp_hist_hinf_pf.csv (the PF's
  * g_p particle histogram per step), the same with the prefix real_ for the
- * realistic plant, and DIR/summary.json (the realistic plant's under
- * "realistic"); prints the tables.
+ * realistic plant and hw_ for the hardware-like one, and DIR/summary.json (the
+ * realistic plant's under "realistic", the hardware-like one's under
+ * "hardware_like"); prints the tables. A run on the hardware-like plant that
+ * the firmware stopped is printed and written as a fault (time, cause; its
+ * figures null, br_run_report.h); on the two LuGre plants every run must go
+ * to the end, or nothing is written.
+ * --hw-law, --hw-c-mps: the hardware-like plant's Maxwell-slip law (default
+ * the slip law) and its attraction rate C (default BR_CIRCLE_HW_C_MPS).
  * --radius-m, --feed-mm-min, --dir: the circle (br_circle_args.h; default the
  * thesis's, clockwise); --dir both runs every controller clockwise, then
  * counter-clockwise into trace_ccw_<name>.csv, trace_real_ccw_<name>.csv and
@@ -37,6 +46,10 @@
 #include "tools/br_tool_limits.h"
 
 #define TOOL "br_demo_circle"
+
+/* --hw-c-mps bounds: from a relaxation far slower than the circle to the clamp's neighbourhood */
+#define HW_C_MIN_MPS 1.0e-5
+#define HW_C_MAX_MPS 10.0
 
 /* g_p histogram of the PF's particles: bins of BR_HIST_W_N from 0 N. */
 #define BR_HIST_BINS 60
@@ -80,9 +93,11 @@ static void demo_sink(void *user, const br_circle_sample_t *s)
 }
 
 /* the outputs, as temporary files until every run succeeded (br_outfile.h) */
-/* the two plants: [0] the reference machine (the estimators' model), [1] the realistic one */
-#define N_PLANTS 2
-static const char *const plant_prefix[N_PLANTS] = {"", "real_"};
+/* the plants: [0] the reference machine (the estimators' model), [1] the realistic one,
+ * [2] the hardware-like one (Maxwell-slip presliding) */
+#define N_PLANTS 3
+#define PLANT_HW 2
+static const char *const plant_prefix[N_PLANTS] = {"", "real_", "hw_"};
 /* the directions of a run: [0] the one --dir names (files unprefixed), [1] with
  * --dir both the counter-clockwise one */
 #define N_DIRS 2
@@ -134,13 +149,16 @@ typedef struct {
     long pf_prop; /* -1: the machine's */
     double ahead; /* < 0: the machine's */
     br_circle_path_t path; /* the circle (default the thesis's) */
+    int hw_clamp;          /* the hardware-like plant's clamp limit instead of the slip law */
+    double hw_c_mps;       /* its slip law's C (<= 0: BR_CIRCLE_HW_C_MPS) */
 } opts_t;
 
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
-            "       [--ahead P] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n" BR_ARGS_COMMON_USAGE
+            "       [--ahead P] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
+            "       [--hw-law slip|clamp] [--hw-c-mps C]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
             "  --gains K0,K1,K2    the H-inf gains instead of the generated ones\n"
@@ -151,9 +169,12 @@ static int usage(const char *argv0, FILE *to)
             "  --ahead P           the estimators' compensation lead, periods past the delay\n"
             "                      (est.comp_ahead_periods, 0 .. %g; docs/modules/est.md)\n"
             BR_CIRCLE_USAGE("--dir cw|ccw|both  ") "                      (both: each controller both ways, the ISO 230-4 pair; --direction the same)\n"
+            "  --hw-law slip|clamp the hardware-like plant's Maxwell-slip law (default slip, docs/demo.md)\n"
+            "  --hw-c-mps C        its slip law's attraction rate C, m/s (default %g, %g .. %g)\n"
             "bounds: --dt %g .. %g s, --nsub 1 .. %d, |gain| <= %g, --radius-m %g .. %g m,\n"
             "        --feed-mm-min %g .. %g, a revolution %g .. %g s (docs/tools.md)\n",
-            argv0, argv0, (double)BR_EST_AHEAD_MAX_PERIODS, BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX,
+            argv0, argv0, (double)BR_EST_AHEAD_MAX_PERIODS, BR_CIRCLE_HW_C_MPS, HW_C_MIN_MPS, HW_C_MAX_MPS,
+            BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX,
             BR_TOOL_GAIN_MAX, BR_TOOL_RADIUS_MIN_M, BR_TOOL_RADIUS_MAX_M, BR_TOOL_FEED_MIN_MM_MIN,
             BR_TOOL_FEED_MAX_MM_MIN, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S);
     return 2;
@@ -178,6 +199,8 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"nsub", required_argument, NULL, 'n'},
                                          {"pf-proposal", required_argument, NULL, 'p'},
                                          {"ahead", required_argument, NULL, 'a'},
+                                         {"hw-law", required_argument, NULL, 'w'},
+                                         {"hw-c-mps", required_argument, NULL, 'c'},
                                          BR_CIRCLE_LONGOPTS BR_CIRCLE_LONGOPT_DIR{NULL, 0, NULL, 0}};
     br_args_t p;
     const int st = br_args_begin(&p, TOOL, argc, argv);
@@ -199,6 +222,12 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'p': bad = br_arg_long(TOOL, p.opt, val, 0, (long)BR_PF_PROPOSAL_OPT_HELD, &o->pf_prop); break;
         case 'a': bad = br_arg_double(TOOL, p.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &o->ahead); break;
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, p.opt, val, 1, &o->path); break;
+        case 'w':
+            o->hw_clamp = strcmp(val, "clamp") == 0;
+            bad = !o->hw_clamp && strcmp(val, "slip") != 0;
+            if (bad) fprintf(stderr, "%s: --hw-law %s: slip or clamp\n", TOOL, val);
+            break;
+        case 'c': bad = br_arg_double(TOOL, p.opt, val, HW_C_MIN_MPS, HW_C_MAX_MPS, &o->hw_c_mps); break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
@@ -249,9 +278,48 @@ static void json_g(char *buf, size_t n, double v)
     }
 }
 
+/* the configuration of one run on plant pl */
+static br_circle_cfg_t plant_cfg(int pl, br_circle_ctrl_t ctrl, const opts_t *o)
+{
+    if (pl == 0) return br_circle_cfg_thesis(ctrl);
+    if (pl == 1) return br_circle_cfg_realistic(ctrl);
+    br_circle_cfg_t c = br_circle_cfg_hardware_like(ctrl);
+    if (o->hw_clamp) c.plant.gms.clamp = 1;
+    if (o->hw_c_mps > 0.0) c.plant.gms.C_mps = o->hw_c_mps;
+    return c;
+}
+
+/* the hardware-like plant's header line and its summary.json "plant" object */
+static void hw_describe(FILE *js, const opts_t *o)
+{
+    const br_circle_cfg_t c = plant_cfg(PLANT_HW, BR_CTRL_HINF_ONLY, o);
+    const br_gms_cfg_t *g = &c.plant.gms;
+    const double pre = br_gms_presliding_m(g, c.plant.Fs_N);
+    double k0 = 0.0;
+    for (int i = 0; i < g->n; i++) k0 += g->k_Npm[i];
+    char law[48];
+    if (g->clamp) snprintf(law, sizeof law, "the clamp limit");
+    else snprintf(law, sizeof law, "the slip law, C %g m/s", g->C_mps);
+    printf("\nhardware-like plant (docs/demo.md): the reference machine with Maxwell-slip presliding instead of "
+           "its LuGre: %d elements, %s,\nbreakaway at Fs", g->n, law);
+    for (int i = 0; i < g->n; i++) printf(" %.3g", 1e6 * g->alpha[i] * c.plant.Fs_N / g->k_Npm[i]);
+    printf(" um, initial stiffness %.3g N/m, presliding %.3g um; the estimators' models stay LuGre\n", k0, 1e6 * pre);
+    fprintf(js, ",\n  \"hardware_like\": {\n    \"plant\": {\"friction\": \"maxwell_slip\", \"law\": \"%s\", ",
+            g->clamp ? "clamp" : "slip");
+    if (g->clamp) fprintf(js, "\"C_mps\": null");
+    else fprintf(js, "\"C_mps\": %.6g", g->C_mps);
+    fprintf(js, ", \"delta\": %.6g, \"initial_stiffness_Npm\": %.6g, \"presliding_m\": %.6g, \"elements\": [",
+            g->delta, k0, pre);
+    for (int i = 0; i < g->n; i++)
+        fprintf(js, "%s{\"breakaway_m\": %.6g, \"share\": %.6g, \"k_Npm\": %.6g, \"sigma1_Nspm\": %.6g}",
+                i ? ", " : "", g->alpha[i] * c.plant.Fs_N / g->k_Npm[i], g->alpha[i], g->k_Npm[i],
+                g->sigma1_Nspm[i]);
+    fprintf(js, "]}");
+}
+
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, BR_CIRCLE_PATH_DEFAULT};
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -317,6 +385,8 @@ int main(int argc, char **argv)
         if (pl == 0) {
             printf("plant = the estimators' and the feedforward's model (the reference machine's numbers):"
                    " the best case, docs/demo.md\n");
+        } else if (pl == PLANT_HW) {
+            hw_describe(js, &opt);
         } else {
             const br_circle_cfg_t rc0 = br_circle_cfg_realistic(BR_CTRL_HINF_ONLY);
             const br_plant_cfg_t *rp = &rc0.plant;
@@ -348,8 +418,7 @@ int main(int argc, char **argv)
             for (unsigned r = 0; r < N_ROWS; r++) {
                 if (!selected[r]) continue;
                 const char *name = br_circle_ctrl_name(rows[r].ctrl);
-                br_circle_cfg_t cfg =
-                    pl == 0 ? br_circle_cfg_thesis(rows[r].ctrl) : br_circle_cfg_realistic(rows[r].ctrl);
+                br_circle_cfg_t cfg = plant_cfg(pl, rows[r].ctrl, &opt);
                 br_circle_use_path(&cfg, opt.path.radius_m, opt.path.feed_mps, ccw_of[d]);
                 if (opt.have_gains) memcpy(cfg.K, opt.K, sizeof opt.K);
                 if (opt.dt > 0.0) {
@@ -366,7 +435,7 @@ int main(int argc, char **argv)
                     fprintf(k.hist, "# g_p particle histogram per step: t,axis, then %d bins of %g N from 0 N\n",
                             BR_HIST_BINS, BR_HIST_W_N);
                 br_circle_result_t res;
-                if (br_circle_run(&cfg, demo_sink, &k, &res) != 0) {
+                if (br_circle_run(&cfg, demo_sink, &k, &res) < 0) {
                     fprintf(stderr, "%s: run %s failed; nothing written\n", TOOL, name);
                     discard_all(&o);
                     return 1;
@@ -376,14 +445,6 @@ int main(int argc, char **argv)
                     discard_all(&o);
                     return 1;
                 }
-                if (res.fault_status != 0) {
-                    /* the demo's runs go to the end: a faulted run is no result (docs/tools.md) */
-                    fprintf(stderr, "%s: run %s faulted at %.4f s (%s, status %d): no result; nothing written\n",
-                            TOOL, name, res.fault_t_s, br_run_fault_name(res.fault_cause), res.fault_status);
-                    discard_all(&o);
-                    return 1;
-                }
-                if (rows[r].ctrl == BR_CTRL_HINF_ONLY) rms_hinf = res.contour_rms_m;
                 char thesis_js[32] = "null", thesis[32] = "-", ratio[32] = "-";
                 if (rows[r].thesis_rms_m > 0.0) {
                     snprintf(thesis_js, sizeof thesis_js, "%.6e", rows[r].thesis_rms_m);
@@ -391,12 +452,40 @@ int main(int argc, char **argv)
                 }
                 char fname[256];
                 snprintf(fname, sizeof fname, "trace_%s%s%s.csv", plant_prefix[pl], dir_prefix[d], name);
-                fprintf(js,
-                        "%s\n%s\"%s\": {\"dt_s\": %.6g, \"contour_rms_m\": %.6e, \"max_err_m\": %.6e, "
-                        "\"thesis_contour_rms_m\": %s, \"fhat_rms_err_N\": %.6e, \"saturated_steps\": %d, "
-                        "\"outlier_steps\": %d, \"trace\": \"%s\"}",
-                        sep, ind, name, cfg.dt_s, res.contour_rms_m, res.max_err_m, thesis_js, res.fhat_rms_err_N,
-                        res.saturated_steps, res.outlier_steps, fname);
+                if (pl == PLANT_HW) {
+                    /* a plant outside the estimators' model class: a run may stop, and is then a
+                     * fault with its time and cause, never a figure (br_run_report.h) */
+                    const br_run_report_t rep = {res.contour_rms_m, res.max_err_m, res.fault_status,
+                                                 res.fault_cause, res.fault_t_s};
+                    fprintf(js, "%s\n%s\"%s\": {\"dt_s\": %.6g, ", sep, ind, name, cfg.dt_s);
+                    br_run_json(js, "contour_rms_m", "max_err_m", &rep);
+                    if (res.fault_status != 0) {
+                        fprintf(js, ", \"thesis_contour_rms_m\": %s, \"trace\": \"%s\"}", thesis_js, fname);
+                        sep = ",";
+                        printf("%-14s %8.1f   FAULT at %.4f s (%s, status %d): no result\n", rows[r].label,
+                               cfg.dt_s * 1e3, res.fault_t_s, br_run_fault_name(res.fault_cause), res.fault_status);
+                        fflush(stdout);
+                        continue;
+                    }
+                    fprintf(js,
+                            ", \"thesis_contour_rms_m\": %s, \"fhat_rms_err_N\": %.6e, \"saturated_steps\": %d, "
+                            "\"outlier_steps\": %d, \"trace\": \"%s\"}",
+                            thesis_js, res.fhat_rms_err_N, res.saturated_steps, res.outlier_steps, fname);
+                } else if (res.fault_status != 0) {
+                    /* the LuGre plants' runs go to the end: a faulted run is no result (docs/tools.md) */
+                    fprintf(stderr, "%s: run %s faulted at %.4f s (%s, status %d): no result; nothing written\n",
+                            TOOL, name, res.fault_t_s, br_run_fault_name(res.fault_cause), res.fault_status);
+                    discard_all(&o);
+                    return 1;
+                } else {
+                    fprintf(js,
+                            "%s\n%s\"%s\": {\"dt_s\": %.6g, \"contour_rms_m\": %.6e, \"max_err_m\": %.6e, "
+                            "\"thesis_contour_rms_m\": %s, \"fhat_rms_err_N\": %.6e, \"saturated_steps\": %d, "
+                            "\"outlier_steps\": %d, \"trace\": \"%s\"}",
+                            sep, ind, name, cfg.dt_s, res.contour_rms_m, res.max_err_m, thesis_js,
+                            res.fhat_rms_err_N, res.saturated_steps, res.outlier_steps, fname);
+                }
+                if (rows[r].ctrl == BR_CTRL_HINF_ONLY) rms_hinf = res.contour_rms_m;
                 sep = ",";
                 if (rms_hinf > 0.0) snprintf(ratio, sizeof ratio, "%.3f", res.contour_rms_m / rms_hinf);
                 printf("%-14s %8.1f %16.3e %16.3e %16s %12s %12.3f\n", rows[r].label, cfg.dt_s * 1e3,
@@ -405,7 +494,7 @@ int main(int argc, char **argv)
             }
             if (d == 1) fprintf(js, "\n%s}", pl == 0 ? "  " : "    ");
         }
-        if (pl == 1) fprintf(js, "\n  }");
+        if (pl > 0) fprintf(js, "\n  }");
     }
     fprintf(js, "\n}\n");
     if (commit_all(&o, selected, pf_selected, n_dirs) != 0) {

@@ -79,6 +79,17 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller);
  * machine's nominal ones; drift, force and encoder noise). */
 br_circle_cfg_t br_circle_cfg_realistic(br_circle_ctrl_t controller);
 
+/* The thesis experiment on the hardware-like plant (docs/demo.md,
+ * "Hardware-like plant"): the reference machine whose LuGre presliding is
+ * replaced by a generalized Maxwell-slip friction of the same Stribeck curve
+ * and a similar initial stiffness (plant.gms, the simulator's truth only; the
+ * estimators and the feedforward keep the machine's LuGre model). */
+br_circle_cfg_t br_circle_cfg_hardware_like(br_circle_ctrl_t controller);
+/* its element damping, each element, N s/m, and its slip law's attraction
+ * rate C, m/s (docs/demo.md, "Hardware-like plant", says why) */
+#define BR_CIRCLE_HW_SIGMA1_NSPM 2000.0
+#define BR_CIRCLE_HW_C_MPS 3.0e-3
+
 /* The estimators' and the feedforward's model from an identified one (a
  * diagnosis's model.json loaded as a plant configuration): its mass, LuGre
  * and viscous parameters and its causes (br_causes_from_model). */

@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "bristle_gen/machine/br_machine.h"
 
@@ -40,10 +41,12 @@ br_plant_cfg_t br_plant_cfg_reference(void)
     c.grad_per_m = 0.0;
     c.delay_s = 0.0;
     c.drift_per_s = 0.0;
+    /* LuGre: no Maxwell-slip elements */
+    memset(&c.gms, 0, sizeof c.gms);
     return c;
 }
 
-static double lugre_force(const br_plant_t *p);
+static double friction_force(const br_plant_t *p);
 
 static double dist_force(const br_plant_cfg_t *c, double x);
 
@@ -91,6 +94,8 @@ int br_plant_init(br_plant_t *p, const br_plant_cfg_t *cfg, const br_plant_state
     if (!isfinite(cfg->drift_per_s)) return bad("drift_per_s (must be finite)");
     if (!(isfinite(cfg->delay_s) && cfg->delay_s >= 0.0 && cfg->delay_s <= BR_PLANT_DELAY_MAX_S))
         return bad("delay_s (must be in 0..BR_PLANT_DELAY_MAX_S)");
+    const char *gms_bad = br_gms_check(&cfg->gms);
+    if (gms_bad) return bad(gms_bad);
     p->cfg = *cfg;
     p->x = *x0;
     /* eq. 1: effective inertia seen by the motor */
@@ -101,7 +106,8 @@ int br_plant_init(br_plant_t *p, const br_plant_cfg_t *cfg, const br_plant_state
     p->cmd_n = 0;
     p->cmd_pushed = 0;
     p->delay_overruns = 0;
-    p->fnl_N = lugre_force(p);
+    memset(&p->gms, 0, sizeof p->gms);
+    p->fnl_N = friction_force(p);
     /* the offset and ripple act from the start: the oracle sees them in the first period */
     p->fdist_N = br_plant_causes_on(cfg) ? dist_force(cfg, br_plant_pos_m(p)) : 0.0;
     return 0;
@@ -115,6 +121,16 @@ static double stribeck_g(const br_plant_cfg_t *c, double v)
     const double g = c->Fc_N + (c->Fs_N - c->Fc_N) * exp(-fabs(v) / c->vs_mps);
     if (v < 0.0 && c->dFc_neg_N != 0.0) return g * ((c->Fc_N + c->dFc_neg_N) / c->Fc_N);
     return g;
+}
+
+/* The Maxwell-slip elements' Stribeck level s(v) = Fc + (Fs - Fc) exp(-(|v| / vs)^delta)
+ * (presliding.md), scaled in -x like g; delta = 1 is g itself */
+static double gms_level(const br_plant_cfg_t *c, double v)
+{
+    if (c->gms.delta == 1.0) return stribeck_g(c, v);
+    const double s = c->Fc_N + (c->Fs_N - c->Fc_N) * exp(-pow(fabs(v) / c->vs_mps, c->gms.delta));
+    if (v < 0.0 && c->dFc_neg_N != 0.0) return s * ((c->Fc_N + c->dFc_neg_N) / c->Fc_N);
+    return s;
 }
 
 /* position factor of the friction, k(x) = max(0, 1 + grad_per_m x) */
@@ -137,13 +153,20 @@ static double dist_force(const br_plant_cfg_t *c, double x)
     return f;
 }
 
-/* eq. 3 at the current state (times k(x) with a gradient, s(t) with a drift) */
-static double lugre_force(const br_plant_t *p)
+/* eq. 3 at the current state, or the Maxwell-slip force (times k(x) with a
+ * gradient, s(t) with a drift) */
+static double friction_force(const br_plant_t *p)
 {
     const br_plant_cfg_t *c = &p->cfg;
     const double v = c->lead_mprad * p->x.omega_radps;
-    const double g = stribeck_g(c, v);
-    const double f = c->sigma0_Npm * p->x.z_m + c->sigma1_Nspm * (v - c->sigma0_Npm * fabs(v) * p->x.z_m / g);
+    double f;
+    if (c->gms.n > 0) {
+        /* F = sum_i (k_i z_i + sigma1_i dz_i/dt) */
+        f = br_gms_force_N(&c->gms, &p->gms, v, gms_level(c, v));
+    } else {
+        const double g = stribeck_g(c, v);
+        f = c->sigma0_Npm * p->x.z_m + c->sigma1_Nspm * (v - c->sigma0_Npm * fabs(v) * p->x.z_m / g);
+    }
     if (c->grad_per_m != 0.0 || c->drift_per_s != 0.0)
         return grad_k(c, c->lead_mprad * p->x.theta_rad) * drift_s(c, p->t_s) * f;
     return f;
@@ -183,14 +206,20 @@ static void substep(br_plant_t *p, double tau, double h, int causes, double tm)
 {
     const br_plant_cfg_t *c = &p->cfg;
     const double L = c->lead_mprad;
+    const int gms = c->gms.n > 0;
     const double w0 = p->x.omega_radps, z0 = p->x.z_m;
     double wm = w0, dth = 0.0, z1 = z0, w1 = w0;
+    br_gms_state_t g1 = p->gms;
     for (int pass = 0; pass < BR_PLANT_PASSES; pass++) {
         dth = wm * h;
         const double dx = L * dth;
-        const double g = stribeck_g(c, L * wm);
-        double zint;
-        if (dx != 0.0) {
+        double zint = 0.0, imp = 0.0;
+        if (gms) {
+            /* Maxwell-slip: every element's exact update at the held velocity;
+             * imp = integral of sum_i (k_i z_i + sigma1_i dz_i/dt) over h */
+            imp = br_gms_advance(&c->gms, &p->gms, &g1, L * wm, h, gms_level(c, L * wm));
+        } else if (dx != 0.0) {
+            const double g = stribeck_g(c, L * wm);
             /* eq. 4 solved exactly over the displacement with g held */
             const double zss = copysign(g / c->sigma0_Npm, dx);
             const double r = c->sigma0_Npm * fabs(dx) / g;
@@ -205,11 +234,15 @@ static void substep(br_plant_t *p, double tau, double h, int causes, double tm)
         if (causes) {
             const double xm = L * (p->x.theta_rad + 0.5 * dth);
             const double s2 = dth < 0.0 ? c->sigma2_Nspm + c->dsigma2_neg_Nspm : c->sigma2_Nspm;
-            const double fric = grad_k(c, xm) * drift_s(c, tm) * (L * s2 * dth + c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0));
+            const double lin = L * s2 * dth;
+            const double fr = gms ? lin + imp : lin + c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0);
+            const double fric = grad_k(c, xm) * drift_s(c, tm) * fr;
             w1 = w0 + (tau * h - L * (fric + dist_force(c, xm) * h)) / p->Jeff_kgm2;
         } else {
-            /* eq. 1 integrated over h: Jeff dw = tau h - L^2 sigma2 dtheta - L (sigma0 int z + sigma1 dz) (eq. 3) */
-            w1 = w0 + (tau * h - L * L * c->sigma2_Nspm * dth - L * (c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0))) / p->Jeff_kgm2;
+            /* eq. 1 integrated over h: Jeff dw = tau h - L^2 sigma2 dtheta - L (sigma0 int z + sigma1 dz) (eq. 3),
+             * or - L imp with the Maxwell-slip friction */
+            const double fz = gms ? imp : c->sigma0_Npm * zint + c->sigma1_Nspm * (z1 - z0);
+            w1 = w0 + (tau * h - L * L * c->sigma2_Nspm * dth - L * fz) / p->Jeff_kgm2;
         }
         /* trapezoidal rule: mean velocity of the substep */
         wm = 0.5 * (w0 + w1);
@@ -217,6 +250,7 @@ static void substep(br_plant_t *p, double tau, double h, int causes, double tm)
     p->x.theta_rad += dth;
     p->x.omega_radps = w1;
     p->x.z_m = z1;
+    p->gms = g1;
 }
 
 void br_plant_step(br_plant_t *p, double duty, double dt_s)
@@ -252,7 +286,7 @@ void br_plant_step(br_plant_t *p, double duty, double dt_s)
     }
     p->t_s += dt_s;
     p->tau_Nm = tau;
-    p->fnl_N = lugre_force(p); /* eq. 3 at the end of the step */
+    p->fnl_N = friction_force(p); /* eq. 3 (or the Maxwell-slip force) at the end of the step */
     if (causes) p->fdist_N = dist_force(c, br_plant_pos_m(p));
 }
 

@@ -29,6 +29,8 @@
 
 #include <stdint.h>
 
+#include "br_gms.h"
+
 typedef struct {
     double J_kgm2, M_kg, lead_mprad, sigma2_Nspm;
     double sigma0_Npm, sigma1_Nspm, Fc_N, Fs_N, vs_mps;
@@ -46,6 +48,12 @@ typedef struct {
     double delay_s;           /* actuator dead time, 0 .. BR_PLANT_DELAY_MAX_S */
     double drift_per_s;       /* friction level (Coulomb, stiction, viscous together) scaled by
                                  max(0, 1 + drift_per_s t) with the time since init (warm-up) */
+    /* The friction's presliding: gms.n == 0 (the default, all zero) is the
+     * LuGre above, bit for bit; gms.n > 0 replaces it by the generalized
+     * Maxwell-slip friction of br_gms.h with the same Stribeck level (Fc_N,
+     * Fs_N, vs_mps, shaped by gms.delta); sigma0_Npm and sigma1_Nspm are then
+     * unused. A truth of the simulator's only: the firmware never reads it. */
+    br_gms_cfg_t gms;
 } br_plant_cfg_t;
 
 /* Actuator delay: the commanded torques of the last BR_PLANT_DELAY_RING
@@ -69,7 +77,8 @@ typedef struct {
     br_plant_state_t x;
     double Jeff_kgm2;
     double tau_Nm;     /* torque applied during the last step (its mean with a delay) */
-    double fnl_N;      /* LuGre force at the end of the last step (direction level, k(x) and s(t) included) */
+    double fnl_N;      /* friction force (LuGre, or Maxwell-slip with cfg.gms.n > 0) at the end of the
+                          last step (direction level, k(x) and s(t) included); sigma2 v excluded */
     /* Causes: bookkeeping (zero and unused while the causes are off). */
     double fdist_N;    /* offset + ripple force at the end of the last step */
     double t_s;        /* plant time: the sum of the steps taken */
@@ -78,6 +87,7 @@ typedef struct {
     int cmd_n;         /* commands kept, <= BR_PLANT_DELAY_RING */
     long cmd_pushed;   /* commands ever pushed */
     long delay_overruns; /* steps whose delayed command was older than the history */
+    br_gms_state_t gms; /* the Maxwell-slip elements (cfg.gms.n > 0): from rest, undeflected, sticking */
 } br_plant_t;
 
 /* Reference machine of ../shared/spec/reference-machine.md. */

@@ -62,6 +62,10 @@ CHECKS = [
     ("test_golden_plant.c", "omega", rf"#define TOL_OMEGA {NUM}", "### plant", rf"\| ω \| {NUM} rad/s"),
     ("test_golden_plant.c", "z", rf"#define TOL_Z {NUM}", "### plant", rf"\| z \| {NUM} m"),
     ("test_golden_plant.c", "f_nl", rf"#define TOL_FNL {NUM}", "### plant", rf"\| f_nl \| {NUM} N"),
+    ("test_golden_plant.c", "z_i (Maxwell-slip)", rf"#define TOL_ZI {NUM}", "### plant",
+     rf"\| z_i \(Maxwell-slip\) \| {NUM} m"),
+    ("test_golden_plant.c", "f_nl (Maxwell-slip)", rf"#define TOL_FNL_GMS {NUM}", "### plant",
+     rf"\| f_nl \(Maxwell-slip\) \| {NUM} N"),
     ("test_golden_plant.c", "encoder near an integer", rf"#define ENC_NEAR_INT {NUM}", "### plant",
      rf"nearest integer\\\| < {NUM}"),
 ]

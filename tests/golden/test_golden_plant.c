@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Golden test: the double-precision plant br_plant_step against
  * golden/traces/plant.csv and plant_wrap.csv (float64 reference
- * golden/ref/plant.py): full trajectories from x0, never reset.
+ * golden/ref/plant.py), and with the Maxwell-slip friction against
+ * plant_gms.csv (slip law) and plant_gms_clamp.csv (clamp limit;
+ * golden/ref/gms.py): full trajectories from x0, never reset.
  * Tolerances: docs/golden.md. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -10,6 +12,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 
 #include "plant/br_sim_plant.h"
 #include "trace_reader.h"
@@ -26,8 +29,27 @@
 #define TOL_Z 1e-16       /* m (bristle scale 4.5e-6 m) */
 #define TOL_FNL 1e-8      /* N: sigma0 TOL_Z + 2 sigma1 L TOL_OMEGA, rounded up */
 #define ENC_NEAR_INT 1e-6 /* counts: +-1 allowed where theta/rad_per_count is this close to an integer */
+/* Maxwell-slip: the element deflections (scale up to 3e-5 m) and the force,
+ * whose element damping adds sigma1_i times the rates' differences
+ * (docs/golden.md, "plant_gms") */
+#define TOL_ZI 1e-14      /* m */
+#define TOL_FNL_GMS 1e-7  /* N */
 
-static void run_plant_trace(const char *name)
+/* the trace's Maxwell-slip elements (gms_* metadata) into cfg */
+static void gms_from_trace(const br_trace_t *t, br_plant_cfg_t *cfg)
+{
+    br_gms_cfg_t *g = &cfg->gms;
+    g->n = (int)br_trace_meta_num(t, "gms_n");
+    assert_true(g->n >= 1 && g->n <= BR_GMS_MAX);
+    g->clamp = (int)br_trace_meta_num(t, "gms_clamp");
+    g->C_mps = br_trace_meta_num(t, "gms_C_mps");
+    g->delta = br_trace_meta_num(t, "gms_delta");
+    br_trace_meta_nums(t, "gms_k_Npm", g->k_Npm, g->n);
+    br_trace_meta_nums(t, "gms_alpha", g->alpha, g->n);
+    br_trace_meta_nums(t, "gms_sigma1_Nspm", g->sigma1_Nspm, g->n);
+}
+
+static void run_plant_trace(const char *name, int gms)
 {
     br_trace_t t;
     br_trace_load(&t, name);
@@ -45,6 +67,7 @@ static void run_plant_trace(const char *name)
         .tau_per_duty_Nm = br_trace_meta_num(&t, "tau_per_duty_Nm"),
         .n_sub = (int)br_trace_meta_num(&t, "n_sub"),
     };
+    if (gms) gms_from_trace(&t, &cfg);
     double x0v[3];
     br_trace_meta_nums(&t, "x0", x0v, 3);
     const double dt = br_trace_meta_num(&t, "dt_s");
@@ -54,7 +77,13 @@ static void run_plant_trace(const char *name)
     assert_int_equal(br_plant_init(&p, &cfg, &x0), 0);
 
     const int cd = br_trace_col(&t, "duty"), cth = br_trace_col(&t, "theta");
-    const int cw = br_trace_col(&t, "omega"), cz = br_trace_col(&t, "z");
+    const int cw = br_trace_col(&t, "omega"), cz = gms ? -1 : br_trace_col(&t, "z");
+    int czi[BR_GMS_MAX];
+    for (int i = 0; i < cfg.gms.n; i++) {
+        char col[16];
+        snprintf(col, sizeof col, "z%d", i + 1);
+        czi[i] = br_trace_col(&t, col);
+    }
     const int cf = br_trace_col(&t, "fnl"), ce = br_trace_col(&t, "encoder");
     br_errstat_t eth, ew, ez, ef, ee;
     br_errstat_init(&eth, "theta", "rad");
@@ -69,8 +98,14 @@ static void run_plant_trace(const char *name)
         const double th = br_trace_get(&t, r, cth);
         br_errstat_add(&eth, &t, r, p.x.theta_rad, th, TOL_THETA + TOL_THETA_REL * fabs(th));
         br_errstat_add(&ew, &t, r, p.x.omega_radps, br_trace_get(&t, r, cw), TOL_OMEGA);
-        br_errstat_add(&ez, &t, r, p.x.z_m, br_trace_get(&t, r, cz), TOL_Z);
-        br_errstat_add(&ef, &t, r, p.fnl_N, br_trace_get(&t, r, cf), TOL_FNL);
+        if (gms) {
+            for (int i = 0; i < cfg.gms.n; i++)
+                br_errstat_add(&ez, &t, r, p.gms.z_m[i], br_trace_get(&t, r, czi[i]), TOL_ZI);
+            br_errstat_add(&ef, &t, r, p.fnl_N, br_trace_get(&t, r, cf), TOL_FNL_GMS);
+        } else {
+            br_errstat_add(&ez, &t, r, p.x.z_m, br_trace_get(&t, r, cz), TOL_Z);
+            br_errstat_add(&ef, &t, r, p.fnl_N, br_trace_get(&t, r, cf), TOL_FNL);
+        }
         /* encoder: exact, except +-1 where floor() sits on an integer boundary */
         const double q = th / rpc;
         const double enc_tol = (fabs(q - nearbyint(q)) < ENC_NEAR_INT) ? 1.0 : 0.0;
@@ -100,13 +135,25 @@ static void run_plant_trace(const char *name)
 static void test_plant_trajectory(void **state)
 {
     (void)state;
-    run_plant_trace("plant");
+    run_plant_trace("plant", 0);
 }
 
 static void test_plant_encoder_wrap(void **state)
 {
     (void)state;
-    run_plant_trace("plant_wrap");
+    run_plant_trace("plant_wrap", 0);
+}
+
+static void test_plant_gms_slip(void **state)
+{
+    (void)state;
+    run_plant_trace("plant_gms", 1);
+}
+
+static void test_plant_gms_clamp(void **state)
+{
+    (void)state;
+    run_plant_trace("plant_gms_clamp", 1);
 }
 
 int main(void)
@@ -114,6 +161,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plant_trajectory),
         cmocka_unit_test(test_plant_encoder_wrap),
+        cmocka_unit_test(test_plant_gms_slip),
+        cmocka_unit_test(test_plant_gms_clamp),
     };
     return cmocka_run_group_tests_name("golden_plant", tests, NULL, NULL);
 }
