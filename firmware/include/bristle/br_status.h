@@ -15,8 +15,10 @@ typedef enum {
     BR_E_INPUT = -3,   /* step input non-finite or out of range */
     BR_E_NUMERIC = -4, /* the result would be non-finite; the state was kept */
     BR_E_STATE = -5,   /* module used before a successful init */
-    BR_E_FAULT = -6    /* latched: outputs off until re-armed (br_app_arm); the cause is kept
+    BR_E_FAULT = -6,   /* latched: outputs off until re-armed (br_app_arm); the cause is kept
                           where it is returned (br_app_t.fault) */
+    BR_E_BUSY = -7     /* no room now (br_link_send: the transmit buffer is full); nothing was
+                          queued, the call may be repeated later */
 } br_status_t;
 
 /* 1 when st reports a failure (an error), 0 for BR_OK and for warnings. */

@@ -1,0 +1,129 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The link's message set: the one table both sides take their ids and
+payload layouts from (docs/link.md, "Messages").
+
+The C side reads it through the generated header
+firmware/gen/bristle_gen/link/br_link_msgs.h (firmware/design/gen_link.py,
+checked by the regen test regen_link_msgs); the Python side reads it here at
+run time, which is why the table lives in Python: an installed bristle.link
+has no C header to read.
+
+A payload is its fields in order, packed, little-endian, without padding.
+Field types: u8, i8, u16, u32, f32 (IEEE 754 binary32)."""
+import struct
+from dataclasses import dataclass
+
+# who sends a message: the target (the firmware) or the host (bristle.link)
+TO_HOST = "to_host"
+TO_TARGET = "to_target"
+
+# struct codes of the field types (little-endian, "<" in pack/unpack)
+TYPES = {"u8": "B", "i8": "b", "u16": "H", "u32": "I", "f32": "f"}
+
+
+@dataclass(frozen=True)
+class Field:
+    name: str
+    type: str
+    doc: str
+
+
+@dataclass(frozen=True)
+class Message:
+    name: str
+    id: int
+    direction: str
+    fields: tuple
+    doc: str
+
+    @property
+    def fmt(self):
+        """the payload's struct format"""
+        return "<" + "".join(TYPES[f.type] for f in self.fields)
+
+    @property
+    def size(self):
+        """the payload's length in bytes (the only length accepted)"""
+        return struct.calcsize(self.fmt)
+
+    def offsets(self):
+        """(field, byte offset) in payload order"""
+        out, off = [], 0
+        for f in self.fields:
+            out.append((f, off))
+            off += struct.calcsize("<" + TYPES[f.type])
+        return out
+
+
+MESSAGES = (
+    Message("status", 0x01, TO_HOST, (
+        Field("tick", "u32", "control period index of the report"),
+        Field("fault_tick", "u32", "period index at which the fault latched (0 without a fault)"),
+        Field("armed", "u8", "1 armed, 0 disarmed"),
+        Field("fault", "u8", "the latched cause (br_app_fault_t; 0 none)"),
+    ), "the application's state, sent periodically or on a state change"),
+    Message("fault", 0x02, TO_HOST, (
+        Field("cause", "u8", "the latched cause (br_app_fault_t)"),
+        Field("tick", "u32", "period index at which it latched"),
+    ), "a fault latched: sent once, when it happens"),
+    Message("arm", 0x10, TO_TARGET, (), "arm request: outputs on, control runs"),
+    Message("disarm", 0x11, TO_TARGET, (), "disarm request: duty 0, outputs off"),
+    Message("fault_reset", 0x12, TO_TARGET, (), "clear a latched fault (the axis stays disarmed)"),
+    Message("param_read", 0x20, TO_TARGET, (
+        Field("param", "u16", "parameter id"),
+    ), "read one run-time parameter; answered by param_value"),
+    Message("param_write", 0x21, TO_TARGET, (
+        Field("param", "u16", "parameter id"),
+        Field("value", "f32", "the new value, in the parameter's unit"),
+    ), "write one run-time parameter (finite, range-checked by the target's hook); answered by param_value"),
+    Message("param_value", 0x22, TO_HOST, (
+        Field("param", "u16", "parameter id"),
+        Field("value", "f32", "the value now in force (a refused write: the value asked for)"),
+        Field("status", "i8", "br_status_t of the read or write (0 BR_OK; negative: refused)"),
+    ), "the answer to param_read and param_write"),
+)
+
+BY_ID = {m.id: m for m in MESSAGES}
+BY_NAME = {m.name: m for m in MESSAGES}
+
+
+def check_table(messages=MESSAGES):
+    """Raises ValueError on a table that cannot be generated: a repeated id or
+    name, an id outside 1..255 or a payload above the frame's maximum."""
+    from .frame import PAYLOAD_MAX
+    ids, names = set(), set()
+    for m in messages:
+        if not 1 <= m.id <= 255 or m.id in ids:
+            raise ValueError("message %s: id 0x%02x out of range or repeated" % (m.name, m.id))
+        if m.name in names or not m.name.isidentifier():
+            raise ValueError("message name %r repeated or not an identifier" % m.name)
+        if m.direction not in (TO_HOST, TO_TARGET) or m.size > PAYLOAD_MAX:
+            raise ValueError("message %s: bad direction or payload above %d bytes" % (m.name, PAYLOAD_MAX))
+        for f in m.fields:
+            if f.type not in TYPES:
+                raise ValueError("message %s field %s: unknown type %s" % (m.name, f.name, f.type))
+        ids.add(m.id)
+        names.add(m.name)
+
+
+class MessageError(ValueError):
+    """A frame's id is not in the table, or its payload has the wrong length."""
+
+
+def pack(name, **values):
+    """The payload of message `name` from its field values (every field, by name)."""
+    m = BY_NAME[name]
+    want = [f.name for f in m.fields]
+    if sorted(values) != sorted(want):
+        raise MessageError("message %s takes the fields %s, got %s" % (name, want, sorted(values)))
+    return struct.pack(m.fmt, *(values[k] for k in want))
+
+
+def unpack(msg_id, payload):
+    """(name, {field: value}) of a payload; MessageError for an unknown id or a wrong length."""
+    m = BY_ID.get(msg_id)
+    if m is None:
+        raise MessageError("unknown message id 0x%02x" % msg_id)
+    if len(payload) != m.size:
+        raise MessageError("message %s: payload of %d bytes, expected %d" % (m.name, len(payload), m.size))
+    return m.name, dict(zip((f.name for f in m.fields), struct.unpack(m.fmt, bytes(payload))))
