@@ -338,6 +338,9 @@ regen: deps
 	$(Q)$(PYTHON) firmware/design/gen_machine.py
 	$(Q)$(PYTHON) firmware/design/synth_hinf.py
 	$(Q)$(PYTHON) firmware/design/gen_noise.py
+	$(Q)echo "== regen: the link's message header and golden frames (docs/link.md)"
+	$(Q)$(PYTHON) firmware/design/gen_link.py
+	$(Q)$(PYTHON) tests/link/gen_golden.py
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)echo "== regen: tuned estimator variances (about 3 min)"

@@ -1,0 +1,57 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+#include "golden_send.h"
+
+#include <string.h>
+
+static size_t sink_read(void *ctx, uint8_t *buf, size_t n)
+{
+    (void)ctx;
+    (void)buf;
+    (void)n;
+    return 0u;
+}
+
+static size_t sink_write(void *ctx, const uint8_t *buf, size_t n)
+{
+    golden_sink_t *s = ctx;
+    const size_t k = n < sizeof s->buf - s->len ? n : sizeof s->buf - s->len;
+    memcpy(&s->buf[s->len], buf, k);
+    s->len += k;
+    return k;
+}
+
+br_status_t golden_link_init(br_link_t *l, golden_sink_t *sink)
+{
+    sink->len = 0u;
+    const br_byte_chan_t ch = {sink, sink_read, sink_write};
+    const br_link_cfg_t cfg = {16u, BR_LINK_FRAME_MAX, NULL, NULL};
+    return br_link_init(l, &cfg, &ch);
+}
+
+br_status_t golden_send(br_link_t *l, const br_link_golden_t *g)
+{
+    br_status_t st;
+    float v;
+    l->tx_seq = g->seq;
+    switch (g->to_target ? 0u : g->id) {
+    case BR_LINK_MSG_STATUS: {
+        const br_link_status_t s = {g->f[0], g->f[1], (uint8_t)g->f[2], (uint8_t)g->f[3]};
+        st = br_link_send_status(l, &s);
+        break;
+    }
+    case BR_LINK_MSG_FAULT:
+        st = br_link_send_fault(l, (uint8_t)g->f[0], g->f[1]);
+        break;
+    case BR_LINK_MSG_PARAM_VALUE:
+        memcpy(&v, &g->f[1], sizeof v);
+        st = br_link_send_param_value(l, (uint16_t)g->f[0], v, (br_status_t)(int32_t)g->f[2]);
+        break;
+    default:
+        return BR_E_INPUT;
+    }
+    if (st != BR_OK) {
+        return st;
+    }
+    br_link_cmd_t cmd;
+    return br_link_step(l, &cmd);
+}
