@@ -67,6 +67,12 @@ from bristle.design import machine
 m = machine.load(os.path.join(sys.argv[1], "machine.json"))
 print("machine.json loads:", m["name"])
 PY
+"$work/venv/bin/python" - <<'PY' || fail "bristle.link does not round-trip a frame when installed"
+from bristle.link import decode_frame, encode_frame, pack, unpack
+f = decode_frame(encode_frame(0x21, 7, pack("param_write", param=3, value=0.5)))
+assert unpack(f.id, f.payload) == ("param_write", {"param": 3, "value": 0.5}), f
+print("bristle.link installed: a param_write frame round-trips")
+PY
 "$cmd" validate --model diag/model.json --log log.csv > val.out 2> val.err || fail "validate failed: $(cat val.err)"
 grep -q "relerr [0-9.e+-]* % over" val.out || fail "validate printed no relerr line on stdout: $(cat val.out)"
 "$cmd" diagnose --log log.csv --out diag2 --no-plots --quiet 2> quiet.err || fail "diagnose --quiet failed"
