@@ -218,6 +218,7 @@ bench: deps
 	$(Q)echo "== bench -> $(BENCH_OUT)"
 	$(Q)mkdir -p $(BENCH_OUT)
 	$(Q)$(BENCH) --json $(BENCH_OUT)/c.json --record $(BENCH_OUT)/pf_input.csv
+	$(Q)build/host-release/sim/bench/br_bench_link | tee $(BENCH_OUT)/link.txt
 	$(Q)$(PYTHON) -m pip install --quiet --disable-pip-version-check --require-virtualenv --no-deps \
 	  -r sim/bench/requirements-particles.txt
 	$(Q)$(PYTHON) sim/bench/pf_particles.py $(BENCH_OUT)/pf_input.csv --out $(BENCH_OUT)/particles.json
