@@ -5,7 +5,7 @@
  * bristle.link (golden frames, C to Python; docs/link.md). */
 #include <stdio.h>
 
-#include "golden_send.h"
+#include "link_support.h"
 
 int main(int argc, char **argv)
 {

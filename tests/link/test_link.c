@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include "bristle/br_link.h"
+#include "link_support.h"
 
 /* A fake channel: rx holds what the host sent, tx what the target wrote;
  * read_max / write_max limit each call (0: no limit), extra makes read lie. */
@@ -339,12 +340,8 @@ static void expect_answer(br_link_t *l, chan_t *c, uint16_t param, int8_t st)
 {
     br_link_cmd_t cmd;
     assert_int_equal(br_link_step(l, &cmd), BR_OK); /* flushes the queue */
-    br_link_dec_t d;
-    br_link_dec_init(&d);
     br_link_frame_t f;
-    int n = 0;
-    for (size_t i = 0; i < c->tx_len; ++i) n += br_link_dec_push(&d, c->tx[i], &f);
-    assert_int_equal(n, 1);
+    assert_int_equal(link_decode_all(c->tx, c->tx_len, &f, 1), 1);
     assert_int_equal(f.id, BR_LINK_MSG_PARAM_VALUE);
     assert_int_equal(f.payload[BR_LINK_MSG_PARAM_VALUE_OFF_PARAM], param);
     assert_int_equal((int8_t)f.payload[BR_LINK_MSG_PARAM_VALUE_OFF_STATUS], st);
@@ -377,18 +374,12 @@ static void test_param_write_checked(void **s)
     assert_true(cmd.value == 3.0f);
     assert_int_equal(br_link_step(&l, &cmd), BR_OK); /* flushes the answers */
     /* the two refusals' answers, in order */
-    br_link_dec_t d;
-    br_link_dec_init(&d);
-    br_link_frame_t f;
-    int n = 0;
-    for (size_t i = 0; i < c.tx_len; ++i) {
-        if (br_link_dec_push(&d, c.tx[i], &f)) {
-            assert_int_equal(f.id, BR_LINK_MSG_PARAM_VALUE);
-            assert_int_equal((int8_t)f.payload[BR_LINK_MSG_PARAM_VALUE_OFF_STATUS], BR_E_PARAM);
-            ++n;
-        }
+    br_link_frame_t f[2];
+    assert_int_equal(link_decode_all(c.tx, c.tx_len, f, 2), 2);
+    for (size_t i = 0; i < 2; ++i) {
+        assert_int_equal(f[i].id, BR_LINK_MSG_PARAM_VALUE);
+        assert_int_equal((int8_t)f[i].payload[BR_LINK_MSG_PARAM_VALUE_OFF_STATUS], BR_E_PARAM);
     }
-    assert_int_equal(n, 2);
     c.tx_len = 0;
     assert_int_equal(br_link_send_param_value(&l, 7, 3.0f, BR_OK), BR_OK);
     expect_answer(&l, &c, 7, BR_OK);
@@ -423,18 +414,13 @@ static void test_send_partial_and_busy(void **s)
         assert_true(c.tx_len - before <= 3);
     }
     assert_int_equal(l.tx_len, 0);
-    br_link_dec_t d;
-    br_link_dec_init(&d);
-    br_link_frame_t f;
-    size_t n = 0;
-    for (size_t i = 0; i < c.tx_len; ++i) {
-        if (br_link_dec_push(&d, c.tx[i], &f)) {
-            assert_int_equal(f.seq, n);
-            assert_int_equal(f.id, BR_LINK_MSG_STATUS);
-            ++n;
-        }
+    br_link_frame_t f[32];
+    assert_true(queued <= 32);
+    assert_int_equal(link_decode_all(c.tx, c.tx_len, f, 32), queued);
+    for (size_t i = 0; i < queued; ++i) {
+        assert_int_equal(f[i].seq, i);
+        assert_int_equal(f[i].id, BR_LINK_MSG_STATUS);
     }
-    assert_int_equal(n, queued);
     assert_int_equal(br_link_send(&l, 1, NULL, BR_LINK_PAYLOAD_MAX + 1u), BR_E_NULL);
     uint8_t p[BR_LINK_PAYLOAD_MAX + 1] = {0};
     assert_int_equal(br_link_send(&l, 1, p, sizeof p), BR_E_PARAM);

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-#include "golden_send.h"
+#include "link_support.h"
 
 #include <string.h>
 
@@ -54,4 +54,19 @@ br_status_t golden_send(br_link_t *l, const br_link_golden_t *g)
     }
     br_link_cmd_t cmd;
     return br_link_step(l, &cmd);
+}
+
+size_t link_decode_all(const uint8_t *b, size_t n, br_link_frame_t *frames, size_t max)
+{
+    br_link_dec_t d;
+    br_link_dec_init(&d);
+    br_link_frame_t f;
+    size_t got = 0u;
+    for (size_t i = 0u; i < n; ++i) {
+        if (br_link_dec_push(&d, b[i], &f)) {
+            if (got < max) frames[got] = f;
+            ++got;
+        }
+    }
+    return got;
 }

@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* What test_link_golden and br_link_emit share: a link whose channel writes
- * into memory, and a golden report sent through the firmware's senders. */
-#ifndef BR_LINK_GOLDEN_SEND_H
-#define BR_LINK_GOLDEN_SEND_H
+/* What the link's C tests and br_link_emit share: a link whose channel
+ * writes into memory, a golden report sent through the firmware's senders,
+ * and a buffer decoded whole. */
+#ifndef BR_LINK_SUPPORT_H
+#define BR_LINK_SUPPORT_H
 
 #include "bristle/br_link.h"
 #include "br_link_golden.h"
@@ -19,5 +20,9 @@ br_status_t golden_link_init(br_link_t *l, golden_sink_t *sink);
  * br_link_send_status / _fault / _param_value, then steps the link until the
  * frame is in the sink. BR_E_INPUT for a case that is not a report. */
 br_status_t golden_send(br_link_t *l, const br_link_golden_t *g);
+
+/* Decodes n bytes with a fresh decoder; returns the number of frames
+ * accepted, the first max of them in frames. */
+size_t link_decode_all(const uint8_t *b, size_t n, br_link_frame_t *frames, size_t max);
 
 #endif
