@@ -105,10 +105,8 @@ static int dec_check(br_link_dec_t *d, br_link_frame_t *f)
         ++d->cnt.rx_short;
         return 0;
     }
-    if (b[0] > BR_LINK_PAYLOAD_MAX) {
-        ++d->cnt.rx_oversized;
-        return 0;
-    }
+    /* a body is at most BR_LINK_BODY_MAX bytes (longer ones overflowed), so a
+     * length that matches them is at most BR_LINK_PAYLOAD_MAX */
     if (n != BR_LINK_BODY_MIN + (size_t)b[0]) {
         ++d->cnt.rx_bad_len;
         return 0;

@@ -19,7 +19,7 @@ import sys
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
 
 from bristle.link import Decoder, FrameError, decode_frame, encode_frame, messages, pack  # noqa: E402
-from bristle.link.frame import PAYLOAD_MAX, SEQ_WINDOW  # noqa: E402
+from bristle.link.frame import PAYLOAD_MAX, SEQ_WINDOW, VERSION  # noqa: E402
 
 
 def valid_frame(rng):
@@ -28,7 +28,8 @@ def valid_frame(rng):
         vals = {f.name: rng.randrange(128) for f in m.fields}
         return encode_frame(m.id, rng.randrange(65536), pack(m.name, **vals))
     return encode_frame(rng.randrange(256), rng.randrange(65536),
-                        bytes(rng.randrange(256) for _ in range(rng.randrange(PAYLOAD_MAX + 1))))
+                        bytes(rng.randrange(256) for _ in range(rng.randrange(PAYLOAD_MAX + 1))),
+                        version=VERSION if rng.random() < 0.8 else rng.randrange(256))
 
 
 def mutate(rng, b):

@@ -203,13 +203,17 @@ static void test_each_drop_counted(void **s)
     /* short: 6 bytes */
     memset(b, 1, sizeof b);
     host_body(&c, b, 6, 0);
-    /* oversized length byte, and a body past BR_LINK_BODY_MAX */
+    /* a length byte of BR_LINK_PAYLOAD_MAX + 1 with that many bytes, and a
+     * longer body: both pass BR_LINK_BODY_MAX */
     uint8_t big[BR_LINK_BODY_MAX + 4] = {BR_LINK_PAYLOAD_MAX + 1u, BR_LINK_VERSION, BR_LINK_MSG_ARM, 1, 0};
     host_body(&c, big, BR_LINK_BODY_MIN + BR_LINK_PAYLOAD_MAX + 1u, 1);
     big[0] = BR_LINK_PAYLOAD_MAX;
     host_body(&c, big, sizeof big, 1);
     /* bad length: says 1 payload byte, has 2 */
     uint8_t bl[9] = {1, BR_LINK_VERSION, BR_LINK_MSG_ARM, 1, 0, 7, 7, 0, 0};
+    host_body(&c, bl, sizeof bl, 1);
+    /* a length byte above BR_LINK_PAYLOAD_MAX on a short body: the length disagrees */
+    bl[0] = 200;
     host_body(&c, bl, sizeof bl, 1);
     /* bad CRC */
     uint8_t bc[7] = {0, BR_LINK_VERSION, BR_LINK_MSG_ARM, 1, 0, 0, 0};
@@ -233,7 +237,7 @@ static void test_each_drop_counted(void **s)
     const br_link_counters_t *k = &l.dec.cnt;
     assert_int_equal(k->rx_short, 1);
     assert_int_equal(k->rx_oversized, 2);
-    assert_int_equal(k->rx_bad_len, 1);
+    assert_int_equal(k->rx_bad_len, 2);
     assert_int_equal(k->rx_bad_crc, 1);
     assert_int_equal(k->rx_bad_version, 1);
     assert_int_equal(k->rx_bad_cobs, 1);

@@ -11,11 +11,11 @@ On the wire a frame is 0x00, COBS(body), 0x00. The body:
     payload n bytes
     crc     u16  CRC-16/CCITT-FALSE of every byte before it, most significant byte first
 
-The decoder drops, and counts, a frame that is short, oversized, badly
+The decoder (the C decoder's twin, byte for byte) drops, and counts, a frame that is short, oversized, badly
 stuffed, of the wrong length, of a bad CRC, of another version, or whose
 sequence number does not advance (1..32767 ahead of the last accepted one,
 modulo 2^16)."""
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 VERSION = 1
 PAYLOAD_MAX = 64
@@ -23,7 +23,6 @@ HEADER_BYTES = 5            # length, version, id, seq
 CRC_BYTES = 2
 BODY_MIN = HEADER_BYTES + CRC_BYTES
 BODY_MAX = BODY_MIN + PAYLOAD_MAX
-ENCODED_MAX = BODY_MAX + 1 + BODY_MAX // 254   # COBS: one code byte per 254 data bytes, and the first
 DELIM = 0x00
 SEQ_WINDOW = 0x7FFF         # a sequence number 1..SEQ_WINDOW ahead of the last is new
 
@@ -65,25 +64,6 @@ def cobs_encode(data):
     return bytes(out)
 
 
-def cobs_decode(data):
-    """The inverse of cobs_encode; FrameError("bad_cobs") for a 0x00 inside or a block cut short."""
-    data = bytes(data)
-    out = bytearray()
-    i = 0
-    while i < len(data):
-        code = data[i]
-        if code == 0 or i + code > len(data):
-            raise FrameError("bad_cobs", "COBS block cut short or a 0x00 inside")
-        block = data[i + 1:i + code]
-        if DELIM in block:
-            raise FrameError("bad_cobs", "0x00 inside a COBS block")
-        out += block
-        i += code
-        if code < 0xFF and i < len(data):
-            out.append(0)
-    return bytes(out)
-
-
 @dataclass(frozen=True)
 class Frame:
     id: int
@@ -106,13 +86,13 @@ def encode_frame(msg_id, seq, payload, version=VERSION):
 
 
 def check_body(body):
-    """A Frame from one unstuffed body, else FrameError naming the counter (the
-    sequence number is the stream decoder's business)."""
+    """A Frame from one unstuffed body (at most BODY_MAX bytes: the Decoder
+    drops longer ones as oversized, so a length that matches is at most
+    PAYLOAD_MAX), else FrameError naming the counter (the sequence number is
+    the stream decoder's business)."""
     n = len(body)
     if n < BODY_MIN:
         raise FrameError("short", "%d bytes, a frame has at least %d" % (n, BODY_MIN))
-    if n > BODY_MAX or body[0] > PAYLOAD_MAX:
-        raise FrameError("oversized", "frame above %d bytes or length above %d" % (BODY_MAX, PAYLOAD_MAX))
     if n != BODY_MIN + body[0]:
         raise FrameError("bad_len", "length byte %d for %d payload bytes" % (body[0], n - BODY_MIN))
     if crc16(body[:-2]) != (body[-2] << 8 | body[-1]):
@@ -122,57 +102,89 @@ def check_body(body):
     return Frame(body[2], body[3] | body[4] << 8, bytes(body[HEADER_BYTES:-2]))
 
 
+COUNTERS = ("frames", "short", "oversized", "bad_len", "bad_cobs", "bad_crc", "bad_version", "replayed")
+
+
+class Decoder:
+    """The stream decoder, byte for byte the C decoder's (br_link_dec_push):
+    COBS undone as the bytes come, the checks at each closing 0x00. feed()
+    takes bytes in any pieces and returns the frames completed, in order;
+    every frame dropped is counted in `counters` (COUNTERS) under the same
+    reason as in C. It never raises on the bytes it is given."""
+
+    def __init__(self):
+        self.counters = dict.fromkeys(COUNTERS, 0)
+        self.last_seq = None
+        self._body = bytearray()
+        self._code = 0
+        self._left = 0
+        self._over = False
+
+    def _append(self, b):
+        if len(self._body) >= BODY_MAX:
+            self._over = True
+        else:
+            self._body.append(b)
+
+    def _end(self):
+        """the checks at a delimiter: the Frame, or None (counted)"""
+        if self._over:
+            self.counters["oversized"] += 1
+            return None
+        if self._code == 0:
+            return None  # two delimiters in a row: the gap between two frames
+        if self._left:
+            self.counters["bad_cobs"] += 1
+            return None
+        try:
+            f = check_body(bytes(self._body))
+        except FrameError as e:
+            self.counters[e.reason] += 1
+            return None
+        if self.last_seq is not None and not 1 <= ((f.seq - self.last_seq) & 0xFFFF) <= SEQ_WINDOW:
+            self.counters["replayed"] += 1
+            return None
+        self.last_seq = f.seq
+        self.counters["frames"] += 1
+        return f
+
+    def feed(self, data):
+        frames = []
+        for b in bytes(data):
+            if b == DELIM:
+                f = self._end()
+                if f is not None:
+                    frames.append(f)
+                self._body.clear()
+                self._code = self._left = 0
+                self._over = False
+            elif self._over:
+                continue  # skipping to the next delimiter
+            elif self._left == 0:
+                # a code byte: the zero a previous block below 0xFF stood for, then the block
+                if self._code not in (0, 0xFF):
+                    self._append(0)
+                self._code, self._left = b, b - 1
+            else:
+                self._append(b)
+                self._left -= 1
+        return frames
+
+
 def decode_frame(wire):
-    """One frame's bytes (with or without the 0x00 delimiters) to a Frame; FrameError otherwise."""
+    """One frame's bytes (with or without its 0x00 delimiters) to a Frame,
+    through a fresh Decoder (so any sequence number is accepted); FrameError
+    naming the counter otherwise ("bad_cobs" also for a 0x00 inside)."""
     wire = bytes(wire)
     if wire[:1] == bytes([DELIM]):
         wire = wire[1:]
     if wire[-1:] == bytes([DELIM]):
         wire = wire[:-1]
-    if len(wire) > ENCODED_MAX:
-        raise FrameError("oversized", "frame above %d bytes" % BODY_MAX)
-    return check_body(cobs_decode(wire))
-
-
-COUNTERS = ("frames", "short", "oversized", "bad_len", "bad_cobs", "bad_crc", "bad_version", "replayed")
-
-
-@dataclass
-class Decoder:
-    """The stream decoder: feed() bytes as they come, in any pieces; it
-    returns the frames completed, in order, and counts every frame dropped
-    (counters: COUNTERS). It never raises on the bytes it is given."""
-    counters: dict = field(default_factory=lambda: dict.fromkeys(COUNTERS, 0))
-    last_seq: int = -1
-    _buf: bytearray = field(default_factory=bytearray)
-    _over: bool = False
-
-    def feed(self, data):
-        frames = []
-        for b in bytes(data):
-            if b != DELIM:
-                if len(self._buf) >= ENCODED_MAX:
-                    self._over = True
-                else:
-                    self._buf.append(b)
-                continue
-            buf, over = bytes(self._buf), self._over
-            self._buf.clear()
-            self._over = False
-            if not buf and not over:
-                continue  # two delimiters in a row: the gap between two frames
-            if over:
-                self.counters["oversized"] += 1
-                continue
-            try:
-                f = check_body(cobs_decode(buf))
-            except FrameError as e:
-                self.counters[e.reason] += 1
-                continue
-            if self.last_seq >= 0 and not 1 <= ((f.seq - self.last_seq) & 0xFFFF) <= SEQ_WINDOW:
-                self.counters["replayed"] += 1
-                continue
-            self.last_seq = f.seq
-            self.counters["frames"] += 1
-            frames.append(f)
-        return frames
+    if not wire or DELIM in wire:
+        raise FrameError("bad_cobs", "not one frame: empty, or a 0x00 inside")
+    d = Decoder()
+    frames = d.feed(bytes([DELIM]) + wire + bytes([DELIM]))
+    if frames:
+        return frames[0]
+    reason = next(k for k, v in d.counters.items() if v)
+    raise FrameError(reason, "frame dropped: %s" % reason)
