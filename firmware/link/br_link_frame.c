@@ -7,6 +7,9 @@
 
 uint16_t br_link_crc16(uint16_t crc, const uint8_t *data, size_t n)
 {
+    if (data == NULL) {
+        return crc;
+    }
     /* MSB-first CRC, polynomial x^16 + x^12 + x^5 + 1 (0x1021), bit by bit */
     for (size_t i = 0u; i < n; ++i) {
         crc = (uint16_t)(crc ^ (uint16_t)((uint16_t)data[i] << 8));
@@ -76,6 +79,9 @@ size_t br_link_cobs_encode(const uint8_t *in, size_t n, uint8_t *out, size_t cap
 
 void br_link_dec_init(br_link_dec_t *d)
 {
+    if (d == NULL) {
+        return;
+    }
     memset(d, 0, sizeof *d);
 }
 
@@ -139,6 +145,9 @@ static int dec_check(br_link_dec_t *d, br_link_frame_t *f)
 
 int br_link_dec_push(br_link_dec_t *d, uint8_t byte, br_link_frame_t *f)
 {
+    if (d == NULL || f == NULL) {
+        return 0;
+    }
     if (byte == 0x00u) {
         /* a delimiter ends the frame (two in a row: the gap between two frames) */
         int got = 0;

@@ -430,6 +430,23 @@ static void test_send_partial_and_busy(void **s)
     assert_int_equal(br_link_send(&l, 1, p, sizeof p), BR_E_PARAM);
 }
 
+static void test_null_guards(void **s)
+{
+    (void)s;
+    br_link_frame_t f;
+    br_link_dec_t d;
+    br_link_dec_init(NULL);
+    br_link_dec_init(&d);
+    assert_int_equal(br_link_dec_push(NULL, 0, &f), 0);
+    assert_int_equal(br_link_dec_push(&d, 0, NULL), 0);
+    assert_int_equal(br_link_crc16(0x1234u, NULL, 5), 0x1234u);
+    br_link_cmd_t cmd;
+    assert_int_equal(br_link_step(NULL, &cmd), BR_E_NULL);
+    assert_int_equal(br_link_cmd_decode(NULL, &cmd), BR_E_NULL);
+    assert_int_equal(br_link_send_status(NULL, NULL), BR_E_NULL);
+    assert_int_equal(br_link_init(NULL, NULL, NULL), BR_E_NULL);
+}
+
 static void test_msg_len_from_table(void **s)
 {
     (void)s;
@@ -454,6 +471,7 @@ int main(void)
         cmocka_unit_test(test_channel_claiming_more_refused),
         cmocka_unit_test(test_param_write_checked),
         cmocka_unit_test(test_send_partial_and_busy),
+        cmocka_unit_test(test_null_guards),
         cmocka_unit_test(test_msg_len_from_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -90,15 +90,17 @@ typedef struct {
     br_link_counters_t cnt;
 } br_link_dec_t;
 
-/* Forgets any partial frame and the last sequence number; zeroes the counters. */
+/* Forgets any partial frame and the last sequence number; zeroes the counters (NULL: nothing). */
 void br_link_dec_init(br_link_dec_t *d);
 
 /* Takes one byte; 1 when it completes a frame that passes every check
- * (copied to *f), else 0 (a dropped frame is counted in d->cnt). */
+ * (copied to *f), else 0 (a dropped frame is counted in d->cnt; a NULL d or
+ * f: 0, the byte ignored). */
 int br_link_dec_push(br_link_dec_t *d, uint8_t byte, br_link_frame_t *f);
 
 /* CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection, xorout 0;
- * "123456789" gives 0x29B1) of n bytes, continuing from crc (0xFFFF to start). */
+ * "123456789" gives 0x29B1) of n bytes, continuing from crc (0xFFFF to start);
+ * NULL data: crc unchanged. */
 uint16_t br_link_crc16(uint16_t crc, const uint8_t *data, size_t n);
 
 /* COBS (Cheshire and Baker 1999) of n bytes into out (cap bytes): no 0x00
