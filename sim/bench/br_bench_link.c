@@ -58,8 +58,12 @@ static size_t mem_write(void *ctx, const uint8_t *buf, size_t n)
     return n;
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    if (argc > 1) {
+        fprintf(stderr, "%s: takes no options ('%s')\n", argv[0], argv[1]);
+        return 2;
+    }
     /* the stream: param_write and arm requests, alternating */
     static uint8_t stream[FRAMES * BR_LINK_FRAME_MAX];
     size_t n = 0;
