@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-"""The cross build folder of another machine's image (`make firmware
-MACHINE=FILE`, docs/configure.md): build/<preset>-<name>-<hash>, <name> the
+"""The build folder of another machine: its image's cross build (`make
+firmware MACHINE=FILE`, docs/configure.md) or its host build (`make tune
+MACHINE=FILE`, docs/tuning.md): build/<preset>-<name>-<hash>, <name> the
 file's validated "name" ([a-z0-9][a-z0-9_-]*) and <hash> the first 8 hex
 digits of the SHA-256 of the file's real path, so that two machine files
 with the same name never share a folder (nor one image).
 
   build_dir.py PRESET FILE     prints the folder (relative to the repository)
 A bad machine file: its "FILE: field a.b.c: problem" lines, exit status 1;
-a preset that is not a cross preset: exit status 2."""
+a preset not among PRESETS: exit status 2."""
 import hashlib
 import os
 import re
@@ -16,7 +17,7 @@ import sys
 
 import machine
 
-PRESETS = ("cm7-release", "cm4-release")
+PRESETS = ("cm7-release", "cm4-release", "host-release")  # the images; the host build `make tune MACHINE=` runs
 
 
 def build_dir(preset, path):

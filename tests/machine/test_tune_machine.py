@@ -40,7 +40,7 @@ def source_state():
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--machine", required=True)
-    ap.add_argument("--max-fev", default="2")
+    ap.add_argument("--max-fev", default="8")
     a = ap.parse_args()
     before = source_state()
     p = subprocess.run(["make", "-C", REPO, "tune", "MACHINE=" + a.machine, "MAX_FEV=" + a.max_fev],
