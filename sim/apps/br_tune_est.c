@@ -56,25 +56,12 @@ typedef struct {
     double x_prev[MAX_P];
 } tune_t;
 
-/* The PF's further start: the point an earlier, unpenalised Nelder-Mead run
- * found on the reference machine (q_omega 2.2e-6 (rad/s)^2, q_z 9.71e-17 m^2,
- * q_gp 2.46 N^2, R 0.23 count^2; 2.164e-8 m, no outlier step, docs/tuning.md),
- * stated as factors on the machine's own hand-tuned start (its estimator
- * section: 5e-6, 1e-14, 0.1, 0.3 count^2 there), so that it means the same on
- * another machine: the three process noises times the factor, R's part beyond
- * the quantisation's 1/12 count^2 times the last. The PF's landscape is rugged
+/* The PF's further start (its variances: q_omega (rad/s)^2, q_z m^2, q_gp N^2,
+ * R in counts^2): the point an earlier, unpenalised Nelder-Mead run found
+ * (2.164e-8 m, no outlier step, docs/tuning.md). The PF's landscape is rugged
  * and Nelder-Mead local, so the tuner searches from the hand-tuned start and
  * from this one and keeps the better result. */
-static const double pf_start2_factor[4] = {2.2e-6 / 5.0e-6, 9.71e-17 / 1.0e-14, 2.46 / 0.1,
-                                           (0.23 - 1.0 / 12.0) / (0.3 - 1.0 / 12.0)};
-
-/* start 2's log-variance i from the start's x0 (rpc2: rad_per_count^2) */
-static double pf_start2_x(const double *x0, int i, double rpc2)
-{
-    if (i < 3) return log(exp(x0[i]) * pf_start2_factor[i]);
-    const double q = 1.0 / 12.0; /* the quantisation's variance, count^2 */
-    return log((q + (exp(x0[i]) / rpc2 - q) * pf_start2_factor[i]) * rpc2);
-}
+static const double pf_start2[4] = {2.2e-6, 9.71e-17, 2.46, 0.23};
 
 /* The tuned parameters: PF (q_omega, q_z, q_gp, R); UKF (q_theta, q_omega, q_z, q_gp, R). */
 static int n_params(const tune_t *t) { return t->pf ? 4 : 5; }
@@ -377,7 +364,7 @@ int main(int argc, char **argv)
     for (int s = 0; ok && s < n_starts; s++) {
         double xs[MAX_P];
         for (int i = 0; i < n; i++) {
-            xs[i] = (s == 0) ? x0[i] : pf_start2_x(x0, i, rpc2);
+            xs[i] = (s == 0) ? x0[i] : log(pf_start2[i] * (i == 3 ? rpc2 : 1.0));
         }
         const double fs = (s == 0) ? f0 : objective(&t, xs, n);
         if (s > 0) {
