@@ -8,12 +8,7 @@
 #include "bristle/br_ctrl.h"
 #include "bristle/br_est.h"
 #include "bristle/br_hal.h"
-
-typedef struct {
-    int32_t ref_counts;
-    float ref_frac_counts;
-    float ref_omega_radps;
-} br_ref_t;
+#include "bristle/br_ref.h"
 
 typedef struct {
     const br_hal_t *hal;
