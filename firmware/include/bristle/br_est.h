@@ -83,10 +83,6 @@ typedef struct {
  * delay_s <= (BR_EST_DELAY_HIST - 2) dt_s (NaN: 0). */
 int br_est_delay_fits(float delay_s, float dt_s);
 
-/* A delay of delay_s (checked by br_est_delay_fits) at the period dt_s as *m
- * whole periods and the fraction *f of the next, 0 <= f < 1. */
-void br_est_delay_periods(float delay_s, float dt_s, uint32_t *m, float *f);
-
 /* Empties the history for the configuration's delay (checked by br_est_cfg_check). */
 void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg);
 
@@ -122,18 +118,16 @@ typedef struct {
     float frac;      /* finite, in [0, 1] */
 } br_meas_t;
 
-/* Actuator-delay identification (br_dlyid.h, docs/modules/dlyid.md).
- * init: candidate j's delay j step_s in periods, its filters unprimed, the
- * candidate standing for the configured delay the nearest to it. */
+/* The actuator-delay identification (br_dlyid.h, docs/modules/dlyid.md) over
+ * the estimator's configuration: cfg->delay_id, with the model, the encoder,
+ * R and g_p's bound of cfg. init: br_dlyid_init (the configured delay's slot
+ * in use, where br_est_delay_init starts d). */
 void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg);
 
-/* One period, after br_est_delay_apply has kept the last command: every
- * candidate's filter predicts with its delay's torque and takes y. Once past
- * the warm-up, when the best candidate's forgotten sum of squared innovations
- * is below switch_ratio times that of the candidate in use, d's delay becomes
- * the best one's (id->n_switch counts the switches). A filter that is not
- * finite restarts the bank at the next measurement, nothing switched. Off
- * (n_cand = 0): nothing. */
+/* One period, after br_est_delay_apply has kept the last command: br_dlyid_step
+ * with each slot's torque from d's history (br_est_delay_torque); when the
+ * bank switches, d's delay becomes the new slot's (id->n_switch counts the
+ * switches). Off (n_cand = 0): nothing. */
 void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d);
 
 /* One estimator step: y is the measurement at t_k, u_prev_Nm the torque that
