@@ -23,7 +23,7 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
     if (cfg == NULL || cfg->ctrl == NULL || est == NULL) {
         return BR_E_NULL;
     }
-    *est = (br_est_t){NULL, NULL};
+    *est = (br_est_t){NULL, NULL, NULL, NULL};
     br_status_t st;
     switch (cfg->est) {
     case BR_APP_EST_NONE:
@@ -37,7 +37,7 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
             st = br_pf_init(mem->pf, cfg->pf);
         }
         if (st == BR_OK) {
-            *est = (br_est_t){mem->pf, br_pf_est_step};
+            *est = br_pf_est(mem->pf);
         }
         return st;
     case BR_APP_EST_UKF:
@@ -49,7 +49,7 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
             st = br_ukf_init(mem->ukf, cfg->ukf);
         }
         if (st == BR_OK) {
-            *est = (br_est_t){mem->ukf, br_ukf_est_step};
+            *est = br_ukf_est(mem->ukf);
         }
         return st;
     case BR_APP_EST_EXTERN:
@@ -171,8 +171,6 @@ br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *
         return st;
     }
     app->guard = cfg->guard;
-    app->kind = cfg->est;
-    app->mem = (mem != NULL) ? *mem : (br_app_mem_t){NULL, NULL};
     app->last_counts = 0;
     app->have_counts = 0;
     app->n_stale = 0u;
@@ -193,12 +191,8 @@ br_status_t br_app_arm(br_app_t *app)
     /* the controller restarts: integral and previous count cleared */
     const br_ctrl_cfg_t kc = app->axis.ctrl.cfg;
     br_status_t st = br_ctrl_init(&app->axis.ctrl, &kc);
-    if (st == BR_OK && app->kind == BR_APP_EST_PF) {
-        const br_pf_cfg_t pc = app->mem.pf->cfg;
-        st = br_pf_init(app->mem.pf, &pc); /* primed again at the next measurement */
-    } else if (st == BR_OK && app->kind == BR_APP_EST_UKF) {
-        const br_ukf_cfg_t uc = app->mem.ukf->cfg;
-        st = br_ukf_init(app->mem.ukf, &uc);
+    if (st == BR_OK && app->axis.est.step != NULL) {
+        st = br_est_restart(&app->axis.est); /* primed again at the next measurement */
     }
     if (st != BR_OK) {
         return st; /* stays latched */
@@ -236,26 +230,6 @@ br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause)
     return latch(app, cause);
 }
 
-/* A period without a measurement: the PF / UKF predict only; an EXTERN
- * estimate is held. */
-static br_status_t est_predict(br_app_t *app)
-{
-    const float u = app->axis.last.tau_Nm;
-    br_status_t st = BR_OK;
-    if (app->kind == BR_APP_EST_PF) {
-        st = br_pf_predict(app->mem.pf, u);
-        if (!BR_FAILED(st)) {
-            app->axis.F_hat_N = br_pf_estimate(app->mem.pf)->F_hat_N;
-        }
-    } else if (app->kind == BR_APP_EST_UKF) {
-        st = br_ukf_predict(app->mem.ukf, u);
-        if (!BR_FAILED(st)) {
-            app->axis.F_hat_N = br_ukf_estimate(app->mem.ukf)->F_hat_N;
-        }
-    }
-    return st;
-}
-
 br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
 {
     if (app == NULL || ref == NULL) {
@@ -286,7 +260,10 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
             return BR_OK;
         }
         counts = app->last_counts;
-        est_st = est_predict(app);
+        if (a->est.step != NULL) {
+            /* the estimator predicts over the period (or holds its estimate) */
+            est_st = br_est_period(&a->est, NULL, a->last.tau_Nm, &a->F_hat_N);
+        }
     } else {
         /* the periods since the last good read: this one and the held ones */
         const uint64_t periods = (uint64_t)app->n_stale + 1u;
@@ -313,7 +290,7 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
         if (a->est.step != NULL) {
             /* the estimator sees the count's centre and the torque of the last period */
             const br_meas_t y = {counts, 0.5f};
-            est_st = a->est.step(a->est.ctx, &y, a->last.tau_Nm, &a->F_hat_N);
+            est_st = br_est_period(&a->est, &y, a->last.tau_Nm, &a->F_hat_N);
         }
     }
     /* a warning (an outlier measurement skipped, whose prediction stays

@@ -19,7 +19,7 @@ br_status_t br_axis_init(br_axis_t *a, const br_hal_t *hal, const br_ctrl_cfg_t 
         return BR_E_NULL;
     }
     a->hal = hal;
-    a->est = (est != NULL) ? *est : (br_est_t){NULL, NULL};
+    a->est = (est != NULL) ? *est : (br_est_t){NULL, NULL, NULL, NULL};
     a->F_hat_N = 0.0f;
     a->last = (br_ctrl_out_t){0};
     a->ready = 1;

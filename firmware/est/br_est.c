@@ -195,3 +195,23 @@ void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t 
         d->f = id->cf[id->cur]; /* d->on: set by br_est_delay_init for the bank */
     }
 }
+
+br_status_t br_est_period(const br_est_t *e, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    if (e == NULL || e->step == NULL || F_hat_N == NULL) {
+        return BR_E_NULL;
+    }
+    if (y != NULL) {
+        return e->step(e->ctx, y, u_prev_Nm, F_hat_N);
+    }
+    /* no measurement: predict, or hold the estimate */
+    return (e->predict != NULL) ? e->predict(e->ctx, u_prev_Nm, F_hat_N) : BR_OK;
+}
+
+br_status_t br_est_restart(const br_est_t *e)
+{
+    if (e == NULL) {
+        return BR_E_NULL;
+    }
+    return (e->reset != NULL) ? e->reset(e->ctx) : BR_OK;
+}

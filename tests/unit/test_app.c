@@ -120,6 +120,8 @@ static void test_init_guards(void **st)
     assert_int_equal(br_app_est_init(&c, &mem, &est), BR_OK);
     assert_ptr_equal(est.ctx, pf);
     assert_ptr_equal(est.step, br_pf_est_step);
+    assert_ptr_equal(est.predict, br_pf_est_predict);
+    assert_ptr_equal(est.reset, br_pf_est_reset);
 
     /* UKF: likewise */
     c.est = BR_APP_EST_UKF;
@@ -138,7 +140,7 @@ static void test_init_guards(void **st)
 
     /* an external estimator: the interface and its step are required */
     const float F = 1.0f;
-    br_est_t ext = {(void *)&F, NULL};
+    br_est_t ext = {(void *)&F, NULL, NULL, NULL};
     c.est = BR_APP_EST_EXTERN;
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_E_NULL);
     c.ext = &ext;
@@ -177,7 +179,7 @@ static void test_extern_drives_compensation(void **st)
     const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     const br_ctrl_cfg_t k = ctrl_cfg();
     const float F = 10.0f;
-    const br_est_t ext = {(void *)&F, const_est_step};
+    const br_est_t ext = {(void *)&F, const_est_step, NULL, NULL};
     const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD};
     br_app_t app;
     const br_ref_t r = {0, 0.0f, 0.0f};
@@ -186,6 +188,78 @@ static void test_extern_drives_compensation(void **st)
     assert_int_equal(br_app_step(&app, &r), BR_OK);
     /* zero error: the duty is the compensation alone, L F / tau_per_duty */
     BR_ASSERT_NEAR(f.duty, 1.27e-3 * 10.0 / 0.64, 1e-7);
+}
+
+/* An estimator behind the interface (EXTERN with predict and reset): a failed
+ * read reaches its predict with the last torque, an arm its reset, whose
+ * error keeps the application latched; no kind is read after init. */
+typedef struct {
+    int steps, predicts, resets;
+    float u;
+    br_status_t reset_st;
+} iface_t;
+
+static br_status_t iface_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    iface_t *e = ctx;
+    (void)y;
+    e->steps++;
+    e->u = u_prev_Nm;
+    *F_hat_N = 1.0f;
+    return BR_OK;
+}
+static br_status_t iface_predict(void *ctx, float u_prev_Nm, float *F_hat_N)
+{
+    iface_t *e = ctx;
+    e->predicts++;
+    e->u = u_prev_Nm;
+    *F_hat_N = 3.0f;
+    return BR_OK;
+}
+static br_status_t iface_reset(void *ctx)
+{
+    iface_t *e = ctx;
+    e->resets++;
+    return e->reset_st;
+}
+
+static void test_estimator_interface(void **st)
+{
+    (void)st;
+    fake_t f = {0, 0.0f, BR_OK, BR_OK, 0, 0};
+    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, fake_disable, fake_enable};
+    const br_ctrl_cfg_t k = ctrl_cfg();
+    iface_t e = {0, 0, 0, 0.0f, BR_OK};
+    const br_est_t ext = {&e, iface_step, iface_predict, iface_reset};
+    const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD};
+    br_app_t app;
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
+    assert_int_equal(e.resets, 0);
+    assert_int_equal(br_app_arm(&app), BR_OK);
+    assert_int_equal(e.resets, 1);
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_int_equal(e.steps, 1);
+    const float tau = app.axis.last.tau_Nm;
+    assert_true(tau != 0.0f);
+    f.enc_st = BR_E_INPUT;
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_int_equal(e.predicts, 1);
+    assert_true(e.u == tau);
+    assert_true(app.axis.F_hat_N == 3.0f);
+    f.enc_st = BR_OK;
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_int_equal(e.steps, 2);
+    assert_int_equal(e.predicts, 1);
+    /* a reset that fails: the arm fails and the fault stays */
+    assert_int_equal(br_app_fault(&app, BR_APP_FAULT_DEADLINE), BR_E_FAULT);
+    e.reset_st = BR_E_PARAM;
+    assert_int_equal(br_app_arm(&app), BR_E_PARAM);
+    assert_int_equal(app.fault, BR_APP_FAULT_DEADLINE);
+    assert_int_equal(br_app_step(&app, &r), BR_E_FAULT);
+    e.reset_st = BR_OK;
+    assert_int_equal(br_app_arm(&app), BR_OK);
+    assert_int_equal(e.resets, 3);
 }
 
 /* The same periods through br_app (kind) and through br_axis with the filter
@@ -213,10 +287,10 @@ static void run_against_axis(br_app_est_kind_t kind)
     br_est_t est;
     if (kind == BR_APP_EST_PF) {
         assert_int_equal(br_pf_init(&pf[1], &pfc), BR_OK);
-        est = (br_est_t){&pf[1], br_pf_est_step};
+        est = br_pf_est(&pf[1]);
     } else {
         assert_int_equal(br_ukf_init(&ukf[1], &ukfc), BR_OK);
-        est = (br_est_t){&ukf[1], br_ukf_est_step};
+        est = br_ukf_est(&ukf[1]);
     }
     br_axis_t axis;
     assert_int_equal(br_axis_init(&axis, &hb, &k, &est), BR_OK);
@@ -274,7 +348,7 @@ static void rig_init(rig_t *g, int ext)
     memset(g, 0, sizeof *g);
     g->hal = (br_hal_t){&g->f, fake_enc, fake_pwm, fake_tick, fake_disable, fake_enable};
     g->k = ctrl_cfg();
-    g->ext = (br_est_t){&est_status, bad_est_step};
+    g->ext = (br_est_t){&est_status, bad_est_step, NULL, NULL};
     est_status = BR_OK;
     g->c = (br_app_cfg_t){&g->k, ext ? BR_APP_EST_EXTERN : BR_APP_EST_NONE, NULL, NULL, &g->ext, GUARD};
     assert_int_equal(br_app_init(&g->app, &g->c, &g->hal, NULL), BR_OK);
@@ -677,6 +751,7 @@ int main(void)
         cmocka_unit_test(test_init_guards),
         cmocka_unit_test(test_none_is_hinf_only),
         cmocka_unit_test(test_extern_drives_compensation),
+        cmocka_unit_test(test_estimator_interface),
         cmocka_unit_test(test_pf_as_wired_by_hand),
         cmocka_unit_test(test_ukf_as_wired_by_hand),
         cmocka_unit_test(test_outputs_off_until_armed),

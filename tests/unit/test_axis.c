@@ -118,10 +118,10 @@ static void test_estimator_drives_compensation(void **st)
     fake_t f = {0, BR_OK, 0.0f, 0};
     br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     fake_est_t e = {10.0f, BR_OK, {0, 0.0f}, 0.0f, 0};
-    br_est_t est = {&e, fake_est_step};
+    br_est_t est = {&e, fake_est_step, NULL, NULL};
     br_axis_t a;
     br_ctrl_cfg_t k = cfg();
-    br_est_t bad = {&e, NULL};
+    br_est_t bad = {&e, NULL, NULL, NULL};
     assert_int_equal(br_axis_init(&a, &hal, &k, &bad), BR_E_NULL);
     assert_int_equal(br_axis_init(&a, &hal, &k, &est), BR_OK);
     br_ref_t r = {0, 0.0f, 0.0f};
