@@ -293,7 +293,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
             rep->fault_t_s = t;
             break;
         }
-        err_add(e, t, x_ref, pos, (double)app.axis.last.duty * pc->tau_per_duty_Nm / L);
+        err_add(e, t, x_ref, pos, (double)app.last.duty * pc->tau_per_duty_Nm / L);
     }
     rc = 0;
 done:

@@ -373,9 +373,9 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
                 k_end = k;
                 break;
             }
-            sat |= ax[i].app.axis.last.saturated;
-            s.duty[i] = (double)ax[i].app.axis.last.duty;
-            s.F_hat_N[i] = (double)ax[i].app.axis.F_hat_N;
+            sat |= ax[i].app.last.saturated;
+            s.duty[i] = (double)ax[i].app.last.duty;
+            s.F_hat_N[i] = (double)ax[i].app.F_hat_N;
             /* against the force a perfect estimator hands over (the oracle's) */
             const double f_true = br_plant_comp_force_N(&ax[i].plant);
             fe2 += (s.F_hat_N[i] - f_true) * (s.F_hat_N[i] - f_true);

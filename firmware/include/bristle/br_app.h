@@ -6,9 +6,10 @@
  *   encoder -> estimator (PF, UKF or none) -> controller (eq. 7, the estimate
  *   as compensation) -> PWM
  *
- * through br_axis_step, over the HAL the caller binds. The production image
- * (hal/stm32h7/image), the replay image (target/mps2) and the simulator's
- * circle experiment (sim/circle) all run br_app_step. docs/modules/app.md.
+ * over the HAL the caller binds: the one home of the control period. The
+ * production images (hal/stm32h7/image, hal/stm32g4/image), the replay image
+ * (target/mps2) and the simulator's circle experiment (sim/circle) all run
+ * br_app_step. docs/modules/app.md.
  *
  * Where the estimator's state lives: in storage the caller provides
  * (br_app_mem_t), not in a union inside br_app_t. A union would make every
@@ -17,12 +18,16 @@
  * carry 94 KB it never uses, and a UKF application (696 B of filter) too.
  * With caller storage each program sizes and places exactly its estimator:
  * on the MCU a static br_pf_t in a RAM section (.bss in the DTCM, never the
- * stack), on the host the heap. br_app_t itself is small (the axis loop). */
+ * stack), on the host the heap. br_app_t itself is small (the controller, the
+ * estimator interface, the guards' state). */
 #ifndef BR_APP_H
 #define BR_APP_H
 
-#include "bristle/br_axis.h"
+#include "bristle/br_ctrl.h"
+#include "bristle/br_est.h"
+#include "bristle/br_hal.h"
 #include "bristle/br_pf.h"
+#include "bristle/br_ref.h"
 #include "bristle/br_ukf.h"
 
 typedef enum {
@@ -105,8 +110,13 @@ typedef struct {
 } br_app_mem_t;
 
 typedef struct {
-    br_axis_t axis; /* the loop; axis.F_hat_N and axis.last are the period's outputs, axis.est
-                       the estimator the configuration's kind named (step, predict, reset) */
+    const br_hal_t *hal;
+    br_est_t est;           /* the estimator the configuration's kind named (step, predict,
+                               reset); est.step == NULL: none, H-infinity only */
+    br_ctrl_t ctrl;
+    float F_hat_N;          /* the period's output: the compensation used (N, load side) */
+    br_ctrl_out_t last;     /* the period's output: torque, duty, errors, saturation */
+    int ready;              /* br_app_init succeeded */
     br_app_guard_cfg_t guard;
     br_app_fault_t fault;   /* NONE while armed; the latched cause otherwise */
     int32_t last_counts;    /* last good encoder read */
@@ -131,10 +141,10 @@ typedef struct {
  * (equal to 1e-6 relative); else the filter's own init status. */
 br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br_est_t *est);
 
-/* Validates and initialises: the guards (BR_E_PARAM), the estimator
- * (br_app_est_init), then the axis loop over hal with the controller
- * (br_axis_init). On any error app is left not ready (br_app_step then returns
- * BR_E_STATE). On success the application is DISARMED: outputs off (duty 0,
+/* Validates and initialises: the estimator (br_app_est_init), the guards
+ * (BR_E_PARAM), the HAL (BR_E_NULL: hal, its encoder_read, pwm_write or
+ * tick_wait NULL), then the controller (br_ctrl_init's status). On any error
+ * app is left not ready (br_app_step then returns BR_E_STATE). On success the application is DISARMED: outputs off (duty 0,
  * hal.pwm_disable) until br_app_arm. */
 br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *hal, const br_app_mem_t *mem);
 
