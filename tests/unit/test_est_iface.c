@@ -80,9 +80,15 @@ static void test_period_routes(void **st)
 /* n periods on two filters of the same configuration: a through the binding
  * (its step, and its predict at every third period), b by hand; estimates
  * equal bit for bit. */
-static void check_binding(br_est_t a, br_status_t (*step)(void *, const br_meas_t *, float, float *),
-                          br_status_t (*predict)(void *, float), const float *b_F, void *b)
+static void check_binding(br_est_t a, const br_est_t *want, br_status_t (*predict)(void *, float), const float *b_F,
+                          void *b)
 {
+    /* the binding is the filter's three functions over its context */
+    assert_ptr_equal(a.ctx, want->ctx);
+    assert_ptr_equal(a.step, want->step);
+    assert_ptr_equal(a.predict, want->predict);
+    assert_ptr_equal(a.reset, want->reset);
+    br_est_step_fn step = want->step;
     float Fa = 0.0f, Fb = 0.0f;
     for (int k = 0; k < 30; k++) {
         const br_meas_t y = {k / 2, 0.5f};
@@ -108,6 +114,17 @@ static void check_binding(br_est_t a, br_status_t (*step)(void *, const br_meas_
     assert_int_equal(a.reset(NULL), BR_E_NULL);
 }
 
+/* after a's reset and b's init: three steps of both, equal bit for bit */
+static void check_fresh(const br_est_t *a, br_status_t (*step)(void *, const br_meas_t *, float, float *), void *b)
+{
+    float Fa = 0.0f, Fb = 0.0f;
+    const br_meas_t y = {5, 0.5f};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(br_est_period(a, &y, 0.0f, &Fa), step(b, &y, 0.0f, &Fb));
+        assert_memory_equal(&Fa, &Fb, sizeof(float));
+    }
+}
+
 static br_status_t pf_predict(void *ctx, float u) { return br_pf_predict(ctx, u); }
 static br_status_t ukf_predict(void *ctx, float u) { return br_ukf_predict(ctx, u); }
 
@@ -120,20 +137,11 @@ static void test_pf_binding(void **st)
     assert_non_null(pf);
     assert_int_equal(br_pf_init(&pf[0], &c), BR_OK);
     assert_int_equal(br_pf_init(&pf[1], &c), BR_OK);
-    const br_est_t e = br_pf_est(&pf[0]);
-    assert_ptr_equal(e.ctx, &pf[0]);
-    assert_ptr_equal(e.step, br_pf_est_step);
-    assert_ptr_equal(e.predict, br_pf_est_predict);
-    assert_ptr_equal(e.reset, br_pf_est_reset);
-    check_binding(e, br_pf_est_step, pf_predict, &pf[1].est.F_hat_N, &pf[1]);
+    const br_est_t e = br_pf_est(&pf[0]), want = {&pf[0], br_pf_est_step, br_pf_est_predict, br_pf_est_reset};
+    check_binding(e, &want, pf_predict, &pf[1].est.F_hat_N, &pf[1]);
     /* the reset is init: the next steps are a fresh filter's */
     assert_int_equal(br_pf_init(&pf[1], &c), BR_OK);
-    float Fa = 0.0f, Fb = 0.0f;
-    const br_meas_t y = {5, 0.5f};
-    for (int k = 0; k < 3; k++) {
-        assert_int_equal(br_est_period(&e, &y, 0.0f, &Fa), br_pf_est_step(&pf[1], &y, 0.0f, &Fb));
-        assert_memory_equal(&Fa, &Fb, sizeof(float));
-    }
+    check_fresh(&e, br_pf_est_step, &pf[1]);
     free(pf);
 }
 
@@ -144,19 +152,10 @@ static void test_ukf_binding(void **st)
     br_ukf_t u[2];
     assert_int_equal(br_ukf_init(&u[0], &c), BR_OK);
     assert_int_equal(br_ukf_init(&u[1], &c), BR_OK);
-    const br_est_t e = br_ukf_est(&u[0]);
-    assert_ptr_equal(e.ctx, &u[0]);
-    assert_ptr_equal(e.step, br_ukf_est_step);
-    assert_ptr_equal(e.predict, br_ukf_est_predict);
-    assert_ptr_equal(e.reset, br_ukf_est_reset);
-    check_binding(e, br_ukf_est_step, ukf_predict, &u[1].est.F_hat_N, &u[1]);
+    const br_est_t e = br_ukf_est(&u[0]), want = {&u[0], br_ukf_est_step, br_ukf_est_predict, br_ukf_est_reset};
+    check_binding(e, &want, ukf_predict, &u[1].est.F_hat_N, &u[1]);
     assert_int_equal(br_ukf_init(&u[1], &c), BR_OK);
-    float Fa = 0.0f, Fb = 0.0f;
-    const br_meas_t y = {5, 0.5f};
-    for (int k = 0; k < 3; k++) {
-        assert_int_equal(br_est_period(&e, &y, 0.0f, &Fa), br_ukf_est_step(&u[1], &y, 0.0f, &Fb));
-        assert_memory_equal(&Fa, &Fb, sizeof(float));
-    }
+    check_fresh(&e, br_ukf_est_step, &u[1]);
 }
 
 int main(void)
