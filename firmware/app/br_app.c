@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The application: configuration -> estimator -> axis loop (br_app.h). */
+/* The application: configuration -> estimator -> one control period (br_app.h). */
 #include "bristle/br_app.h"
 
 #include <math.h>
@@ -23,7 +23,7 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
     if (cfg == NULL || cfg->ctrl == NULL || est == NULL) {
         return BR_E_NULL;
     }
-    *est = (br_est_t){NULL, NULL};
+    *est = (br_est_t){NULL, NULL, NULL, NULL};
     br_status_t st;
     switch (cfg->est) {
     case BR_APP_EST_NONE:
@@ -37,7 +37,7 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
             st = br_pf_init(mem->pf, cfg->pf);
         }
         if (st == BR_OK) {
-            *est = (br_est_t){mem->pf, br_pf_est_step};
+            *est = br_pf_est(mem->pf);
         }
         return st;
     case BR_APP_EST_UKF:
@@ -49,7 +49,7 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
             st = br_ukf_init(mem->ukf, cfg->ukf);
         }
         if (st == BR_OK) {
-            *est = (br_est_t){mem->ukf, br_ukf_est_step};
+            *est = br_ukf_est(mem->ukf);
         }
         return st;
     case BR_APP_EST_EXTERN:
@@ -104,12 +104,12 @@ static br_status_t guard_check(const br_app_guard_cfg_t *g)
 /* Duty 0, outputs off where the port can. */
 static void outputs_off(br_app_t *app)
 {
-    const br_hal_t *hal = app->axis.hal;
+    const br_hal_t *hal = app->hal;
     (void)hal->pwm_write(hal->ctx, 0.0f);
     if (hal->pwm_disable != NULL) {
         (void)hal->pwm_disable(hal->ctx);
     }
-    app->axis.last = (br_ctrl_out_t){0};
+    app->last = (br_ctrl_out_t){0};
 }
 
 static br_status_t latch(br_app_t *app, br_app_fault_t cause)
@@ -153,7 +153,7 @@ br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *
     if (app == NULL) {
         return BR_E_NULL;
     }
-    app->axis.ready = 0;
+    app->ready = 0;
     if (cfg == NULL) {
         return BR_E_NULL;
     }
@@ -166,13 +166,19 @@ br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *
     if (st != BR_OK) {
         return st;
     }
-    st = br_axis_init(&app->axis, hal, cfg->ctrl, (est.step != NULL) ? &est : NULL);
+    if (hal == NULL || hal->encoder_read == NULL || hal->pwm_write == NULL || hal->tick_wait == NULL) {
+        return BR_E_NULL;
+    }
+    st = br_ctrl_init(&app->ctrl, cfg->ctrl);
     if (st != BR_OK) {
         return st;
     }
+    app->hal = hal;
+    app->est = est;
+    app->F_hat_N = 0.0f;
+    app->last = (br_ctrl_out_t){0};
+    app->ready = 1;
     app->guard = cfg->guard;
-    app->kind = cfg->est;
-    app->mem = (mem != NULL) ? *mem : (br_app_mem_t){NULL, NULL};
     app->last_counts = 0;
     app->have_counts = 0;
     app->n_stale = 0u;
@@ -187,29 +193,25 @@ br_status_t br_app_arm(br_app_t *app)
     if (app == NULL) {
         return BR_E_NULL;
     }
-    if (!app->axis.ready) {
+    if (!app->ready) {
         return BR_E_STATE;
     }
     /* the controller restarts: integral and previous count cleared */
-    const br_ctrl_cfg_t kc = app->axis.ctrl.cfg;
-    br_status_t st = br_ctrl_init(&app->axis.ctrl, &kc);
-    if (st == BR_OK && app->kind == BR_APP_EST_PF) {
-        const br_pf_cfg_t pc = app->mem.pf->cfg;
-        st = br_pf_init(app->mem.pf, &pc); /* primed again at the next measurement */
-    } else if (st == BR_OK && app->kind == BR_APP_EST_UKF) {
-        const br_ukf_cfg_t uc = app->mem.ukf->cfg;
-        st = br_ukf_init(app->mem.ukf, &uc);
+    const br_ctrl_cfg_t kc = app->ctrl.cfg;
+    br_status_t st = br_ctrl_init(&app->ctrl, &kc);
+    if (st == BR_OK && app->est.step != NULL) {
+        st = br_est_restart(&app->est); /* primed again at the next measurement */
     }
     if (st != BR_OK) {
         return st; /* stays latched */
     }
-    app->axis.F_hat_N = 0.0f;
-    app->axis.last = (br_ctrl_out_t){0};
+    app->F_hat_N = 0.0f;
+    app->last = (br_ctrl_out_t){0};
     app->have_counts = 0;
     app->n_stale = 0u;
     app->n_frozen = 0u;
     lock_reset(app);
-    const br_hal_t *hal = app->axis.hal;
+    const br_hal_t *hal = app->hal;
     st = hal->pwm_write(hal->ctx, 0.0f);
     if (st == BR_OK && hal->pwm_enable != NULL) {
         st = hal->pwm_enable(hal->ctx);
@@ -227,7 +229,7 @@ br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause)
     if (app == NULL) {
         return BR_E_NULL;
     }
-    if (!app->axis.ready) {
+    if (!app->ready) {
         return BR_E_STATE;
     }
     if (cause <= BR_APP_FAULT_NONE || cause > BR_APP_FAULT_LOST_LOCK) {
@@ -236,36 +238,15 @@ br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause)
     return latch(app, cause);
 }
 
-/* A period without a measurement: the PF / UKF predict only; an EXTERN
- * estimate is held. */
-static br_status_t est_predict(br_app_t *app)
-{
-    const float u = app->axis.last.tau_Nm;
-    br_status_t st = BR_OK;
-    if (app->kind == BR_APP_EST_PF) {
-        st = br_pf_predict(app->mem.pf, u);
-        if (!BR_FAILED(st)) {
-            app->axis.F_hat_N = br_pf_estimate(app->mem.pf)->F_hat_N;
-        }
-    } else if (app->kind == BR_APP_EST_UKF) {
-        st = br_ukf_predict(app->mem.ukf, u);
-        if (!BR_FAILED(st)) {
-            app->axis.F_hat_N = br_ukf_estimate(app->mem.ukf)->F_hat_N;
-        }
-    }
-    return st;
-}
-
 br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
 {
     if (app == NULL || ref == NULL) {
         return BR_E_NULL;
     }
-    if (!app->axis.ready) {
+    if (!app->ready) {
         return BR_E_STATE;
     }
-    br_axis_t *a = &app->axis;
-    const br_hal_t *hal = a->hal;
+    const br_hal_t *hal = app->hal;
     if (app->fault != BR_APP_FAULT_NONE) {
         outputs_off(app);
         return BR_E_FAULT;
@@ -282,11 +263,14 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
             /* nothing to hold yet: duty 0 this period, outputs stay enabled
              * (not latched: a good read next period runs the loop) */
             (void)hal->pwm_write(hal->ctx, 0.0f);
-            a->last = (br_ctrl_out_t){0};
+            app->last = (br_ctrl_out_t){0};
             return BR_OK;
         }
         counts = app->last_counts;
-        est_st = est_predict(app);
+        if (app->est.step != NULL) {
+            /* the estimator predicts over the period (or holds its estimate) */
+            est_st = br_est_period(&app->est, NULL, app->last.tau_Nm, &app->F_hat_N);
+        }
     } else {
         /* the periods since the last good read: this one and the held ones */
         const uint64_t periods = (uint64_t)app->n_stale + 1u;
@@ -300,7 +284,7 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
             if ((uint64_t)mag > (uint64_t)app->guard.enc_max_delta_counts * periods) {
                 return latch(app, BR_APP_FAULT_ENC_JUMP);
             }
-            if (mag == 0u && fabsf(a->last.duty) >= app->guard.frozen_duty) {
+            if (mag == 0u && fabsf(app->last.duty) >= app->guard.frozen_duty) {
                 if (++app->n_frozen >= app->guard.frozen_periods) {
                     return latch(app, BR_APP_FAULT_ENC_FROZEN);
                 }
@@ -310,10 +294,10 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
         }
         app->last_counts = counts;
         app->have_counts = 1;
-        if (a->est.step != NULL) {
+        if (app->est.step != NULL) {
             /* the estimator sees the count's centre and the torque of the last period */
             const br_meas_t y = {counts, 0.5f};
-            est_st = a->est.step(a->est.ctx, &y, a->last.tau_Nm, &a->F_hat_N);
+            est_st = br_est_period(&app->est, &y, app->last.tau_Nm, &app->F_hat_N);
         }
     }
     /* a warning (an outlier measurement skipped, whose prediction stays
@@ -323,15 +307,15 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
     }
     /* an estimator that keeps rejecting the measurement (and re-anchoring on
      * it) has lost the axis: stop rather than compensate with its estimate */
-    if (a->est.step != NULL && lock_lost(app, est_st == BR_W_OUTLIER)) {
+    if (app->est.step != NULL && lock_lost(app, est_st == BR_W_OUTLIER)) {
         return latch(app, BR_APP_FAULT_LOST_LOCK);
     }
-    br_ctrl_in_t in = {counts, ref->ref_counts, ref->ref_frac_counts, ref->ref_omega_radps, a->F_hat_N};
-    st = br_ctrl_step(&a->ctrl, &in, &a->last);
+    br_ctrl_in_t in = {counts, ref->ref_counts, ref->ref_frac_counts, ref->ref_omega_radps, app->F_hat_N};
+    st = br_ctrl_step(&app->ctrl, &in, &app->last);
     if (st != BR_OK) {
         return latch(app, (st == BR_E_INPUT) ? BR_APP_FAULT_CTRL_INPUT : BR_APP_FAULT_CTRL_STATE);
     }
-    st = hal->pwm_write(hal->ctx, a->last.duty);
+    st = hal->pwm_write(hal->ctx, app->last.duty);
     if (st != BR_OK) {
         return latch(app, BR_APP_FAULT_HAL);
     }

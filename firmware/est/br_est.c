@@ -7,7 +7,13 @@
 #include <stddef.h>
 
 #include "br_check.h"
-#include "br_dlyid_check.h"
+
+/* What the delay identification reads of cfg. */
+static br_dlyid_axis_t dlyid_axis(const br_est_cfg_t *cfg)
+{
+    const br_dlyid_axis_t ax = {&cfg->model, cfg->rad_per_count, cfg->r_var_rad2, cfg->gp_max_N};
+    return ax;
+}
 
 int br_est_var_ok(float v, int zero_ok)
 {
@@ -51,7 +57,13 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
         return BR_E_PARAM;
     }
     /* last: the bank's constants use g_p's range and the model's (checked above) */
-    if (!br_dlyid_cfg_ok(cfg)) {
+    const br_dlyid_axis_t ax = dlyid_axis(cfg);
+    if (!br_dlyid_cfg_ok(&cfg->delay_id, &ax)) {
+        return BR_E_PARAM;
+    }
+    /* the largest candidate within the command history (br_est_delay_torque's m <= HIST - 2) */
+    const br_dlyid_cfg_t *id = &cfg->delay_id;
+    if (id->n_cand > 0u && !br_est_delay_fits((float)(id->n_cand - 1u) * id->step_s, cfg->model.dt_s)) {
         return BR_E_PARAM;
     }
     return BR_OK;
@@ -70,16 +82,9 @@ int br_est_delay_fits(float delay_s, float dt_s)
     return delay_s <= (float)(BR_EST_DELAY_HIST - 2u) * dt_s;
 }
 
-void br_est_delay_periods(float delay_s, float dt_s, uint32_t *m, float *f)
-{
-    const float q = delay_s / dt_s;
-    *m = (uint32_t)q;
-    *f = q - (float)*m;
-}
-
 void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg)
 {
-    br_est_delay_periods(cfg->model.causes.delay_s, cfg->model.dt_s, &d->m, &d->f);
+    br_dlyid_periods(cfg->model.causes.delay_s, cfg->model.dt_s, &d->m, &d->f);
     d->on = cfg->model.causes.delay_s > 0.0f || cfg->delay_id.n_cand > 0u;
     d->head = 0u;
     d->n = 0u;
@@ -165,4 +170,48 @@ float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_d
      * at speeds far beyond any axis'): the filtered estimate */
     const float F = F_hat_N + (fh - f0);
     return isfinite(F) ? F : F_hat_N;
+}
+
+void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg)
+{
+    const br_dlyid_axis_t ax = dlyid_axis(cfg);
+    br_dlyid_init(id, &cfg->delay_id, &ax);
+}
+
+void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d)
+{
+    const uint32_t n = cfg->delay_id.n_cand;
+    if (n == 0u || n > BR_DLYID_MAX_CAND) {
+        return; /* off (or a configuration no check has seen): the history is not read */
+    }
+    /* (dly4) each slot's torque: u_j = (1 - f_j) u[k-1-m_j] + f_j u[k-2-m_j] */
+    float u[BR_DLYID_MAX_SLOTS];
+    for (uint32_t j = 0; j <= n; j++) {
+        u[j] = br_est_delay_torque(d, id->cm[j], id->cf[j]);
+    }
+    const br_dlyid_axis_t ax = dlyid_axis(cfg);
+    if (br_dlyid_step(id, &cfg->delay_id, &ax, y->counts, y->frac, u)) {
+        d->m = id->cm[id->cur];
+        d->f = id->cf[id->cur]; /* d->on: set by br_est_delay_init for the bank */
+    }
+}
+
+br_status_t br_est_period(const br_est_t *e, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    if (e == NULL || e->step == NULL || F_hat_N == NULL) {
+        return BR_E_NULL;
+    }
+    if (y != NULL) {
+        return e->step(e->ctx, y, u_prev_Nm, F_hat_N);
+    }
+    /* no measurement: predict, or hold the estimate */
+    return (e->predict != NULL) ? e->predict(e->ctx, u_prev_Nm, F_hat_N) : BR_OK;
+}
+
+br_status_t br_est_restart(const br_est_t *e)
+{
+    if (e == NULL) {
+        return BR_E_NULL;
+    }
+    return (e->reset != NULL) ? e->reset(e->ctx) : BR_OK;
 }

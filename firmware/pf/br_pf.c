@@ -712,3 +712,32 @@ br_status_t br_pf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float
     }
     return st;
 }
+
+br_status_t br_pf_est_predict(void *ctx, float u_prev_Nm, float *F_hat_N)
+{
+    br_pf_t *pf = ctx;
+    if (F_hat_N == NULL) {
+        return BR_E_NULL;
+    }
+    const br_status_t st = br_pf_predict(pf, u_prev_Nm);
+    if (!BR_FAILED(st)) {
+        *F_hat_N = pf->est.F_hat_N;
+    }
+    return st;
+}
+
+br_status_t br_pf_est_reset(void *ctx)
+{
+    br_pf_t *pf = ctx;
+    if (pf == NULL) {
+        return BR_E_NULL;
+    }
+    const br_pf_cfg_t c = pf->cfg; /* init reads the configuration it overwrites */
+    return br_pf_init(pf, &c);
+}
+
+br_est_t br_pf_est(br_pf_t *pf)
+{
+    const br_est_t e = {pf, br_pf_est_step, br_pf_est_predict, br_pf_est_reset};
+    return e;
+}

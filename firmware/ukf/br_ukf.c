@@ -494,3 +494,32 @@ br_status_t br_ukf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, floa
     }
     return st;
 }
+
+br_status_t br_ukf_est_predict(void *ctx, float u_prev_Nm, float *F_hat_N)
+{
+    br_ukf_t *ukf = ctx;
+    if (F_hat_N == NULL) {
+        return BR_E_NULL;
+    }
+    const br_status_t st = br_ukf_predict(ukf, u_prev_Nm);
+    if (!BR_FAILED(st)) {
+        *F_hat_N = ukf->est.F_hat_N;
+    }
+    return st;
+}
+
+br_status_t br_ukf_est_reset(void *ctx)
+{
+    br_ukf_t *ukf = ctx;
+    if (ukf == NULL) {
+        return BR_E_NULL;
+    }
+    const br_ukf_cfg_t c = ukf->cfg; /* init reads the configuration it overwrites */
+    return br_ukf_init(ukf, &c);
+}
+
+br_est_t br_ukf_est(br_ukf_t *ukf)
+{
+    const br_est_t e = {ukf, br_ukf_est_step, br_ukf_est_predict, br_ukf_est_reset};
+    return e;
+}

@@ -238,7 +238,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     br_hal_t hal;
     br_app_t app;
     br_app_mem_t mem = {NULL, NULL};
-    const br_est_t ext = {&p, oracle_step};
+    const br_est_t ext = {&p, oracle_step, NULL, NULL};
     /* the encoder's plausibility guard from the trajectory's own top speed
      * (twice it: the axis lags and overshoots), in counts/s of this plant */
     double vmax = 0.0;
@@ -250,7 +250,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     const br_plant_state_t x0 = {tr->ref[0] / pc->lead_mprad, 0.0, 0.0};
     int rc = -1;
     if (ctrl == BR_CTRL_HINF_PF && (mem.pf = calloc(1, sizeof *mem.pf)) == NULL) return -1;
-    br_est_t ffe = {&w.ff, br_ff_est_step};
+    br_est_t ffe = {&w.ff, br_ff_est_step, NULL, NULL};
     if (ff == 1) {
         ac.est = BR_APP_EST_EXTERN;
         ac.ext = &ffe;
@@ -261,7 +261,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
             fprintf(stderr, "br_track: PF init failed\n");
             goto done;
         }
-        ffe = (br_est_t){&w, pf_ff_step};
+        ffe = (br_est_t){&w, pf_ff_step, NULL, NULL};
         ac.est = BR_APP_EST_EXTERN;
         ac.ext = &ffe;
     }
@@ -293,7 +293,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
             rep->fault_t_s = t;
             break;
         }
-        err_add(e, t, x_ref, pos, (double)app.axis.last.duty * pc->tau_per_duty_Nm / L);
+        err_add(e, t, x_ref, pos, (double)app.last.duty * pc->tau_per_duty_Nm / L);
     }
     rc = 0;
 done:

@@ -132,7 +132,7 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
     if (br_hal_sim_init(&port, &plant, c->dt_s, &hal) != BR_OK) return -1;
     const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(c);
     rec_est_t wrap = {est, &plant, rec, 0};
-    const br_est_t e = {&wrap, rec_est_step};
+    const br_est_t e = {&wrap, rec_est_step, NULL, NULL};
     const br_app_cfg_t ac = {&cc, BR_APP_EST_EXTERN, NULL, NULL, &e,
                              br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
     if (br_app_init(&app, &ac, &hal, NULL) != BR_OK || br_app_arm(&app) != BR_OK) {
@@ -587,8 +587,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "br_bench: filter init failed\n");
         goto done;
     }
-    if (record_axis(&cpf, (br_est_t){pf, br_pf_est_step}, &rpf) != 0) goto done;
-    if (record_axis(&cukf, (br_est_t){ukf, br_ukf_est_step}, &rukf) != 0) goto done;
+    if (record_axis(&cpf, br_pf_est(pf), &rpf) != 0) goto done;
+    if (record_axis(&cukf, br_ukf_est(ukf), &rukf) != 0) goto done;
     fhat_pf = malloc((size_t)rpf.n * sizeof *fhat_pf);
     fhat_ukf = malloc((size_t)rukf.n * sizeof *fhat_ukf);
     if (!fhat_pf || !fhat_ukf) goto done;

@@ -262,14 +262,14 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
                             inner_pwm_enable};
     }
     const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(c);
-    br_est_t ext = {NULL, NULL};
+    br_est_t ext = {NULL, NULL, NULL, NULL};
     br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext,
                        br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
     switch (c->controller) {
     case BR_CTRL_HINF_ONLY:
         break;
     case BR_CTRL_HINF_TRUE:
-        ext = (br_est_t){&a->plant, oracle_step};
+        ext = (br_est_t){&a->plant, oracle_step, NULL, NULL};
         ac.est = BR_APP_EST_EXTERN;
         break;
     case BR_CTRL_HINF_FF:
@@ -277,7 +277,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
             fprintf(stderr, "br_circle: invalid feedforward configuration\n");
             return -1;
         }
-        ext = (br_est_t){&a->ff, br_ff_est_step};
+        ext = (br_est_t){&a->ff, br_ff_est_step, NULL, NULL};
         ac.est = BR_APP_EST_EXTERN;
         break;
     case BR_CTRL_HINF_UKF:
@@ -389,9 +389,9 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
                 k_end = k;
                 break;
             }
-            sat |= ax[i].app.axis.last.saturated;
-            s.duty[i] = (double)ax[i].app.axis.last.duty;
-            s.F_hat_N[i] = (double)ax[i].app.axis.F_hat_N;
+            sat |= ax[i].app.last.saturated;
+            s.duty[i] = (double)ax[i].app.last.duty;
+            s.F_hat_N[i] = (double)ax[i].app.F_hat_N;
             /* against the force a perfect estimator hands over (the oracle's) */
             const double f_true = br_plant_comp_force_N(&ax[i].plant);
             fe2 += (s.F_hat_N[i] - f_true) * (s.F_hat_N[i] - f_true);

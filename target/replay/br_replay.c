@@ -207,7 +207,7 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
             out[0] = k;
             out[1] = (uint32_t)(int32_t)st[a];
             out[2] = br_replay_idx_hash(x->pf.idx, r->cfg.pf.n_particles);
-            out[3] = f2w(x->app.axis.F_hat_N);
+            out[3] = f2w(x->app.F_hat_N);
             out[4] = f2w(x->duty);
             out[5] = t1[a] - t0;
             if (io->write(io->ctx, out, (uint32_t)sizeof out) != 0) return -1;

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The application module: configuration guards, and that each estimator kind
- * runs the same loop as wiring the estimator into br_axis by hand. */
+/* The application module: configuration guards, the latched faults, the
+ * estimator interface, and that each estimator kind runs the same period as
+ * the filter and the controller stepped by hand. */
 #include "br_test.h"
 
 #include <math.h>
@@ -90,6 +91,16 @@ static void test_init_guards(void **st)
     assert_int_equal(br_app_init(NULL, &c, &hal, NULL), BR_E_NULL);
     assert_int_equal(br_app_init(&app, NULL, &hal, NULL), BR_E_NULL);
     assert_int_equal(br_app_init(&app, &c, NULL, NULL), BR_E_NULL);
+    /* every HAL function the period calls */
+    br_hal_t h2 = hal;
+    h2.encoder_read = NULL;
+    assert_int_equal(br_app_init(&app, &c, &h2, NULL), BR_E_NULL);
+    h2 = hal;
+    h2.pwm_write = NULL;
+    assert_int_equal(br_app_init(&app, &c, &h2, NULL), BR_E_NULL);
+    h2 = hal;
+    h2.tick_wait = NULL;
+    assert_int_equal(br_app_init(&app, &c, &h2, NULL), BR_E_NULL);
     assert_int_equal(br_app_est_init(&c, NULL, NULL), BR_E_NULL);
     c.ctrl = NULL;
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_E_NULL);
@@ -120,6 +131,8 @@ static void test_init_guards(void **st)
     assert_int_equal(br_app_est_init(&c, &mem, &est), BR_OK);
     assert_ptr_equal(est.ctx, pf);
     assert_ptr_equal(est.step, br_pf_est_step);
+    assert_ptr_equal(est.predict, br_pf_est_predict);
+    assert_ptr_equal(est.reset, br_pf_est_reset);
 
     /* UKF: likewise */
     c.est = BR_APP_EST_UKF;
@@ -138,7 +151,7 @@ static void test_init_guards(void **st)
 
     /* an external estimator: the interface and its step are required */
     const float F = 1.0f;
-    br_est_t ext = {(void *)&F, NULL};
+    br_est_t ext = {(void *)&F, NULL, NULL, NULL};
     c.est = BR_APP_EST_EXTERN;
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_E_NULL);
     c.ext = &ext;
@@ -167,7 +180,7 @@ static void test_none_is_hinf_only(void **st)
     assert_int_equal(br_app_arm(&app), BR_OK);
     assert_int_equal(br_app_step(&app, &r), BR_OK);
     BR_ASSERT_NEAR(f.duty, -0.5 * 1000 * 6.0e-6 / 0.64, 1e-7);
-    BR_ASSERT_NEAR(app.axis.F_hat_N, 0.0, 0.0);
+    BR_ASSERT_NEAR(app.F_hat_N, 0.0, 0.0);
 }
 
 static void test_extern_drives_compensation(void **st)
@@ -177,7 +190,7 @@ static void test_extern_drives_compensation(void **st)
     const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     const br_ctrl_cfg_t k = ctrl_cfg();
     const float F = 10.0f;
-    const br_est_t ext = {(void *)&F, const_est_step};
+    const br_est_t ext = {(void *)&F, const_est_step, NULL, NULL};
     const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD};
     br_app_t app;
     const br_ref_t r = {0, 0.0f, 0.0f};
@@ -188,12 +201,89 @@ static void test_extern_drives_compensation(void **st)
     BR_ASSERT_NEAR(f.duty, 1.27e-3 * 10.0 / 0.64, 1e-7);
 }
 
-/* The same periods through br_app (kind) and through br_axis with the filter
- * wired by hand: bit-identical estimates and duties. */
-static void run_against_axis(br_app_est_kind_t kind)
+/* An estimator behind the interface (EXTERN with predict and reset): a failed
+ * read reaches its predict with the last torque, an arm its reset, whose
+ * error keeps the application latched; no kind is read after init. */
+typedef struct {
+    int steps, predicts, resets;
+    float u;
+    br_status_t reset_st;
+    br_meas_t y;
+} iface_t;
+
+static br_status_t iface_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
 {
-    fake_t fa = {0, 0.0f, BR_OK, BR_OK, 0, 0}, fb = {0, 0.0f, BR_OK, BR_OK, 0, 0};
-    const br_hal_t ha = {&fa, fake_enc, fake_pwm, fake_tick, NULL, NULL}, hb = {&fb, fake_enc, fake_pwm, fake_tick, NULL, NULL};
+    iface_t *e = ctx;
+    e->y = *y;
+    e->steps++;
+    e->u = u_prev_Nm;
+    *F_hat_N = 1.0f;
+    return BR_OK;
+}
+static br_status_t iface_predict(void *ctx, float u_prev_Nm, float *F_hat_N)
+{
+    iface_t *e = ctx;
+    e->predicts++;
+    e->u = u_prev_Nm;
+    *F_hat_N = 3.0f;
+    return BR_OK;
+}
+static br_status_t iface_reset(void *ctx)
+{
+    iface_t *e = ctx;
+    e->resets++;
+    return e->reset_st;
+}
+
+static void test_estimator_interface(void **st)
+{
+    (void)st;
+    fake_t f = {0, 0.0f, BR_OK, BR_OK, 0, 0};
+    const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, fake_disable, fake_enable};
+    const br_ctrl_cfg_t k = ctrl_cfg();
+    iface_t e = {0, 0, 0, 0.0f, BR_OK, {0, 0.0f}};
+    const br_est_t ext = {&e, iface_step, iface_predict, iface_reset};
+    const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD};
+    br_app_t app;
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
+    assert_int_equal(e.resets, 0);
+    assert_int_equal(br_app_arm(&app), BR_OK);
+    assert_int_equal(e.resets, 1);
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_int_equal(e.steps, 1);
+    const float tau = app.last.tau_Nm;
+    assert_true(tau != 0.0f);
+    f.enc_st = BR_E_INPUT;
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_int_equal(e.predicts, 1);
+    assert_true(e.u == tau);
+    assert_true(app.F_hat_N == 3.0f);
+    f.enc_st = BR_OK;
+    const float tau2 = app.last.tau_Nm;
+    assert_int_equal(br_app_step(&app, &r), BR_OK);
+    assert_int_equal(e.steps, 2);
+    assert_int_equal(e.predicts, 1);
+    assert_true(e.u == tau2); /* the step sees the torque of the last period */
+    assert_true(e.y.counts == 0 && e.y.frac == 0.5f); /* the count's centre */
+    /* a reset that fails: the arm fails and the fault stays */
+    assert_int_equal(br_app_fault(&app, BR_APP_FAULT_DEADLINE), BR_E_FAULT);
+    e.reset_st = BR_E_PARAM;
+    assert_int_equal(br_app_arm(&app), BR_E_PARAM);
+    assert_int_equal(app.fault, BR_APP_FAULT_DEADLINE);
+    assert_int_equal(br_app_step(&app, &r), BR_E_FAULT);
+    e.reset_st = BR_OK;
+    assert_int_equal(br_app_arm(&app), BR_OK);
+    assert_int_equal(e.resets, 3);
+}
+
+/* The same periods through br_app (kind) and written out by hand (the
+ * filter's step with the count's centre and the last torque, then the
+ * controller with its estimate): bit-identical estimates and duties. */
+static void run_against_hand(br_app_est_kind_t kind)
+{
+    fake_t fa = {0, 0.0f, BR_OK, BR_OK, 0, 0};
+    const br_hal_t ha = {&fa, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     const br_ctrl_cfg_t k = ctrl_cfg();
     br_pf_cfg_t pfc = br_circle_pf_cfg_tuned(1e-3f);
     pfc.n_particles = 200u;
@@ -203,33 +293,37 @@ static void run_against_axis(br_app_est_kind_t kind)
     assert_non_null(pf);
     assert_non_null(ukf);
     br_app_cfg_t c = {&k, kind, &pfc, &ukfc, NULL, GUARD};
-    /* the jumpy counts below make the filters reject measurements: the axis
-     * loop has no lock monitor, so it must not trip here */
+    /* the jumpy counts below make the filters reject measurements: the lock
+     * monitor (not part of the period written out here) must not trip */
     c.guard.lock_max_outliers = c.guard.lock_window_periods - 1u;
     const br_app_mem_t mem = {&pf[0], &ukf[0]};
     br_app_t app;
     assert_int_equal(br_app_init(&app, &c, &ha, &mem), BR_OK);
     assert_int_equal(br_app_arm(&app), BR_OK); /* re-initialises the filter: the same as init */
-    br_est_t est;
     if (kind == BR_APP_EST_PF) {
         assert_int_equal(br_pf_init(&pf[1], &pfc), BR_OK);
-        est = (br_est_t){&pf[1], br_pf_est_step};
     } else {
         assert_int_equal(br_ukf_init(&ukf[1], &ukfc), BR_OK);
-        est = (br_est_t){&ukf[1], br_ukf_est_step};
     }
-    br_axis_t axis;
-    assert_int_equal(br_axis_init(&axis, &hb, &k, &est), BR_OK);
+    br_ctrl_t ctrl;
+    assert_int_equal(br_ctrl_init(&ctrl, &k), BR_OK);
+    br_ctrl_out_t out = {0};
+    float F = 0.0f;
     for (int i = 0; i < 50; i++) {
         const br_ref_t r = {i * 3, 0.25f, 0.5f};
-        fa.counts = fb.counts = i * 3 + (i % 4) - 1;
-        const br_status_t sa = br_app_step(&app, &r), sb = br_axis_step(&axis, &r);
+        fa.counts = i * 3 + (i % 4) - 1;
+        const br_status_t sa = br_app_step(&app, &r);
+        const br_meas_t y = {fa.counts, 0.5f};
+        const br_status_t sb = (kind == BR_APP_EST_PF) ? br_pf_est_step(&pf[1], &y, out.tau_Nm, &F)
+                                                       : br_ukf_est_step(&ukf[1], &y, out.tau_Nm, &F);
         assert_int_equal(sa, sb);
         assert_false(BR_FAILED(sa));
-        assert_memory_equal(&app.axis.F_hat_N, &axis.F_hat_N, sizeof(float));
-        assert_memory_equal(&fa.duty, &fb.duty, sizeof(float));
+        const br_ctrl_in_t in = {fa.counts, r.ref_counts, r.ref_frac_counts, r.ref_omega_radps, F};
+        assert_int_equal(br_ctrl_step(&ctrl, &in, &out), BR_OK);
+        assert_memory_equal(&app.F_hat_N, &F, sizeof(float));
+        assert_memory_equal(&fa.duty, &out.duty, sizeof(float));
     }
-    assert_true(app.axis.F_hat_N != 0.0f);
+    assert_true(app.F_hat_N != 0.0f);
     free(pf);
     free(ukf);
 }
@@ -237,13 +331,13 @@ static void run_against_axis(br_app_est_kind_t kind)
 static void test_pf_as_wired_by_hand(void **st)
 {
     (void)st;
-    run_against_axis(BR_APP_EST_PF);
+    run_against_hand(BR_APP_EST_PF);
 }
 
 static void test_ukf_as_wired_by_hand(void **st)
 {
     (void)st;
-    run_against_axis(BR_APP_EST_UKF);
+    run_against_hand(BR_APP_EST_UKF);
 }
 
 /* ---- fail-safe: latched faults (docs/reliability.md) ----------------------- */
@@ -274,7 +368,7 @@ static void rig_init(rig_t *g, int ext)
     memset(g, 0, sizeof *g);
     g->hal = (br_hal_t){&g->f, fake_enc, fake_pwm, fake_tick, fake_disable, fake_enable};
     g->k = ctrl_cfg();
-    g->ext = (br_est_t){&est_status, bad_est_step};
+    g->ext = (br_est_t){&est_status, bad_est_step, NULL, NULL};
     est_status = BR_OK;
     g->c = (br_app_cfg_t){&g->k, ext ? BR_APP_EST_EXTERN : BR_APP_EST_NONE, NULL, NULL, &g->ext, GUARD};
     assert_int_equal(br_app_init(&g->app, &g->c, &g->hal, NULL), BR_OK);
@@ -331,13 +425,13 @@ static void test_ctrl_input_latches_until_rearmed(void **st)
     for (int i = 0; i < 5; i++) {
         assert_int_equal(br_app_step(&g.app, &r), BR_OK);
     }
-    assert_true(g.app.axis.ctrl.eps_rads != 0.0f);
+    assert_true(g.app.ctrl.eps_rads != 0.0f);
     assert_int_equal(br_app_step(&g.app, &bad), BR_E_FAULT);
     assert_latched(&g, BR_APP_FAULT_CTRL_INPUT);
     /* a good reference does not clear it; only the arm does, restarting the integral */
     assert_int_equal(br_app_arm(&g.app), BR_OK);
     assert_int_equal(g.app.fault, BR_APP_FAULT_NONE);
-    assert_true(g.app.axis.ctrl.eps_rads == 0.0f);
+    assert_true(g.app.ctrl.eps_rads == 0.0f);
     assert_int_equal(br_app_step(&g.app, &r), BR_OK);
     assert_true(g.f.duty < 0.0f && g.f.on);
 }
@@ -349,7 +443,7 @@ static void test_ctrl_state_latches(void **st)
     rig_init(&g, 0);
     const br_ref_t r = {0, 0.0f, 0.0f};
     assert_int_equal(br_app_step(&g.app, &r), BR_OK);
-    g.app.axis.ctrl.eps_rads = INFINITY; /* a corrupted integrator */
+    g.app.ctrl.eps_rads = INFINITY; /* a corrupted integrator */
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
     assert_latched(&g, BR_APP_FAULT_CTRL_STATE);
 }
@@ -677,6 +771,7 @@ int main(void)
         cmocka_unit_test(test_init_guards),
         cmocka_unit_test(test_none_is_hinf_only),
         cmocka_unit_test(test_extern_drives_compensation),
+        cmocka_unit_test(test_estimator_interface),
         cmocka_unit_test(test_pf_as_wired_by_hand),
         cmocka_unit_test(test_ukf_as_wired_by_hand),
         cmocka_unit_test(test_outputs_off_until_armed),

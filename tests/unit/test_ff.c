@@ -170,7 +170,7 @@ static void test_est_adapter(void **st)
     br_ff_cfg_t c = ref_cfg();
     br_ff_t ff;
     assert_int_equal(br_ff_init(&ff, &c), BR_OK);
-    const br_est_t est = {&ff, br_ff_est_step};
+    const br_est_t est = {&ff, br_ff_est_step, NULL, NULL};
     const br_meas_t y = {123, 0.5f};
     const br_ff_in_t in = {2e-5f, 0.0f, 0.0f};
     float want, got;

@@ -6,9 +6,10 @@
  *   encoder -> estimator (PF, UKF or none) -> controller (eq. 7, the estimate
  *   as compensation) -> PWM
  *
- * through br_axis_step, over the HAL the caller binds. The production image
- * (hal/stm32h7/image), the replay image (target/mps2) and the simulator's
- * circle experiment (sim/circle) all run br_app_step. docs/modules/app.md.
+ * over the HAL the caller binds: the one home of the control period. The
+ * production images (hal/stm32h7/image, hal/stm32g4/image), the replay image
+ * (target/mps2) and the simulator's circle experiment (sim/circle) all run
+ * br_app_step. docs/modules/app.md.
  *
  * Where the estimator's state lives: in storage the caller provides
  * (br_app_mem_t), not in a union inside br_app_t. A union would make every
@@ -17,20 +18,25 @@
  * carry 94 KB it never uses, and a UKF application (696 B of filter) too.
  * With caller storage each program sizes and places exactly its estimator:
  * on the MCU a static br_pf_t in a RAM section (.bss in the DTCM, never the
- * stack), on the host the heap. br_app_t itself is small (the axis loop). */
+ * stack), on the host the heap. br_app_t itself is small (the controller, the
+ * estimator interface, the guards' state). */
 #ifndef BR_APP_H
 #define BR_APP_H
 
-#include "bristle/br_axis.h"
+#include "bristle/br_ctrl.h"
+#include "bristle/br_est.h"
+#include "bristle/br_hal.h"
 #include "bristle/br_pf.h"
+#include "bristle/br_ref.h"
 #include "bristle/br_ukf.h"
 
 typedef enum {
     BR_APP_EST_NONE = 0,  /* no compensation: H-infinity only */
     BR_APP_EST_PF = 1,    /* particle filter, cfg->pf, state in mem->pf */
     BR_APP_EST_UKF = 2,   /* unscented Kalman filter, cfg->ukf, state in mem->ukf */
-    BR_APP_EST_EXTERN = 3 /* an estimator the caller runs behind br_est_t (cfg->ext): the
-                             simulator's true-friction oracle, a wrapper around a PF or UKF */
+    BR_APP_EST_EXTERN = 3 /* an estimator the caller runs behind br_est_t (cfg->ext, its
+                             predict and reset may be NULL): the simulator's true-friction
+                             oracle, a wrapper around a PF or UKF */
 } br_app_est_kind_t;
 
 /* Why the outputs are off (br_app_t.fault). Every cause but NONE is latched:
@@ -104,10 +110,14 @@ typedef struct {
 } br_app_mem_t;
 
 typedef struct {
-    br_axis_t axis; /* the loop; axis.F_hat_N and axis.last are the period's outputs */
+    const br_hal_t *hal;
+    br_est_t est;           /* the estimator the configuration's kind named (step, predict,
+                               reset); est.step == NULL: none, H-infinity only */
+    br_ctrl_t ctrl;
+    float F_hat_N;          /* the period's output: the compensation used (N, load side) */
+    br_ctrl_out_t last;     /* the period's output: torque, duty, errors, saturation */
+    int ready;              /* br_app_init succeeded */
     br_app_guard_cfg_t guard;
-    br_app_est_kind_t kind;
-    br_app_mem_t mem;       /* the PF's / UKF's storage: predict and re-initialise at an arm */
     br_app_fault_t fault;   /* NONE while armed; the latched cause otherwise */
     int32_t last_counts;    /* last good encoder read */
     int have_counts;        /* last_counts valid (a good read since the arm) */
@@ -119,26 +129,30 @@ typedef struct {
 } br_app_t;
 
 /* The estimator the configuration names, initialised in its storage, as the
- * br_est_t the loop drives (est->step == NULL for BR_APP_EST_NONE). For a
- * caller that puts something in front of it (the simulator's extended-model
- * wrapper) before handing it to br_app_init as BR_APP_EST_EXTERN.
+ * br_est_t the loop drives: br_pf_est / br_ukf_est (step, predict, reset),
+ * the caller's *cfg->ext for EXTERN, est->step == NULL for BR_APP_EST_NONE.
+ * The one place where the kind is read: the period and the arm go through
+ * the interface. For a caller that puts something in front of it (the
+ * simulator's extended-model wrapper) before handing it to br_app_init as
+ * BR_APP_EST_EXTERN.
  * BR_E_NULL: cfg, cfg->ctrl, est, or the config / storage / br_est_t the kind
  * needs is NULL (mem may be NULL for NONE and EXTERN). BR_E_PARAM: an unknown
  * kind, or a PF / UKF whose period (model.dt_s) is not the controller's
  * (equal to 1e-6 relative); else the filter's own init status. */
 br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br_est_t *est);
 
-/* Validates and initialises: the guards (BR_E_PARAM), the estimator
- * (br_app_est_init), then the axis loop over hal with the controller
- * (br_axis_init). On any error app is left not ready (br_app_step then returns
- * BR_E_STATE). On success the application is DISARMED: outputs off (duty 0,
+/* Validates and initialises: the estimator (br_app_est_init), the guards
+ * (BR_E_PARAM), the HAL (BR_E_NULL: hal, its encoder_read, pwm_write or
+ * tick_wait NULL), then the controller (br_ctrl_init's status). On any error
+ * app is left not ready (br_app_step then returns BR_E_STATE). On success the application is DISARMED: outputs off (duty 0,
  * hal.pwm_disable) until br_app_arm. */
 br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *hal, const br_app_mem_t *mem);
 
 /* Arms (after init) or re-arms (after a fault): the controller restarts (its
- * integral and its previous count cleared), the PF / UKF are re-initialised
- * from their own configuration (primed again at the next measurement; an
- * EXTERN estimator is the caller's), the encoder guards restart, the fault
+ * integral and its previous count cleared), the estimator restarts through
+ * its reset (br_est_restart: the PF / UKF re-initialised from their own
+ * configuration, primed again at the next measurement; an EXTERN estimator
+ * without a reset is the caller's), the encoder guards restart, the fault
  * is cleared and hal.pwm_enable (if any) turns the outputs on at duty 0.
  * BR_E_NULL, BR_E_STATE (not initialised), or the re-initialisation's error
  * (the application then stays latched). */
@@ -150,8 +164,9 @@ br_status_t br_app_arm(br_app_t *app);
 br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause);
 
 /* One control period, after the tick (docs/modules/app.md):
- *   encoder read    a failed read holds the last count (the PF / UKF predict
- *                   only, an EXTERN estimate is held) for up to
+ *   encoder read    a failed read holds the last count (the estimator's
+ *                   predict: the PF / UKF predict only; an estimator without
+ *                   one, an EXTERN one, holds its estimate) for up to
  *                   enc_stale_periods periods, then ENC_STALE; a delta above
  *                   enc_max_delta_counts is ENC_JUMP; an unchanged count while
  *                   the last |duty| >= frozen_duty for frozen_periods is

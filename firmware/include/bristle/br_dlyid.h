@@ -3,12 +3,15 @@
  * a bank of small Kalman filters, one per candidate delay, all driven by the
  * commands the estimator keeps, scored by their innovations; the estimator
  * takes the best candidate's delay when it is decisively better than the one
- * in use. The configuration and state types; the functions are the
- * estimators' (br_est.h: br_est_dlyid_init, br_est_dlyid_step). */
+ * in use. A module below the estimators: it reads the model's configuration
+ * and what the caller hands it, never the estimators' types (br_est.h wraps
+ * it for the PF and the UKF: br_est_dlyid_init, br_est_dlyid_step). */
 #ifndef BR_DLYID_H
 #define BR_DLYID_H
 
 #include <stdint.h>
+
+#include "bristle/br_model.h"
 
 /* Most candidate delays. */
 #define BR_DLYID_MAX_CAND 8u
@@ -65,5 +68,43 @@ typedef struct {
     uint32_t n_switch;                       /* switches so far */
     int primed;
 } br_dlyid_t;
+
+/* What the bank reads of the estimator it serves (br_est_cfg_t holds each). */
+typedef struct {
+    const br_model_cfg_t *model; /* the period, lead, inertias, sigma0 and the configured delay
+                                    (causes.delay_s) */
+    float rad_per_count;         /* encoder resolution, > 0 */
+    float r_var_rad2;            /* the estimator's measurement noise variance, > 0 */
+    float gp_max_N;              /* g_p's upper bound, > 0 */
+} br_dlyid_axis_t;
+
+/* A delay of delay_s at the period dt_s as *m whole periods and the fraction
+ * *f of the next, 0 <= f < 1 (the caller keeps delay_s / dt_s within uint32).
+ * The one split of a delay into periods: the bank's candidates and the
+ * estimators' command history (br_est_delay_init) both use it. */
+void br_dlyid_periods(float delay_s, float dt_s, uint32_t *m, float *f);
+
+/* 1 when c is off (n_cand = 0) or within br_dlyid_cfg_t's ranges with finite
+ * constants (dly1) at ax's period (ax checked before: a model br_model_init
+ * accepts, rad_per_count, r_var_rad2 and gp_max_N finite and > 0). Whether the
+ * largest candidate fits a command history is the caller's check. */
+int br_dlyid_cfg_ok(const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax);
+
+/* Candidate j's delay j step_s in periods, its filters unprimed, the
+ * configured delay's slot (n_cand) in use. Off (n_cand = 0): nothing. */
+void br_dlyid_init(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax);
+
+/* One period's measurement (counts + frac counts): every slot's filter
+ * predicts with u_Nm[j], the torque its delay (cm[j] + cf[j] periods) brought
+ * over the last period (from the caller's command history), and takes the
+ * measurement (dly2-dly5). Once past the warm-up, when the best slot's
+ * forgotten sum of squared innovations is below switch_ratio times that of
+ * the slot in use and the one in use explains the motion worse than the noise
+ * allows, the best becomes the one in use (dly6, dly7) and 1 is returned: the
+ * caller then models the delay cm[cur] + cf[cur] periods. A filter that is
+ * not finite restarts the bank at the next measurement, nothing switched.
+ * Off (n_cand = 0): 0, nothing read. */
+int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax, int32_t counts, float frac,
+                  const float u_Nm[BR_DLYID_MAX_SLOTS]);
 
 #endif

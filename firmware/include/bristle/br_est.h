@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* What every friction estimator (PF, UKF) shares: the configuration common
- * to both, the measurement it takes and the interface through which the axis
- * loop drives it. */
+ * to both, the measurement it takes and the interface through which the
+ * application drives it (br_est_t: step, predict, reset). */
 #ifndef BR_EST_H
 #define BR_EST_H
 
@@ -83,10 +83,6 @@ typedef struct {
  * delay_s <= (BR_EST_DELAY_HIST - 2) dt_s (NaN: 0). */
 int br_est_delay_fits(float delay_s, float dt_s);
 
-/* A delay of delay_s (checked by br_est_delay_fits) at the period dt_s as *m
- * whole periods and the fraction *f of the next, 0 <= f < 1. */
-void br_est_delay_periods(float delay_s, float dt_s, uint32_t *m, float *f);
-
 /* Empties the history for the configuration's delay (checked by br_est_cfg_check). */
 void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg);
 
@@ -122,30 +118,53 @@ typedef struct {
     float frac;      /* finite, in [0, 1] */
 } br_meas_t;
 
-/* Actuator-delay identification (br_dlyid.h, docs/modules/dlyid.md).
- * init: candidate j's delay j step_s in periods, its filters unprimed, the
- * candidate standing for the configured delay the nearest to it. */
+/* The actuator-delay identification (br_dlyid.h, docs/modules/dlyid.md) over
+ * the estimator's configuration: cfg->delay_id, with the model, the encoder,
+ * R and g_p's bound of cfg. init: br_dlyid_init (the configured delay's slot
+ * in use, where br_est_delay_init starts d). */
 void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg);
 
-/* One period, after br_est_delay_apply has kept the last command: every
- * candidate's filter predicts with its delay's torque and takes y. Once past
- * the warm-up, when the best candidate's forgotten sum of squared innovations
- * is below switch_ratio times that of the candidate in use, d's delay becomes
- * the best one's (id->n_switch counts the switches). A filter that is not
- * finite restarts the bank at the next measurement, nothing switched. Off
- * (n_cand = 0): nothing. */
+/* One period, after br_est_delay_apply has kept the last command: br_dlyid_step
+ * with each slot's torque from d's history (br_est_delay_torque); when the
+ * bank switches, d's delay becomes the new slot's (id->n_switch counts the
+ * switches). Off (n_cand = 0): nothing. */
 void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d);
+
+/* The estimator interface (docs/modules/est.md, "The interface"): what the
+ * application calls, whatever the estimator is. */
 
 /* One estimator step: y is the measurement at t_k, u_prev_Nm the torque that
  * was applied over [t_{k-1}, t_k]. Unless the status is an error (negative),
- * *F_hat_N is the friction estimate f_nl at t_k (load side, N); BR_W_OUTLIER
+ * *F_hat_N is the compensation force at t_k (load side, N: the friction
+ * estimate f_nl, or the force predicted ahead, br_est_comp_N); BR_W_OUTLIER
  * means the measurement was skipped and the estimate is the prediction's. */
 typedef br_status_t (*br_est_step_fn)(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
 
+/* A period without a measurement (a failed encoder read): the estimator
+ * predicts over it with u_prev_Nm. Unless the status is an error, *F_hat_N is
+ * the predicted estimate at t_k. */
+typedef br_status_t (*br_est_predict_fn)(void *ctx, float u_prev_Nm, float *F_hat_N);
+
+/* Starts the estimator again from its own configuration (at an arm): primed
+ * again at the next measurement. BR_OK or the re-initialisation's error. */
+typedef br_status_t (*br_est_reset_fn)(void *ctx);
+
 typedef struct {
     void *ctx;
-    br_est_step_fn step;
+    br_est_step_fn step;       /* required */
+    br_est_predict_fn predict; /* NULL: the estimate is held over a period without a measurement */
+    br_est_reset_fn reset;     /* NULL: nothing to start again (an estimator the caller restarts) */
 } br_est_t;
+
+/* One period of the estimator e, the one call through which a period reaches
+ * it: y the period's measurement, or NULL for a period without one (then
+ * e->predict, or the estimate held: BR_OK, *F_hat_N unchanged). Returns the
+ * step's or the prediction's status; BR_E_NULL for a NULL e, e->step or
+ * F_hat_N. */
+br_status_t br_est_period(const br_est_t *e, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
+
+/* Starts e again (e->reset; BR_OK when it has none). BR_E_NULL for a NULL e. */
+br_status_t br_est_restart(const br_est_t *e);
 
 /* The step inputs both estimators accept: u finite, frac finite and in [0, 1];
  * BR_OK, else BR_E_INPUT. */

@@ -184,7 +184,16 @@ const br_pf_est_t *br_pf_estimate(const br_pf_t *pf);
  * first measurement or after a failed init (no set). */
 br_status_t br_pf_stats(const br_pf_t *pf, br_pf_stats_t *out);
 
-/* br_est_t binding: ctx is a br_pf_t *. */
+/* br_est_t binding: ctx is a br_pf_t *. step: br_pf_step, *F_hat_N the
+ * compensation (the estimate's F_hat_N, or br_est_comp_N's force ahead);
+ * predict: br_pf_predict, *F_hat_N the predicted estimate's F_hat_N (written
+ * unless the status is an error); reset: br_pf_init from the filter's own
+ * configuration. */
 br_status_t br_pf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
+br_status_t br_pf_est_predict(void *ctx, float u_prev_Nm, float *F_hat_N);
+br_status_t br_pf_est_reset(void *ctx);
+
+/* The three above over pf, as the application drives it. */
+br_est_t br_pf_est(br_pf_t *pf);
 
 #endif

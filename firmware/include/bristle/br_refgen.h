@@ -22,7 +22,7 @@
 #define BR_REFGEN_H
 
 #include <stdint.h>
-#include "bristle/br_axis.h"
+#include "bristle/br_ref.h"
 #include "bristle/br_status.h"
 
 /* Largest amplitude in counts (keeps ref_counts well inside int32). */

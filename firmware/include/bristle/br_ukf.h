@@ -115,8 +115,16 @@ br_status_t br_ukf_chol4(const float A[BR_NX][BR_NX], float L[BR_NX][BR_NX]);
 /* The last step's estimate (NULL for a NULL filter). */
 const br_ukf_est_t *br_ukf_estimate(const br_ukf_t *ukf);
 
-/* br_est_t binding: ctx is a br_ukf_t *. *F_hat_N is written on BR_OK and on
- * BR_W_OUTLIER (the prediction's estimate), as for the PF. */
+/* br_est_t binding: ctx is a br_ukf_t *. step: br_ukf_step, *F_hat_N the
+ * compensation, written on BR_OK and on BR_W_OUTLIER (the prediction's
+ * estimate), as for the PF; predict: br_ukf_predict, *F_hat_N the predicted
+ * estimate's F_hat_N (written unless the status is an error); reset:
+ * br_ukf_init from the filter's own configuration. */
 br_status_t br_ukf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
+br_status_t br_ukf_est_predict(void *ctx, float u_prev_Nm, float *F_hat_N);
+br_status_t br_ukf_est_reset(void *ctx);
+
+/* The three above over ukf, as the application drives it. */
+br_est_t br_ukf_est(br_ukf_t *ukf);
 
 #endif

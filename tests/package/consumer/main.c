@@ -1,12 +1,15 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* A consumer of bristle's public API (tests/package): the reference
- * machine's friction from its generated header through br_lugre, and the
- * version macros. Exits 0 when the installed headers and library agree with
- * what the test expects. */
+ * machine's friction from its generated header through br_lugre, a period's
+ * reference (br_ref.h) from br_refgen, the application's header on its own,
+ * and the version macros. Exits 0 when the installed headers and library
+ * agree with what the test expects. */
 #include <stdio.h>
 #include <string.h>
 
+#include "bristle/br_app.h"
 #include "bristle/br_lugre.h"
+#include "bristle/br_refgen.h"
 #include "bristle/br_version.h"
 #include "bristle_gen/machine/br_machine.h"
 
@@ -32,6 +35,24 @@ int main(void)
         if (br_lugre_step(&s, 0.01f, 1e-3f, &F_N) != BR_OK) return 1;
     if (!(F_N > 0.99f * cfg.Fc_N && F_N < 1.01f * cfg.Fc_N)) {
         printf("friction %g N, expected about Fc = %g N\n", (double)F_N, (double)cfg.Fc_N);
+        return 1;
+    }
+    /* the first reference of a 1 mm sine at phase pi/2: its peak, A / (L r) counts */
+    const br_refgen_cfg_t rc = {1e-3f, 1.0f, 1.57079637f, BR_MACHINE_CTRL_PERIOD_S_F, BR_MACHINE_LEAD_MPRAD_F,
+                                BR_MACHINE_RAD_PER_COUNT_F};
+    br_refgen_t g;
+    br_ref_t r;
+    if (br_refgen_init(&g, &rc) != BR_OK || br_refgen_step(&g, &r) != BR_OK) return 1;
+    const float peak = 1e-3f / (BR_MACHINE_LEAD_MPRAD_F * BR_MACHINE_RAD_PER_COUNT_F);
+    if (!((float)r.ref_counts > 0.999f * peak && (float)r.ref_counts < 1.001f * peak)) {
+        printf("reference %ld counts, expected about %g\n", (long)r.ref_counts, (double)peak);
+        return 1;
+    }
+    /* the application's guards for the machine's period and top speed: at
+     * least one count a period (br_app.h on its own, br_app.c linked) */
+    const br_app_guard_cfg_t gc = br_app_guard_cfg(BR_MACHINE_CTRL_PERIOD_S_F, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F);
+    if (gc.enc_max_delta_counts < 1u) {
+        printf("guards: %lu counts a period\n", (unsigned long)gc.enc_max_delta_counts);
         return 1;
     }
     char v[32];

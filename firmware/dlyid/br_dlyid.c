@@ -1,13 +1,13 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Actuator-delay identification while the axis runs. See br_dlyid.h, br_est.h
- * and docs/modules/dlyid.md (equations dly1-dly6). */
+/* Actuator-delay identification while the axis runs. See br_dlyid.h and
+ * docs/modules/dlyid.md (equations dly1-dly7). */
+#include "bristle/br_dlyid.h"
+
 #include <math.h>
 #include <stddef.h>
 
 #include "bristle/br_encoder.h"
-#include "bristle/br_est.h"
 #include "br_check.h"
-#include "br_dlyid_check.h"
 
 /* Longest warm-up, in periods: far beyond any start-up, and a uint32 */
 #define BR_DLYID_WARMUP_MAX_PERIODS 1.0e9f
@@ -16,10 +16,9 @@
  * theta += T omega + T^2/2 (u - L F) / J_eff, omega += T (u - L F) / J_eff; the forgetting
  * e^(-T / memory_s); R + rpc^2 / 12; the friction's variance per period. Returns 1 when
  * every one is finite (a period or mass far out of range overflows them). */
-static int constants(br_dlyid_t *id, const br_est_cfg_t *cfg)
+static int constants(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax)
 {
-    const br_dlyid_cfg_t *c = &cfg->delay_id;
-    const br_model_cfg_t *mc = &cfg->model;
+    const br_model_cfg_t *mc = ax->model;
     const float T = mc->dt_s;
     const float L = mc->lead_mprad;
     const float inv_J = 1.0f / (mc->J_kgm2 + L * L * mc->M_kg);
@@ -28,23 +27,29 @@ static int constants(br_dlyid_t *id, const br_est_cfg_t *cfg)
     id->a02 = -L * id->b0;
     id->a12 = -L * id->b1;
     id->q_force_N2 = c->q_force_N2ps * T;
-    const float rpc = cfg->rad_per_count;
-    id->r_rad2 = cfg->r_var_rad2 + rpc * rpc * (1.0f / 12.0f);
+    const float rpc = ax->rad_per_count;
+    id->r_rad2 = ax->r_var_rad2 + rpc * rpc * (1.0f / 12.0f);
     id->forget = expf(-T / c->memory_s);
     /* (dly7) the travel over which LuGre's bristles carry the friction's jump at a reversal,
      * in rad at the motor */
     const float s0L = mc->lugre.sigma0_Npm * L; /* > 0 unless the product underflows: refused below */
-    id->settle_rad = (s0L > 0.0f) ? BR_DLYID_SETTLE_LENGTHS * cfg->gp_max_N / s0L : INFINITY;
+    id->settle_rad = (s0L > 0.0f) ? BR_DLYID_SETTLE_LENGTHS * ax->gp_max_N / s0L : INFINITY;
     /* b0 and b1 are finite when L b0 and L b1 are (L > 0, br_model_init); R' is finite
-     * where br_est_cfg_check accepts R and rpc */
+     * where the estimator's check (br_est_cfg_check) accepts R and rpc */
     return isfinite(id->a02) && isfinite(id->a12) && isfinite(id->q_force_N2) && id->forget < 1.0f &&
            isfinite(id->settle_rad);
 }
 
-int br_dlyid_cfg_ok(const br_est_cfg_t *cfg)
+void br_dlyid_periods(float delay_s, float dt_s, uint32_t *m, float *f)
 {
-    const br_dlyid_cfg_t *c = &cfg->delay_id;
-    const float dt = cfg->model.dt_s;
+    const float q = delay_s / dt_s;
+    *m = (uint32_t)q;
+    *f = q - (float)*m;
+}
+
+int br_dlyid_cfg_ok(const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax)
+{
+    const float dt = ax->model->dt_s;
     if (c->n_cand == 0u) {
         return 1;
     }
@@ -53,46 +58,41 @@ int br_dlyid_cfg_ok(const br_est_cfg_t *cfg)
         !(c->warmup_s / dt <= BR_DLYID_WARMUP_MAX_PERIODS) || !(c->switch_ratio > 0.0f && c->switch_ratio < 1.0f)) {
         return 0;
     }
-    /* the largest candidate within the command history (br_est_delay_torque's m <= HIST - 2) */
-    if (!br_est_delay_fits((float)(c->n_cand - 1u) * c->step_s, dt)) {
-        return 0;
-    }
     br_dlyid_t scratch;
-    return constants(&scratch, cfg);
+    return constants(&scratch, c, ax);
 }
 
-void br_est_dlyid_init(br_dlyid_t *id, const br_est_cfg_t *cfg)
+void br_dlyid_init(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax)
 {
-    const br_dlyid_cfg_t *c = &cfg->delay_id;
-    const br_model_cfg_t *mc = &cfg->model;
+    const br_model_cfg_t *mc = ax->model;
     const float T = mc->dt_s;
     id->n_switch = 0u;
     id->primed = 0;
     id->k = 0u;
     id->cur = 0u;
     id->warmup = 0u;
-    /* off, or unchecked: nothing below is read (br_est_dlyid_step returns first) */
+    /* off, or unchecked: nothing below is read (br_dlyid_step returns first) */
     const uint32_t n = c->n_cand;
     if (n == 0u || n > BR_DLYID_MAX_CAND) {
-        return; /* off (br_est_dlyid_step does nothing), or a configuration no check has seen */
+        return; /* off (br_dlyid_step does nothing), or a configuration no check has seen */
     }
-    (void)constants(id, cfg); /* finite: checked by br_est_cfg_check */
+    (void)constants(id, c, ax); /* finite: checked by br_dlyid_cfg_ok */
     id->warmup = (uint32_t)(c->warmup_s / T + 0.5f);
     for (uint32_t j = 0; j <= n; j++) {
         /* the candidates j step_s; slot n the configured delay, where the estimator starts
          * (br_est_delay_init's m and f) */
-        br_est_delay_periods((j < n) ? (float)j * c->step_s : mc->causes.delay_s, T, &id->cm[j], &id->cf[j]);
+        br_dlyid_periods((j < n) ? (float)j * c->step_s : mc->causes.delay_s, T, &id->cm[j], &id->cf[j]);
     }
     id->cur = n;
 }
 
 /* (dly2) the first measurement: every filter at theta = frac rpc, at rest, F = 0, P0 */
-static void prime(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, uint32_t n)
+static void prime(br_dlyid_t *id, const br_dlyid_axis_t *ax, int32_t counts, float frac, uint32_t n)
 {
-    const float rpc = cfg->rad_per_count;
-    const float T = cfg->model.dt_s;
+    const float rpc = ax->rad_per_count;
+    const float T = ax->model->dt_s;
     for (uint32_t j = 0; j <= n; j++) {
-        id->x[j][0] = y->frac * rpc;
+        id->x[j][0] = frac * rpc;
         id->x[j][1] = 0.0f;
         id->x[j][2] = 0.0f;
         id->J[j] = 0.0f;
@@ -105,8 +105,8 @@ static void prime(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, u
     /* theta within the measurement noise, omega within a count per period, F within g_p's range */
     id->P[0][0] = id->r_rad2;
     id->P[1][1] = (rpc / T) * (rpc / T);
-    id->P[2][2] = cfg->gp_max_N * cfg->gp_max_N;
-    id->origin_counts = y->counts;
+    id->P[2][2] = ax->gp_max_N * ax->gp_max_N;
+    id->origin_counts = counts;
     id->k = 0u;
     id->dir = 0;
     id->settle_left_rad = 0.0f;
@@ -116,7 +116,7 @@ static void prime(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, u
 
 /* (dly3) P- = A P A^T + diag(0, 0, q_F), A = [1 T a02; 0 1 a12; 0 0 1]; then the gain
  * K = P-[:,0] / S, S = P-_00 + R, and P+ = P- - K P-[0,:]. P does not depend on the
- * data: with the finite constants br_est_cfg_check requires it is the Riccati recursion
+ * data: with the finite constants br_dlyid_cfg_ok requires it is the Riccati recursion
  * of an observable system (theta measured), bounded. */
 static void covariance(br_dlyid_t *id, float T, float K[BR_DLYID_NX])
 {
@@ -187,32 +187,33 @@ static void reversal(br_dlyid_t *id, float w_min, float T)
     }
 }
 
-void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t *y, br_est_delay_t *d)
+int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax, int32_t counts, float frac,
+                  const float u_Nm[BR_DLYID_MAX_SLOTS])
 {
-    const uint32_t n = cfg->delay_id.n_cand;
+    const uint32_t n = c->n_cand;
     if (n == 0u || n > BR_DLYID_MAX_CAND) {
-        return;
+        return 0;
     }
     if (!id->primed) {
-        prime(id, cfg, y, n);
-        return;
+        prime(id, ax, counts, frac, n);
+        return 0;
     }
-    const float rpc = cfg->rad_per_count;
+    const float rpc = ax->rad_per_count;
     float K[BR_DLYID_NX];
-    const float T = cfg->model.dt_s;
+    const float T = ax->model->dt_s;
     reversal(id, rpc / T, T);
     const int scored = !(id->settle_left_rad > 0.0f);
     covariance(id, T, K);
     /* theta re-expressed relative to the new count (wrap-safe), the measurement frac rpc */
-    const float shift = (float)br_counts_delta(y->counts, id->origin_counts) * rpc;
-    const float y_rel = y->frac * rpc;
+    const float shift = (float)br_counts_delta(counts, id->origin_counts) * rpc;
+    const float y_rel = frac * rpc;
     int finite = 1;
     /* the candidates and the configured delay's slot n */
     for (uint32_t j = 0; j <= n; j++) {
         float *x = id->x[j];
         /* (dly4) candidate j's prediction with the torque its delay brings: u_j = (1 - f_j)
-         * u[k-1-m_j] + f_j u[k-2-m_j] */
-        const float u = br_est_delay_torque(d, id->cm[j], id->cf[j]);
+         * u[k-1-m_j] + f_j u[k-2-m_j] (the caller's, from its command history) */
+        const float u = u_Nm[j];
         const float th = x[0] + T * x[1] + id->a02 * x[2] + id->b0 * u - shift;
         const float om = x[1] + id->a12 * x[2] + id->b1 * u;
         /* (dly5) innovation nu_j = y - theta-_j, update x+ = x- + K nu_j, J_j <- forget J_j + nu_j^2 */
@@ -225,16 +226,16 @@ void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t 
         }
         finite = finite && isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(id->J[j]);
     }
-    id->origin_counts = y->counts;
+    id->origin_counts = counts;
     if (!finite) {
         id->primed = 0; /* the bank restarts at the next measurement */
-        return;
+        return 0;
     }
     if (id->k < UINT32_MAX) {
         id->k++;
     }
     if (id->k < id->warmup) {
-        return;
+        return 0;
     }
     /* (dly6) the best candidate takes over when its sum is below switch_ratio times the
      * sum of the one in use ... */
@@ -246,14 +247,13 @@ void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t 
     }
     /* ... and the one in use explains the motion worse than the noise allows */
     const float J_noise = BR_DLYID_NOISE_FACTOR * (id->r_rad2 + id->P[0][0]) / (1.0f - id->forget);
-    if (best == id->cur || !(id->J[best] < cfg->delay_id.switch_ratio * id->J[id->cur]) ||
+    if (best == id->cur || !(id->J[best] < c->switch_ratio * id->J[id->cur]) ||
         !(id->J[id->cur] > J_noise)) {
-        return;
+        return 0;
     }
     id->cur = best;
-    d->m = id->cm[best];
-    d->f = id->cf[best]; /* d->on: set by br_est_delay_init for the bank */
     if (id->n_switch < UINT32_MAX) {
         id->n_switch++;
     }
+    return 1;
 }
