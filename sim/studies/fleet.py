@@ -213,13 +213,15 @@ def main():
             "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],
             "controllers": summarise(good),
             "kinds": {k: summarise(good, (k,)) for k in kinds},
-            "axes": [{k: v for k, v in r.items() if k not in ("wall_s", "chain_s")} for r in good]}
+            "axes": [{k: v for k, v in r.items() if k not in ("wall_s", "cpu_s", "chain_s")} for r in good]}
     with open(os.path.join(a.out, "summary.json"), "w", encoding="utf-8") as f:
         json.dump(summ, f, indent=1, sort_keys=True)
         f.write("\n")
     per = [r["wall_s"] for r in recs]
     timing = {"wall_s": wall, "workers": a.workers if not a.scheduler else None, "scheduler": a.scheduler,
               "axis_wall_s_median": float(np.median(per)), "axis_wall_s_max": float(max(per)),
+              "axis_cpu_s_median": float(np.median([r["cpu_s"] for r in recs])),
+              "axis_cpu_s_max": float(max(r["cpu_s"] for r in recs)),
               "chain_s_median": float(np.median([r["chain_s"] for r in recs if "chain_s" in r] or [0.0]))}
     with open(os.path.join(a.out, "timing.json"), "w", encoding="utf-8") as f:
         json.dump(timing, f, indent=1)
@@ -227,8 +229,8 @@ def main():
     cdf_plot(good, os.path.join(a.out, "cdf.png"), a.n)
     if a.md:
         write_md(a.md, summ, a.command)
-    print("%d axes in %.0f s (median %.1f s an axis); chain failed on %d"
-          % (a.n, wall, timing["axis_wall_s_median"], len(summ["axes_chain_failed"])))
+    print("%d axes in %.0f s (an axis: median %.1f s wall, %.1f s CPU); chain failed on %d"
+          % (a.n, wall, timing["axis_wall_s_median"], timing["axis_cpu_s_median"], len(summ["axes_chain_failed"])))
     for line in table(summ["controllers"]):
         print(line)
     for f in summ["axes_chain_failed"]:

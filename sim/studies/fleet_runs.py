@@ -12,6 +12,7 @@ tool's exit 1) is that run's failure, not its neighbours'."""
 import contextlib
 import json
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -144,7 +145,7 @@ def one_axis(a, i):
     os.environ["CMAKE_BUILD_PARALLEL_LEVEL"] = "1"  # one compile per worker: the workers share the cores
     os.environ["OPENBLAS_NUM_THREADS"] = "1"
     a = types.SimpleNamespace(**a)
-    t0 = time.time()
+    t0, c0 = time.time(), cpu_s()
     ax = fleet_axis.draw(a.seed, i)
     d = os.path.join(a.out, "axes", "%04d" % i)
     shutil.rmtree(d, ignore_errors=True)
@@ -174,5 +175,11 @@ def one_axis(a, i):
     if not a.keep:
         for b in ("host-truth", "host-machine"):
             shutil.rmtree(os.path.join(d, b), ignore_errors=True)
-    rec["wall_s"] = time.time() - t0
+    rec["wall_s"], rec["cpu_s"] = time.time() - t0, cpu_s() - c0
     return rec
+
+
+def cpu_s():
+    """CPU seconds of this process and its finished children (the tools, the builds, the diagnosis)"""
+    return sum(getattr(resource.getrusage(w), k) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)
+               for k in ("ru_utime", "ru_stime"))

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The fleet study (docs/fleet.md), label `study`.
 
-- A fleet of 2 axes on the thesis circle on Dask's local cluster of 2
+- A fleet of 2 axes on the thesis circle and the point-to-point moves on Dask's local cluster of 2
   workers: summary.json's structure; H-inf only's contour RMS finite and
   positive on every run that went to the end; every faulted run listed in
   "lost" with its cause and time and never carrying an RMS; a chain failure
@@ -34,7 +34,7 @@ SEED = 7
 def study(out, n, workers):
     shutil.rmtree(out, ignore_errors=True)
     r = subprocess.run([sys.executable, os.path.join(REPO, "sim", "studies", "fleet.py"), "--out", out, "--n", str(n),
-                        "--seed", str(SEED), "--workers", str(workers), "--kinds", "thesis_circle"],
+                        "--seed", str(SEED), "--workers", str(workers), "--kinds", "thesis_circle,p2p"],
                        capture_output=True, text=True, timeout=500)
     if r.returncode != 0:
         raise AssertionError("fleet.py exit %d\n%s\n%s" % (r.returncode, r.stdout[-3000:], r.stderr[-3000:]))
@@ -52,8 +52,10 @@ class Fleet(unittest.TestCase):
         s = self.two
         self.assertEqual(s["n_axes"], 2)
         self.assertEqual([r["i"] for r in s["axes"]], [0, 1])
-        self.assertEqual(sorted(s["kinds"]), ["thesis_circle"])
-        for ctl in (s["controllers"], s["kinds"]["thesis_circle"]):
+        self.assertEqual(sorted(s["kinds"]), ["p2p", "thesis_circle"])
+        # br_track runs the UKF too
+        self.assertEqual(sorted(s["kinds"]["p2p"]), ["hinf_only", "hinf_pf", "hinf_ukf"])
+        for ctl in (s["controllers"], *s["kinds"].values()):
             for name, v in ctl.items():
                 self.assertIn(name, fleet.CONTROLLERS)
                 for k in ("median_m", "p90_m", "max_m", "lost", "n", "n_completed"):
@@ -66,9 +68,11 @@ class Fleet(unittest.TestCase):
             if "chain_failed" in r:
                 self.assertTrue(r["chain_failed"]["stage"] and r["chain_failed"]["message"])
                 continue
-            h = r["runs"]["thesis_circle"]["hinf_only"]
-            self.assertFalse(h["faulted"], "axis %d: H-inf only faulted" % r["i"])
-            self.assertTrue(math.isfinite(h["rms_m"]) and h["rms_m"] > 0.0)
+            self.assertEqual(sorted(r["runs"]), ["p2p", "thesis_circle"])
+            for name, runs in r["runs"].items():
+                h = runs["hinf_only"]
+                self.assertFalse(h["faulted"], "axis %d, %s: H-inf only faulted" % (r["i"], name))
+                self.assertTrue(math.isfinite(h["rms_m"]) and h["rms_m"] > 0.0)
 
     def test_faulted_runs_listed_never_an_rms(self):
         s = self.two
