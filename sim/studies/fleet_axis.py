@@ -41,7 +41,9 @@ FEED_TOOL_MAX_MM_MIN = 3000.0   # the tools' bound (sim/tools/br_tool_limits.h B
 RADIUS_M = (1e-3, 50e-3)
 MAX_REV_S = 12.0           # one revolution at most this long (the run's cost)
 P2P_MOVES = 4
+MOVE_ACC_MAX_MPS2 = 5.0    # the moves' (and the scaled EMPS reference's) acceleration at most (half a g)
 P2P_DWELL_S = 0.2
+P2P_ENDS = (0.05, 0.95)    # the moves stay between these shares of the travel
 EMPS_REF = os.path.join(os.path.dirname(REPO), "shared", "data", "emps", "emps_estimation.csv")
 EMPS_SPEED_SHARE = 0.8     # the scaled EMPS reference peaks at this share of the axis's speed and force limits
 
@@ -98,8 +100,9 @@ def trajectories(rng, vmax):
         radius = loguniform(rng, RADIUS_M[0], max(rmax, RADIUS_M[0]))
         out.append({"kind": "circle", "name": "circle%d" % k, "feed_mm_min": feed, "radius_m": radius,
                     "direction": "cw" if rng.uniform() < 0.5 else "ccw"})
-    # point-to-point: P2P_MOVES moves there and back over the travel, at up to the speed limit
-    moves = [(float(rng.uniform(0.2, 0.8)) * TRAVEL_M, float(rng.uniform(0.2, 1.0)) * vmax) for _ in range(P2P_MOVES)]
+    # point-to-point: P2P_MOVES moves there and back, each over a share of the room left between
+    # P2P_ENDS of the travel, at a share of the speed limit
+    moves = [(float(rng.uniform(0.2, 1.0)), float(rng.uniform(0.2, 1.0)) * vmax) for _ in range(P2P_MOVES)]
     out.append({"kind": "p2p", "name": "p2p", "moves": moves})
     out.append({"kind": "emps", "name": "emps"})
     return out
@@ -139,11 +142,14 @@ def truth_file(ax, given):
 
 
 def p2p_reference(moves, vmax, acc, dt=1e-3):
-    """trapezoidal moves there and back from x = 0.05 travel, each followed by a dwell: (t, ref)"""
-    xs, x = [0.0] * int(round(P2P_DWELL_S / dt)), 0.05 * TRAVEL_M
-    xs = [x] * len(xs)
+    """trapezoidal moves there and back from the travel's low end, each over its share of the room
+    left in its direction and followed by a dwell: (t, ref)"""
+    lo, hi = P2P_ENDS[0] * TRAVEL_M, P2P_ENDS[1] * TRAVEL_M
+    x = lo
+    xs = [x] * int(round(P2P_DWELL_S / dt))
     sign = 1.0
-    for dist, v in moves:
+    for share, v in moves:
+        dist = share * (hi - x if sign > 0 else x - lo)
         v = min(v, vmax)
         ta = v / acc
         if acc * ta * ta > dist:  # a triangle
@@ -178,9 +184,11 @@ def emps_reference(vmax, acc, dt=1e-3):
 
 
 def move_acc(ax):
-    """the acceleration of the moves: half what the amplifier leaves beyond stiction and viscous at top speed"""
+    """the acceleration of the moves: half what the amplifier leaves beyond stiction and viscous at top
+    speed, at most MOVE_ACC_MAX_MPS2"""
     f = ax["friction"]
-    return 0.5 * (ax["force_max_N"] - f["Fs_N"] - f["sigma2_Nspm"] * ax["max_speed_mps"]) / ax["Meff_kg"]
+    spare = ax["force_max_N"] - f["Fs_N"] - f["sigma2_Nspm"] * ax["max_speed_mps"]
+    return min(0.5 * spare / ax["Meff_kg"], MOVE_ACC_MAX_MPS2)
 
 
 def write_reference(path, t, ref):
