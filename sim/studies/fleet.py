@@ -171,7 +171,8 @@ def distribute(a, args):
     if a.scheduler:
         client, cluster = Client(a.scheduler), None
     else:
-        cluster = LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        cluster = LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               dashboard_address=None)
         client = Client(cluster)
     try:
         # the workers import fleet_runs and its neighbours from this folder (the same path on every worker)
