@@ -86,6 +86,7 @@ def cdf_plot(recs, path, n_axes):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker  # noqa: F401 - the minor tick labels off
     fig, axs = plt.subplots(1, len(KINDS), figsize=(15, 4.2), sharey=True)
     colours = {"hinf_only": "k", "hinf_ff": "tab:brown", "hinf_ukf": "tab:blue", "hinf_pf": "tab:red"}
     for ax, kind in zip(axs, KINDS):
@@ -98,6 +99,7 @@ def cdf_plot(recs, path, n_axes):
                 ax.step(v, np.arange(1, len(v) + 1) / len(runs), where="post", color=colours[ctrl],
                         label="%s (%d of %d)" % (ctrl, len(v), len(runs)))
         ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_title(kind)
         ax.set_xlabel("contour RMS [m]" if "circle" in kind else "tracking RMS [m]")
         ax.grid(True, which="both", alpha=0.3)
@@ -141,9 +143,10 @@ def write_md(path, summ, command):
         L += ["**Provisional**: %d axes, not the study's %d." % (summ["n_axes"], FULL_N), ""]
     fails = summ["axes_chain_failed"]
     L += ["Axes through the chain: %d of %d%s" % (summ["n_axes"] - len(fails), summ["n_axes"],
-                                                  "; the chain failed on:" if fails else "."), ""]
-    L += ["- axis %d, %s: %s" % (f["axis"], f["stage"], f["message"]) for f in fails]
-    L += ["", "### All trajectories", ""] + table(summ["controllers"])
+                                                  "; the chain failed on:" if fails else ".")]
+    L += [""] + ["- axis %d, %s: %s" % (f["axis"], f["stage"], f["message"]) for f in fails] if fails else []
+    L += ["", "### All trajectories (the contour RMS of the circles and the tracking RMS of the tracks together)",
+          ""] + table(summ["controllers"])
     for kind, ctl in summ["kinds"].items():
         L += ["", "### %s" % kind, ""] + table(ctl)
     lines = lost_lines(summ)
@@ -158,6 +161,16 @@ def write_md(path, summ, command):
     head = text.split("<!-- fleet:begin -->")[0] if "<!-- fleet:begin -->" in text else text
     with open(path, "w", encoding="utf-8") as f:
         f.write(head.rstrip("\n") + "\n\n<!-- fleet:begin -->\n" + "\n".join(L) + "<!-- fleet:end -->\n")
+
+
+def axis_timing(recs, f):
+    """f (median, max) over the axes of each stage's wall and CPU seconds, and of their totals"""
+    out = {}
+    for key in ("wall_s", "cpu_s"):
+        stages = sorted({k for r in recs for k in r["timing"][key]})
+        out[key] = {k: float(f([r["timing"][key].get(k, 0.0) for r in recs])) for k in stages}
+        out[key]["total"] = float(f([sum(r["timing"][key].values()) for r in recs]))
+    return out
 
 
 def _add_path(path):
@@ -214,16 +227,12 @@ def main():
             "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],
             "controllers": summarise(good),
             "kinds": {k: summarise(good, (k,)) for k in kinds},
-            "axes": [{k: v for k, v in r.items() if k not in ("wall_s", "cpu_s", "chain_s")} for r in good]}
+            "axes": [{k: v for k, v in r.items() if k != "timing"} for r in good]}
     with open(os.path.join(a.out, "summary.json"), "w", encoding="utf-8") as f:
         json.dump(summ, f, indent=1, sort_keys=True)
         f.write("\n")
-    per = [r["wall_s"] for r in recs]
     timing = {"wall_s": wall, "workers": a.workers if not a.scheduler else None, "scheduler": a.scheduler,
-              "axis_wall_s_median": float(np.median(per)), "axis_wall_s_max": float(max(per)),
-              "axis_cpu_s_median": float(np.median([r["cpu_s"] for r in recs])),
-              "axis_cpu_s_max": float(max(r["cpu_s"] for r in recs)),
-              "chain_s_median": float(np.median([r["chain_s"] for r in recs if "chain_s" in r] or [0.0]))}
+              "axis_median": axis_timing(recs, np.median), "axis_max": axis_timing(recs, np.max)}
     with open(os.path.join(a.out, "timing.json"), "w", encoding="utf-8") as f:
         json.dump(timing, f, indent=1)
         f.write("\n")
@@ -231,7 +240,8 @@ def main():
     if a.md:
         write_md(a.md, summ, a.command)
     print("%d axes in %.0f s (an axis: median %.1f s wall, %.1f s CPU); chain failed on %d"
-          % (a.n, wall, timing["axis_wall_s_median"], timing["axis_cpu_s_median"], len(summ["axes_chain_failed"])))
+          % (a.n, wall, timing["axis_median"]["wall_s"]["total"], timing["axis_median"]["cpu_s"]["total"],
+             len(summ["axes_chain_failed"])))
     for line in table(summ["controllers"]):
         print(line)
     for f in summ["axes_chain_failed"]:

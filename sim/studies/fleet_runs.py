@@ -105,7 +105,21 @@ def track_runs(d, exe, truth, ref, name, log):
     return out
 
 
-def chain(a, ax, d, log):
+class Stopwatch:
+    """wall and CPU seconds per stage of one axis, added up by stage (timing.json, never summary.json)"""
+
+    def __init__(self):
+        self.t, self.w, self.c = {}, time.time(), cpu_s()
+
+    def lap(self, stage):
+        w, c = time.time(), cpu_s()
+        for key, v in (("wall_s", w - self.w), ("cpu_s", c - self.c)):
+            self.t.setdefault(key, {})
+            self.t[key][stage] = self.t[key].get(stage, 0.0) + v
+        self.w, self.c = w, c
+
+
+def chain(a, ax, d, log, sw):
     """the user's chain: the paths of the truth model and the two tools built for machine.json"""
     given, truth = os.path.join(d, "given.json"), os.path.join(d, "truth.json")
     g = fleet_axis.given_file(ax, "fleet-%04d" % ax["i"])
@@ -116,10 +130,12 @@ def chain(a, ax, d, log):
     machine_chain.truth_model(truth, truth_model, a.src)
     simlog = step("build for the truth", machine_chain.host_build, a, truth, os.path.join(d, "host-truth"),
                   "br_simlog")
+    sw.lap("builds")
     ident = os.path.join(d, "ident.csv")
     tool("identification log", [simlog, "--out", ident, "--traj", "ident", "--model", truth_model,
                                 "--force-noise", "%.6g" % ax["force_noise_N"], "--seed", str(run_seed(a.seed, ax["i"], 0)),
                                 "--machine-out", os.path.join(d, "ident.machine.json")], log)
+    sw.lap("identification_log")
     diag = os.path.join(d, "diagnose")
     env = dict(os.environ, PYTHONPATH=os.path.join(a.src, "python"), MPLBACKEND="Agg")
     r = subprocess.run([sys.executable, "-m", "bristle.diagnose", "diagnose", "--log", ident, "--out", diag,
@@ -127,10 +143,12 @@ def chain(a, ax, d, log):
                        env=env)
     if r.returncode != 0:
         raise ChainError("diagnosis", (r.stderr.strip().splitlines() or ["exit %d" % r.returncode])[-1])
+    sw.lap("diagnosis")
     machine_json = os.path.join(diag, "machine.json")
     bdir = os.path.join(d, "host-machine")
     robust = step("build for machine.json", machine_chain.host_build, a, machine_json, bdir, "br_robust_run")
     track = step("build for machine.json", machine_chain.host_build, a, machine_json, bdir, "br_track")
+    sw.lap("builds")
     with open(machine_json, encoding="utf-8") as f:
         mj = json.load(f)
     return truth_model, robust, track, {sec: mj[sec] for sec in ("mechanics", "friction", "causes")}
@@ -145,7 +163,7 @@ def one_axis(a, i):
     os.environ["CMAKE_BUILD_PARALLEL_LEVEL"] = "1"  # one compile per worker: the workers share the cores
     os.environ["OPENBLAS_NUM_THREADS"] = "1"
     a = types.SimpleNamespace(**a)
-    t0, c0 = time.time(), cpu_s()
+    sw = Stopwatch()
     ax = fleet_axis.draw(a.seed, i)
     d = os.path.join(a.out, "axes", "%04d" % i)
     shutil.rmtree(d, ignore_errors=True)
@@ -153,8 +171,7 @@ def one_axis(a, i):
     rec = {"i": i, "axis": {k: v for k, v in ax.items() if k not in ("i", "traj")}, "runs": {}, "traj": {}}
     with open(os.path.join(d, "chain.log"), "w", encoding="utf-8") as log, contextlib.redirect_stdout(log):
         try:
-            truth, robust, track, rec["machine"] = chain(a, ax, d, log)
-            rec["chain_s"] = time.time() - t0
+            truth, robust, track, rec["machine"] = chain(a, ax, d, log, sw)
             acc = fleet_axis.move_acc(ax)
             for k, tr in enumerate(trajectory_set(a, ax)):
                 rec["traj"][tr["name"]] = tr
@@ -175,7 +192,8 @@ def one_axis(a, i):
     if not a.keep:
         for b in ("host-truth", "host-machine"):
             shutil.rmtree(os.path.join(d, b), ignore_errors=True)
-    rec["wall_s"], rec["cpu_s"] = time.time() - t0, cpu_s() - c0
+    sw.lap("runs")
+    rec["timing"] = sw.t
     return rec
 
 
