@@ -53,7 +53,7 @@ export BR_MK_MAX_FEV  := $(value MAX_FEV)
 # the counts: digits only (they are written into recipes)
 _nodigits = $(subst 0,,$(subst 1,,$(subst 2,,$(subst 3,,$(subst 4,,$(subst 5,,$(subst 6,,$(subst 7,,$(subst 8,,$(subst 9,,$(1)))))))))))
 _check_count = $(if $(value $(1)),$(if $(or $(call _nodigits,$(value $(1))),$(filter-out 1,$(words $(value $(1))))),$(error $(1) must be a whole number)))
-$(foreach v,JOBS N DIAGNOSE_FIRST DL_N DL_N_VERIFY DL_N_NOMINAL DL_JOBS FUZZ_SECONDS MUTANTS_BUDGET MAX_FEV,$(call _check_count,$(v)))
+$(foreach v,JOBS N SEED DIAGNOSE_FIRST DL_N DL_N_VERIFY DL_N_NOMINAL DL_JOBS FUZZ_SECONDS MUTANTS_BUDGET MAX_FEV,$(call _check_count,$(v)))
 # The board whose firmware image `make firmware` / `make test` build and size:
 # its CMakeLists (hal/<board>/) writes into <build>/board-<board>.txt the image's path, its
 # part's flash size (KiB) and its RAM regions (NAME:ORIGIN:KiB).
@@ -110,7 +110,7 @@ define print_size
 	done
 endef
 
-.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness
+.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet
 
 help:
 	@echo "bristle targets:"
@@ -128,6 +128,7 @@ help:
 	@echo "  make firmware [MACHINE=<json>] [BOARD=stm32g4]  cross build (cm7-release; BOARD=stm32g4: cm4-release; another machine: build/<preset>-<name>-<hash>), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make emps      the EMPS drive through the chain: its log -> diagnose -> machine.json -> image -> tracking in the simulator -> $(EMPS_OUT), docs/machines/emps.md"
 	@echo "  make robustness [N=200] [DIAGNOSE_FIRST=K]  Monte Carlo over N plants around the reference machine -> $(ROBUST_OUT), docs/robustness-results.md"
+	@echo "  make fleet [N=200] [SEED=s]  N axes across the machine files a user may bring, each through the chain, every controller -> $(FLEET_OUT), docs/fleet.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune [MACHINE=<json>] [MAX_FEV=n]  Nelder-Mead tuning of the PF and UKF noise (the reference: regenerates firmware/gen/bristle_gen/est/; another machine: its build folder's tune/, with tune/machine.json; docs/tuning.md)"
@@ -371,6 +372,18 @@ robustness: deps
 	$(Q)MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 $(PYTHON) sim/studies/robustness.py --bin build/host-release/sim --out $(ROBUST_OUT) \
 	  --n $(N) $(if $(DIAGNOSE_FIRST),--diagnose-first $(DIAGNOSE_FIRST)) --md docs/robustness-results.md \
 	  --command "make robustness N=$(N)$(if $(DIAGNOSE_FIRST), DIAGNOSE_FIRST=$(DIAGNOSE_FIRST))"
+
+# The fleet study (docs/fleet.md): N axes drawn across the machine files a user
+# may bring, each through the user's chain, every controller on its trajectory
+# set, on Dask's local cluster of both cores; SEED the study's seed.
+FLEET_OUT := out/fleet
+SEED ?= 20261201
+fleet: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== fleet study, $(N) axes -> $(FLEET_OUT), docs/fleet.md"
+	$(Q)MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 $(PYTHON) sim/studies/fleet.py --out $(FLEET_OUT) --n $(N) --seed $(SEED) \
+	  --workers 2 --md docs/fleet.md --command "make fleet N=$(N) SEED=$(SEED)"
 
 # The mutation check (docs/mutants.md): every mutant of tests/mutants/ in
 # scratch copies under build/mutants (the tree itself is never written),

@@ -7,6 +7,7 @@
  *                u = kp kv (ref - q) - kv qdot, |u| <= u_max, F = gain u), --pd
  *   hinf_only    the firmware (br_app_step), H-infinity only, control period
  *   hinf_pf      the firmware with the PF on the nominal model, the PF's period
+ *   hinf_ukf     the firmware with the UKF on the nominal model, the control period
  *   hinf_pf_ext  the same PF on the extended model: est.model.causes set from
  *                the plant's causes (--model), the firmware's extended model
  *   hinf_true    the limit: H-infinity compensating the plant's true friction
@@ -27,7 +28,7 @@
  *
  * Usage: br_track --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]
  *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,
- *                        hinf_pf_ext_ff,hinf_true_ff] [--json OUT] [--trace DIR]
+ *                        hinf_pf_ext_ff,hinf_true_ff,hinf_ukf] [--json OUT] [--trace DIR]
  * Prints one line per controller: tracking RMS and maximum error. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
@@ -244,12 +245,16 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     double vmax = 0.0;
     for (long i = 0; i < tr->n; i++) vmax = fmax(vmax, fabs(traj_vel(tr, (double)i * tr->dt)));
     const double counts_per_m = pc->counts_per_rev / (2.0 * BR_PI * pc->lead_mprad);
-    br_app_cfg_t ac = {&cc, ctrl == BR_CTRL_HINF_PF ? BR_APP_EST_PF : BR_APP_EST_NONE, &c.pf, &c.ukf, &ext,
+    const br_app_est_kind_t kind = ctrl == BR_CTRL_HINF_PF    ? BR_APP_EST_PF
+                                   : ctrl == BR_CTRL_HINF_UKF ? BR_APP_EST_UKF
+                                                              : BR_APP_EST_NONE;
+    br_app_cfg_t ac = {&cc, kind, &c.pf, &c.ukf, &ext,
                        br_app_guard_cfg(cc.dt_s, (float)(2.0 * vmax * counts_per_m + 1.0 / c.dt_s))};
     if (ctrl == BR_CTRL_HINF_TRUE) ac.est = BR_APP_EST_EXTERN;
     const br_plant_state_t x0 = {tr->ref[0] / pc->lead_mprad, 0.0, 0.0};
     int rc = -1;
     if (ctrl == BR_CTRL_HINF_PF && (mem.pf = calloc(1, sizeof *mem.pf)) == NULL) return -1;
+    if (ctrl == BR_CTRL_HINF_UKF && (mem.ukf = calloc(1, sizeof *mem.ukf)) == NULL) return -1;
     br_est_t ffe = {&w.ff, br_ff_est_step, NULL, NULL};
     if (ff == 1) {
         ac.est = BR_APP_EST_EXTERN;
@@ -298,6 +303,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     rc = 0;
 done:
     free(mem.pf);
+    free(mem.ukf);
     return rc;
 }
 
@@ -308,7 +314,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]\n"
             "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,\n"
-            "                  hinf_pf_ext_ff,hinf_true_ff] [--json OUT] [--trace DIR]\n"
+            "                  hinf_pf_ext_ff,hinf_true_ff,hinf_ukf] [--json OUT] [--trace DIR]\n"
             BR_ARGS_COMMON_USAGE
             "  --ref LOG.csv       the measured log whose reference trajectory is tracked\n"
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
@@ -376,9 +382,9 @@ int main(int argc, char **argv)
         fprintf(js, "{\n  \"generator\": \"br_track (sim/apps/br_track.c); generated, do not edit\",\n"
                     "  \"duration_s\": %.6g", (double)(tr.n - 1) * tr.dt);
     static const char *const names[] = {"pd",      "hinf_only", "hinf_pf",        "hinf_pf_ext", "hinf_true",
-                                        "hinf_ff", "hinf_pf_ff", "hinf_pf_ext_ff", "hinf_true_ff"};
+                                        "hinf_ff", "hinf_pf_ff", "hinf_pf_ext_ff", "hinf_true_ff", "hinf_ukf"};
     int rc = 0;
-    for (int w = 0; w < 9 && rc == 0; w++) {
+    for (int w = 0; w < 10 && rc == 0; w++) {
         const size_t len = strlen(names[w]);
         const char *hit = strstr(ctrls, names[w]);
         while (hit && ((hit != ctrls && hit[-1] != ',') || (hit[len] != ',' && hit[len] != '\0')))
@@ -403,8 +409,8 @@ int main(int argc, char **argv)
             } else if (run_pd(&tr, &plant, pd, &e) != 0) rc = 1;
         } else {
             const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : (w == 4 || w == 8) ? BR_CTRL_HINF_TRUE
-                                          : w == 5 ? BR_CTRL_HINF_FF : BR_CTRL_HINF_PF;
-            const int ff = w == 5 ? 1 : w >= 6 ? 2 : 0;
+                                          : w == 5 ? BR_CTRL_HINF_FF : w == 9 ? BR_CTRL_HINF_UKF : BR_CTRL_HINF_PF;
+            const int ff = w == 5 ? 1 : (w >= 6 && w <= 8) ? 2 : 0;
             if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &rep) != 0) rc = 1;
         }
         if (e.trace && fclose(e.trace) != 0) rc = 1;

@@ -113,7 +113,7 @@ def check_make(markers):
     p = make("-n", "firmware", "BOARD=$(shell touch %s/board-mk)" % markers)
     check(p.returncode != 0 and "BOARD must be stm32h7 or stm32g4" in p.stderr, "make BOARD=<not a board>: refused")
     no_markers(markers, "make -n firmware BOARD=$(shell ...)")
-    for var in ("N", "JOBS", "DL_N", "DIAGNOSE_FIRST", "FUZZ_SECONDS", "MUTANTS_BUDGET"):
+    for var in ("N", "SEED", "JOBS", "DL_N", "DIAGNOSE_FIRST", "FUZZ_SECONDS", "MUTANTS_BUDGET"):
         p = make("-n", "robustness", "%s=1;touch %s/%s-sq $(shell touch %s/%s-mk)" % (var, markers, var, markers, var))
         check(p.returncode != 0 and ("%s must be a whole number" % var) in p.stderr,
               "make %s=<not a number>: refused" % var)

@@ -1,0 +1,258 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The fleet study (docs/fleet.md, issue 28 item 2): N axes drawn across the
+range of machine files a user may bring, each through the user's chain
+(fleet_runs.py), every controller on its trajectory set; the independent axes
+run on Dask's local cluster, or on an existing one (--scheduler).
+
+Usage:
+  fleet.py --out DIR [--n N] [--seed S] [--workers W | --scheduler ADDRESS]
+           [--kinds thesis_circle,circle,p2p,emps] [--md DOC] [--command CMD] [--keep-builds]
+
+Writes DIR/summary.json (the same for the same N, seed and kinds, whatever the
+workers: no time in it), DIR/timing.json (wall times), DIR/cdf.png, DIR/axes/NNNN/.
+"controllers": per controller median_m, p90_m, max_m of the RMS (contour RMS on
+the circles, tracking RMS on the tracks) over the runs that went to the end,
+and "lost": every run that faulted, lost lock (persistent outliers) or ended
+worse than H-inf only, with its axis, trajectory, time and cause. "kinds": the
+same per trajectory kind. Every lost run and every axis whose chain failed is
+printed; the exit status is 0 then, 1 only on the study's own error.
+"""
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import fleet_axis  # noqa: E402
+import fleet_runs  # noqa: E402
+
+REPO = fleet_axis.REPO
+KINDS = ("thesis_circle", "circle", "p2p", "emps")
+CONTROLLERS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")
+FULL_N = 200  # the study's size (make fleet's default N)
+
+
+def why_lost(run_, hinf):
+    """a run's cause of loss, or None: a fault, persistent outliers, worse than H-inf only (hinf: its RMS)"""
+    if run_["faulted"]:
+        return run_["fault_cause"]
+    if run_.get("persistent_outliers"):
+        return "persistent_outliers"
+    if hinf is not None and run_["rms_m"] > hinf:
+        return "worse_than_hinf_only"
+    return None
+
+
+def stats(vals):
+    if not vals:
+        return {"median_m": None, "p90_m": None, "max_m": None}
+    v = np.array(vals)
+    return {"median_m": float(np.median(v)), "p90_m": float(np.percentile(v, 90)), "max_m": float(v.max())}
+
+
+def summarise(recs, kinds=None):
+    """per controller: the RMS statistics of the completed runs, the ratio to H-inf only, the lost runs"""
+    out = {}
+    for ctrl in CONTROLLERS:
+        vals, ratios, lost, n = [], [], [], 0
+        for r in recs:
+            for name, runs in r["runs"].items():
+                kind = r["traj"][name]["kind"]
+                if ctrl not in runs or (kinds and kind not in kinds):
+                    continue
+                n += 1
+                run_, h = runs[ctrl], runs.get("hinf_only")
+                hinf = None if ctrl == "hinf_only" or h is None or h["faulted"] else h["rms_m"]
+                if not run_["faulted"]:
+                    vals.append(run_["rms_m"])
+                    if hinf:
+                        ratios.append(run_["rms_m"] / hinf)
+                cause = why_lost(run_, hinf)
+                if cause:
+                    lost.append({"axis": r["i"], "trajectory": name, "kind": kind, "t_s": run_.get("fault_t_s"),
+                                 "cause": cause})
+        if n:
+            out[ctrl] = {"n": n, "n_completed": len(vals), **stats(vals),
+                         "median_ratio_to_hinf_only": float(np.median(ratios)) if ratios else None,
+                         "n_lost": len(lost), "lost": lost}
+    return out
+
+
+def cdf_plot(recs, path, n_axes):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker  # noqa: F401 - the minor tick labels off
+    fig, axs = plt.subplots(1, len(KINDS), figsize=(15, 4.2), sharey=True)
+    colours = {"hinf_only": "k", "hinf_ff": "tab:brown", "hinf_ukf": "tab:blue", "hinf_pf": "tab:red"}
+    for ax, kind in zip(axs, KINDS):
+        for ctrl in CONTROLLERS:
+            runs = [rr[ctrl] for r in recs for name, rr in r["runs"].items()
+                    if r["traj"][name]["kind"] == kind and ctrl in rr]
+            v = np.sort([x["rms_m"] for x in runs if not x["faulted"]])
+            if len(v):
+                # faulted runs never reach the curve: it ends below 1 by their share
+                ax.step(v, np.arange(1, len(v) + 1) / len(runs), where="post", color=colours[ctrl],
+                        label="%s (%d of %d)" % (ctrl, len(v), len(runs)))
+        ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_title(kind)
+        ax.set_xlabel("contour RMS [m]" if "circle" in kind else "tracking RMS [m]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7, loc="lower right")
+    axs[0].set_ylabel("fraction of runs")
+    fig.suptitle("Fleet: %d axes" % n_axes)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fmt(v):
+    return "—" if v is None else "%.3e" % v
+
+
+def table(ctl):
+    L = ["| controller | runs | went to the end | median RMS | p90 | max | median / H-inf only | lost |",
+         "|---|---|---|---|---|---|---|---|"]
+    for k, v in ctl.items():
+        ratio = "—" if v["median_ratio_to_hinf_only"] is None else "%.3f" % v["median_ratio_to_hinf_only"]
+        L.append("| %s | %d | %d | %s m | %s m | %s m | %s | %d |" % (k, v["n"], v["n_completed"], fmt(v["median_m"]),
+                                                                    fmt(v["p90_m"]), fmt(v["max_m"]), ratio, v["n_lost"]))
+    return L
+
+
+def lost_lines(summ):
+    out = []
+    for k, v in summ["controllers"].items():
+        for x in v["lost"]:
+            when = " at %.4f s" % x["t_s"] if x["t_s"] is not None else ""
+            out.append("%s: axis %d, %s, %s%s" % (k, x["axis"], x["trajectory"], x["cause"], when))
+    return out
+
+
+def write_md(path, summ, command):
+    L = ["<!-- generated by sim/studies/fleet.py --md; do not edit below -->", "",
+         "## Measured: %d axes" % summ["n_axes"], "",
+         "Command: `%s` (seed %d, trajectory kinds %s; the axes, the chain and the definitions above)."
+         % (command, summ["seed"], ", ".join(summ["kinds_run"])), ""]
+    if summ["n_axes"] < FULL_N:
+        L += ["**Provisional**: %d axes, not the study's %d." % (summ["n_axes"], FULL_N), ""]
+    fails = summ["axes_chain_failed"]
+    L += ["Axes through the chain: %d of %d%s" % (summ["n_axes"] - len(fails), summ["n_axes"],
+                                                  "; the chain failed on:" if fails else ".")]
+    L += [""] + ["- axis %d, %s: %s" % (f["axis"], f["stage"], f["message"]) for f in fails] if fails else []
+    L += ["", "### All trajectories (the contour RMS of the circles and the tracking RMS of the tracks together)",
+          ""] + table(summ["controllers"])
+    for kind, ctl in summ["kinds"].items():
+        L += ["", "### %s" % kind, ""] + table(ctl)
+    lines = lost_lines(summ)
+    L += ["", "### Lost runs (%d)" % len(lines), "",
+          "A run is lost when the firmware stopped it (its fault's cause and time), its filter re-anchored "
+          "in more than 1 % of the axis-periods (persistent_outliers), or it ended worse than H-inf only on the "
+          "same axis and trajectory. A lost run that faulted has no RMS in the tables above.", ""]
+    L += ["- " + x for x in lines] or ["none"]
+    L += ["", "CDF per trajectory kind: `out/fleet/cdf.png`.", ""]
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    head = text.split("<!-- fleet:begin -->")[0] if "<!-- fleet:begin -->" in text else text
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(head.rstrip("\n") + "\n\n<!-- fleet:begin -->\n" + "\n".join(L) + "<!-- fleet:end -->\n")
+
+
+def axis_timing(recs, f):
+    """f (median, max) over the axes of each stage's wall and CPU seconds, and of their totals"""
+    out = {}
+    for key in ("wall_s", "cpu_s"):
+        stages = sorted({k for r in recs for k in r["timing"][key]})
+        out[key] = {k: float(f([r["timing"][key].get(k, 0.0) for r in recs])) for k in stages}
+        out[key]["total"] = float(f([sum(r["timing"][key].values()) for r in recs]))
+    return out
+
+
+def _add_path(path):
+    if path not in sys.path:
+        sys.path.insert(0, path)
+
+
+def distribute(a, args):
+    """every axis as one task on a Dask cluster, with dask's progress bar; records in index order"""
+    from distributed import Client, LocalCluster, progress
+    if a.scheduler:
+        client, cluster = Client(a.scheduler), None
+    else:
+        cluster = LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               dashboard_address=None)
+        client = Client(cluster)
+    try:
+        # the workers import fleet_runs and its neighbours from this folder (the same path on every worker)
+        client.run(_add_path, HERE)
+        futures = client.map(fleet_runs.one_axis, [args] * a.n, range(a.n), pure=False)
+        progress(futures)
+        sys.stdout.write("\n")
+        recs = client.gather(futures)
+    finally:
+        client.close()
+        if cluster:
+            cluster.close()
+    return sorted(recs, key=lambda r: r["i"])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--n", type=int, default=200)
+    ap.add_argument("--seed", type=int, default=20261201)
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="the local cluster's worker processes")
+    ap.add_argument("--scheduler", help="an existing Dask scheduler's address (tcp://host:port) instead")
+    ap.add_argument("--kinds", default=",".join(KINDS), help="the trajectory kinds, comma-separated")
+    ap.add_argument("--md", help="docs page: its part after <!-- fleet:begin --> is rewritten")
+    ap.add_argument("--command", default="make fleet")
+    ap.add_argument("--keep-builds", action="store_true", help="keep each axis's two host builds")
+    a = ap.parse_args()
+    kinds = [k for k in a.kinds.split(",") if k]
+    if not (1 <= a.n <= 100000) or a.workers < 1 or not kinds or set(kinds) - set(KINDS):
+        ap.error("--n in 1..100000, --workers >= 1, --kinds from %s" % ",".join(KINDS))
+    os.makedirs(a.out, exist_ok=True)
+    args = {"src": REPO, "out": os.path.abspath(a.out), "seed": a.seed, "kinds": kinds, "keep": a.keep_builds}
+    t0 = time.time()
+    recs = distribute(a, args)
+    wall = time.time() - t0
+    errors = [r for r in recs if "error" in r]
+    good = [r for r in recs if "error" not in r]
+    summ = {"generator": "sim/studies/fleet.py", "n_axes": a.n, "seed": a.seed, "kinds_run": kinds,
+            "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],
+            "controllers": summarise(good),
+            "kinds": {k: summarise(good, (k,)) for k in kinds},
+            "axes": [{k: v for k, v in r.items() if k != "timing"} for r in good]}
+    with open(os.path.join(a.out, "summary.json"), "w", encoding="utf-8") as f:
+        json.dump(summ, f, indent=1, sort_keys=True)
+        f.write("\n")
+    timing = {"wall_s": wall, "workers": a.workers if not a.scheduler else None, "scheduler": a.scheduler,
+              "axis_median": axis_timing(recs, np.median), "axis_max": axis_timing(recs, np.max)}
+    with open(os.path.join(a.out, "timing.json"), "w", encoding="utf-8") as f:
+        json.dump(timing, f, indent=1)
+        f.write("\n")
+    cdf_plot(good, os.path.join(a.out, "cdf.png"), a.n)
+    if a.md:
+        write_md(a.md, summ, a.command)
+    print("%d axes in %.0f s (an axis: median %.1f s wall, %.1f s CPU); chain failed on %d"
+          % (a.n, wall, timing["axis_median"]["wall_s"]["total"], timing["axis_median"]["cpu_s"]["total"],
+             len(summ["axes_chain_failed"])))
+    for line in table(summ["controllers"]):
+        print(line)
+    for f in summ["axes_chain_failed"]:
+        print("chain failed: axis %d, %s: %s" % (f["axis"], f["stage"], f["message"]))
+    for line in lost_lines(summ):
+        print("lost: " + line)
+    print("wrote %s/summary.json, timing.json, cdf.png%s" % (a.out, ", " + a.md if a.md else ""))
+    for r in errors:
+        print("fleet: internal error on axis %d:\n%s" % (r["i"], r["error"]), file=sys.stderr)
+    return 1 if errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

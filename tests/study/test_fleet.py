@@ -1,0 +1,127 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The fleet study (docs/fleet.md), label `study`.
+
+- A fleet of 2 axes on the thesis circle and the point-to-point moves on Dask's local cluster of 2
+  workers: summary.json's structure; H-inf only's contour RMS finite and
+  positive on every run that went to the end; every faulted run listed in
+  "lost" with its cause and time and never carrying an RMS; a chain failure
+  listed with its stage.
+- The study with N=1 on 1 worker: axis 0's record is the same (the axes do
+  not depend on the scheduling, the worker count or N).
+- The statistics on records made here: a faulted run stays out of the RMS
+  figures and is lost with its cause; a run worse than H-inf only is lost.
+
+Usage: test_fleet.py --work DIR"""
+import argparse
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(REPO, "sim", "studies"))
+import fleet  # noqa: E402
+import fleet_axis  # noqa: E402
+
+ARGS = None
+SEED = 7
+
+
+def study(out, n, workers):
+    shutil.rmtree(out, ignore_errors=True)
+    r = subprocess.run([sys.executable, os.path.join(REPO, "sim", "studies", "fleet.py"), "--out", out, "--n", str(n),
+                        "--seed", str(SEED), "--workers", str(workers), "--kinds", "thesis_circle,p2p"],
+                       capture_output=True, text=True, timeout=500)
+    if r.returncode != 0:
+        raise AssertionError("fleet.py exit %d\n%s\n%s" % (r.returncode, r.stdout[-3000:], r.stderr[-3000:]))
+    with open(os.path.join(out, "summary.json"), encoding="utf-8") as f:
+        return json.load(f), r.stdout
+
+
+class Fleet(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.two, cls.out2 = study(os.path.join(ARGS.work, "two"), 2, 2)
+        cls.one, _ = study(os.path.join(ARGS.work, "one"), 1, 1)
+
+    def test_structure(self):
+        s = self.two
+        self.assertEqual(s["n_axes"], 2)
+        self.assertEqual([r["i"] for r in s["axes"]], [0, 1])
+        self.assertEqual(sorted(s["kinds"]), ["p2p", "thesis_circle"])
+        # br_track runs the UKF too
+        self.assertEqual(sorted(s["kinds"]["p2p"]), ["hinf_only", "hinf_pf", "hinf_ukf"])
+        for ctl in (s["controllers"], *s["kinds"].values()):
+            for name, v in ctl.items():
+                self.assertIn(name, fleet.CONTROLLERS)
+                for k in ("median_m", "p90_m", "max_m", "lost", "n", "n_completed"):
+                    self.assertIn(k, v)
+        self.assertTrue(os.path.isfile(os.path.join(ARGS.work, "two", "cdf.png")))
+
+    def test_hinf_only_finite(self):
+        """H-inf only went to the end on every axis whose chain went through, with a finite RMS"""
+        for r in self.two["axes"]:
+            if "chain_failed" in r:
+                self.assertTrue(r["chain_failed"]["stage"] and r["chain_failed"]["message"])
+                continue
+            self.assertEqual(sorted(r["runs"]), ["p2p", "thesis_circle"])
+            for name, runs in r["runs"].items():
+                h = runs["hinf_only"]
+                self.assertFalse(h["faulted"], "axis %d, %s: H-inf only faulted" % (r["i"], name))
+                self.assertTrue(math.isfinite(h["rms_m"]) and h["rms_m"] > 0.0)
+
+    def test_faulted_runs_listed_never_an_rms(self):
+        s = self.two
+        for r in s["axes"]:
+            for name, runs in r["runs"].items():
+                for ctrl, run_ in runs.items():
+                    lost = [x for x in s["controllers"][ctrl]["lost"] if x["axis"] == r["i"] and x["trajectory"] == name]
+                    if run_["faulted"]:
+                        self.assertNotIn("rms_m", run_)
+                        self.assertEqual(len(lost), 1, (r["i"], name, ctrl))
+                        self.assertEqual(lost[0]["cause"], run_["fault_cause"])
+                        self.assertTrue(lost[0]["cause"])
+                        self.assertIn("%s: axis %d, %s, %s" % (ctrl, r["i"], name, run_["fault_cause"]), self.out2)
+                    else:
+                        self.assertTrue(math.isfinite(run_["rms_m"]))
+
+    def test_independent_of_workers_and_n(self):
+        self.assertEqual(self.two["axes"][0], self.one["axes"][0])
+
+    def test_statistics(self):
+        """a faulted run: out of the figures, lost with its cause; worse than H-inf only: lost"""
+        def rec(i, pf):
+            return {"i": i, "traj": {"c": {"kind": "circle"}},
+                    "runs": {"c": {"hinf_only": {"faulted": False, "rms_m": 1e-6, "max_m": 2e-6}, "hinf_pf": pf}}}
+        recs = [rec(0, {"faulted": True, "fault_t_s": 0.05, "fault_cause": "lost_lock"}),
+                rec(1, {"faulted": False, "rms_m": 2e-6, "max_m": 3e-6}),
+                rec(2, {"faulted": False, "rms_m": 1e-8, "max_m": 3e-8})]
+        pf = fleet.summarise(recs)["hinf_pf"]
+        self.assertEqual((pf["n"], pf["n_completed"], pf["n_lost"]), (3, 2, 2))
+        self.assertEqual(pf["max_m"], 2e-6)
+        self.assertEqual([(x["axis"], x["cause"], x["t_s"]) for x in pf["lost"]],
+                         [(0, "lost_lock", 0.05), (1, "worse_than_hinf_only", None)])
+
+    def test_axis_draw_in_range(self):
+        for i in range(50):
+            ax = fleet_axis.draw(SEED, i)
+            self.assertEqual(ax, fleet_axis.draw(SEED, i))
+            self.assertTrue(2e-3 <= ax["lead_m_per_rev"] <= 40e-3 and 1.0 <= ax["Meff_kg"] <= 200.0)
+            self.assertTrue(2 ** 12 <= ax["counts_per_rev"] <= 2 ** 26)
+            # the travel fits a signed 32-bit count
+            self.assertLess(fleet_axis.TRAVEL_M / ax["lead_m_per_rev"] * ax["counts_per_rev"], 2 ** 31)
+            self.assertTrue(0.25e-3 <= ax["period_s"] <= 2e-3 and 0.0 <= ax["delay_s"] <= 3e-3)
+
+
+if __name__ == "__main__":
+    args = sys.argv[1:]
+    if "--work" not in args[:-1]:
+        sys.exit("usage: test_fleet.py --work DIR [unittest's options]")
+    k = args.index("--work")
+    ARGS = argparse.Namespace(work=args[k + 1])
+    os.makedirs(ARGS.work, exist_ok=True)
+    unittest.main(argv=[sys.argv[0]] + args[:k] + args[k + 2:], verbosity=2)
