@@ -6,6 +6,7 @@
 #include <stddef.h>
 
 #include "bristle/br_encoder.h"
+#include "br_app_motion.h"
 #include "br_check.h"
 
 /* The estimator runs at the controller's period: the same float, up to a few
@@ -66,19 +67,18 @@ br_status_t br_app_est_init(const br_app_cfg_t *cfg, const br_app_mem_t *mem, br
  * difference can hold with room, a stale hold of at most a second at 1 kHz). */
 #define BR_APP_MAX_DELTA_LIMIT (1u << 30)
 #define BR_APP_STALE_LIMIT 1000u
-#define BR_APP_FROZEN_LIMIT (1u << 20)
+/* Longest braking ramp, periods (from the speed fault's speed at max_accel). */
+#define BR_APP_BRAKE_LIMIT (1u << 20)
 
 br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s)
 {
-    br_app_guard_cfg_t g = {0u, BR_APP_GUARD_STALE_PERIODS, BR_APP_GUARD_FROZEN_DUTY, 0u, 0u, 0u};
+    br_app_guard_cfg_t g = {0u, BR_APP_GUARD_STALE_PERIODS, 0u, 0u};
     if (!br_finite_pos(dt_s) || !br_finite_pos(max_speed_counts_per_s)) {
-        return g; /* zero delta, frozen periods and lock window: rejected by br_app_init */
+        return g; /* zero delta and lock window: rejected by br_app_init */
     }
-    const float d = ceilf(max_speed_counts_per_s * dt_s);
-    const float f = ceilf(BR_APP_GUARD_FROZEN_S / dt_s);
+    const float d = ceilf(BR_APP_JUMP_SPEEDS * max_speed_counts_per_s * dt_s);
     const float w = ceilf(BR_APP_GUARD_LOCK_S / dt_s);
     g.enc_max_delta_counts = (d <= (float)BR_APP_MAX_DELTA_LIMIT) ? (uint32_t)d : BR_APP_MAX_DELTA_LIMIT + 1u;
-    g.frozen_periods = (f <= (float)BR_APP_FROZEN_LIMIT) ? (uint32_t)f : BR_APP_FROZEN_LIMIT + 1u;
     g.lock_window_periods = (w <= (float)BR_APP_LOCK_WINDOW_MAX) ? (uint32_t)w : BR_APP_LOCK_WINDOW_MAX + 1u;
     if (g.lock_window_periods <= BR_APP_LOCK_WINDOW_MAX) {
         g.lock_max_outliers = (uint32_t)ceilf(BR_APP_GUARD_LOCK_FRACTION * (float)g.lock_window_periods);
@@ -89,34 +89,28 @@ br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s)
 static br_status_t guard_check(const br_app_guard_cfg_t *g)
 {
     if (g->enc_max_delta_counts < 1u || g->enc_max_delta_counts > BR_APP_MAX_DELTA_LIMIT ||
-        g->enc_stale_periods > BR_APP_STALE_LIMIT || g->frozen_periods < 1u ||
-        g->frozen_periods > BR_APP_FROZEN_LIMIT || g->lock_window_periods < 1u ||
+        g->enc_stale_periods > BR_APP_STALE_LIMIT || g->lock_window_periods < 1u ||
         g->lock_window_periods > BR_APP_LOCK_WINDOW_MAX || g->lock_max_outliers >= g->lock_window_periods) {
         return BR_E_PARAM; /* a lock limit of the whole window or more could never trip */
-    }
-    /* written so that a NaN fails */
-    if (!(g->frozen_duty > 0.0f && g->frozen_duty <= 1.0f)) {
-        return BR_E_PARAM;
     }
     return BR_OK;
 }
 
-/* Duty 0, outputs off where the port can. */
-static void outputs_off(br_app_t *app)
-{
-    const br_hal_t *hal = app->hal;
-    (void)hal->pwm_write(hal->ctx, 0.0f);
-    if (hal->pwm_disable != NULL) {
-        (void)hal->pwm_disable(hal->ctx);
-    }
-    app->last = (br_ctrl_out_t){0};
-}
-
+/* A fault where the position is not trusted (or the loop cannot run): duty
+ * 0, outputs off at once. */
 static br_status_t latch(br_app_t *app, br_app_fault_t cause)
 {
     app->fault = cause;
-    outputs_off(app);
+    br_app_outputs_off(app);
     return BR_E_FAULT;
+}
+
+/* A fault where the position is trusted: the braking ramp from the count of
+ * this period, then outputs off. */
+static br_status_t latch_brake(br_app_t *app, br_app_fault_t cause, int32_t counts)
+{
+    app->fault = cause;
+    return br_app_brake_start(app, counts);
 }
 
 /* The lock monitor's window emptied (at init and at every arm). */
@@ -163,6 +157,9 @@ br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *
         return st;
     }
     st = guard_check(&cfg->guard);
+    if (st == BR_OK) {
+        st = br_app_motion_check(&cfg->motion);
+    }
     if (st != BR_OK) {
         return st;
     }
@@ -173,6 +170,13 @@ br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *
     if (st != BR_OK) {
         return st;
     }
+    app->motion = cfg->motion;
+    br_app_motion_reset(app); /* the limits in counts at the controller's period */
+    /* a braking ramp of bounded length, a limiter that moves in a period */
+    if (!(app->lim_vmax * (1.0f + BR_APP_SPEED_MARGIN) <= (float)BR_APP_BRAKE_LIMIT * app->lim_amax) ||
+        !(app->lim_vmax > 0.0f && app->lim_amax > 0.0f)) {
+        return BR_E_PARAM;
+    }
     app->hal = hal;
     app->est = est;
     app->F_hat_N = 0.0f;
@@ -182,7 +186,6 @@ br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *
     app->last_counts = 0;
     app->have_counts = 0;
     app->n_stale = 0u;
-    app->n_frozen = 0u;
     lock_reset(app);
     (void)latch(app, BR_APP_FAULT_DISARMED);
     return BR_OK;
@@ -209,8 +212,8 @@ br_status_t br_app_arm(br_app_t *app)
     app->last = (br_ctrl_out_t){0};
     app->have_counts = 0;
     app->n_stale = 0u;
-    app->n_frozen = 0u;
     lock_reset(app);
+    br_app_motion_reset(app);
     const br_hal_t *hal = app->hal;
     st = hal->pwm_write(hal->ctx, 0.0f);
     if (st == BR_OK && hal->pwm_enable != NULL) {
@@ -232,7 +235,7 @@ br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause)
     if (!app->ready) {
         return BR_E_STATE;
     }
-    if (cause <= BR_APP_FAULT_NONE || cause > BR_APP_FAULT_LOST_LOCK) {
+    if (cause <= BR_APP_FAULT_NONE || cause > BR_APP_FAULT_TRAVEL) {
         return BR_E_PARAM;
     }
     return latch(app, cause);
@@ -247,14 +250,19 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
         return BR_E_STATE;
     }
     const br_hal_t *hal = app->hal;
-    if (app->fault != BR_APP_FAULT_NONE) {
-        outputs_off(app);
+    const int braking = (app->fault != BR_APP_FAULT_NONE && app->stop == BR_APP_STOP_BRAKING);
+    if (app->fault != BR_APP_FAULT_NONE && !braking) {
+        br_app_outputs_off(app);
         return BR_E_FAULT;
     }
     int32_t counts = 0;
     br_status_t st = hal->encoder_read(hal->ctx, &counts);
     br_status_t est_st = BR_OK;
     if (st != BR_OK) {
+        if (braking) {
+            br_app_outputs_off(app); /* the ramp needs the position: off */
+            return BR_E_FAULT;
+        }
         /* no position this period: hold the last one for enc_stale_periods */
         if (++app->n_stale > app->guard.enc_stale_periods) {
             return latch(app, BR_APP_FAULT_ENC_STALE);
@@ -273,7 +281,7 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
         }
     } else {
         /* the periods since the last good read: this one and the held ones */
-        const uint64_t periods = (uint64_t)app->n_stale + 1u;
+        const uint32_t periods = app->n_stale + 1u;
         app->n_stale = 0u;
         if (app->have_counts) {
             const int32_t d = br_counts_delta(counts, app->last_counts);
@@ -284,12 +292,17 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
             if ((uint64_t)mag > (uint64_t)app->guard.enc_max_delta_counts * periods) {
                 return latch(app, BR_APP_FAULT_ENC_JUMP);
             }
-            if (mag == 0u && fabsf(app->last.duty) >= app->guard.frozen_duty) {
-                if (++app->n_frozen >= app->guard.frozen_periods) {
-                    return latch(app, BR_APP_FAULT_ENC_FROZEN);
-                }
-            } else {
-                app->n_frozen = 0u;
+            app->last_counts = counts;
+            if (braking) {
+                return br_app_brake_period(app, counts, d, periods);
+            }
+            /* the speed fault and the stuck-encoder model */
+            const br_app_fault_t f = br_app_motion_watch(app, d, periods);
+            if (f == BR_APP_FAULT_SPEED) {
+                return latch_brake(app, f, counts);
+            }
+            if (f != BR_APP_FAULT_NONE) {
+                return latch(app, f);
             }
         }
         app->last_counts = counts;
@@ -303,14 +316,23 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
     /* a warning (an outlier measurement skipped, whose prediction stays
      * usable): control goes on and the status is passed up */
     if (BR_FAILED(est_st)) {
-        return latch(app, BR_APP_FAULT_ESTIMATOR);
+        return latch_brake(app, BR_APP_FAULT_ESTIMATOR, counts);
     }
     /* an estimator that keeps rejecting the measurement (and re-anchoring on
      * it) has lost the axis: stop rather than compensate with its estimate */
     if (app->est.step != NULL && lock_lost(app, est_st == BR_W_OUTLIER)) {
-        return latch(app, BR_APP_FAULT_LOST_LOCK);
+        return latch_brake(app, BR_APP_FAULT_LOST_LOCK, counts);
     }
-    br_ctrl_in_t in = {counts, ref->ref_counts, ref->ref_frac_counts, ref->ref_omega_radps, app->F_hat_N};
+    /* the reference within the machine's speed, acceleration and soft travel */
+    br_ref_t r;
+    if (br_app_ref_limit(app, ref, counts, &r) != BR_OK) {
+        return latch(app, BR_APP_FAULT_CTRL_INPUT);
+    }
+    const br_app_fault_t lf = br_app_limits_check(app, &r, counts);
+    if (lf != BR_APP_FAULT_NONE) {
+        return latch_brake(app, lf, counts);
+    }
+    br_ctrl_in_t in = {counts, r.ref_counts, r.ref_frac_counts, r.ref_omega_radps, app->F_hat_N};
     st = br_ctrl_step(&app->ctrl, &in, &app->last);
     if (st != BR_OK) {
         return latch(app, (st == BR_E_INPUT) ? BR_APP_FAULT_CTRL_INPUT : BR_APP_FAULT_CTRL_STATE);

@@ -59,7 +59,11 @@ def machine_fields(m, p):
         ("BR_MACHINE_MAX_SPEED_COUNTS_PER_S", lim["max_speed_mps"] / (p["L_mprad"] * p["rad_per_count"]),
          "that speed in encoder counts per second (max_speed / (L rad_per_count)); times the period:\n"
          " * the largest encoder delta of one period (br_app_guard_cfg)"),
-        ("BR_MACHINE_TRAVEL_M", lim["travel_m"], "stroke of the table"),
+        ("BR_MACHINE_TRAVEL_M", lim["travel_m"], "stroke of the table, centred on encoder count 0"),
+        ("BR_MACHINE_MAX_ACCEL_MPS2", machine.limit_defaults(m)[0],
+         "the reference limiter's and the braking ramp's acceleration (br_app_motion_cfg)"),
+        ("BR_MACHINE_MAX_FOLLOWING_M", machine.limit_defaults(m)[1],
+         "largest |reference - position| before the axis brakes (br_app_motion_cfg)"),
     ]
 
 

@@ -281,7 +281,13 @@ SCHEMA = {
     },
     "limits": {
         "max_speed_mps": Num(0.0, 100.0, "largest table speed the axis is used at", lo_open=True),
-        "travel_m": Num(0.0, 100.0, "stroke of the table", lo_open=True),
+        "travel_m": Num(0.0, 100.0, "stroke of the table, centred on encoder count 0", lo_open=True),
+        # the drive protections (docs/modules/app.md); a file without them
+        # gets the defaults of limit_defaults()
+        "max_accel_mps2": Optional(Num(0.0, 1000.0, "the reference limiter's and the braking ramp's acceleration",
+                                       lo_open=True)),
+        "max_following_error_m": Optional(Num(0.0, 1.0, "largest |reference - position| before the axis brakes",
+                                              lo_open=True)),
     },
     # where each value comes from (a diagnosis's machine.json writes it); optional
     "provenance": Optional(Provenance()),
@@ -297,7 +303,21 @@ def _leaf(dotted):
         if not isinstance(node, dict) or k not in node:
             return None
         node = node[k]
+    if isinstance(node, Optional):
+        node = node.section
     return node if isinstance(node, (Num, Str)) else None
+
+
+def limit_defaults(m):
+    """The drive limits of machine m, the file's or, where it leaves them out,
+    the defaults: max_accel_mps2 half of what the actuator gives beyond
+    stiction, (torque_limit / L - Fs) / (2 (M + J / L^2)); max_following_error_m
+    what max_speed_mps covers in 10 ms."""
+    lim, mech = m["limits"], m["mechanics"]
+    L = mech["lead_m_per_rev"] / (2.0 * math.pi)
+    mass = mech["table_mass_kg"] + mech["inertia_kgm2"] / (L * L)
+    accel = (m["control"]["torque_limit_Nm"] / L - m["friction"]["Fs_N"]) / (2.0 * mass)
+    return (lim.get("max_accel_mps2", accel), lim.get("max_following_error_m", 0.01 * lim["max_speed_mps"]))
 
 
 def provenance(m, dotted):

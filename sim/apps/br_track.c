@@ -39,6 +39,7 @@
 #include <string.h>
 
 #include "bristle/br_app.h"
+#include "bristle/br_machine_cfg.h"
 #include "circle/br_circle.h"
 #include "hal/br_hal_sim.h"
 #include "plant/br_model_params.h"
@@ -249,7 +250,8 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
                                    : ctrl == BR_CTRL_HINF_UKF ? BR_APP_EST_UKF
                                                               : BR_APP_EST_NONE;
     br_app_cfg_t ac = {&cc, kind, &c.pf, &c.ukf, &ext,
-                       br_app_guard_cfg(cc.dt_s, (float)(2.0 * vmax * counts_per_m + 1.0 / c.dt_s))};
+                       br_app_guard_cfg(cc.dt_s, (float)(2.0 * vmax * counts_per_m + 1.0 / c.dt_s)),
+                       br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE)};
     if (ctrl == BR_CTRL_HINF_TRUE) ac.est = BR_APP_EST_EXTERN;
     const br_plant_state_t x0 = {tr->ref[0] / pc->lead_mprad, 0.0, 0.0};
     int rc = -1;

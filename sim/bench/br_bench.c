@@ -37,6 +37,7 @@
 #include "hal/br_hal_sim.h"
 #include "bristle_gen/est/br_noise_table.h"
 #include "bristle_gen/machine/br_machine.h"
+#include "bristle/br_machine_cfg.h"
 #include "bristle/br_app.h"
 #include "tools/br_args.h"
 
@@ -134,7 +135,8 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
     rec_est_t wrap = {est, &plant, rec, 0};
     const br_est_t e = {&wrap, rec_est_step, NULL, NULL};
     const br_app_cfg_t ac = {&cc, BR_APP_EST_EXTERN, NULL, NULL, &e,
-                             br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
+                             br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F),
+                             br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE)};
     if (br_app_init(&app, &ac, &hal, NULL) != BR_OK || br_app_arm(&app) != BR_OK) {
         fprintf(stderr, "br_bench: application init failed\n");
         return -1;

@@ -10,6 +10,7 @@
 #include "bristle_gen/ctrl/br_hinf_gains.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
+#include "bristle/br_machine_cfg.h"
 #include "bristle/br_app.h"
 #include "plant/br_model_params.h"
 #include "tools/br_rng.h"
@@ -264,7 +265,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
     const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(c);
     br_est_t ext = {NULL, NULL, NULL, NULL};
     br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, &c->pf, &c->ukf, &ext,
-                       br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
+                       br_app_guard_cfg(cc.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F), br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE)};
     switch (c->controller) {
     case BR_CTRL_HINF_ONLY:
         break;

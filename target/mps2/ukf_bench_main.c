@@ -133,6 +133,7 @@ int main(void)
         .est = BR_APP_EST_UKF,
         .ukf = &bench_ukf_cfg,
         .guard = br_app_guard_cfg(BR_UKF_BENCH_DT_S, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F),
+        .motion = br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE),
     };
     const br_app_mem_t mem = {.ukf = &ukf};
     uint32_t last_raw;

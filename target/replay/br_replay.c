@@ -6,6 +6,7 @@
 
 #include "bristle_gen/est/br_noise_table.h"
 #include "bristle_gen/machine/br_machine.h"
+#include "bristle/br_machine_cfg.h"
 
 static uint32_t f2w(float f)
 {
@@ -163,7 +164,8 @@ int br_replay_run(br_replay_t *r, const br_replay_io_t *io, uint32_t n_particles
     r->cfg.pf.scalar_path = scalar_path;
     const uint32_t na = r->cfg.n_axes;
     const br_app_cfg_t app_cfg = {&r->cfg.ctrl, BR_APP_EST_PF, &r->cfg.pf, NULL, NULL,
-                                 br_app_guard_cfg(r->cfg.ctrl.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F)};
+                                 br_app_guard_cfg(r->cfg.ctrl.dt_s, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F),
+                                 br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE)};
     for (uint32_t a = 0u; a < na; ++a) {
         br_replay_axis_t *x = &r->ax[a];
         x->hal.ctx = x;

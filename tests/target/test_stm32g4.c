@@ -115,8 +115,8 @@ static void test_app_on_port(void **st)
     assert_int_equal(br_stm32_hal(&port, &hal), BR_OK);
     assert_ptr_equal(hal.ctx, &port);
     const br_ctrl_cfg_t k = {{-0.5f, -0.01f, -10.0f}, 1e-3f, 0.64f, 0.64f, 6.0e-6f, 1.27e-3f};
-    const br_app_guard_cfg_t guard = {100u, 3u, 0.5f, 5u, 10u, 2u};
-    const br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, guard};
+    const br_app_guard_cfg_t guard = {100u, 3u, 10u, 2u};
+    const br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, guard, BR_TEST_WIDE_MOTION};
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
     assert_true(pwm_off(&f)); /* disarmed */
     assert_int_equal(br_app_arm(&app), BR_OK);

@@ -47,9 +47,10 @@ static br_status_t fake_enable(void *ctx)
     return BR_OK;
 }
 
-/* guards of the tests: 100 counts per period, 3 held reads, frozen at
- * |duty| >= 0.5 for 5 periods, lost lock at 3 outlier steps within 10 periods */
-#define GUARD {100u, 3u, 0.5f, 5u, 10u, 2u}
+/* guards of the tests: 100 counts per period, 3 held reads, lost lock at 3
+ * outlier steps within 10 periods; drive protections out of the way */
+#define GUARD {100u, 3u, 10u, 2u}
+#define MOTION BR_TEST_WIDE_MOTION
 static br_status_t fake_tick(void *ctx, uint32_t *t)
 {
     (void)ctx;
@@ -87,7 +88,7 @@ static void test_init_guards(void **st)
     br_app_t app;
     br_est_t est;
 
-    br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD};
+    br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD, MOTION};
     assert_int_equal(br_app_init(NULL, &c, &hal, NULL), BR_E_NULL);
     assert_int_equal(br_app_init(&app, NULL, &hal, NULL), BR_E_NULL);
     assert_int_equal(br_app_init(&app, &c, NULL, NULL), BR_E_NULL);
@@ -173,7 +174,7 @@ static void test_none_is_hinf_only(void **st)
     fake_t f = {1000, 0.0f, BR_OK, BR_OK, 0, 0};
     const br_hal_t hal = {&f, fake_enc, fake_pwm, fake_tick, NULL, NULL};
     const br_ctrl_cfg_t k = ctrl_cfg();
-    const br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD};
+    const br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD, MOTION};
     br_app_t app;
     const br_ref_t r = {0, 0.0f, 0.0f};
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
@@ -191,7 +192,7 @@ static void test_extern_drives_compensation(void **st)
     const br_ctrl_cfg_t k = ctrl_cfg();
     const float F = 10.0f;
     const br_est_t ext = {(void *)&F, const_est_step, NULL, NULL};
-    const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD};
+    const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD, MOTION};
     br_app_t app;
     const br_ref_t r = {0, 0.0f, 0.0f};
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
@@ -243,7 +244,7 @@ static void test_estimator_interface(void **st)
     const br_ctrl_cfg_t k = ctrl_cfg();
     iface_t e = {0, 0, 0, 0.0f, BR_OK, {0, 0.0f}};
     const br_est_t ext = {&e, iface_step, iface_predict, iface_reset};
-    const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD};
+    const br_app_cfg_t c = {&k, BR_APP_EST_EXTERN, NULL, NULL, &ext, GUARD, MOTION};
     br_app_t app;
     const br_ref_t r = {0, 0.0f, 0.0f};
     assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
@@ -292,7 +293,7 @@ static void run_against_hand(br_app_est_kind_t kind)
     br_ukf_t *ukf = calloc(2, sizeof *ukf);
     assert_non_null(pf);
     assert_non_null(ukf);
-    br_app_cfg_t c = {&k, kind, &pfc, &ukfc, NULL, GUARD};
+    br_app_cfg_t c = {&k, kind, &pfc, &ukfc, NULL, GUARD, MOTION};
     /* the jumpy counts below make the filters reject measurements: the lock
      * monitor (not part of the period written out here) must not trip */
     c.guard.lock_max_outliers = c.guard.lock_window_periods - 1u;
@@ -370,7 +371,7 @@ static void rig_init(rig_t *g, int ext)
     g->k = ctrl_cfg();
     g->ext = (br_est_t){&est_status, bad_est_step, NULL, NULL};
     est_status = BR_OK;
-    g->c = (br_app_cfg_t){&g->k, ext ? BR_APP_EST_EXTERN : BR_APP_EST_NONE, NULL, NULL, &g->ext, GUARD};
+    g->c = (br_app_cfg_t){&g->k, ext ? BR_APP_EST_EXTERN : BR_APP_EST_NONE, NULL, NULL, &g->ext, GUARD, MOTION};
     assert_int_equal(br_app_init(&g->app, &g->c, &g->hal, NULL), BR_OK);
     assert_int_equal(br_app_arm(&g->app), BR_OK);
     assert_true(g->f.on);
@@ -393,6 +394,25 @@ static void assert_latched(rig_t *g, br_app_fault_t cause)
     }
 }
 
+/* a fault where the position is trusted: the braking ramp (outputs on, the
+ * controller following it) for at most `periods` periods, then outputs off
+ * and latched */
+static void assert_brakes_then_off(rig_t *g, br_app_fault_t cause, int periods)
+{
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    assert_int_equal(g->app.fault, cause);
+    assert_int_equal(g->app.stop, BR_APP_STOP_BRAKING);
+    assert_true(g->f.on);
+    int n = 0;
+    while (g->app.stop == BR_APP_STOP_BRAKING && n <= periods) {
+        assert_true(g->f.on);
+        assert_int_equal(br_app_step(&g->app, &r), BR_E_FAULT);
+        n++;
+    }
+    assert_true(n <= periods);
+    assert_latched(g, cause);
+}
+
 static void test_outputs_off_until_armed(void **st)
 {
     (void)st;
@@ -400,7 +420,7 @@ static void test_outputs_off_until_armed(void **st)
     memset(&g, 0, sizeof g);
     g.hal = (br_hal_t){&g.f, fake_enc, fake_pwm, fake_tick, fake_disable, fake_enable};
     g.k = ctrl_cfg();
-    g.c = (br_app_cfg_t){&g.k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD};
+    g.c = (br_app_cfg_t){&g.k, BR_APP_EST_NONE, NULL, NULL, NULL, GUARD, MOTION};
     const br_ref_t r = {0, 0.0f, 0.0f};
     g.f.counts = 1000;
     g.f.on = 1;
@@ -460,7 +480,8 @@ static void test_estimator_error_latches(void **st)
     assert_true(g.f.on);
     est_status = BR_E_NUMERIC;
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
-    assert_latched(&g, BR_APP_FAULT_ESTIMATOR);
+    /* at rest: the ramp is the settle alone */
+    assert_brakes_then_off(&g, BR_APP_FAULT_ESTIMATOR, (int)BR_APP_BRAKE_SETTLE_PERIODS);
 }
 
 /* The lock monitor: an estimator that keeps rejecting the measurement (the
@@ -483,9 +504,8 @@ static void test_lost_lock_latches(void **st)
      * one more: the third of the last 10 periods */
     est_status = BR_W_OUTLIER;
     assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
-    g.f.duty = 0.3f;
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
-    assert_latched(&g, BR_APP_FAULT_LOST_LOCK);
+    assert_brakes_then_off(&g, BR_APP_FAULT_LOST_LOCK, (int)BR_APP_BRAKE_SETTLE_PERIODS);
     /* a good estimate does not clear it; the arm does, with an empty window */
     est_status = BR_OK;
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
@@ -495,7 +515,7 @@ static void test_lost_lock_latches(void **st)
     assert_int_equal(br_app_step(&g.app, &r), BR_W_OUTLIER);
     /* outliers for ever (re-anchoring at every step): the third faults */
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
-    assert_latched(&g, BR_APP_FAULT_LOST_LOCK);
+    assert_brakes_then_off(&g, BR_APP_FAULT_LOST_LOCK, (int)BR_APP_BRAKE_SETTLE_PERIODS);
     /* predict-only periods (failed reads) leave the window as clean periods */
     rig_init(&g, 1);
     est_status = BR_W_OUTLIER;
@@ -533,12 +553,13 @@ static void test_encoder_jump_latches(void **st)
     rig_t g;
     rig_init(&g, 0);
     const br_ref_t r = {0, 0.0f, 0.0f};
-    /* across the int32 wrap both ways, at the speed limit: fine */
-    g.f.counts = INT32_MAX - 40;
+    /* across zero both ways, at the limit: fine (the int32 wrap lies beyond
+     * any stroke's soft limits: test_port, test_stm32h7 test the wrap) */
+    g.f.counts = -40;
     assert_int_equal(br_app_step(&g.app, &r), BR_OK);
-    g.f.counts = (int32_t)((uint32_t)INT32_MAX + 60u); /* +100 through the wrap */
+    g.f.counts = 60; /* +100 */
     assert_int_equal(br_app_step(&g.app, &r), BR_OK);
-    g.f.counts = INT32_MAX - 40; /* -100 back */
+    g.f.counts = -40; /* -100 back */
     assert_int_equal(br_app_step(&g.app, &r), BR_OK);
     /* one count above the axis's maximum speed: a glitch, not a count */
     g.f.counts -= 101;
@@ -595,7 +616,7 @@ static void test_encoder_stale_holds_then_latches(void **st)
     pfc.n_particles = 100u;
     br_pf_t *pf = calloc(1, sizeof *pf);
     assert_non_null(pf);
-    const br_app_cfg_t c = {&k, BR_APP_EST_PF, &pfc, NULL, NULL, GUARD};
+    const br_app_cfg_t c = {&k, BR_APP_EST_PF, &pfc, NULL, NULL, GUARD, MOTION};
     const br_app_mem_t mem = {pf, NULL};
     br_app_t app;
     assert_int_equal(br_app_init(&app, &c, &hal, &mem), BR_OK);
@@ -639,42 +660,155 @@ static void test_encoder_stale_holds_then_latches(void **st)
     free(pf);
 }
 
+/* the rig with the machine's drive protections (machine file) */
+static void rig_machine(rig_t *g)
+{
+    rig_init(g, 0);
+    g->c.motion = br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE);
+    g->c.guard = br_app_guard_cfg(1e-3f, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F);
+    assert_int_equal(br_app_init(&g->app, &g->c, &g->hal, NULL), BR_OK);
+    assert_int_equal(br_app_arm(&g->app), BR_OK);
+}
+
+/* The stuck encoder, from the model: a counter that stops while the axis
+ * moves latches at the first still period; a still counter under a steady
+ * force (a load held) never does; a force that grows beyond what stiction
+ * holds without a count does, before the following error. */
 static void test_encoder_frozen_latches(void **st)
 {
     (void)st;
     rig_t g;
-    rig_init(&g, 0);
-    /* a position error that commands |duty| >= 0.5 (gain 0.5 Nm/rad, 0.64 Nm per duty) */
-    const int32_t far = 120000;
-    const br_ref_t r = {far, 0.0f, 0.0f};
-    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
-    assert_true(fabsf(g.f.duty) >= 0.5f);
-    /* the axis moves: no fault however long */
+    rig_machine(&g);
+    br_ref_t r = {0, 0.5f, 0.0f};
+    /* moving at 200 counts a period, the reference on the count */
     for (int i = 0; i < 20; i++) {
-        g.f.counts += 1;
+        g.f.counts += 200;
+        r.ref_counts = g.f.counts;
         assert_int_equal(br_app_step(&g.app, &r), BR_OK);
     }
-    /* stops shorter than 5 periods, each ended by a move, do not add up: the
-     * count starts again at every move */
-    for (int k = 0; k < 3; k++) {
-        for (int i = 0; i < 4; i++) {
-            assert_int_equal(br_app_step(&g.app, &r), BR_OK);
-        }
-        g.f.counts += 1;
-        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
-    }
-    /* the counter stops while commanded: 4 periods pass, the 5th faults */
-    for (int i = 0; i < 4; i++) {
-        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
-    }
+    /* the counter stops, the reference goes on: the model predicts 200 counts */
+    r.ref_counts += 200;
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
     assert_latched(&g, BR_APP_FAULT_ENC_FROZEN);
-    /* a still axis at a small duty is not frozen */
-    rig_init(&g, 0);
-    const br_ref_t near = {10, 0.0f, 0.0f};
-    for (int i = 0; i < 20; i++) {
-        assert_int_equal(br_app_step(&g.app, &near), BR_OK);
+    /* still, reference on the count, 2000 periods: never */
+    rig_machine(&g);
+    const br_ref_t still = {0, 0.5f, 0.0f};
+    for (int i = 0; i < 2000; i++) {
+        assert_int_equal(br_app_step(&g.app, &still), BR_OK);
     }
+    /* a reference the axis should follow, a counter that never moves: the
+     * drive's force grows past the stiction band: ENC_FROZEN, not FOLLOWING */
+    rig_machine(&g);
+    const br_ref_t far = {100000, 0.0f, 0.0f};
+    br_status_t s = BR_OK;
+    for (int i = 0; i < 1000 && s == BR_OK; i++) {
+        s = br_app_step(&g.app, &far);
+    }
+    assert_int_equal(s, BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_ENC_FROZEN);
+}
+
+/* The reference limiter: within the limits the reference passes bit for
+ * bit; a step is limited (flagged) to the machine's speed and acceleration,
+ * lands on the target and passes again; a target beyond the soft travel
+ * limit is held at it. */
+static void test_reference_limiter(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_machine(&g);
+    /* the fake axis jumps to the reference without a force: no stuck model */
+    g.app.motion.stuck_band_N = 1e9f;
+    const br_app_t *a = &g.app;
+    const float vmax = a->lim_vmax, amax = a->lim_amax;
+    assert_true(vmax > 0.0f && amax > 0.0f);
+    br_ref_t r = {0, 0.5f, 0.0f};
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    assert_false(a->ref_limited);
+    /* a 10 mm step */
+    const int32_t step = (int32_t)(0.01f * a->motion.counts_per_m);
+    r.ref_counts = step;
+    float prev_v = 0.0f, prev_p = 0.5f;
+    int n = 0;
+    while (n < 10000) {
+        /* the axis follows the limited reference exactly */
+        g.f.counts = a->lim_counts;
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+        if (!a->ref_limited) break;
+        const float p = (float)a->lim_counts + a->lim_frac;
+        const float v = p - prev_p;
+        assert_true(fabsf(v) <= vmax * 1.0001f);
+        assert_true(fabsf(v - prev_v) <= amax * 1.0001f + 1.0f);
+        /* never past the target by more than a count (float rounding of the braking curve) */
+        assert_true(p <= (float)step + 1.0f);
+        prev_v = v;
+        prev_p = p;
+        n++;
+    }
+    assert_true(n > 1 && n < 10000);
+    assert_true(a->n_ref_limited >= (uint32_t)n);
+    print_message("10 mm step: limited for %d periods\n", n);
+    /* a target beyond the soft limit: held at it, flagged */
+    rig_machine(&g);
+    g.app.motion.stuck_band_N = 1e9f;
+    const br_ref_t beyond = {(int32_t)(1.1f * a->lim_hi), 0.0f, 0.0f};
+    for (int i = 0; i < 100000 && g.app.fault == BR_APP_FAULT_NONE; i++) {
+        g.f.counts = a->lim_counts;
+        assert_int_equal(br_app_step(&g.app, &beyond), BR_OK);
+        assert_true(a->ref_limited);
+        /* at most one period's change of speed past it (the braking curve's
+         * float rounding at 1.6e7 counts: 28 counts, 0.2 um, measured) */
+        assert_true((float)a->lim_counts + a->lim_frac <= a->lim_hi + amax);
+    }
+}
+
+/* Speed, following error and travel: latched, the axis brakes (controller
+ * on a ramp at the machine's acceleration), then outputs off. */
+static void test_motion_faults_brake(void **st)
+{
+    (void)st;
+    rig_t g;
+    const br_ref_t r = {0, 0.5f, 0.0f};
+    /* speed: a delta above speed_fault (below the jump limit) */
+    rig_machine(&g);
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    const int32_t fast = (int32_t)(g.app.motion.speed_fault_mps * g.app.motion.counts_per_m * 1e-3f) + 2;
+    g.c.guard.enc_max_delta_counts = 100000u;
+    g.app.guard.enc_max_delta_counts = 100000u;
+    g.f.counts += fast;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_SPEED);
+    /* from that speed the ramp is at most speed / accel + the settle long */
+    const int ramp = (int)ceilf((float)fast / g.app.lim_amax) + (int)BR_APP_BRAKE_SETTLE_PERIODS;
+    assert_int_equal(g.app.stop, BR_APP_STOP_BRAKING);
+    assert_true(g.f.on);
+    /* the axis follows the ramp */
+    while (g.app.stop == BR_APP_STOP_BRAKING) {
+        g.f.counts = g.app.brk_counts;
+        assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+        assert_true(g.app.brk_left <= (uint32_t)ramp);
+    }
+    assert_latched(&g, BR_APP_FAULT_SPEED);
+    /* following error: the count 1.5 following limits from the reference */
+    rig_machine(&g);
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    g.app.guard.enc_max_delta_counts = 1u << 30;
+    g.app.motion.speed_fault_mps = 1e6f;
+    g.f.counts += (int32_t)(1.5f * g.app.motion.max_following_m * g.app.motion.counts_per_m);
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_FOLLOWING);
+    assert_int_equal(g.app.stop, BR_APP_STOP_BRAKING);
+    /* beyond the soft limit: travel (the reference there too) */
+    rig_machine(&g);
+    g.f.counts = (int32_t)(g.app.lim_hi + 2.0f * g.app.motion.max_following_m * g.app.motion.counts_per_m);
+    const br_ref_t there = {g.f.counts, 0.5f, 0.0f};
+    assert_int_equal(br_app_step(&g.app, &there), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_TRAVEL);
+    assert_brakes_then_off(&g, BR_APP_FAULT_TRAVEL, (int)BR_APP_BRAKE_SETTLE_PERIODS);
+    /* a failed read while braking: outputs off at once */
+    rig_machine(&g);
+    assert_int_equal(br_app_fault(&g.app, BR_APP_FAULT_DEADLINE), BR_E_FAULT);
+    assert_latched(&g, BR_APP_FAULT_DEADLINE);
 }
 
 static void test_external_fault_latches(void **st)
@@ -699,9 +833,9 @@ static void test_guard_config(void **st)
     bad[0].enc_max_delta_counts = 0u;
     bad[1].enc_max_delta_counts = (1u << 30) + 1u;
     bad[2].enc_stale_periods = 1001u;
-    bad[3].frozen_duty = NAN;
-    bad[4].frozen_duty = 1.5f;
-    bad[5].frozen_periods = 0u;
+    bad[3].lock_max_outliers = 10u;
+    bad[4].lock_window_periods = 2u; /* 2 of 2 */
+    bad[5].enc_max_delta_counts = 0xFFFFFFFFu;
     bad[6].lock_window_periods = 0u;
     bad[7].lock_window_periods = BR_APP_LOCK_WINDOW_MAX + 1u;
     bad[8].lock_max_outliers = ok.lock_window_periods; /* could never trip */
@@ -711,11 +845,10 @@ static void test_guard_config(void **st)
         assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
         assert_int_equal(br_app_arm(&g.app), BR_E_STATE);
     }
-    /* the machine's: 1 ms at 0.1 m/s = 13107.2 counts -> 13108; 50 ms of periods */
+    /* the machine's: 1 ms at 0.1 m/s = 13107.2 counts, times BR_APP_JUMP_SPEEDS
+     * (2.2) = 28835.84 -> 28836 */
     const br_app_guard_cfg_t m = br_app_guard_cfg(1e-3f, 13107200.0f);
-    assert_int_equal(m.enc_max_delta_counts, 13108u);
-    assert_true((float)m.frozen_periods * 1e-3f >= BR_APP_GUARD_FROZEN_S);
-    assert_true((float)(m.frozen_periods - 1u) * 1e-3f < BR_APP_GUARD_FROZEN_S);
+    assert_int_equal(m.enc_max_delta_counts, 28836u);
     /* the lock window: 100 ms of periods, a quarter of them */
     assert_true((float)m.lock_window_periods * 1e-3f >= BR_APP_GUARD_LOCK_S);
     assert_true((float)(m.lock_window_periods - 1u) * 1e-3f < BR_APP_GUARD_LOCK_S);
@@ -784,6 +917,8 @@ int main(void)
         cmocka_unit_test(test_encoder_stale_holds_then_latches),
         cmocka_unit_test(test_encoder_jump_after_held_reads),
         cmocka_unit_test(test_encoder_frozen_latches),
+        cmocka_unit_test(test_reference_limiter),
+        cmocka_unit_test(test_motion_faults_brake),
         cmocka_unit_test(test_external_fault_latches),
         cmocka_unit_test(test_guard_config),
         cmocka_unit_test(test_machine_cfg_one_home),

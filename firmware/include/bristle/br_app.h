@@ -49,13 +49,24 @@ typedef enum {
     BR_APP_FAULT_ESTIMATOR = 4,  /* the estimator's step or predict failed */
     BR_APP_FAULT_ENC_JUMP = 5,   /* |counts delta| above the axis's maximum speed */
     BR_APP_FAULT_ENC_STALE = 6,  /* more failed encoder reads in a row than enc_stale_periods */
-    BR_APP_FAULT_ENC_FROZEN = 7, /* counter unchanged while |duty| >= frozen_duty, frozen_periods long */
+    BR_APP_FAULT_ENC_FROZEN = 7, /* counter unchanged where the model predicts more than
+                                    stuck_counts of motion (br_app_motion_cfg_t) */
     BR_APP_FAULT_DEADLINE = 8,   /* missed control periods (reported by the caller, br_app_fault) */
     BR_APP_FAULT_HAL = 9,        /* pwm_write failed */
-    BR_APP_FAULT_LOST_LOCK = 10  /* more than lock_max_outliers outlier steps (BR_W_OUTLIER: the
+    BR_APP_FAULT_LOST_LOCK = 10, /* more than lock_max_outliers outlier steps (BR_W_OUTLIER: the
                                     estimator rejected the measurement, re-anchoring included)
                                     within the last lock_window_periods periods */
+    BR_APP_FAULT_SPEED = 11,     /* measured |speed| above speed_fault_mps */
+    BR_APP_FAULT_FOLLOWING = 12, /* |limited reference - position| above max_following_m */
+    BR_APP_FAULT_TRAVEL = 13     /* position beyond a soft travel limit by more than max_following_m */
 } br_app_fault_t;
+
+/* How a latched fault stops the axis (br_app_t.stop, docs/modules/app.md). */
+typedef enum {
+    BR_APP_STOP_OFF = 0,    /* outputs off (duty 0, pwm_disable): the position is not trusted */
+    BR_APP_STOP_BRAKING = 1 /* the controller follows a ramp to standstill at max_accel_mps2
+                               (no compensation), then outputs off */
+} br_app_stop_t;
 
 /* The guards of one period (docs/reliability.md). br_app_guard_cfg builds them
  * from the machine's maximum speed. */
@@ -64,9 +75,6 @@ typedef struct {
                                       (max speed x period), 1..2^30; above: BR_APP_FAULT_ENC_JUMP */
     uint32_t enc_stale_periods;    /* failed reads in a row that are held (last count, the
                                       estimator predicts); the next one faults. 0..1000 */
-    float frozen_duty;             /* |duty| of the last period from which an unchanged count
-                                      counts as frozen, in (0, 1] */
-    uint32_t frozen_periods;       /* frozen periods in a row before the fault, 1..2^20 */
     uint32_t lock_window_periods;  /* the lock monitor's window: the last so many periods,
                                       1..BR_APP_LOCK_WINDOW_MAX */
     uint32_t lock_max_outliers;    /* outlier steps allowed in the window, 0..window - 1; one
@@ -79,19 +87,71 @@ typedef struct {
 
 /* Defaults of br_app_guard_cfg (docs/reliability.md). */
 #define BR_APP_GUARD_STALE_PERIODS 3u   /* three missed reads are held, the fourth faults */
-#define BR_APP_GUARD_FROZEN_DUTY 0.5f   /* half the amplifier's duty ... */
-#define BR_APP_GUARD_FROZEN_S 0.05f     /* ... for 50 ms without a count */
 #define BR_APP_GUARD_LOCK_S 0.1f        /* lock monitor: outlier steps in the last 100 ms ... */
 #define BR_APP_GUARD_LOCK_FRACTION 0.25f /* ... above a quarter of its periods: lost lock (docs/reliability.md) */
 
 /* The guards for a period dt_s and a maximum speed in counts/s (the machine's
- * BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F): enc_max_delta_counts = ceil(speed dt),
- * frozen_periods = ceil(BR_APP_GUARD_FROZEN_S / dt), lock_window_periods =
+ * BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F): enc_max_delta_counts =
+ * ceil(BR_APP_JUMP_SPEEDS speed dt) (a delta no motion below the speed fault
+ * can make, see BR_APP_JUMP_SPEEDS), lock_window_periods =
  * ceil(BR_APP_GUARD_LOCK_S / dt), lock_max_outliers = ceil(BR_APP_GUARD_LOCK_FRACTION
  * window) (25 of 100 periods at 1 ms, 17 of 67 at 1.5 ms), the defaults above. A
  * non-finite or non-positive input gives a configuration br_app_init rejects. */
 br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s);
 
+/* The speed fault's margin over the machine's max_speed_mps (the reference
+ * limiter's speed): a measured speed above max_speed (1 + margin) latches SPEED. */
+#define BR_APP_SPEED_MARGIN 0.1f
+/* The encoder jump limit in machine speeds: twice the speed fault's speed is
+ * more than the axis can reach in one period after the speed fault's limit
+ * (its acceleration times a period is far below the speed: 14 mm/s at 1 ms on
+ * the reference machine), so a larger delta is a lie of the encoder. */
+#define BR_APP_JUMP_SPEEDS (2.0f * (1.0f + BR_APP_SPEED_MARGIN))
+/* The stuck-encoder detector's threshold: predicted motion, in counts, that a
+ * still counter must not hide. */
+#define BR_APP_STUCK_COUNTS 8.0f
+/* Standstill after a braking ramp: so many periods at zero reference speed,
+ * then outputs off. */
+#define BR_APP_BRAKE_SETTLE_PERIODS 20u
+
+/* The machine's values the drive protections derive from, physical units
+ * (bristle/br_machine_cfg.h: BR_MACHINE_APP_MACHINE, from the machine file). */
+typedef struct {
+    float lead_mprad;       /* L, m/rad */
+    float rad_per_count;    /* encoder resolution on the motor */
+    float mass_kg;          /* table mass M */
+    float inertia_kgm2;     /* motor + screw J */
+    float Fc_N;             /* Coulomb friction: the least force that brakes a coasting axis */
+    float Fs_N;             /* stiction: the most force friction holds at standstill */
+    float max_speed_mps;    /* limits.max_speed_mps */
+    float max_accel_mps2;   /* limits.max_accel_mps2 */
+    float max_following_m;  /* limits.max_following_error_m */
+    float travel_m;         /* limits.travel_m: the stroke, centred on count 0 */
+} br_app_machine_t;
+
+/* The drive protections of br_app_step, derived by br_app_motion_cfg
+ * (docs/modules/app.md, "Drive protections"). */
+typedef struct {
+    float counts_per_m;      /* 1 / (L rad_per_count) */
+    float max_speed_mps;     /* the reference limiter's speed */
+    float max_accel_mps2;    /* the reference limiter's and the braking ramp's acceleration */
+    float speed_fault_mps;   /* max_speed (1 + BR_APP_SPEED_MARGIN): above, SPEED */
+    float max_following_m;   /* |limited reference - position| above: FOLLOWING */
+    float soft_min_m;        /* soft travel limits: the reference is held inside them, a */
+    float soft_max_m;        /* position beyond them by max_following_m is TRAVEL */
+    float stop_bound_m;      /* the stopping distance bound the soft limits keep from the ends */
+    float mass_kg;           /* moved mass M + J / L^2 (the stuck-encoder model) */
+    float stuck_band_N;      /* force change friction can hold without motion: 2 Fs */
+    float stuck_counts;      /* predicted motion without a count that latches ENC_FROZEN */
+} br_app_motion_cfg_t;
+
+/* The protections of machine m (docs/modules/app.md): speed_fault = max_speed
+ * (1 + BR_APP_SPEED_MARGIN); stop_bound = speed_fault^2 mass / (2 Fc) (an
+ * axis coasting from the speed fault's speed, braked by Coulomb friction
+ * alone) + max_following; soft limits = +-(travel / 2 - stop_bound); mass =
+ * M + J / L^2; stuck band 2 Fs; BR_APP_STUCK_COUNTS. Values br_app_init
+ * rejects (all zero) for a NULL m or a non-finite or non-positive value. */
+br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m);
 /* Can be const, in flash. Only the pointer the kind names is read. */
 typedef struct {
     const br_ctrl_cfg_t *ctrl;
@@ -100,6 +160,7 @@ typedef struct {
     const br_ukf_cfg_t *ukf;
     const br_est_t *ext;
     br_app_guard_cfg_t guard;
+    br_app_motion_cfg_t motion;
 } br_app_cfg_t;
 
 /* The estimator's state, owned by the caller (see above); only the pointer
@@ -122,7 +183,28 @@ typedef struct {
     int32_t last_counts;    /* last good encoder read */
     int have_counts;        /* last_counts valid (a good read since the arm) */
     uint32_t n_stale;       /* failed reads in a row */
-    uint32_t n_frozen;      /* frozen periods in a row */
+    br_app_motion_cfg_t motion;
+    br_app_stop_t stop;     /* how the latched fault stops the axis */
+    /* the reference limiter (counts, counts per period) */
+    int32_t lim_counts;     /* the limited reference: integer part ... */
+    float lim_frac;         /* ... and fraction in [0, 1) */
+    float lim_v;            /* its speed, counts per period */
+    int lim_primed;         /* lim_* valid (the first period after the arm sets them) */
+    int lim_active;         /* limiting (the reference was beyond a limit and is not caught up) */
+    int ref_limited;        /* the period's flag: the reference handed to the controller was limited */
+    uint32_t n_ref_limited; /* periods limited since the arm */
+    float lim_vmax, lim_amax; /* the limits in counts per period (per period^2) */
+    float lim_lo, lim_hi;   /* the soft travel limits in counts */
+    /* measured motion (stuck-encoder model, speed fault) */
+    float v_meas;           /* speed of the last good read, counts per period */
+    float hold_N;           /* friction + load when the count last moved (model: F - m a) */
+    float v_pred;           /* the model's speed since the count stopped, counts per period */
+    float d_pred;           /* the model's motion since the count stopped, counts */
+    /* the braking ramp */
+    int32_t brk_counts;     /* the ramp's position: integer part ... */
+    float brk_frac;         /* ... and fraction */
+    float brk_v;            /* its speed, counts per period */
+    uint32_t brk_left;      /* periods left before outputs off */
     uint32_t lock_bits[BR_APP_LOCK_WORDS]; /* lock monitor: bit k = period k of the window was an outlier */
     uint32_t lock_pos;      /* the window's slot of the next period */
     uint32_t n_lock;        /* outlier periods in the window (the bits set) */

@@ -15,6 +15,7 @@
 #ifndef BR_MACHINE_CFG_H
 #define BR_MACHINE_CFG_H
 
+#include "bristle/br_app.h"
 #include "bristle/br_pf.h"
 #include "bristle/br_ukf.h"
 #include "bristle_gen/est/br_est_machine.h"
@@ -22,6 +23,16 @@
 #include "bristle_gen/est/br_pf_tuned.h"
 #include "bristle_gen/est/br_ukf_tuned.h"
 #include "bristle_gen/machine/br_machine.h"
+
+/* the machine's values the drive protections derive from (br_app_motion_cfg) */
+#define BR_MACHINE_APP_MACHINE                                                                     \
+    {                                                                                              \
+        .lead_mprad = BR_MACHINE_LEAD_MPRAD_F, .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,        \
+        .mass_kg = BR_MACHINE_M_KG_F, .inertia_kgm2 = BR_MACHINE_J_KGM2_F,                         \
+        .Fc_N = BR_MACHINE_FC_N_F, .Fs_N = BR_MACHINE_FS_N_F,                                      \
+        .max_speed_mps = BR_MACHINE_MAX_SPEED_MPS_F, .max_accel_mps2 = BR_MACHINE_MAX_ACCEL_MPS2_F, \
+        .max_following_m = BR_MACHINE_MAX_FOLLOWING_M_F, .travel_m = BR_MACHINE_TRAVEL_M_F         \
+    }
 
 /* an estimator's delay identification (E: PF or UKF; docs/modules/dlyid.md; 0 candidates: off) */
 #define BR_MACHINE_DELAY_ID_CFG(E)                                                                 \

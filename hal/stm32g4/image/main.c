@@ -87,6 +87,7 @@ int main(void)
         .est = BR_IMAGE_EST,
         .ukf = &br_image_ukf_cfg,
         .guard = br_app_guard_cfg(BR_IMAGE_DT_S, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F),
+        .motion = br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE),
     };
     const br_app_mem_t mem = {.ukf = &ukf};
 

@@ -114,6 +114,7 @@ int main(void)
         .ukf = &br_image_ukf_cfg,
 #endif
         .guard = br_app_guard_cfg(BR_IMAGE_DT_S, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F),
+        .motion = br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE),
     };
 #if BR_IMAGE_USES_PF
     const br_app_mem_t mem = {.pf = &br_image_pf};

@@ -74,9 +74,15 @@
  * the largest encoder delta of one period (br_app_guard_cfg) */
 #define BR_MACHINE_MAX_SPEED_COUNTS_PER_S (13107200.0)
 #define BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F (1.310720000e+07f)
-/* stroke of the table */
+/* stroke of the table, centred on encoder count 0 */
 #define BR_MACHINE_TRAVEL_M (0.3)
 #define BR_MACHINE_TRAVEL_M_F (3.000000119e-01f)
+/* the reference limiter's and the braking ramp's acceleration (br_app_motion_cfg) */
+#define BR_MACHINE_MAX_ACCEL_MPS2 (2.0)
+#define BR_MACHINE_MAX_ACCEL_MPS2_F (2.000000000e+00f)
+/* largest |reference - position| before the axis brakes (br_app_motion_cfg) */
+#define BR_MACHINE_MAX_FOLLOWING_M (0.001)
+#define BR_MACHINE_MAX_FOLLOWING_M_F (1.000000047e-03f)
 
 /* the causes a diagnosis found (the file's "causes"), a br_causes_t initialiser;
  * all 0: the thesis model */

@@ -1,0 +1,297 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The drive protections of br_app_step (br_app_motion.h, docs/modules/app.md,
+ * "Drive protections"). Positions in counts (an int32 and a fraction, as
+ * br_ref_t), speeds in counts per period, accelerations in counts per
+ * period^2. */
+#include "br_app_motion.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "bristle/br_encoder.h"
+#include "br_check.h"
+
+/* A reference within the limits passes through when its speed and its change
+ * of speed are within this fraction above them (rounding of a reference at
+ * the limit itself). */
+#define BR_APP_LIM_RTOL 1.0e-3f
+/* The limiter has caught up when within this many counts of the reference. */
+#define BR_APP_LIM_CATCH_COUNTS 0.5f
+
+br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m)
+{
+    br_app_motion_cfg_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    if (m == NULL || !br_finite_pos(m->lead_mprad) || !br_finite_pos(m->rad_per_count) ||
+        !br_finite_pos(m->mass_kg) || !br_finite_pos(m->inertia_kgm2) || !br_finite_pos(m->Fc_N) ||
+        !br_finite_pos(m->Fs_N) || !br_finite_pos(m->max_speed_mps) || !br_finite_pos(m->max_accel_mps2) ||
+        !br_finite_pos(m->max_following_m) || !br_finite_pos(m->travel_m)) {
+        return c; /* all zero: rejected by br_app_init */
+    }
+    c.counts_per_m = 1.0f / (m->lead_mprad * m->rad_per_count);
+    c.max_speed_mps = m->max_speed_mps;
+    c.max_accel_mps2 = m->max_accel_mps2;
+    c.speed_fault_mps = m->max_speed_mps * (1.0f + BR_APP_SPEED_MARGIN);
+    c.max_following_m = m->max_following_m;
+    /* moved mass seen at the table: M + J / L^2 */
+    c.mass_kg = m->mass_kg + m->inertia_kgm2 / (m->lead_mprad * m->lead_mprad);
+    /* coasting from the speed fault's speed against Coulomb friction alone:
+     * v^2 / (2 Fc / mass), plus the following error the position may be off */
+    c.stop_bound_m = c.speed_fault_mps * c.speed_fault_mps * c.mass_kg / (2.0f * m->Fc_N) + m->max_following_m;
+    c.soft_max_m = 0.5f * m->travel_m - c.stop_bound_m;
+    c.soft_min_m = -c.soft_max_m;
+    /* at standstill friction holds any force in [-Fs, Fs]: a change of 2 Fs */
+    c.stuck_band_N = 2.0f * m->Fs_N;
+    c.stuck_counts = BR_APP_STUCK_COUNTS;
+    return c;
+}
+
+br_status_t br_app_motion_check(const br_app_motion_cfg_t *m)
+{
+    if (!br_finite_pos(m->counts_per_m) || !br_finite_pos(m->max_speed_mps) || !br_finite_pos(m->max_accel_mps2) ||
+        !br_finite_pos(m->max_following_m) || !br_finite_pos(m->mass_kg) || !br_finite_pos(m->stuck_band_N) ||
+        !br_finite_pos(m->stuck_counts) || !br_finite_pos(m->stop_bound_m)) {
+        return BR_E_PARAM;
+    }
+    /* written so that a NaN fails: a speed fault at or above the limiter's
+     * speed, soft limits that leave travel */
+    if (!(m->speed_fault_mps >= m->max_speed_mps && isfinite(m->speed_fault_mps)) ||
+        !(m->soft_max_m > m->soft_min_m && isfinite(m->soft_max_m) && isfinite(m->soft_min_m))) {
+        return BR_E_PARAM;
+    }
+    /* the soft limits in counts must fit an int32 with room */
+    if (!(fabsf(m->soft_max_m) * m->counts_per_m < 1.0e9f && fabsf(m->soft_min_m) * m->counts_per_m < 1.0e9f)) {
+        return BR_E_PARAM;
+    }
+    return BR_OK;
+}
+
+void br_app_motion_reset(br_app_t *app)
+{
+    const br_app_motion_cfg_t *m = &app->motion;
+    const float dt = app->ctrl.cfg.dt_s;
+    app->stop = BR_APP_STOP_OFF;
+    app->lim_counts = 0;
+    app->lim_frac = 0.0f;
+    app->lim_v = 0.0f;
+    app->lim_primed = 0;
+    app->lim_active = 0;
+    app->ref_limited = 0;
+    app->n_ref_limited = 0u;
+    app->lim_vmax = m->max_speed_mps * m->counts_per_m * dt;
+    app->lim_amax = m->max_accel_mps2 * m->counts_per_m * dt * dt;
+    app->lim_lo = m->soft_min_m * m->counts_per_m;
+    app->lim_hi = m->soft_max_m * m->counts_per_m;
+    app->v_meas = 0.0f;
+    app->hold_N = 0.0f;
+    app->v_pred = 0.0f;
+    app->d_pred = 0.0f;
+    app->brk_counts = 0;
+    app->brk_frac = 0.0f;
+    app->brk_v = 0.0f;
+    app->brk_left = 0u;
+}
+
+/* (ac + af) - (bc + bf) in counts (wrap-safe integer part) */
+static float pos_diff(int32_t ac, float af, int32_t bc, float bf)
+{
+    return (float)br_counts_delta(ac, bc) + (af - bf);
+}
+
+/* *c + *f moved by dv counts, the fraction kept in [0, 1) */
+static void pos_add(int32_t *c, float *f, float dv)
+{
+    const float total = *f + dv;
+    const float whole = floorf(total);
+    *c = (int32_t)((uint32_t)*c + (uint32_t)(int32_t)whole);
+    *f = total - whole;
+    if (*f >= 1.0f) { /* rounding of total - whole */
+        *f = 0.0f;
+        *c = (int32_t)((uint32_t)*c + 1u);
+    }
+}
+
+/* a position given in counts as a float (a soft limit) as br_ref_t parts */
+static void pos_from_float(float p, int32_t *c, float *f)
+{
+    const float whole = floorf(p);
+    *c = (int32_t)whole;
+    *f = p - whole;
+}
+
+br_status_t br_app_ref_limit(br_app_t *app, const br_ref_t *ref, int32_t counts, br_ref_t *out)
+{
+    const float dt = app->ctrl.cfg.dt_s, rpc = app->ctrl.cfg.rad_per_count;
+    /* written so that a NaN fails (the controller's own range) */
+    if (!(ref->ref_frac_counts >= 0.0f && ref->ref_frac_counts <= 1.0f) || !isfinite(ref->ref_omega_radps)) {
+        return BR_E_INPUT;
+    }
+    if (!app->lim_primed) {
+        /* from the axis at standstill, where it is */
+        app->lim_counts = counts;
+        app->lim_frac = 0.5f;
+        app->lim_v = 0.0f;
+        app->lim_primed = 1;
+    }
+    const float vmax = app->lim_vmax, amax = app->lim_amax;
+    /* the target: the reference held inside the soft travel limits */
+    int32_t tc = ref->ref_counts;
+    float tf = ref->ref_frac_counts;
+    const float tpos = (float)tc + tf;
+    const int clamped = (tpos > app->lim_hi) || (tpos < app->lim_lo);
+    if (tpos > app->lim_hi) {
+        pos_from_float(app->lim_hi, &tc, &tf);
+    } else if (tpos < app->lim_lo) {
+        pos_from_float(app->lim_lo, &tc, &tf);
+    }
+    /* the reference's own speed, counts per period; 0 where it is clamped */
+    const float vt = clamped ? 0.0f : ref->ref_omega_radps * dt / rpc;
+    const float e = pos_diff(tc, tf, app->lim_counts, app->lim_frac);
+    const float tol = 1.0f + BR_APP_LIM_RTOL;
+    if (!app->lim_active && !clamped && fabsf(e) <= vmax * tol && fabsf(e - app->lim_v) <= amax * tol &&
+        fabsf(vt) <= vmax * tol) {
+        /* within every limit: the reference as it is, bit for bit */
+        app->lim_counts = tc;
+        app->lim_frac = tf;
+        app->lim_v = e;
+        app->ref_limited = 0;
+        *out = *ref;
+        return BR_OK;
+    }
+    app->lim_active = 1;
+    app->ref_limited = 1;
+    app->n_ref_limited++;
+    /* speed that still stops at the target with deceleration amax in whole
+     * periods: v (v + a) / (2 a) = |e| solved for v (the discrete braking
+     * curve, v_stop = -a/2 + sqrt(a^2/4 + 2 a |e|)) */
+    const float ae = fabsf(e);
+    const float vstop = -0.5f * amax + sqrtf(0.25f * amax * amax + 2.0f * amax * ae);
+    const float vtc = br_clampf(vt, -vmax, vmax);
+    /* toward the target on the braking curve, riding on the target's speed,
+     * never past it in one period */
+    float vdes = vtc + copysignf(fminf(vstop, ae), e);
+    vdes = br_clampf(vdes, app->lim_v - amax, app->lim_v + amax);
+    vdes = br_clampf(vdes, -vmax, vmax);
+    pos_add(&app->lim_counts, &app->lim_frac, vdes);
+    app->lim_v = vdes;
+    /* caught up: on the target at its speed; the next period passes through */
+    if (fabsf(pos_diff(tc, tf, app->lim_counts, app->lim_frac)) <= BR_APP_LIM_CATCH_COUNTS &&
+        fabsf(vdes - vtc) <= amax && !clamped) {
+        app->lim_active = 0;
+    }
+    out->ref_counts = app->lim_counts;
+    out->ref_frac_counts = app->lim_frac;
+    out->ref_omega_radps = vdes * rpc / dt;
+    return BR_OK;
+}
+
+br_app_fault_t br_app_motion_watch(br_app_t *app, int32_t d, uint32_t periods)
+{
+    const br_app_motion_cfg_t *m = &app->motion;
+    const float dt = app->ctrl.cfg.dt_s;
+    const float cpp = m->counts_per_m * dt; /* counts per period per m/s */
+    const float v = (float)d / (float)periods;
+    if (fabsf(v) > m->speed_fault_mps * cpp) {
+        app->v_meas = v; /* the braking ramp starts from it */
+        return BR_APP_FAULT_SPEED;
+    }
+    /* the model's force per count/period^2: F = mass a, a = counts / (counts_per_m dt^2) */
+    const float k_m = m->mass_kg / (cpp * dt);
+    /* the force the drive applied over the period that ended (load side) */
+    const float F = app->last.tau_Nm / app->ctrl.cfg.lead_mprad;
+    if (d != 0 || periods != 1u) {
+        /* the count moved (or a held read: no period-wise model): friction +
+         * load now, F - mass a (eq. of motion), the speed the model starts from */
+        app->hold_N = F - k_m * (v - app->v_meas);
+        app->v_meas = v;
+        app->v_pred = v;
+        app->d_pred = 0.0f;
+        return BR_APP_FAULT_NONE;
+    }
+    /* a still count: the speed the model predicts with the force beyond what
+     * held the axis when it last moved, friction taking up to the band
+     * (never reversing the motion) */
+    float v1 = app->v_pred + (F - app->hold_N) / k_m;
+    const float brake = m->stuck_band_N / k_m;
+    v1 = (v1 > brake) ? v1 - brake : ((v1 < -brake) ? v1 + brake : 0.0f);
+    /* the motion at the period's end speed (the speed may have dropped at
+     * its start: the least motion the model allows) */
+    app->d_pred += v1;
+    app->v_pred = v1;
+    app->v_meas = 0.0f;
+    if (!(fabsf(app->d_pred) <= m->stuck_counts)) {
+        return BR_APP_FAULT_ENC_FROZEN; /* the model predicts motion the counter does not show */
+    }
+    return BR_APP_FAULT_NONE;
+}
+
+br_app_fault_t br_app_limits_check(const br_app_t *app, const br_ref_t *r, int32_t counts)
+{
+    const br_app_motion_cfg_t *m = &app->motion;
+    const float follow = m->max_following_m * m->counts_per_m;
+    const float ef = pos_diff(r->ref_counts, r->ref_frac_counts, counts, 0.5f);
+    if (!(fabsf(ef) <= follow)) {
+        return BR_APP_FAULT_FOLLOWING;
+    }
+    const float pos = (float)counts + 0.5f;
+    if (!(pos <= app->lim_hi + follow && pos >= app->lim_lo - follow)) {
+        return BR_APP_FAULT_TRAVEL;
+    }
+    return BR_APP_FAULT_NONE;
+}
+
+void br_app_outputs_off(br_app_t *app)
+{
+    const br_hal_t *hal = app->hal;
+    (void)hal->pwm_write(hal->ctx, 0.0f);
+    if (hal->pwm_disable != NULL) {
+        (void)hal->pwm_disable(hal->ctx);
+    }
+    app->last = (br_ctrl_out_t){0};
+    app->stop = BR_APP_STOP_OFF;
+}
+
+/* one period of the ramp: its speed toward 0 by amax, the controller follows
+ * it without compensation; outputs off when it has stood for the settle
+ * periods or anything fails */
+static br_status_t brake_run(br_app_t *app, int32_t counts)
+{
+    const float amax = app->lim_amax;
+    const float dt = app->ctrl.cfg.dt_s, rpc = app->ctrl.cfg.rad_per_count;
+    app->brk_v = (app->brk_v > amax) ? app->brk_v - amax : ((app->brk_v < -amax) ? app->brk_v + amax : 0.0f);
+    pos_add(&app->brk_counts, &app->brk_frac, app->brk_v);
+    br_ctrl_in_t in = {counts, app->brk_counts, app->brk_frac, app->brk_v * rpc / dt, 0.0f};
+    if (app->brk_left == 0u || br_ctrl_step(&app->ctrl, &in, &app->last) != BR_OK ||
+        app->hal->pwm_write(app->hal->ctx, app->last.duty) != BR_OK) {
+        br_app_outputs_off(app);
+        return BR_E_FAULT;
+    }
+    app->brk_left--;
+    return BR_E_FAULT;
+}
+
+br_status_t br_app_brake_start(br_app_t *app, int32_t counts)
+{
+    const float amax = app->lim_amax;
+    const float vlim = app->motion.speed_fault_mps * app->motion.counts_per_m * app->ctrl.cfg.dt_s;
+    app->stop = BR_APP_STOP_BRAKING;
+    app->brk_counts = counts;
+    app->brk_frac = 0.5f;
+    app->brk_v = br_clampf(app->v_meas, -vlim, vlim);
+    /* the periods the ramp takes from that speed, then the settle; bounded
+     * by the speed fault's speed (vlim / amax <= 2^20 at init's limits) */
+    app->brk_left = (uint32_t)ceilf(fabsf(app->brk_v) / amax) + BR_APP_BRAKE_SETTLE_PERIODS;
+    return brake_run(app, counts);
+}
+
+br_status_t br_app_brake_period(br_app_t *app, int32_t counts, int32_t d, uint32_t periods)
+{
+    const br_app_motion_cfg_t *m = &app->motion;
+    const float vlim = m->speed_fault_mps * m->counts_per_m * app->ctrl.cfg.dt_s;
+    const float ef = pos_diff(app->brk_counts, app->brk_frac, counts, 0.5f);
+    /* a ramp the axis does not follow, or a speed above the fault's: off */
+    if (!(fabsf((float)d / (float)periods) <= vlim) || !(fabsf(ef) <= m->max_following_m * m->counts_per_m)) {
+        br_app_outputs_off(app);
+        return BR_E_FAULT;
+    }
+    return brake_run(app, counts);
+}
