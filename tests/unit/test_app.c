@@ -739,8 +739,9 @@ static void test_reference_limiter(void **st)
         const float v = p - prev_p;
         assert_true(fabsf(v) <= vmax * 1.0001f);
         assert_true(fabsf(v - prev_v) <= amax * 1.0001f + 1.0f);
-        /* never past the target by more than a count (float rounding of the braking curve) */
-        assert_true(p <= (float)step + 1.0f);
+        /* never past the target by more than one period's change of speed
+         * (the braking curve's float rounding) */
+        assert_true(p <= (float)step + amax);
         prev_v = v;
         prev_p = p;
         n++;
