@@ -50,9 +50,9 @@ def main():
     check(source_state() == before, "the source tree is unchanged")
     folder = subprocess.run([sys.executable, os.path.join(DESIGN, "build_dir.py"), "host-release", a.machine],
                             capture_output=True, text=True, check=True).stdout.strip()
-    tune = os.path.join(folder, "tune")
+    tune = os.path.join(REPO, folder, "tune")  # build_dir.py names it relative to the repository
     out = os.path.join(tune, "machine.json")
-    check(os.path.isfile(out) and "make firmware MACHINE=%s" % out in p.stdout,
+    check(os.path.isfile(out) and "make firmware MACHINE=%s" % os.path.join(folder, "tune", "machine.json") in p.stdout,
           "tune/machine.json written in the build folder and the next command printed")
     if FAILURES:
         return 1
