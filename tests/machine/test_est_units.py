@@ -26,19 +26,10 @@ import sys
 
 import numpy as np
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DESIGN = os.path.join(REPO, "firmware", "design")
-sys.path.insert(0, DESIGN)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import DESIGN, check, result  # noqa: E402
 import machine  # noqa: E402
 import upgrade_machine  # noqa: E402
-
-FAILURES = []
-
-
-def check(cond, what):
-    print("%s: %s" % ("ok  " if cond else "FAIL", what))
-    if not cond:
-        FAILURES.append(what)
 
 
 def close(a, b, rel=1e-12):
@@ -168,8 +159,7 @@ def main():
           and "Traceback" not in r.stderr and not os.path.exists(new_path),
           "upgrade_machine.py: a broken file is named, nothing written (%r)" % r.stderr.strip())
 
-    print("%d failure(s)" % len(FAILURES))
-    return 1 if FAILURES else 0
+    return result()
 
 
 if __name__ == "__main__":
