@@ -26,6 +26,7 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(REPO, "sim", "studies"))
 import fleet  # noqa: E402
 import fleet_axis  # noqa: E402
+import fleet_why  # noqa: E402
 
 ARGS = None
 SEED = 7
@@ -88,6 +89,14 @@ class Fleet(unittest.TestCase):
                         self.assertIn("%s: axis %d, %s, %s" % (ctrl, r["i"], name, run_["fault_cause"]), self.out2)
                     else:
                         self.assertTrue(math.isfinite(run_["rms_m"]))
+
+    def test_why_reads_every_estimator_run(self):
+        """fleet_why.py (docs/fleet.md, "Why runs are lost") sees each estimator run of the summary, with its fault"""
+        want = sorted((ctrl, run_["faulted"]) for r in self.two["axes"] for runs in r.get("runs", {}).values()
+                      for ctrl, run_ in runs.items() if ctrl in fleet_why.CTRLS)
+        got = sorted((r["ctrl"], r["faulted"]) for r in fleet_why.runs(os.path.join(ARGS.work, "two")))
+        self.assertEqual(got, want)
+        self.assertTrue(all(r["d_m"] > 0.0 and math.isfinite(r["d_m"]) for r in fleet_why.runs(os.path.join(ARGS.work, "two"))))
 
     def test_independent_of_workers_and_n(self):
         self.assertEqual(self.two["axes"][0], self.one["axes"][0])
