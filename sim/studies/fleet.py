@@ -36,14 +36,18 @@ CONTROLLERS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")
 FULL_N = 200  # the study's size (make fleet's default N)
 
 
+# the causes of loss that are not faults (the run went to the end)
+NOT_FAULTS = ("persistent_outliers", "worse_than_hinf_only")
+
+
 def why_lost(run_, hinf):
     """a run's cause of loss, or None: a fault, persistent outliers, worse than H-inf only (hinf: its RMS)"""
     if run_["faulted"]:
         return run_["fault_cause"]
     if run_.get("persistent_outliers"):
-        return "persistent_outliers"
+        return NOT_FAULTS[0]
     if hinf is not None and run_["rms_m"] > hinf:
-        return "worse_than_hinf_only"
+        return NOT_FAULTS[1]
     return None
 
 
@@ -233,6 +237,9 @@ def main():
     ap.add_argument("--md", help="docs page: its part after <!-- fleet:begin --> is rewritten")
     ap.add_argument("--command", default="make fleet")
     ap.add_argument("--keep-builds", action="store_true", help="keep each axis's two host builds")
+    ap.add_argument("--expect-faults", action="store_true",
+                    help="with --md: the page may tabulate faulted runs (listed with time and cause); "
+                         "without it a faulted run makes the study exit 1 after writing the page")
     ap.add_argument("--md-out-name", help="with --md-only: the out folder as the page names it (default --out)")
     ap.add_argument("--md-only", action="store_true",
                     help="run nothing: write --md from OUT/summary.json (a study run before)")
@@ -242,11 +249,12 @@ def main():
             ap.error("--md-only needs --md")
         try:
             with open(os.path.join(a.out, "summary.json"), encoding="utf-8") as f:
-                write_md(a.md, json.load(f), a.command, a.out, a.md_out_name)
+                summ_md = json.load(f)
+            write_md(a.md, summ_md, a.command, a.out, a.md_out_name)
         except (OSError, ValueError, KeyError) as e:
             sys.exit("fleet.py: %s/summary.json: %s" % (a.out, e))
         print("wrote %s from %s/summary.json" % (a.md, a.out))
-        return 0
+        return unexpected_faults(summ_md, a)
     kinds = [k for k in a.kinds.split(",") if k]
     if not (1 <= a.n <= 100000) or a.workers < 1 or not kinds or set(kinds) - set(KINDS):
         ap.error("--n in 1..100000, --workers >= 1, --kinds from %s" % ",".join(KINDS))
@@ -285,7 +293,20 @@ def main():
     print("wrote %s/summary.json, timing.json, cdf.png%s" % (a.out, ", " + a.md if a.md else ""))
     for r in errors:
         print("fleet: internal error on axis %d:\n%s" % (r["i"], r["error"]), file=sys.stderr)
-    return 1 if errors else 0
+    if errors:
+        return 1
+    return unexpected_faults(summ, a)
+
+
+def unexpected_faults(summ, a):
+    """1 when the page just written lists faulted runs nobody said to expect (docs/tools.md:
+    a docs-writing target fails on a fault it did not expect), else 0"""
+    n = sum(1 for v in summ["controllers"].values() for x in v["lost"] if x["cause"] not in NOT_FAULTS)
+    if n and a.md and not a.expect_faults:
+        print("fleet: %d runs faulted (listed in %s with time and cause); --expect-faults accepts them"
+              % (n, a.md), file=sys.stderr)
+        return 1
+    return 0
 
 
 if __name__ == "__main__":

@@ -101,6 +101,17 @@ class Fleet(unittest.TestCase):
     def test_independent_of_workers_and_n(self):
         self.assertEqual(self.two["axes"][0], self.one["axes"][0])
 
+    def test_page_with_faults_fails_unless_expected(self):
+        """--md with a faulted run: exit 1 unless --expect-faults; a run only worse than H-inf only is no fault"""
+        import types
+        fault = {"controllers": {"hinf_pf": {"lost": [{"cause": "lost_lock", "t_s": 0.1}]}}}
+        worse = {"controllers": {"hinf_pf": {"lost": [{"cause": "worse_than_hinf_only", "t_s": None}]}}}
+        page = types.SimpleNamespace(md="page.md", expect_faults=False)
+        self.assertEqual(fleet.unexpected_faults(fault, page), 1)
+        self.assertEqual(fleet.unexpected_faults(worse, page), 0)
+        self.assertEqual(fleet.unexpected_faults(fault, types.SimpleNamespace(md="page.md", expect_faults=True)), 0)
+        self.assertEqual(fleet.unexpected_faults(fault, types.SimpleNamespace(md=None, expect_faults=False)), 0)
+
     def test_statistics(self):
         """a faulted run: out of the figures, lost with its cause; worse than H-inf only: lost"""
         def rec(i, pf):
