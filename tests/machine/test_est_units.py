@@ -76,8 +76,8 @@ def main():
     # invariance: the same file on other machines
     fine = copy.deepcopy(good)
     fine["encoder"]["counts_per_rev"] = 8 * cpr
-    Pf, Uf = machine.est_per_step(loaded(fine, work, "enc8.json"), "pf"), None
-    Uf = machine.est_per_step(loaded(fine, work, "enc8.json"), "ukf")
+    m8 = loaded(fine, work, "enc8.json")
+    Pf, Uf = machine.est_per_step(m8, "pf"), machine.est_per_step(m8, "ukf")
     check(close(Pf["q_theta_counts2"], 64.0 * P["q_theta_counts2"]), "8x the counts: 64x theta's noise in counts^2")
     check(close(Pf["r_counts2"] - 1.0 / 12.0, 64.0 * (P["r_counts2"] - 1.0 / 12.0)),
           "8x the counts: R beyond the quantisation 64x in counts^2")
