@@ -105,7 +105,10 @@ def est_fields(m):
     out.append(("BR_EST_PF_NOISE_SKIP", pf["noise_skip"], "extra noise-table advance per step"))
     out += [("BR_EST_PF_ADAPT_NIS_REF", pf["adapt"]["nis_ref"], "innovation-driven noise of omega, z and g_p (0: off)"),
             ("BR_EST_PF_ADAPT_ALPHA", P["adapt_alpha"], "its NIS smoothing per step (period / tau_s)"),
-            ("BR_EST_PF_ADAPT_MAX_SCALE", pf["adapt"]["max_scale"], "its largest variance factor")]
+            ("BR_EST_PF_ADAPT_MAX_SCALE", pf["adapt"]["max_scale"], "its largest variance factor"),
+            ("BR_EST_PF_GP_CURVE_ON", 1 if pf.get("gp_curve") else 0,
+             "g_p along the Stribeck curve (0: off, g_p a random walk)"),
+            ("BR_EST_PF_GP_CURVE_RHO", machine.pf_gp_curve_rho(m), "its offset's factor per step, exp(-period / tau_s)")]
     for k, c in (("q_theta_rad2", "Q_THETA_RAD2"), ("q_omega_rad2ps2", "Q_OMEGA_RAD2PS2"),
                  ("q_z_m2", "Q_Z_M2"), ("q_gp_N2", "Q_GP_N2")):
         out.append(("BR_EST_UKF_" + c, U[k], "process noise variance per step"))

@@ -264,6 +264,12 @@ SCHEMA = {
                              "alpha = period_s / tau_s)", lo_open=True),
                 "max_scale": Num(1.0, 1.0e12, "largest factor on the variances of omega, z and g_p"),
             },
+            # g_p along the model's Stribeck curve (docs/modules/pf.md, "Fast moves"); absent = off,
+            # g_p a random walk (the thesis)
+            "gp_curve": Optional({
+                "tau_s": Num(0.0, 100.0, "time constant of g_p's offset from the Stribeck curve g(v): "
+                             "per step the offset is multiplied by exp(-period_s / tau_s)", lo_open=True),
+            }),
         }, **_gates()),
         "ukf": dict({
             "process_noise": _process_noise(),
@@ -539,6 +545,13 @@ def est_per_step(m, est):
             "p0_gp_N2": p0["gp_Fs2"] * Fs * Fs,
         })
     return out
+
+
+def pf_gp_curve_rho(m):
+    """The PF's g_p-along-the-curve factor per step, rho = exp(-T / tau_s)
+    (docs/modules/pf.md, "Fast moves"); 0 when estimator.pf.gp_curve is absent (off)."""
+    e = m["estimator"]["pf"]
+    return math.exp(-e["period_s"] / e["gp_curve"]["tau_s"]) if e.get("gp_curve") else 0.0
 
 
 def est_physical(m, est, per_step):

@@ -97,6 +97,10 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     if (cfg->proposal > BR_PF_PROPOSAL_OPT_HELD) {
         return BR_E_PARAM;
     }
+    /* g_p along the curve: off, or on with rho in [0, 1] */
+    if (cfg->gp_curve.on > 1u || (cfg->gp_curve.on && !(cfg->gp_curve.rho >= 0.0f && cfg->gp_curve.rho <= 1.0f))) {
+        return BR_E_PARAM;
+    }
     /* g_p is static in the model: its process noise is the only thing that keeps
      * the resampled particles apart in g_p; without it the cloud collapses */
     if (!(cfg->est.q_var[BR_X_GP] > 0.0f)) {
@@ -264,6 +268,21 @@ static inline float clamp_sel(float v, float lo, float hi)
     return (a < hi) ? a : hi;
 }
 
+/* cfg.gp_curve: the model's Stribeck level at motor speed w, g(L w) = Fc +
+ * (Fs - Fc) e^(-|L w| / vs) (eq. 5) */
+static float gp_curve_N(const br_pf_t *pf, float w)
+{
+    const br_lugre_cfg_t *lg = &pf->model.cfg.lugre;
+    return lg->Fc_N + (lg->Fs_N - lg->Fc_N) * br_exp_neg(-fabsf(pf->model.cfg.lead_mprad * w) / lg->vs_mps);
+}
+
+/* cfg.gp_curve: g_p moved from speed w0 to w1, its offset from the curve
+ * times k (rho over a step, 1 for a re-anchoring's shift) */
+static float gp_along_curve(const br_pf_t *pf, float gp, float w0, float w1, float k)
+{
+    return gp_curve_N(pf, w1) + k * (gp - gp_curve_N(pf, w0));
+}
+
 /* A valid particle's log-weight l and innovation e = theta_j - y added to
  * the pass's sums (br_pf_lsum_t: the largest l, the count of valid particles,
  * cfg.adapt's sums of d_j = e and d_j^2 in particle order) */
@@ -333,7 +352,9 @@ static void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j
         th_a = th;
     }
     const float z = xn[BR_X_Z] + c->k.q[2] * n[2];
-    const float gp = clamp_sel(xn[BR_X_GP] + c->k.q[3] * n[3], c->k.gp_min, c->k.gp_max);
+    /* g_p's random walk (g_p' = 0), or with cfg.gp_curve on its offset from the Stribeck curve */
+    const float gp0 = pf->cfg.gp_curve.on ? gp_along_curve(pf, xn[BR_X_GP], x[BR_X_OMEGA], om, pf->cfg.gp_curve.rho) : xn[BR_X_GP];
+    const float gp = clamp_sel(gp0 + c->k.q[3] * n[3], c->k.gp_min, c->k.gp_max);
     /* the particle's one division, k_p = sigma0 L / g_p for eq. 4 here and in the next step */
     const float kg = c->k.s0L / gp;
     /* the force to compensate of the predicted particle: eq. 6's f_nl, or
@@ -436,9 +457,11 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
     br_pf_lsum_t ls = {-INFINITY, 0u, 0.0f, 0.0f};
     float n[BR_NX];
-    if (pf->model.extended || pf->cfg.scalar_path || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR) {
+    if (pf->model.extended || pf->cfg.scalar_path || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR ||
+        pf->cfg.gp_curve.on) {
         /* one particle at a time (the extended model always: its kernel branches;
-         * cfg.proposal always: the kernels draw from the prior) */
+         * cfg.proposal always: the kernels draw from the prior; cfg.gp_curve:
+         * the kernels' g_p is the thesis's random walk) */
         for (uint32_t j = 0; j < m; j++) {
             noise_wrapped(pf, j, n);
             if (pf->model.extended) {
@@ -602,6 +625,13 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
             pf->x[BR_X_THETA][j] += d_th;
+            if (pf->cfg.gp_curve.on) {
+                /* g_p moves along the curve with the velocity (its offset kept) */
+                const float w0 = pf->x[BR_X_OMEGA][j];
+                pf->x[BR_X_GP][j] = br_clampf(gp_along_curve(pf, pf->x[BR_X_GP][j], w0, w0 + d_om, 1.0f),
+                                              pf->cfg.est.gp_min_N, pf->cfg.est.gp_max_N);
+                pf->kgp[j] = br_model_kp_of(&pf->model, pf->x[BR_X_GP][j]);
+            }
             pf->x[BR_X_OMEGA][j] += d_om;
             /* f_nl depends on omega: the estimate is that of the moved cloud */
             float xj[BR_NX];

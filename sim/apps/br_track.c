@@ -29,7 +29,9 @@
  * Usage: br_track --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]
  *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,
  *                        hinf_pf_ext_ff,hinf_true_ff,hinf_ukf] [--json OUT] [--trace DIR]
- * Prints one line per controller: tracking RMS and maximum error. */
+ * Prints one line per controller: tracking RMS and maximum error. --trace
+ * writes each run's trace, and for hinf_pf and hinf_pf_ext one row per PF
+ * step (pf_trace_row). */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
@@ -165,6 +167,7 @@ typedef struct {
     double sum2, emax;
     long n;
     FILE *trace;
+    FILE *pf_trace; /* --pf-trace: the PF's steps (hinf_pf only) */
 } err_t;
 
 static void err_add(err_t *e, double t, double ref, double pos, double force_N)
@@ -205,6 +208,48 @@ static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, f
     (void)u_prev_Nm;
     *F_hat_N = (float)br_plant_comp_force_N((const br_plant_t *)ctx);
     return BR_OK;
+}
+
+/* --pf-trace: one row per PF step of the hinf_pf runs (docs/modules/pf.md,
+ * "Fast moves"): the plant's truth beside the filter's cloud after the step,
+ * the best particle's miss and the gate. Positions in counts relative to the
+ * filter's origin, speeds in m/s, forces in N. */
+static void pf_trace_row(FILE *f, double t, const br_plant_t *p, const br_pf_t *pf)
+{
+    const uint32_t m = pf->cfg.n_particles;
+    const double rpc = (double)pf->cfg.est.rad_per_count, L = (double)pf->cfg.est.model.lead_mprad;
+    double s[BR_NX] = {0}, s2[BR_NX] = {0};
+    for (uint32_t j = 0; j < m; j++) {
+        for (int i = 0; i < BR_NX; i++) {
+            const double v = (double)pf->x[i][j];
+            s[i] += v;
+            s2[i] += v * v;
+        }
+    }
+    double mean[BR_NX], sd[BR_NX];
+    for (int i = 0; i < BR_NX; i++) {
+        mean[i] = s[i] / m;
+        sd[i] = sqrt(fmax(s2[i] / m - mean[i] * mean[i], 0.0));
+    }
+    /* the best predicted particle (largest log-weight) and a resampled copy of it: its signed miss */
+    uint32_t jb = 0;
+    for (uint32_t j = 1; j < m; j++)
+        if (pf->l[j] > pf->l[jb]) jb = j;
+    double miss = NAN;
+    for (uint32_t i = 0; i < m; i++)
+        if (pf->idx[i] == jb) {
+            miss = ((double)pf->x[BR_X_THETA][i] - (double)pf->prev_frac * rpc) / rpc;
+            break;
+        }
+    const double inv2r = (double)pf->inv_2r;
+    const double th_true = p->x.theta_rad - (double)pf->origin_counts * rpc;
+    /* the plant's Stribeck level g(v) (eq. 5) */
+    const double g_true = p->cfg.Fc_N + (p->cfg.Fs_N - p->cfg.Fc_N) * exp(-fabs(br_plant_vel_mps(p)) / p->cfg.vs_mps);
+    fprintf(f, "%.6f,%.6e,%.6e,%.6e,%.6e,%.4f,%.4f,%.4f,%.6e,%.6e,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u\n", t,
+            br_plant_vel_mps(p), p->fnl_N, (double)pf->est.F_hat_N, L * mean[BR_X_OMEGA], (th_true - mean[0]) / rpc,
+            sd[0] / rpc, miss, L * sd[BR_X_OMEGA], mean[BR_X_Z], mean[BR_X_GP], sd[BR_X_GP],
+            sqrt(-(double)pf->lmax / inv2r) / rpc, sqrt(-(double)pf->outlier_l / inv2r) / rpc, (double)pf->nis_avg,
+            (double)pf->q_scale_std, g_true, (unsigned)pf->n_outliers);
 }
 
 /* the firmware (br_app_step) with the build's machine configuration */
@@ -293,7 +338,10 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
             br_ff_set_ref(&w.ff, &in);
         }
         const double pos = br_plant_pos_m(&p);
+        const uint32_t pos0 = mem.pf ? mem.pf->noise_pos : 0u;
         st = br_app_step(&app, &r);
+        /* a PF step moved the noise table on */
+        if (e->pf_trace && mem.pf && mem.pf->noise_pos != pos0 && mem.pf->primed) pf_trace_row(e->pf_trace, t, &p, mem.pf);
         if (st != BR_OK && st != BR_W_OUTLIER) {
             rep->fault_status = (int)st;
             rep->fault_cause = (int)app.fault;
@@ -323,7 +371,8 @@ static int usage(const char *argv0, FILE *to)
             "  --pd KP,KV,GAIN,UMAX the log's position loop (all > 0): adds the pd run\n"
             "  --ctrl LIST         the controllers to run, comma-separated\n"
             "  --json OUT          the runs' figures as JSON\n"
-            "  --trace DIR         each run's trace as CSV into DIR\n",
+            "  --trace DIR         each run's trace as CSV into DIR (track_NAME.csv), and for\n"
+            "                      the PF runs its steps (pf_NAME.csv: truth, cloud, miss, gate)\n",
             argv0, argv0);
     return 2;
 }
@@ -392,7 +441,7 @@ int main(int argc, char **argv)
         while (hit && ((hit != ctrls && hit[-1] != ',') || (hit[len] != ',' && hit[len] != '\0')))
             hit = strstr(hit + 1, names[w]);
         if (!hit) continue;
-        err_t e = {0.0, 0.0, 0, NULL};
+        err_t e = {0.0, 0.0, 0, NULL, NULL};
         if (trace) {
             char path[1024];
             snprintf(path, sizeof path, "%s/track_%s.csv", trace, names[w]);
@@ -402,6 +451,17 @@ int main(int argc, char **argv)
                 break;
             }
             fprintf(e.trace, "t,ref,pos,err,force\n");
+            if (w == 2 || w == 3) {
+                snprintf(path, sizeof path, "%s/pf_%s.csv", trace, names[w]);
+                if ((e.pf_trace = fopen(path, "w")) == NULL) {
+                    fprintf(stderr, "br_track: cannot write %s: %s\n", path, strerror(errno));
+                    rc = 1;
+                    break;
+                }
+                fprintf(e.pf_trace, "t,v_mps,fnl_true_N,F_hat_N,v_mean_mps,th_err_counts,th_sd_counts,best_miss_counts,"
+                                    "v_sd_mps,z_mean_m,gp_mean_N,gp_sd_N,miss_min_counts,gate_counts,nis_avg,"
+                                    "q_scale_std,g_true_N,n_outliers\n");
+            }
         }
         br_run_report_t rep = {0.0, 0.0, 0, 0, 0.0};
         if (w == 0) {
@@ -416,6 +476,7 @@ int main(int argc, char **argv)
             if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &rep) != 0) rc = 1;
         }
         if (e.trace && fclose(e.trace) != 0) rc = 1;
+        if (e.pf_trace && fclose(e.pf_trace) != 0) rc = 1;
         if (rc != 0) break;
         rep.rms_m = e.n > 0 ? sqrt(e.sum2 / (double)e.n) : 0.0;
         rep.max_m = e.emax;

@@ -26,19 +26,10 @@ import sys
 
 import numpy as np
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DESIGN = os.path.join(REPO, "firmware", "design")
-sys.path.insert(0, DESIGN)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import DESIGN, check, result  # noqa: E402
 import machine  # noqa: E402
 import upgrade_machine  # noqa: E402
-
-FAILURES = []
-
-
-def check(cond, what):
-    print("%s: %s" % ("ok  " if cond else "FAIL", what))
-    if not cond:
-        FAILURES.append(what)
 
 
 def close(a, b, rel=1e-12):
@@ -85,8 +76,8 @@ def main():
     # invariance: the same file on other machines
     fine = copy.deepcopy(good)
     fine["encoder"]["counts_per_rev"] = 8 * cpr
-    Pf, Uf = machine.est_per_step(loaded(fine, work, "enc8.json"), "pf"), None
-    Uf = machine.est_per_step(loaded(fine, work, "enc8.json"), "ukf")
+    m8 = loaded(fine, work, "enc8.json")
+    Pf, Uf = machine.est_per_step(m8, "pf"), machine.est_per_step(m8, "ukf")
     check(close(Pf["q_theta_counts2"], 64.0 * P["q_theta_counts2"]), "8x the counts: 64x theta's noise in counts^2")
     check(close(Pf["r_counts2"] - 1.0 / 12.0, 64.0 * (P["r_counts2"] - 1.0 / 12.0)),
           "8x the counts: R beyond the quantisation 64x in counts^2")
@@ -168,8 +159,7 @@ def main():
           and "Traceback" not in r.stderr and not os.path.exists(new_path),
           "upgrade_machine.py: a broken file is named, nothing written (%r)" % r.stderr.strip())
 
-    print("%d failure(s)" % len(FAILURES))
-    return 1 if FAILURES else 0
+    return result()
 
 
 if __name__ == "__main__":

@@ -34,18 +34,9 @@ import shutil
 import subprocess
 import sys
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DESIGN = os.path.join(REPO, "firmware", "design")
-sys.path.insert(0, DESIGN)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import DESIGN, REPO, check, result  # noqa: E402
 import machine  # noqa: E402
-
-FAILURES = []
-
-
-def check(cond, what):
-    print("%s: %s" % ("ok  " if cond else "FAIL", what))
-    if not cond:
-        FAILURES.append(what)
 
 
 def hostile(markers, tag):
@@ -280,8 +271,7 @@ def main():
     check_atomic(work)
     if not a.no_make:
         check_make(markers)
-    print("%d failure(s)" % len(FAILURES))
-    return 1 if FAILURES else 0
+    return result()
 
 
 if __name__ == "__main__":

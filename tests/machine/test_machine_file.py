@@ -17,18 +17,9 @@ import re
 import subprocess
 import sys
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DESIGN = os.path.join(REPO, "firmware", "design")
-sys.path.insert(0, DESIGN)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import DESIGN, REPO, check, result  # noqa: E402
 import machine  # noqa: E402
-
-FAILURES = []
-
-
-def check(cond, what):
-    print("%s: %s" % ("ok  " if cond else "FAIL", what))
-    if not cond:
-        FAILURES.append(what)
 
 
 def write(work, name, obj):
@@ -191,8 +182,7 @@ def main():
           and "Traceback" not in err, "unstable.json: synth_hinf.py refuses it (%r)" % err.strip())
     check(not os.path.exists(os.path.join(work, "unstable.h")), "unstable.json: no header written")
 
-    print("%d failure(s)" % len(FAILURES))
-    return 1 if FAILURES else 0
+    return result()
 
 
 if __name__ == "__main__":

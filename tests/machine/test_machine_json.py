@@ -21,17 +21,9 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(REPO, "firmware", "design"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import REPO, check, result  # noqa: E402
 import machine  # noqa: E402
-
-FAILURES = []
-
-
-def check(cond, what):
-    print("%s: %s" % ("ok  " if cond else "FAIL", what))
-    if not cond:
-        FAILURES.append(what)
 
 
 def diagnose(log, out, *extra):
@@ -110,8 +102,7 @@ def main():
     check(r.returncode == 1 and "field provenance.friction.Fc_N: 'measured' is not one of" in r.stderr
           and "Traceback" not in r.stderr and not os.path.exists(out),
           "a broken machine file: exit 1, the loader's message, nothing written")
-    print("%d failure(s)" % len(FAILURES))
-    return 1 if FAILURES else 0
+    return result()
 
 
 if __name__ == "__main__":

@@ -16,19 +16,10 @@ import sys
 
 import numpy as np
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DESIGN = os.path.join(REPO, "firmware", "design")
-sys.path.insert(0, DESIGN)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import DESIGN, FAILURES, REPO, check, result  # noqa: E402
 import machine  # noqa: E402
 import tuned_machine  # noqa: E402
-
-FAILURES = []
-
-
-def check(cond, what):
-    print("%s: %s" % ("ok  " if cond else "FAIL", what))
-    if not cond:
-        FAILURES.append(what)
 
 
 def source_state():
@@ -50,9 +41,9 @@ def main():
     check(source_state() == before, "the source tree is unchanged")
     folder = subprocess.run([sys.executable, os.path.join(DESIGN, "build_dir.py"), "host-release", a.machine],
                             capture_output=True, text=True, check=True).stdout.strip()
-    tune = os.path.join(folder, "tune")
+    tune = os.path.join(REPO, folder, "tune")  # build_dir.py names it relative to the repository
     out = os.path.join(tune, "machine.json")
-    check(os.path.isfile(out) and "make firmware MACHINE=%s" % out in p.stdout,
+    check(os.path.isfile(out) and "make firmware MACHINE=%s" % os.path.join(folder, "tune", "machine.json") in p.stdout,
           "tune/machine.json written in the build folder and the next command printed")
     if FAILURES:
         return 1
@@ -69,8 +60,7 @@ def main():
         check(all(machine.provenance(m, f) == "derived" for f in fields), "%s: the tuned settings are derived" % est)
     strip = lambda d: {k: v for k, v in d.items() if k not in ("estimator", "provenance", "source", "file")}
     check(strip(m) == strip(given), "every value outside the estimator section is the given file's")
-    print("%d failure(s)" % len(FAILURES))
-    return 1 if FAILURES else 0
+    return result()
 
 
 if __name__ == "__main__":

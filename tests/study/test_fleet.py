@@ -26,6 +26,7 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(REPO, "sim", "studies"))
 import fleet  # noqa: E402
 import fleet_axis  # noqa: E402
+import fleet_why  # noqa: E402
 
 ARGS = None
 SEED = 7
@@ -89,8 +90,27 @@ class Fleet(unittest.TestCase):
                     else:
                         self.assertTrue(math.isfinite(run_["rms_m"]))
 
+    def test_why_reads_every_estimator_run(self):
+        """fleet_why.py (docs/fleet.md, "Why runs are lost") sees each estimator run of the summary, with its fault"""
+        want = sorted((ctrl, run_["faulted"]) for r in self.two["axes"] for runs in r.get("runs", {}).values()
+                      for ctrl, run_ in runs.items() if ctrl in fleet_why.CTRLS)
+        got = sorted((r["ctrl"], r["faulted"]) for r in fleet_why.runs(os.path.join(ARGS.work, "two")))
+        self.assertEqual(got, want)
+        self.assertTrue(all(r["d_m"] > 0.0 and math.isfinite(r["d_m"]) for r in fleet_why.runs(os.path.join(ARGS.work, "two"))))
+
     def test_independent_of_workers_and_n(self):
         self.assertEqual(self.two["axes"][0], self.one["axes"][0])
+
+    def test_page_with_faults_fails_unless_expected(self):
+        """--md with a faulted run: exit 1 unless --expect-faults; a run only worse than H-inf only is no fault"""
+        import types
+        fault = {"controllers": {"hinf_pf": {"lost": [{"cause": "lost_lock", "t_s": 0.1}]}}}
+        worse = {"controllers": {"hinf_pf": {"lost": [{"cause": "worse_than_hinf_only", "t_s": None}]}}}
+        page = types.SimpleNamespace(md="page.md", expect_faults=False)
+        self.assertEqual(fleet.unexpected_faults(fault, page), 1)
+        self.assertEqual(fleet.unexpected_faults(worse, page), 0)
+        self.assertEqual(fleet.unexpected_faults(fault, types.SimpleNamespace(md="page.md", expect_faults=True)), 0)
+        self.assertEqual(fleet.unexpected_faults(fault, types.SimpleNamespace(md=None, expect_faults=False)), 0)
 
     def test_statistics(self):
         """a faulted run: out of the figures, lost with its cause; worse than H-inf only: lost"""

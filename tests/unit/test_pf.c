@@ -120,6 +120,13 @@ static void test_init_guards(void **st)
     c = cfg_adapt(); c.adapt.max_scale = 0.5f;           assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg_adapt(); c.adapt.max_scale = 2.0f * BR_EST_VAR_MAX; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     c = cfg_adapt(); c.adapt.max_scale = NAN;            assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    /* cfg.gp_curve: off or on, rho in [0, 1] when on */
+    c = cfg(100); c.gp_curve = (br_pf_gp_curve_t){2u, 0.5f};  assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.gp_curve = (br_pf_gp_curve_t){1u, -0.1f}; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.gp_curve = (br_pf_gp_curve_t){1u, 1.01f}; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.gp_curve = (br_pf_gp_curve_t){1u, NAN};   assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    c = cfg(100); c.gp_curve = (br_pf_gp_curve_t){1u, 0.0f};  assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c = cfg(100); c.gp_curve = (br_pf_gp_curve_t){1u, 1.0f};  assert_int_equal(br_pf_init(pf, &c), BR_OK);
     /* cfg.proposal: one of BR_PF_PROPOSAL_*; its constants finite (a period
      * so long that (h/2)^2 Q_omega overflows is refused with OPT_HELD only) */
     c = cfg(100); c.proposal = BR_PF_PROPOSAL_OPT_HELD + 1u; assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
@@ -1016,6 +1023,38 @@ static void test_adapt_keeps_lock_under_force_noise(void **st)
 
 #endif /* BR_TEST_THESIS_MACHINE */
 
+/* cfg.gp_curve (docs/modules/pf.md, "Fast moves"): a cloud at rest pushed
+ * well beyond the Stribeck velocity by predictions alone. With g_p along the
+ * curve (rho = 1: the offset kept) the mean g_p falls by Fs - Fc with the
+ * curve; as the thesis's random walk it stays at its start, Fs. */
+static void test_gp_curve_follows_breakaway(void **st)
+{
+    (void)st;
+    for (uint32_t on = 0u; on <= 1u; on++) {
+        br_pf_t *pf = calloc(1, sizeof *pf);
+        assert_non_null(pf);
+        br_pf_cfg_t c = cfg(200);
+        c.gp_curve = (br_pf_gp_curve_t){on, 1.0f};
+        assert_int_equal(br_pf_init(pf, &c), BR_OK);
+        const br_lugre_cfg_t *lg = &c.est.model.lugre;
+        const br_meas_t y = {0, 0.5f};
+        assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
+        const float gp_start = stats(pf).mean[BR_X_GP];
+        /* a force of 5 Fs on the table: above 100 vs within the first steps */
+        const float u = 5.0f * lg->Fs_N * c.est.model.lead_mprad;
+        for (int k = 0; k < 20; k++) assert_int_equal(br_pf_predict(pf, u), BR_OK);
+        const br_pf_stats_t s = stats(pf);
+        assert_true(c.est.model.lead_mprad * s.mean[BR_X_OMEGA] > 100.0f * lg->vs_mps);
+        const float drop = gp_start - s.mean[BR_X_GP], step = lg->Fs_N - lg->Fc_N;
+        if (on) {
+            assert_true(fabsf(drop - step) < 0.1f * step);
+        } else {
+            assert_true(fabsf(drop) < 0.1f * step);
+        }
+        free(pf);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1027,6 +1066,7 @@ int main(void)
         cmocka_unit_test(test_predict_is_model_step),
         cmocka_unit_test(test_vector_path_is_scalar_path),
         cmocka_unit_test(test_gp_stays_in_range),
+        cmocka_unit_test(test_gp_curve_follows_breakaway),
         cmocka_unit_test(test_one_invalid_particle),
         cmocka_unit_test(test_theta_nan_particle),
         cmocka_unit_test(test_fnl_overflow_is_invalid),

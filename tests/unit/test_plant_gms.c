@@ -124,14 +124,20 @@ static void test_gms_presliding_m(void **st)
 }
 
 /* the demo's hardware-like plant: initial stiffness within 5 % of the
- * machine's sigma0 (presliding.md: comparable), same Stribeck curve */
+ * reference machine's sigma0 (presliding.md: comparable), same Stribeck curve */
 static void test_hardware_like_plant(void **st)
 {
     (void)st;
     const br_plant_cfg_t c = gms_cfg(), ref = br_plant_cfg_reference();
     double k0 = 0.0;
     for (int i = 0; i < c.gms.n; i++) k0 += c.gms.k_Npm[i];
+#ifdef BR_TEST_THESIS_MACHINE
+    /* comparable to LuGre's on the reference machine (docs/demo.md); another machine's
+     * sigma0 is its own, the breakaway displacements the demo's */
     assert_true(fabs(k0 / ref.sigma0_Npm - 1.0) < 0.05);
+#else
+    assert_true(isfinite(k0) && k0 > 0.0);
+#endif
     assert_true(c.Fc_N == ref.Fc_N && c.Fs_N == ref.Fs_N && c.vs_mps == ref.vs_mps && c.gms.delta == 1.0);
     assert_int_equal(c.gms.clamp, 0);
 }

@@ -77,7 +77,8 @@
                    BR_EST_PF_X0_STD_OMEGA_RADPS_F, BR_EST_PF_X0_STD_Z_M_F, BR_EST_PF_X0_STD_GP_N_F}, \
         .noise = br_noise_table, .noise_len = BR_NOISE_LEN, .noise_skip = BR_EST_PF_NOISE_SKIP,    \
         .adapt = {.nis_ref = BR_EST_PF_ADAPT_NIS_REF_F, .alpha = BR_EST_PF_ADAPT_ALPHA_F,            \
-                  .max_scale = BR_EST_PF_ADAPT_MAX_SCALE_F}                                        \
+                  .max_scale = BR_EST_PF_ADAPT_MAX_SCALE_F},                                       \
+        .gp_curve = {.on = BR_EST_PF_GP_CURVE_ON, .rho = BR_EST_PF_GP_CURVE_RHO_F}                 \
     }
 
 /* the machine file's (hand-tuned) variances: the start of the tuning */

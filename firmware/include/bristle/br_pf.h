@@ -52,6 +52,19 @@ typedef struct {
     float max_scale; /* largest variance factor, >= 1 (when on) */
 } br_pf_adapt_t;
 
+/* cfg.gp_curve (docs/modules/pf.md, "Fast moves: g_p along the Stribeck
+ * curve"): off (on = 0) g_p is a random walk, g_p' = 0 (the thesis). On, the
+ * walk is on g_p's offset from the model's curve g(v) = Fc + (Fs - Fc)
+ * e^(-|v| / vs) (eq. 5), which relaxes towards 0 by rho per step:
+ *   g_p <- g(L w1) + rho (g_p - g(L w0)) + sqrt(q_g) n
+ * (w0, w1 the particle's speed before and after the step), and a
+ * re-anchoring moves g_p with the velocity it moves. Runs the per-particle
+ * step for every particle (the kernels are the thesis model's). */
+typedef struct {
+    uint32_t on;     /* 0: off (the thesis filter), 1: on */
+    float rho;       /* the offset's factor per step, [0, 1] (1: no relaxation) */
+} br_pf_gp_curve_t;
+
 /* cfg.proposal (docs/modules/pf.md, "A proposal that uses the measurement"):
  * how step 1 draws theta and omega. PRIOR: the thesis's bootstrap filter
  * (x_j <- f_d(x_j) + sqrt(Q) n_j, weighed by the likelihood). OPT: the
@@ -80,6 +93,7 @@ typedef struct {
                                 the rare cases fixed up in scalar; both give identical results */
     br_pf_adapt_t adapt;     /* innovation-driven process noise of omega, z and g_p (all 0: off) */
     uint32_t proposal;       /* BR_PF_PROPOSAL_*: 0 (default) the thesis's bootstrap filter */
+    br_pf_gp_curve_t gp_curve; /* g_p along the model's Stribeck curve (on = 0: off, g_p' = 0) */
 } br_pf_cfg_t;
 
 /* What each step makes: the force to compensate and theta's origin. */

@@ -26,7 +26,9 @@ marked "assumed"; what follows from the log and the rest is "derived". The
   estimator        the base's, as they are: format 2 states them in the
                    machine's own units (per second, in metres, in Fs, Fc and
                    Fs/sigma0), so they follow the identified friction and
-                   encoder by themselves (docs/machine-file.md)
+                   encoder by themselves (docs/machine-file.md); and when the
+                   log identified the Stribeck curve and the base has no
+                   estimator.pf.gp_curve, the PF's g_p along it ("derived")
 """
 import copy
 import importlib
@@ -44,6 +46,9 @@ from . import closedloop, output, params
 REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", ".."))
 # presliding lengths shorter than this many position quanta are not resolved
 PRESLIDING_MIN_QUANTA = 2.0
+# the PF's g_p offset from an identified Stribeck curve relaxes with this time
+# constant (docs/modules/pf.md, "Fast moves": measured 10 periods of 1.5 ms)
+GP_CURVE_TAU_S = 0.015
 
 
 def _loader():
@@ -198,6 +203,14 @@ def build(prep, diag, given=None, log_path=None):
             _set(m, "friction." + q.name, p[q.name], prov, "identified")
     if fr["Fs_N"] < fr["Fc_N"]:
         fr["Fs_N"] = fr["Fc_N"] * base_fr["Fs_N"] / base_fr["Fc_N"]
+
+    # the PF's g_p along the Stribeck curve (docs/modules/pf.md, "Fast moves"), when the log
+    # identified the curve (Fs_N and vs_mps) and the base does not state it: without it g_p
+    # is a random walk that cannot follow the drop from Fs to Fc as the axis breaks away
+    pf = m["estimator"]["pf"]
+    if "gp_curve" not in pf and not unresolved & {"vs_mps", "Fs_N"}:
+        pf["gp_curve"] = {"tau_s": GP_CURVE_TAU_S}
+        prov["estimator.pf.gp_curve.tau_s"] = "derived"
 
     # the causes, under the names of model.json (one table: the causes' PARAMS)
     m["causes"] = {}

@@ -86,6 +86,11 @@
 /* its largest variance factor */
 #define BR_EST_PF_ADAPT_MAX_SCALE (100.0)
 #define BR_EST_PF_ADAPT_MAX_SCALE_F (1.000000000e+02f)
+/* g_p along the Stribeck curve (0: off, g_p a random walk) */
+#define BR_EST_PF_GP_CURVE_ON 0u
+/* its offset's factor per step, exp(-period / tau_s) */
+#define BR_EST_PF_GP_CURVE_RHO (0.0)
+#define BR_EST_PF_GP_CURVE_RHO_F (0.000000000e+00f)
 /* process noise variance per step */
 #define BR_EST_UKF_Q_THETA_RAD2 (9.999999763885725e-15)
 #define BR_EST_UKF_Q_THETA_RAD2_F (9.999999825e-15f)
