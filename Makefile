@@ -129,6 +129,7 @@ help:
 	@echo "  make emps      the EMPS drive through the chain: its log -> diagnose -> machine.json -> image -> tracking in the simulator -> $(EMPS_OUT), docs/machines/emps.md"
 	@echo "  make robustness [N=200] [DIAGNOSE_FIRST=K]  Monte Carlo over N plants around the reference machine -> $(ROBUST_OUT), docs/robustness-results.md"
 	@echo "  make fleet [N=200] [SEED=s]  N axes across the machine files a user may bring, each through the chain, every controller -> $(FLEET_OUT), docs/fleet.md"
+	@echo "  make faults                 the fault campaign on the simulator (production guards) -> docs/reliability-faults.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune [MACHINE=<json>] [MAX_FEV=n]  Nelder-Mead tuning of the PF and UKF noise (the reference: regenerates firmware/gen/bristle_gen/est/; another machine: its build folder's tune/, with tune/machine.json; docs/tuning.md)"
@@ -372,6 +373,17 @@ robustness: deps
 	$(Q)MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 $(PYTHON) sim/studies/robustness.py --bin build/host-release/sim --out $(ROBUST_OUT) \
 	  --n $(N) $(if $(DIAGNOSE_FIRST),--diagnose-first $(DIAGNOSE_FIRST)) --md docs/robustness-results.md \
 	  --command "make robustness N=$(N)$(if $(DIAGNOSE_FIRST), DIAGNOSE_FIRST=$(DIAGNOSE_FIRST))"
+
+# The fault campaign (docs/reliability.md, "Fault campaign"): every injected
+# fault and ordinary condition, each controller, on the reference machine's
+# plants -> docs/reliability-faults.md; exits 1 on a bound broken that
+# sim/studies/faults.sh does not list.
+.PHONY: faults
+faults: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== fault campaign -> docs/reliability-faults.md"
+	$(Q)bash sim/studies/faults.sh build/host-release/sim/br_faults docs/reliability-faults.md
 
 # The fleet study (docs/fleet.md): N axes drawn across the machine files a user
 # may bring, each through the user's chain, every controller on its trajectory

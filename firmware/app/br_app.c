@@ -105,6 +105,14 @@ static br_status_t latch(br_app_t *app, br_app_fault_t cause)
     return BR_E_FAULT;
 }
 
+/* A fault where the position is not trusted but the last speed is: the
+ * open-loop brake against speed v (counts per period), then outputs off. */
+static br_status_t latch_open(br_app_t *app, br_app_fault_t cause, float v)
+{
+    app->fault = cause;
+    return br_app_brake_open_start(app, v);
+}
+
 /* A fault where the position is trusted: the braking ramp from the count of
  * this period, then outputs off. */
 static br_status_t latch_brake(br_app_t *app, br_app_fault_t cause, int32_t counts)
@@ -251,6 +259,9 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
     }
     const br_hal_t *hal = app->hal;
     const int braking = (app->fault != BR_APP_FAULT_NONE && app->stop == BR_APP_STOP_BRAKING);
+    if (app->fault != BR_APP_FAULT_NONE && app->stop == BR_APP_STOP_OPEN) {
+        return br_app_brake_open_period(app); /* no encoder read: it is not trusted */
+    }
     if (app->fault != BR_APP_FAULT_NONE && !braking) {
         br_app_outputs_off(app);
         return BR_E_FAULT;
@@ -260,12 +271,12 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
     br_status_t est_st = BR_OK;
     if (st != BR_OK) {
         if (braking) {
-            br_app_outputs_off(app); /* the ramp needs the position: off */
-            return BR_E_FAULT;
+            /* the ramp needs the position: on open loop from the ramp's speed */
+            return br_app_brake_open_start(app, app->brk_v);
         }
         /* no position this period: hold the last one for enc_stale_periods */
         if (++app->n_stale > app->guard.enc_stale_periods) {
-            return latch(app, BR_APP_FAULT_ENC_STALE);
+            return latch_open(app, BR_APP_FAULT_ENC_STALE, app->v_meas);
         }
         if (!app->have_counts) {
             /* nothing to hold yet: duty 0 this period, outputs stay enabled
@@ -274,7 +285,11 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
             app->last = (br_ctrl_out_t){0};
             return BR_OK;
         }
-        counts = app->last_counts;
+        /* the position the controller sees: the last good read moved on at
+         * the speed measured then over the periods held (held at the count
+         * itself the controller would see the axis stop and push it off) */
+        const float ahead = br_clampf(app->v_meas * (float)app->n_stale, -1.0e9f, 1.0e9f);
+        counts = (int32_t)((uint32_t)app->last_counts + (uint32_t)(int32_t)lrintf(ahead));
         if (app->est.step != NULL) {
             /* the estimator predicts over the period (or holds its estimate) */
             est_st = br_est_period(&app->est, NULL, app->last.tau_Nm, &app->F_hat_N);
@@ -290,7 +305,10 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
             /* the largest delta of one period, times the periods the delta spans (after
              * held reads the axis moved for all of them; <= 2^30 (1000 + 1), no overflow) */
             if ((uint64_t)mag > (uint64_t)app->guard.enc_max_delta_counts * periods) {
-                return latch(app, BR_APP_FAULT_ENC_JUMP);
+                if (braking) {
+                    return br_app_brake_open_start(app, app->brk_v);
+                }
+                return latch_open(app, BR_APP_FAULT_ENC_JUMP, app->v_meas);
             }
             app->last_counts = counts;
             if (braking) {
@@ -302,7 +320,7 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
                 return latch_brake(app, f, counts);
             }
             if (f != BR_APP_FAULT_NONE) {
-                return latch(app, f);
+                return latch_open(app, f, app->v_pred); /* ENC_FROZEN: the model's speed */
             }
         }
         app->last_counts = counts;
@@ -326,7 +344,7 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
     /* the reference within the machine's speed, acceleration and soft travel */
     br_ref_t r;
     if (br_app_ref_limit(app, ref, counts, &r) != BR_OK) {
-        return latch(app, BR_APP_FAULT_CTRL_INPUT);
+        return latch_brake(app, BR_APP_FAULT_CTRL_INPUT, counts); /* the position is trusted */
     }
     const br_app_fault_t lf = br_app_limits_check(app, &r, counts);
     if (lf != BR_APP_FAULT_NONE) {
@@ -335,7 +353,9 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
     br_ctrl_in_t in = {counts, r.ref_counts, r.ref_frac_counts, r.ref_omega_radps, app->F_hat_N};
     st = br_ctrl_step(&app->ctrl, &in, &app->last);
     if (st != BR_OK) {
-        return latch(app, (st == BR_E_INPUT) ? BR_APP_FAULT_CTRL_INPUT : BR_APP_FAULT_CTRL_STATE);
+        /* the controller's input or state: braking without it, on open loop */
+        return latch_open(app, (st == BR_E_INPUT) ? BR_APP_FAULT_CTRL_INPUT : BR_APP_FAULT_CTRL_STATE,
+                          app->v_meas);
     }
     st = hal->pwm_write(hal->ctx, app->last.duty);
     if (st != BR_OK) {

@@ -20,11 +20,12 @@
 
 br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m)
 {
-    br_app_motion_cfg_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    br_app_motion_cfg_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     if (m == NULL || !br_finite_pos(m->lead_mprad) || !br_finite_pos(m->rad_per_count) ||
         !br_finite_pos(m->mass_kg) || !br_finite_pos(m->inertia_kgm2) || !br_finite_pos(m->Fc_N) ||
         !br_finite_pos(m->Fs_N) || !br_finite_pos(m->max_speed_mps) || !br_finite_pos(m->max_accel_mps2) ||
-        !br_finite_pos(m->max_following_m) || !br_finite_pos(m->travel_m)) {
+        !br_finite_pos(m->max_following_m) || !br_finite_pos(m->travel_m) || !isfinite(m->travel_min_m) ||
+        !br_finite_pos(m->period_s)) {
         return c; /* all zero: rejected by br_app_init */
     }
     c.counts_per_m = 1.0f / (m->lead_mprad * m->rad_per_count);
@@ -34,11 +35,15 @@ br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m)
     c.max_following_m = m->max_following_m;
     /* moved mass seen at the table: M + J / L^2 */
     c.mass_kg = m->mass_kg + m->inertia_kgm2 / (m->lead_mprad * m->lead_mprad);
-    /* coasting from the speed fault's speed against Coulomb friction alone:
-     * v^2 / (2 Fc / mass), plus the following error the position may be off */
-    c.stop_bound_m = c.speed_fault_mps * c.speed_fault_mps * c.mass_kg / (2.0f * m->Fc_N) + m->max_following_m;
-    c.soft_max_m = 0.5f * m->travel_m - c.stop_bound_m;
-    c.soft_min_m = -c.soft_max_m;
+    /* a braking ramp from the speed fault's speed at max_accel: v^2 / (2 a),
+     * the period the fault is seen in, v dt, and the following error the
+     * position may be off */
+    c.stop_bound_m = c.speed_fault_mps * c.speed_fault_mps / (2.0f * m->max_accel_mps2) +
+                     c.speed_fault_mps * m->period_s + m->max_following_m;
+    /* the open-loop brake: friction gives Fc of the deceleration mass a */
+    c.brake_N = fmaxf(c.mass_kg * m->max_accel_mps2 - m->Fc_N, 0.0f);
+    c.soft_min_m = m->travel_min_m + c.stop_bound_m;
+    c.soft_max_m = m->travel_min_m + m->travel_m - c.stop_bound_m;
     /* at standstill friction holds any force in [-Fs, Fs]: a change of 2 Fs */
     c.stuck_band_N = 2.0f * m->Fs_N;
     c.stuck_counts = BR_APP_STUCK_COUNTS;
@@ -49,7 +54,8 @@ br_status_t br_app_motion_check(const br_app_motion_cfg_t *m)
 {
     if (!br_finite_pos(m->counts_per_m) || !br_finite_pos(m->max_speed_mps) || !br_finite_pos(m->max_accel_mps2) ||
         !br_finite_pos(m->max_following_m) || !br_finite_pos(m->mass_kg) || !br_finite_pos(m->stuck_band_N) ||
-        !br_finite_pos(m->stuck_counts) || !br_finite_pos(m->stop_bound_m)) {
+        !br_finite_pos(m->stuck_counts) || !br_finite_pos(m->stop_bound_m) || !(m->brake_N >= 0.0f) ||
+        !isfinite(m->brake_N)) {
         return BR_E_PARAM;
     }
     /* written so that a NaN fails: a speed fault at or above the limiter's
@@ -58,8 +64,10 @@ br_status_t br_app_motion_check(const br_app_motion_cfg_t *m)
         !(m->soft_max_m > m->soft_min_m && isfinite(m->soft_max_m) && isfinite(m->soft_min_m))) {
         return BR_E_PARAM;
     }
-    /* the soft limits in counts must fit an int32 with room */
-    if (!(fabsf(m->soft_max_m) * m->counts_per_m < 1.0e9f && fabsf(m->soft_min_m) * m->counts_per_m < 1.0e9f)) {
+    /* the position the TRAVEL fault allows, a soft limit plus the following
+     * limit, must fit the int32 count (2^31) */
+    const float reach_m = fmaxf(fabsf(m->soft_max_m), fabsf(m->soft_min_m)) + m->max_following_m;
+    if (!(reach_m * m->counts_per_m < 2147483648.0f)) {
         return BR_E_PARAM;
     }
     return BR_OK;
@@ -89,6 +97,7 @@ void br_app_motion_reset(br_app_t *app)
     app->brk_frac = 0.0f;
     app->brk_v = 0.0f;
     app->brk_left = 0u;
+    app->brk_duty = 0.0f;
 }
 
 /* (ac + af) - (bc + bf) in counts (wrap-safe integer part) */
@@ -191,7 +200,10 @@ br_app_fault_t br_app_motion_watch(br_app_t *app, int32_t d, uint32_t periods)
     const float cpp = m->counts_per_m * dt; /* counts per period per m/s */
     const float v = (float)d / (float)periods;
     if (fabsf(v) > m->speed_fault_mps * cpp) {
-        app->v_meas = v; /* the braking ramp starts from it */
+        /* the braking ramp starts from the last speed below the fault's
+         * (v_meas kept): a lying count must not set the ramp's speed (one
+         * 2e4-count lie at 30 % of max speed made the PF's ramp run up to
+         * the speed fault's speed and stop 23 mm on) */
         return BR_APP_FAULT_SPEED;
     }
     /* the model's force per count/period^2: F = mass a, a = counts / (counts_per_m dt^2) */
@@ -294,4 +306,32 @@ br_status_t br_app_brake_period(br_app_t *app, int32_t counts, int32_t d, uint32
         return BR_E_FAULT;
     }
     return brake_run(app, counts);
+}
+
+br_status_t br_app_brake_open_start(br_app_t *app, float v_counts_per_period)
+{
+    const br_ctrl_cfg_t *k = &app->ctrl.cfg;
+    const float amax = app->lim_amax;
+    const float vlim = app->motion.speed_fault_mps * app->motion.counts_per_m * k->dt_s;
+    const float v = br_clampf(v_counts_per_period, -vlim, vlim);
+    /* the force against the motion, as a duty: F L / tau_per_duty, within
+     * the controller's torque limit */
+    const float duty_max = k->tau_max_Nm / k->tau_per_duty_Nm;
+    const float duty = br_clampf(app->motion.brake_N * k->lead_mprad / k->tau_per_duty_Nm, 0.0f, duty_max);
+    app->stop = BR_APP_STOP_OPEN;
+    app->brk_duty = (v > 0.0f) ? -duty : ((v < 0.0f) ? duty : 0.0f);
+    /* the periods that speed takes to stop at amax (<= 2^20 at init's limits) */
+    app->brk_left = (uint32_t)ceilf(fabsf(v) / amax);
+    return br_app_brake_open_period(app);
+}
+
+br_status_t br_app_brake_open_period(br_app_t *app)
+{
+    if (app->brk_left == 0u || app->hal->pwm_write(app->hal->ctx, app->brk_duty) != BR_OK) {
+        br_app_outputs_off(app);
+        return BR_E_FAULT;
+    }
+    app->last = (br_ctrl_out_t){app->brk_duty * app->ctrl.cfg.tau_per_duty_Nm, app->brk_duty, 0.0f, 0.0f, 0};
+    app->brk_left--;
+    return BR_E_FAULT;
 }

@@ -59,7 +59,16 @@ def machine_fields(m, p):
         ("BR_MACHINE_MAX_SPEED_COUNTS_PER_S", lim["max_speed_mps"] / (p["L_mprad"] * p["rad_per_count"]),
          "that speed in encoder counts per second (max_speed / (L rad_per_count)); times the period:\n"
          " * the largest encoder delta of one period (br_app_guard_cfg)"),
-        ("BR_MACHINE_TRAVEL_M", lim["travel_m"], "stroke of the table, centred on encoder count 0"),
+        ("BR_MACHINE_TRAVEL_M", lim["travel_m"], "stroke of the table, from BR_MACHINE_TRAVEL_MIN_M"),
+        ("BR_MACHINE_TRAVEL_MIN_M", machine.limit_defaults(m)[2],
+         "position of the stroke's low end (position 0 is encoder count 0)"),
+        ("BR_MACHINE_LOOP_PERIOD_S", machine.loop_period_s(m),
+         "the longest period the application may run at (control or PF period; machine.loop_period_s)"),
+        ("BR_MACHINE_COAST_M", machine.coast_m(m),
+         "how far the axis coasts from the speed fault's speed with the outputs off (machine.coast_m)"),
+        ("BR_MACHINE_STOP_BOUND_M", machine.stop_bound_m(m),
+         "stopping distance the soft travel limits keep from the stroke's ends (machine.stop_bound_m;\n"
+         " * br_app_motion_cfg derives the same in float32)"),
         ("BR_MACHINE_MAX_ACCEL_MPS2", machine.limit_defaults(m)[0],
          "the reference limiter's and the braking ramp's acceleration (br_app_motion_cfg)"),
         ("BR_MACHINE_MAX_FOLLOWING_M", machine.limit_defaults(m)[1],

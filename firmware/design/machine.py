@@ -287,7 +287,9 @@ SCHEMA = {
     },
     "limits": {
         "max_speed_mps": Num(0.0, 100.0, "largest table speed the axis is used at", lo_open=True),
-        "travel_m": Num(0.0, 100.0, "stroke of the table, centred on encoder count 0", lo_open=True),
+        "travel_m": Num(0.0, 100.0, "stroke of the table, from travel_min_m", lo_open=True),
+        "travel_min_m": Optional(Num(-100.0, 100.0, "position of the stroke's low end (position 0 is encoder "
+                                     "count 0); without it the stroke is centred on 0, -travel_m / 2")),
         # the drive protections (docs/modules/app.md); a file without them
         # gets the defaults of limit_defaults()
         "max_accel_mps2": Optional(Num(0.0, 1000.0, "the reference limiter's and the braking ramp's acceleration",
@@ -323,7 +325,49 @@ def limit_defaults(m):
     L = mech["lead_m_per_rev"] / (2.0 * math.pi)
     mass = mech["table_mass_kg"] + mech["inertia_kgm2"] / (L * L)
     accel = (m["control"]["torque_limit_Nm"] / L - m["friction"]["Fs_N"]) / (2.0 * mass)
-    return (lim.get("max_accel_mps2", accel), lim.get("max_following_error_m", 0.01 * lim["max_speed_mps"]))
+    lo = lim["travel_min_m"] if "travel_min_m" in lim else -0.5 * lim["travel_m"] if "travel_m" in lim else None
+    return (lim.get("max_accel_mps2", accel), following_m(m), lo)
+
+
+def following_m(m):
+    """max_following_error_m of machine m, the file's or what max_speed_mps covers in 10 ms."""
+    lim = m["limits"]
+    return lim.get("max_following_error_m", 0.01 * lim["max_speed_mps"])
+
+
+def stop_bound_m(m):
+    """The stopping distance the soft travel limits keep from the stroke's
+    ends (br_app_motion_cfg, docs/modules/app.md): a braking ramp (closed or
+    open loop) from the speed fault's speed, max_speed (1 + SPEED_MARGIN), at
+    max_accel, v^2 / (2 a), plus the period the fault is seen in, v period,
+    plus the following error limit. The generated BR_MACHINE_STOP_BOUND_M;
+    test_app holds the firmware's br_app_motion_cfg to it."""
+    v = m["limits"]["max_speed_mps"] * (1.0 + SPEED_MARGIN)
+    a = limit_defaults(m)[0]
+    return v * v / (2.0 * a) + v * loop_period_s(m) + following_m(m)
+
+
+def loop_period_s(m):
+    """The longest period the application may run at: control.period_s, or
+    the PF's when the machine runs the PF (the image's loop runs at it)."""
+    return max(m["control"]["period_s"], m["estimator"]["pf"]["period_s"])
+
+
+def coast_m(m):
+    """How far the axis coasts from the speed fault's speed with the outputs
+    off (the faults that cannot brake: HAL, DEADLINE), against Coulomb
+    friction alone: v^2 (M + J / L^2) / (2 Fc). The machine's own
+    end-of-travel protection (limit switches, end stops, dynamic braking)
+    covers what the stroke's margin does not (docs/reliability.md)."""
+    mech = m["mechanics"]
+    L = mech["lead_m_per_rev"] / (2.0 * math.pi)
+    mass = mech["table_mass_kg"] + mech["inertia_kgm2"] / (L * L)
+    v = m["limits"]["max_speed_mps"] * (1.0 + SPEED_MARGIN)
+    return v * v * mass / (2.0 * m["friction"]["Fc_N"])
+
+
+# the speed fault's margin over limits.max_speed_mps (BR_APP_SPEED_MARGIN)
+SPEED_MARGIN = 0.2
 
 
 def provenance(m, dotted):
@@ -408,9 +452,46 @@ def _cross_checks(m, errors):
     need(["estimator.pf.adapt.nis_ref"],
          lambda: get("estimator.pf.adapt.nis_ref") == 0.0 or get("estimator.pf.adapt.nis_ref") >= 1.0e-6,
          "estimator.pf.adapt.nis_ref", "must be 0 (off) or >= 1e-6")
+    # the drive's acceleration when the file leaves it out: the actuator must
+    # give more than stiction
+    if all(get(f) is not None for f in ("control.torque_limit_Nm", "friction.Fs_N", "mechanics.lead_m_per_rev",
+                                        "limits.max_speed_mps")) and get("limits.max_accel_mps2") is None \
+            and not limit_defaults(m)[0] > 0.0:
+        errors.append(("limits.max_accel_mps2", "missing, and the default, half of what the actuator gives beyond "
+                       "stiction, is not positive: control.torque_limit_Nm / L is below friction.Fs_N; give the "
+                       "axis's acceleration"))
+    # the soft travel limits (br_app_motion_cfg): the stroke less the stopping
+    # distance at each end must leave travel, and fit the int32 position count
+    elif all(get(f) is not None for f in ("limits.travel_m", "limits.max_speed_mps", "friction.Fc_N",
+                                        "mechanics.lead_m_per_rev", "encoder.counts_per_rev")):
+        _soft_limit_checks(m, errors)
     need(["encoder.counts_per_rev", "encoder.counter_bits"],
          lambda: get("encoder.counts_per_rev") <= 2 ** get("encoder.counter_bits"),
          "encoder.counts_per_rev", "more counts per revolution than the counter holds (2^counter_bits)")
+
+
+def soft_limits_m(m):
+    """The soft travel limits (lo, hi) of machine m in metres: the stroke
+    [travel_min_m, travel_min_m + travel_m] less stop_bound_m at each end
+    (br_app_motion_cfg)."""
+    lo = limit_defaults(m)[2]
+    b = stop_bound_m(m)
+    return lo + b, lo + m["limits"]["travel_m"] - b
+
+
+def _soft_limit_checks(m, errors):
+    lo, hi = soft_limits_m(m)
+    if not lo < hi:
+        errors.append(("limits.travel_m", "%s m leaves no travel inside the soft limits: the axis needs %s m at "
+                       "each end to brake from the speed fault's speed (docs/reliability.md, \"Drive protections\")"
+                       % (_g(m["limits"]["travel_m"]), _g(stop_bound_m(m)))))
+        return
+    L = m["mechanics"]["lead_m_per_rev"] / (2.0 * math.pi)
+    counts_per_m = m["encoder"]["counts_per_rev"] / (2.0 * math.pi * L)
+    reach = max(abs(lo), abs(hi)) + following_m(m)
+    if reach * counts_per_m >= 2.0 ** 31:
+        errors.append(("limits.travel_m", "the stroke reaches %s m from position 0: %.4g counts, beyond the "
+                       "int32 position count (2^31)" % (_g(reach), reach * counts_per_m)))
 
 
 def display_name(path):

@@ -35,6 +35,14 @@ br_status_t br_app_brake_start(br_app_t *app, int32_t counts);
 /* One braking period on a good read (delta d over `periods`). BR_E_FAULT. */
 br_status_t br_app_brake_period(br_app_t *app, int32_t counts, int32_t d, uint32_t periods);
 
+/* The open-loop brake from v (counts per period, the last trusted speed):
+ * stop OPEN, its first period. Always BR_E_FAULT. */
+br_status_t br_app_brake_open_start(br_app_t *app, float v_counts_per_period);
+
+/* One open-loop braking period (no encoder read): the braking duty, outputs
+ * off when the periods are done or the write fails. BR_E_FAULT. */
+br_status_t br_app_brake_open_period(br_app_t *app);
+
 /* Duty 0 and the outputs off (stop OFF). */
 void br_app_outputs_off(br_app_t *app);
 

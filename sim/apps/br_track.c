@@ -145,6 +145,26 @@ static double traj_acc(const traj_t *tr, double t)
     return (traj_ref(tr, t + tr->dt) - 2.0 * traj_ref(tr, t) + traj_ref(tr, t - tr->dt)) / (tr->dt * tr->dt);
 }
 
+/* the run-in of a log that starts at speed v0 (run_fw): from rest at
+ * constant acceleration v0 / t_s over the t_s before the log, ending at the
+ * log's first sample x0 with its speed */
+typedef struct {
+    double x0, v0, t_s;
+} run_in_t;
+
+/* the run-in's position at t in [-t_s, 0): x0 - v0 t_s / 2 + v0 tau^2 / (2 t_s), tau = t + t_s */
+static double run_in_ref(const run_in_t *ri, double t)
+{
+    const double tau = t + ri->t_s;
+    return (ri->t_s > 0.0) ? ri->x0 - 0.5 * ri->v0 * ri->t_s + 0.5 * ri->v0 * tau * tau / ri->t_s : ri->x0;
+}
+
+/* its speed: v0 tau / t_s */
+static double run_in_vel(const run_in_t *ri, double t)
+{
+    return (ri->t_s > 0.0) ? ri->v0 * (t + ri->t_s) / ri->t_s : 0.0;
+}
+
 /* the PF's estimate plus the feedforward, clamped to what the controller accepts */
 typedef struct {
     br_est_t inner;
@@ -298,7 +318,16 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
                        br_app_guard_cfg(cc.dt_s, (float)(2.0 * vmax * counts_per_m + 1.0 / c.dt_s)),
                        br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE)};
     if (ctrl == BR_CTRL_HINF_TRUE) ac.est = BR_APP_EST_EXTERN;
-    const br_plant_state_t x0 = {tr->ref[0] / pc->lead_mprad, 0.0, 0.0};
+    /* a log that starts in motion (EMPS: 0.015 m/s at its first sample): a
+     * run-in from rest before it at half the limiter's acceleration, n_run
+     * periods, not counted in the figures; the drive's reference limiter
+     * would otherwise limit the speed step at the arm and the run would
+     * track another trajectory than the log's */
+    const double v0 = (tr->ref[1] - tr->ref[0]) / tr->dt;
+    const double a_run = 0.5 * (double)ac.motion.max_accel_mps2;
+    const long n_run = (a_run > 0.0) ? (long)ceil(fabs(v0) / a_run / c.dt_s) : 0;
+    const run_in_t ri = {tr->ref[0], v0, (double)n_run * c.dt_s};
+    const br_plant_state_t x0 = {run_in_ref(&ri, -ri.t_s) / pc->lead_mprad, 0.0, 0.0};
     int rc = -1;
     if (ctrl == BR_CTRL_HINF_PF && (mem.pf = calloc(1, sizeof *mem.pf)) == NULL) return -1;
     if (ctrl == BR_CTRL_HINF_UKF && (mem.ukf = calloc(1, sizeof *mem.ukf)) == NULL) return -1;
@@ -327,14 +356,17 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     const double L = pc->lead_mprad, rpc = 2.0 * BR_PI / pc->counts_per_rev;
     const long n = lround((double)(tr->n - 1) * tr->dt / c.dt_s);
     rep->fault_status = 0;
-    for (long k = 0; k <= n; k++) {
+    for (long k = -n_run; k <= n; k++) {
         const double t = (double)k * c.dt_s;
         uint32_t tick;
         hal.tick_wait(hal.ctx, &tick);
-        const double x_ref = traj_ref(tr, t), counts = x_ref / L / rpc, whole = floor(counts);
-        const br_ref_t r = {(int32_t)whole, (float)(counts - whole), (float)(traj_vel(tr, t) / L)};
+        const double x_ref = (k < 0) ? run_in_ref(&ri, t) : traj_ref(tr, t);
+        const double v_ref = (k < 0) ? run_in_vel(&ri, t) : traj_vel(tr, t);
+        const double counts = x_ref / L / rpc, whole = floor(counts);
+        const br_ref_t r = {(int32_t)whole, (float)(counts - whole), (float)(v_ref / L)};
         if (ff) {
-            const br_ff_in_t in = {(float)traj_vel(tr, t), (float)traj_acc(tr, t), (float)x_ref};
+            const double a_ref = (k < 0) ? ri.v0 / ri.t_s : traj_acc(tr, t);
+            const br_ff_in_t in = {(float)v_ref, (float)a_ref, (float)x_ref};
             br_ff_set_ref(&w.ff, &in);
         }
         const double pos = br_plant_pos_m(&p);
@@ -348,7 +380,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
             rep->fault_t_s = t;
             break;
         }
-        err_add(e, t, x_ref, pos, (double)app.last.duty * pc->tau_per_duty_Nm / L);
+        if (k >= 0) err_add(e, t, x_ref, pos, (double)app.last.duty * pc->tau_per_duty_Nm / L);
     }
     rc = 0;
 done:

@@ -13,9 +13,13 @@ import json
 import math
 import os
 
+import sys
+
 import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "firmware", "design"))
+import machine  # noqa: E402  (the stop bound of the drive protections)
 
 # the ranges of issue 28 (a machine file a user may bring)
 LEAD_M = (2e-3, 40e-3)
@@ -29,7 +33,10 @@ DELAY_MAX_S = 3e-3
 P_DELAY = 0.5              # probability that the axis has an actuator delay the machine file does not know
 P_PRESLIDING = 0.0         # hook: the presliding plant of the presliding issue, once it exists
 MOTOR_REV_PER_S = 50.0     # 3000 rpm: the axis's speed limit is lead x this
-TRAVEL_M = 0.3             # every axis's stroke (the reference's)
+TRAVEL_M = 0.3             # every axis's working range from position 0 (the reference's stroke); the
+                           # circles (centred on 0) reach RADIUS_M[1] below it. The stroke adds each axis's
+                           # stop bound at both ends (given_file: the drive's soft limits are the range)
+WORK_BELOW_M = 0.055       # the range's reach below 0: the largest circle radius and 5 mm
 IDENT_ACC_MPS2 = 0.5       # the identification run's acceleration (docs/simlog.md)
 FORCE_MARGIN = 3.0         # amplifier force: this times (stiction + viscous at top speed + mass x 2 m/s^2)
 SIZING_ACC_MPS2 = 2.0
@@ -63,8 +70,10 @@ def draw(study_seed, i):
     lead = loguniform(rng, *LEAD_M)
     meff = loguniform(rng, *MASS_KG)      # the moving mass at the load, J/L^2 + M
     share = float(rng.uniform(0.2, 0.75))  # of it the motor and screw's (reference 0.71, heavy 0.43)
-    # the encoder: the signed 32-bit position count must hold the travel (br_ref_t, the plant's counter)
-    top_bits = min(ENC_BITS[1], int(math.floor(math.log2(2.0 ** 31 * lead / TRAVEL_M))))
+    # the encoder: the signed 32-bit position count must hold the working range and the following
+    # limit beyond it (br_ref_t, the plant's counter, the TRAVEL fault's reach)
+    reach = TRAVEL_M + 0.01 * lead * MOTOR_REV_PER_S
+    top_bits = min(ENC_BITS[1], int(math.floor(math.log2(2.0 ** 31 * lead / reach))))
     bits = int(rng.integers(ENC_BITS[0], top_bits + 1))
     L = lead / (2.0 * math.pi)
     inertia, mass = share * meff * L ** 2, (1.0 - share) * meff
@@ -125,9 +134,20 @@ def given_file(ax, name):
     m["control"]["period_s"] = ax["period_s"]
     m["control"]["torque_limit_Nm"] = tau
     m["estimator"]["pf"]["period_s"] = float(round(PF_PERIOD_RATIO * ax["period_s"], 6))
-    m["limits"] = {"max_speed_mps": ax["max_speed_mps"], "travel_m": TRAVEL_M}
+    # the drive's acceleration limit from the data sheet: half the amplifier's force on the moving
+    # mass (the trajectories' move_acc stays below it)
+    m["limits"] = {"max_speed_mps": ax["max_speed_mps"], "max_accel_mps2": 0.5 * ax["force_max_N"] / ax["Meff_kg"]}
+    set_stroke(m)
     m["provenance"] = {"friction." + k: "assumed" for k in m["friction"]}
     return m
+
+
+def set_stroke(m):
+    """The stroke of machine m: the working range [-WORK_BELOW_M, TRAVEL_M] and the stop bound of
+    the drive's protections (from m's own friction) at both ends, so that the soft limits are the
+    range."""
+    b = machine.stop_bound_m(m)
+    m["limits"].update({"travel_min_m": -WORK_BELOW_M - b, "travel_m": TRAVEL_M + WORK_BELOW_M + 2.0 * b})
 
 
 def truth_file(ax, given):
@@ -136,6 +156,7 @@ def truth_file(ax, given):
     m.pop("provenance")
     m["source"] = "sim/studies/fleet.py: the truth of a drawn axis (docs/fleet.md)"
     m["friction"] = dict(ax["friction"])
+    set_stroke(m)
     if ax["delay_s"] > 0.0:
         m["causes"] = {"actuator_delay": {"delay_s": ax["delay_s"]}}
     return m

@@ -18,6 +18,9 @@ const char *br_run_fault_name(int cause)
     case BR_APP_FAULT_DEADLINE: return "deadline";
     case BR_APP_FAULT_HAL: return "hal";
     case BR_APP_FAULT_LOST_LOCK: return "lost_lock";
+    case BR_APP_FAULT_SPEED: return "speed";
+    case BR_APP_FAULT_FOLLOWING: return "following";
+    case BR_APP_FAULT_TRAVEL: return "travel";
     default: return "unknown";
     }
 }

@@ -76,7 +76,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     g.enc_max_delta_counts = max_delta;
     /* drive protections far from the counter's range (1 count = 1 m): the
      * extension is what this fuzzes; a motion fault ends the input */
-    const br_app_motion_cfg_t mc = {1.0f, 1e9f, 1e15f, 1.1e9f, 1e9f, -9e8f, 9e8f, 1.0f, 10.0f, 36.0f, 8.0f};
+    const br_app_motion_cfg_t mc = {.counts_per_m = 1.0f, .max_speed_mps = 1e9f, .max_accel_mps2 = 1e15f,
+                                    .speed_fault_mps = 1.1e9f, .max_following_m = 1e9f, .soft_min_m = -9e8f,
+                                    .soft_max_m = 9e8f, .stop_bound_m = 1.0f, .brake_N = 0.0f, .mass_kg = 10.0f,
+                                    .stuck_band_N = 36.0f, .stuck_counts = 8.0f};
     const br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, g, mc};
     br_app_t app;
     if (br_app_init(&app, &c, &hal, NULL) != BR_OK || br_app_arm(&app) != BR_OK) abort();

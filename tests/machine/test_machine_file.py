@@ -151,6 +151,31 @@ def main():
         "firmware's [0, 1e-06]" % q_z,
         "field estimator.ukf.p0_var.speed_m2_per_s2: gives p0_omega_rad2ps2 = %.6g per step on this machine, outside "
         "the firmware's (0 excluded) [0, 1e+06]" % p0_om])
+    # a stroke that leaves no travel inside the soft limits (the stop bound at
+    # each end, br_app_motion_cfg), and one beyond the int32 position count
+    bad = copy.deepcopy(good)
+    bad["limits"]["travel_m"] = 1.5 * machine.stop_bound_m(good)
+    expect_errors(work, "stroke.json", bad, [
+        "field limits.travel_m: %s m leaves no travel inside the soft limits: the axis needs %s m at each end to "
+        "brake from the speed fault's speed (docs/reliability.md, \"Drive protections\")"
+        % (machine._g(bad["limits"]["travel_m"]), machine._g(machine.stop_bound_m(good)))])
+    bad = copy.deepcopy(good)
+    bad["limits"].pop("max_accel_mps2", None)
+    bad["control"]["torque_limit_Nm"] = 0.5 * good["friction"]["Fs_N"] * good["mechanics"]["lead_m_per_rev"] / (
+        2.0 * math.pi)
+    expect_errors(work, "accel.json", bad, [
+        "field limits.max_accel_mps2: missing, and the default, half of what the actuator gives beyond stiction, is "
+        "not positive: control.torque_limit_Nm / L is below friction.Fs_N; give the axis's acceleration"])
+    bad = copy.deepcopy(good)
+    bad["limits"]["travel_min_m"] = 20.0
+    path = write(work, "reach.json", bad)
+    try:
+        machine.load(path)
+        lines = []
+    except machine.MachineError as e:
+        lines = e.lines
+    check(len(lines) == 1 and "field limits.travel_m: the stroke reaches" in lines[0]
+          and "beyond the int32 position count (2^31)" in lines[0], "reach.json: a stroke beyond the int32 count (%s)" % lines)
     path = write(work, "syntax.json", "{\n  \"name\": \"x\",\n}\n")
     rc, err = run("machine.py", path)
     check(rc == 1 and err.startswith("%s: not valid JSON: line 3" % machine.display_name(path))

@@ -133,8 +133,17 @@ class Fleet(unittest.TestCase):
             self.assertTrue(2e-3 <= ax["lead_m_per_rev"] <= 40e-3 and 1.0 <= ax["Meff_kg"] <= 200.0)
             self.assertTrue(2 ** 12 <= ax["counts_per_rev"] <= 2 ** 26)
             # the travel fits a signed 32-bit count
-            self.assertLess(fleet_axis.TRAVEL_M / ax["lead_m_per_rev"] * ax["counts_per_rev"], 2 ** 31)
+            self.assertLess((fleet_axis.TRAVEL_M + 0.01 * ax["max_speed_mps"]) / ax["lead_m_per_rev"]
+                            * ax["counts_per_rev"], 2 ** 31)
             self.assertTrue(0.25e-3 <= ax["period_s"] <= 2e-3 and 0.0 <= ax["delay_s"] <= 3e-3)
+            # the machine file a user writes for it loads, and its soft travel limits (the drive's
+            # protections) hold the working range every trajectory stays in
+            path = os.path.join(ARGS.work, "given-%d.json" % i)
+            with open(path, "w") as f:
+                json.dump(fleet_axis.given_file(ax, "given-%d" % i), f)
+            lo, hi = fleet_axis.machine.soft_limits_m(fleet_axis.machine.load(path))
+            self.assertAlmostEqual(lo, -fleet_axis.WORK_BELOW_M, delta=1e-9)
+            self.assertAlmostEqual(hi, fleet_axis.TRAVEL_M, delta=1e-9)
 
 
 if __name__ == "__main__":

@@ -463,6 +463,13 @@ static void test_app_faults_disable_pwm(void **st)
     const br_ref_t bad = {0, 0.0f, NAN};
     assert_int_equal(br_app_step(&g.app, &bad), BR_E_FAULT);
     assert_int_equal(g.app.fault, BR_APP_FAULT_CTRL_INPUT);
+    /* the position is trusted: the braking ramp (from standstill: its
+     * settle periods) with the PWM on, then off */
+    assert_int_equal(g.app.stop, BR_APP_STOP_BRAKING);
+    assert_false(pwm_off(&g.f));
+    for (int i = 0; i < 100 && g.app.stop == BR_APP_STOP_BRAKING; i++) {
+        assert_int_equal(br_app_step(&g.app, &bad), BR_E_FAULT);
+    }
     assert_true(pwm_off(&g.f));
     /* deadline: the port trips, the application latches */
     app_up(&g);

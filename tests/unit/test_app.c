@@ -413,6 +413,29 @@ static void assert_brakes_then_off(rig_t *g, br_app_fault_t cause, int periods)
     assert_latched(g, cause);
 }
 
+/* a fault where the position is not trusted but the last speed v (counts per
+ * period) is: the open-loop brake (outputs on, a duty against v, no encoder
+ * read) for the periods v takes to stop at max_accel, then outputs off and
+ * latched; at v = 0 off at once */
+static void assert_open_brakes_then_off(rig_t *g, br_app_fault_t cause, float v)
+{
+    const br_ref_t r = {0, 0.0f, 0.0f};
+    assert_int_equal(g->app.fault, cause);
+    const int periods = (int)ceilf(fabsf(v) / g->app.lim_amax);
+    /* a speed to brake: the brake runs (it took the period of the latch) */
+    assert_int_equal(periods > 0, g->app.stop == BR_APP_STOP_OPEN);
+    int n = 0;
+    while (g->app.stop == BR_APP_STOP_OPEN && n <= periods) {
+        assert_true(g->f.on);
+        assert_true(v > 0.0f ? g->f.duty < 0.0f : g->f.duty > 0.0f);
+        g->f.enc_st = BR_E_INPUT; /* never read */
+        assert_int_equal(br_app_step(&g->app, &r), BR_E_FAULT);
+        n++;
+    }
+    assert_true(n <= periods);
+    assert_latched(g, cause);
+}
+
 static void test_outputs_off_until_armed(void **st)
 {
     (void)st;
@@ -447,7 +470,8 @@ static void test_ctrl_input_latches_until_rearmed(void **st)
     }
     assert_true(g.app.ctrl.eps_rads != 0.0f);
     assert_int_equal(br_app_step(&g.app, &bad), BR_E_FAULT);
-    assert_latched(&g, BR_APP_FAULT_CTRL_INPUT);
+    /* the position is trusted: the braking ramp, from standstill only its settle */
+    assert_brakes_then_off(&g, BR_APP_FAULT_CTRL_INPUT, (int)BR_APP_BRAKE_SETTLE_PERIODS);
     /* a good reference does not clear it; only the arm does, restarting the integral */
     assert_int_equal(br_app_arm(&g.app), BR_OK);
     assert_int_equal(g.app.fault, BR_APP_FAULT_NONE);
@@ -564,7 +588,8 @@ static void test_encoder_jump_latches(void **st)
     /* one count above the axis's maximum speed: a glitch, not a count */
     g.f.counts -= 101;
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
-    assert_latched(&g, BR_APP_FAULT_ENC_JUMP);
+    /* braked on open loop against the last good speed, -100 counts a period */
+    assert_open_brakes_then_off(&g, BR_APP_FAULT_ENC_JUMP, -100.0f);
     /* INT32_MIN apart (|delta| 2^31) as well */
     rig_init(&g, 0);
     assert_int_equal(br_app_step(&g.app, &r), BR_OK);
@@ -604,6 +629,38 @@ static void test_encoder_jump_after_held_reads(void **st)
     /* and a good read right after a good one is held to one period again */
     assert_int_equal(held_then(&g, 0u, 101), BR_E_FAULT);
     assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_JUMP);
+}
+
+/* Held reads at speed: the controller sees the last count moved on at the
+ * speed measured then, so with the reference moving on at that speed its
+ * duty is the one of a good read (held at the count itself the controller
+ * would see a following error grow by the speed each period and push). */
+static void test_held_reads_extrapolate(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_init(&g, 0);
+    const int32_t v = 1000; /* counts per period: the guard's limit raised to let it through */
+    g.app.guard.enc_max_delta_counts = 4000u;
+    br_ref_t r = {0, 0.5f, (float)v * g.k.rad_per_count / g.k.dt_s};
+    for (int i = 0; i < 50; i++) {
+        g.f.counts += v;
+        r.ref_counts = g.f.counts;
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    }
+    const float d0 = g.f.duty;
+    g.f.enc_st = BR_E_INPUT;
+    for (int i = 0; i < 3; i++) {
+        r.ref_counts += v;
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+        /* the duty of a controller on the reference: as before the hold */
+        assert_true(fabsf(g.f.duty - d0) <= 1e-3f);
+    }
+    /* the fourth failed read: ENC_STALE, braked on open loop against the
+     * last good speed */
+    r.ref_counts += v;
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_open_brakes_then_off(&g, BR_APP_FAULT_ENC_STALE, (float)v);
 }
 
 static void test_encoder_stale_holds_then_latches(void **st)
@@ -689,7 +746,10 @@ static void test_encoder_frozen_latches(void **st)
     /* the counter stops, the reference goes on: the model predicts 200 counts */
     r.ref_counts += 200;
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
-    assert_latched(&g, BR_APP_FAULT_ENC_FROZEN);
+    /* braked on open loop against the model's speed (+: 200 counts a period
+     * less what friction and the drive take in the still period) */
+    assert_true(g.app.v_pred > 0.0f);
+    assert_open_brakes_then_off(&g, BR_APP_FAULT_ENC_FROZEN, g.app.v_pred);
     /* still, reference on the count, 2000 periods: never */
     rig_machine(&g);
     const br_ref_t still = {0, 0.5f, 0.0f};
@@ -705,6 +765,10 @@ static void test_encoder_frozen_latches(void **st)
         s = br_app_step(&g.app, &far);
     }
     assert_int_equal(s, BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_FROZEN);
+    if (g.app.stop == BR_APP_STOP_OPEN) {
+        assert_open_brakes_then_off(&g, BR_APP_FAULT_ENC_FROZEN, g.app.v_pred);
+    }
     assert_latched(&g, BR_APP_FAULT_ENC_FROZEN);
 }
 
@@ -749,6 +813,17 @@ static void test_reference_limiter(void **st)
     assert_true(n > 1 && n < 10000);
     assert_true(a->n_ref_limited >= (uint32_t)n);
     print_message("10 mm step: limited for %d periods\n", n);
+    /* a reference at half the speed limit from standstill: within the speed,
+     * beyond the acceleration: limited */
+    rig_machine(&g);
+    g.app.motion.stuck_band_N = 1e9f;
+    br_ref_t mv = {0, 0.5f, 0.0f};
+    assert_int_equal(br_app_step(&g.app, &mv), BR_OK);
+    assert_false(a->ref_limited);
+    mv.ref_counts += (int32_t)(0.5f * vmax);
+    mv.ref_omega_radps = 0.5f * vmax * g.k.rad_per_count / g.k.dt_s;
+    assert_int_equal(br_app_step(&g.app, &mv), BR_OK);
+    assert_true(a->ref_limited);
     /* a target beyond the soft limit: held at it, flagged */
     rig_machine(&g);
     g.app.motion.stuck_band_N = 1e9f;
@@ -779,6 +854,9 @@ static void test_motion_faults_brake(void **st)
     g.f.counts += fast;
     assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
     assert_int_equal(g.app.fault, BR_APP_FAULT_SPEED);
+    /* the ramp starts from the last speed below the fault's (here the axis
+     * stood), never from the delta that tripped it (a lying count) */
+    assert_true(g.app.brk_v == 0.0f);
     /* from that speed the ramp is at most speed / accel + the settle long */
     const int ramp = (int)ceilf((float)fast / g.app.lim_amax) + (int)BR_APP_BRAKE_SETTLE_PERIODS;
     assert_int_equal(g.app.stop, BR_APP_STOP_BRAKING);
@@ -810,6 +888,46 @@ static void test_motion_faults_brake(void **st)
     rig_machine(&g);
     assert_int_equal(br_app_fault(&g.app, BR_APP_FAULT_DEADLINE), BR_E_FAULT);
     assert_latched(&g, BR_APP_FAULT_DEADLINE);
+}
+
+/* The drive protections of the machine file: br_app_motion_cfg's float32
+ * stop bound and soft limits are machine.stop_bound_m's (the generated
+ * header); a stroke that leaves no travel inside them, a non-finite stroke
+ * start, and soft limits beyond the int32 count are refused at init; a count
+ * across the int32 wrap lies beyond every stroke: TRAVEL, never a small
+ * delta read as motion inside it. */
+static void test_motion_cfg_machine(void **st)
+{
+    (void)st;
+    const br_app_machine_t mm = BR_MACHINE_APP_MACHINE;
+    const br_app_motion_cfg_t c = br_app_motion_cfg(&mm);
+    assert_true(fabs((double)c.stop_bound_m - BR_MACHINE_STOP_BOUND_M) <= 1e-6 * BR_MACHINE_STOP_BOUND_M);
+    assert_true(fabs((double)c.soft_min_m - (BR_MACHINE_TRAVEL_MIN_M + BR_MACHINE_STOP_BOUND_M)) <= 1e-6);
+    assert_true(fabs((double)c.soft_max_m - (BR_MACHINE_TRAVEL_MIN_M + BR_MACHINE_TRAVEL_M - BR_MACHINE_STOP_BOUND_M)) <=
+                1e-6);
+    rig_t g;
+    rig_init(&g, 0);
+    g.c.motion = c;
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_OK);
+    br_app_machine_t bad = mm;
+    bad.travel_m = 1.5f * c.stop_bound_m; /* the stop bound at each end: nothing left */
+    g.c.motion = br_app_motion_cfg(&bad);
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
+    bad = mm;
+    bad.travel_min_m = NAN;
+    g.c.motion = br_app_motion_cfg(&bad);
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
+    bad = mm;
+    bad.travel_min_m = 2147483648.0f / c.counts_per_m; /* starts beyond the int32 count */
+    g.c.motion = br_app_motion_cfg(&bad);
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
+    /* across the wrap */
+    rig_machine(&g);
+    g.app.motion.stuck_band_N = 1e9f;
+    g.f.counts = INT32_MAX - 40;
+    const br_ref_t r = {INT32_MAX - 40, 0.5f, 0.0f};
+    assert_int_equal(br_app_step(&g.app, &r), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_TRAVEL);
 }
 
 static void test_external_fault_latches(void **st)
@@ -847,9 +965,9 @@ static void test_guard_config(void **st)
         assert_int_equal(br_app_arm(&g.app), BR_E_STATE);
     }
     /* the machine's: 1 ms at 0.1 m/s = 13107.2 counts, times BR_APP_JUMP_SPEEDS
-     * (2.2) = 28835.84 -> 28836 */
+     * (2 x 1.2 = 2.4) = 31457.28 -> 31458 */
     const br_app_guard_cfg_t m = br_app_guard_cfg(1e-3f, 13107200.0f);
-    assert_int_equal(m.enc_max_delta_counts, 28836u);
+    assert_int_equal(m.enc_max_delta_counts, 31458u);
     /* the lock window: 100 ms of periods, a quarter of them */
     assert_true((float)m.lock_window_periods * 1e-3f >= BR_APP_GUARD_LOCK_S);
     assert_true((float)(m.lock_window_periods - 1u) * 1e-3f < BR_APP_GUARD_LOCK_S);
@@ -916,10 +1034,12 @@ int main(void)
         cmocka_unit_test(test_hal_error_latches),
         cmocka_unit_test(test_encoder_jump_latches),
         cmocka_unit_test(test_encoder_stale_holds_then_latches),
+        cmocka_unit_test(test_held_reads_extrapolate),
         cmocka_unit_test(test_encoder_jump_after_held_reads),
         cmocka_unit_test(test_encoder_frozen_latches),
         cmocka_unit_test(test_reference_limiter),
         cmocka_unit_test(test_motion_faults_brake),
+        cmocka_unit_test(test_motion_cfg_machine),
         cmocka_unit_test(test_external_fault_latches),
         cmocka_unit_test(test_guard_config),
         cmocka_unit_test(test_machine_cfg_one_home),

@@ -31,7 +31,8 @@
         .mass_kg = BR_MACHINE_M_KG_F, .inertia_kgm2 = BR_MACHINE_J_KGM2_F,                         \
         .Fc_N = BR_MACHINE_FC_N_F, .Fs_N = BR_MACHINE_FS_N_F,                                      \
         .max_speed_mps = BR_MACHINE_MAX_SPEED_MPS_F, .max_accel_mps2 = BR_MACHINE_MAX_ACCEL_MPS2_F, \
-        .max_following_m = BR_MACHINE_MAX_FOLLOWING_M_F, .travel_m = BR_MACHINE_TRAVEL_M_F         \
+        .max_following_m = BR_MACHINE_MAX_FOLLOWING_M_F, .travel_m = BR_MACHINE_TRAVEL_M_F,        \
+        .travel_min_m = BR_MACHINE_TRAVEL_MIN_M_F, .period_s = BR_MACHINE_LOOP_PERIOD_S_F          \
     }
 
 /* an estimator's delay identification (E: PF or UKF; docs/modules/dlyid.md; 0 candidates: off) */

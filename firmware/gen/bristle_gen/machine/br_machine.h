@@ -74,9 +74,22 @@
  * the largest encoder delta of one period (br_app_guard_cfg) */
 #define BR_MACHINE_MAX_SPEED_COUNTS_PER_S (13107200.0)
 #define BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F (1.310720000e+07f)
-/* stroke of the table, centred on encoder count 0 */
+/* stroke of the table, from BR_MACHINE_TRAVEL_MIN_M */
 #define BR_MACHINE_TRAVEL_M (0.3)
 #define BR_MACHINE_TRAVEL_M_F (3.000000119e-01f)
+/* position of the stroke's low end (position 0 is encoder count 0) */
+#define BR_MACHINE_TRAVEL_MIN_M (-0.15)
+#define BR_MACHINE_TRAVEL_MIN_M_F (-1.500000060e-01f)
+/* the longest period the application may run at (control or PF period; machine.loop_period_s) */
+#define BR_MACHINE_LOOP_PERIOD_S (0.0015)
+#define BR_MACHINE_LOOP_PERIOD_S_F (1.500000013e-03f)
+/* how far the axis coasts from the speed fault's speed with the outputs off (machine.coast_m) */
+#define BR_MACHINE_COAST_M (0.03566469703137263)
+#define BR_MACHINE_COAST_M_F (3.566469625e-02f)
+/* stopping distance the soft travel limits keep from the stroke's ends (machine.stop_bound_m;
+ * br_app_motion_cfg derives the same in float32) */
+#define BR_MACHINE_STOP_BOUND_M (0.0047799999999999995)
+#define BR_MACHINE_STOP_BOUND_M_F (4.780000076e-03f)
 /* the reference limiter's and the braking ramp's acceleration (br_app_motion_cfg) */
 #define BR_MACHINE_MAX_ACCEL_MPS2 (2.0)
 #define BR_MACHINE_MAX_ACCEL_MPS2_F (2.000000000e+00f)
