@@ -26,9 +26,12 @@ remaining one passes. The parameters set aside are not identified.
 
 Profile test: each parameter set aside, in that order, is held at the
 machine file's value (prep.fixed, model.solve / fit_shape) and the
-extended model refitted; it stays held when the held-out relerr does not
-rise by more than HOLD_TOL relative (the log cannot tell the machine
-file's value from its own fit), else it keeps the fitted value, reported
+extended model refitted; it stays held when the log cannot tell the
+machine file's value from its own fit (with every parameter held so far): the
+held-out relerr rises by no more than HOLD_TOL relative and the free fit
+is not better consistently over the held-out blocks
+(selection.block_p_value, p < P_MAX), or when the free fit put it on its
+physical bound (the log pulls it to a non-physical value); else it keeps the fitted value, reported
 as poorly determined (the log does show a difference). Every fit is also
 bounded to the physical ranges (model.COEF_LOWER), so no parameter is ever
 fitted to a non-physical value.
@@ -37,7 +40,7 @@ import math
 
 import numpy as np
 
-from . import model
+from . import model, selection
 
 Z = 1.96
 REL_95 = 0.5     # a parameter is identified when its 95 % interval is within +-50 % of its scale
@@ -146,15 +149,13 @@ def apply(prep, diag, p0, say=print):
             kept.append((k, r))
             continue
         trial = _refit(prep, fit, dict(fixed, **{k: p0.get(k, 0.0)}))
-        if trial.relerr(prep, te) <= free_rel * (1.0 + HOLD_TOL) + 1e-9:
+        if _at_bound(fit, k) or not _tells(prep, trial, fit, free_rel):
             fixed[k] = p0.get(k, 0.0)
             held.append((k, r))
             best = trial
         else:
             kept.append((k, r))
-    prep.fixed = fixed if held else None
-    if held:
-        best = _refit(prep, fit, fixed)
+    prep.fixed = fixed if held else None  # best was refitted with exactly these
     diag.extended = best
     out = {"method": "relative standard error at the machine file's values, sensitivities over the training part "
                      f"(docs/diagnose.md, Identifiability); identified when {Z:g} rse <= {REL_95:g}",
@@ -175,6 +176,24 @@ def apply(prep, diag, p0, say=print):
         say(f"identifiability: extended model refitted with {', '.join(k for k, _ in held)} held: held-out relerr "
             f"{free_rel:.4g} % -> {best.relerr(prep, te):.4g} %")
     return out
+
+
+def _at_bound(fit, name):
+    """The free fit put the parameter on its physical bound (model.COEF_LOWER):
+    the log pulls it beyond, to a non-physical value."""
+    coef = model.FIXED_COEF.get(name, (None,))[0]
+    if name == "dsigma2_neg_Nspm":
+        return fit.coef.get("sigma2_neg", 1.0) <= model.COEF_LOWER["sigma2_neg"]
+    return coef in model.COEF_LOWER and fit.coef.get(coef, 1.0) <= model.COEF_LOWER[coef]
+
+
+def _tells(prep, held, free, free_rel):
+    """The log tells the held model from the free one: its held-out relerr
+    rises by more than HOLD_TOL, or the free model's squared error is lower
+    consistently over the held-out blocks (selection's block test, p < P_MAX)."""
+    if held.relerr(prep, prep.test) > free_rel * (1.0 + HOLD_TOL) + 1e-9:
+        return True
+    return selection.block_p_value(prep, held.residual(prep), free.residual(prep)) < selection.P_MAX
 
 
 def _r(v):
