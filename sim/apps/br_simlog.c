@@ -3,7 +3,7 @@
  * ../shared/spec/measured-log.md) from the plant simulator, with any of the
  * causes a diagnosis names switched on. docs/simlog.md.
  *
- * Usage: br_simlog --out FILE [--traj ident|circle] [--cycles N] [--duration S]
+ * Usage: br_simlog --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--duration S]
  *                  [--seed N] [--force-noise N] [--model MODEL.json]
  *                  [--offset F] [--asym DFC,DFV] [--ripple A,P[,PHASE]]
  *                  [--gradient S] [--delay D] [--drift R] [--machine-out FILE]
@@ -88,18 +88,19 @@ static void circle_sink(void *user, const br_circle_sample_t *s)
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s --out FILE [--traj ident|circle] [--cycles N] [--duration S] [--seed N]\n"
+            "usage: %s --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--duration S] [--seed N]\n"
             "          [--force-noise N] [--model MODEL.json] [--offset F] [--asym DFC,DFV]\n"
             "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--drift R] [--machine-out FILE] [--truth]\n"
             BR_ARGS_COMMON_USAGE
             "  --out FILE          the log (CSV t,ref,pos,force; with --truth the plant's truth too)\n"
-            "  --traj ident|circle an identification run (default) or the circle's x axis\n"
+            "  --traj T            ident: an identification run (default); circle: the circle's x axis;\n"
+            "                      backforth: a slow back-and-forth; sweep: a frequency sweep\n"
             "  --cycles N          repetitions of the identification moves\n"
-            "  --duration S        length of the circle run\n"
+            "  --duration S        length of the circle, back-and-forth or sweep run (default 8 s)\n"
             "  --seed N            seed of the force noise\n"
             "  --force-noise N     standard deviation of the noise on the logged force\n"
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
-            "  --machine-out FILE  the run's machine file (ident only)\n"
+            "  --machine-out FILE  the run's machine file (not with circle)\n"
             "  cause options       switch causes on in the plant (docs/simlog.md)\n"
             "bounds: --cycles 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N (docs/tools.md)\n",
             argv0, argv0, BR_TOOL_CYCLES_MAX, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
@@ -165,12 +166,18 @@ static int parse(int argc, char **argv, opts_t *o)
         fprintf(stderr, "%s: --out is required\n", TOOL);
         return 2;
     }
-    if (strcmp(o->traj, "ident") != 0 && strcmp(o->traj, "circle") != 0) {
-        fprintf(stderr, "%s: --traj %s: must be ident or circle\n", TOOL, o->traj);
+    if (strcmp(o->traj, "ident") != 0 && strcmp(o->traj, "circle") != 0 && strcmp(o->traj, "backforth") != 0 &&
+        strcmp(o->traj, "sweep") != 0) {
+        fprintf(stderr, "%s: --traj %s: must be ident, circle, backforth or sweep\n", TOOL, o->traj);
         return 2;
     }
-    if (o->machine_out && strcmp(o->traj, "ident") != 0) {
-        fprintf(stderr, "%s: --machine-out applies to --traj ident only\n", TOOL);
+    if (o->machine_out && strcmp(o->traj, "circle") == 0) {
+        fprintf(stderr, "%s: --machine-out does not apply to --traj circle (its loop is the H-inf controller)\n",
+                TOOL);
+        return 2;
+    }
+    if (o->cycles > 0 && strcmp(o->traj, "ident") != 0) {
+        fprintf(stderr, "%s: --cycles applies to --traj ident only (the others take --duration)\n", TOOL);
         return 2;
     }
     if (o->machine_out && strcmp(o->machine_out, o->out) == 0) {
@@ -232,8 +239,11 @@ int main(int argc, char **argv)
                0};
     write_header(&o);
     int rc;
-    if (strcmp(opt.traj, "ident") == 0) {
-        br_ident_cfg_t c = br_ident_cfg_default(&plant);
+    if (strcmp(opt.traj, "circle") != 0) {
+        /* the EMPS-form loop on moves or a sweep */
+        br_ident_cfg_t c = strcmp(opt.traj, "backforth") == 0 ? br_ident_cfg_backforth(&plant, opt.duration)
+                           : strcmp(opt.traj, "sweep") == 0   ? br_ident_cfg_sweep(&plant, opt.duration)
+                                                              : br_ident_cfg_default(&plant);
         if (opt.cycles > 0) c.cycles = (int)opt.cycles;
         rc = br_ident_run(&c, &plant, ident_sink, &o);
         if (rc == 0 && opt.machine_out) write_machine(machine_file.f, &c);

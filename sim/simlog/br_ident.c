@@ -30,6 +30,31 @@ br_ident_cfg_t br_ident_cfg_default(const br_plant_cfg_t *plant)
     c.pd.kv = 90.0 * m;
     c.pd.gain_N = 1.0;
     c.pd.u_max = plant->tau_per_duty_Nm / L; /* the amplifier's limit at the load */
+    c.duration_s = 0.0;
+    c.sweep_pp_m = c.sweep_f0_hz = c.sweep_f1_hz = 0.0;
+    return c;
+}
+
+br_ident_cfg_t br_ident_cfg_backforth(const br_plant_cfg_t *plant, double duration_s)
+{
+    br_ident_cfg_t c = br_ident_cfg_default(plant);
+    const br_move_t there = {0.020, 0.005, 0.0}, back = {0.0, 0.005, 0.0};
+    c.n_moves = 2;
+    c.moves[0] = there;
+    c.moves[1] = back;
+    c.duration_s = duration_s;
+    /* enough cycles to fill the duration (each 8.02 s) */
+    c.cycles = (int)ceil(duration_s / (2.0 * (0.020 / 0.005 + 0.005 / c.acc_mps2))) + 1;
+    return c;
+}
+
+br_ident_cfg_t br_ident_cfg_sweep(const br_plant_cfg_t *plant, double duration_s)
+{
+    br_ident_cfg_t c = br_ident_cfg_default(plant);
+    c.duration_s = duration_s;
+    c.sweep_pp_m = 0.004;
+    c.sweep_f0_hz = 0.1;
+    c.sweep_f1_hz = 4.0;
     return c;
 }
 
@@ -58,6 +83,7 @@ static double move_pos(double d, double v, double a, double t)
 
 double br_ident_duration_s(const br_ident_cfg_t *c)
 {
+    if (c->duration_s > 0.0) return c->duration_s;
     double T = c->dwell0_s, x = 0.0;
     for (int k = 0; k < c->cycles; k++) {
         for (int i = 0; i < c->n_moves; i++) {
@@ -68,8 +94,19 @@ double br_ident_duration_s(const br_ident_cfg_t *c)
     return T;
 }
 
+/* the sweep's reference: phi(tau) = 2 pi (f0 tau + (f1 - f0) tau^2 / (2 T)),
+ * tau the time since the first dwell, T the sweep's length */
+static double sweep_ref_m(const br_ident_cfg_t *c, double t)
+{
+    const double tau = t - c->dwell0_s, T = c->duration_s - c->dwell0_s;
+    if (tau <= 0.0 || T <= 0.0) return 0.0;
+    const double phi = 2.0 * BR_PI * (c->sweep_f0_hz * tau + (c->sweep_f1_hz - c->sweep_f0_hz) * tau * tau / (2.0 * T));
+    return 0.5 * c->sweep_pp_m * (1.0 - cos(phi));
+}
+
 double br_ident_ref_m(const br_ident_cfg_t *c, double t)
 {
+    if (c->sweep_pp_m > 0.0) return sweep_ref_m(c, t);
     double t0 = c->dwell0_s, x = 0.0;
     if (t <= t0) return 0.0;
     for (int k = 0; k < c->cycles; k++) {
@@ -89,7 +126,9 @@ double br_ident_ref_m(const br_ident_cfg_t *c, double t)
 int br_ident_run(const br_ident_cfg_t *c, const br_plant_cfg_t *plant_cfg, br_log_sink_t sink, void *user)
 {
     if (!(c->dt_s > 0.0 && c->acc_mps2 > 0.0 && c->cycles >= 1 && c->n_moves >= 1 &&
-          c->n_moves <= BR_IDENT_MAX_MOVES && c->pd.u_max > 0.0)) {
+          c->n_moves <= BR_IDENT_MAX_MOVES && c->pd.u_max > 0.0 && c->duration_s >= 0.0 &&
+          !(c->sweep_pp_m > 0.0 && !(c->duration_s > c->dwell0_s && c->sweep_f0_hz > 0.0 &&
+                                     c->sweep_f1_hz >= c->sweep_f0_hz)))) {
         fprintf(stderr, "br_ident: invalid run configuration\n");
         return -1;
     }

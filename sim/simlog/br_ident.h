@@ -37,6 +37,11 @@ typedef struct {
     int n_moves;
     br_move_t moves[BR_IDENT_MAX_MOVES]; /* from x = 0 */
     br_pd_cfg_t pd;
+    double duration_s;  /* > 0: the run's length (the moves cut or repeated); 0: the moves' */
+    /* a sweep instead of the moves when sweep_pp_m > 0: after dwell0_s,
+     * ref = sweep_pp_m (1 - cos phi(t)) / 2 with phi' = 2 pi f(t), f rising
+     * linearly from sweep_f0_hz to sweep_f1_hz at duration_s */
+    double sweep_pp_m, sweep_f0_hz, sweep_f1_hz;
 } br_ident_cfg_t;
 
 /* One logged period: what a measured log holds, plus the plant's truth. */
@@ -56,7 +61,15 @@ typedef void (*br_log_sink_t)(void *user, const br_log_row_t *row);
  * kp and velocity-loop rate kv gain / m as EMPS: 160.18 1/s, 90 1/s). */
 br_ident_cfg_t br_ident_cfg_default(const br_plant_cfg_t *plant);
 
-/* Duration of the reference (all cycles), s. */
+/* The slow back-and-forth (docs/simlog.md): 0 -> 0.02 m -> 0 at 5 mm/s,
+ * 0.5 m/s^2, no dwell at the reversals, repeated over duration_s. */
+br_ident_cfg_t br_ident_cfg_backforth(const br_plant_cfg_t *plant, double duration_s);
+
+/* The sweep (docs/simlog.md): 4 mm peak to peak, 0.1 -> 4 Hz over duration_s
+ * (peak speed 0.05 m/s at the end). */
+br_ident_cfg_t br_ident_cfg_sweep(const br_plant_cfg_t *plant, double duration_s);
+
+/* Duration of the run, s: duration_s when > 0, else the moves' (all cycles). */
 double br_ident_duration_s(const br_ident_cfg_t *c);
 
 /* Reference position at t (before 0: 0; after the end: the last target). */

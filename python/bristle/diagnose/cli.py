@@ -20,8 +20,8 @@ import sys
 import time
 
 from .. import __version__
-from . import (causes, closedloop, logreader, machinefile, machinejson, model, modelfile, output, report, selection,
-               signals)
+from . import (causes, closedloop, identify, logreader, machinefile, machinejson, model, modelfile, output, report,
+               selection, signals, units)
 
 # Exit statuses (docs/diagnose.md, "Exit status")
 EXIT_OK = 0
@@ -81,6 +81,8 @@ def cmd_diagnose(args):
     t0 = time.monotonic()
     lg = logreader.read_log(args.log)
     log.debug("read %s in %.2f s", args.log, time.monotonic() - t0)
+    base = machinejson.base(given)
+    units.check(lg, base)  # seconds, metres, newtons: a log 1000 times off is refused naming the unit
     if ctrl is not None and abs(ctrl["dt_s"] - lg.dt) > 1e-6 * lg.dt:
         raise closedloop.ControllerError(f"{mpath}: controller period {ctrl['dt_s']:g} s differs from the log's "
                                          f"{lg.dt:.6g} s")
@@ -90,6 +92,8 @@ def cmd_diagnose(args):
     log.debug("low-pass cutoff %g Hz", args.fc)
     t0 = time.monotonic()
     diag = selection.diagnose(prep, progress=say)
+    # what the log cannot identify: held at the machine file's values (identify.py)
+    diag.identifiability = identify.apply(prep, diag, identify.prior(base), say=say)
     log.debug("fits and cause tests in %.2f s", time.monotonic() - t0)
     closed = None
     if ctrl is not None:

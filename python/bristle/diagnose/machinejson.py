@@ -88,6 +88,15 @@ def given(path):
     return path
 
 
+def base(given=None):
+    """The machine file a diagnosis starts from: the given one, else the reference machine."""
+    mach = _loader()
+    try:
+        return mach.load(given or mach.REFERENCE_MACHINE)
+    except mach.MachineError as e:
+        raise closedloop.ControllerError("\n".join(e.lines)) from None
+
+
 def _leaves(d, prefix=""):
     for k, v in d.items():
         path = prefix + k
@@ -162,7 +171,9 @@ def build(prep, diag, given=None, log_path=None):
     # the moving mass at the load
     Meff = p["Meff_kg"]
     J, M = m["mechanics"]["inertia_kgm2"], m["mechanics"]["table_mass_kg"]
-    if kind("mechanics.inertia_kgm2") == "given" and kind("mechanics.table_mass_kg") == "given" and given:
+    if "Meff_kg" in getattr(diag, "identifiability", {}).get("held", {}):
+        notes.append("the log cannot identify the moving mass: the mechanics are the base's")
+    elif kind("mechanics.inertia_kgm2") == "given" and kind("mechanics.table_mass_kg") == "given" and given:
         share = M / (J / L ** 2 + M)
         _set(m, "mechanics.table_mass_kg", share * Meff, prov, "identified")
         _set(m, "mechanics.inertia_kgm2", (1.0 - share) * Meff * L ** 2, prov, "identified")
@@ -194,10 +205,14 @@ def build(prep, diag, given=None, log_path=None):
         unresolved |= {"sigma0_Npm", "sigma1_Nspm"}
         notes.append("the presliding length Fc/sigma0 %.3g m is under %g position steps: sigma0_Npm and "
                      "sigma1_Nspm are not identified" % (p["Fc_N"] / p["sigma0_Npm"], PRESLIDING_MIN_QUANTA))
+    held = set(getattr(diag, "identifiability", {}).get("held", {}))
+    unresolved |= held & set(fr)
     for q in params.NOMINAL:
         if q.name not in fr:
             continue  # Meff_kg: above
-        if q.name in unresolved:
+        if q.name in held:
+            pass  # the base's value, and its provenance (identify.py held it there)
+        elif q.name in unresolved:
             prov["friction." + q.name] = "assumed"
         else:
             _set(m, "friction." + q.name, p[q.name], prov, "identified")
@@ -213,10 +228,14 @@ def build(prep, diag, given=None, log_path=None):
         prov["estimator.pf.gp_curve.tau_s"] = "derived"
 
     # the causes, under the names of model.json (one table: the causes' PARAMS)
+    base_causes = {"causes.%s.%s" % (c, k) for c, v in m.get("causes", {}).items() for k in v}
     m["causes"] = {}
     for c in causes_.of(diag.extended.causes):
         for q in c.PARAMS:
-            _set(m, "causes.%s.%s" % (c.NAME, q.name), p[q.name], prov, "identified")
+            # held at the machine file's value (identify.py): the base's, or assumed
+            path = "causes.%s.%s" % (c.NAME, q.name)
+            _set(m, path, p[q.name], prov, kind(path) if q.name in held and path in base_causes else
+                 "assumed" if q.name in held else "identified")
 
     log_name = os.path.basename(log_path or prep.path)
     if given is None:

@@ -147,22 +147,62 @@ def target(prep, causes, nl):
     return prep.y
 
 
+# the physical lower bound of each linear coefficient (params.NOMINAL, the
+# asymmetric cause's sigma2 + dsigma2_neg >= 0): a solution outside them is
+# solved again with the bounds (docs/diagnose.md, "Identifiability")
+COEF_LOWER = {"Meff": 1e-9, "sigma2": 0.0, "Fc": 1e-9, "sigma1": 0.0, "sigma2_neg": 0.0}
+
+# a parameter held at a value (prep.fixed, identify.py) as a linear
+# constraint on one coefficient: coef = value + sum(a * other coef)
+FIXED_COEF = {"Meff_kg": ("Meff", {}), "sigma2_Nspm": ("sigma2", {}), "Fc_N": ("Fc", {}),
+              "sigma1_Nspm": ("sigma1", {}), "dsigma2_neg_Nspm": ("sigma2_neg", {"sigma2": 1.0})}
+# a shape parameter held: its index in (rho, beta, vs) and its value from
+# the held parameters (the machine file's ratio to Fc for sigma0 and Fs)
+FIXED_SHAPE = {"sigma0_Npm": (0, lambda f: f["sigma0_Npm"] / f["Fc_ref_N"]),
+               "Fs_N": (1, lambda f: f["Fs_N"] / f["Fc_ref_N"]),
+               "vs_mps": (2, lambda f: f["vs_mps"])}
+
+
+def _held(prep, cols):
+    """{coef: (value, {other: a})} of the parameters held on this log."""
+    fixed = getattr(prep, "fixed", None) or {}
+    out = {}
+    for name, v in fixed.items():
+        if name in FIXED_COEF and FIXED_COEF[name][0] in cols:
+            coef, tie = FIXED_COEF[name]
+            out[coef] = (v, {k: a for k, a in tie.items() if k in cols})
+    # a tie to a held coefficient is a value (the ties are one level deep: FIXED_COEF)
+    for e, (v, tie) in list(out.items()):
+        held = {k: a for k, a in tie.items() if k in out}
+        out[e] = (v + sum(a * out[k][0] for k, a in held.items()), {k: a for k, a in tie.items() if k not in held})
+    return out
+
+
 def solve(prep, shape, causes, nl):
-    """Linear least squares of the coefficients on the training part; sigma1
-    is kept >= 0 (dropped when the free solution is negative). The fit keeps
-    its training residual and sum of squares (train_sse)."""
+    """Linear least squares of the coefficients on the training part, the
+    held parameters (prep.fixed) substituted, within COEF_LOWER (bounded
+    least squares when the free solution leaves them). The fit keeps its
+    training residual and sum of squares (train_sse)."""
     cols = columns(prep, shape, causes, nl)
     y = target(prep, causes, nl)
-    names = list(cols)
     tr = prep.train
-    yt = y[tr]
-    for _ in range(2):
-        X = np.column_stack([cols[k][tr] for k in names])
-        sol, *_ = np.linalg.lstsq(X, yt, rcond=None)
-        coef = dict(zip(names, sol))
-        if coef.get("sigma1", 0.0) >= 0.0:
-            break
-        names.remove("sigma1")
+    held = _held(prep, cols)
+    free = [k for k in cols if k not in held]
+    # coef_e = v_e + sum a_ek coef_k: its column moves to the target and onto the others'
+    yt = y[tr].copy()
+    Xc = {k: cols[k][tr].copy() for k in free}
+    for e, (v, tie) in held.items():
+        yt -= v * cols[e][tr]
+        for k, a in tie.items():
+            Xc[k] += a * cols[e][tr]
+    X = np.column_stack([Xc[k] for k in free])
+    sol, *_ = np.linalg.lstsq(X, yt, rcond=None)
+    lo = np.array([COEF_LOWER.get(k, -np.inf) for k in free])
+    if np.any(sol < lo):
+        sol = optimize.lsq_linear(X, yt, bounds=(lo, np.full(len(free), np.inf)), method="bvls").x
+    coef = dict(zip(free, sol))
+    for e, (v, tie) in held.items():
+        coef[e] = v + sum(a * coef[k] for k, a in tie.items())
     coef.setdefault("sigma1", 0.0)
     fit = Fit(causes, shape, nl, coef)
     fit.train_resid = yt - X @ sol
@@ -170,27 +210,46 @@ def solve(prep, shape, causes, nl):
     return fit
 
 
+def _held_shape(prep):
+    """{index in (log rho, beta, log vs): value} of the held shape parameters."""
+    fixed = getattr(prep, "fixed", None) or {}
+    out = {}
+    for name, (i, value) in FIXED_SHAPE.items():
+        if name in fixed:
+            v = value(fixed)
+            out[i] = math.log(v) if i != 1 else v
+    return out
+
+
 def fit_shape(prep, causes, nl, starts=SHAPE_STARTS, max_nfev=40):
     """Searches the LuGre shape (log rho, beta, log vs) by bounded least
-    squares on the training residual, the coefficients solved inside."""
+    squares on the training residual, the coefficients solved inside; a
+    held shape parameter (prep.fixed) is not searched."""
     lo = np.array([math.log(RHO_BOUNDS[0]), BETA_BOUNDS[0], math.log(VS_BOUNDS[0])])
     hi = np.array([math.log(RHO_BOUNDS[1]), BETA_BOUNDS[1], math.log(VS_BOUNDS[1])])
     ratio = _neg_ratio(causes_.of(causes), nl)
+    held = _held_shape(prep)
+    free = [i for i in range(3) if i not in held]
 
-    def unpack(u):
+    def unpack(uf):
+        u = [held.get(i, 0.0) for i in range(3)]
+        for i, x in zip(free, uf):
+            u[i] = x
         return (math.exp(u[0]), u[1], math.exp(u[2]))
 
-    def resid(u):
-        shape = unpack(u)
+    def resid(uf):
+        shape = unpack(uf)
         r = solve(prep, shape, causes, nl).train_resid
         prep.forget(("bristle", shape, ratio))  # a shape is seldom seen twice
         return r
 
+    if not free:
+        return solve(prep, unpack(()), causes, nl)
     best = None
     for s in starts:
-        u0 = np.clip([math.log(s[0]), s[1], math.log(s[2])], lo + 1e-9, hi - 1e-9)
-        r = optimize.least_squares(resid, u0, bounds=(lo, hi), diff_step=1e-4, x_scale=[1.0, 0.5, 1.0],
-                                   max_nfev=max_nfev, xtol=1e-5, ftol=1e-7)
+        u0 = np.clip([math.log(s[0]), s[1], math.log(s[2])], lo + 1e-9, hi - 1e-9)[free]
+        r = optimize.least_squares(resid, u0, bounds=(lo[free], hi[free]), diff_step=1e-4,
+                                   x_scale=np.array([1.0, 0.5, 1.0])[free], max_nfev=max_nfev, xtol=1e-5, ftol=1e-7)
         if best is None or r.cost < best.cost:
             best = r
     return solve(prep, unpack(best.x), causes, nl)

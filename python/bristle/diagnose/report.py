@@ -77,6 +77,10 @@ def build(prep, diag, machine=None, closed=None, log_path=None, floor=None):
     ivals = intervals.jackknife(prep, ext)
     ext_params = ext.params()
     unident = intervals.unidentified(prep, ext_params, ivals)
+    ident = getattr(diag, "identifiability", None)
+    if ident:
+        for k, h in list(ident["held"].items()) + list(ident["poorly_determined"].items()):
+            unident[k] = h["why"]
     for cand, refined in diag.findings:
         mod = causes_.get(cand.cause)
         findings.append({
@@ -118,6 +122,7 @@ def build(prep, diag, machine=None, closed=None, log_path=None, floor=None):
                      "relerr_percent": diag.extended.relerr(prep, te),
                      "relerr_train_percent": diag.extended.relerr(prep, tr)},
         "gain_percent_points": nom.relerr(prep, te) - diag.extended.relerr(prep, te),
+        "identifiability": ident,
         "noise_floor_percent": floor.percent,
         "noise_floor": floor.summary(),
         "unexplained": une,

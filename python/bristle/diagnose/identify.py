@@ -1,0 +1,204 @@
+# SPDX-License-Identifier: Apache-2.0
+"""What a log can identify, parameter by parameter, and the fit that takes
+what it cannot from the machine file (docs/diagnose.md, "Identifiability").
+
+A circle of 0.1 mm, a slow back-and-forth at one speed or a sweep does not
+move the axis the way long moves at several speeds do: on the thesis circle
+(speeds under 0.25 mm/s, ten Stribeck velocities) the viscous force sigma2 v
+is a few mN beside a Coulomb level of 7 N, and a free fit put sigma2 at
+-134 N s/m.
+
+Sensitivity (at the machine file's values p0, the extended model's causes):
+the relative sensitivity column of parameter i over the training part,
+
+  S_i = dF / d(theta_i / s_i),    s_i = |p0 of the parameter's scale| (SCALE)
+
+(a finite difference of step H s_i), and with the extended fit's training
+residual RMS sigma and the filtered residual's correlation (one independent
+sample per 1 / (2 fc)), kappa = 1 / (2 fc dt), the relative standard error
+
+  rse_i = sigma sqrt(kappa) sqrt([(S^T S)^-1]_ii)
+
+over the parameters still free. The worst parameter with Z rse_i > REL_95
+(its 95 % interval wider than +-50 % of the machine file's value) is the
+log's weakest; it is set aside and the rest assessed again, until every
+remaining one passes. The parameters set aside are not identified.
+
+Profile test: each parameter set aside, in that order, is held at the
+machine file's value (prep.fixed, model.solve / fit_shape) and the
+extended model refitted; it stays held when the log cannot tell the
+machine file's value from its own fit (with every parameter held so far): the
+held-out relerr rises by no more than HOLD_TOL relative and the free fit
+is not better consistently over the held-out blocks
+(selection.block_p_value, p < P_MAX), or when the free fit put it on its
+physical bound (the log pulls it to a non-physical value); else it keeps the fitted value, reported
+as poorly determined (the log does show a difference). Every fit is also
+bounded to the physical ranges (model.COEF_LOWER), so no parameter is ever
+fitted to a non-physical value.
+"""
+import math
+
+import numpy as np
+
+from . import model, selection
+
+Z = 1.96
+REL_95 = 0.5     # a parameter is identified when its 95 % interval is within +-50 % of its scale
+H = 1e-3         # finite-difference step, in units of the scale
+HOLD_TOL = 0.05  # held-out relerr may rise 5 % (relative) when a parameter is held
+# the parameters assessed and the machine-file parameter that gives each its scale
+SCALE = {"Meff_kg": "Meff_kg", "sigma2_Nspm": "sigma2_Nspm", "Fc_N": "Fc_N", "Fs_N": "Fs_N", "vs_mps": "vs_mps",
+         "sigma0_Npm": "sigma0_Npm", "sigma1_Nspm": "sigma1_Nspm",
+         "dFc_neg_N": "Fc_N", "dsigma2_neg_Nspm": "sigma2_Nspm"}
+# what the log must contain for each (the reason given with a parameter not identified)
+NEEDS = {"Meff_kg": "accelerations",
+         "sigma2_Nspm": "sliding at several speeds well above the Stribeck velocity",
+         "Fc_N": "sliding in both directions",
+         "Fs_N": "breakaway and speeds around the Stribeck velocity",
+         "vs_mps": "speeds around the Stribeck velocity, a few times the velocity resolution",
+         "sigma0_Npm": "reversals with a presliding travel of several position steps",
+         "sigma1_Nspm": "fast presliding (reversals at high acceleration)",
+         "dFc_neg_N": "sliding in -x",
+         "dsigma2_neg_Nspm": "sliding in -x at several speeds"}
+# parameters that can be held at the machine file's value (model.FIXED_COEF, FIXED_SHAPE)
+HOLDABLE = set(model.FIXED_COEF) | set(model.FIXED_SHAPE)
+
+
+def prior(machine):
+    """The load-side values of a machine file (firmware/design/machine.py's
+    dict): the moving mass J/L^2 + M, the friction, the causes' parameters
+    (0 when it states none)."""
+    L = machine["mechanics"]["lead_m_per_rev"] / (2.0 * math.pi)
+    p = {"Meff_kg": machine["mechanics"]["inertia_kgm2"] / L ** 2 + machine["mechanics"]["table_mass_kg"]}
+    p.update({k: float(v) for k, v in machine["friction"].items() if k in SCALE})
+    for c in machine.get("causes", {}).values():
+        p.update({k: float(v) for k, v in c.items()})
+    return p
+
+
+def _assessed(fit):
+    return [k for k in SCALE if k in fit.params()]
+
+
+def sensitivity(prep, fit, p0):
+    """{param: S_i} over the training part at p0 (the fit's other parameters,
+    a cause's own, kept), for the parameters of fit that SCALE lists."""
+    point = dict(fit.params())
+    for k in _assessed(fit):
+        point[k] = p0.get(k, 0.0)
+    tr = prep.train
+
+    def pred(p):
+        return model.from_params(p, fit.causes).predict(prep)[tr]
+
+    y0 = pred(point)
+    out = {}
+    for k in _assessed(fit):
+        s = abs(p0[SCALE[k]])
+        p = dict(point)
+        p[k] += H * s
+        out[k] = (pred(p) - y0) / H
+    return out
+
+
+def rel_se(S, names, sigma, kappa):
+    """{name: relative standard error} of the parameters named, the others' columns left out."""
+    X = np.column_stack([S[k] for k in names])
+    inv = np.linalg.pinv(X.T @ X)
+    return {k: float(sigma * math.sqrt(kappa * max(inv[i, i], 0.0))) for i, k in enumerate(names)}
+
+
+def assess(prep, fit, p0):
+    """[(param, rse when set aside)] in the order set aside, and {param: rse} of the rest."""
+    S = sensitivity(prep, fit, p0)
+    sigma = float(np.sqrt(np.mean(fit.train_resid ** 2))) if hasattr(fit, "train_resid") else 0.0
+    # a model fitted on a finite log never reaches zero: at least 0.1 % of the force
+    sigma = max(sigma, 1e-3 * float(np.sqrt(np.mean(prep.y[prep.train] ** 2))))
+    kappa = max(1.0, 1.0 / (2.0 * prep.fc_hz * prep.dt))
+    names = [k for k in S if np.any(S[k] != 0.0)]
+    aside = [(k, math.inf) for k in S if k not in names]  # no effect at all on this log
+    while names:
+        r = rel_se(S, names, sigma, kappa)
+        worst = max(names, key=lambda k: r[k])
+        if Z * r[worst] <= REL_95:
+            return aside, r
+        aside.append((worst, r[worst]))
+        names.remove(worst)
+    return aside, {}
+
+
+def _refit(prep, fit, fixed):
+    prep.fixed = fixed
+    f = model.solve(prep, fit.shape, fit.causes, fit.nl)
+    return model.refine(prep, f, rounds=1)
+
+
+def apply(prep, diag, p0, say=print):
+    """Assesses the extended model of diag, holds what the log cannot tell
+    from the machine file and refits; replaces diag.extended and returns
+    the report's "identifiability" block."""
+    fit = diag.extended
+    aside, rest = assess(prep, fit, p0)
+    te = prep.test
+    free_rel = fit.relerr(prep, te)
+    fixed = {"Fc_ref_N": p0["Fc_N"]}
+    held, kept = [], []
+    best = fit
+    for k, r in aside:
+        if k not in HOLDABLE:
+            kept.append((k, r))
+            continue
+        trial = _refit(prep, fit, dict(fixed, **{k: p0.get(k, 0.0)}))
+        if _at_bound(fit, k) or not _tells(prep, trial, fit, free_rel):
+            fixed[k] = p0.get(k, 0.0)
+            held.append((k, r))
+            best = trial
+        else:
+            kept.append((k, r))
+    prep.fixed = fixed if held else None  # best was refitted with exactly these
+    diag.extended = best
+    out = {"method": "relative standard error at the machine file's values, sensitivities over the training part "
+                     f"(docs/diagnose.md, Identifiability); identified when {Z:g} rse <= {REL_95:g}",
+           "identified": {k: _r(v) for k, v in rest.items()},
+           "held": {}, "poorly_determined": {}}
+    for k, r in held:
+        out["held"][k] = {"value": p0.get(k, 0.0), "rse": _r(r),
+                          "why": f"the log cannot separate it (95 % interval ±{_pct(r)} of the machine file's value; "
+                                 f"it needs {NEEDS[k]}): taken from the machine file"}
+        say(f"identifiability: {k} not identified by this log (it needs {NEEDS[k]}): the machine file's "
+            f"{p0.get(k, 0.0):.4g} is used")
+    for k, r in kept:
+        out["poorly_determined"][k] = {"rse": _r(r),
+                                       "why": f"weakly determined (95 % interval ±{_pct(r)} of the machine file's "
+                                              f"value; it needs {NEEDS[k]}), but the log's fit differs from the "
+                                              "machine file's value by more than its residual allows: kept as fitted"}
+    if held:
+        say(f"identifiability: extended model refitted with {', '.join(k for k, _ in held)} held: held-out relerr "
+            f"{free_rel:.4g} % -> {best.relerr(prep, te):.4g} %")
+    return out
+
+
+def _at_bound(fit, name):
+    """The free fit put the parameter on its physical bound (model.COEF_LOWER):
+    the log pulls it beyond, to a non-physical value."""
+    coef = model.FIXED_COEF.get(name, (None,))[0]
+    if name == "dsigma2_neg_Nspm":
+        return fit.coef.get("sigma2_neg", 1.0) <= model.COEF_LOWER["sigma2_neg"]
+    return coef in model.COEF_LOWER and fit.coef.get(coef, 1.0) <= model.COEF_LOWER[coef]
+
+
+def _tells(prep, held, free, free_rel):
+    """The log tells the held model from the free one: its held-out relerr
+    rises by more than HOLD_TOL, or the free model's squared error is lower
+    consistently over the held-out blocks (selection's block test, p < P_MAX)."""
+    if held.relerr(prep, prep.test) > free_rel * (1.0 + HOLD_TOL) + 1e-9:
+        return True
+    return selection.block_p_value(prep, held.residual(prep), free.residual(prep)) < selection.P_MAX
+
+
+def _r(v):
+    return None if not math.isfinite(v) else float(v)
+
+
+def _pct(r):
+    return "∞" if not math.isfinite(r) else f"{100 * Z * r:.3g} %"
