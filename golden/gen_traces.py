@@ -35,6 +35,7 @@ import gen_est_traces  # noqa: E402
 import gen_ext_traces  # noqa: E402
 import gen_gms_traces  # noqa: E402
 import gen_mslip_traces  # noqa: E402
+import gen_mslip_model_traces  # noqa: E402
 
 SEED = 20240611  # base seed; trace i uses SEED + i (recorded in each header)
 SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
@@ -45,7 +46,7 @@ SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                # the Maxwell-slip plant (gen_gms_traces.py)
                "plant_gms": 8, "plant_gms_clamp": 9,
                # the firmware's Maxwell-slip kernel (gen_mslip_traces.py)
-               "mslip": 10}
+               "mslip": 10, "model_ms": 11}
 
 DT = 1.0e-3
 INT32_MAX = 2**31 - 1
@@ -449,6 +450,7 @@ def main(argv=None):
     paths.append(gen_ext_traces.generate(args.out, m, sys.modules[__name__]))
     paths += gen_gms_traces.generate(args.out, m, sys.modules[__name__])
     paths.append(gen_mslip_traces.generate(args.out, m, sys.modules[__name__]))
+    paths.append(gen_mslip_model_traces.generate(args.out, m, sys.modules[__name__]))
     for pth in paths:
         print("wrote", os.path.relpath(pth))
     return 0

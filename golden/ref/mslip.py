@@ -53,3 +53,23 @@ def presliding_curve(p, g, travel):
     k = np.asarray(p.k, dtype=np.float64)
     s = np.asarray(travel, dtype=np.float64)[:, None]
     return np.sum(k * np.minimum(-d + s, d), axis=1)
+
+
+def model_step(mp, p, theta, omega, gp, z, u, h, passes):
+    """The Maxwell-slip estimation model's step (docs/modules/model.md,
+    "Maxwell-slip model"): mp the eq. 6 parameters (ref.model.ModelParams),
+    the elements moved along the step's travel at the level g_p, the rigid
+    body by the trapezoidal rule solved by `passes` fixed-point passes from
+    omega_m = omega. Returns (theta1, omega1, z1)."""
+    z = np.asarray(z, dtype=np.float64)
+    f0 = force(p, z, 0.0)
+    om_m, th1, om1, z1 = omega, theta, omega, z
+    for _ in range(passes):
+        dth = om_m * h                                  # the step's rotation at the mean speed
+        z1 = move(p, z, mp.L * dth, gp)                 # its travel L dtheta, clamped at Delta_i(g_p)
+        f1 = force(p, z1, 0.0)
+        # J_eff (omega1 - omega) = u h - L^2 sigma2 dtheta - L h (f0 + f1) / 2
+        om1 = omega + (u * h - mp.L * mp.L * mp.sigma2 * dth - mp.L * h * 0.5 * (f0 + f1)) / mp.Jeff
+        th1 = theta + dth
+        om_m = 0.5 * (omega + om1)
+    return th1, om1, z1

@@ -8,7 +8,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "bristle/br_model.h"
 #include "bristle/br_mslip.h"
+#include "bristle_gen/machine/br_machine.h"
 
 /* four elements, shares 0.1-0.4 (a test choice; no machine value involved) */
 static br_mslip_cfg_t cfg4(void)
@@ -157,6 +159,79 @@ static void test_inner_loop_closes(void **state)
     }
 }
 
+/* the estimation model with elements (docs/modules/model.md, "Maxwell-slip model") */
+static br_model_cfg_t model_cfg4(void)
+{
+    br_model_cfg_t c;
+    memset(&c, 0, sizeof c);
+    c.J_kgm2 = BR_MACHINE_J_KGM2_F;
+    c.M_kg = BR_MACHINE_M_KG_F;
+    c.lead_mprad = BR_MACHINE_LEAD_MPRAD_F;
+    c.sigma2_Nspm = BR_MACHINE_SIGMA2_NSPM_F;
+    c.lugre.sigma0_Npm = BR_MACHINE_SIGMA0_NPM_F;
+    c.lugre.sigma1_Nspm = BR_MACHINE_SIGMA1_NSPM_F;
+    c.lugre.Fc_N = BR_MACHINE_FC_N_F;
+    c.lugre.Fs_N = BR_MACHINE_FS_N_F;
+    c.lugre.vs_mps = BR_MACHINE_VS_MPS_F;
+    c.dt_s = 1e-3f;
+    c.mslip = cfg4();
+    c.mslip.sigma2_Nspm = 0.0f;
+    return c;
+}
+
+static void test_model_guards(void **state)
+{
+    (void)state;
+    br_model_t m;
+    br_model_cfg_t c = model_cfg4();
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    /* the element set is checked, its viscous term is the model's sigma2 (must be 0) */
+    c = model_cfg4(); c.mslip.share[0] = 0.5f; assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = model_cfg4(); c.mslip.n = BR_MSLIP_MAX + 1; assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = model_cfg4(); c.mslip.sigma2_Nspm = 1.0f; assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    /* no cause but the delay with elements */
+    c = model_cfg4(); c.causes.offset_N = 1.0f; assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = model_cfg4(); c.causes.drift_per_s = 0.01f; assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = model_cfg4(); c.causes.delay_s = 1e-3f; assert_int_equal(br_model_init(&m, &c), BR_OK);
+    /* the element step needs elements */
+    float x[BR_NX] = {0.0f, 0.01f, 0.0f, 18.0f}, z[BR_MSLIP_MAX] = {1e-7f, 0.0f, 0.0f, 0.0f}, x1[BR_NX], z1[BR_MSLIP_MAX];
+    c = model_cfg4(); c.mslip.n = 0;
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    assert_int_equal(br_model_ms_step(&m, x, z, 0.0f, x1, z1), BR_E_STATE);
+    c = model_cfg4();
+    assert_int_equal(br_model_init(&m, &c), BR_OK);
+    assert_int_equal(br_model_ms_step(&m, x, NULL, 0.0f, x1, z1), BR_E_NULL);
+    /* bad input: BR_E_INPUT, outputs = inputs */
+    const float bad_gp[] = {0.0f, -1.0f, NAN};
+    for (size_t j = 0; j < 3; j++) {
+        float xb[BR_NX] = {0.0f, 0.01f, 0.0f, bad_gp[j]};
+        assert_int_equal(br_model_ms_step(&m, xb, z, 0.0f, x1, z1), BR_E_INPUT);
+        assert_memory_equal(x1, xb, sizeof xb);
+        assert_memory_equal(z1, z, 4 * sizeof(float));
+    }
+    z[2] = INFINITY;
+    assert_int_equal(br_model_ms_step(&m, x, z, 0.0f, x1, z1), BR_E_INPUT);
+    assert_memory_equal(x1, x, sizeof x);
+    z[2] = 0.0f;
+    assert_int_equal(br_model_ms_step(&m, x, z, NAN, x1, z1), BR_E_INPUT);
+    /* an overflowing torque: BR_E_NUMERIC, outputs = inputs */
+    assert_int_equal(br_model_ms_step(&m, x, z, 3e38f, x1, z1), BR_E_NUMERIC);
+    assert_memory_equal(x1, x, sizeof x);
+    assert_memory_equal(z1, z, 4 * sizeof(float));
+    /* in place, and at rest below the breakaway the axis sticks: over 20 s of a constant
+     * force of 0.5 Fs it stays within the largest element's breakaway (20 um), the
+     * elements carry the force, and the axis comes to rest (sigma2 damps it at
+     * sigma2 / (2 M_load) = 0.7 /s) */
+    float xs[BR_NX] = {0.0f, 0.0f, 0.0f, BR_MACHINE_FS_N_F}, zs[BR_MSLIP_MAX] = {0};
+    for (int j = 0; j < 20000; j++) {
+        assert_int_equal(br_model_ms_step(&m, xs, zs, 0.5f * BR_MACHINE_FS_N_F * BR_MACHINE_LEAD_MPRAD_F, xs, zs),
+                         BR_OK);
+    }
+    assert_true(fabsf(BR_MACHINE_LEAD_MPRAD_F * xs[BR_X_THETA]) < 0.4f * BR_MACHINE_FS_N_F / cfg4().k_Npm[3]);
+    BR_ASSERT_NEAR(br_model_ms_fnl_N(&m, zs), 0.5f * BR_MACHINE_FS_N_F, 0.05 * BR_MACHINE_FS_N_F);
+    assert_true(fabsf(BR_MACHINE_LEAD_MPRAD_F * xs[BR_X_OMEGA]) < 1e-6f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -164,6 +239,7 @@ int main(void)
         cmocka_unit_test(test_step_guards),
         cmocka_unit_test(test_bounded_and_sliding),
         cmocka_unit_test(test_inner_loop_closes),
+        cmocka_unit_test(test_model_guards),
     };
     return cmocka_run_group_tests_name("mslip", tests, NULL, NULL);
 }
