@@ -49,10 +49,10 @@ CHECKS = [
     ("test_golden_mslip.c", "force sum roundings", rf"#define C_F_SUM {NUM}", "### mslip",
      rf"\(n \+ {NUM}\)u·"),
     # model_ms
-    ("test_golden_model_ms.c", "theta_1", rf"#define C_THETA {NUM}", "### model_ms", rf"\| θ₁ \| {NUM}u·S_θ"),
-    ("test_golden_model_ms.c", "omega_1", rf"#define C_OMEGA {NUM}", "### model_ms", rf"\| ω₁ \| {NUM}u·S_ω"),
-    ("test_golden_model_ms.c", "z_1", rf"#define C_Z {NUM}", "### model_ms", rf"\| z_i,1 \| {NUM}u·S_z"),
-    ("test_golden_model_ms.c", "f_nl", rf"#define C_FNL {NUM}", "### model_ms", rf"\| f_nl \| {NUM}u·"),
+    ("test_golden_mslip.c", "theta_1", rf"#define C_THETA {NUM}", "### model_ms", rf"\| θ₁ \| {NUM}u·S_θ"),
+    ("test_golden_mslip.c", "omega_1", rf"#define C_OMEGA {NUM}", "### model_ms", rf"\| ω₁ \| {NUM}u·S_ω"),
+    ("test_golden_mslip.c", "z_1", rf"#define C_ZM {NUM}", "### model_ms", rf"\| z_i,1 \| {NUM}u·S_z"),
+    ("test_golden_mslip.c", "f_nl", rf"#define C_FNL {NUM}", "### model_ms", rf"\| f_nl \| {NUM}u·"),
     # lugre
     ("test_golden_lugre.c", "drift factor", rf"#define C_DRIFT {NUM}", "### lugre", rf"\| z \| {NUM}·D_k"),
     ("test_golden_lugre.c", "g", rf"g, {NUM} \* U32 \* g\)", "### lugre", rf"\| g \| {NUM}u·g"),
