@@ -34,6 +34,8 @@ from ref import plant as rplant  # noqa: E402
 import gen_est_traces  # noqa: E402
 import gen_ext_traces  # noqa: E402
 import gen_gms_traces  # noqa: E402
+import gen_mslip_traces  # noqa: E402
+import gen_mslip_model_traces  # noqa: E402
 
 SEED = 20240611  # base seed; trace i uses SEED + i (recorded in each header)
 SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
@@ -42,7 +44,9 @@ SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                # the extended model (gen_ext_traces.py)
                "model_ext": 7,
                # the Maxwell-slip plant (gen_gms_traces.py)
-               "plant_gms": 8, "plant_gms_clamp": 9}
+               "plant_gms": 8, "plant_gms_clamp": 9,
+               # the firmware's Maxwell-slip kernel (gen_mslip_traces.py)
+               "mslip": 10, "model_ms": 11}
 
 DT = 1.0e-3
 INT32_MAX = 2**31 - 1
@@ -445,6 +449,8 @@ def main(argv=None):
     paths += gen_est_traces.generate(args.out, m, sys.modules[__name__])
     paths.append(gen_ext_traces.generate(args.out, m, sys.modules[__name__]))
     paths += gen_gms_traces.generate(args.out, m, sys.modules[__name__])
+    paths.append(gen_mslip_traces.generate(args.out, m, sys.modules[__name__]))
+    paths.append(gen_mslip_model_traces.generate(args.out, m, sys.modules[__name__]))
     for pth in paths:
         print("wrote", os.path.relpath(pth))
     return 0

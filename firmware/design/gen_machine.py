@@ -95,6 +95,27 @@ def render_causes(m):
              " * all 0: the thesis model */", "#define BR_MACHINE_CAUSES \\", "{ \\"] + rows + ["}"])
 
 
+def render_mslip(m):
+    """BR_MACHINE_MSLIP, the br_mslip_cfg_t initialiser of the estimators'
+    Maxwell-slip friction (friction_model maxwell_slip); nothing for LuGre, so a
+    file without the section gives the header it gave before it existed."""
+    el = machine.mslip_elements(m)
+    if not el:
+        return []
+    k = ", ".join(machine.c_float(e[0]) for e in el)
+    a = ", ".join(machine.c_float(e[1]) for e in el)
+    return ["", "/* the estimators' friction (friction_model maxwell_slip, docs/modules/mslip.md): a",
+            " * br_mslip_cfg_t initialiser, k_i = share_i Fs / breakaway_i; the viscous friction",
+            " * stays the model's sigma2 (eq. 6), so the elements' own is 0 */",
+            "#define BR_MACHINE_MSLIP \\",
+            "{ \\",
+            "    .n = %d, \\" % len(el),
+            "    .k_Npm = {%s}, \\" % k,
+            "    .share = {%s}, \\" % a,
+            "    .sigma2_Nspm = 0.0f \\",
+            "}"]
+
+
 def est_fields(m):
     """The estimators' settings as the firmware takes them: per step, in its
     state's units, from the file's physical ones (machine.est_per_step)."""
@@ -186,6 +207,7 @@ def render_machine(m):
     ]
     out += render_defines(machine_fields(m, machine.params(m)))
     out += render_causes(m)
+    out += render_mslip(m)
     out += ["", "#endif", ""]
     return "\n".join(out)
 

@@ -37,6 +37,11 @@ PF_MAX_PARTICLES = 2048
 EST_AHEAD_MAX_PERIODS = 2.0
 # BR_DLYID_MAX_CAND of firmware/include/bristle/br_dlyid.h
 DLYID_MAX_CAND = 8
+# BR_MSLIP_MAX of firmware/include/bristle/br_mslip.h: the most Maxwell-slip elements
+MSLIP_MAX = 8
+# |sum of the shares - 1| accepted; tighter than the firmware's BR_MSLIP_SHARE_TOL (1e-5, on
+# float32 shares), so every file accepted here passes br_mslip_cfg_check
+MSLIP_SHARE_TOL = 1.0e-6
 # BR_EST_DELAY_HIST - 2 of firmware/include/bristle/br_est.h: the longest delay, in periods, an
 # estimator's command history holds
 EST_DELAY_MAX_PERIODS = 62
@@ -81,6 +86,30 @@ class Int(Num):
         if v < self.lo or v > self.hi:
             return None, "%d is outside %s" % (v, self.range_text())
         return v, None
+
+
+class NumList(Num):
+    """A list of n_lo..n_hi numbers, each in the range of Num."""
+
+    def __init__(self, lo, hi, n_lo, n_hi, doc, lo_open=False, hi_open=False):
+        super().__init__(lo, hi, doc, lo_open, hi_open)
+        self.n_lo, self.n_hi = n_lo, n_hi
+
+    def range_text(self):
+        return "a list of %d to %d numbers in %s" % (self.n_lo, self.n_hi, super().range_text())
+
+    def check(self, v):
+        if not isinstance(v, list):
+            return None, "expected a list of numbers, got %s" % _kind(v)
+        if not self.n_lo <= len(v) <= self.n_hi:
+            return None, "has %d entries, expected %d to %d" % (len(v), self.n_lo, self.n_hi)
+        out, each = [], Num(self.lo, self.hi, self.doc, self.lo_open, self.hi_open)
+        for i, e in enumerate(v):
+            x, problem = each.check(e)
+            if problem:
+                return None, "entry %d: %s" % (i, problem)
+            out.append(x)
+        return out, None
 
 
 class Str:
@@ -230,6 +259,15 @@ SCHEMA = {
             "drift_per_s": Num(-1.0, 1.0, "friction level scaled by max(0, 1 + drift_per_s t), t since the start"),
         }),
     },
+    # the estimators' friction model (docs/modules/mslip.md); absent = "lugre", the thesis model
+    "friction_model": Optional({
+        "model": Str(r"lugre|maxwell_slip", "the friction the estimators and the feedforward predict with: "
+                     "lugre (eqs. 3-5, the thesis) or maxwell_slip (the clamp form of presliding.md)"),
+        "breakaway_m": Optional(NumList(0.0, 1.0e-2, 1, MSLIP_MAX, "maxwell_slip: each element's breakaway "
+                                        "displacement at Fs_N, d_i (k_i = share_i Fs_N / d_i)", lo_open=True)),
+        "share": Optional(NumList(0.0, 1.0, 1, MSLIP_MAX, "maxwell_slip: each element's share of the "
+                                  "Stribeck level, summing to 1", lo_open=True)),
+    }),
     "control": {
         "period_s": Num(1.0e-5, 0.1, "control period (H-inf only, UKF)"),
         "estimator": Str(r"(pf|ukf|none)(,(pf|ukf|none))*", "the estimators the firmware image may run, in the "
@@ -465,6 +503,7 @@ def _cross_checks(m, errors):
     elif all(get(f) is not None for f in ("limits.travel_m", "limits.max_speed_mps", "friction.Fc_N",
                                         "mechanics.lead_m_per_rev", "encoder.counts_per_rev")):
         _soft_limit_checks(m, errors)
+    _friction_model_checks(get, errors)
     need(["encoder.counts_per_rev", "encoder.counter_bits"],
          lambda: get("encoder.counts_per_rev") <= 2 ** get("encoder.counter_bits"),
          "encoder.counts_per_rev", "more counts per revolution than the counter holds (2^counter_bits)")
@@ -492,6 +531,40 @@ def _soft_limit_checks(m, errors):
     if reach * counts_per_m >= 2.0 ** 31:
         errors.append(("limits.travel_m", "the stroke reaches %s m from position 0: %.4g counts, beyond the "
                        "int32 position count (2^31)" % (_g(reach), reach * counts_per_m)))
+def _friction_model_checks(get, errors):
+    """maxwell_slip needs its element set, lugre has none; the shares sum to 1."""
+    model = get("friction_model.model")
+    if model is None:
+        return
+    d, a = get("friction_model.breakaway_m"), get("friction_model.share")
+    if model == "lugre":
+        for f, v in (("breakaway_m", d), ("share", a)):
+            if v is not None:
+                errors.append(("friction_model." + f, "given with model lugre (only maxwell_slip has elements)"))
+        return
+    for f, v in (("breakaway_m", d), ("share", a)):
+        if v is None:
+            errors.append(("friction_model." + f, "missing (model maxwell_slip needs its element set)"))
+    if d is None or a is None:
+        return
+    extra = sorted(c for c in (get("causes") or {}) if c != "actuator_delay")
+    if extra:
+        errors.append(("friction_model.model", "maxwell_slip is not combined with the causes %s yet "
+                       "(only actuator_delay; docs/modules/model.md)" % ", ".join(extra)))
+    if len(d) != len(a):
+        errors.append(("friction_model.share", "has %d entries, breakaway_m %d" % (len(a), len(d))))
+    elif abs(math.fsum(a) - 1.0) > MSLIP_SHARE_TOL:
+        errors.append(("friction_model.share", "sums to %.9g, must be 1 (within %g)" % (math.fsum(a), MSLIP_SHARE_TOL)))
+
+
+def mslip_elements(m):
+    """The Maxwell-slip element set of the file as the firmware takes it:
+    [(k_i N/m, share_i)], k_i = share_i Fs / d_i; [] for the LuGre model."""
+    fm = m.get("friction_model") or {}
+    if fm.get("model") != "maxwell_slip":
+        return []
+    Fs = m["friction"]["Fs_N"]
+    return [(a * Fs / d, a) for d, a in zip(fm["breakaway_m"], fm["share"])]
 
 
 def display_name(path):

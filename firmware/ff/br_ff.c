@@ -6,6 +6,7 @@
 #include <stddef.h>
 
 #include "br_check.h"
+#include "br_mslip_kernel.h"
 
 #define BR_FF_2PI 6.28318530717958647692f
 
@@ -39,14 +40,43 @@ br_status_t br_ff_init(br_ff_t *ff, const br_ff_cfg_t *cfg)
         !br_finite_nonneg(cfg->mass_kg) || !br_finite_pos(cfg->comp_max_N) || !causes_ok(cfg)) {
         return BR_E_PARAM;
     }
+    /* the elements: a valid set whose viscous term is the feedforward's sigma2 (0 here) */
+    if (br_mslip_cfg_check(&cfg->mslip) != BR_OK || cfg->mslip.sigma2_Nspm != 0.0f) {
+        return BR_E_PARAM;
+    }
     ff->cfg = *cfg;
     ff->c_neg = (cfg->Fc_N + cfg->causes.dFc_neg_N) / cfg->Fc_N;
     ff->ripple_k_radpm = (cfg->causes.ripple_amp_N != 0.0f) ? BR_FF_2PI / cfg->causes.ripple_period_m : 0.0f;
     ff->in.v_mps = 0.0f;
     ff->in.a_mps2 = 0.0f;
     ff->in.p_m = 0.0f;
+    int i;
+    for (i = 0; i < BR_MSLIP_MAX; i++) {
+        /* Delta_i = c_i g, c_i = share_i / k_i; undeflected at the start */
+        ff->ms_c_mpN[i] = (i < cfg->mslip.n) ? cfg->mslip.share[i] / cfg->mslip.k_Npm[i] : 0.0f;
+        ff->ms_z_m[i] = 0.0f;
+    }
     ff->ready = 1;
     return BR_OK;
+}
+
+/* eq. 5, the Stribeck level at v (scaled by c in -x) */
+static float level_N(const br_ff_t *ff, float v)
+{
+    const br_ff_cfg_t *c = &ff->cfg;
+    float g = c->Fc_N + (c->Fs_N - c->Fc_N) * expf(-fabsf(v) / c->vs_mps);
+    if (v < 0.0f) {
+        g *= ff->c_neg;
+    }
+    return g;
+}
+
+/* the elements of the stored reference moved to in's position at the level g:
+ * z1_i = clamp(z_i + (p - p_stored), -c_i g, c_i g); returns sum k_i z1_i */
+static float elements_N(const br_ff_t *ff, const br_ff_in_t *in, float g, float z1[BR_MSLIP_MAX])
+{
+    const br_mslip_cfg_t *m = &ff->cfg.mslip;
+    return br_msk_move(m->n, m->k_Npm, ff->ms_c_mpN, ff->ms_z_m, z1, in->p_m - ff->in.p_m, g);
 }
 
 static int in_ok(const br_ff_in_t *in)
@@ -70,14 +100,12 @@ br_status_t br_ff_step(const br_ff_t *ff, const br_ff_in_t *in, float *comp_N)
     const br_causes_t *k = &c->causes;
     const float v = in->v_mps;
     const int neg = v < 0.0f;
-    /* eq. 5, the Stribeck level (scaled by c in -x) */
-    float g = c->Fc_N + (c->Fs_N - c->Fc_N) * expf(-fabsf(v) / c->vs_mps);
-    if (neg) {
-        g *= ff->c_neg;
-    }
-    /* the steady-state LuGre force with a smoothed sign, plus viscous friction */
+    const float g = level_N(ff, v);
+    /* the steady-state LuGre force with a smoothed sign (or the elements along the
+     * reference's path), plus viscous friction */
     const float s2 = neg ? c->sigma2_Nspm + k->dsigma2_neg_Nspm : c->sigma2_Nspm;
-    float f = tanhf(v / c->v_eps_mps) * g + s2 * v;
+    float z1[BR_MSLIP_MAX];
+    float f = ((c->mslip.n > 0) ? elements_N(ff, in, g, z1) : tanhf(v / c->v_eps_mps) * g) + s2 * v;
     /* position gradient k(p) */
     if (k->grad_per_m != 0.0f) {
         f *= fmaxf(0.0f, 1.0f + k->grad_per_m * in->p_m);
@@ -103,6 +131,15 @@ br_status_t br_ff_set_ref(br_ff_t *ff, const br_ff_in_t *in)
     }
     if (!in_ok(in)) {
         return BR_E_INPUT;
+    }
+    if (ff->cfg.mslip.n > 0 && ff->ready) {
+        /* the elements along the reference's travel since the stored one */
+        float z1[BR_MSLIP_MAX];
+        (void)elements_N(ff, in, level_N(ff, in->v_mps), z1);
+        int i;
+        for (i = 0; i < ff->cfg.mslip.n; i++) {
+            ff->ms_z_m[i] = z1[i];
+        }
     }
     ff->in = *in;
     return BR_OK;

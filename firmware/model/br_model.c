@@ -42,8 +42,24 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
         (c->ripple_amp_N != 0.0f && !br_finite_pos(c->ripple_period_m))) {
         return BR_E_PARAM;
     }
+    /* the Maxwell-slip friction: a valid element set, its viscous term the model's
+     * sigma2 (one home), and no cause beyond the delay (not combined yet) */
+    st = br_mslip_cfg_check(&cfg->mslip);
+    if (st != BR_OK) {
+        return st;
+    }
+    if (cfg->mslip.n > 0 && (cfg->mslip.sigma2_Nspm != 0.0f || c->offset_N != 0.0f || c->dFc_neg_N != 0.0f ||
+                             c->dsigma2_neg_Nspm != 0.0f || c->ripple_amp_N != 0.0f || c->grad_per_m != 0.0f ||
+                             c->drift_per_s != 0.0f)) {
+        return BR_E_PARAM;
+    }
     m->cfg = *cfg;
     float L = cfg->lead_mprad;
+    int i;
+    for (i = 0; i < BR_MSLIP_MAX; i++) {
+        /* Delta_i = c_i g_p, c_i = share_i / k_i */
+        m->ms_c_mpN[i] = (i < cfg->mslip.n) ? cfg->mslip.share[i] / cfg->mslip.k_Npm[i] : 0.0f;
+    }
     /* eq. 1: effective inertia on the motor side, J + L^2 M */
     m->inv_Jeff = 1.0f / (cfg->J_kgm2 + L * L * cfg->M_kg);
     m->visc_Nmsprad = L * L * cfg->sigma2_Nspm;
@@ -229,4 +245,42 @@ br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm,
     out[BR_X_THETA] += th0;
     copy_state(out, x_next);
     return BR_OK;
+}
+
+float br_model_ms_fnl_N(const br_model_t *m, const float z_m[])
+{
+    return br_msk_force(m->cfg.mslip.n, m->cfg.mslip.k_Npm, z_m);
+}
+
+br_status_t br_model_ms_step(const br_model_t *m, const float x[BR_NX], const float z_m[], float u_Nm,
+                             float x_next[BR_NX], float z_next_m[])
+{
+    if (m == NULL || x == NULL || z_m == NULL || x_next == NULL || z_next_m == NULL) {
+        return BR_E_NULL;
+    }
+    if (!m->ready || m->cfg.mslip.n < 1) {
+        return BR_E_STATE;
+    }
+    const int n = m->cfg.mslip.n;
+    float xo[BR_NX], zo[BR_MSLIP_MAX];
+    int ok = all_finite(x) && isfinite(u_Nm) && x[BR_X_GP] > 0.0f;
+    int i;
+    for (i = 0; i < n; i++) {
+        ok = ok && isfinite(z_m[i]);
+    }
+    if (!ok) {
+        copy_state(x, x_next);
+        for (i = 0; i < n; i++) {
+            z_next_m[i] = z_m[i];
+        }
+        return BR_E_INPUT;
+    }
+    const br_model_km_t k = br_model_km(m);
+    br_model_km_step(&k, x, z_m, u_Nm, xo, zo);
+    const int fin = all_finite(xo) && isfinite(br_msk_force(n, k.k, zo));
+    copy_state(fin ? xo : x, x_next);
+    for (i = 0; i < n; i++) {
+        z_next_m[i] = fin ? zo[i] : z_m[i];
+    }
+    return fin ? BR_OK : BR_E_NUMERIC;
 }

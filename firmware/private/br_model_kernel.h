@@ -17,6 +17,7 @@
 #include "bristle/br_model.h"
 #include "br_inline.h"
 #include "br_lugre_kernel.h"
+#include "br_mslip_kernel.h"
 
 typedef struct {
     float L;        /* lead, m/rad */
@@ -311,5 +312,54 @@ static inline int br_model_kx_rk4(const br_model_kx_t *k, const float x[BR_NX], 
  * speeds), for the thesis model and for the extended one. */
 void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u_Nm, float out[BR_NX]);
 void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float u_Nm, float out[BR_NX]);
+
+/* ---- The Maxwell-slip model's step (docs/modules/model.md, "Maxwell-slip model") ----
+ * x = [theta, omega, (unused), g_p] and the element deflections z[0..n-1]:
+ *   f0 = sum k_i z_i
+ *   pass p = 1..BR_MODEL_MS_PASSES (from omega_m = omega0):
+ *     dtheta = omega_m h;  z1_i = clamp(z_i + L dtheta, -c_i g_p, c_i g_p);  f1 = sum k_i z1_i
+ *     eq. 6 by the trapezoidal rule: Jeff (omega1 - omega0) = u h - L^2 sigma2 dtheta - L h (f0 + f1) / 2
+ *     omega_m = (omega0 + omega1) / 2
+ * z1 must not be z (the passes read z). */
+typedef struct {
+    float L;        /* lead, m/rad */
+    float visc;     /* L^2 sigma2 */
+    float inv_Jeff; /* 1 / (J + L^2 M) */
+    float h;        /* step, s */
+    float Lh_half;  /* L h / 2 */
+    int n;          /* elements */
+    const float *k; /* stiffness, N/m */
+    const float *c; /* share / k, m/N */
+} br_model_km_t;
+
+static inline br_model_km_t br_model_km(const br_model_t *m)
+{
+    const br_model_km_t k = {m->cfg.lead_mprad, m->visc_Nmsprad, m->inv_Jeff, m->cfg.dt_s,
+                             0.5f * m->cfg.lead_mprad * m->cfg.dt_s, m->cfg.mslip.n, m->cfg.mslip.k_Npm,
+                             m->ms_c_mpN};
+    return k;
+}
+
+BR_INLINE void br_model_km_step(const br_model_km_t *k, const float x[BR_NX], const float z[], float u,
+                                float out[BR_NX], float z1[])
+{
+    const float w0 = x[BR_X_OMEGA], gp = x[BR_X_GP];
+    const float f0 = br_msk_force(k->n, k->k, z);
+    const float uh = u * k->h;
+    float wm = w0, w1 = w0, dth = 0.0f;
+    int pass;
+    for (pass = 0; pass < BR_MODEL_MS_PASSES; pass++) {
+        dth = wm * k->h;
+        /* the elements along the travel L dtheta, clamped at c_i g_p */
+        const float f1 = br_msk_move(k->n, k->k, k->c, z, z1, k->L * dth, gp);
+        /* eq. 6, trapezoidal: Jeff (w1 - w0) = u h - L^2 sigma2 dtheta - L h (f0 + f1) / 2 */
+        w1 = w0 + (uh - k->visc * dth - k->Lh_half * (f0 + f1)) * k->inv_Jeff;
+        wm = 0.5f * (w0 + w1);
+    }
+    out[BR_X_THETA] = x[BR_X_THETA] + dth;
+    out[BR_X_OMEGA] = w1;
+    out[BR_X_Z] = x[BR_X_Z];
+    out[BR_X_GP] = gp;
+}
 
 #endif

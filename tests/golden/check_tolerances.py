@@ -43,6 +43,16 @@ CHECKS = [
     ("test_golden_pf.c", "f_nl in F-hat", rf"#define C_FNL {NUM}", "### pf", rf"\+ {NUM}u S_f,j"),
     ("test_golden_pf.c", "float32 sums", rf"#define C_SUM {NUM}", "### pf", rf"D_i \+ {NUM}m·u"),
     ("test_golden_pf.c", "br_exp_neg error", rf"#define EXP_REL {NUM}", "### pf", rf"ρ = {NUM} \+"),
+    # mslip
+    ("test_golden_mslip.c", "element bound factor", rf"#define C_Z {NUM}", "### mslip",
+     rf"\| z_i \| {NUM}·E_i"),
+    ("test_golden_mslip.c", "force sum roundings", rf"#define C_F_SUM {NUM}", "### mslip",
+     rf"\(n \+ {NUM}\)u·"),
+    # model_ms
+    ("test_golden_mslip.c", "theta_1", rf"#define C_THETA {NUM}", "### model_ms", rf"\| θ₁ \| {NUM}u·S_θ"),
+    ("test_golden_mslip.c", "omega_1", rf"#define C_OMEGA {NUM}", "### model_ms", rf"\| ω₁ \| {NUM}u·S_ω"),
+    ("test_golden_mslip.c", "z_1", rf"#define C_ZM {NUM}", "### model_ms", rf"\| z_i,1 \| {NUM}u·S_z"),
+    ("test_golden_mslip.c", "f_nl", rf"#define C_FNL {NUM}", "### model_ms", rf"\| f_nl \| {NUM}u·"),
     # lugre
     ("test_golden_lugre.c", "drift factor", rf"#define C_DRIFT {NUM}", "### lugre", rf"\| z \| {NUM}·D_k"),
     ("test_golden_lugre.c", "g", rf"g, {NUM} \* U32 \* g\)", "### lugre", rf"\| g \| {NUM}u·g"),

@@ -53,6 +53,59 @@ def expect_errors(work, name, obj, wanted):
               "%s: %s exits 1 with the messages, no traceback (rc %d)" % (name, script, rc))
 
 
+def friction_model_cases(work, good):
+    """friction_model (docs/machine-file.md): the Maxwell-slip element set, each
+    refusal the firmware's br_mslip_cfg_check / br_model_init would make, and a
+    valid set's header (BR_MACHINE_MSLIP: k_i = share_i Fs / d_i)."""
+    def fm(**kw):
+        b = copy.deepcopy(good)
+        b["friction_model"] = dict({"model": "maxwell_slip", "breakaway_m": [2e-6, 5e-6, 1e-5, 2e-5],
+                                    "share": [0.25, 0.25, 0.25, 0.25]}, **kw)
+        return b
+    expect_errors(work, "fm-sum.json", fm(share=[0.25, 0.25, 0.25, 0.26]),
+                  ["field friction_model.share: sums to 1.01, must be 1 (within 1e-06)"])
+    expect_errors(work, "fm-len.json", fm(share=[0.5, 0.5]),
+                  ["field friction_model.share: has 2 entries, breakaway_m 4"])
+    expect_errors(work, "fm-many.json", fm(breakaway_m=[1e-6] * 9, share=[1.0 / 9] * 9),
+                  ["field friction_model.breakaway_m: has 9 entries, expected 1 to 8",
+                   "field friction_model.share: has 9 entries, expected 1 to 8"])
+    expect_errors(work, "fm-range.json", fm(breakaway_m=[2e-6, 0.0, 1e-5, 2e-5], share=[0.25, 0.25, "a", 0.25]),
+                  ["field friction_model.breakaway_m: entry 1: 0 is outside (0, 0.01]",
+                   "field friction_model.share: entry 2: expected a number, got a string"])
+    b = fm()
+    del b["friction_model"]["share"]
+    expect_errors(work, "fm-missing.json", b,
+                  ["field friction_model.share: missing (model maxwell_slip needs its element set)"])
+    expect_errors(work, "fm-lugre.json", fm(model="lugre"),
+                  ["field friction_model.breakaway_m: given with model lugre (only maxwell_slip has elements)",
+                   "field friction_model.share: given with model lugre (only maxwell_slip has elements)"])
+    expect_errors(work, "fm-model.json", fm(model="gms"),
+                  ["field friction_model.model: 'gms' does not match lugre|maxwell_slip"])
+    b = fm()
+    b["causes"] = {"offset": {"offset_N": 1.0}}
+    expect_errors(work, "fm-causes.json", b, ["field friction_model.model: maxwell_slip is not combined with the "
+                                              "causes offset yet (only actuator_delay; docs/modules/model.md)"])
+    m = machine.load(write(work, "fm-ok.json", fm()))
+    check(machine.mslip_elements(m) == [(0.25 * 18.0 / d, 0.25) for d in (2e-6, 5e-6, 1e-5, 2e-5)]
+          if m["friction"]["Fs_N"] == 18.0 else len(machine.mslip_elements(m)) == 4,
+          "friction_model: k_i = share_i Fs / d_i")
+    rc, err = run("gen_machine.py", "--machine", os.path.join(work, "fm-ok.json"), "--gen-root", work)
+    with open(os.path.join(work, "bristle_gen", "machine", "br_machine.h")) as f:
+        h = f.read()
+    check(rc == 0 and "#define BR_MACHINE_MSLIP" in h and ".n = 4," in h,
+          "friction_model maxwell_slip: gen_machine.py writes BR_MACHINE_MSLIP")
+    lug = copy.deepcopy(good)
+    lug["friction_model"] = {"model": "lugre"}
+    rc, err = run("gen_machine.py", "--machine", write(work, "fm-lugre-ok.json", lug), "--gen-root", work)
+    with open(os.path.join(work, "bristle_gen", "machine", "br_machine.h")) as f:
+        h = f.read()
+    check(rc == 0 and "BR_MACHINE_MSLIP" not in h, "friction_model lugre: no element set in the header")
+    # the firmware's limit is the schema's
+    with open(os.path.join(REPO, "firmware", "include", "bristle", "br_mslip.h")) as f:
+        mm = re.search(r"#define\s+BR_MSLIP_MAX\s+([0-9]+)", f.read())
+    check(mm is not None and int(mm.group(1)) == machine.MSLIP_MAX, "br_mslip.h: BR_MSLIP_MAX is the schema's")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--work", required=True)
@@ -132,6 +185,7 @@ def main():
     m = machine.load(write(work, "provenance-ok.json", ok))
     check(machine.provenance(m, "friction.Fc_N") == "identified" and machine.provenance(m, "friction.Fs_N") == "given",
           "provenance: a listed field has its kind, an unlisted one is given")
+    friction_model_cases(work, good)
     bad = copy.deepcopy(good)
     bad["format_version"] = 3
     expect_errors(work, "version.json", bad, ["field format_version: 3 is not a version this loader reads (2)"])

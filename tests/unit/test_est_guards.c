@@ -68,6 +68,25 @@ static void test_pf_needs_gp_noise(void **st)
     free(pf);
 }
 
+/* an element set in the model is refused by both estimators (not wired yet) */
+static void test_mslip_refused(void **st)
+{
+    (void)st;
+    br_pf_t *pf = calloc(1, sizeof *pf);
+    br_ukf_t *ukf = calloc(1, sizeof *ukf);
+    assert_non_null(pf);
+    assert_non_null(ukf);
+    br_pf_cfg_t c = br_circle_pf_cfg_tuned(PF_DT_S);
+    br_ukf_cfg_t u = br_circle_ukf_cfg_tuned(UKF_DT_S);
+    const br_mslip_cfg_t ms = {.n = 1, .k_Npm = {1.0e6f}, .share = {1.0f}};
+    c.est.model.mslip = ms;
+    u.est.model.mslip = ms;
+    assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
+    assert_int_equal(br_ukf_init(ukf, &u), BR_E_PARAM);
+    free(pf);
+    free(ukf);
+}
+
 static void test_ukf_p0_bounds(void **st)
 {
     (void)st;
@@ -264,6 +283,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_variance_bounds),
         cmocka_unit_test(test_pf_needs_gp_noise),
+        cmocka_unit_test(test_mslip_refused),
         cmocka_unit_test(test_ukf_p0_bounds),
         cmocka_unit_test(test_pf_log_weight_overflow),
         cmocka_unit_test(test_ukf_recovers_from_huge_covariance),

@@ -186,6 +186,55 @@ static void test_est_adapter(void **st)
     assert_int_equal(br_ff_est_step(NULL, &y, 0.0f, &got), BR_E_NULL);
 }
 
+/* the Maxwell-slip feedforward: guards, and the elements along the reference's
+ * path against the clamp written here in double, through a reversal and an inner loop */
+static void test_mslip_elements(void **st)
+{
+    (void)st;
+    br_ff_t ff;
+    br_ff_cfg_t c = ref_cfg();
+    c.mslip.n = 2;
+    c.mslip.k_Npm[0] = 2.25e6f; c.mslip.k_Npm[1] = 2.25e5f; /* breakaways 2 and 20 um at 18 N, shares 1/4, 3/4 */
+    c.mslip.share[0] = 0.25f; c.mslip.share[1] = 0.75f;
+    assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    br_ff_cfg_t b = c;
+    b.mslip.share[1] = 0.5f; /* shares not summing to 1 */
+    assert_int_equal(br_ff_init(&ff, &b), BR_E_PARAM);
+    b = c;
+    b.mslip.sigma2_Nspm = 1.0f; /* the viscous term is the feedforward's sigma2 */
+    assert_int_equal(br_ff_init(&ff, &b), BR_E_PARAM);
+    b = c;
+    b.mslip.n = -1;
+    assert_int_equal(br_ff_init(&ff, &b), BR_E_PARAM);
+    assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    double z[2] = {0.0, 0.0}, p_prev = 0.0;
+    const double k[2] = {2.25e6, 2.25e5}, a[2] = {0.25, 0.75};
+    for (int j = 0; j < 400; j++) {
+        /* 30 um out, 12 um back (an inner reversal), out again */
+        const double p = (j < 150) ? 0.2e-6 * j : (j < 210) ? 30e-6 - 0.2e-6 * (j - 150) : 18e-6 + 0.2e-6 * (j - 210);
+        const double v = (j < 150 || j >= 210) ? 2e-5 : -2e-5;
+        const br_ff_in_t in = {(float)v, 0.0f, (float)p};
+        if (j == 209) { /* after the inner reversal the 20 um element holds a deflection inside its bound */
+            assert_true(fabsf(ff.ms_z_m[1]) < 0.5f * 0.75f * c.Fs_N / 2.25e5f && ff.ms_z_m[1] != 0.0f);
+        }
+        float F = 0.0f, F2 = 0.0f;
+        /* evaluated before it is stored: the elements moved by the travel, not stored */
+        assert_int_equal(br_ff_step(&ff, &in, &F), BR_OK);
+        assert_int_equal(br_ff_set_ref(&ff, &in), BR_OK);
+        assert_int_equal(br_ff_est_step(&ff, NULL, 0.0f, &F2), BR_OK);
+        assert_true(F == F2);
+        const double g = (double)c.Fc_N + ((double)c.Fs_N - c.Fc_N) * exp(-fabs(v) / c.vs_mps);
+        double f = 0.0;
+        for (int i = 0; i < 2; i++) {
+            const double d = a[i] * g / k[i];
+            z[i] = fmin(fmax(z[i] + ((double)(float)p - p_prev), -d), d);
+            f += k[i] * z[i];
+        }
+        p_prev = (double)(float)p;
+        BR_ASSERT_NEAR(F, f + (double)c.sigma2_Nspm * (float)v, 1e-4 * (double)c.Fs_N);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -194,6 +243,7 @@ int main(void)
         cmocka_unit_test(test_map_causes_and_inertia),
         cmocka_unit_test(test_clamp_and_inputs),
         cmocka_unit_test(test_est_adapter),
+        cmocka_unit_test(test_mslip_elements),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -12,12 +12,19 @@
  *
  * with v, a, p the reference's load-side velocity, acceleration and position.
  * The causes are those of br_causes_t (a diagnosis's model.json); the actuator
- * delay has no static map and is ignored. */
+ * delay has no static map and is ignored.
+ *
+ * With a Maxwell-slip element set (cfg.mslip.n >= 1, docs/modules/mslip.md) the
+ * term s(v) g(v) is replaced by the elements driven along the reference's
+ * position path: br_ff_set_ref moves them by the travel p - p_prev at the level
+ * g(v) (z_i <- clamp(z_i + dp, -share_i g / k_i, +share_i g / k_i)), and the
+ * term is sum_i k_i z_i: the presliding memory a static map has not. */
 #ifndef BR_FF_H
 #define BR_FF_H
 
 #include "bristle/br_est.h"
 #include "bristle/br_model.h"
+#include "bristle/br_mslip.h"
 #include "bristle/br_status.h"
 
 typedef struct {
@@ -29,6 +36,8 @@ typedef struct {
     float mass_kg;      /* moving mass of the inertia term M a, >= 0 (0: off) */
     float comp_max_N;   /* output clamp, > 0 (the controller's tau_max / L) */
     br_causes_t causes; /* diagnosed causes as feedforward maps; delay_s ignored */
+    br_mslip_cfg_t mslip; /* n = 0: the static map; n >= 1: the Maxwell-slip elements along the
+                             reference (their sigma2 must be 0: the viscous term is sigma2_Nspm) */
 } br_ff_cfg_t;
 
 /* The reference at t_k, load side. */
@@ -43,6 +52,8 @@ typedef struct {
     float c_neg;          /* (Fc + dFc_neg) / Fc */
     float ripple_k_radpm; /* 2 pi / P, 0 without ripple */
     br_ff_in_t in;        /* the reference br_ff_est_step evaluates (br_ff_set_ref) */
+    float ms_c_mpN[BR_MSLIP_MAX]; /* share_i / k_i */
+    float ms_z_m[BR_MSLIP_MAX];   /* the elements at the stored reference's position */
     int ready;
 } br_ff_t;
 
@@ -51,12 +62,13 @@ typedef struct {
  * reference starts at rest at 0. BR_OK, BR_E_NULL or BR_E_PARAM. */
 br_status_t br_ff_init(br_ff_t *ff, const br_ff_cfg_t *cfg);
 
-/* comp_N for the reference in. BR_E_NULL, BR_E_STATE (not initialised),
+/* comp_N for the reference in (with elements: those of the stored reference moved
+ * by in's travel from it, without storing them). BR_E_NULL, BR_E_STATE (not initialised),
  * BR_E_INPUT (a non-finite input; *comp_N = 0). */
 br_status_t br_ff_step(const br_ff_t *ff, const br_ff_in_t *in, float *comp_N);
 
 /* Keeps the reference br_ff_est_step evaluates: the caller sets it before
- * each br_app_step. BR_E_INPUT (non-finite; the stored one is kept). */
+ * each br_app_step (with elements: they move by the travel from the stored one). BR_E_INPUT (non-finite; the stored one is kept). */
 br_status_t br_ff_set_ref(br_ff_t *ff, const br_ff_in_t *in);
 
 /* br_est_step_fn over a br_ff_t (ctx): the feedforward as the compensation

@@ -34,6 +34,11 @@
         .max_following_m = BR_MACHINE_MAX_FOLLOWING_M_F, .travel_m = BR_MACHINE_TRAVEL_M_F,        \
         .travel_min_m = BR_MACHINE_TRAVEL_MIN_M_F, .period_s = BR_MACHINE_LOOP_PERIOD_S_F          \
     }
+/* the estimators' friction: the machine file's friction_model (BR_MACHINE_MSLIP, written
+ * only for maxwell_slip); without it n = 0, LuGre (eqs. 3-5) */
+#ifndef BR_MACHINE_MSLIP
+#define BR_MACHINE_MSLIP {.n = 0}
+#endif
 
 /* an estimator's delay identification (E: PF or UKF; docs/modules/dlyid.md; 0 candidates: off) */
 #define BR_MACHINE_DELAY_ID_CFG(E)                                                                 \
@@ -52,7 +57,7 @@
         .lugre = {.sigma0_Npm = BR_MACHINE_SIGMA0_NPM_F, .sigma1_Nspm = BR_MACHINE_SIGMA1_NSPM_F,  \
                   .Fc_N = BR_MACHINE_FC_N_F, .Fs_N = BR_MACHINE_FS_N_F,                            \
                   .vs_mps = BR_MACHINE_VS_MPS_F},                                                  \
-        .dt_s = (dt), .causes = BR_MACHINE_CAUSES                                                  \
+        .dt_s = (dt), .causes = BR_MACHINE_CAUSES, .mslip = BR_MACHINE_MSLIP                       \
     }
 
 /* The PF at period dt with the process noise q_omega, q_z, q_gp and the

@@ -15,6 +15,7 @@
 #include <stdint.h>
 
 #include "bristle/br_lugre.h"
+#include "bristle/br_mslip.h"
 #include "bristle/br_status.h"
 
 enum { BR_X_THETA = 0, BR_X_OMEGA = 1, BR_X_Z = 2, BR_X_GP = 3, BR_NX = 4 };
@@ -54,7 +55,14 @@ typedef struct {
     br_lugre_cfg_t lugre;
     float dt_s;         /* discretisation step, > 0 */
     br_causes_t causes; /* all 0: the thesis model */
+    br_mslip_cfg_t mslip; /* n = 0: LuGre (eqs. 3-5, the thesis); n >= 1: the Maxwell-slip friction
+                             in clamp form with the level g_p (docs/modules/model.md, "Maxwell-slip
+                             model"); its sigma2 must be 0 (the viscous friction is sigma2_Nspm) and
+                             no cause but the delay may be on */
 } br_model_cfg_t;
+
+/* Fixed-point passes of the Maxwell-slip model's trapezoidal step (docs/modules/model.md). */
+#define BR_MODEL_MS_PASSES 2
 
 typedef struct {
     br_model_cfg_t cfg;
@@ -66,6 +74,7 @@ typedef struct {
     float ripple_k_radpm;  /* 2 pi / P (0 without ripple) */
     uint32_t n_steps;      /* the model's clock: steps of dt_s since init (saturates) */
     float drift_k;         /* s(t) = max(0, 1 + drift n_steps dt_s): the friction scale now (1 without drift) */
+    float ms_c_mpN[BR_MSLIP_MAX]; /* Maxwell-slip: share_i / k_i (Delta_i = c_i g_p) */
     int ready;
 } br_model_t;
 
@@ -103,5 +112,18 @@ br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm,
  * p0_m (the estimators keep theta relative to an integer count origin). */
 br_status_t br_model_step_at(const br_model_t *m, const float x[BR_NX], float p0_m, float u_Nm,
                              float x_next[BR_NX]);
+
+/* The Maxwell-slip model (cfg.mslip.n >= 1): the friction is that of the
+ * element deflections z_m[0..n-1], which the caller carries beside x (x[BR_X_Z]
+ * is not used and is carried unchanged). br_model_ms_fnl_N: sum_i k_i z_i.
+ * br_model_ms_step: one step of dt_s with u held (theta absolute or relative:
+ * the model does not depend on it): the elements clamp-moved along the
+ * step's travel at the level g_p, the rigid body by the trapezoidal rule in
+ * BR_MODEL_MS_PASSES fixed-point passes. z_next_m may be z_m, x_next may be x.
+ * BR_E_STATE without elements; non-finite x, z or u, or g_p <= 0, give
+ * BR_E_INPUT, a non-finite result BR_E_NUMERIC, both with the outputs = inputs. */
+float br_model_ms_fnl_N(const br_model_t *m, const float z_m[]);
+br_status_t br_model_ms_step(const br_model_t *m, const float x[BR_NX], const float z_m[], float u_Nm,
+                             float x_next[BR_NX], float z_next_m[]);
 
 #endif
