@@ -101,7 +101,7 @@ class ToolsTest(unittest.TestCase):
             self.assertIn("usage:", r.stderr)
             self.assert_untouched(out)
         r = run("br_simlog", "--out", out, "--machine-out", os.path.join(self.w, "m.json"), "--traj", "circle")
-        self.assert_refused(r, 2, "ident only")
+        self.assert_refused(r, 2, "does not apply to --traj circle")
         self.assert_untouched(out)
 
     def test_simlog_failed_run_writes_nothing(self):
