@@ -20,8 +20,8 @@ import sys
 import time
 
 from .. import __version__
-from . import (causes, closedloop, logreader, machinefile, machinejson, model, modelfile, output, report, selection,
-               signals)
+from . import (causes, closedloop, logreader, machinefile, machinejson, model, modelfile, output, plausible, report,
+               selection, signals)
 
 # Exit statuses (docs/diagnose.md, "Exit status")
 EXIT_OK = 0
@@ -86,6 +86,10 @@ def cmd_diagnose(args):
                                          f"{lg.dt:.6g} s")
     say(f"{args.log}: {lg.n} samples at {1e3 * lg.dt:.4g} ms" +
         (f" (of {lg.n_total}: the first {lg.n} are used)" if lg.n_total > lg.n else ""))
+    # samples no axis within the machine's limits produces: replaced, or the log refused
+    impossible = plausible.check(lg, given)
+    for line in plausible.describe(impossible):
+        log.warning("%s: %s", args.log, line)
     prep = signals.Prepared(lg, fc_hz=args.fc)
     log.debug("low-pass cutoff %g Hz", args.fc)
     t0 = time.monotonic()
@@ -104,6 +108,8 @@ def cmd_diagnose(args):
     with output.Staging(args.out) as stage:
         out = stage.dir
         rep = report.build(prep, diag, machine=machine, closed=closed, log_path=args.log)
+        if impossible:
+            rep["impossible_samples"] = output.rounded(impossible)
         output.write_json(os.path.join(out, "report.json"), rep)
         output.write_json(os.path.join(out, "model.json"), modelfile.build(prep, diag, log_path=args.log))
         machinejson.write(out, prep, diag, given, args.log, say)
