@@ -50,20 +50,17 @@ def _plots():
     return plots
 
 
+# what a diagnosis writes into OUT (output.check_out: OUT is replaced as a whole)
+OUTPUT_NAMES = frozenset(("report.json", "model.json", "machine.json", "report.md", CLOSED_LOOP_FIGURE[0]) +
+                         tuple(f[0] for f in FIGURES))
+
+
 def check_out(out):
-    """OUT before the fit: an existing directory, or a new one whose nearest
-    existing parent is a directory this process may write in."""
-    p = os.path.abspath(out)
-    if os.path.exists(p):
-        if not os.path.isdir(p):
-            raise logreader.LogError(out, 0, "--out names an existing file, not a directory")
-    else:
-        while not os.path.exists(p):
-            p = os.path.dirname(p)
-        if not os.path.isdir(p):
-            raise logreader.LogError(out, 0, f"--out cannot be created: {p} is not a directory")
-    if not os.access(p, os.W_OK | os.X_OK):
-        raise logreader.LogError(out, 0, f"--out cannot be written: no permission in {p}")
+    """OUT before the fit (output.check_out): new, empty or a previous
+    diagnosis's, in a folder this process may write in."""
+    problem = output.check_out(out, OUTPUT_NAMES)
+    if problem:
+        raise logreader.LogError(out, 0, problem)
 
 
 def cmd_diagnose(args):
@@ -104,7 +101,7 @@ def cmd_diagnose(args):
             raise closedloop.ControllerError(f"{mpath}: {e}") from None
         closed = {"controller": f"{mpath} ({ctrl['type']})",
                   **{name: {k: v for k, v in s.items() if k.startswith("relerr")} for name, s in sims.items()}}
-    # every output into a staging folder, moved into OUT at the end (output.Staging)
+    # every output into a staging folder that takes OUT's place at the end (output.Staging)
     with output.Staging(args.out) as stage:
         out = stage.dir
         rep = report.build(prep, diag, machine=machine, closed=closed, log_path=args.log)
@@ -200,7 +197,8 @@ def parser(prog="bristle-diagnose"):
     d.add_argument("--log", required=True, metavar="CSV",
                    help="the measured log (../shared/spec/measured-log.md: t, pos, force columns)")
     d.add_argument("--out", required=True, metavar="DIR",
-                   help="output directory (created if needed; existing files in it are replaced)")
+                   help="output directory, replaced as a whole when the run succeeds: new, empty, or a previous "
+                        "diagnosis's (a folder holding other files is refused)")
     d.add_argument("--machine", metavar="JSON",
                    help="the log's controller file, or a firmware machine file (format 2) whose values "
                         "machine.json takes; default: <log>.machine.json beside the log, else a file of "
