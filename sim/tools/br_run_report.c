@@ -18,6 +18,7 @@ const char *br_run_fault_name(int cause)
     case BR_APP_FAULT_DEADLINE: return "deadline";
     case BR_APP_FAULT_HAL: return "hal";
     case BR_APP_FAULT_LOST_LOCK: return "lost_lock";
+    case BR_RUN_CAUSE_NOT_FOLLOWED: return "not_followed";
     default: return "unknown";
     }
 }
