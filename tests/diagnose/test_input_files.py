@@ -7,7 +7,8 @@ open_regular, jsonfile.py, modelfile.py; firmware/design/machine.py load):
   validate --model, and to the machine-file loader: exit 1 at once with the
   file named (before: /dev/zero and a FIFO hung the diagnosis);
 - "causes": ["offset", "offset"] (applied the offset twice) and a field
-  given twice in a model file: refused with the field named.
+  given twice in a model file: refused with the field named;
+- the 1 MiB limit of a model file: exactly 1 MiB read, one byte more refused.
 
 Each command runs under a timeout: a guard that is missing hangs, and the
 timeout fails the test.
@@ -97,6 +98,23 @@ class InputFiles(unittest.TestCase):
         r = run("validate", "--model", path, "--log", self.log)
         self.assertEqual(r.returncode, 1, r.stdout)
         self.assertRegex(r.stderr, r"dupkey\.json:\d+: field \"Fc_N\" given twice")
+
+    def test_size_limit(self):
+        """jsonfile.MAX_BYTES (1 MiB, the C loader's): a model padded with spaces
+        to exactly 1 MiB validates, one byte more is refused"""
+        with open(self.model) as f:
+            text = f.read().rstrip("\n")
+        path = os.path.join(ARGS.work, "padded.json")
+        for size, ok in ((1 << 20, True), ((1 << 20) + 1, False)):
+            with open(path, "w") as f:
+                f.write(text + " " * (size - len(text.encode())))
+            self.assertEqual(os.path.getsize(path), size)
+            r = run("validate", "--model", path, "--log", self.log)
+            if ok:
+                self.assertEqual(r.returncode, 0, r.stderr)
+            else:
+                self.assertEqual(r.returncode, 1, r.stdout)
+                self.assertIn(f"{path}:0: larger than 1 MiB", r.stderr)
 
 
 if __name__ == "__main__":
