@@ -11,11 +11,9 @@ docs/diagnose.md "Impossible samples"):
   with the line named.
 
 Usage: test_impossible.py --simlog BIN --work DIR"""
-import argparse
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
 import unittest
@@ -23,6 +21,8 @@ import unittest
 import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import work_args  # noqa: E402
 sys.path.insert(0, os.path.join(REPO, "python"))
 from bristle.diagnose import logreader, machinejson, plausible  # noqa: E402
 
@@ -169,10 +169,4 @@ class Audit(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--simlog", required=True)
-    ap.add_argument("--work", required=True)
-    ARGS, rest = ap.parse_known_args()
-    shutil.rmtree(ARGS.work, ignore_errors=True)
-    os.makedirs(ARGS.work)
-    unittest.main(argv=[sys.argv[0]] + rest)
+    work_args.main(sys.modules[__name__])

@@ -14,15 +14,16 @@ Each command runs under a timeout: a guard that is missing hangs, and the
 timeout fails the test.
 
 Usage: test_input_files.py --simlog BIN --work DIR"""
-import argparse
 import json
 import os
-import shutil
 import subprocess
 import sys
 import unittest
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import work_args  # noqa: E402
+
 ARGS = None
 TIMEOUT_S = 60
 
@@ -118,10 +119,4 @@ class InputFiles(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--simlog", required=True)
-    ap.add_argument("--work", required=True)
-    ARGS, rest = ap.parse_known_args()
-    shutil.rmtree(ARGS.work, ignore_errors=True)
-    os.makedirs(ARGS.work)
-    unittest.main(argv=[sys.argv[0]] + rest)
+    work_args.main(sys.modules[__name__])
