@@ -13,6 +13,7 @@ and writes every output through br_outfile (docs/tools.md):
 - a good log with quoted cells, a byte-order mark, CRLF, spaces, extra
   columns and blank lines tracks as the plain one does;
 - --trace writes its files only when every run succeeded;
+- br_pf_study refuses a FIFO as --table at once;
 - br_bench checks its --json and --record destinations before the run
   (a folder as --record: exit 1, nothing run, an existing --json byte for
   byte; it wrote them with fopen after a run of minutes).
@@ -119,6 +120,20 @@ class TrackInput(unittest.TestCase):
         self.assertEqual(os.listdir(tdir), ["track_hinf_only.csv"])
         with open(os.path.join(tdir, "track_hinf_only.csv")) as f:
             self.assertEqual(len(f.read().splitlines()), 1 + 1000)
+
+
+class PfStudyTable(unittest.TestCase):
+    def test_fifo_table_refused(self):
+        """br_pf_study --table FIFO: refused at once (its open waited for a writer)"""
+        w = os.path.join(ARGS.work, "pf_table")
+        shutil.rmtree(w, ignore_errors=True)
+        os.makedirs(w)
+        fifo = os.path.join(w, "fifo")
+        os.mkfifo(fifo)
+        r = subprocess.run([os.path.join(ARGS.bin, "br_pf_study"), "--table", fifo], capture_output=True, text=True,
+                           timeout=60)
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn(f"{fifo}: not a regular file", r.stderr)
 
 
 class BenchOutputs(unittest.TestCase):
