@@ -11,7 +11,6 @@ none of the previous run's, and an OUT holding other files, or the current
 directory, is refused.
 
 Usage: test_output_atomic.py --simlog BIN --work DIR"""
-import argparse
 import os
 import shutil
 import subprocess
@@ -21,6 +20,9 @@ import unittest
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "python"))
 from bristle.diagnose import output  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import work_args  # noqa: E402
 
 ARGS = None
 
@@ -201,8 +203,4 @@ class AtomicOutputTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--simlog", required=True)
-    ap.add_argument("--work", required=True)
-    ARGS, rest = ap.parse_known_args()
-    unittest.main(argv=[sys.argv[0]] + rest)
+    work_args.main(sys.modules[__name__])
