@@ -14,6 +14,7 @@ import json
 import math
 import os
 import re
+import stat
 import struct
 import sys
 
@@ -579,6 +580,9 @@ def load(path=REFERENCE_MACHINE):
     (its display name). Raises MachineError listing every problem."""
     name = display_name(path)
     try:
+        # a device or a FIFO would block or never end: only a regular file is read
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            raise MachineError(["%s: cannot read: not a regular file (a device, a FIFO or a folder)" % name])
         with open(path, "r", encoding="utf-8") as f:
             text = f.read()
     except OSError as e:

@@ -10,10 +10,12 @@
  *            z m^2, g_p N^2; --r measurement variance in counts^2
  * Prints one JSON object: contour_rms_m, max_err_m, fhat_rms_err_N, outliers
  * (exit 1 when one is not finite). Bounds: br_tool_limits.h. */
+#define _POSIX_C_SOURCE 200809L /* stat */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "circle/br_circle.h"
 #include "tools/br_args.h"
@@ -23,6 +25,11 @@
 
 static float *load_table(const char *path, uint32_t *len)
 {
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) { /* a FIFO's open would wait for a writer */
+        fprintf(stderr, "%s: %s: not a regular file (a device, a FIFO or a folder)\n", TOOL, path);
+        return NULL;
+    }
     FILE *f = fopen(path, "rb");
     if (!f) {
         fprintf(stderr, "%s: cannot open %s\n", TOOL, path);

@@ -33,8 +33,6 @@
  * writes each run's trace, and for hinf_pf and hinf_pf_ext one row per PF
  * step (pf_trace_row). */
 #define _POSIX_C_SOURCE 200809L
-#include <ctype.h>
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -48,6 +46,7 @@
 #include "plant/br_plant_json.h"
 #include "simlog/br_cause_args.h"
 #include "tools/br_args.h"
+#include "tools/br_logcsv.h"
 #include "tools/br_outfile.h"
 #include "tools/br_run_report.h"
 
@@ -59,68 +58,18 @@ typedef struct {
     long n;
 } traj_t;
 
-/* the t and ref columns of a measured log (../shared/spec/measured-log.md) */
+/* the t and ref columns of a measured log, by the diagnosis's rules (tools/br_logcsv.h) */
 static int read_traj(const char *path, traj_t *tr)
 {
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        fprintf(stderr, "br_track: cannot read %s: %s\n", path, strerror(errno));
-        return -1;
-    }
-    char line[4096];
-    int col_t = -1, col_ref = -1, ncol = 0;
-    if (!fgets(line, sizeof line, f)) goto bad_header;
-    for (char *tok = strtok(line, ",\r\n"); tok; tok = strtok(NULL, ",\r\n"), ncol++) {
-        while (isspace((unsigned char)*tok) || *tok == '"' || (unsigned char)*tok == 0xEF || (unsigned char)*tok == 0xBB ||
-               (unsigned char)*tok == 0xBF)
-            tok++;
-        char name[16] = {0};
-        for (int i = 0; i < 15 && tok[i] && tok[i] != '"' && !isspace((unsigned char)tok[i]); i++)
-            name[i] = (char)tolower((unsigned char)tok[i]);
-        if (strcmp(name, "t") == 0) col_t = ncol;
-        if (strcmp(name, "ref") == 0) col_ref = ncol;
-    }
-    if (col_t < 0 || col_ref < 0) goto bad_header;
-    long cap = 65536, lineno = 1;
-    double t_first = 0.0, t_second = 0.0;
-    tr->ref = malloc((size_t)cap * sizeof *tr->ref);
-    tr->n = 0;
-    while (tr->ref && fgets(line, sizeof line, f)) {
-        lineno++;
-        double t = NAN, r = NAN;
-        int c = 0;
-        for (char *tok = strtok(line, ",\r\n"); tok; tok = strtok(NULL, ",\r\n"), c++) {
-            char *end;
-            const double v = strtod(tok, &end);
-            if (c == col_t) t = end != tok ? v : NAN;
-            if (c == col_ref) r = end != tok ? v : NAN;
-        }
-        if (!isfinite(t) || !isfinite(r)) {
-            fprintf(stderr, "br_track: %s:%ld: t or ref is not a number\n", path, lineno);
-            fclose(f);
-            return -1;
-        }
-        if (tr->n == cap) {
-            double *p = realloc(tr->ref, (size_t)(cap *= 2) * sizeof *tr->ref);
-            if (!p) break;
-            tr->ref = p;
-        }
-        if (tr->n == 0) t_first = t;
-        if (tr->n == 1) t_second = t;
-        tr->ref[tr->n++] = r;
-    }
-    fclose(f);
-    if (!tr->ref || tr->n < 2 || !(t_second > t_first)) {
-        fprintf(stderr, "br_track: %s: fewer than two samples (or out of memory)\n", path);
-        return -1;
-    }
-    tr->t0 = t_first;
-    tr->dt = t_second - t_first;
+    static const char *const names[] = {"t", "ref"};
+    br_logcsv_t lg;
+    if (br_logcsv_read("br_track", path, names, 2, 2, &lg) != 0) return -1;
+    tr->t0 = lg.t0;
+    tr->dt = lg.col[0][1] - lg.col[0][0];
+    tr->n = lg.n;
+    tr->ref = lg.col[1];
+    free(lg.col[0]);
     return 0;
-bad_header:
-    fprintf(stderr, "br_track: %s:1: the header lacks a t or a ref column\n", path);
-    fclose(f);
-    return -1;
 }
 
 /* the reference at t (from the log's start), linear between samples, held
@@ -391,6 +340,18 @@ done:
 
 #define TOOL "br_track"
 
+/* DIR/KIND_NAME.csv through br_outfile (docs/tools.md, rule 2) */
+static int open_trace(br_outfile_t *o, const char *dir, const char *kind, const char *name)
+{
+    char path[BR_OUTFILE_PATH_MAX];
+    const int n = snprintf(path, sizeof path, "%s/%s_%s.csv", dir, kind, name);
+    if (n < 0 || (size_t)n >= sizeof path) {
+        fprintf(stderr, "%s: cannot write %s/%s_%s.csv: path too long\n", TOOL, dir, kind, name);
+        return -1;
+    }
+    return br_outfile_open(o, TOOL, path);
+}
+
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
@@ -467,6 +428,8 @@ int main(int argc, char **argv)
     static const char *const names[] = {"pd",      "hinf_only", "hinf_pf",        "hinf_pf_ext", "hinf_true",
                                         "hinf_ff", "hinf_pf_ff", "hinf_pf_ext_ff", "hinf_true_ff", "hinf_ukf"};
     int rc = 0;
+    static br_outfile_t traces[20];
+    int ntraces = 0;
     for (int w = 0; w < 10 && rc == 0; w++) {
         const size_t len = strlen(names[w]);
         const char *hit = strstr(ctrls, names[w]);
@@ -475,21 +438,19 @@ int main(int argc, char **argv)
         if (!hit) continue;
         err_t e = {0.0, 0.0, 0, NULL, NULL};
         if (trace) {
-            char path[1024];
-            snprintf(path, sizeof path, "%s/track_%s.csv", trace, names[w]);
-            if ((e.trace = fopen(path, "w")) == NULL) {
-                fprintf(stderr, "br_track: cannot write %s: %s\n", path, strerror(errno));
+            /* each trace to a temporary file, renamed with the others when every run succeeded */
+            if (open_trace(&traces[ntraces], trace, "track", names[w]) != 0) {
                 rc = 1;
                 break;
             }
+            e.trace = traces[ntraces++].f;
             fprintf(e.trace, "t,ref,pos,err,force\n");
             if (w == 2 || w == 3) {
-                snprintf(path, sizeof path, "%s/pf_%s.csv", trace, names[w]);
-                if ((e.pf_trace = fopen(path, "w")) == NULL) {
-                    fprintf(stderr, "br_track: cannot write %s: %s\n", path, strerror(errno));
+                if (open_trace(&traces[ntraces], trace, "pf", names[w]) != 0) {
                     rc = 1;
                     break;
                 }
+                e.pf_trace = traces[ntraces++].f;
                 fprintf(e.pf_trace, "t,v_mps,fnl_true_N,F_hat_N,v_mean_mps,th_err_counts,th_sd_counts,best_miss_counts,"
                                     "v_sd_mps,z_mean_m,gp_mean_N,gp_sd_N,miss_min_counts,gate_counts,nis_avg,"
                                     "q_scale_std,g_true_N,n_outliers\n");
@@ -507,11 +468,15 @@ int main(int argc, char **argv)
             const int ff = w == 5 ? 1 : (w >= 6 && w <= 8) ? 2 : 0;
             if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &rep) != 0) rc = 1;
         }
-        if (e.trace && fclose(e.trace) != 0) rc = 1;
-        if (e.pf_trace && fclose(e.pf_trace) != 0) rc = 1;
         if (rc != 0) break;
-        rep.rms_m = e.n > 0 ? sqrt(e.sum2 / (double)e.n) : 0.0;
+        rep.rms_m = e.n > 0 ? sqrt(e.sum2 / (double)e.n) : NAN;
         rep.max_m = e.emax;
+        /* a run of no period, or a non-finite figure, is no result (docs/tools.md, rule 3) */
+        if (rep.fault_status == 0 && !(isfinite(rep.rms_m) && isfinite(rep.max_m))) {
+            fprintf(stderr, "%s: %s: the tracking error is not finite (or no period ran): no result\n", TOOL, names[w]);
+            rc = 1;
+            break;
+        }
         /* a faulted run is a fault (time, cause), never an RMS beside full runs */
         br_run_print(stdout, names[w], "tracking", &rep);
         if (js) {
@@ -520,8 +485,12 @@ int main(int argc, char **argv)
             fprintf(js, "}");
         }
     }
+    if (js) fprintf(js, "\n}\n");
+    for (int i = 0; i < ntraces; i++) {
+        if (rc == 0 && br_outfile_commit(&traces[i], TOOL) != 0) rc = 1;
+        br_outfile_discard(&traces[i]);
+    }
     if (js) {
-        fprintf(js, "\n}\n");
         if (rc != 0) br_outfile_discard(&out);
         else if (br_outfile_commit(&out, TOOL) != 0) rc = 1;
     }

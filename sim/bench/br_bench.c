@@ -40,6 +40,7 @@
 #include "bristle/br_machine_cfg.h"
 #include "bristle/br_app.h"
 #include "tools/br_args.h"
+#include "tools/br_outfile.h"
 
 #define TOOL "br_bench"
 
@@ -426,13 +427,9 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
             (double)c->adapt.alpha, (double)c->adapt.max_scale);
 }
 
-static int write_record(const char *path, const char *plant, const br_pf_cfg_t *cfg, const rec_t *rec, const float *fhat)
+/* the recording into f (a br_outfile's temporary file, docs/tools.md) */
+static void write_record(FILE *f, const char *plant, const br_pf_cfg_t *cfg, const rec_t *rec, const float *fhat)
 {
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "br_bench: cannot write %s\n", path);
-        return -1;
-    }
     fprintf(f, "# br_bench PF recording: x axis of the thesis circle on the %s plant, H-inf + PF in closed loop\n# pf_cfg ",
             plant);
     json_pf_cfg(f, cfg);
@@ -441,11 +438,6 @@ static int write_record(const char *path, const char *plant, const br_pf_cfg_t *
         fprintf(f, "%ld,%ld,%.9g,%.9g,%.9g,%.9g,%d\n", k, (long)rec->counts[k], (double)rec->frac[k],
                 (double)rec->u_prev[k], rec->fnl_true[k], (double)fhat[k], rec->status[k]);
     }
-    if (fclose(f) != 0) {
-        fprintf(stderr, "br_bench: error writing %s\n", path);
-        return -1;
-    }
-    return 0;
 }
 
 /* ---- the PF's two paths, its cost against m, the demo per controller ---- */
@@ -563,6 +555,13 @@ int main(int argc, char **argv)
         if (bad) return usage(argv[0], stderr);
     }
 
+    /* the outputs: checked before the run, written to temporary files, renamed when the run succeeded */
+    br_outfile_t jout = {0}, rout = {0};
+    if (json_path && br_outfile_open(&jout, TOOL, json_path) != 0) return 1;
+    if (rec_path && br_outfile_open(&rout, TOOL, rec_path) != 0) {
+        br_outfile_discard(&jout);
+        return 1;
+    }
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
     const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
@@ -687,13 +686,9 @@ int main(int argc, char **argv)
     printf("     br_ukf_t %zu bytes\n", sizeof(br_ukf_t));
     printf("ROM: br_noise_table %zu bytes (%u float32 samples)\n", sizeof br_noise_table, (unsigned)BR_NOISE_LEN);
 
-    if (rec_path && write_record(rec_path, plant, &cpf.pf, &rpf, fhat_pf) != 0) goto done;
-    if (json_path) {
-        FILE *f = fopen(json_path, "w");
-        if (!f) {
-            fprintf(stderr, "br_bench: cannot write %s\n", json_path);
-            goto done;
-        }
+    if (rout.f) write_record(rout.f, plant, &cpf.pf, &rpf, fhat_pf);
+    if (jout.f) {
+        FILE *f = jout.f;
         fprintf(f, "{\n  \"plant\": \"%s\",\n  \"machine\": {\"cpu_model\": ", plant);
         json_str(f, cpu);
         fprintf(f, ", \"cpus_online\": %ld, \"compiler\": ", ncpu);
@@ -736,14 +731,15 @@ int main(int argc, char **argv)
         fprintf(f, "  \"pf_cfg\": ");
         json_pf_cfg(f, &cpf.pf);
         fprintf(f, "\n}\n");
-        if (fclose(f) != 0) {
-            fprintf(stderr, "br_bench: error writing %s\n", json_path);
-            goto done;
-        }
     }
     rc = (tpf.mismatches || tpfs.mismatches || tukf.mismatches || tpf.errors || tukf.errors) ? 1 : 0;
     if (rc) fprintf(stderr, "br_bench: a replay differed from the closed loop or failed\n");
+    /* committed only when the run succeeded, the JSON last */
+    if (rc == 0 && rout.f && br_outfile_commit(&rout, TOOL) != 0) rc = 1;
+    if (rc == 0 && jout.f && br_outfile_commit(&jout, TOOL) != 0) rc = 1;
 done:
+    br_outfile_discard(&rout);
+    br_outfile_discard(&jout);
     free(pf);
     free(ukf);
     free(fhat_pf);

@@ -14,6 +14,7 @@
 #include "bristle/br_app.h"
 #include "plant/br_model_params.h"
 #include "tools/br_rng.h"
+#include "tools/br_run_report.h"
 
 #define BR_PI 3.14159265358979323846
 
@@ -348,7 +349,7 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     int rc = -1;
     if (axis_init(&ax[0], c, 0.0, 0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI, 1) != 0) goto done;
     const long n = lround(c->duration_s / c->dt_s);
-    double sum2 = 0.0, emax = 0.0, fe2 = 0.0;
+    double sum2 = 0.0, emax = 0.0, fe2 = 0.0, track_max = 0.0, lost_t = 0.0;
     int nsat = 0, nout = 0;
     long k_end = n; /* the last period run */
     res->fault_status = 0;
@@ -404,6 +405,11 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
         }
         /* contour error of a circle: radial deviation from the radius */
         const double er = hypot(s.pos_m[0], s.pos_m[1]) - c->radius_m;
+        /* and how far the table is from where the reference is: a table that stays
+         * put on the circle has no radial error at all */
+        const double te = hypot(s.ref_m[0] - s.pos_m[0], s.ref_m[1] - s.pos_m[1]);
+        if (!(te <= c->radius_m) && !(track_max > c->radius_m)) lost_t = t;
+        track_max = fmax(track_max, te);
         s.radial_err_m = er;
         sum2 += er * er;
         if (fabs(er) > emax) emax = fabs(er);
@@ -418,6 +424,17 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     res->saturated_steps = nsat;
     res->outlier_steps = nout;
     res->fhat_rms_err_N = ns > 0 ? sqrt(fe2 / (2.0 * (double)ns)) : 0.0;
+    res->track_max_m = track_max;
+    /* a table farther from the reference point than the circle's radius did not go
+     * round the circle (a motionless axis sits on the circle with no radial
+     * error): a fault of the harness's, never a perfect result (docs/circle-test.md) */
+    if (res->fault_status == 0 && !(track_max <= c->radius_m)) {
+        fprintf(stderr, "br_circle: the table did not follow the circle: it was %.3e m from the reference point, more "
+                        "than the radius %.3e m (first at %.4f s); no result\n", track_max, c->radius_m, lost_t);
+        res->fault_status = BR_RUN_NOT_FOLLOWED;
+        res->fault_cause = BR_RUN_CAUSE_NOT_FOLLOWED;
+        res->fault_t_s = lost_t;
+    }
     rc = (res->fault_status != 0) ? 1 : 0;
 done:
     for (int i = 0; i < 2; i++) {

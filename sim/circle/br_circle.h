@@ -60,11 +60,14 @@ typedef struct {
     int saturated_steps;    /* periods where either axis saturated */
     int outlier_steps;      /* axis-periods whose measurement the estimator rejected */
     double fhat_rms_err_N;  /* RMS of (compensation - the plant's force, br_plant_comp_force_N) over both axes */
-    int fault_status;       /* 0, or the negative status with which the firmware stopped an axis */
+    int fault_status;       /* 0, or the negative status with which the firmware stopped an axis, or
+                               BR_RUN_NOT_FOLLOWED (tools/br_run_report.h): the table was farther than the
+                               radius from the reference point (it did not go round the circle) */
     double fault_t_s;       /* when it did */
     int fault_cause;        /* the latched br_app_fault_t of that axis (0 without a fault) */
     double fault_duty;      /* the duty the simulator's PWM holds after the fault (0: drive off) */
     double last_outlier_t_s; /* time of the last outlier step (-1: none) */
+    double track_max_m;     /* max distance between the reference point and the table */
 } br_circle_result_t;
 
 /* The thesis experiment with the reference machine, the H-inf gains and the

@@ -2,6 +2,7 @@
 /* model.json -> br_plant_cfg_t (br_plant_json.h). The JSON is read by cJSON
  * (Debian's libcjson-dev, docs/architecture.md); this file keeps only the
  * numbers under the top-level "params", by the table of br_model_params.h. */
+#define _POSIX_C_SOURCE 200809L /* stat */
 #include "br_plant_json.h"
 
 #include <cjson/cJSON.h>
@@ -10,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "br_model_params.h"
 
@@ -130,6 +132,9 @@ int br_plant_cfg_from_model_text(const char *text, const char *name, const br_pl
 int br_plant_cfg_from_model_json(const char *path, const br_plant_cfg_t *base, br_plant_cfg_t *out, char *msg,
                                  size_t msg_len)
 {
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) /* a FIFO's open would wait, a device never end */
+        return fail_at(msg, msg_len, path, 0, "not a regular file (a device, a FIFO or a folder)");
     FILE *f = fopen(path, "rb");
     if (!f) {
         char what[256];

@@ -10,10 +10,19 @@
 
 #include <stdio.h>
 
+/* A run that went to the end with its table not following the reference (a
+ * circle's table farther from the reference point than the radius: a
+ * motionless axis sits on the circle with no radial error) is no result
+ * either: the harness reports it as a fault of its own, status
+ * BR_RUN_NOT_FOLLOWED, cause BR_RUN_CAUSE_NOT_FOLLOWED ("not_followed"),
+ * outside the firmware's statuses and br_app_fault_t. */
+#define BR_RUN_NOT_FOLLOWED (-1000)
+#define BR_RUN_CAUSE_NOT_FOLLOWED (-1)
+
 typedef struct {
     double rms_m;   /* contour or tracking RMS over the run */
     double max_m;   /* largest error */
-    int fault_status; /* 0: ran to the end; else the firmware's negative status */
+    int fault_status; /* 0: ran to the end; else the firmware's negative status (or BR_RUN_NOT_FOLLOWED) */
     int fault_cause;  /* br_app_fault_t of the latched fault (0 unknown) */
     double fault_t_s; /* when the firmware stopped the axis */
 } br_run_report_t;

@@ -8,6 +8,7 @@
 #include "br_test.h"
 
 #include "circle/br_circle.h"
+#include "tools/br_run_report.h"
 #include "bristle/br_app.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
@@ -82,6 +83,30 @@ static void test_hinf_only_quadrant_glitches(void **st)
         assert_true(g.max_out[i] > 2e-6); /* "a few um", as the thesis shows */
 #endif
     }
+}
+
+/* A motionless axis is never a perfect result: with zero gains the table
+ * stays at the circle's start, on the circle, with no radial error at all
+ * (br_demo_circle --gains 0,0,0 once rated it at contour RMS 0). The run is
+ * no result: the fault BR_RUN_NOT_FOLLOWED, rc 1. The thesis run followed,
+ * its table within a small part of the radius. */
+static void test_motionless_axis_is_no_result(void **st)
+{
+    (void)st;
+    br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
+    br_circle_result_t r;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 0);
+    assert_int_equal(r.fault_status, 0);
+    print_message("H-inf only: the table at most %.3e m from the reference point (radius %.1e m)\n", r.track_max_m,
+                  c.radius_m);
+    assert_true(r.track_max_m < 0.2 * c.radius_m);
+    c.K[0] = c.K[1] = c.K[2] = 0.0f;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), 1);
+    assert_int_equal(r.fault_status, BR_RUN_NOT_FOLLOWED);
+    assert_int_equal(r.fault_cause, BR_RUN_CAUSE_NOT_FOLLOWED);
+    assert_true(r.track_max_m > c.radius_m);
+    /* the reference is a radius away after a sixth of the revolution */
+    assert_true(r.fault_t_s > 0.0 && r.fault_t_s < c.period_s / 5.0);
 }
 
 static void test_same_gains_at_pf_period(void **st)
@@ -318,6 +343,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_diverged_estimate_stops_safe),
                                        cmocka_unit_test(test_hinf_only_quadrant_glitches),
+                                       cmocka_unit_test(test_motionless_axis_is_no_result),
                                        cmocka_unit_test(test_same_gains_at_pf_period),
                                        cmocka_unit_test(test_ukf_beats_thesis_ratio),
                                        cmocka_unit_test(test_pf_beats_thesis_ratio),

@@ -5,9 +5,11 @@
  * is refused at open. */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -130,6 +132,43 @@ static void test_refused_at_open(void **state)
     br_outfile_discard(&o);
 }
 
+/* A write that fails (here: past a file-size limit, EFBIG with SIGXFSZ
+ * ignored, as a full disk fails) is a failed commit: the destination keeps
+ * its old text and the temporary file is removed. The write fails inside
+ * fwrite, so only the stream's error flag records it (the final fflush has
+ * nothing left to write); then after a failed fflush of buffered text. */
+static void test_write_error_fails_commit(void **state)
+{
+    (void)state;
+    char path[300];
+    snprintf(path, sizeof path, "%s/keep", dir);
+    put(path, "old\n");
+    static char big[1 << 16];
+    memset(big, 'x', sizeof big);
+    struct rlimit old_lim;
+    assert_int_equal(getrlimit(RLIMIT_FSIZE, &old_lim), 0);
+    void (*old_sig)(int) = signal(SIGXFSZ, SIG_IGN);
+    for (int how = 0; how < 2; how++) {
+        br_outfile_t o;
+        assert_int_equal(br_outfile_open(&o, "test", path), 0);
+        struct rlimit lim = {4096, old_lim.rlim_max};
+        assert_int_equal(setrlimit(RLIMIT_FSIZE, &lim), 0);
+        if (how == 0) {
+            assert_true(fwrite(big, 1, sizeof big, o.f) < sizeof big);
+            assert_true(ferror(o.f));
+        } else {
+            /* under one buffer each: the limit is met when the stream flushes */
+            for (int k = 0; k < 4; k++) assert_int_equal(fwrite(big, 1, 2000, o.f), 2000);
+        }
+        const int rc = br_outfile_commit(&o, "test");
+        assert_int_equal(setrlimit(RLIMIT_FSIZE, &old_lim), 0);
+        assert_int_equal(rc, -1);
+        expect(path, "old\n");
+        assert_int_equal(others(), 0);
+    }
+    signal(SIGXFSZ, old_sig);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -137,6 +176,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_commit_replaces, setup, teardown),
         cmocka_unit_test_setup_teardown(test_relative_path, setup, teardown),
         cmocka_unit_test_setup_teardown(test_refused_at_open, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_write_error_fails_commit, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "plant/br_plant_json.h"
@@ -146,6 +147,40 @@ static void test_file(void **st)
     assert_non_null(strstr(msg, ":0: cannot open"));
 }
 
+/* the 1 MiB limit (MAX_FILE_BYTES): a valid model padded with spaces to
+ * exactly 1 MiB is read, one byte more is refused; a FIFO is refused before
+ * it is opened (an open would wait for a writer) */
+static void write_padded(const char *path, long size)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(good, f);
+    for (long k = (long)strlen(good); k < size; k++) fputc(' ', f);
+    assert_int_equal(fclose(f), 0);
+}
+
+static void test_size_limit(void **st)
+{
+    (void)st;
+    char path[] = "/tmp/br_test_model_big_XXXXXX";
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    const br_plant_cfg_t base = br_plant_cfg_reference();
+    br_plant_cfg_t c;
+    char msg[256] = "";
+    write_padded(path, 1L << 20);
+    assert_int_equal(br_plant_cfg_from_model_json(path, &base, &c, msg, sizeof msg), 0);
+    write_padded(path, (1L << 20) + 1);
+    assert_int_equal(br_plant_cfg_from_model_json(path, &base, &c, msg, sizeof msg), -1);
+    assert_non_null(strstr(msg, ":0: larger than 1 MiB"));
+    unlink(path);
+    assert_int_equal(mkfifo(path, 0600), 0);
+    assert_int_equal(br_plant_cfg_from_model_json(path, &base, &c, msg, sizeof msg), -1);
+    assert_non_null(strstr(msg, ":0: not a regular file"));
+    unlink(path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -153,6 +188,7 @@ int main(void)
         cmocka_unit_test(test_causes_default_off),
         cmocka_unit_test(test_rejects),
         cmocka_unit_test(test_file),
+        cmocka_unit_test(test_size_limit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

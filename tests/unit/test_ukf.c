@@ -460,6 +460,38 @@ static void test_cholesky_failure_recovers(void **st)
     run_at_rest(&u, -5, 10);
 }
 
+/* The reset after a failed Cholesky of the *posterior* covariance (step 4):
+ * with beta < alpha^2 (here 0 < 1, kappa = -3: a valid scaled UT whose
+ * predicted covariance need not be positive definite) and fast moves under
+ * torque, a step's posterior Pm has no Cholesky factor; the step reports
+ * BR_E_NUMERIC and commits P = diag(p0_var), so after every step P has a
+ * factor. Without the reset in sigma_points the unfactorable Pm was
+ * committed (P had no factor after one step: the audit's surviving mutant). */
+static void test_posterior_cholesky_failure_resets(void **st)
+{
+    (void)st;
+    br_ukf_t u;
+    br_ukf_cfg_t c = ref_cfg();
+    c.alpha = 1.0f;
+    c.beta = 0.0f;
+    c.kappa = -3.0f;
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    int numeric = 0;
+    for (int k = 0; k < 3000; k++) {
+        /* 50 counts a period, reversing with the torque every 500 periods */
+        const int sgn = ((k / 500) % 2) ? -1 : 1;
+        const br_meas_t y = {(int32_t)(50 * k * sgn), 0.5f};
+        const br_status_t s = br_ukf_step(&u, &y, 0.05f * (float)sgn);
+        assert_true(s == BR_OK || s == BR_W_OUTLIER || s == BR_E_NUMERIC);
+        numeric += s == BR_E_NUMERIC;
+        float L[BR_NX][BR_NX];
+        assert_int_equal(br_ukf_chol4((const float(*)[BR_NX])u.P, L), BR_OK);
+        assert_true(state_finite(&u));
+    }
+    print_message("BR_E_NUMERIC steps: %d, resets %u\n", numeric, (unsigned)u.n_recover);
+    assert_true(numeric >= 1); /* the recovery was exercised */
+}
+
 static void test_nonfinite_result_keeps_state(void **st)
 {
     (void)st;
@@ -806,6 +838,7 @@ int main(void)
         cmocka_unit_test(test_reanchor_after_lost_lock),
         cmocka_unit_test(test_chol4),
         cmocka_unit_test(test_cholesky_failure_recovers),
+        cmocka_unit_test(test_posterior_cholesky_failure_resets),
         cmocka_unit_test(test_nonfinite_result_keeps_state),
         cmocka_unit_test(test_gp_clamped),
         cmocka_unit_test(test_converges_open_loop),

@@ -20,8 +20,8 @@ import sys
 import time
 
 from .. import __version__
-from . import (causes, closedloop, identify, logreader, machinefile, machinejson, model, modelfile, output, report,
-               selection, signals, units)
+from . import (causes, closedloop, identify, logreader, machinefile, machinejson, model, modelfile, output, plausible,
+               report, selection, signals, units)
 
 # Exit statuses (docs/diagnose.md, "Exit status")
 EXIT_OK = 0
@@ -50,20 +50,17 @@ def _plots():
     return plots
 
 
+# what a diagnosis writes into OUT (output.check_out: OUT is replaced as a whole)
+OUTPUT_NAMES = frozenset(("report.json", "model.json", "machine.json", "report.md", CLOSED_LOOP_FIGURE[0]) +
+                         tuple(f[0] for f in FIGURES))
+
+
 def check_out(out):
-    """OUT before the fit: an existing directory, or a new one whose nearest
-    existing parent is a directory this process may write in."""
-    p = os.path.abspath(out)
-    if os.path.exists(p):
-        if not os.path.isdir(p):
-            raise logreader.LogError(out, 0, "--out names an existing file, not a directory")
-    else:
-        while not os.path.exists(p):
-            p = os.path.dirname(p)
-        if not os.path.isdir(p):
-            raise logreader.LogError(out, 0, f"--out cannot be created: {p} is not a directory")
-    if not os.access(p, os.W_OK | os.X_OK):
-        raise logreader.LogError(out, 0, f"--out cannot be written: no permission in {p}")
+    """OUT before the fit (output.check_out): new, empty or a previous
+    diagnosis's, in a folder this process may write in."""
+    problem = output.check_out(out, OUTPUT_NAMES)
+    if problem:
+        raise logreader.LogError(out, 0, problem)
 
 
 def cmd_diagnose(args):
@@ -88,6 +85,10 @@ def cmd_diagnose(args):
                                          f"{lg.dt:.6g} s")
     say(f"{args.log}: {lg.n} samples at {1e3 * lg.dt:.4g} ms" +
         (f" (of {lg.n_total}: the first {lg.n} are used)" if lg.n_total > lg.n else ""))
+    # samples no axis within the machine's limits produces: replaced, or the log refused
+    impossible = plausible.check(lg, given)
+    for line in plausible.describe(impossible):
+        log.warning("%s: %s", args.log, line)
     prep = signals.Prepared(lg, fc_hz=args.fc)
     log.debug("low-pass cutoff %g Hz", args.fc)
     t0 = time.monotonic()
@@ -104,10 +105,12 @@ def cmd_diagnose(args):
             raise closedloop.ControllerError(f"{mpath}: {e}") from None
         closed = {"controller": f"{mpath} ({ctrl['type']})",
                   **{name: {k: v for k, v in s.items() if k.startswith("relerr")} for name, s in sims.items()}}
-    # every output into a staging folder, moved into OUT at the end (output.Staging)
+    # every output into a staging folder that takes OUT's place at the end (output.Staging)
     with output.Staging(args.out) as stage:
         out = stage.dir
         rep = report.build(prep, diag, machine=machine, closed=closed, log_path=args.log)
+        if impossible:
+            rep["impossible_samples"] = output.rounded(impossible)
         output.write_json(os.path.join(out, "report.json"), rep)
         output.write_json(os.path.join(out, "model.json"), modelfile.build(prep, diag, log_path=args.log))
         machinejson.write(out, prep, diag, given, args.log, say)
@@ -198,7 +201,8 @@ def parser(prog="bristle-diagnose"):
     d.add_argument("--log", required=True, metavar="CSV",
                    help="the measured log (../shared/spec/measured-log.md: t, pos, force columns)")
     d.add_argument("--out", required=True, metavar="DIR",
-                   help="output directory (created if needed; existing files in it are replaced)")
+                   help="output directory, replaced as a whole when the run succeeds: new, empty, or a previous "
+                        "diagnosis's (a folder holding other files is refused)")
     d.add_argument("--machine", metavar="JSON",
                    help="the log's controller file, or a firmware machine file (format 2) whose values "
                         "machine.json takes; default: <log>.machine.json beside the log, else a file of "

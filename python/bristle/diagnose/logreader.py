@@ -29,6 +29,7 @@ bounded memory.
 import csv
 import os
 import re
+import stat
 
 import numpy as np
 
@@ -68,6 +69,37 @@ class Log:
         self.dt = dt
         self.n = len(t)
         self.n_total = n_total  # rows in the file (may exceed n with max_samples)
+
+
+def open_regular(path, mode="rb", **kw):
+    """path opened, when it is a regular file: a device (/dev/zero, a
+    terminal), a FIFO, a socket or a folder is refused with LogError before
+    it is opened (a FIFO's open or a device's read would block or never
+    end), and checked again on the open file."""
+    display = os.fspath(path)
+    try:
+        st = os.stat(path)
+    except OSError as e:
+        raise LogError(display, 0, f"cannot open: {e.strerror}") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise LogError(display, 0, f"not a regular file ({_kind(st.st_mode)}); a log, model or machine file is "
+                                   "read from a file")
+    try:
+        f = open(path, mode, **kw)
+    except OSError as e:
+        raise LogError(display, 0, f"cannot open: {e.strerror}") from None
+    if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+        f.close()
+        raise LogError(display, 0, "not a regular file (it changed while being opened)")
+    return f
+
+
+def _kind(mode):
+    for test, name in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "not a file"
 
 
 def _cell_value(path, lineno, name, cell):
@@ -124,10 +156,7 @@ def _rows(path):
     """Yields (line, t, ref, pos, force) of every validated row; raises
     LogError at the first problem, including too few samples at the end."""
     display = os.fspath(path)
-    try:
-        f = open(path, "rb")
-    except OSError as e:
-        raise LogError(display, 0, f"cannot open: {e.strerror}") from None
+    f = open_regular(path)
     idx = ncols = None
     t_prev = dt0 = None
     n = 0
@@ -214,6 +243,7 @@ def read_log(path, max_samples=DEFAULT_MAX_SAMPLES):
     """Validates the whole file (streaming) and keeps its first max_samples
     rows in four preallocated float64 arrays."""
     display = os.fspath(path)
+    open_regular(path).close()  # a device or a FIFO: refused before the lines are counted
     cap = max(1, min(_count_lines(path), max_samples))
     cols = [np.empty(cap) for _ in COLUMNS]
     t, ref, pos, force = cols

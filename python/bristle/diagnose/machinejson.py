@@ -33,7 +33,6 @@ marked "assumed"; what follows from the log and the rest is "derived". The
 import copy
 import importlib
 import importlib.util
-import json
 import math
 import os
 import re
@@ -41,7 +40,8 @@ import re
 import numpy as np
 
 from . import causes as causes_
-from . import closedloop, output, params
+from . import closedloop, jsonfile, output, params
+from .logreader import LogError
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", ".."))
 # presliding lengths shorter than this many position quanta are not resolved
@@ -67,10 +67,9 @@ def is_machine_file(path):
     """True when path is a machine file (it has "format_version"),
     not the diagnosis's controller file (python/bristle/diagnose/machines/)."""
     try:
-        with open(path, encoding="utf-8-sig") as f:
-            raw = json.load(f)
-    except (OSError, ValueError, TypeError):
-        return False
+        raw, _ = jsonfile.load(path)
+    except LogError:
+        return False  # machinefile.load names the problem
     return isinstance(raw, dict) and "format_version" in raw
 
 

@@ -42,6 +42,10 @@ def load(path):
                else ["(not a list)"])
     if unknown:
         raise LogError(path, jsonfile.line_of(text, "causes"), f"unknown cause(s) {', '.join(unknown)}")
+    twice = sorted({c for c in listed if listed.count(c) > 1})
+    if twice:
+        raise LogError(path, jsonfile.line_of(text, "causes"), f"field causes lists {', '.join(twice)} twice "
+                                                               "(each cause once)")
     p = m.get("params")
     if not isinstance(p, dict):
         raise LogError(path, jsonfile.line_of(text, "params"), "no \"params\" object")

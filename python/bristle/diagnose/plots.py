@@ -6,7 +6,36 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 
+# A series is drawn with at most this many points: a figure is about 1200
+# pixels wide, and 2 million points drawn as they are took the diagnosis of a
+# 5-million-row log to 1.75 GB (docs/diagnose.md, "Memory"). A log of EMPS's
+# length (25 000 samples) is drawn whole.
+MAX_POINTS = 100_000
+
+
+def envelope(x, y):
+    """(x, y) of a line for the plot: as they are when short, else the
+    minimum and maximum of y in each of MAX_POINTS / 2 consecutive buckets, in
+    their order (a spike stays visible)."""
+    n = len(y)
+    if n <= MAX_POINTS:
+        return x, y
+    k = -(-n // (MAX_POINTS // 2))
+    m = n // k
+    blocks = np.asarray(y[: m * k]).reshape(m, k)
+    base = np.arange(m) * k
+    lo, hi = base + blocks.argmin(axis=1), base + blocks.argmax(axis=1)
+    idx = np.concatenate((np.sort(np.stack((lo, hi), axis=1), axis=1).ravel(), np.arange(m * k, n)))
+    return np.asarray(x)[idx], np.asarray(y)[idx]
+
+
+def dots(*arrays):
+    """Every arrays' same samples for a dot plot: all when short, else every
+    k-th, at most MAX_POINTS."""
+    k = max(1, -(-len(arrays[0]) // MAX_POINTS))
+    return tuple(a[::k] for a in arrays)
 
 
 def save(fig, path):
@@ -25,18 +54,19 @@ def force_fit(path, prep, diag):
     fig, axs = plt.subplots(2, 1, figsize=(11, 6.5), sharex=True)
     ax = axs[0]
     _shade_held_out(ax, prep)
-    ax.plot(t[w], prep.y[w], color="k", lw=0.8, label="measured (filtered)")
-    ax.plot(t[w], diag.nominal.predict(prep)[w], color="tab:red", lw=0.7, label="nominal model")
+    ax.plot(*envelope(t[w], prep.y[w]), color="k", lw=0.8, label="measured (filtered)")
+    ax.plot(*envelope(t[w], diag.nominal.predict(prep)[w]), color="tab:red", lw=0.7, label="nominal model")
     if diag.extended.causes:
-        ax.plot(t[w], diag.extended.predict(prep)[w], color="tab:blue", lw=0.7, ls="--", label="extended model")
+        ax.plot(*envelope(t[w], diag.extended.predict(prep)[w]), color="tab:blue", lw=0.7, ls="--",
+                label="extended model")
     ax.set_ylabel("force at the load [N]")
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title("Measured force and the force the models predict from the measured motion")
     ax = axs[1]
     _shade_held_out(ax, prep)
-    ax.plot(t[w], (prep.y - diag.nominal.predict(prep))[w], color="tab:red", lw=0.6, label="nominal")
+    ax.plot(*envelope(t[w], (prep.y - diag.nominal.predict(prep))[w]), color="tab:red", lw=0.6, label="nominal")
     if diag.extended.causes:
-        ax.plot(t[w], diag.extended.residual(prep)[w], color="tab:blue", lw=0.6, label="extended")
+        ax.plot(*envelope(t[w], diag.extended.residual(prep)[w]), color="tab:blue", lw=0.6, label="extended")
     ax.set_ylabel("residual [N]")
     ax.set_xlabel("t [s]")
     ax.legend(loc="upper right", fontsize=8)
@@ -50,9 +80,9 @@ def residuals(path, prep, diag):
     ee = diag.extended.residual(prep)[w] if diag.extended.causes else None
     fig, axs = plt.subplots(3, 1, figsize=(11, 9))
     for ax, x, lab in ((axs[0], t, "t [s]"), (axs[1], prep.v[w], "velocity [m/s]"), (axs[2], prep.xm[w], "position [m]")):
-        ax.plot(x, en, ".", ms=1.0, color="tab:red", alpha=0.5, label="nominal")
+        ax.plot(*dots(x, en), ".", ms=1.0, color="tab:red", alpha=0.5, label="nominal")
         if ee is not None:
-            ax.plot(x, ee, ".", ms=1.0, color="tab:blue", alpha=0.5, label="extended")
+            ax.plot(*dots(x, ee), ".", ms=1.0, color="tab:blue", alpha=0.5, label="extended")
         ax.axhline(0, color="k", lw=0.5)
         ax.set_xlabel(lab)
         ax.set_ylabel("residual [N]")
@@ -67,14 +97,15 @@ def closed_loop(path, prep, sims):
     measured and re-simulated (both filtered); and their difference."""
     t = prep.t
     fig, axs = plt.subplots(3, 1, figsize=(11, 8.5), sharex=True)
-    axs[0].plot(t, 1e6 * (prep.ref - prep.pos), color="k", lw=0.8, label="measured")
-    axs[1].plot(t, prep.lp(prep.force), color="k", lw=0.8, label="measured")
+    axs[0].plot(*envelope(t, 1e6 * (prep.ref - prep.pos)), color="k", lw=0.8, label="measured")
+    axs[1].plot(*envelope(t, prep.lp(prep.force)), color="k", lw=0.8, label="measured")
     for name, col in (("nominal", "tab:red"), ("extended", "tab:blue")):
         if name in sims:
-            axs[0].plot(t, 1e6 * (prep.ref - sims[name]["q"]), color=col, lw=0.7, ls="--", label=f"re-simulated, {name}")
+            axs[0].plot(*envelope(t, 1e6 * (prep.ref - sims[name]["q"])), color=col, lw=0.7, ls="--",
+                        label=f"re-simulated, {name}")
             fs = prep.lp(sims[name]["force"])
-            axs[1].plot(t, fs, color=col, lw=0.7, ls="--", label=f"re-simulated, {name}")
-            axs[2].plot(t, fs - prep.lp(prep.force), color=col, lw=0.6, label=name)
+            axs[1].plot(*envelope(t, fs), color=col, lw=0.7, ls="--", label=f"re-simulated, {name}")
+            axs[2].plot(*envelope(t, fs - prep.lp(prep.force)), color=col, lw=0.6, label=name)
     axs[0].set_ylabel("following error\nreference - position [µm]")
     axs[1].set_ylabel("force at the load [N]")
     axs[2].set_ylabel("force: re-simulated\n- measured [N]")
@@ -121,7 +152,8 @@ def friction_map(path, prep, diag):
     fig, ax = plt.subplots(figsize=(10, 6))
     for sgn, col, lab in ((1, "tab:red", "moving in +x"), (-1, "tab:blue", "moving in -x")):
         sel = mv & (np.sign(v) == sgn)
-        ax.plot(1e3 * v[sel][::3], fr[sel][::3], ".", ms=1.0, color=col, alpha=0.25, rasterized=True)
+        vd, fd = dots(v[sel][::3], fr[sel][::3])
+        ax.plot(1e3 * vd, fd, ".", ms=1.0, color=col, alpha=0.25, rasterized=True)
         if sel.sum() > 40:
             edges = np.quantile(v[sel], np.linspace(0, 1, 31))
             k = np.clip(np.searchsorted(edges, v[sel]) - 1, 0, 29)

@@ -3,7 +3,7 @@
 is modelfile.py's. Generated files carry output.GENERATOR and no timestamp,
 numbers rounded (output.rounded), so that a rerun writes the same files."""
 from . import causes as causes_
-from . import intervals, model, noise, output, selection, signals, unexplained
+from . import intervals, model, noise, output, plausible, selection, signals, unexplained
 from .evidence import Residual
 
 # The EMPS paper's two IDIM-LS model structures (rigid + viscous + Coulomb as
@@ -151,6 +151,8 @@ def markdown(rep, figures):
     L = [f"<!-- {rep['generator']} -->", "", f"# Diagnosis of `{rep['log']}`", ""]
     L += [f"{rep['samples']} samples at {1e3 * rep['period_s']:.4g} ms. Held out: {rep['method']['held_out']}.", ""]
     L += [f"**Verdict: {rep['verdict']}**", ""]
+    for line in plausible.describe(rep.get("impossible_samples")):
+        L += [f"Impossible samples: {line}.", ""]
     L += ["| model | held-out relerr | training relerr |", "|---|---|---|",
           f"| nominal (rigid + viscous + symmetric LuGre) | {_fmt(rep['nominal']['relerr_percent'], ' %')} | "
           f"{_fmt(rep['nominal']['relerr_train_percent'], ' %')} |",

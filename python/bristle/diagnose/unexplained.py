@@ -123,7 +123,7 @@ def figure(path, prep, diag):
     fig, axs = plots.plt.subplots(2, 3, figsize=(13, 7))
     for ax, name in zip(axs.ravel(), SIGNALS):
         s = sig[name]
-        ax.plot(s, e, ".", ms=0.8, color="0.55", alpha=0.4, rasterized=True)
+        ax.plot(*plots.dots(s, e), ".", ms=0.8, color="0.55", alpha=0.4, rasterized=True)
         m, _ = bin_means(e, s, name, sig["direction"])
         d = sig["direction"]
         if name in JOINT or name == "direction":
@@ -131,11 +131,11 @@ def figure(path, prep, diag):
                                      (0.0, "tab:green", "fit, at rest", "none")):
                 sel = np.flatnonzero(d == dv)
                 if len(sel):
-                    o = sel[np.argsort(s[sel], kind="stable")]
+                    o = plots.dots(sel[np.argsort(s[sel], kind="stable")])[0]
                     ax.plot(s[o], m[o], color=col, lw=1.2, ls=ls, marker="o" if ls == "none" else None, ms=3,
                             label=lab)
         else:
-            o = np.argsort(s, kind="stable")
+            o = plots.dots(np.argsort(s, kind="stable"))[0]
             ax.plot(s[o], m[o], color="tab:red", lw=1.2, label="mean per bin")
         ax.axhline(0, color="k", lw=0.5)
         flag = "  ← goes with" if shares[name] >= GOES_WITH_MIN else ""
