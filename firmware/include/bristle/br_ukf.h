@@ -19,6 +19,11 @@
  * outlier_sigma sqrt(S + rpc^2 / 12), the innovation's spread with the
  * encoder's quantisation) skips the update; reanchor_after of them in a row
  * re-anchor the filter on the measurement (as the PF does).
+ * With cfg.load the state has a fifth entry, the external force F_d (the
+ * torque in step 2 is u - L F_d), a gated innovation that a change of F_d
+ * of at most 2 load.max_N explains is re-acquired (P_dd inflated, the
+ * period predicted again) instead of rejected, and F_hat is friction + F_d
+ * within +-load.max_N (docs/modules/ukf.md, "External force").
  * theta is stored relative to an integer origin (the latest accepted count),
  * as in the PF, so float32 keeps sub-count resolution at any travel.
  * See docs/modules/ukf.md. */
