@@ -121,6 +121,7 @@ def est_fields(m):
     state's units, from the file's physical ones (machine.est_per_step)."""
     pf, ukf = m["estimator"]["pf"], m["estimator"]["ukf"]
     P, U = machine.est_per_step(m, "pf"), machine.est_per_step(m, "ukf")
+    ld = machine.ukf_load(m)
     out = [("BR_EST_PF_PERIOD_S", pf["period_s"], "the PF's period (its loop runs at it)"),
            ("BR_EST_PF_PERIOD_NS", int(round(pf["period_s"] * 1e9)), "the same in whole nanoseconds (an MCU tick)"),
            ("BR_EST_PF_N_PARTICLES", pf["n_particles"], "particle count")]
@@ -149,7 +150,10 @@ def est_fields(m):
     out += gate_fields("UKF", ukf, U)
     out += [("BR_EST_UKF_ALPHA", ukf["alpha"], "sigma-point spread"),
             ("BR_EST_UKF_BETA", ukf["beta"], "prior-distribution weight"),
-            ("BR_EST_UKF_KAPPA", ukf["kappa"], "secondary scaling")]
+            ("BR_EST_UKF_KAPPA", ukf["kappa"], "secondary scaling"),
+            ("BR_EST_UKF_LOAD_Q_N2", ld["q_N2"], "external force: random walk per step (0 with P0: off)"),
+            ("BR_EST_UKF_LOAD_P0_N2", ld["p0_N2"], "its initial (and recovery) variance; 0: no external force"),
+            ("BR_EST_UKF_LOAD_MAX_N", ld["max_N"], "its bound, and the compensation's (the actuator's force)")]
     return out
 
 

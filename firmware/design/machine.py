@@ -321,7 +321,14 @@ SCHEMA = {
             },
             "alpha": Num(0.1, 1.0, "sigma-point spread"),
             "beta": Num(0.0, 10.0, "prior-distribution weight (2 for a Gaussian)"),
-            "kappa": Num(-3.0, 100.0, "secondary scaling (n + kappa > 0, n = 4)", lo_open=True),
+            "kappa": Num(-3.0, 100.0, "secondary scaling (n + kappa > 0, n = 4, 5 with load)", lo_open=True),
+            # the external-force state (docs/modules/ukf.md, "External force"); absent = off,
+            # the thesis's four states
+            "load": Optional({
+                "q_N2_per_s": Num(0.0, 1.0e9, "random walk of the external force F_d, variance per second "
+                                  "(N^2/s); its initial variance and bound are the actuator's force "
+                                  "(control.torque_limit_Nm / L), squared and itself", lo_open=True),
+            }),
         }, **_gates()),
     },
     "limits": {
@@ -702,7 +709,21 @@ def est_per_step(m, est):
             "p0_omega_rad2ps2": p0["speed_m2_per_s2"] / (L * L), "p0_z_m2": p0["z_zs2"] * zs * zs,
             "p0_gp_N2": p0["gp_Fs2"] * Fs * Fs,
         })
+
     return out
+
+
+def ukf_load(m):
+    """The UKF's external-force state as the firmware takes it (br_ukf_load_t,
+    docs/modules/ukf.md, "External force"): {"q_N2" per step (q_N2_per_s times
+    control.period_s), "p0_N2" and "max_N" from the actuator's force
+    control.torque_limit_Nm / L, squared and itself}; all 0 (off) when
+    estimator.ukf.load is absent."""
+    ld = m["estimator"]["ukf"].get("load")
+    if not ld:
+        return {"q_N2": 0.0, "p0_N2": 0.0, "max_N": 0.0}
+    F_act = m["control"]["torque_limit_Nm"] * 2.0 * math.pi / m["mechanics"]["lead_m_per_rev"]
+    return {"q_N2": ld["q_N2_per_s"] * m["control"]["period_s"], "p0_N2": F_act * F_act, "max_N": F_act}
 
 
 def pf_gp_curve_rho(m):
@@ -812,7 +833,7 @@ _PER_STEP_BOUNDS = {
     "ukf": [("q_theta_rad2", "process_noise.theta_m2_per_s", 0.0, 1.0, True),
             ("p0_theta_counts2", "p0_var.theta_m2", 0.0, 1.0e6, False),
             ("p0_omega_rad2ps2", "p0_var.speed_m2_per_s2", 0.0, 1.0e6, False),
-            ("p0_z_m2", "p0_var.z_zs2", 0.0, 1.0, False), ("p0_gp_N2", "p0_var.gp_Fs2", 0.0, 1.0e8, False)],
+            ("p0_z_m2", "p0_var.z_zs2", 0.0, 1.0, False), ("p0_gp_N2", "p0_var.gp_Fs2", 0.0, 1.0e8, False),],
     "both": [("q_omega_rad2ps2", "process_noise.force_Fs2_s", 0.0, 1.0e3, True),
              ("q_z_m2", "process_noise.z_zs2_per_s", 0.0, 1.0e-6, True),
              ("q_gp_N2", "process_noise.gp_Fs2_per_s", 0.0, 1.0e6, True),
@@ -824,6 +845,13 @@ FLOAT32_MIN_NORMAL = 1.1754943508222875e-38
 def _per_step_checks(m, errors):
     """Each per-step value within the firmware's bounds, a normal float32 (no
     subnormal) when not 0; a problem is named by the file's field it comes from."""
+    if m["estimator"]["ukf"].get("load"):
+        # br_ukf_init: q 0 or a normal float, P0 a normal float, both <= BR_EST_VAR_MAX
+        ld = ukf_load(m)
+        for key, x in (("q_N2", ld["q_N2"]), ("p0_N2", ld["p0_N2"])):
+            if not FLOAT32_MIN_NORMAL <= x <= 1.0e12:
+                errors.append(("estimator.ukf.load.q_N2_per_s", "gives %s = %.6g per step on this machine, "
+                               "outside the firmware's (0 excluded) [%g, %g]" % (key, x, FLOAT32_MIN_NORMAL, 1.0e12)))
     for est in ("pf", "ukf"):
         v = est_per_step(m, est)
         for key, field, lo, hi, zero_ok in _PER_STEP_BOUNDS[est] + _PER_STEP_BOUNDS["both"]:

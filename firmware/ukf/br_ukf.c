@@ -9,19 +9,28 @@
 #include "bristle/br_encoder.h"
 #include "br_check.h"
 
-static int vec_finite(const float v[BR_NX])
-{
-    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]) && isfinite(v[3]);
-}
+#define NM BR_UKF_NMAX
 
-static int mat_finite(const float A[BR_NX][BR_NX])
+static int vec_finite(const float *v, int n)
 {
     int ok = 1;
-    for (int i = 0; i < BR_NX; i++) {
-        ok = ok && vec_finite(A[i]);
+    for (int i = 0; i < n; i++) {
+        ok = ok && isfinite(v[i]);
     }
     return ok;
 }
+
+static int mat_finite(const float A[NM][NM], int n)
+{
+    int ok = 1;
+    for (int i = 0; i < n; i++) {
+        ok = ok && vec_finite(A[i], n);
+    }
+    return ok;
+}
+
+/* P0's diagonal entry i: p0_var, and load.p0_N2 for F_d */
+static float p0_of(const br_ukf_cfg_t *cfg, int i) { return (i < BR_NX) ? cfg->p0_var[i] : cfg->load.p0_N2; }
 
 static br_status_t check_cfg(const br_ukf_cfg_t *cfg)
 {
@@ -34,9 +43,20 @@ static br_status_t check_cfg(const br_ukf_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
+    /* the external force: off (p0 = 0, then q and max must be 0 too), or p0 a
+     * variance, q 0 or a variance, max > 0 and finite */
+    const br_ukf_load_t *ld = &cfg->load;
+    if (ld->p0_N2 == 0.0f) {
+        if (ld->q_N2 != 0.0f || ld->max_N != 0.0f) {
+            return BR_E_PARAM;
+        }
+    } else if (!br_est_var_ok(ld->p0_N2, 0) || !br_est_var_ok(ld->q_N2, 1) || !br_finite_pos(ld->max_N)) {
+        return BR_E_PARAM;
+    }
     /* scaled UT: alpha in (0, 1], beta >= 0, n + lambda = alpha^2 (n + kappa) > 0 */
+    const float n = (cfg->load.p0_N2 > 0.0f) ? (float)BR_UKF_NMAX : (float)BR_NX;
     if (!br_finite_pos(cfg->alpha) || cfg->alpha > 1.0f || !br_finite_nonneg(cfg->beta) || !isfinite(cfg->kappa) ||
-        !((float)BR_NX + cfg->kappa > 0.0f)) {
+        !(n + cfg->kappa > 0.0f)) {
         return BR_E_PARAM;
     }
     return BR_OK;
@@ -56,7 +76,8 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
-    const float n = (float)BR_NX;
+    ukf->n = (cfg->load.p0_N2 > 0.0f) ? BR_UKF_NMAX : BR_NX;
+    const float n = (float)ukf->n;
     /* scaled UT (Julier 2002): lambda = alpha^2 (n + kappa) - n, so n + lambda = alpha^2 (n + kappa) */
     const float n_lam = cfg->alpha * cfg->alpha * (n + cfg->kappa);
     const float lambda = n_lam - n;
@@ -79,16 +100,21 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
     br_est_delay_init(&ukf->delay, &cfg->est);
     br_est_dlyid_init(&ukf->dlyid, &cfg->est);
-    for (int i = 0; i < BR_NX; i++) {
+    /* theta response to F_d over one period, L dt^2 / (2 J_eff), J_eff = J + L^2 M (eq. 1) */
+    const br_model_cfg_t *mc = &cfg->est.model;
+    ukf->load_rad_per_N2 = (ukf->n > BR_NX) ? mc->lead_mprad * mc->dt_s * mc->dt_s /
+                                                  (2.0f * (mc->J_kgm2 + mc->lead_mprad * mc->lead_mprad * mc->M_kg))
+                                            : 0.0f;
+    for (int i = 0; i < NM; i++) {
         ukf->x[i] = 0.0f;
-        for (int j = 0; j < BR_NX; j++) {
-            ukf->P[i][j] = (i == j) ? cfg->p0_var[i] : 0.0f;
+        for (int j = 0; j < NM; j++) {
+            ukf->P[i][j] = (i == j) ? p0_of(cfg, i) : 0.0f;
             ukf->S[i][j] = 0.0f;
         }
     }
     ukf->x[BR_X_GP] = cfg->est.gp0_N;
-    for (int s = 0; s < BR_UKF_NSIG; s++) {
-        for (int i = 0; i < BR_NX; i++) {
+    for (int s = 0; s < BR_UKF_NSIG_MAX; s++) {
+        for (int i = 0; i < NM; i++) {
             ukf->X[s][i] = ukf->x[i];
             ukf->Y[s][i] = ukf->x[i];
         }
@@ -99,25 +125,24 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->n_outliers = 0u;
     ukf->n_recover = 0u;
     ukf->n_predicted = 0u;
+    ukf->n_load_acq = 0u;
     ukf->primed = 0;
     ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N},
                               {cfg->p0_var[0], cfg->p0_var[1], cfg->p0_var[2], cfg->p0_var[3]},
-                              0, 0.0f, 0.0f, 0.0f};
+                              0, 0.0f, 0.0f, 0.0f, 0.0f, cfg->load.p0_N2};
     ukf->ready = 1;
     return BR_OK;
 }
 
-br_status_t br_ukf_chol4(const float A[BR_NX][BR_NX], float L[BR_NX][BR_NX])
+/* Cholesky-Banachiewicz of the leading n x n block of A into L (upper part zeroed). */
+static br_status_t chol_n(const float A[NM][NM], float L[NM][NM], int n)
 {
-    if (A == NULL || L == NULL) {
-        return BR_E_NULL;
-    }
-    for (int i = 0; i < BR_NX; i++) {
-        for (int j = 0; j < BR_NX; j++) {
+    for (int i = 0; i < n; i++) {
+        for (int j = 0; j < n; j++) {
             L[i][j] = 0.0f;
         }
     }
-    for (int j = 0; j < BR_NX; j++) {
+    for (int j = 0; j < n; j++) {
         /* Cholesky-Banachiewicz: L_jj = sqrt(A_jj - sum_{k<j} L_jk^2) */
         float d = A[j][j];
         for (int k = 0; k < j; k++) {
@@ -130,7 +155,7 @@ br_status_t br_ukf_chol4(const float A[BR_NX][BR_NX], float L[BR_NX][BR_NX])
         L[j][j] = ljj;
         /* L_ij = (A_ij - sum_{k<j} L_ik L_jk) / L_jj, i > j; a non-finite entry
          * reaches the pivot of row i and is caught there */
-        for (int i = j + 1; i < BR_NX; i++) {
+        for (int i = j + 1; i < n; i++) {
             float s = A[i][j];
             for (int k = 0; k < j; k++) {
                 s -= L[i][k] * L[j][k];
@@ -141,47 +166,68 @@ br_status_t br_ukf_chol4(const float A[BR_NX][BR_NX], float L[BR_NX][BR_NX])
     return BR_OK;
 }
 
-/* P0 = diag(p0_var): the initial covariance and the recovery point. */
-static void reset_cov(const br_ukf_cfg_t *cfg, float P[BR_NX][BR_NX])
+br_status_t br_ukf_chol4(const float A[BR_NX][BR_NX], float L[BR_NX][BR_NX])
 {
+    if (A == NULL || L == NULL) {
+        return BR_E_NULL;
+    }
+    float a[NM][NM], l[NM][NM];
     for (int i = 0; i < BR_NX; i++) {
         for (int j = 0; j < BR_NX; j++) {
-            P[i][j] = (i == j) ? cfg->p0_var[i] : 0.0f;
+            a[i][j] = A[i][j];
+        }
+    }
+    const br_status_t st = chol_n((const float(*)[NM])a, l, BR_NX);
+    for (int i = 0; i < BR_NX; i++) {
+        for (int j = 0; j < BR_NX; j++) {
+            L[i][j] = l[i][j];
+        }
+    }
+    return st;
+}
+
+/* P0 = diag(p0_var[, load.p0_N2]): the initial covariance and the recovery point. */
+static void reset_cov(const br_ukf_t *ukf, float P[NM][NM])
+{
+    for (int i = 0; i < ukf->n; i++) {
+        for (int j = 0; j < ukf->n; j++) {
+            P[i][j] = (i == j) ? p0_of(&ukf->cfg, i) : 0.0f;
         }
     }
 }
 
 /* Sigma points of (x, P) into ukf->X, factor into ukf->S. On a failed Cholesky
- * P is reset to diag(p0_var) (x kept) and BR_E_NUMERIC returned; the points are
+ * P is reset to P0 (x kept) and BR_E_NUMERIC returned; the points are
  * then those of the reset P, so they are always usable. */
-static br_status_t sigma_points(br_ukf_t *ukf, const float x[BR_NX], float P[BR_NX][BR_NX])
+static br_status_t sigma_points(br_ukf_t *ukf, const float x[NM], float P[NM][NM])
 {
-    br_status_t st = br_ukf_chol4((const float(*)[BR_NX])P, ukf->S);
+    const int n = ukf->n;
+    br_status_t st = chol_n((const float(*)[NM])P, ukf->S, n);
     if (st != BR_OK) {
-        /* recovery: P <- diag(p0_var), whose factor is diag(sqrt(p0_var)) */
-        reset_cov(&ukf->cfg, P);
-        for (int i = 0; i < BR_NX; i++) {
-            for (int j = 0; j < BR_NX; j++) {
-                ukf->S[i][j] = (i == j) ? sqrtf(ukf->cfg.p0_var[i]) : 0.0f;
+        /* recovery: P <- P0, whose factor is diag(sqrt(P0)) */
+        reset_cov(ukf, P);
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < n; j++) {
+                ukf->S[i][j] = (i == j) ? sqrtf(p0_of(&ukf->cfg, i)) : 0.0f;
             }
         }
         ukf->n_recover++;
         st = BR_E_NUMERIC;
     }
     const float c = ukf->c_sigma;
-    for (int i = 0; i < BR_NX; i++) {
+    for (int i = 0; i < n; i++) {
         ukf->X[0][i] = x[i];
     }
-    for (int k = 0; k < BR_NX; k++) {
+    for (int k = 0; k < n; k++) {
         /* X_{1+k} = x + c S_k, X_{1+n+k} = x - c S_k (S_k: column k of the factor) */
-        for (int i = 0; i < BR_NX; i++) {
+        for (int i = 0; i < n; i++) {
             const float d = c * ukf->S[i][k];
             ukf->X[1 + k][i] = x[i] + d;
-            ukf->X[1 + BR_NX + k][i] = x[i] - d;
+            ukf->X[1 + n + k][i] = x[i] - d;
         }
     }
     /* the model needs g_p > 0: every sigma point's g_p in [gp_min, gp_max] */
-    for (int s = 0; s < BR_UKF_NSIG; s++) {
+    for (int s = 0; s < 2 * n + 1; s++) {
         ukf->X[s][BR_X_GP] = br_clampf(ukf->X[s][BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
     }
     return st;
@@ -189,17 +235,25 @@ static br_status_t sigma_points(br_ukf_t *ukf, const float x[BR_NX], float P[BR_
 
 /* Unscented mean of f_nl (eq. 6) over the sigma points in ukf->X:
  * F_hat = sum_j Wm_j f_nl(X_j), written as f_0 + sum_{j>=1} W_j (f_j - f_0)
- * (sum Wm = 1) so that a large |Wm_0| (small alpha) does not cancel in float32. */
+ * (sum Wm = 1) so that a large |Wm_0| (small alpha) does not cancel in float32.
+ * With the external force (cfg.load) the compensation is friction + F_d, the
+ * force a position measurement can tell (docs/modules/ukf.md, "External
+ * force"), clamped to +-max_N. */
 static float fnl_unscented(const br_ukf_t *ukf, int32_t origin_counts)
 {
     /* the force to compensate: f_nl for the thesis model (eq. 6), the extended model's otherwise */
     const float p0 = (float)origin_counts * ukf->m_per_count;
     const float f0 = br_model_fcomp_N(&ukf->model, ukf->X[0], p0);
     float df = 0.0f;
-    for (int s = 1; s < BR_UKF_NSIG; s++) {
+    for (int s = 1; s < 2 * ukf->n + 1; s++) {
         df += br_model_fcomp_N(&ukf->model, ukf->X[s], p0) - f0;
     }
-    return f0 + ukf->wi * df;
+    const float F = f0 + ukf->wi * df;
+    if (ukf->n == BR_NX) {
+        return F;
+    }
+    /* + the unscented mean of F_d, linear: the central point's (the mean's); the sum within +-max_N */
+    return br_clampf(F + ukf->X[0][BR_UKF_X_LOAD], -ukf->cfg.load.max_N, ukf->cfg.load.max_N);
 }
 
 /* The estimate of the committed x, P, origin. */
@@ -210,12 +264,14 @@ static void set_estimate(br_ukf_t *ukf, float F_hat_N, float innov, float innov_
         ukf->est.mean[i] = ukf->x[i];
         ukf->est.var[i] = ukf->P[i][i];
     }
+    ukf->est.load_N = (ukf->n > BR_NX) ? ukf->x[BR_UKF_X_LOAD] : 0.0f;
+    ukf->est.load_var_N2 = (ukf->n > BR_NX) ? ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD] : 0.0f;
     ukf->est.origin_counts = ukf->origin_counts;
     ukf->est.innov_rad = innov;
     ukf->est.innov_var_rad2 = innov_var;
 }
 
-/* First measurement: x = [frac rpc, 0, 0, gp0] relative to origin = counts, P = P0. */
+/* First measurement: x = [frac rpc, 0, 0, gp0(, 0)] relative to origin = counts, P = P0. */
 static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
 {
     ukf->origin_counts = y->counts;
@@ -225,8 +281,9 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
     ukf->x[BR_X_OMEGA] = 0.0f;
     ukf->x[BR_X_Z] = 0.0f;
     ukf->x[BR_X_GP] = ukf->cfg.est.gp0_N;
-    reset_cov(&ukf->cfg, ukf->P);
-    (void)sigma_points(ukf, ukf->x, ukf->P); /* diagonal with p0_var > 0: cannot fail */
+    ukf->x[BR_UKF_X_LOAD] = 0.0f;
+    reset_cov(ukf, ukf->P);
+    (void)sigma_points(ukf, ukf->x, ukf->P); /* diagonal with P0 > 0: cannot fail */
     set_estimate(ukf, fnl_unscented(ukf, ukf->origin_counts), 0.0f, 0.0f);
     ukf->primed = 1;
     return BR_OK;
@@ -234,24 +291,32 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
 
 /* Steps 1-2: sigma points of the posterior (x, P) of the last step and their
  * prediction through eq. 6 discretised, Y_j = f_d(X_j, u_{k-1}), into the
- * predicted mean xm and covariance Pm. *chol_reset is set when a failed
+ * predicted mean xm and covariance Pm. With the external force F_d (cfg.load)
+ * the torque is u - L F_d_j (eq. 1 with the load beside the friction) and
+ * F_d_j carries over (a random walk). *chol_reset is set when a failed
  * Cholesky reset P (kept in ukf->P: the recovery outlives a later failure).
  * Returns 0 when the prediction is not finite. */
-static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[BR_NX], float Pm[BR_NX][BR_NX], int *chol_reset)
+static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[NM], float Pm[NM][NM], int *chol_reset)
 {
+    const int n = ukf->n, nsig = 2 * n + 1;
     const float p0 = (float)ukf->origin_counts * ukf->m_per_count; /* theta's origin */
+    const float L = ukf->cfg.est.model.lead_mprad;
     br_model_tick(&ukf->model); /* the model's clock moves on by one period (friction_drift) */
     *chol_reset = sigma_points(ukf, ukf->x, ukf->P) != BR_OK;
-    for (int s = 0; s < BR_UKF_NSIG; s++) {
-        if (br_model_step_at(&ukf->model, ukf->X[s], p0, u_prev_Nm, ukf->Y[s]) != BR_OK) {
+    for (int s = 0; s < nsig; s++) {
+        /* the torque on the axis: u, less L F_d with the external force */
+        const float u = (n > BR_NX) ? u_prev_Nm - L * ukf->X[s][BR_UKF_X_LOAD] : u_prev_Nm;
+        if (br_model_step_at(&ukf->model, ukf->X[s], p0, u, ukf->Y[s]) != BR_OK) {
             return 0;
         }
+        /* F_d' = 0 (its random walk is in Q) */
+        ukf->Y[s][BR_UKF_X_LOAD] = ukf->X[s][BR_UKF_X_LOAD];
     }
     /* predicted mean x- = sum_j Wm_j Y_j = Y_0 + m, m = sum_{j>=1} W (Y_j - Y_0) (sum Wm = 1) */
-    float mdev[BR_NX];
-    for (int i = 0; i < BR_NX; i++) {
+    float mdev[NM];
+    for (int i = 0; i < n; i++) {
         float d = 0.0f;
-        for (int s = 1; s < BR_UKF_NSIG; s++) {
+        for (int s = 1; s < nsig; s++) {
             d += ukf->Y[s][i] - ukf->Y[0][i];
         }
         mdev[i] = ukf->wi * d;
@@ -261,37 +326,37 @@ static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[BR_NX], float Pm[BR_
      * the central point (d_j = Y_j - Y_0) as the algebraically equal
      *   P- = sum_{j>=1} W d_j d_j^T + (beta - alpha^2) m m^T + Q,
      * which has no large |Wc_0| to cancel in float32 and is PSD for beta >= alpha^2 */
-    for (int i = 0; i < BR_NX; i++) {
+    for (int i = 0; i < n; i++) {
         for (int j = 0; j <= i; j++) {
             Pm[i][j] = ukf->cmm * mdev[i] * mdev[j];
         }
     }
-    for (int s = 1; s < BR_UKF_NSIG; s++) {
-        float d[BR_NX];
-        for (int i = 0; i < BR_NX; i++) {
+    for (int s = 1; s < nsig; s++) {
+        float d[NM];
+        for (int i = 0; i < n; i++) {
             d[i] = ukf->Y[s][i] - ukf->Y[0][i];
         }
-        for (int i = 0; i < BR_NX; i++) {
+        for (int i = 0; i < n; i++) {
             for (int j = 0; j <= i; j++) {
                 Pm[i][j] += ukf->wi * d[i] * d[j];
             }
         }
     }
-    for (int i = 0; i < BR_NX; i++) {
-        Pm[i][i] += ukf->cfg.est.q_var[i];
+    for (int i = 0; i < n; i++) {
+        Pm[i][i] += (i < BR_NX) ? ukf->cfg.est.q_var[i] : ukf->cfg.load.q_N2;
         for (int j = 0; j < i; j++) {
             Pm[j][i] = Pm[i][j];
         }
     }
-    return vec_finite(xm) && mat_finite((const float(*)[BR_NX])Pm);
+    return vec_finite(xm, n) && mat_finite((const float(*)[NM])Pm, n);
 }
 
 /* A step whose prediction or update is not finite: the mean and origin are
- * kept, P is reset to diag(p0_var) and the reset counted, so the next step
+ * kept, P is reset to P0 and the reset counted, so the next step
  * starts again from a usable covariance instead of failing forever. */
 static br_status_t fail_reset(br_ukf_t *ukf)
 {
-    reset_cov(&ukf->cfg, ukf->P);
+    reset_cov(ukf, ukf->P);
     ukf->n_recover++;
     return BR_E_NUMERIC;
 }
@@ -300,8 +365,8 @@ static br_status_t fail_reset(br_ukf_t *ukf)
  * as in step 1 and sets *chol_reset), the unscented mean of f_nl over them
  * into *F_hat, then x = xm, P = Pm. Returns 0, committing nothing, when
  * *F_hat is not finite. */
-static int posterior(br_ukf_t *ukf, const float xm[BR_NX], float Pm[BR_NX][BR_NX], int32_t origin_counts,
-                     float *F_hat, int *chol_reset)
+static int posterior(br_ukf_t *ukf, const float xm[NM], float Pm[NM][NM], int32_t origin_counts, float *F_hat,
+                     int *chol_reset)
 {
     if (sigma_points(ukf, xm, Pm) != BR_OK) {
         *chol_reset = 1;
@@ -310,9 +375,9 @@ static int posterior(br_ukf_t *ukf, const float xm[BR_NX], float Pm[BR_NX][BR_NX
     if (!isfinite(*F_hat)) {
         return 0;
     }
-    for (int i = 0; i < BR_NX; i++) {
+    for (int i = 0; i < ukf->n; i++) {
         ukf->x[i] = xm[i];
-        for (int j = 0; j < BR_NX; j++) {
+        for (int j = 0; j < ukf->n; j++) {
             ukf->P[i][j] = Pm[i][j];
         }
     }
@@ -320,15 +385,82 @@ static int posterior(br_ukf_t *ukf, const float xm[BR_NX], float Pm[BR_NX][BR_NX
 }
 
 /* P <- (P + P^T) / 2 */
-static void symmetrise(float P[BR_NX][BR_NX])
+static void symmetrise(float P[NM][NM], int n)
 {
-    for (int i = 0; i < BR_NX; i++) {
-        for (int j = i + 1; j < BR_NX; j++) {
+    for (int i = 0; i < n; i++) {
+        for (int j = i + 1; j < n; j++) {
             const float m = 0.5f * (P[i][j] + P[j][i]);
             P[i][j] = m;
             P[j][i] = m;
         }
     }
+}
+
+/* The mean's bounded states: g_p in [gp_min, gp_max], F_d in [-max_N, max_N]. */
+static void clamp_mean(const br_ukf_t *ukf, float x[NM])
+{
+    x[BR_X_GP] = br_clampf(x[BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
+    if (ukf->n > BR_NX) {
+        x[BR_UKF_X_LOAD] = br_clampf(x[BR_UKF_X_LOAD], -ukf->cfg.load.max_N, ukf->cfg.load.max_N);
+    }
+}
+
+/* Step 3: theta- re-expressed relative to the new origin y.counts (wrap-safe
+ * integer delta) into *theta_new; the innovation nu = frac rpc - theta- and
+ * S = P-_00 + R (h(x) = theta). Returns 1 when nu passes the gate,
+ * nu^2 <= g^2 (S + rpc^2 / 12) (docs/modules/ukf.md). */
+static int innovate(const br_ukf_t *ukf, const br_meas_t *y, const float xm[NM], const float Pm[NM][NM],
+                    float *theta_new, float *nu, float *S)
+{
+    const float rpc = ukf->cfg.est.rad_per_count;
+    const float shift = (float)br_counts_delta(y->counts, ukf->origin_counts) * rpc;
+    *theta_new = xm[BR_X_THETA] - shift;
+    *nu = y->frac * rpc - *theta_new;
+    *S = Pm[0][0] + ukf->cfg.est.r_var_rad2;
+    return !(*nu * *nu > ukf->out_s2 * (*S + ukf->quant_var_rad2));
+}
+
+/* Load re-acquisition (cfg.load; docs/modules/ukf.md, "External force"): a
+ * gated innovation nu that a change of the external force explains, the force
+ * dF = nu / (g k^2), g = L dt^2 / (2 J_eff), k the periods since the last
+ * measurement, with |dF| <= 2 max_N: the last posterior's F_d variance is
+ * inflated by dF^2 and the period predicted again into xm, Pm (the model's
+ * clock put back first). Returns 1 when that prediction's innovation passes
+ * the gate (ukf->P keeps the inflation), 0 otherwise (ukf->P, xm and Pm
+ * untouched). */
+static int load_reacquire(br_ukf_t *ukf, const br_meas_t *y, float u_a, float nu, float xm[NM], float Pm[NM][NM],
+                          int *chol_reset)
+{
+    if (ukf->n == BR_NX) {
+        return 0;
+    }
+    const float k = (float)ukf->n_predicted + 1.0f;
+    const float dF = nu / (ukf->load_rad_per_N2 * k * k);
+    if (!(fabsf(dF) <= 2.0f * ukf->cfg.load.max_N)) {
+        return 0;
+    }
+    const float keep = ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD];
+    /* P_dd += dF^2 (the last posterior's), then the period again from it */
+    ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD] = keep + dF * dF;
+    br_model_set_clock(&ukf->model, ukf->model.n_steps - 1u);
+    float xr[NM], Pr[NM][NM], th, nu_r, S_r;
+    int reset = 0;
+    if (predict(ukf, u_a, xr, Pr, &reset) && innovate(ukf, y, xr, (const float(*)[NM])Pr, &th, &nu_r, &S_r)) {
+        for (int i = 0; i < ukf->n; i++) {
+            xm[i] = xr[i];
+            for (int j = 0; j < ukf->n; j++) {
+                Pm[i][j] = Pr[i][j];
+            }
+        }
+        *chol_reset = *chol_reset || reset;
+        if (ukf->n_load_acq < UINT32_MAX) {
+            ukf->n_load_acq++;
+        }
+        return 1;
+    }
+    /* not a load: the first prediction stands (its clock too: predict ticked again) */
+    ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD] = keep;
+    return 0;
 }
 
 br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
@@ -351,76 +483,75 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     if (!ukf->primed) {
         return prime(ukf, y);
     }
+    const int n = ukf->n;
     const float rpc = ukf->cfg.est.rad_per_count;
 
     /* 1.-2. sigma points of the last posterior, predicted mean and covariance */
-    float xm[BR_NX], Pm[BR_NX][BR_NX];
+    float xm[NM], Pm[NM][NM];
     int chol_reset;
     if (!predict(ukf, u_a, xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }
 
-    /* 3. measurement: theta re-expressed relative to the new origin y.counts
-     *    (wrap-safe integer delta); y_rel = frac rpc, innovation nu = y_rel - theta- */
-    const float shift = (float)br_counts_delta(y->counts, ukf->origin_counts) * rpc;
-    const float theta_new = xm[BR_X_THETA] - shift;
-    const float nu = y->frac * rpc - theta_new;
-    /* innovation variance S = H P- H^T + R = P-_00 + R (h(x) = theta) */
-    const float S = Pm[0][0] + ukf->cfg.est.r_var_rad2;
+    /* 3. measurement, innovation and its variance; the gate */
+    float theta_new, nu, S;
+    int pass = innovate(ukf, y, xm, (const float(*)[NM])Pm, &theta_new, &nu, &S);
     if (!isfinite(nu) || !br_finite_pos(S)) {
         return fail_reset(ukf);
     }
+    /* a gated innovation that a load explains is re-acquired, not rejected (cfg.load) */
+    if (!pass && load_reacquire(ukf, y, u_a, nu, xm, Pm, &chol_reset)) {
+        pass = innovate(ukf, y, xm, (const float(*)[NM])Pm, &theta_new, &nu, &S);
+    }
     br_status_t verdict = BR_OK;
     int32_t origin_new = y->counts;
-    /* gate (docs/modules/ukf.md): outlier when nu^2 > g^2 (P-_00 + R + rpc^2 / 12),
-     * the innovation's variance with the encoder's quantisation */
-    if (nu * nu > ukf->out_s2 * (S + ukf->quant_var_rad2)) {
+    if (!pass) {
         /* outlier: keep the prediction in the old origin's frame, no update */
         verdict = BR_W_OUTLIER;
         origin_new = ukf->origin_counts;
         if (ukf->n_outliers + 1u >= ukf->cfg.est.reanchor_after) {
             /* lost lock: re-anchor on the measurement, theta = frac rpc relative
              * to y.counts, omega = the measured velocity over the last period
-             * (wrap-safe count difference), z and g_p means kept, P = diag(p0_var) */
+             * (wrap-safe count difference), z, g_p (and F_d) means kept, P = P0 */
             const float dcounts = (float)br_counts_delta(y->counts, ukf->prev_counts);
             xm[BR_X_THETA] = y->frac * rpc;
             const float periods = (float)ukf->n_predicted + 1.0f;
             xm[BR_X_OMEGA] = (dcounts + (y->frac - ukf->prev_frac)) * rpc / (periods * ukf->cfg.est.model.dt_s);
-            reset_cov(&ukf->cfg, Pm);
+            reset_cov(ukf, Pm);
             origin_new = y->counts;
-            if (!vec_finite(xm)) {
+            if (!vec_finite(xm, n)) {
                 return fail_reset(ukf);
             }
         }
     } else {
         /* gain K = P- H^T / S = P-_{:,0} / S; mean x+ = x- + K nu (theta in the new frame) */
-        float K[BR_NX];
-        for (int i = 0; i < BR_NX; i++) {
+        float K[NM];
+        for (int i = 0; i < n; i++) {
             K[i] = Pm[i][0] / S;
         }
         xm[BR_X_THETA] = theta_new;
-        for (int i = 0; i < BR_NX; i++) {
+        for (int i = 0; i < n; i++) {
             xm[i] += K[i] * nu;
         }
         /* Joseph form P+ = A P- A^T + R K K^T, A = I - K H, H = e_0^T:
          *   (A P-)_ij = P-_ij - K_i P-_0j,  (A P- A^T)_ij = (A P-)_ij - (A P-)_i0 K_j */
-        float AP[BR_NX][BR_NX];
-        for (int i = 0; i < BR_NX; i++) {
-            for (int j = 0; j < BR_NX; j++) {
+        float AP[NM][NM];
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < n; j++) {
                 AP[i][j] = Pm[i][j] - K[i] * Pm[0][j];
             }
         }
         const float r = ukf->cfg.est.r_var_rad2;
-        for (int i = 0; i < BR_NX; i++) {
-            for (int j = 0; j < BR_NX; j++) {
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < n; j++) {
                 Pm[i][j] = AP[i][j] - AP[i][0] * K[j] + r * K[i] * K[j];
             }
         }
         /* P+ <- (P+ + P+^T) / 2 */
-        symmetrise(Pm);
-        /* g_p of the mean kept in [gp_min, gp_max], as the sigma points' are */
-        xm[BR_X_GP] = br_clampf(xm[BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
-        if (!vec_finite(xm) || !mat_finite((const float(*)[BR_NX])Pm)) {
+        symmetrise(Pm, n);
+        /* g_p of the mean kept in [gp_min, gp_max], as the sigma points' are; F_d in [-max, max] */
+        clamp_mean(ukf, xm);
+        if (!vec_finite(xm, n) || !mat_finite((const float(*)[NM])Pm, n)) {
             return fail_reset(ukf);
         }
     }
@@ -458,14 +589,14 @@ br_status_t br_ukf_predict(br_ukf_t *ukf, float u_prev_Nm)
     if (!ukf->primed) {
         return BR_E_STATE; /* nothing to predict from before the first measurement */
     }
-    float xm[BR_NX], Pm[BR_NX][BR_NX];
+    float xm[NM], Pm[NM][NM];
     int chol_reset;
     /* no measurement: the delay's identification starts again at the next one */
     ukf->dlyid.primed = 0;
     if (!predict(ukf, br_est_delay_apply(&ukf->delay, u_prev_Nm), xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }
-    xm[BR_X_GP] = br_clampf(xm[BR_X_GP], ukf->cfg.est.gp_min_N, ukf->cfg.est.gp_max_N);
+    clamp_mean(ukf, xm);
     /* the predicted set's sigma points give the estimate, as after an update */
     float F_hat;
     if (!posterior(ukf, xm, Pm, ukf->origin_counts, &F_hat, &chol_reset)) {

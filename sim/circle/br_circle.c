@@ -94,6 +94,16 @@ void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods)
     }
 }
 
+void br_circle_use_ukf_load(br_circle_cfg_t *c, double q_N2ps)
+{
+    if (q_N2ps > 0.0) {
+        const double F_act = (double)BR_MACHINE_TORQUE_LIMIT_NM_F / c->plant.lead_mprad;
+        c->ukf.load.q_N2 = (float)(q_N2ps * c->dt_s);
+        c->ukf.load.p0_N2 = (float)(F_act * F_act);
+        c->ukf.load.max_N = (float)F_act;
+    }
+}
+
 double br_circle_feed_mps(const br_circle_cfg_t *c)
 {
     return 2.0 * BR_PI * c->radius_m / c->period_s;

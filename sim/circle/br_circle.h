@@ -103,6 +103,13 @@ void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *model);
  * machine file's. */
 void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods);
 
+/* The tools' --ukf-load: the UKF's external-force state (docs/modules/ukf.md,
+ * "External force") with the random walk q_N2ps (N^2/s) at the run's period,
+ * P0 = the actuator's force squared and |F_d| <= the actuator's force, as
+ * machine.py derives them from estimator.ukf.load; q_N2ps <= 0 leaves the
+ * machine file's. */
+void br_circle_use_ukf_load(br_circle_cfg_t *c, double q_N2ps);
+
 /* The tools' --delay-id: 0 turns both estimators' delay identification off
  * (est.delay_id, docs/modules/dlyid.md); any other value leaves the machine's. */
 void br_circle_use_delay_id(br_circle_cfg_t *c, long on);

@@ -250,6 +250,28 @@ def main():
     withc["causes"] = {"friction_drift": {"drift_per_s": 2.0}}
     expect_errors(work, "drift.json", withc, ["field causes.friction_drift.drift_per_s: 2 is outside [-1, 1]"])
 
+    # the UKF's external-force state (estimator.ukf.load, docs/modules/ukf.md): absent = 0 (off);
+    # present: q per step = q_N2_per_s * control.period_s, P0 and the bound from the actuator's force
+    withl = copy.deepcopy(good)
+    withl["estimator"]["ukf"]["load"] = {"q_N2_per_s": 1.0e4}
+    path = write(work, "load.json", withl)
+    rc, err = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, "load_gen"))
+    with open(os.path.join(work, "load_gen", "bristle_gen", "est", "br_est_machine.h")) as f:
+        hdr = f.read()
+    F_act = good["control"]["torque_limit_Nm"] * 2.0 * math.pi / good["mechanics"]["lead_m_per_rev"]
+    check(rc == 0 and "#define BR_EST_UKF_LOAD_Q_N2_F (%s)" % machine.c_float(1.0e4 * good["control"]["period_s"]) in hdr
+          and "#define BR_EST_UKF_LOAD_P0_N2_F (%s)" % machine.c_float(F_act * F_act) in hdr
+          and "#define BR_EST_UKF_LOAD_MAX_N_F (%s)" % machine.c_float(F_act) in hdr,
+          "load.json: gen_machine.py writes the UKF's external force (q per step, the actuator's force)")
+    off = machine.ukf_load(machine.load(machine.REFERENCE_MACHINE))
+    check(off == {"q_N2": 0.0, "p0_N2": 0.0, "max_N": 0.0}, "no estimator.ukf.load: the external force is off")
+    withl["estimator"]["ukf"]["load"] = {"q_N2_per_s": 0.0}
+    expect_errors(work, "load0.json", withl, ["field estimator.ukf.load.q_N2_per_s: 0 is outside (0, 1e+09]"])
+    withl["estimator"]["ukf"]["load"] = {"q_N2_per_s": 1.0e-40}
+    expect_errors(work, "load_sub.json", withl, [
+        "field estimator.ukf.load.q_N2_per_s: gives q_N2 = 1e-43 per step on this machine, outside the "
+        "firmware's (0 excluded) [1.17549e-38, 1e+12]"])
+
     # weights that make the sampled loop unstable: no design, a clear message
     bad = copy.deepcopy(good)
     bad["control"]["hinf"]["weight_theta_per_rad"] = 1.0e3

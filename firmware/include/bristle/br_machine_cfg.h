@@ -113,7 +113,8 @@
         .p0_var = {BR_EST_UKF_P0_THETA_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F *                    \
                        BR_MACHINE_RAD_PER_COUNT_F,                                                 \
                    BR_EST_UKF_P0_OMEGA_RAD2PS2_F, BR_EST_UKF_P0_Z_M2_F, BR_EST_UKF_P0_GP_N2_F},    \
-        .alpha = BR_EST_UKF_ALPHA_F, .beta = BR_EST_UKF_BETA_F, .kappa = BR_EST_UKF_KAPPA_F        \
+        .alpha = BR_EST_UKF_ALPHA_F, .beta = BR_EST_UKF_BETA_F, .kappa = BR_EST_UKF_KAPPA_F,       \
+        .load = {BR_EST_UKF_LOAD_Q_N2_F, BR_EST_UKF_LOAD_P0_N2_F, BR_EST_UKF_LOAD_MAX_N_F}         \
     }
 
 #define BR_MACHINE_UKF_CFG_DEFAULT(dt)                                                             \

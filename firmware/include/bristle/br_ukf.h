@@ -19,6 +19,11 @@
  * outlier_sigma sqrt(S + rpc^2 / 12), the innovation's spread with the
  * encoder's quantisation) skips the update; reanchor_after of them in a row
  * re-anchor the filter on the measurement (as the PF does).
+ * With cfg.load the state has a fifth entry, the external force F_d (the
+ * torque in step 2 is u - L F_d), a gated innovation that a change of F_d
+ * of at most 2 load.max_N explains is re-acquired (P_dd inflated, the
+ * period predicted again) instead of rejected, and F_hat is friction + F_d
+ * within +-load.max_N (docs/modules/ukf.md, "External force").
  * theta is stored relative to an integer origin (the latest accepted count),
  * as in the PF, so float32 keeps sub-count resolution at any travel.
  * See docs/modules/ukf.md. */
@@ -31,8 +36,23 @@
 #include "bristle/br_model.h"
 #include "bristle/br_status.h"
 
-/* number of sigma points, 2 n + 1 */
+/* number of sigma points of the thesis's state, 2 n + 1 */
 #define BR_UKF_NSIG (2 * BR_NX + 1)
+/* with the external force (cfg.load): n = BR_NX + 1, index BR_UKF_X_LOAD */
+#define BR_UKF_NMAX (BR_NX + 1)
+#define BR_UKF_X_LOAD BR_NX
+#define BR_UKF_NSIG_MAX (2 * BR_UKF_NMAX + 1)
+
+/* The external force (a load, a cutting force: docs/modules/ukf.md, "External
+ * force"), a fifth state F_d (N, load side, acting as friction does, against
+ * +x) with a random walk. Off (the thesis's four states, bit for bit) when
+ * p0_N2 is 0. */
+typedef struct {
+    float q_N2;    /* random-walk variance of F_d per step (N^2), 0 or a normal float <= BR_EST_VAR_MAX */
+    float p0_N2;   /* initial (and recovery) variance of F_d (N^2); 0: no external-force state */
+    float max_N;   /* |F_d| is kept <= max_N (the actuator's force); a gated innovation that a change of
+                      F_d of at most 2 max_N explains is re-acquired as a load, not rejected; > 0 when on */
+} br_ukf_load_t;
 
 typedef struct {
     br_est_cfg_t est;        /* what the UKF shares with the PF: model (est.model.dt_s is the UKF's
@@ -42,6 +62,7 @@ typedef struct {
     float alpha;             /* sigma-point spread, in (0, 1]; use >= 0.1 in float32 (1 recommended) */
     float beta;              /* prior-distribution weight, >= 0 (2 for a Gaussian) */
     float kappa;             /* secondary scaling, n + kappa > 0 (so n + lambda > 0) */
+    br_ukf_load_t load;      /* the external-force state (all 0: off, n = 4) */
 } br_ukf_cfg_t;
 
 typedef struct {
@@ -51,11 +72,16 @@ typedef struct {
     float F_hat_N;           /* unscented mean of f_nl over the posterior sigma points */
     float innov_rad;         /* last innovation y - theta- (0 on the priming step) */
     float innov_var_rad2;    /* its predicted variance S = P-_00 + R */
+    float load_N;            /* the external force's mean F_d (0 without cfg.load) */
+    float load_var_N2;       /* its variance */
 } br_ukf_est_t;
 
 typedef struct {
     br_ukf_cfg_t cfg;
     br_model_t model;
+    int n;                           /* state dimension: BR_NX, or BR_UKF_NMAX with cfg.load */
+    float load_rad_per_N2;           /* L dt^2 / (2 J_eff): theta's response to F_d over one period (the
+                                        load re-acquisition's force, rad / N; 0 without cfg.load) */
     float c_sigma;                   /* sqrt(n + lambda) */
     float wm0, wc0, wi;              /* weights: Wm_0, Wc_0, and Wm_i = Wc_i = W for i >= 1 */
     float cmm;                       /* beta - alpha^2: the m m^T term of P- about the central point */
@@ -64,11 +90,11 @@ typedef struct {
     float m_per_count;               /* L rpc: load position per encoder count */
     br_est_delay_t delay;            /* commands for the actuator delay (model.causes.delay_s) */
     br_dlyid_t dlyid;             /* the delay's identification (cfg.est.delay_id) */
-    float x[BR_NX];                  /* mean; theta relative to origin_counts */
-    float P[BR_NX][BR_NX];           /* covariance, symmetric positive definite */
-    float S[BR_NX][BR_NX];           /* scratch: Cholesky factor of the last factorised P (lower) */
-    float X[BR_UKF_NSIG][BR_NX];     /* sigma points (scratch; after a step without error, the posterior's) */
-    float Y[BR_UKF_NSIG][BR_NX];     /* scratch: propagated sigma points of the last step */
+    float x[BR_UKF_NMAX];            /* mean; theta relative to origin_counts (first n used) */
+    float P[BR_UKF_NMAX][BR_UKF_NMAX];   /* covariance, symmetric positive definite */
+    float S[BR_UKF_NMAX][BR_UKF_NMAX];   /* scratch: Cholesky factor of the last factorised P (lower) */
+    float X[BR_UKF_NSIG_MAX][BR_UKF_NMAX]; /* sigma points (scratch; after a step without error, the posterior's) */
+    float Y[BR_UKF_NSIG_MAX][BR_UKF_NMAX]; /* scratch: propagated sigma points of the last step */
     int32_t origin_counts;
     int32_t prev_counts;             /* last measurement (accepted or not): the measured */
     float prev_frac;                 /*   velocity for a re-anchoring */
@@ -76,6 +102,7 @@ typedef struct {
     uint32_t n_recover;              /* covariance resets since init (failed Cholesky, or a
                                         non-finite prediction or update) */
     uint32_t n_predicted;            /* predict-only steps since the last measurement */
+    uint32_t n_load_acq;             /* gated innovations re-acquired as a load (cfg.load) */
     int primed;                      /* x, P set from the first measurement */
     br_ukf_est_t est;
     int ready;

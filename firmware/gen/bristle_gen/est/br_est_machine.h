@@ -160,5 +160,14 @@
 /* secondary scaling */
 #define BR_EST_UKF_KAPPA (0.0)
 #define BR_EST_UKF_KAPPA_F (0.000000000e+00f)
+/* external force: random walk per step (0 with P0: off) */
+#define BR_EST_UKF_LOAD_Q_N2 (0.0)
+#define BR_EST_UKF_LOAD_Q_N2_F (0.000000000e+00f)
+/* its initial (and recovery) variance; 0: no external force */
+#define BR_EST_UKF_LOAD_P0_N2 (0.0)
+#define BR_EST_UKF_LOAD_P0_N2_F (0.000000000e+00f)
+/* its bound, and the compensation's (the actuator's force) */
+#define BR_EST_UKF_LOAD_MAX_N (0.0)
+#define BR_EST_UKF_LOAD_MAX_N_F (0.000000000e+00f)
 
 #endif

@@ -1,0 +1,144 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The UKF's external-force state (cfg.load; docs/modules/ukf.md, "External
+ * force"): its configuration guards, a load step followed without an
+ * outlier (and, without the state, the outliers it causes), the
+ * compensation of friction + load within the bound, and a counter jump no
+ * load can explain still rejected. */
+#include "br_test.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "bristle_gen/machine/br_machine.h"
+#include "circle/br_circle_est.h"
+#include "bristle/br_ukf.h"
+
+#define DT_F BR_MACHINE_CTRL_PERIOD_S_F
+
+static br_ukf_cfg_t load_cfg(void)
+{
+    br_ukf_cfg_t c = br_circle_ukf_cfg_tuned(DT_F);
+    const float F_act = BR_MACHINE_TORQUE_LIMIT_NM_F / c.est.model.lead_mprad;
+    c.load.q_N2 = 1.0e4f * DT_F; /* 1e4 N^2/s, the campaign's */
+    c.load.p0_N2 = F_act * F_act;
+    c.load.max_N = F_act;
+    return c;
+}
+
+static int init_with(br_ukf_cfg_t c)
+{
+    br_ukf_t u;
+    return br_ukf_init(&u, &c);
+}
+
+static void test_load_guards(void **st)
+{
+    (void)st;
+    br_ukf_t u;
+    br_ukf_cfg_t c = load_cfg();
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    assert_int_equal(u.n, BR_UKF_NMAX);
+    c = br_circle_ukf_cfg_tuned(DT_F);
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    assert_int_equal(u.n, BR_NX); /* all 0: off */
+    /* off needs all three 0 */
+    c = br_circle_ukf_cfg_tuned(DT_F); c.load.q_N2 = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = br_circle_ukf_cfg_tuned(DT_F); c.load.max_N = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    const float bad[] = {NAN, INFINITY, -1.0f, 1.0e-40f, 2.0f * BR_EST_VAR_MAX};
+    for (unsigned b = 0; b < sizeof bad / sizeof bad[0]; b++) {
+        c = load_cfg(); c.load.p0_N2 = bad[b]; assert_int_equal(init_with(c), BR_E_PARAM);
+        c = load_cfg(); c.load.q_N2 = bad[b];  assert_int_equal(init_with(c), BR_E_PARAM);
+    }
+    c = load_cfg(); c.load.q_N2 = 0.0f; assert_int_equal(init_with(c), BR_OK); /* a constant load */
+    c = load_cfg(); c.load.max_N = 0.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = load_cfg(); c.load.max_N = -5.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = load_cfg(); c.load.max_N = NAN; assert_int_equal(init_with(c), BR_E_PARAM);
+    /* n + kappa > 0 with n = 5: kappa = -4.5 passes with the state, not without */
+    c = load_cfg(); c.kappa = -4.5f; assert_int_equal(init_with(c), BR_OK);
+    c = br_circle_ukf_cfg_tuned(DT_F); c.kappa = -4.5f; assert_int_equal(init_with(c), BR_E_PARAM);
+}
+
+/* Counts of an axis held still for 0.1 s, then pushed by an external force
+ * F_N (toward -x: a force against +x, as friction) with no torque: theta(t) =
+ * -L F_N t^2 / (2 J_eff) from t0, frictionless (the model's friction and
+ * the load then share the force the filter sees). Runs n periods through u,
+ * returns the number of outlier steps; *F_comp the last compensation. */
+static int run_pushed(br_ukf_t *u, double F_N, int n, float *F_comp)
+{
+    const br_model_cfg_t *m = &u->cfg.est.model;
+    const double L = m->lead_mprad, Jeff = m->J_kgm2 + L * L * m->M_kg, rpc = u->cfg.est.rad_per_count;
+    const br_est_t e = br_ukf_est(u);
+    int outliers = 0;
+    for (int k = 0; k < n; k++) {
+        const double t = (double)k * m->dt_s - 0.1;
+        const double th = (t > 0.0) ? -L * F_N * t * t / (2.0 * Jeff) : 0.0;
+        const double cts = th / rpc + 0.5;
+        const double whole = floor(cts);
+        const br_meas_t y = {(int32_t)whole, (float)(cts - whole)};
+        const br_status_t st = e.step(e.ctx, &y, 0.0f, F_comp);
+        assert_true(st == BR_OK || st == BR_W_OUTLIER);
+        outliers += st == BR_W_OUTLIER;
+    }
+    return outliers;
+}
+
+static void test_load_step_followed(void **st)
+{
+    (void)st;
+    br_ukf_t u;
+    br_ukf_cfg_t c = load_cfg();
+    const double F = 0.5 * (double)c.load.max_N; /* half the actuator's force */
+    float comp = 0.0f;
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    assert_int_equal(run_pushed(&u, F, 250, &comp), 0);
+    assert_true(u.n_load_acq >= 1u);
+    /* the compensation carries the load: friction + F_d of the size of the push (the model's
+     * viscous sigma2 v, ~50 N at the end's 1.1 m/s, and its sliding friction share the rest) */
+    printf("  load %.1f N: compensation %.2f N, F_d %.2f N, %u re-acquisitions\n", F, (double)comp,
+           (double)u.est.load_N, u.n_load_acq);
+    assert_true(comp > 0.8 * F && comp < 1.3 * F);
+    /* without the state the same push is a run of outliers (the lock monitor's trip) */
+    br_ukf_cfg_t off = br_circle_ukf_cfg_tuned(DT_F);
+    assert_int_equal(br_ukf_init(&u, &off), BR_OK);
+    assert_true(run_pushed(&u, F, 250, &comp) > 10);
+}
+
+static void test_load_bounded(void **st)
+{
+    (void)st;
+    br_ukf_t u;
+    br_ukf_cfg_t c = load_cfg();
+    c.load.max_N = 100.0f; /* a bound below the push: F_d and the compensation stay within it */
+    float comp = 0.0f;
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    (void)run_pushed(&u, 250.0, 250, &comp);
+    assert_true(fabsf(u.est.load_N) <= 100.0f);
+    assert_true(fabsf(comp) <= 100.0f);
+}
+
+static void test_jump_not_a_load(void **st)
+{
+    (void)st;
+    br_ukf_t u;
+    br_ukf_cfg_t c = load_cfg();
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    const br_meas_t y = {100, 0.5f};
+    for (int k = 0; k < 200; k++) {
+        assert_int_equal(br_ukf_step(&u, &y, 0.0f), BR_OK);
+    }
+    /* 2e4 counts in one period: a force of ~1e4 N, beyond 2 max_N: still an outlier, no re-acquisition */
+    const br_meas_t j = {100 + 20000, 0.5f};
+    assert_int_equal(br_ukf_step(&u, &j, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(u.n_load_acq, 0u);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_load_guards),
+        cmocka_unit_test(test_load_step_followed),
+        cmocka_unit_test(test_load_bounded),
+        cmocka_unit_test(test_jump_not_a_load),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
