@@ -258,7 +258,8 @@ def ukf_meta(cfg):
 
 def generate(out_dir, m, gt):
     """Writes the estimator traces; gt is the gen_traces module (write_trace,
-    f32, read_gains, SEED, SEED_OFFSET). Returns the paths."""
+    f32, read_gains, SEED, SEED_OFFSET). Returns the paths and the recorded
+    input's rows (est_input.csv's, for gen_load_traces.py)."""
     rows_in, rows_pf, rows_w, rows_x, meta_in, meta_pf = record(m, gt)
     paths = [gt.write_trace(out_dir, "est_input", meta_in, EST_INPUT_COLUMNS, rows_in, [
         "Recorded closed-loop input of the estimators: x axis of the circle (A = 1e-4 m,",
@@ -290,4 +291,4 @@ def generate(out_dir, m, gt):
         "posterior sigma points, innovation nu = y - theta- and its variance S",
         "(0 when priming), diagonal of the predicted covariance P- (incl. Q; P0 when",
         "priming)."]))
-    return paths
+    return paths, rows_in

@@ -30,6 +30,23 @@ A Cholesky failure (pivot <= 0 or non-finite) resets P to diag(p0_var), the
 mean kept, and the step reports BR_E_NUMERIC (it otherwise completes); a
 non-finite prediction, update or F_hat: BR_E_NUMERIC, the previous state kept.
 A non-finite u or a frac outside [0, 1]: BR_E_INPUT, nothing changes.
+
+External force (cfg.load, docs/modules/ukf.md "External force"; None: the
+four states above): x = [theta, omega, z, g_p, F_d], n = 5, F_d in N on the
+load side, against +x as friction is:
+    J_eff omega' = u - L (sigma2 L omega + f_nl(x) + F_d)
+      (step 2: each sigma point stepped by the eq. 6 model with torque u - L F_d_j),
+    F_d' = 0, Q_dd = load.q_N2, P0_dd = load.p0_N2, F_d = 0 when priming,
+    |F_d| <= load.max_N: the mean clamped after each update;
+    F_hat = sum Wm_j (f_nl(X_j) + F_d_j), clamped to +-load.max_N.
+Re-acquisition: a gated innovation nu (step 4) over k = 1 period since the
+last measurement is explained by a force change dF = nu / (g k^2),
+g = L dt^2 / (2 J_eff) (theta's response to a constant force over one
+period from rest: (L F / J_eff) dt^2 / 2). If |dF| <= 2 load.max_N, the last
+posterior's P_dd is increased by dF^2, step 2 is repeated from it and the gate
+applied to the new innovation; passing, it is an ordinary update (BR_OK,
+counted in n_load_acq) of that prediction. Failing, the step is the outlier
+of the first prediction (P_dd not inflated).
 """
 import math
 from dataclasses import dataclass
@@ -43,8 +60,7 @@ BR_E_INPUT = -3
 BR_E_NUMERIC = -4
 BR_W_OUTLIER = 1  # a warning (positive): the step predicted only
 
-NX = 4
-NSIG = 2 * NX + 1
+NX = 4          # the thesis's states
 
 
 @dataclass(frozen=True)
@@ -63,6 +79,14 @@ class UkfCfg:
     alpha: float
     beta: float
     kappa: float
+    load: object = None   # LoadCfg: the external-force state F_d; None: off (n = 4)
+
+
+@dataclass(frozen=True)
+class LoadCfg:
+    q_N2: float    # random walk of F_d per step, N^2
+    p0_N2: float   # P0 of F_d, N^2
+    max_N: float   # |F_d| and |F_hat| bound, N; re-acquisition up to |dF| <= 2 max_N
 
 
 def wrapdiff(now, prev):
@@ -71,15 +95,16 @@ def wrapdiff(now, prev):
 
 
 def chol(A):
-    """Lower Cholesky factor of a 4 x 4 matrix (element-wise loops); None on a
+    """Lower Cholesky factor of an n x n matrix (element-wise loops); None on a
     pivot <= 0 or a non-finite value."""
-    L = [[0.0] * NX for _ in range(NX)]
-    for j in range(NX):
+    n = len(A)
+    L = [[0.0] * n for _ in range(n)]
+    for j in range(n):
         s = A[j][j] - sum(L[j][k] * L[j][k] for k in range(j))
         if not (s > 0.0) or not math.isfinite(s):
             return None
         L[j][j] = math.sqrt(s)
-        for i in range(j + 1, NX):
+        for i in range(j + 1, n):
             L[i][j] = (A[i][j] - sum(L[i][k] * L[j][k] for k in range(j))) / L[j][j]
     return L
 
@@ -87,33 +112,48 @@ def chol(A):
 class Ukf:
     def __init__(self, cfg):
         self.cfg = cfg
-        n = NX
+        self.n = n = NX if cfg.load is None else NX + 1
+        self.nsig = 2 * n + 1
         lam = cfg.alpha ** 2 * (n + cfg.kappa) - n
         self.c = math.sqrt(n + lam)
         self.wm = [lam / (n + lam)] + [1.0 / (2.0 * (n + lam))] * (2 * n)
         self.wc = [lam / (n + lam) + 1.0 - cfg.alpha ** 2 + cfg.beta] + self.wm[1:]
-        self.x = [0.0, 0.0, 0.0, cfg.gp0]
+        self.p0 = list(cfg.p0_var) + ([] if cfg.load is None else [cfg.load.p0_N2])
+        self.q = list(cfg.q_var) + ([] if cfg.load is None else [cfg.load.q_N2])
+        m = cfg.model
+        # theta's response to a constant force over one period: L dt^2 / (2 J_eff)
+        self.g_load = m.L * cfg.dt * cfg.dt / (2.0 * (m.J + m.L * m.L * m.M))
+        self.x = [0.0, 0.0, 0.0, cfg.gp0] + [0.0] * (n - NX)
         self.P = self._P0()
         self.origin = 0
         self.prev_counts = 0
         self.prev_frac = 0.0
         self.n_outliers = 0
         self.n_recover = 0
+        self.n_load_acq = 0
         self.primed = False
         self.F_hat = 0.0
         self.nu = 0.0
         self.S = 0.0
-        self.Pm_diag = list(cfg.p0_var)   # diag of the last prediction's P- (P0 when priming)
+        self.Pm_diag = list(self.p0)   # diag of the last prediction's P- (P0 when priming)
         self.reanchored = False
+        self.load_acq = False          # this step re-acquired a load
 
     def _P0(self):
-        return [[self.cfg.p0_var[i] if i == j else 0.0 for j in range(NX)] for i in range(NX)]
+        return [[self.p0[i] if i == j else 0.0 for j in range(self.n)] for i in range(self.n)]
 
     def _clamp_gp(self, v):
         return min(max(v, self.cfg.gp_min), self.cfg.gp_max)
 
+    def _clamp_mean(self, x):
+        """g_p of the mean in [gp_min, gp_max]; F_d in [-max_N, max_N]."""
+        x[3] = self._clamp_gp(x[3])
+        if self.cfg.load is not None:
+            x[NX] = min(max(x[NX], -self.cfg.load.max_N), self.cfg.load.max_N)
+
     def _sigma(self, x, P):
         """Sigma points of (x, P); (points, P used, Cholesky ok)."""
+        n = self.n
         L = chol(P)
         ok = L is not None
         if not ok:
@@ -121,64 +161,115 @@ class Ukf:
             L = chol(P)
         X = [list(x)]
         for sgn in (1.0, -1.0):
-            for i in range(NX):
-                X.append([x[r] + sgn * self.c * L[r][i] for r in range(NX)])
+            for i in range(n):
+                X.append([x[r] + sgn * self.c * L[r][i] for r in range(n)])
         for Xj in X:
             Xj[3] = self._clamp_gp(Xj[3])
         return X, P, ok
 
     def _fhat(self, X):
-        return sum(w * rmodel.fnl(self.cfg.model, np.array(Xj)) for w, Xj in zip(self.wm, X))
+        F = sum(w * rmodel.fnl(self.cfg.model, np.array(Xj[:NX])) for w, Xj in zip(self.wm, X))
+        if self.cfg.load is None:
+            return F
+        # friction + the external force's unscented mean, within the actuator's force
+        F = F + sum(w * Xj[NX] for w, Xj in zip(self.wm, X))
+        return min(max(F, -self.cfg.load.max_N), self.cfg.load.max_N)
+
+    def _predict(self, x, P, u):
+        """Steps 1-2 from (x, P): (xm, Pm, Cholesky ok), or None when a model
+        step fails or the prediction is not finite."""
+        c, n = self.cfg, self.n
+        X, P, ok = self._sigma(x, P)
+        Y = []
+        for Xj in X:
+            # the torque on the axis: u, less L F_d with the external force (eq. 1 with the load)
+            uj = u if c.load is None else u - c.model.L * Xj[NX]
+            st, y1, _ = rmodel.step(c.model, np.array(Xj[:NX]), uj, c.dt)
+            if st != rmodel.BR_OK:
+                return None
+            # F_d' = 0: carried over (its random walk is Q_dd)
+            Y.append([float(v) for v in y1] + Xj[NX:])
+        xm = [sum(self.wm[j] * Y[j][r] for j in range(self.nsig)) for r in range(n)]
+        Pm = [[sum(self.wc[j] * (Y[j][r] - xm[r]) * (Y[j][s] - xm[s]) for j in range(self.nsig))
+               + (self.q[r] if r == s else 0.0) for s in range(n)] for r in range(n)]
+        if not all(math.isfinite(v) for v in xm) or not all(math.isfinite(v) for row in Pm for v in row):
+            return None
+        return xm, Pm, ok
+
+    def _innovate(self, xm, Pm, counts, frac):
+        """Step 3 and the gate: (theta- in the new origin's frame, nu, S, passes)."""
+        c = self.cfg
+        rpc = c.rad_per_count
+        th_new = xm[0] - wrapdiff(counts, self.origin) * rpc
+        nu = frac * rpc - th_new
+        S = Pm[0][0] + c.r_var
+        # the gate: the innovation's variance with the encoder's quantisation rpc^2/12
+        return th_new, nu, S, not (nu * nu > c.outlier_sigma ** 2 * (S + rpc * rpc / 12.0))
+
+    def _reacquire(self, nu, u, counts, frac):
+        """Load re-acquisition of a gated nu: the prediction from the posterior
+        with P_dd + dF^2 and its innovation, or None when no force change
+        within 2 max_N explains nu or the new innovation is gated too."""
+        c = self.cfg
+        if c.load is None:
+            return None
+        dF = nu / (self.g_load * 1.0 * 1.0)    # k = 1 period since the last measurement
+        if not abs(dF) <= 2.0 * c.load.max_N:
+            return None
+        P = [list(row) for row in self.P]
+        P[NX][NX] = P[NX][NX] + dF * dF
+        pred = self._predict(self.x, P, u)
+        if pred is None:
+            return None
+        inn = self._innovate(pred[0], pred[1], counts, frac)
+        return (pred, inn, P) if inn[3] else None
 
     def step(self, counts, frac, u):
-        c = self.cfg
+        c, n = self.cfg, self.n
         if not math.isfinite(u) or not math.isfinite(frac) or not 0.0 <= frac <= 1.0:
             return BR_E_INPUT
         rpc = c.rad_per_count
         self.reanchored = False
+        self.load_acq = False
         if not self.primed:
             self.origin = self.prev_counts = int(counts)
             self.prev_frac = frac
-            self.x = [frac * rpc, 0.0, 0.0, c.gp0]
+            self.x = [frac * rpc, 0.0, 0.0, c.gp0] + [0.0] * (n - NX)
             self.P = self._P0()
             X, self.P, _ = self._sigma(self.x, self.P)
             self.F_hat = self._fhat(X)
             self.nu = self.S = 0.0
-            self.Pm_diag = list(c.p0_var)
+            self.Pm_diag = list(self.p0)
             self.primed = True
             return BR_OK
         status = BR_OK
-        # 1. sigma points
-        X, P, ok = self._sigma(self.x, self.P)
+        # 1.-2. sigma points and prediction
+        pred = self._predict(self.x, self.P, u)
+        if pred is None:
+            return BR_E_NUMERIC
+        xm, Pm, ok = pred
         if not ok:
             status = BR_E_NUMERIC
             self.n_recover += 1
-        # 2. predict
-        Y = []
-        for Xj in X:
-            st, y1, _ = rmodel.step(c.model, np.array(Xj), u, c.dt)
-            if st != rmodel.BR_OK:
-                return BR_E_NUMERIC
-            Y.append([float(v) for v in y1])
-        xm = [sum(self.wm[j] * Y[j][r] for j in range(NSIG)) for r in range(NX)]
-        Pm = [[sum(self.wc[j] * (Y[j][r] - xm[r]) * (Y[j][s] - xm[s]) for j in range(NSIG))
-               + (c.q_var[r] if r == s else 0.0) for s in range(NX)] for r in range(NX)]
-        if not all(math.isfinite(v) for v in xm) or not all(math.isfinite(v) for row in Pm for v in row):
-            return BR_E_NUMERIC
-        # 3. origin and innovation
-        delta = wrapdiff(counts, self.origin)
-        th_new = xm[0] - delta * rpc
-        nu = frac * rpc - th_new
-        S = Pm[0][0] + c.r_var
-        # the gate: the innovation's variance with the encoder's quantisation rpc^2/12
-        if nu * nu > c.outlier_sigma ** 2 * (S + rpc * rpc / 12.0):
+        # 3. origin, innovation, gate
+        th_new, nu, S, passes = self._innovate(xm, Pm, counts, frac)
+        if not passes:
+            acq = self._reacquire(nu, u, counts, frac)
+            if acq is not None:
+                (xm, Pm, ok), (th_new, nu, S, passes), self.P = acq
+                self.load_acq = True
+                self.n_load_acq += 1
+                if not ok and status == BR_OK:
+                    status = BR_E_NUMERIC
+                    self.n_recover += 1
+        if not passes:
             # 4. outlier: the prediction, old frame; re-anchoring after a run
             status_o = BR_W_OUTLIER
             x_new, P_new, origin_new = xm, Pm, self.origin
             n_out = self.n_outliers + 1
             if n_out >= c.reanchor_after:
                 w_meas = (wrapdiff(counts, self.prev_counts) + frac - self.prev_frac) * rpc / c.dt
-                x_new = [frac * rpc, w_meas, xm[2], xm[3]]
+                x_new = [frac * rpc, w_meas] + xm[2:]
                 P_new = self._P0()
                 origin_new = int(counts)
                 self.reanchored = True
@@ -187,15 +278,15 @@ class Ukf:
             status_o = BR_OK
             n_out = 0
             xm = [th_new] + xm[1:]
-            K = [Pm[r][0] / S for r in range(NX)]
-            x_new = [xm[r] + K[r] * nu for r in range(NX)]
-            x_new[3] = self._clamp_gp(x_new[3])
+            K = [Pm[r][0] / S for r in range(n)]
+            x_new = [xm[r] + K[r] * nu for r in range(n)]
+            self._clamp_mean(x_new)
             # A = I - K H (H = e_0^T): A[r][s] = delta_rs - K[r] (s == 0)
-            A = [[(1.0 if r == s else 0.0) - (K[r] if s == 0 else 0.0) for s in range(NX)] for r in range(NX)]
-            AP = [[sum(A[r][t] * Pm[t][s] for t in range(NX)) for s in range(NX)] for r in range(NX)]
-            Pj = [[sum(AP[r][t] * A[s][t] for t in range(NX)) + K[r] * c.r_var * K[s]
-                   for s in range(NX)] for r in range(NX)]
-            P_new = [[0.5 * (Pj[r][s] + Pj[s][r]) for s in range(NX)] for r in range(NX)]
+            A = [[(1.0 if r == s else 0.0) - (K[r] if s == 0 else 0.0) for s in range(n)] for r in range(n)]
+            AP = [[sum(A[r][t] * Pm[t][s] for t in range(n)) for s in range(n)] for r in range(n)]
+            Pj = [[sum(AP[r][t] * A[s][t] for t in range(n)) + K[r] * c.r_var * K[s]
+                   for s in range(n)] for r in range(n)]
+            P_new = [[0.5 * (Pj[r][s] + Pj[s][r]) for s in range(n)] for r in range(n)]
             origin_new = int(counts)
         if not all(math.isfinite(v) for v in x_new) or not all(math.isfinite(v) for row in P_new for v in row):
             return BR_E_NUMERIC
@@ -209,7 +300,7 @@ class Ukf:
             return BR_E_NUMERIC
         self.x, self.P, self.origin, self.F_hat = x_new, P_new, origin_new, F
         self.nu, self.S = nu, S
-        self.Pm_diag = [Pm[i][i] for i in range(NX)]
+        self.Pm_diag = [Pm[i][i] for i in range(n)]
         self.prev_counts, self.prev_frac = int(counts), frac
         self.n_outliers = n_out
         return status if status != BR_OK else status_o
