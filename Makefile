@@ -211,8 +211,8 @@ figures: deps
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/studies/make_figures.py build/host-release out/figures
 
 # C bench (records the input, times PF and UKF, memory), then the particles
-# library's PF (installed with --no-deps, sim/bench/requirements-particles.txt)
-# and the numpy PF on the same recording; the numpy script prints the summary
+# library's PF (installed by `deps`, sim/bench/requirements-particles.txt:
+# nothing is installed here) and the numpy PF on the same recording; the numpy script prints the summary
 # table and merges everything into bench.json. docs/bench.md.
 bench: deps
 	$(call configure,host-release)
@@ -221,8 +221,6 @@ bench: deps
 	$(Q)mkdir -p $(BENCH_OUT)
 	$(Q)$(BENCH) --json $(BENCH_OUT)/c.json --record $(BENCH_OUT)/pf_input.csv
 	$(Q)build/host-release/sim/bench/br_bench_link | tee $(BENCH_OUT)/link.txt
-	$(Q)$(PYTHON) -m pip install --quiet --disable-pip-version-check --require-virtualenv --no-deps \
-	  -r sim/bench/requirements-particles.txt
 	$(Q)$(PYTHON) sim/bench/pf_particles.py $(BENCH_OUT)/pf_input.csv --out $(BENCH_OUT)/particles.json
 	$(Q)$(PYTHON) sim/bench/pf_numpy.py $(BENCH_OUT)/pf_input.csv --c-json $(BENCH_OUT)/c.json \
 	  --particles-json $(BENCH_OUT)/particles.json --out $(BENCH_OUT)/bench.json

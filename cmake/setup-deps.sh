@@ -7,15 +7,21 @@
 #   target tests and make target-bench, docs/target.md), cppcheck (the
 #   static test), clang with its compiler-rt (the libFuzzer targets of the
 #   fuzz preset), Python's venv module;
-#   .venv in the project root with the pinned cmake/python-requirements.txt.
+#   .venv in the project root (or BR_VENV: the install test's fresh one) with
+#   the pinned cmake/python-requirements.txt and, without its declared
+#   dependencies, sim/bench/requirements-particles.txt (make bench's
+#   third-party PF): every file checked against the --hash lines
+#   (pip --require-hashes; cmake/pin-hashes.py writes them). This is the only
+#   place that installs Python packages: no make target or test does at run time.
 # Quick when everything is in place: dpkg status checks, and a stamp in .venv
-# keyed by the hash of the requirements file (and of the interpreter).
+# keyed by the hash of the requirements files (and of the interpreter).
 # Exits non-zero with a message when something cannot be installed.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 req="$root/cmake/python-requirements.txt"
-venv="$root/.venv"
+req_nodeps="$root/sim/bench/requirements-particles.txt"
+venv="${BR_VENV:-$root/.venv}"
 stamp="$venv/.bristle-requirements.sha256"
 
 die() { echo "setup-deps: error: $*" >&2; exit 1; }
@@ -76,29 +82,32 @@ if [[ ! -x "$venv/bin/python" ]]; then
   "$python" -m venv "$venv" || die "python3 -m venv failed (Debian: apt-get install python3-venv)"
 fi
 
-key="$( { sha256sum "$req" | cut -d' ' -f1; "$venv/bin/python" -VV; } | sha256sum | cut -d' ' -f1)"
+key="$( { sha256sum "$req" "$req_nodeps" | cut -d' ' -f1; "$venv/bin/python" -VV; } | sha256sum | cut -d' ' -f1)"
 if [[ -f "$stamp" && "$(cat "$stamp")" == "$key" ]]; then
   exit 0
 fi
 say "installing pinned Python packages into .venv"
 rm -f "$stamp"
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check --require-virtualenv \
-  -r "$req" || die "pip install -r cmake/python-requirements.txt failed"
+pip=("$venv/bin/python" -m pip install --quiet --disable-pip-version-check --require-virtualenv --require-hashes)
+"${pip[@]}" -r "$req" || die "pip install --require-hashes -r cmake/python-requirements.txt failed"
+"${pip[@]}" --no-deps -r "$req_nodeps" ||
+  die "pip install --require-hashes --no-deps -r sim/bench/requirements-particles.txt failed"
 
 # Every pin must be what is installed, not merely something that imports.
-"$venv/bin/python" - "$req" <<'PY' || die "installed Python packages do not match the pins"
+"$venv/bin/python" - "$req" "$req_nodeps" <<'PY' || die "installed Python packages do not match the pins"
 import re, sys
 from importlib.metadata import version, PackageNotFoundError
 bad = []
-for line in open(sys.argv[1]):
+text = "".join(open(p).read() for p in sys.argv[1:])
+for line in re.sub(r"\\\n", " ", text).splitlines():
     line = line.split("#", 1)[0].strip()
     if not line:
         continue
-    m = re.fullmatch(r"([A-Za-z0-9_.\-]+)==(\S+)", line)
+    m = re.fullmatch(r"([A-Za-z0-9_.\-]+)==(\S+)(\s+--hash=sha256:[0-9a-f]{64})+", line)
     if not m:
-        bad.append(f"unpinned requirement: {line}")
+        bad.append(f"requirement without an exact pin and a hash: {line}")
         continue
-    name, want = m.groups()
+    name, want = m.group(1), m.group(2)
     try:
         have = version(name)
     except PackageNotFoundError:

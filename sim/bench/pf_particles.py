@@ -47,8 +47,8 @@ try:
     from particles import distributions as dists
     from particles import state_space_models as ssm
 except ImportError as e:  # pragma: no cover - reported, not hidden
-    sys.exit("pf_particles: the `particles` library does not import (%s); make bench installs it "
-             "(sim/bench/requirements-particles.txt)" % e)
+    sys.exit("pf_particles: the `particles` library does not import (%s); cmake/setup-deps.sh (make deps) "
+             "installs it (sim/bench/requirements-particles.txt)" % e)
 
 
 class _Draw(dists.ProbDist):

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # The Python package as a user gets it (docs/python-package.md): a fresh
-# virtual environment, `pip install` of the repository with the pinned set
-# as constraints (cmake/python-requirements.txt), then the console command
+# virtual environment with the pinned set, hash-checked, by the one script
+# that installs Python packages (cmake/setup-deps.sh, BR_VENV), then
+# `pip install --no-index` of the repository (nothing more is fetched: its
+# declared dependency ranges must accept the pins), then the console command
 # from a directory outside the source tree, with no PYTHONPATH:
 #   --help (of the command and of both sub-commands), --version (= VERSION),
 #   a usage error (exit 2), a missing log (exit 1, "error: ..."),
@@ -16,18 +18,18 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 
 rm -rf "$work"
 mkdir -p "$work/run"
-"$py3" -m venv "$work/venv"
-# PIP_CONSTRAINT (not -c) also holds the build back-end's own environment
-# (setuptools) to the pins; DIST_EXTRA_CONFIG keeps setuptools' build/ and
-# egg-info out of the source tree
+BR_VENV="$work/venv" BR_PYTHON3="$py3" "$src/cmake/setup-deps.sh" > /dev/null ||
+  fail "cmake/setup-deps.sh into a fresh venv"
+# --no-build-isolation: the build back-end is the venv's pinned setuptools;
+# DIST_EXTRA_CONFIG keeps setuptools' build/ and egg-info out of the source tree
 mkdir -p "$work/setuptools"
 printf '[build]\nbuild_base = %s/build\n[egg_info]\negg_base = %s\n' "$work/setuptools" "$work/setuptools" \
   > "$work/setuptools.cfg"
-DIST_EXTRA_CONFIG="$work/setuptools.cfg" PIP_CONSTRAINT="$src/cmake/python-requirements.txt" \
-  "$work/venv/bin/python" -m pip install --quiet \
-  --disable-pip-version-check --require-virtualenv "$src" || fail "pip install $src"
+DIST_EXTRA_CONFIG="$work/setuptools.cfg" "$work/venv/bin/python" -m pip install --quiet \
+  --disable-pip-version-check --require-virtualenv --no-index --no-build-isolation "$src" ||
+  fail "pip install --no-index $src"
 cmd="$work/venv/bin/bristle-diagnose"
-[[ -x $cmd ]] || fail "pip install made no console command bristle-diagnose"
+[[ -x $cmd ]] || fail "the install made no console command bristle-diagnose"
 cd "$work/run"   # outside the source tree: the package must not need it
 unset PYTHONPATH
 export MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1
