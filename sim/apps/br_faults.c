@@ -307,20 +307,6 @@ static int usage(const char *argv0, FILE *to)
     return 2;
 }
 
-/* 1 when name is an item of the comma-separated list (NULL: every name) */
-static int in_list(const char *list, const char *name)
-{
-    if (list == NULL) return 1;
-    const size_t n = strlen(name);
-    for (const char *p = list; p && *p;) {
-        const char *e = strchr(p, ',');
-        const size_t len = e ? (size_t)(e - p) : strlen(p);
-        if (len == n && strncmp(p, name, n) == 0) return 1;
-        p = e ? e + 1 : NULL;
-    }
-    return 0;
-}
-
 static void print_row(FILE *f, const scenario_t *s, br_circle_ctrl_t ctrl, const outcome_t *o, int expected)
 {
     fprintf(f, "| %s | %s | %s | ", s->name, s->what, br_circle_ctrl_name(ctrl));
@@ -401,9 +387,9 @@ int main(int argc, char **argv)
     fprintf(f, "|---|---|---|---|---|---|---|---|\n");
     int n_broken = 0, n_stale = 0, n_run = 0;
     for (size_t i = 0; i < N_SCEN; i++) {
-        if (!in_list(only, k_scen[i].name)) continue;
+        if (only && !br_arg_list_has(only, k_scen[i].name)) continue;
         for (size_t k = 0; k < N_CTRL; k++) {
-            if (!in_list(ctrls, br_circle_ctrl_name(k_ctrls[k]))) continue;
+            if (ctrls && !br_arg_list_has(ctrls, br_circle_ctrl_name(k_ctrls[k]))) continue;
             outcome_t o;
             if (run_one(&k_scen[i], k_ctrls[k], plant, gp_tau_s, load_q, &o) != 0) {
                 br_outfile_discard(&out);
@@ -412,7 +398,7 @@ int main(int argc, char **argv)
             judge(&k_scen[i], &mc, br_circle_cfg_thesis(k_ctrls[k]).dt_s, &o);
             char key[96];
             snprintf(key, sizeof key, "%s/%s", k_scen[i].name, br_circle_ctrl_name(k_ctrls[k]));
-            const int expected = expect != NULL && in_list(expect, key);
+            const int expected = br_arg_list_has(expect, key);
             print_row(f, &k_scen[i], k_ctrls[k], &o, expected);
             if (md) print_row(stdout, &k_scen[i], k_ctrls[k], &o, expected);
             n_run++;

@@ -90,19 +90,6 @@ static int usage(const char *argv0, FILE *to)
     return 2;
 }
 
-/* 1 when name is in the comma-separated list */
-static int in_list(const char *list, const char *name)
-{
-    const size_t n = strlen(name);
-    for (const char *p = list; p && *p;) {
-        const char *e = strchr(p, ',');
-        const size_t len = e ? (size_t)(e - p) : strlen(p);
-        if (len == n && strncmp(p, name, n) == 0) return 1;
-        p = e ? e + 1 : NULL;
-    }
-    return 0;
-}
-
 typedef struct {
     FILE *trace, *hist;
 } sinks_t;
@@ -226,7 +213,7 @@ int main(int argc, char **argv)
     }
     int first = 1, rc = 0;
     for (unsigned r = 0; r < N_RUNS && rc == 0; r++) {
-        if (only ? !in_list(only, runs[r].name) : (runs[r].identified && !model_path)) continue;
+        if (only ? !br_arg_list_has(only, runs[r].name) : (runs[r].identified && !model_path)) continue;
         br_circle_cfg_t c = br_circle_cfg_thesis(runs[r].ctrl);
         c.plant = plant;
         c.real = real;

@@ -118,3 +118,15 @@ int br_arg_long(const char *tool, const char *opt, const char *val, long lo, lon
     *out = v;
     return 0;
 }
+
+int br_arg_list_has(const char *list, const char *name)
+{
+    const size_t n = strlen(name);
+    for (const char *p = list; p && *p;) {
+        const char *e = strchr(p, ',');
+        const size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (len == n && strncmp(p, name, n) == 0) return 1;
+        p = e ? e + 1 : NULL;
+    }
+    return 0;
+}

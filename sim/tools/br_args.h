@@ -69,4 +69,8 @@ int br_arg_double(const char *tool, const char *opt, const char *val, double lo,
 /* the whole of val as a decimal integer in [lo, hi]: 0 or -1, as above */
 int br_arg_long(const char *tool, const char *opt, const char *val, long lo, long hi, long *out);
 
+/* 1 when name is an item of the comma-separated list (no spaces), 0
+ * otherwise or for a NULL list */
+int br_arg_list_has(const char *list, const char *name);
+
 #endif
