@@ -6,6 +6,7 @@
  * load can explain still rejected. */
 #include "br_test.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -89,14 +90,20 @@ static void test_load_step_followed(void **st)
     br_ukf_cfg_t c = load_cfg();
     const double F = 0.5 * (double)c.load.max_N; /* half the actuator's force */
     float comp = 0.0f;
+    /* pushed from rest until the axis reaches the machine's top speed (beyond it the
+     * push is no condition the axis meets: the model's viscous sigma2 v grows with the
+     * speed and F_d with it): 0.1 s still, then v_max J_eff / (L^2 F) */
+    const br_model_cfg_t *m = &c.est.model;
+    const double L = m->lead_mprad, Jeff = m->J_kgm2 + L * L * m->M_kg;
+    const int n = 100 + (int)ceil((double)BR_MACHINE_MAX_SPEED_MPS_F * Jeff / (L * L * F) / m->dt_s);
     assert_int_equal(br_ukf_init(&u, &c), BR_OK);
-    assert_int_equal(run_pushed(&u, F, 250, &comp), 0);
+    assert_int_equal(run_pushed(&u, F, n, &comp), 0);
     assert_true(u.n_load_acq >= 1u);
-    /* the compensation carries the load: friction + F_d of the size of the push (the model's
-     * viscous sigma2 v, ~50 N at the end's 1.1 m/s, and its sliding friction share the rest) */
+    /* the compensation carries the load: friction + F_d of the size of the push
+     * (measured at their top speeds: reference machine 0.99 F, heavy 1.05 F) */
     printf("  load %.1f N: compensation %.2f N, F_d %.2f N, %u re-acquisitions\n", F, (double)comp,
            (double)u.est.load_N, u.n_load_acq);
-    assert_true(comp > 0.8 * F && comp < 1.3 * F);
+    assert_true(comp > 0.9 * F && comp < 1.1 * F);
     /* without the state the same push is a run of outliers (the lock monitor's trip) */
     br_ukf_cfg_t off = br_circle_ukf_cfg_tuned(DT_F);
     assert_int_equal(br_ukf_init(&u, &off), BR_OK);
