@@ -11,10 +11,8 @@
     issue found failing): all three found, every parameter within 20 %.
 
 Usage: test_floor.py --simlog BIN --work DIR"""
-import argparse
 import math
 import os
-import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -22,6 +20,7 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(REPO, "python"))
 sys.path.insert(0, HERE)
 import axis_sim  # noqa: E402
+import work_args  # noqa: E402
 from bristle.diagnose import logreader, noise, report, selection, signals  # noqa: E402
 
 FAILS = []
@@ -39,16 +38,7 @@ def diagnose(path):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--simlog", required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    os.makedirs(a.work, exist_ok=True)
-
-    def simlog(name, *flags):
-        p = os.path.join(a.work, name + ".csv")
-        subprocess.run([a.simlog, "--out", p] + [str(f) for f in flags], check=True)
-        return p
+    a, simlog = work_args.simlog_script()
 
     for sigma in (0.05, 0.2):
         p = simlog(f"noise{sigma}", "--seed", 11, "--force-noise", sigma)

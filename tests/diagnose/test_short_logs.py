@@ -20,7 +20,6 @@ The plant's values come from machines/reference.json (the reference
 machine br_simlog simulates), never from numbers written here.
 
 Usage: test_short_logs.py --simlog BIN --work DIR"""
-import argparse
 import json
 import math
 import os
@@ -31,6 +30,8 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+import work_args  # noqa: E402
 sys.path.insert(0, os.path.join(REPO, "python"))
 from bristle.diagnose import causes, identify, machinejson, params  # noqa: E402
 
@@ -66,18 +67,8 @@ def in_bounds(p):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--simlog", required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    os.makedirs(a.work, exist_ok=True)
+    a, simlog = work_args.simlog_script("--duration", 24, "--force-noise", 0.1)
     p0 = identify.prior(machinejson.base(None))
-
-    def simlog(name, *flags):
-        p = os.path.join(a.work, name + ".csv")
-        subprocess.run([a.simlog, "--out", p] + [str(f) for f in ("--duration", 24, "--force-noise", 0.1) + flags],
-                       check=True)
-        return p
 
     # the thesis circle, asymmetric friction
     r, rep = diagnose(simlog("circle", "--traj", "circle", "--asym", "2,30", "--seed", 1), os.path.join(a.work, "c"))
