@@ -87,6 +87,8 @@ void br_app_motion_reset(br_app_t *app)
     app->n_ref_limited = 0u;
     app->lim_vmax = m->max_speed_mps * m->counts_per_m * dt;
     app->lim_amax = m->max_accel_mps2 * m->counts_per_m * dt * dt;
+    /* the model's force per count/period^2: F = mass a, a = counts / (counts_per_m dt^2) */
+    app->mot_k_m = m->mass_kg / ((m->counts_per_m * dt) * dt);
     app->lim_lo = m->soft_min_m * m->counts_per_m;
     app->lim_hi = m->soft_max_m * m->counts_per_m;
     app->v_meas = 0.0f;
@@ -206,8 +208,7 @@ br_app_fault_t br_app_motion_watch(br_app_t *app, int32_t d, uint32_t periods)
          * the speed fault's speed and stop 23 mm on) */
         return BR_APP_FAULT_SPEED;
     }
-    /* the model's force per count/period^2: F = mass a, a = counts / (counts_per_m dt^2) */
-    const float k_m = m->mass_kg / (cpp * dt);
+    const float k_m = app->mot_k_m;
     /* the force the drive applied over the period that ended (load side) */
     const float F = app->last.tau_Nm / app->ctrl.cfg.lead_mprad;
     if (d != 0 || periods != 1u) {

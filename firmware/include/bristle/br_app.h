@@ -209,6 +209,7 @@ typedef struct {
     uint32_t n_ref_limited; /* periods limited since the arm */
     float lim_vmax, lim_amax; /* the limits in counts per period (per period^2) */
     float lim_lo, lim_hi;   /* the soft travel limits in counts */
+    float mot_k_m;          /* the stuck-encoder model's force per count/period^2: mass / (counts_per_m dt^2) */
     /* measured motion (stuck-encoder model, speed fault) */
     float v_meas;           /* speed of the last good read, counts per period */
     float hold_N;           /* friction + load when the count last moved (model: F - m a) */
