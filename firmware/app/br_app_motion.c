@@ -5,6 +5,7 @@
  * period^2. */
 #include "br_app_motion.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
@@ -20,12 +21,12 @@
 
 br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m)
 {
-    br_app_motion_cfg_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    br_app_motion_cfg_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     if (m == NULL || !br_finite_pos(m->lead_mprad) || !br_finite_pos(m->rad_per_count) ||
         !br_finite_pos(m->mass_kg) || !br_finite_pos(m->inertia_kgm2) || !br_finite_pos(m->Fc_N) ||
         !br_finite_pos(m->Fs_N) || !br_finite_pos(m->max_speed_mps) || !br_finite_pos(m->max_accel_mps2) ||
         !br_finite_pos(m->max_following_m) || !br_finite_pos(m->travel_m) || !isfinite(m->travel_min_m) ||
-        !br_finite_pos(m->period_s)) {
+        !br_finite_pos(m->period_s) || (m->coast_in_stroke != 0 && m->coast_in_stroke != 1)) {
         return c; /* all zero: rejected by br_app_init */
     }
     c.counts_per_m = 1.0f / (m->lead_mprad * m->rad_per_count);
@@ -42,6 +43,9 @@ br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m)
                      c.speed_fault_mps * m->period_s + m->max_following_m;
     /* the open-loop brake: friction gives Fc of the deceleration mass a */
     c.brake_N = fmaxf(c.mass_kg * m->max_accel_mps2 - m->Fc_N, 0.0f);
+    /* the coast envelope: with the outputs off, Coulomb friction alone
+     * decelerates the moved mass, Fc / (M + J / L^2) */
+    c.coast_decel_mps2 = m->coast_in_stroke ? m->Fc_N / c.mass_kg : 0.0f;
     c.soft_min_m = m->travel_min_m + c.stop_bound_m;
     c.soft_max_m = m->travel_min_m + m->travel_m - c.stop_bound_m;
     /* at standstill friction holds any force in [-Fs, Fs]: a change of 2 Fs */
@@ -55,7 +59,7 @@ br_status_t br_app_motion_check(const br_app_motion_cfg_t *m)
     if (!br_finite_pos(m->counts_per_m) || !br_finite_pos(m->max_speed_mps) || !br_finite_pos(m->max_accel_mps2) ||
         !br_finite_pos(m->max_following_m) || !br_finite_pos(m->mass_kg) || !br_finite_pos(m->stuck_band_N) ||
         !br_finite_pos(m->stuck_counts) || !br_finite_pos(m->stop_bound_m) || !(m->brake_N >= 0.0f) ||
-        !isfinite(m->brake_N)) {
+        !isfinite(m->brake_N) || !(m->coast_decel_mps2 >= 0.0f) || !isfinite(m->coast_decel_mps2)) {
         return BR_E_PARAM;
     }
     /* written so that a NaN fails: a speed fault at or above the limiter's
@@ -91,6 +95,11 @@ void br_app_motion_reset(br_app_t *app)
     app->mot_k_m = m->mass_kg / ((m->counts_per_m * dt) * dt);
     app->lim_lo = m->soft_min_m * m->counts_per_m;
     app->lim_hi = m->soft_max_m * m->counts_per_m;
+    app->lim_acoast = m->coast_decel_mps2 * m->counts_per_m * dt * dt;
+    /* the stroke's ends (a soft limit plus the stop bound), less the
+     * following limit the position may be ahead of the reference */
+    app->lim_end_lo = (m->soft_min_m - m->stop_bound_m + m->max_following_m) * m->counts_per_m;
+    app->lim_end_hi = (m->soft_max_m + m->stop_bound_m - m->max_following_m) * m->counts_per_m;
     app->v_meas = 0.0f;
     app->hold_N = 0.0f;
     app->v_pred = 0.0f;
@@ -129,6 +138,34 @@ static void pos_from_float(float p, int32_t *c, float *f)
     *f = p - whole;
 }
 
+/* The speed that still stops within room counts at deceleration a in whole
+ * periods: v (v + a) / (2 a) = room solved for v (the discrete braking
+ * curve), v_stop = -a/2 + sqrt(a^2/4 + 2 a room); 0 at or beyond it. */
+static float brake_cap(float a, float room)
+{
+    return (room > 0.0f) ? -0.5f * a + sqrtf(0.25f * a * a + 2.0f * a * room) : 0.0f;
+}
+
+/* The coast envelope (docs/modules/app.md, "Drive protections"): the largest
+ * step v (counts per period) toward an end room counts away after which a
+ * coast with the outputs off still stops before it. The table may run at
+ * k v, k = 1 + BR_APP_SPEED_MARGIN, before SPEED latches; the fault is seen a
+ * period late and the discrete coast adds up to a period more: k^2 v^2 /
+ * (2 a) + 2 k v + v <= room, solved for v:
+ *   v = a / k^2 (sqrt((2k + 1)^2 + 2 k^2 room / a) - (2k + 1))
+ * FLT_MAX without an envelope (a = 0). */
+static float coast_cap(const br_app_t *app, float room)
+{
+    const float a = app->lim_acoast, k = 1.0f + BR_APP_SPEED_MARGIN, b = 2.0f * k + 1.0f;
+    if (!(a > 0.0f)) {
+        return FLT_MAX;
+    }
+    if (!(room > 0.0f)) {
+        return 0.0f;
+    }
+    return a / (k * k) * (sqrtf(b * b + 2.0f * k * k * room / a) - b);
+}
+
 br_status_t br_app_ref_limit(br_app_t *app, const br_ref_t *ref, int32_t counts, br_ref_t *out)
 {
     const float dt = app->ctrl.cfg.dt_s, rpc = app->ctrl.cfg.rad_per_count;
@@ -158,8 +195,13 @@ br_status_t br_app_ref_limit(br_app_t *app, const br_ref_t *ref, int32_t counts,
     const float vt = clamped ? 0.0f : ref->ref_omega_radps * dt / rpc;
     const float e = pos_diff(tc, tf, app->lim_counts, app->lim_frac);
     const float tol = 1.0f + BR_APP_LIM_RTOL;
+    /* the caps on a step toward each end: the braking curve that stops at
+     * the soft limit, the coast envelope */
+    const float lpos = (float)app->lim_counts + app->lim_frac;
+    const float cap_hi = fminf(brake_cap(amax, app->lim_hi - lpos), coast_cap(app, app->lim_end_hi - lpos));
+    const float cap_lo = fminf(brake_cap(amax, lpos - app->lim_lo), coast_cap(app, lpos - app->lim_end_lo));
     if (!app->lim_active && !clamped && fabsf(e) <= vmax * tol && fabsf(e - app->lim_v) <= amax * tol &&
-        fabsf(vt) <= vmax * tol) {
+        fabsf(vt) <= vmax * tol && e <= cap_hi && -e <= cap_lo) {
         /* within every limit: the reference as it is, bit for bit */
         app->lim_counts = tc;
         app->lim_frac = tf;
@@ -171,17 +213,20 @@ br_status_t br_app_ref_limit(br_app_t *app, const br_ref_t *ref, int32_t counts,
     app->lim_active = 1;
     app->ref_limited = 1;
     app->n_ref_limited++;
-    /* speed that still stops at the target with deceleration amax in whole
-     * periods: v (v + a) / (2 a) = |e| solved for v (the discrete braking
-     * curve, v_stop = -a/2 + sqrt(a^2/4 + 2 a |e|)) */
+    /* speed that still stops at the target with deceleration amax */
     const float ae = fabsf(e);
-    const float vstop = -0.5f * amax + sqrtf(0.25f * amax * amax + 2.0f * amax * ae);
+    const float vstop = brake_cap(amax, ae);
     const float vtc = br_clampf(vt, -vmax, vmax);
     /* toward the target on the braking curve, riding on the target's speed,
      * never past it in one period */
     float vdes = vtc + copysignf(fminf(vstop, ae), e);
     vdes = br_clampf(vdes, app->lim_v - amax, app->lim_v + amax);
     vdes = br_clampf(vdes, -vmax, vmax);
+    /* inside the braking curve to the soft limits and the coast envelope
+     * (its deceleration, Fc / (k^2 mass), is below max_accel on a machine
+     * where it binds before the braking curve, so a reference on the
+     * envelope follows it) */
+    vdes = br_clampf(vdes, -cap_lo, cap_hi);
     pos_add(&app->lim_counts, &app->lim_frac, vdes);
     app->lim_v = vdes;
     /* caught up: on the target at its speed; the next period passes through */

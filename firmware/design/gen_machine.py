@@ -66,6 +66,9 @@ def machine_fields(m, p):
          "the longest period the application may run at (control or PF period; machine.loop_period_s)"),
         ("BR_MACHINE_COAST_M", machine.coast_m(m),
          "how far the axis coasts from the speed fault's speed with the outputs off (machine.coast_m)"),
+        ("BR_MACHINE_COAST_IN_STROKE", machine.coast_in_stroke(m),
+         "limits.coast_stop: 1 stroke (the reference limiter caps the speed toward each end so that\n"
+         " * a coast from it stops inside the stroke), 0 external"),
         ("BR_MACHINE_STOP_BOUND_M", machine.stop_bound_m(m),
          "stopping distance the soft travel limits keep from the stroke's ends (machine.stop_bound_m;\n"
          " * br_app_motion_cfg derives the same in float32)"),

@@ -342,6 +342,10 @@ SCHEMA = {
                                        lo_open=True)),
         "max_following_error_m": Optional(Num(0.0, 1.0, "largest |reference - position| before the axis brakes",
                                               lo_open=True)),
+        "coast_stop": Optional(Str(r"stroke|external", "where a stop with the outputs off (HAL, DEADLINE) ends: "
+                                   "stroke (the default: the reference limiter caps the speed toward each end so "
+                                   "that such a coast stops inside the stroke) or external (the machine's own "
+                                   "end-of-travel protection takes it; no cap)")),
     },
     # where each value comes from (a diagnosis's machine.json writes it); optional
     "provenance": Optional(Provenance()),
@@ -399,12 +403,19 @@ def loop_period_s(m):
     return max(m["control"]["period_s"], m["estimator"]["pf"]["period_s"])
 
 
+def coast_in_stroke(m):
+    """1 when the reference limiter keeps a coast inside the stroke
+    (limits.coast_stop "stroke", the default), 0 for "external"."""
+    return 0 if m["limits"].get("coast_stop", "stroke") == "external" else 1
+
+
 def coast_m(m):
     """How far the axis coasts from the speed fault's speed with the outputs
     off (the faults that cannot brake: HAL, DEADLINE), against Coulomb
-    friction alone: v^2 (M + J / L^2) / (2 Fc). The machine's own
-    end-of-travel protection (limit switches, end stops, dynamic braking)
-    covers what the stroke's margin does not (docs/reliability.md)."""
+    friction alone: v^2 (M + J / L^2) / (2 Fc). Kept inside the stroke by
+    the reference limiter's coast envelope (limits.coast_stop "stroke") or by
+    the machine's own end-of-travel protection ("external";
+    docs/modules/app.md)."""
     mech = m["mechanics"]
     L = mech["lead_m_per_rev"] / (2.0 * math.pi)
     mass = mech["table_mass_kg"] + mech["inertia_kgm2"] / (L * L)

@@ -60,24 +60,29 @@ typedef struct {
     double speed_share; /* cruise speed / max_speed_mps (0: the axis holds its position) */
     int ordinary;       /* 1: nothing may latch; 0: a fault that must latch within the bounds */
     const char *what;
+    int to_end;         /* 1: the move as commanded is the stop bound before the high soft limit at
+                           the injection and runs on beyond the stroke (the limiter's braking
+                           curve and the coast envelope) */
 } scenario_t;
 
 static const scenario_t k_scen[] = {
-    {"enc_stuck_30", K_ENC_STUCK, 0.0, 0.3, 0, "counter stops at 30 % of max speed"},
-    {"enc_stuck_90", K_ENC_STUCK, 0.0, 0.9, 0, "counter stops at 90 % of max speed"},
-    {"enc_jump_30", K_ENC_OFFSET, 2.0e5, 0.3, 0, "counter jumps 2e5 counts at 30 %"},
-    {"enc_lie_30", K_ENC_OFFSET, 2.0e4, 0.3, 0, "counter off by 2e4 counts (below the jump limit) at 30 %"},
-    {"enc_noise_30", K_ENC_NOISE, 3.0, 0.3, 1, "each read off by up to 3 counts at 30 %"},
-    {"enc_drop3_90", K_ENC_DROP, 3.0, 0.9, 1, "3 failed reads in a row at 90 %"},
-    {"enc_drop5_90", K_ENC_DROP, 5.0, 0.9, 0, "5 failed reads in a row at 90 %"},
-    {"load_half_hold", K_LOAD_STEP, 0.5, 0.0, 1, "load step of half the actuator's force, holding"},
-    {"load_half_30", K_LOAD_STEP, 0.5, 0.3, 1, "load step of half the actuator's force at 30 %"},
-    {"load_small_30", K_LOAD_STEP, 0.02, 0.3, 1, "load step of 2 % of the actuator's force at 30 %"},
-    {"cutting_30", K_LOAD_WAVE, 0.3, 0.3, 1, "cutting-force-like load, 30 % of the actuator's force, at 30 %"},
-    {"ref_max_speed", K_REF_STEP, 0.0, 1.0, 1, "cruise at max_speed_mps"},
-    {"ref_step_10mm", K_REF_STEP, 0.01, 0.0, 1, "reference step of 10 mm, holding"},
-    {"ref_nan_90", K_REF_NAN, 0.0, 0.9, 0, "NaN reference speed at 90 %"},
-    {"deadline_90", K_DEADLINE, 0.0, 0.9, 0, "missed periods reported at 90 %"},
+    {"enc_stuck_30", K_ENC_STUCK, 0.0, 0.3, 0, "counter stops at 30 % of max speed", 0},
+    {"enc_stuck_90", K_ENC_STUCK, 0.0, 0.9, 0, "counter stops at 90 % of max speed", 0},
+    {"enc_jump_30", K_ENC_OFFSET, 2.0e5, 0.3, 0, "counter jumps 2e5 counts at 30 %", 0},
+    {"enc_lie_30", K_ENC_OFFSET, 2.0e4, 0.3, 0, "counter off by 2e4 counts (below the jump limit) at 30 %", 0},
+    {"enc_noise_30", K_ENC_NOISE, 3.0, 0.3, 1, "each read off by up to 3 counts at 30 %", 0},
+    {"enc_drop3_90", K_ENC_DROP, 3.0, 0.9, 1, "3 failed reads in a row at 90 %", 0},
+    {"enc_drop5_90", K_ENC_DROP, 5.0, 0.9, 0, "5 failed reads in a row at 90 %", 0},
+    {"load_half_hold", K_LOAD_STEP, 0.5, 0.0, 1, "load step of half the actuator's force, holding", 0},
+    {"load_half_30", K_LOAD_STEP, 0.5, 0.3, 1, "load step of half the actuator's force at 30 %", 0},
+    {"load_small_30", K_LOAD_STEP, 0.02, 0.3, 1, "load step of 2 % of the actuator's force at 30 %", 0},
+    {"cutting_30", K_LOAD_WAVE, 0.3, 0.3, 1, "cutting-force-like load, 30 % of the actuator's force, at 30 %", 0},
+    {"ref_max_speed", K_REF_STEP, 0.0, 1.0, 1, "cruise at max_speed_mps", 0},
+    {"ref_step_10mm", K_REF_STEP, 0.01, 0.0, 1, "reference step of 10 mm, holding", 0},
+    {"ref_nan_90", K_REF_NAN, 0.0, 0.9, 0, "NaN reference speed at 90 %", 0},
+    {"deadline_90", K_DEADLINE, 0.0, 0.9, 0, "missed periods reported at 90 %", 0},
+    {"ref_to_end", K_REF_STEP, 0.0, 1.0, 1, "max_speed_mps toward the stroke's end, the reference beyond it", 1},
+    {"deadline_end", K_DEADLINE, 0.0, 0.9, 0, "missed periods at 90 % toward the stroke's end", 1},
 };
 #define N_SCEN (sizeof k_scen / sizeof k_scen[0])
 
@@ -169,9 +174,15 @@ static int run_one(const scenario_t *s, br_circle_ctrl_t ctrl, const char *plant
     const double L = c.plant.lead_mprad, rpc = 2.0 * BR_PI / c.plant.counts_per_rev, dt = c.dt_s;
     const double F_max = (double)BR_MACHINE_TORQUE_LIMIT_NM_F / L;
     const double v = s->speed_share * (double)mc.max_speed_mps, acc = 0.5 * (double)mc.max_accel_mps2;
-    /* from 5 mm inside the low soft limit (a move) or the middle of the stroke (holding) */
-    const double p0 = (v > 0.0) ? (double)mc.soft_min_m + 0.005 : 0.5 * ((double)mc.soft_min_m + (double)mc.soft_max_m);
     const double t_inj = ((acc > 0.0) ? v / acc : 0.0) + INJECT_AFTER_S;
+    /* from 5 mm inside the low soft limit (a move), the middle of the
+     * stroke (holding), or (toward the end) where the move as commanded
+     * reaches the stop bound before the high soft limit at the injection */
+    double p_inj, v_inj;
+    move_at(t_inj, 0.0, v, acc, &p_inj, &v_inj);
+    const double p0 = s->to_end ? (double)mc.soft_max_m - (double)mc.stop_bound_m - p_inj
+                      : (v > 0.0) ? (double)mc.soft_min_m + 0.005
+                                  : 0.5 * ((double)mc.soft_min_m + (double)mc.soft_max_m);
     br_plant_t p;
     br_hal_sim_t port;
     inj_t j = {{0}, s, 0, 0, 0, 0x9E3779B97F4A7C15ull};

@@ -25,9 +25,9 @@
  * of other guards: the tests' controller (L 1.27e-3 m/rad, 6e-6 rad per
  * count), a 120000-count step passes the limiter (1 m/s, 1000 m/s^2), 10 mm of
  * following error, a 10 m stroke centred on 0, a stiction band (2 x 1000 N) above the
- * actuator's force (no stuck-encoder fault). */
+ * actuator's force (no stuck-encoder fault), no coast envelope. */
 #define BR_TEST_WIDE_MOTION                                                                       \
     br_app_motion_cfg(&(const br_app_machine_t){1.27e-3f, 6.0e-6f, 10.0f, 4e-5f, 7.0f, 1000.0f, 1.0f, 1000.0f, \
-                                                0.01f, 10.0f, -5.0f, 1e-3f})
+                                                0.01f, 10.0f, -5.0f, 1e-3f, 0})
 
 #endif

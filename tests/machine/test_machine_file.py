@@ -230,6 +230,14 @@ def main():
         lines = e.lines
     check(len(lines) == 1 and "field limits.travel_m: the stroke reaches" in lines[0]
           and "beyond the int32 position count (2^31)" in lines[0], "reach.json: a stroke beyond the int32 count (%s)" % lines)
+    bad = copy.deepcopy(good)
+    bad["limits"]["coast_stop"] = "brake"
+    expect_errors(work, "coast.json", bad, ["field limits.coast_stop: 'brake' does not match stroke|external"])
+    ext = copy.deepcopy(good)
+    ext["limits"]["coast_stop"] = "external"
+    check(machine.coast_in_stroke(machine.load(write(work, "coast-ext.json", ext))) == 0
+          and machine.coast_in_stroke(machine.load(write(work, "coast-default.json", good))) == 1,
+          "limits.coast_stop: external turns the coast envelope off, the default is on")
     path = write(work, "syntax.json", "{\n  \"name\": \"x\",\n}\n")
     rc, err = run("machine.py", path)
     check(rc == 1 and err.startswith("%s: not valid JSON: line 3" % machine.display_name(path))

@@ -838,6 +838,94 @@ static void test_reference_limiter(void **st)
     }
 }
 
+/* A reference at max speed toward the stroke's end and beyond it (the axis
+ * follows the limited reference exactly): held on the braking curve that
+ * stops at the soft limit (without it the reference passed the soft limit at
+ * full speed: TRAVEL on the closed loop, br_faults ref_to_end) and, with the
+ * machine's coast envelope (limits.coast_stop stroke), never so fast that a
+ * coast with the outputs off, from the speed fault's margin above it, runs
+ * past the stroke's end; it still reaches the soft limit. The reference
+ * ramps within the limiter's acceleration, so it passes through until one
+ * of these acts. With the envelope
+ * off (external) the speed near the end is the limiter's. */
+/* r moved by dv counts, its fraction kept in [0, 1) */
+static void pos_add_test(br_ref_t *r, float dv)
+{
+    const float total = r->ref_frac_counts + dv, whole = floorf(total);
+    r->ref_counts += (int32_t)whole;
+    r->ref_frac_counts = total - whole;
+}
+
+static void run_to_end(int coast_in_stroke, float *v_near_end)
+{
+    rig_t g;
+    rig_init(&g, 0);
+    br_app_machine_t mm = BR_MACHINE_APP_MACHINE;
+    mm.coast_in_stroke = coast_in_stroke;
+    g.c.motion = br_app_motion_cfg(&mm);
+    g.c.guard = br_app_guard_cfg(1e-3f, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F);
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_OK);
+    assert_int_equal(br_app_arm(&g.app), BR_OK);
+    g.app.motion.stuck_band_N = 1e9f;
+    const br_app_t *a = &g.app;
+    const float vmax = a->lim_vmax, amax = a->lim_amax, k = 1.0f + BR_APP_SPEED_MARGIN, ac = a->lim_acoast;
+    assert_true(coast_in_stroke ? ac > 0.0f : ac == 0.0f);
+    /* from twice the coast's length before the soft limit, at standstill */
+    const float coast_counts = (float)BR_MACHINE_COAST_M * a->motion.counts_per_m;
+    float p = floorf(a->lim_hi - 2.0f * coast_counts);
+    g.f.counts = (int32_t)p;
+    br_ref_t r = {(int32_t)p, 0.5f, 0.0f};
+    assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+    p = (float)a->lim_counts + a->lim_frac;
+    *v_near_end = 0.0f;
+    int i = 0;
+    /* the reference ramps at half the limiter's acceleration: passed
+     * through until a limit acts */
+    float vr = 0.0f;
+    for (; i < 20000; i++) {
+        vr = fminf(vr + 0.5f * amax, vmax);
+        pos_add_test(&r, vr);
+        r.ref_omega_radps = vr * g.k.rad_per_count / g.k.dt_s;
+        g.f.counts = a->lim_counts;
+        assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+        /* the step: the limiter's own (positions near 2^24 counts are whole
+         * counts in float; the coast's length grows 700 counts per count of it) */
+        const float v = a->lim_v;
+        p = (float)a->lim_counts + a->lim_frac;
+        assert_true(v <= vmax * 1.0001f && v >= -amax);
+        /* the braking curve: at most one period's change of speed past the soft limit */
+        assert_true(p <= a->lim_hi + amax);
+        if (coast_in_stroke) {
+            /* a coast from k v, seen a period late, stops inside the stroke
+             * less the following limit (positions in float near 2^24 counts
+             * are whole counts: the limiter's position before the step, after
+             * it and the room each round by up to a count; 2.8 measured) */
+            assert_true((k * v) * (k * v) / (2.0f * ac) + 2.0f * k * v <= a->lim_end_hi - p + 4.0f);
+        }
+        if (a->lim_end_hi - p < 0.25f * coast_counts) *v_near_end = fmaxf(*v_near_end, v);
+        if (v == 0.0f && p >= a->lim_hi - 1.0f) break;
+    }
+    assert_true(i < 20000); /* stood at the soft limit */
+}
+
+static void test_reference_to_the_end(void **st)
+{
+    (void)st;
+    float v_in = 0.0f, v_ext = 0.0f;
+    run_to_end(1, &v_in);
+    run_to_end(0, &v_ext);
+    print_message("largest step within a quarter of the coast from the end: %.0f counts (envelope), %.0f (external)\n",
+                  (double)v_in, (double)v_ext);
+    assert_true(v_ext > 1.5f * v_in);
+    /* limits.coast_stop is 0 or 1 */
+    br_app_machine_t bad = BR_MACHINE_APP_MACHINE;
+    bad.coast_in_stroke = 2;
+    rig_t g;
+    rig_init(&g, 0);
+    g.c.motion = br_app_motion_cfg(&bad);
+    assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_E_PARAM);
+}
+
 /* Speed, following error and travel: latched, the axis brakes (controller
  * on a ramp at the machine's acceleration), then outputs off. */
 static void test_motion_faults_brake(void **st)
@@ -1038,6 +1126,7 @@ int main(void)
         cmocka_unit_test(test_encoder_jump_after_held_reads),
         cmocka_unit_test(test_encoder_frozen_latches),
         cmocka_unit_test(test_reference_limiter),
+        cmocka_unit_test(test_reference_to_the_end),
         cmocka_unit_test(test_motion_faults_brake),
         cmocka_unit_test(test_motion_cfg_machine),
         cmocka_unit_test(test_external_fault_latches),

@@ -138,6 +138,8 @@ typedef struct {
     float travel_m;         /* limits.travel_m: the stroke ... */
     float travel_min_m;     /* ... from here (limits.travel_min_m; position 0 is count 0) */
     float period_s;         /* control.period_s: a fault is seen a period late */
+    int coast_in_stroke;    /* limits.coast_stop: 1 stroke (the limiter keeps a coast with the
+                               outputs off inside the stroke), 0 external (no cap) */
 } br_app_machine_t;
 
 /* The drive protections of br_app_step, derived by br_app_motion_cfg
@@ -151,6 +153,8 @@ typedef struct {
     float soft_min_m;        /* soft travel limits: the reference is held inside them, a */
     float soft_max_m;        /* position beyond them by max_following_m is TRAVEL */
     float stop_bound_m;      /* the stopping distance bound the soft limits keep from the ends */
+    float coast_decel_mps2;  /* the coast envelope's deceleration, Fc / mass; 0: no envelope
+                                (limits.coast_stop external) */
     float brake_N;           /* the open-loop braking force: mass max_accel - Fc, >= 0 */
     float mass_kg;           /* moved mass M + J / L^2 (the stuck-encoder model) */
     float stuck_band_N;      /* force change friction can hold without motion: 2 Fs */
@@ -163,7 +167,8 @@ typedef struct {
  * speed_fault period (the period the fault is seen in) + max_following;
  * soft limits = [travel_min + stop_bound, travel_min + travel - stop_bound];
  * brake_N = max(0, mass max_accel - Fc); mass =
- * M + J / L^2; stuck band 2 Fs; BR_APP_STUCK_COUNTS. Values br_app_init
+ * M + J / L^2; stuck band 2 Fs; BR_APP_STUCK_COUNTS; coast_decel = Fc / mass
+ * with coast_in_stroke, else 0 (the coast envelope, br_app_ref_limit). Values br_app_init
  * rejects (all zero) for a NULL m or a non-finite or non-positive value. */
 br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m);
 /* Can be const, in flash. Only the pointer the kind names is read. */
@@ -209,6 +214,9 @@ typedef struct {
     uint32_t n_ref_limited; /* periods limited since the arm */
     float lim_vmax, lim_amax; /* the limits in counts per period (per period^2) */
     float lim_lo, lim_hi;   /* the soft travel limits in counts */
+    float lim_acoast;       /* the coast envelope's deceleration, counts per period^2 (0: off) */
+    float lim_end_lo, lim_end_hi; /* the stroke's ends less the following limit, counts: a coast
+                                     from the limited reference stops inside them */
     float mot_k_m;          /* the stuck-encoder model's force per count/period^2: mass / (counts_per_m dt^2) */
     /* measured motion (stuck-encoder model, speed fault) */
     float v_meas;           /* speed of the last good read, counts per period */

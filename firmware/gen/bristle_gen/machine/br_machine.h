@@ -86,6 +86,9 @@
 /* how far the axis coasts from the speed fault's speed with the outputs off (machine.coast_m) */
 #define BR_MACHINE_COAST_M (0.03566469703137263)
 #define BR_MACHINE_COAST_M_F (3.566469625e-02f)
+/* limits.coast_stop: 1 stroke (the reference limiter caps the speed toward each end so that
+ * a coast from it stops inside the stroke), 0 external */
+#define BR_MACHINE_COAST_IN_STROKE 1u
 /* stopping distance the soft travel limits keep from the stroke's ends (machine.stop_bound_m;
  * br_app_motion_cfg derives the same in float32) */
 #define BR_MACHINE_STOP_BOUND_M (0.0047799999999999995)
