@@ -17,7 +17,8 @@ br_status_t br_rec_init(br_rec_t *rec, const br_rec_cfg_t *cfg)
     if (cfg->slots == NULL) {
         return BR_E_NULL;
     }
-    if (cfg->capacity < 1u || cfg->capacity > BR_REC_CAPACITY_MAX || cfg->pre_samples >= cfg->capacity ||
+    /* pre_samples < capacity: room for the trigger sample (and so capacity >= 1) */
+    if (cfg->capacity > BR_REC_CAPACITY_MAX || cfg->pre_samples >= cfg->capacity ||
         !isfinite(cfg->trig_following_counts) || cfg->trig_following_counts < 0.0f ||
         cfg->dump_frames_per_period < 1u || cfg->dump_frames_per_period > BR_REC_DUMP_FRAMES_MAX) {
         return BR_E_PARAM;

@@ -57,7 +57,7 @@ static void test_rec_init_guards(void **st)
         float thr;
         br_status_t want;
     } cases[] = {
-        {0u, 0u, 2u, 0.0f, BR_E_PARAM},                       /* zero capacity */
+        {0u, 0u, 2u, 0.0f, BR_E_PARAM},                       /* zero capacity (no room for the trigger) */
         {BR_REC_CAPACITY_MAX + 1u, 0u, 2u, 0.0f, BR_E_PARAM}, /* index beyond the u16 */
         {8u, 8u, 2u, 0.0f, BR_E_PARAM},                       /* pre-trigger = capacity: no room for the trigger */
         {8u, 9u, 2u, 0.0f, BR_E_PARAM},                       /* pre-trigger > capacity */
