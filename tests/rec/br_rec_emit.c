@@ -13,7 +13,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: br_rec_emit OUT\n");
         return 2;
     }
-    static rec_sink_t sink;
+    static golden_sink_t sink;
     if (rec_golden_run(&sink) != BR_OK) {
         fprintf(stderr, "br_rec_emit: the scripted run failed\n");
         return 1;

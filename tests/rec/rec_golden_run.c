@@ -4,7 +4,7 @@
 #include "bristle/br_tlm.h"
 #include "br_rec_golden.h"
 
-br_status_t rec_golden_run(rec_sink_t *sink)
+br_status_t rec_golden_run(golden_sink_t *sink)
 {
     br_link_t l;
     br_status_t st = rec_link_init(&l, sink, 4096u);

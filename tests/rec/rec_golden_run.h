@@ -11,6 +11,6 @@
  * samples, pre-trigger all but one) records them, a command trigger asked
  * before the last; a dump from 0 to its rec_end. The link's frames start at
  * BR_REC_GOLDEN_SEQ0; the bytes land in sink. BR_OK or the first error. */
-br_status_t rec_golden_run(rec_sink_t *sink);
+br_status_t rec_golden_run(golden_sink_t *sink);
 
 #endif

@@ -3,33 +3,11 @@
 
 #include <string.h>
 
-static size_t sink_read(void *ctx, uint8_t *buf, size_t n)
-{
-    (void)ctx;
-    (void)buf;
-    (void)n;
-    return 0u;
-}
-
-static size_t sink_write(void *ctx, const uint8_t *buf, size_t n)
-{
-    rec_sink_t *s = ctx;
-    size_t k = n < s->room ? n : s->room;
-    if (k > sizeof s->buf - s->len) {
-        k = sizeof s->buf - s->len;
-    }
-    memcpy(&s->buf[s->len], buf, k);
-    s->len += k;
-    ++s->writes;
-    return k;
-}
-
-br_status_t rec_link_init(br_link_t *l, rec_sink_t *sink, size_t room)
+br_status_t rec_link_init(br_link_t *l, golden_sink_t *sink, size_t room)
 {
     sink->len = 0u;
     sink->room = room;
-    sink->writes = 0u;
-    const br_byte_chan_t ch = {sink, sink_read, sink_write};
+    const br_byte_chan_t ch = golden_chan(sink);
     const br_link_cfg_t cfg = {BR_LINK_RX_BUDGET_MAX, BR_LINK_TX_BUF_BYTES, NULL, NULL};
     return br_link_init(l, &cfg, &ch);
 }

@@ -91,7 +91,7 @@ static void test_tlm_init_guards(void **st)
     assert_int_equal(br_tlm_init(&t, NULL), BR_E_NULL);
     assert_int_equal(br_tlm_init(&t, &c), BR_E_PARAM); /* N = 0 */
     br_link_t l;
-    static rec_sink_t sink;
+    static golden_sink_t sink;
     assert_int_equal(rec_link_init(&l, &sink, 4096u), BR_OK);
     const br_rec_sample_t s = rec_sample_of(0u);
     assert_int_equal(br_tlm_step(&t, &l, &s), BR_E_STATE);
@@ -360,7 +360,7 @@ static void test_condition_trigger(void **st)
 }
 
 /* decodes the sink: the frames in order */
-static size_t decode_sink(const rec_sink_t *k, br_link_frame_t *f, size_t max)
+static size_t decode_sink(const golden_sink_t *k, br_link_frame_t *f, size_t max)
 {
     br_link_dec_t d;
     br_link_dec_init(&d);
@@ -391,7 +391,7 @@ static void test_dump_bounded_complete(void **st)
     assert_int_equal(br_rec_trigger(&r), BR_OK);
     push_range(&r, 50u, 80u); /* the trigger and 29 after it */
     assert_int_equal(r.state, BR_REC_DONE);
-    static rec_sink_t sink;
+    static golden_sink_t sink;
     br_link_t l;
     assert_int_equal(rec_link_init(&l, &sink, 16u), BR_OK); /* 16 bytes a period: the queue fills */
     assert_int_equal(br_rec_dump_request(&r, 0u), BR_OK);
@@ -480,7 +480,7 @@ static void test_commands(void **st)
 static void test_tlm_decimation(void **st)
 {
     (void)st;
-    static rec_sink_t sink;
+    static golden_sink_t sink;
     const uint32_t ns[2] = {3u, 1u};
     for (int k = 0; k < 2; ++k) {
         br_link_t l;
@@ -513,7 +513,7 @@ static void test_tlm_decimation(void **st)
 static void test_tlm_drop_full(void **st)
 {
     (void)st;
-    static rec_sink_t sink;
+    static golden_sink_t sink;
     br_link_t l;
     assert_int_equal(rec_link_init(&l, &sink, 0u), BR_OK);
     br_tlm_t t;

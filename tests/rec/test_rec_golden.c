@@ -36,7 +36,7 @@ static void test_requests_decode(void **s)
 static void test_run_encodes_equal(void **s)
 {
     (void)s;
-    static rec_sink_t sink;
+    static golden_sink_t sink;
     assert_int_equal(rec_golden_run(&sink), BR_OK);
     assert_int_equal(sink.len, sizeof br_rec_golden_stream);
     assert_memory_equal(sink.buf, br_rec_golden_stream, sizeof br_rec_golden_stream);
