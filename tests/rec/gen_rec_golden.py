@@ -17,14 +17,15 @@ bytes must be STREAM's. test_rec_golden.py (Python) decodes what br_rec_emit
 wrote with bristle.link: the same values, the dump into the same rows.
 
 Usage: gen_rec_golden.py [--out FILE]"""
-import argparse
 import os
 import struct
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "python"))
+sys.path.insert(0, os.path.join(HERE, "..", "link"))
 
+import gen_golden  # noqa: E402
 from bristle.link import encode_frame, messages, pack  # noqa: E402
 
 
@@ -109,13 +110,7 @@ def render():
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=os.path.join(HERE, "br_rec_golden.h"))
-    a = ap.parse_args(argv)
-    tmp = a.out + ".tmp"
-    with open(tmp, "w", encoding="utf-8", newline="\n") as f:
-        f.write(render())
-    os.replace(tmp, a.out)
+    gen_golden.write_header(render, os.path.join(HERE, "br_rec_golden.h"), __doc__, argv)
 
 
 if __name__ == "__main__":

@@ -7,28 +7,20 @@ encodes from them; the dump becomes the samples as rows, the telemetry the
 same rows.
 
 Usage: test_rec_golden.py --emit BIN --work DIR"""
-import argparse
 import os
-import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, "..", "link"))
 
 import gen_rec_golden as g  # noqa: E402
+from test_link_golden import emitted  # noqa: E402
 from bristle.link import Decoder, dump_rows, telemetry_rows, unpack  # noqa: E402
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--emit", required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    os.makedirs(a.work, exist_ok=True)
-    path = os.path.join(a.work, "rec.bin")
-    subprocess.run([a.emit, path], check=True)
-    with open(path, "rb") as f:
-        wire = f.read()
+    wire = emitted("rec.bin")
     dec = Decoder()
     frames = dec.feed(wire)
     want = g.stream_messages()
