@@ -342,6 +342,7 @@ regen: deps
 	$(Q)echo "== regen: the link's message header and golden frames (docs/link.md)"
 	$(Q)$(PYTHON) firmware/design/gen_link.py
 	$(Q)$(PYTHON) tests/link/gen_golden.py
+	$(Q)$(PYTHON) tests/rec/gen_rec_golden.py
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)echo "== regen: tuned estimator variances (about 3 min)"

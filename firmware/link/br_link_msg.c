@@ -111,6 +111,15 @@ br_status_t br_link_cmd_decode(const br_link_frame_t *f, br_link_cmd_t *cmd)
     case BR_LINK_MSG_PARAM_WRITE:
         kind = BR_LINK_CMD_PARAM_WRITE;
         break;
+    case BR_LINK_MSG_REC_ARM:
+        kind = BR_LINK_CMD_REC_ARM;
+        break;
+    case BR_LINK_MSG_REC_TRIGGER:
+        kind = BR_LINK_CMD_REC_TRIGGER;
+        break;
+    case BR_LINK_MSG_REC_DUMP:
+        kind = BR_LINK_CMD_REC_DUMP;
+        break;
     default:
         return BR_E_INPUT; /* not a request the target receives */
     }
@@ -122,6 +131,8 @@ br_status_t br_link_cmd_decode(const br_link_frame_t *f, br_link_cmd_t *cmd)
     } else if (kind == BR_LINK_CMD_PARAM_WRITE) {
         cmd->param = get_u16(&f->payload[BR_LINK_MSG_PARAM_WRITE_OFF_PARAM]);
         cmd->value = get_f32(&f->payload[BR_LINK_MSG_PARAM_WRITE_OFF_VALUE]);
+    } else if (kind == BR_LINK_CMD_REC_DUMP) {
+        cmd->first = get_u16(&f->payload[BR_LINK_MSG_REC_DUMP_OFF_FIRST]);
     }
     cmd->kind = kind;
     return BR_OK;

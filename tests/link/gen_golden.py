@@ -74,14 +74,20 @@ def render():
     return "\n".join(out)
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=os.path.join(HERE, "br_link_golden.h"))
+def write_header(text_of, default_out, doc, argv=None):
+    """The generators' command line: --out FILE (default default_out), the
+    header text_of() returns written whole, through a temporary file."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("--out", default=default_out)
     a = ap.parse_args(argv)
     tmp = a.out + ".tmp"
     with open(tmp, "w", encoding="utf-8", newline="\n") as f:
-        f.write(render())
+        f.write(text_of())
     os.replace(tmp, a.out)
+
+
+def main(argv=None):
+    write_header(render, os.path.join(HERE, "br_link_golden.h"), __doc__, argv)
 
 
 if __name__ == "__main__":

@@ -14,16 +14,24 @@ static size_t sink_read(void *ctx, uint8_t *buf, size_t n)
 static size_t sink_write(void *ctx, const uint8_t *buf, size_t n)
 {
     golden_sink_t *s = ctx;
-    const size_t k = n < sizeof s->buf - s->len ? n : sizeof s->buf - s->len;
+    size_t k = n < sizeof s->buf - s->len ? n : sizeof s->buf - s->len;
+    k = k < s->room ? k : s->room;
     memcpy(&s->buf[s->len], buf, k);
     s->len += k;
     return k;
 }
 
+br_byte_chan_t golden_chan(golden_sink_t *sink)
+{
+    const br_byte_chan_t ch = {sink, sink_read, sink_write};
+    return ch;
+}
+
 br_status_t golden_link_init(br_link_t *l, golden_sink_t *sink)
 {
     sink->len = 0u;
-    const br_byte_chan_t ch = {sink, sink_read, sink_write};
+    sink->room = sizeof sink->buf;
+    const br_byte_chan_t ch = golden_chan(sink);
     const br_link_cfg_t cfg = {16u, BR_LINK_FRAME_MAX, NULL, NULL};
     return br_link_init(l, &cfg, &ch);
 }

@@ -11,7 +11,11 @@
 typedef struct {
     uint8_t buf[4096];
     size_t len;
+    size_t room; /* bytes one write takes at most (golden_link_init: all of buf) */
 } golden_sink_t;
+
+/* a channel writing into sink (nothing to read) */
+br_byte_chan_t golden_chan(golden_sink_t *sink);
 
 /* a link over a sink (nothing to read), budgets large enough for one frame a step */
 br_status_t golden_link_init(br_link_t *l, golden_sink_t *sink);

@@ -18,16 +18,21 @@ import gen_golden  # noqa: E402
 from bristle.link import Decoder, encode_frame, messages, pack, unpack  # noqa: E402
 
 
-def main():
+def emitted(name, argv=None):
+    """The bytes the emitter of --emit BIN writes into DIR/name (--work DIR)."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--emit", required=True)
     ap.add_argument("--work", required=True)
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     os.makedirs(a.work, exist_ok=True)
-    path = os.path.join(a.work, "reports.bin")
+    path = os.path.join(a.work, name)
     subprocess.run([a.emit, path], check=True)
     with open(path, "rb") as f:
-        wire = f.read()
+        return f.read()
+
+
+def main():
+    wire = emitted("reports.bin")
     reports = [c for c in gen_golden.CASES if messages.BY_NAME[c[0]].direction == messages.TO_HOST]
     assert len(reports) == 6, reports
     dec = Decoder()

@@ -133,7 +133,10 @@ typedef enum {
     BR_LINK_CMD_DISARM,
     BR_LINK_CMD_FAULT_RESET,
     BR_LINK_CMD_PARAM_READ,
-    BR_LINK_CMD_PARAM_WRITE /* finite and accepted by param_check */
+    BR_LINK_CMD_PARAM_WRITE, /* finite and accepted by param_check */
+    BR_LINK_CMD_REC_ARM,     /* the recorder's requests (bristle/br_rec.h: br_rec_command) */
+    BR_LINK_CMD_REC_TRIGGER,
+    BR_LINK_CMD_REC_DUMP
 } br_link_cmd_kind_t;
 
 typedef struct {
@@ -141,6 +144,7 @@ typedef struct {
     uint16_t seq;   /* the frame's sequence number */
     uint16_t param; /* PARAM_READ, PARAM_WRITE */
     float value;    /* PARAM_WRITE */
+    uint16_t first; /* REC_DUMP: the first sample index to send */
 } br_link_cmd_t;
 
 typedef struct {

@@ -1,9 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """bristle.link: the host's side of the firmware's link (docs/link.md):
 frames (bristle.link.frame) and the message table with its packing
-(bristle.link.messages). The serial transport is not here yet."""
+(bristle.link.messages), the recorder's dumps and telemetry as rows and
+the measured-log CSV (bristle.link.record). The serial transport is not here
+yet."""
 from .frame import Decoder, Frame, FrameError, crc16, decode_frame, encode_frame
 from .messages import MESSAGES, MessageError, pack, unpack
+from .record import Capture, DumpError, dump_rows, telemetry_rows, write_measured_log
 
 __all__ = ["Decoder", "Frame", "FrameError", "crc16", "decode_frame", "encode_frame",
-           "MESSAGES", "MessageError", "pack", "unpack"]
+           "MESSAGES", "MessageError", "pack", "unpack",
+           "Capture", "DumpError", "dump_rows", "telemetry_rows", "write_measured_log"]

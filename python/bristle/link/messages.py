@@ -9,7 +9,7 @@ run time, which is why the table lives in Python: an installed bristle.link
 has no C header to read.
 
 A payload is its fields in order, packed, little-endian, without padding.
-Field types: u8, i8, u16, u32, f32 (IEEE 754 binary32)."""
+Field types: u8, i8, u16, u32, i32, f32 (IEEE 754 binary32)."""
 import struct
 from dataclasses import dataclass
 
@@ -18,7 +18,7 @@ TO_HOST = "to_host"
 TO_TARGET = "to_target"
 
 # struct codes of the field types (little-endian, "<" in pack/unpack)
-TYPES = {"u8": "B", "i8": "b", "u16": "H", "u32": "I", "f32": "f"}
+TYPES = {"u8": "B", "i8": "b", "u16": "H", "u32": "I", "i32": "i", "f32": "f"}
 
 
 @dataclass(frozen=True)
@@ -55,6 +55,21 @@ class Message:
         return out
 
 
+# One control period's sample (firmware/rec/br_rec_sample.c): the payload of
+# tlm_sample, and of rec_sample after its index.
+SAMPLE_FIELDS = (
+    Field("tick", "u32", "the control period's index (the caller's)"),
+    Field("counts", "i32", "the encoder count the period used"),
+    Field("ref_counts", "i32", "the limited reference the controller tracked: whole counts ..."),
+    Field("ref_frac", "f32", "... and the fraction of a count, in [0, 1)"),
+    Field("duty", "f32", "PWM duty written, [-1, 1]"),
+    Field("F_hat_N", "f32", "the compensation force used (N, load side)"),
+    Field("n_outliers", "u16", "outlier periods in the lock monitor's window"),
+    Field("status", "i8", "br_app_step's status (1 BR_W_OUTLIER: the measurement was skipped)"),
+    Field("fault", "u8", "br_app_fault_t (0 none, 1 disarmed)"),
+    Field("flags", "u8", "bit 0 reference limited, 1 torque saturated, 2 encoder read held, 3-4 br_app_stop_t"),
+)
+
 MESSAGES = (
     Message("status", 0x01, TO_HOST, (
         Field("tick", "u32", "control period index of the report"),
@@ -81,6 +96,27 @@ MESSAGES = (
         Field("value", "f32", "the value now in force (a refused write: the value asked for)"),
         Field("status", "i8", "br_status_t of the read or write (0 BR_OK; negative: refused)"),
     ), "the answer to param_read and param_write"),
+    # telemetry and the recorder: ids 0x40-0x5F (docs/link.md, "Telemetry", "The recorder")
+    Message("tlm_sample", 0x40, TO_HOST, SAMPLE_FIELDS,
+            "telemetry: one control period's sample, every N periods (br_tlm)"),
+    Message("rec_sample", 0x41, TO_HOST, (
+        Field("index", "u16", "the sample's place in the capture, 0 the oldest"),
+    ) + SAMPLE_FIELDS, "a recorder dump's chunk: one sample of the capture (br_rec)"),
+    Message("rec_end", 0x42, TO_HOST, (
+        Field("count", "u16", "samples in the capture (0: no capture complete, see state)"),
+        Field("trigger_index", "u16", "the trigger sample's index (the samples before it are the pre-trigger ones)"),
+        Field("trigger_tick", "u32", "the trigger sample's tick"),
+        Field("cause", "u8", "what triggered (br_rec_trig_t: 1 fault, 2 command, 3 condition; 0 none)"),
+        Field("state", "u8", "the recorder's state (br_rec_state_t: 0 armed, 1 collecting, 2 done)"),
+        Field("missed_faults", "u16", "faults that latched while a capture was held (not captured)"),
+    ), "the end of a dump (after its last rec_sample), or the answer to a dump before a capture is complete"),
+    Message("rec_arm", 0x50, TO_TARGET, (),
+            "recorder: drop the capture, record again and wait for a trigger"),
+    Message("rec_trigger", 0x51, TO_TARGET, (),
+            "recorder: the next sample recorded is the trigger (when armed)"),
+    Message("rec_dump", 0x52, TO_TARGET, (
+        Field("first", "u16", "the first index to send (0: the whole capture)"),
+    ), "recorder: send the capture from index first, then rec_end"),
 )
 
 BY_ID = {m.id: m for m in MESSAGES}

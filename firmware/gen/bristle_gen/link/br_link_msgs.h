@@ -57,6 +57,58 @@
 #define BR_LINK_MSG_PARAM_VALUE_OFF_VALUE 2u /* f32 the value now in force (a refused write: the value asked for) */
 #define BR_LINK_MSG_PARAM_VALUE_OFF_STATUS 6u /* i8 br_status_t of the read or write (0 BR_OK; negative: refused) */
 
+/* telemetry: one control period's sample, every N periods (br_tlm) (BR_LINK_TO_HOST) */
+#define BR_LINK_MSG_TLM_SAMPLE 0x40u
+#define BR_LINK_MSG_TLM_SAMPLE_LEN 29u
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_TICK 0u /* u32 the control period's index (the caller's) */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_COUNTS 4u /* i32 the encoder count the period used */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_REF_COUNTS 8u /* i32 the limited reference the controller tracked: whole counts ... */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_REF_FRAC 12u /* f32 ... and the fraction of a count, in [0, 1) */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_DUTY 16u /* f32 PWM duty written, [-1, 1] */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_F_HAT_N 20u /* f32 the compensation force used (N, load side) */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_N_OUTLIERS 24u /* u16 outlier periods in the lock monitor's window */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_STATUS 26u /* i8 br_app_step's status (1 BR_W_OUTLIER: the measurement was skipped) */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_FAULT 27u /* u8 br_app_fault_t (0 none, 1 disarmed) */
+#define BR_LINK_MSG_TLM_SAMPLE_OFF_FLAGS 28u /* u8 bit 0 reference limited, 1 torque saturated, 2 encoder read held, 3-4 br_app_stop_t */
+
+/* a recorder dump's chunk: one sample of the capture (br_rec) (BR_LINK_TO_HOST) */
+#define BR_LINK_MSG_REC_SAMPLE 0x41u
+#define BR_LINK_MSG_REC_SAMPLE_LEN 31u
+#define BR_LINK_MSG_REC_SAMPLE_OFF_INDEX 0u /* u16 the sample's place in the capture, 0 the oldest */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_TICK 2u /* u32 the control period's index (the caller's) */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_COUNTS 6u /* i32 the encoder count the period used */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_REF_COUNTS 10u /* i32 the limited reference the controller tracked: whole counts ... */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_REF_FRAC 14u /* f32 ... and the fraction of a count, in [0, 1) */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_DUTY 18u /* f32 PWM duty written, [-1, 1] */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_F_HAT_N 22u /* f32 the compensation force used (N, load side) */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_N_OUTLIERS 26u /* u16 outlier periods in the lock monitor's window */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_STATUS 28u /* i8 br_app_step's status (1 BR_W_OUTLIER: the measurement was skipped) */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_FAULT 29u /* u8 br_app_fault_t (0 none, 1 disarmed) */
+#define BR_LINK_MSG_REC_SAMPLE_OFF_FLAGS 30u /* u8 bit 0 reference limited, 1 torque saturated, 2 encoder read held, 3-4 br_app_stop_t */
+
+/* the end of a dump (after its last rec_sample), or the answer to a dump before a capture is complete (BR_LINK_TO_HOST) */
+#define BR_LINK_MSG_REC_END 0x42u
+#define BR_LINK_MSG_REC_END_LEN 12u
+#define BR_LINK_MSG_REC_END_OFF_COUNT 0u /* u16 samples in the capture (0: no capture complete, see state) */
+#define BR_LINK_MSG_REC_END_OFF_TRIGGER_INDEX 2u /* u16 the trigger sample's index (the samples before it are the pre-trigger ones) */
+#define BR_LINK_MSG_REC_END_OFF_TRIGGER_TICK 4u /* u32 the trigger sample's tick */
+#define BR_LINK_MSG_REC_END_OFF_CAUSE 8u /* u8 what triggered (br_rec_trig_t: 1 fault, 2 command, 3 condition; 0 none) */
+#define BR_LINK_MSG_REC_END_OFF_STATE 9u /* u8 the recorder's state (br_rec_state_t: 0 armed, 1 collecting, 2 done) */
+#define BR_LINK_MSG_REC_END_OFF_MISSED_FAULTS 10u /* u16 faults that latched while a capture was held (not captured) */
+
+/* recorder: drop the capture, record again and wait for a trigger (BR_LINK_TO_TARGET) */
+#define BR_LINK_MSG_REC_ARM 0x50u
+#define BR_LINK_MSG_REC_ARM_LEN 0u
+
+/* recorder: the next sample recorded is the trigger (when armed) (BR_LINK_TO_TARGET) */
+#define BR_LINK_MSG_REC_TRIGGER 0x51u
+#define BR_LINK_MSG_REC_TRIGGER_LEN 0u
+
+/* recorder: send the capture from index first, then rec_end (BR_LINK_TO_TARGET) */
+#define BR_LINK_MSG_REC_DUMP 0x52u
+#define BR_LINK_MSG_REC_DUMP_LEN 2u
+#define BR_LINK_MSG_REC_DUMP_OFF_FIRST 0u /* u16 the first index to send (0: the whole capture) */
+
 /* X(NAME, id, payload length, direction) for every message */
 #define BR_LINK_MSG_TABLE(X) \
     X(STATUS, BR_LINK_MSG_STATUS, BR_LINK_MSG_STATUS_LEN, BR_LINK_TO_HOST) \
@@ -66,6 +118,12 @@
     X(FAULT_RESET, BR_LINK_MSG_FAULT_RESET, BR_LINK_MSG_FAULT_RESET_LEN, BR_LINK_TO_TARGET) \
     X(PARAM_READ, BR_LINK_MSG_PARAM_READ, BR_LINK_MSG_PARAM_READ_LEN, BR_LINK_TO_TARGET) \
     X(PARAM_WRITE, BR_LINK_MSG_PARAM_WRITE, BR_LINK_MSG_PARAM_WRITE_LEN, BR_LINK_TO_TARGET) \
-    X(PARAM_VALUE, BR_LINK_MSG_PARAM_VALUE, BR_LINK_MSG_PARAM_VALUE_LEN, BR_LINK_TO_HOST)
+    X(PARAM_VALUE, BR_LINK_MSG_PARAM_VALUE, BR_LINK_MSG_PARAM_VALUE_LEN, BR_LINK_TO_HOST) \
+    X(TLM_SAMPLE, BR_LINK_MSG_TLM_SAMPLE, BR_LINK_MSG_TLM_SAMPLE_LEN, BR_LINK_TO_HOST) \
+    X(REC_SAMPLE, BR_LINK_MSG_REC_SAMPLE, BR_LINK_MSG_REC_SAMPLE_LEN, BR_LINK_TO_HOST) \
+    X(REC_END, BR_LINK_MSG_REC_END, BR_LINK_MSG_REC_END_LEN, BR_LINK_TO_HOST) \
+    X(REC_ARM, BR_LINK_MSG_REC_ARM, BR_LINK_MSG_REC_ARM_LEN, BR_LINK_TO_TARGET) \
+    X(REC_TRIGGER, BR_LINK_MSG_REC_TRIGGER, BR_LINK_MSG_REC_TRIGGER_LEN, BR_LINK_TO_TARGET) \
+    X(REC_DUMP, BR_LINK_MSG_REC_DUMP, BR_LINK_MSG_REC_DUMP_LEN, BR_LINK_TO_TARGET)
 
 #endif
