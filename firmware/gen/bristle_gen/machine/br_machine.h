@@ -112,4 +112,14 @@
     .drift_per_s = 0.000000000e+00f, /* friction_drift: friction level scaled by max(0, 1 + drift_per_s t), t since the start */ \
 }
 
+/* reversal compensation (reversal_comp): pulse amplitude at a = 0 */
+#define BR_MACHINE_QEC_A0_N (3.388)
+#define BR_MACHINE_QEC_A0_N_F (3.388000011e+00f)
+/* its change per |reference acceleration|, N per m/s^2 */
+#define BR_MACHINE_QEC_A1_KG (-5888.0)
+#define BR_MACHINE_QEC_A1_KG_F (-5.888000000e+03f)
+/* the pulse's decay time constant */
+#define BR_MACHINE_QEC_TAU_S (0.3172)
+#define BR_MACHINE_QEC_TAU_S_F (3.172000051e-01f)
+
 #endif
