@@ -37,6 +37,7 @@ import gen_gms_traces  # noqa: E402
 import gen_mslip_traces  # noqa: E402
 import gen_mslip_model_traces  # noqa: E402
 import gen_load_traces  # noqa: E402
+import gen_qec_traces  # noqa: E402
 
 SEED = 20240611  # base seed; trace i uses SEED + i (recorded in each header)
 SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
@@ -48,7 +49,9 @@ SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                # the Maxwell-slip plant (gen_gms_traces.py)
                "plant_gms": 8, "plant_gms_clamp": 9,
                # the firmware's Maxwell-slip kernel (gen_mslip_traces.py)
-               "mslip": 10, "model_ms": 11}
+               "mslip": 10, "model_ms": 11,
+               # the reversal compensation's pulse (gen_qec_traces.py)
+               "qec": 12}
 
 DT = 1.0e-3
 INT32_MAX = 2**31 - 1
@@ -455,6 +458,7 @@ def main(argv=None):
     paths += gen_gms_traces.generate(args.out, m, sys.modules[__name__])
     paths.append(gen_mslip_traces.generate(args.out, m, sys.modules[__name__]))
     paths.append(gen_mslip_model_traces.generate(args.out, m, sys.modules[__name__]))
+    paths.append(gen_qec_traces.generate(args.out, m, sys.modules[__name__]))
     for pth in paths:
         print("wrote", os.path.relpath(pth))
     return 0

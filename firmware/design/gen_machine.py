@@ -119,6 +119,19 @@ def render_mslip(m):
             "}"]
 
 
+def render_qec(m):
+    """BR_MACHINE_QEC_*: the reversal compensation's pulse (reversal_comp,
+    docs/modules/qec.md); nothing without the section, so a file without it
+    gives the header it gave before it existed."""
+    r = m.get("reversal_comp")
+    if not r:
+        return []
+    return [""] + render_defines([
+        ("BR_MACHINE_QEC_A0_N", r["A0_N"], "reversal compensation (reversal_comp): pulse amplitude at a = 0"),
+        ("BR_MACHINE_QEC_A1_KG", r["A1_kg"], "its change per |reference acceleration|, N per m/s^2"),
+        ("BR_MACHINE_QEC_TAU_S", r["tau_s"], "the pulse's decay time constant")])
+
+
 def est_fields(m):
     """The estimators' settings as the firmware takes them: per step, in its
     state's units, from the file's physical ones (machine.est_per_step)."""
@@ -215,6 +228,7 @@ def render_machine(m):
     out += render_defines(machine_fields(m, machine.params(m)))
     out += render_causes(m)
     out += render_mslip(m)
+    out += render_qec(m)
     out += ["", "#endif", ""]
     return "\n".join(out)
 

@@ -269,6 +269,14 @@ SCHEMA = {
         "share": Optional(NumList(0.0, 1.0, 1, MSLIP_MAX, "maxwell_slip: each element's share of the "
                                   "Stribeck level, summing to 1", lo_open=True)),
     }),
+    # the reversal (quadrant-error) compensation, the industrial baseline tuned from a circle test
+    # (docs/modules/qec.md); absent = no pulse
+    "reversal_comp": Optional({
+        "A0_N": Num(0.0, 1.0e5, "pulse amplitude at zero acceleration of the reference"),
+        "A1_kg": Num(-1.0e6, 1.0e6, "the amplitude's change per |reference acceleration|, N per m/s^2 "
+                     "(the amplitude max(0, A0_N + A1_kg |a|))"),
+        "tau_s": Num(0.0, 10.0, "the pulse's decay time constant (exponential)", lo_open=True),
+    }),
     "control": {
         "period_s": Num(1.0e-5, 0.1, "control period (H-inf only, UKF)"),
         "estimator": Str(r"(pf|ukf|none)(,(pf|ukf|none))*", "the estimators the firmware image may run, in the "

@@ -67,6 +67,7 @@ static const demo_row_t rows[] = {
     {BR_CTRL_HINF_PF, "H-inf + PF", 4.0e-7},
     {BR_CTRL_HINF_TRUE, "true friction", 0.0},
     {BR_CTRL_HINF_FF, "H-inf + FF", 0.0},
+    {BR_CTRL_HINF_QEC, "H-inf + QEC", 0.0},
 };
 #define N_ROWS (sizeof rows / sizeof rows[0])
 

@@ -7,6 +7,7 @@
  *   hinf_only                 H-inf alone
  *   hinf_ff, hinf_ukf, hinf_pf  + feedforward / UKF / PF on the machine's nominal model
  *   hinf_true                 + the plant's true friction (the limit, an oracle)
+ *   hinf_qec                  + the machine file's reversal (quadrant-error) pulse (docs/modules/qec.md)
  *   hinf_ff_id, hinf_ukf_id, hinf_pf_id  the same on the model a diagnosis identified
  *                             (--model: its parameters and causes)
  *
@@ -56,6 +57,7 @@ static const run_t runs[] = {
     {"hinf_only", BR_CTRL_HINF_ONLY, 0}, {"hinf_ff", BR_CTRL_HINF_FF, 0},       {"hinf_ukf", BR_CTRL_HINF_UKF, 0},
     {"hinf_pf", BR_CTRL_HINF_PF, 0},     {"hinf_true", BR_CTRL_HINF_TRUE, 0},   {"hinf_ff_id", BR_CTRL_HINF_FF, 1},
     {"hinf_ukf_id", BR_CTRL_HINF_UKF, 1}, {"hinf_pf_id", BR_CTRL_HINF_PF, 1},
+    {"hinf_qec", BR_CTRL_HINF_QEC, 0},
 };
 #define N_RUNS (sizeof runs / sizeof runs[0])
 

@@ -26,6 +26,7 @@ const char *br_circle_ctrl_name(br_circle_ctrl_t c)
     case BR_CTRL_HINF_PF: return "hinf_pf";
     case BR_CTRL_HINF_TRUE: return "hinf_true";
     case BR_CTRL_HINF_FF: return "hinf_ff";
+    case BR_CTRL_HINF_QEC: return "hinf_qec";
     }
     return "unknown";
 }
@@ -46,6 +47,7 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     c.pf = br_circle_pf_cfg_tuned((float)c.dt_s);
     c.ukf = br_circle_ukf_cfg_tuned((float)c.dt_s);
     c.ff = br_circle_ff_cfg_machine();
+    c.qec = br_circle_qec_cfg_machine((float)c.dt_s);
     c.real = (br_circle_real_t){0.0, 0.0, 0.0, 0u};
     return c;
 }
@@ -177,6 +179,7 @@ typedef struct {
     br_app_t app;
     br_app_mem_t mem; /* the filter's state, owned: PF or UKF only */
     br_ff_t ff;       /* the feedforward (BR_CTRL_HINF_FF) */
+    br_qec_t qec;     /* the reversal compensation (BR_CTRL_HINF_QEC) */
     double phase;
     /* the run's drift and noise (br_circle_real_t) */
     br_circle_real_t real;
@@ -292,6 +295,14 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
         ext = (br_est_t){&a->ff, br_ff_est_step, NULL, NULL};
         ac.est = BR_APP_EST_EXTERN;
         break;
+    case BR_CTRL_HINF_QEC:
+        if ((float)c->dt_s != c->qec.dt_s || br_qec_init(&a->qec, &c->qec) != BR_OK) {
+            fprintf(stderr, "br_circle: invalid reversal compensation configuration\n");
+            return -1;
+        }
+        ext = (br_est_t){&a->qec, br_qec_est_step, NULL, NULL};
+        ac.est = BR_APP_EST_EXTERN;
+        break;
     case BR_CTRL_HINF_UKF:
         if ((a->mem.ukf = calloc(1, sizeof *a->mem.ukf)) == NULL) return -1;
         ac.est = BR_APP_EST_UKF;
@@ -381,12 +392,13 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
             s.counts[i] = br_plant_encoder(&ax[i].plant);
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
-            if (c->controller == BR_CTRL_HINF_FF) {
-                /* the feedforward's reference at t_k, load side */
+            if (c->controller == BR_CTRL_HINF_FF || c->controller == BR_CTRL_HINF_QEC) {
+                /* the feedforward's (the reversal compensation's) reference at t_k, load side */
                 const double w = circle_omega(c), ph = w * t + ax[i].phase;
                 const br_ff_in_t in = {(float)(c->radius_m * w * cos(ph)), (float)(-c->radius_m * w * w * sin(ph)),
                                        (float)s.ref_m[i]};
-                br_ff_set_ref(&ax[i].ff, &in);
+                if (c->controller == BR_CTRL_HINF_FF) br_ff_set_ref(&ax[i].ff, &in);
+                else br_qec_set_ref(&ax[i].qec, &in);
             }
             br_status_t st = br_app_step(&ax[i].app, &r);
             if (st == BR_W_OUTLIER) {

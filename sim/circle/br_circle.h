@@ -11,6 +11,7 @@
 #include "bristle/br_ctrl.h"
 #include "bristle/br_ff.h"
 #include "bristle/br_pf.h"
+#include "bristle/br_qec.h"
 #include "bristle/br_ukf.h"
 #include "plant/br_sim_plant.h"
 
@@ -21,7 +22,8 @@ typedef enum {
     BR_CTRL_HINF_UKF = 1,
     BR_CTRL_HINF_PF = 2,
     BR_CTRL_HINF_TRUE = 3,
-    BR_CTRL_HINF_FF = 4 /* H-inf + static friction feedforward on the reference (firmware/ff) */
+    BR_CTRL_HINF_FF = 4, /* H-inf + static friction feedforward on the reference (firmware/ff) */
+    BR_CTRL_HINF_QEC = 5 /* H-inf + the reversal (quadrant-error) pulse of the machine file (firmware/qec) */
 } br_circle_ctrl_t;
 
 /* What a real machine adds during the run (docs/robustness.md); all 0: the
@@ -50,6 +52,7 @@ typedef struct {
     br_pf_cfg_t pf;      /* BR_CTRL_HINF_PF: the filter (its model.dt_s must equal dt_s) */
     br_ukf_cfg_t ukf;    /* BR_CTRL_HINF_UKF: likewise (an extended model: est.model.causes) */
     br_ff_cfg_t ff;      /* BR_CTRL_HINF_FF: the feedforward's identified model */
+    br_qec_cfg_t qec;    /* BR_CTRL_HINF_QEC: the reversal compensation (its dt_s must equal dt_s) */
     br_circle_real_t real; /* drift and noise of the run (all 0 for the thesis experiment) */
 } br_circle_cfg_t;
 

@@ -9,6 +9,7 @@
 #include "br_circle_est.h"
 
 #include "bristle/br_machine_cfg.h"
+#include "bristle_gen/machine/br_machine.h"
 
 br_model_cfg_t br_machine_model_cfg(float dt_s)
 {
@@ -56,5 +57,22 @@ br_ff_cfg_t br_circle_ff_cfg_machine(void)
     c.v_eps_mps = (float)BR_CIRCLE_FF_VEPS_MPS;
     c.mass_kg = 0.0f;
     c.comp_max_N = BR_MACHINE_TORQUE_LIMIT_NM_F / m.lead_mprad;
+    return c;
+}
+
+br_qec_cfg_t br_circle_qec_cfg_machine(float dt_s)
+{
+    br_qec_cfg_t c = {0};
+#ifdef BR_MACHINE_QEC_A0_N
+    c.A0_N = BR_MACHINE_QEC_A0_N_F;
+    c.A1_kg = BR_MACHINE_QEC_A1_KG_F;
+    c.tau_s = BR_MACHINE_QEC_TAU_S_F;
+#else
+    c.tau_s = dt_s; /* no reversal_comp: no pulse (A0 = A1 = 0) */
+#endif
+    c.dt_s = dt_s;
+    c.comp_max_N = br_circle_ff_cfg_machine().comp_max_N;
+    c.with_ff = 0;
+    c.ff = br_circle_ff_cfg_machine();
     return c;
 }

@@ -6,6 +6,7 @@
 
 #include "bristle/br_ff.h"
 #include "bristle/br_pf.h"
+#include "bristle/br_qec.h"
 #include "bristle/br_ukf.h"
 
 /* The eq. 6 estimation model of the machine at period dt_s. */
@@ -33,5 +34,11 @@ br_ukf_cfg_t br_circle_ukf_cfg_tuned(float dt_s);
  * the viscous coefficient; no causes, no inertia term), clamped to the
  * machine's torque limit / L. */
 br_ff_cfg_t br_circle_ff_cfg_machine(void);
+
+/* The reversal compensation at period dt_s from the machine file's
+ * reversal_comp (A0, A1, tau; docs/modules/qec.md), the pulse alone (no
+ * feedforward under it), clamped like the feedforward; a machine without the
+ * section: amplitude 0 (no pulse). */
+br_qec_cfg_t br_circle_qec_cfg_machine(float dt_s);
 
 #endif

@@ -33,7 +33,8 @@ import numpy as np  # noqa: E402
 import iso230_4  # noqa: E402  (beside this script)
 
 LABELS = {"hinf_only": "H-inf only", "hinf_ukf": "H-inf + UKF", "hinf_pf": "H-inf + PF",
-          "hinf_true": "true friction (limit)", "hinf_ff": "H-inf + feedforward"}
+          "hinf_true": "true friction (limit)", "hinf_ff": "H-inf + feedforward",
+          "hinf_qec": "H-inf + reversal pulse (QEC)"}
 COMPENSATED = ("hinf_ukf", "hinf_pf", "hinf_true")  # errors in nm: their own panel
 STARTUP_S = 1.0   # Fig. 8 looks for its transition after the start-up
 REVERSAL_WIN_S = 0.5  # ... within this of an axis reversal

@@ -45,6 +45,10 @@ CHECKS = [
     ("test_golden_pf.c", "f_nl in F-hat", rf"#define C_FNL {NUM}", "### pf", rf"\+ {NUM}u S_f,j"),
     ("test_golden_pf.c", "float32 sums", rf"#define C_SUM {NUM}", "### pf", rf"D_i \+ {NUM}m·u"),
     ("test_golden_pf.c", "br_exp_neg error", rf"#define EXP_REL {NUM}", "### pf", rf"ρ = {NUM} \+"),
+    # qec
+    ("test_golden_qec.c", "amplitude roundings", rf"#define C_AMP {NUM}", "### qec", rf"2\({NUM} \+ 4n\)u"),
+    ("test_golden_qec.c", "per-period roundings", rf"#define C_STEP {NUM}", "### qec", rf"2\(2 \+ {NUM}n\)u"),
+    ("test_golden_qec.c", "safety factor", rf"#define C_Q {NUM}", "### qec", rf"\| p \| {NUM}\(2 \+ 4n\)u"),
     # mslip
     ("test_golden_mslip.c", "element bound factor", rf"#define C_Z {NUM}", "### mslip",
      rf"\| z_i \| {NUM}·E_i"),

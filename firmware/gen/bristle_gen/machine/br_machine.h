@@ -115,4 +115,14 @@
     .drift_per_s = 0.000000000e+00f, /* friction_drift: friction level scaled by max(0, 1 + drift_per_s t), t since the start */ \
 }
 
+/* reversal compensation (reversal_comp): pulse amplitude at a = 0 */
+#define BR_MACHINE_QEC_A0_N (3.3884)
+#define BR_MACHINE_QEC_A0_N_F (3.388400078e+00f)
+/* its change per |reference acceleration|, N per m/s^2 */
+#define BR_MACHINE_QEC_A1_KG (-5888.4)
+#define BR_MACHINE_QEC_A1_KG_F (-5.888399902e+03f)
+/* the pulse's decay time constant */
+#define BR_MACHINE_QEC_TAU_S (0.31719)
+#define BR_MACHINE_QEC_TAU_S_F (3.171899915e-01f)
+
 #endif
