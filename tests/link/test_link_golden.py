@@ -29,7 +29,7 @@ def main():
     with open(path, "rb") as f:
         wire = f.read()
     reports = [c for c in gen_golden.CASES if messages.BY_NAME[c[0]].direction == messages.TO_HOST]
-    assert len(reports) == 6, reports
+    assert len(reports) == 7, reports
     dec = Decoder()
     frames = dec.feed(wire)
     assert len(frames) == len(reports), (len(frames), dec.counters)

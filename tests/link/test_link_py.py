@@ -51,7 +51,7 @@ def test_roundtrip_every_message():
         vals = {}
         for f in m.fields:
             vals[f.name] = {"u8": rng.randrange(256), "i8": rng.randrange(-128, 128), "u16": rng.randrange(65536),
-                            "u32": rng.randrange(1 << 32),
+                            "u32": rng.randrange(1 << 32), "i32": rng.randrange(-(1 << 31), 1 << 31),
                             "f32": struct.unpack("<f", struct.pack("<f", rng.uniform(-1e3, 1e3)))[0]}[f.type]
         seq = rng.randrange(65536)
         fr = decode_frame(encode_frame(m.id, seq, pack(m.name, **vals)))
