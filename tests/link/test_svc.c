@@ -452,6 +452,9 @@ static void test_params(void **st)
     steps(g, 1u);
     f = last_value(g);
     assert_int_equal(status_of(&f), BR_E_INPUT);
+    /* the table's own rule, apart from the estimators' (which refuse subnormals too) */
+    assert_int_equal(br_param_check(BR_LINK_PARAM_Q_Z_M2, BR_LINK_PARAM_EST_UKF, 1.0e-40f), BR_E_PARAM);
+    assert_int_equal(br_param_check(BR_LINK_PARAM_Q_Z_M2, BR_LINK_PARAM_EST_UKF, 0.0f), BR_OK);
     /* the estimators' own rule on the whole configuration: R below BR_EST_R_MIN_COUNTS2 */
     host_param_write(&g->wire, BR_LINK_PARAM_R_COUNTS2, 0.5f * BR_EST_R_MIN_COUNTS2);
     steps(g, 1u);
