@@ -243,7 +243,7 @@ br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause)
     if (!app->ready) {
         return BR_E_STATE;
     }
-    if (cause <= BR_APP_FAULT_NONE || cause > BR_APP_FAULT_TRAVEL) {
+    if (cause <= BR_APP_FAULT_NONE || cause > BR_APP_FAULT_REF_UNDERRUN) {
         return BR_E_PARAM;
     }
     return latch(app, cause);

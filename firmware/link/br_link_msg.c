@@ -76,6 +76,47 @@ br_status_t br_link_send_param_value(br_link_t *l, uint16_t param, float value, 
     return br_link_send(l, BR_LINK_MSG_PARAM_VALUE, p, sizeof p);
 }
 
+br_status_t br_link_send_ref_status(br_link_t *l, const br_link_ref_status_t *s)
+{
+    if (s == NULL) {
+        return BR_E_NULL;
+    }
+    uint8_t p[BR_LINK_MSG_REF_STATUS_LEN];
+    put_u32(&p[BR_LINK_MSG_REF_STATUS_OFF_TICK], s->tick);
+    p[BR_LINK_MSG_REF_STATUS_OFF_QUEUED] = s->queued;
+    p[BR_LINK_MSG_REF_STATUS_OFF_FREE] = s->free;
+    p[BR_LINK_MSG_REF_STATUS_OFF_STATE] = s->state;
+    put_u32(&p[BR_LINK_MSG_REF_STATUS_OFF_DROPPED], s->dropped);
+    put_u32(&p[BR_LINK_MSG_REF_STATUS_OFF_LATE], s->late);
+    put_u32(&p[BR_LINK_MSG_REF_STATUS_OFF_UNDERRUNS], s->underruns);
+    return br_link_send(l, BR_LINK_MSG_REF_STATUS, p, sizeof p);
+}
+
+/* the payloads of setpoint and segment as a queue item */
+static void get_setpoint(const uint8_t *p, br_refq_item_t *r)
+{
+    r->kind = BR_REFQ_SETPOINT;
+    r->tick = get_u32(&p[BR_LINK_MSG_SETPOINT_OFF_TICK]);
+    r->periods = 1u;
+    r->counts = (int32_t)get_u32(&p[BR_LINK_MSG_SETPOINT_OFF_COUNTS]);
+    r->frac = get_f32(&p[BR_LINK_MSG_SETPOINT_OFF_FRAC]);
+    r->v = get_f32(&p[BR_LINK_MSG_SETPOINT_OFF_OMEGA_RADPS]);
+    r->flags = p[BR_LINK_MSG_SETPOINT_OFF_FLAGS];
+}
+
+static void get_segment(const uint8_t *p, br_refq_item_t *r)
+{
+    r->kind = BR_REFQ_SEGMENT;
+    r->tick = get_u32(&p[BR_LINK_MSG_SEGMENT_OFF_TICK]);
+    r->periods = get_u32(&p[BR_LINK_MSG_SEGMENT_OFF_PERIODS]);
+    r->counts = (int32_t)get_u32(&p[BR_LINK_MSG_SEGMENT_OFF_COUNTS]);
+    r->frac = get_f32(&p[BR_LINK_MSG_SEGMENT_OFF_FRAC]);
+    r->v = get_f32(&p[BR_LINK_MSG_SEGMENT_OFF_V_CPS]);
+    r->a = get_f32(&p[BR_LINK_MSG_SEGMENT_OFF_A_CPS2]);
+    r->j = get_f32(&p[BR_LINK_MSG_SEGMENT_OFF_J_CPS3]);
+    r->flags = p[BR_LINK_MSG_SEGMENT_OFF_FLAGS];
+}
+
 int br_link_msg_len(uint8_t id, unsigned direction)
 {
 #define BR_LINK_MSG_ROW(name, mid, len, dir) \
@@ -111,6 +152,12 @@ br_status_t br_link_cmd_decode(const br_link_frame_t *f, br_link_cmd_t *cmd)
     case BR_LINK_MSG_PARAM_WRITE:
         kind = BR_LINK_CMD_PARAM_WRITE;
         break;
+    case BR_LINK_MSG_SETPOINT:
+        kind = BR_LINK_CMD_SETPOINT;
+        break;
+    case BR_LINK_MSG_SEGMENT:
+        kind = BR_LINK_CMD_SEGMENT;
+        break;
     case BR_LINK_MSG_REC_ARM:
         kind = BR_LINK_CMD_REC_ARM;
         break;
@@ -131,6 +178,10 @@ br_status_t br_link_cmd_decode(const br_link_frame_t *f, br_link_cmd_t *cmd)
     } else if (kind == BR_LINK_CMD_PARAM_WRITE) {
         cmd->param = get_u16(&f->payload[BR_LINK_MSG_PARAM_WRITE_OFF_PARAM]);
         cmd->value = get_f32(&f->payload[BR_LINK_MSG_PARAM_WRITE_OFF_VALUE]);
+    } else if (kind == BR_LINK_CMD_SETPOINT) {
+        get_setpoint(f->payload, &cmd->ref);
+    } else if (kind == BR_LINK_CMD_SEGMENT) {
+        get_segment(f->payload, &cmd->ref);
     } else if (kind == BR_LINK_CMD_REC_DUMP) {
         cmd->first = get_u16(&f->payload[BR_LINK_MSG_REC_DUMP_OFF_FIRST]);
     }

@@ -21,6 +21,7 @@ const char *br_run_fault_name(int cause)
     case BR_APP_FAULT_SPEED: return "speed";
     case BR_APP_FAULT_FOLLOWING: return "following";
     case BR_APP_FAULT_TRAVEL: return "travel";
+    case BR_APP_FAULT_REF_UNDERRUN: return "ref_underrun";
     case BR_RUN_CAUSE_NOT_FOLLOWED: return "not_followed";
     default: return "unknown";
     }

@@ -34,8 +34,13 @@ CASES = (
     ("param_read", 0x000A, dict(param=0xBEEF)),
     ("param_write", 0x000B, dict(param=3, value=struct.unpack("<f", struct.pack("<f", 1.5e-7))[0])),
     ("param_write", 0x000C, dict(param=0, value=-1.0e30)),
+    ("setpoint", 0x000D, dict(tick=0x00010000, counts=-123456, frac=0.75,
+                              omega_radps=struct.unpack("<f", struct.pack("<f", -0.3))[0], flags=0)),
+    ("segment", 0x000E, dict(tick=7, periods=400, counts=0x7FFFFFFF, frac=0.0, v_cps=2.0e4, a_cps2=-3.0e4,
+                             j_cps3=struct.unpack("<f", struct.pack("<f", 2.5e5 / 3.0))[0], flags=1)),
+    ("ref_status", 0x0004, dict(tick=99, queued=3, free=5, state=2, dropped=0, late=0x00FF00FF, underruns=1)),
 )
-FIELDS_MAX = 4
+FIELDS_MAX = 8
 
 
 def field_word(ftype, v):

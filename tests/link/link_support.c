@@ -54,6 +54,12 @@ br_status_t golden_send(br_link_t *l, const br_link_golden_t *g)
         memcpy(&v, &g->f[1], sizeof v);
         st = br_link_send_param_value(l, (uint16_t)g->f[0], v, (br_status_t)(int32_t)g->f[2]);
         break;
+    case BR_LINK_MSG_REF_STATUS: {
+        const br_link_ref_status_t r = {g->f[0], (uint8_t)g->f[1], (uint8_t)g->f[2], (uint8_t)g->f[3],
+                                        g->f[4], g->f[5], g->f[6]};
+        st = br_link_send_ref_status(l, &r);
+        break;
+    }
     default:
         return BR_E_INPUT;
     }

@@ -47,9 +47,31 @@ static void test_requests_decode(void **s)
             assert_int_equal(cmd.param, g->f[0]);
             assert_int_equal(f32_bits(cmd.value), g->f[1]);
         }
+        if (g->id == BR_LINK_MSG_SETPOINT) {
+            assert_int_equal(cmd.kind, BR_LINK_CMD_SETPOINT);
+            assert_int_equal(cmd.ref.kind, BR_REFQ_SETPOINT);
+            assert_int_equal(cmd.ref.tick, g->f[0]);
+            assert_int_equal(cmd.ref.periods, 1u);
+            assert_int_equal((uint32_t)cmd.ref.counts, g->f[1]);
+            assert_int_equal(f32_bits(cmd.ref.frac), g->f[2]);
+            assert_int_equal(f32_bits(cmd.ref.v), g->f[3]);
+            assert_int_equal(cmd.ref.flags, g->f[4]);
+        }
+        if (g->id == BR_LINK_MSG_SEGMENT) {
+            assert_int_equal(cmd.kind, BR_LINK_CMD_SEGMENT);
+            assert_int_equal(cmd.ref.kind, BR_REFQ_SEGMENT);
+            assert_int_equal(cmd.ref.tick, g->f[0]);
+            assert_int_equal(cmd.ref.periods, g->f[1]);
+            assert_int_equal((uint32_t)cmd.ref.counts, g->f[2]);
+            assert_int_equal(f32_bits(cmd.ref.frac), g->f[3]);
+            assert_int_equal(f32_bits(cmd.ref.v), g->f[4]);
+            assert_int_equal(f32_bits(cmd.ref.a), g->f[5]);
+            assert_int_equal(f32_bits(cmd.ref.j), g->f[6]);
+            assert_int_equal(cmd.ref.flags, g->f[7]);
+        }
         ++n;
     }
-    assert_int_equal(n, 6);
+    assert_int_equal(n, 8);
 }
 
 /* the reports: the firmware's bytes are the Python's */
@@ -68,7 +90,7 @@ static void test_reports_encode_equal(void **s)
         assert_memory_equal(sink.buf, g->wire, g->wire_len);
         ++n;
     }
-    assert_int_equal(n, 6);
+    assert_int_equal(n, 7);
 }
 
 int main(void)

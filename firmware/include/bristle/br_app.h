@@ -58,7 +58,9 @@ typedef enum {
                                     within the last lock_window_periods periods */
     BR_APP_FAULT_SPEED = 11,     /* measured |speed| above speed_fault_mps */
     BR_APP_FAULT_FOLLOWING = 12, /* |limited reference - position| above max_following_m */
-    BR_APP_FAULT_TRAVEL = 13     /* position beyond a soft travel limit by more than max_following_m */
+    BR_APP_FAULT_TRAVEL = 13,    /* position beyond a soft travel limit by more than max_following_m */
+    BR_APP_FAULT_REF_UNDERRUN = 14 /* the streamed reference ran dry for longer than its fault
+                                      time (br_refq, reported by br_svc through br_app_fault) */
 } br_app_fault_t;
 
 /* How a latched fault stops the axis (br_app_t.stop, docs/modules/app.md). */

@@ -25,6 +25,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bristle/br_refq.h"
 #include "bristle/br_status.h"
 #include "bristle_gen/link/br_link_msgs.h"
 
@@ -136,7 +137,9 @@ typedef enum {
     BR_LINK_CMD_PARAM_WRITE, /* finite and accepted by param_check */
     BR_LINK_CMD_REC_ARM,     /* the recorder's requests (bristle/br_rec.h: br_rec_command) */
     BR_LINK_CMD_REC_TRIGGER,
-    BR_LINK_CMD_REC_DUMP
+    BR_LINK_CMD_REC_DUMP,
+    BR_LINK_CMD_SETPOINT,    /* ref: a setpoint (kind BR_REFQ_SETPOINT, periods 1) */
+    BR_LINK_CMD_SEGMENT      /* ref: a segment (kind BR_REFQ_SEGMENT) */
 } br_link_cmd_kind_t;
 
 typedef struct {
@@ -145,6 +148,7 @@ typedef struct {
     uint16_t param; /* PARAM_READ, PARAM_WRITE */
     float value;    /* PARAM_WRITE */
     uint16_t first; /* REC_DUMP: the first sample index to send */
+    br_refq_item_t ref; /* SETPOINT, SEGMENT: the item as received (br_refq_push checks it) */
 } br_link_cmd_t;
 
 typedef struct {
@@ -166,6 +170,17 @@ typedef struct {
     uint8_t armed;       /* 1 armed, 0 disarmed */
     uint8_t fault;       /* br_app_fault_t, 0 none */
 } br_link_status_t;
+
+/* The reference queue's report (ref_status). */
+typedef struct {
+    uint32_t tick;      /* control period index of the report */
+    uint8_t queued;     /* items queued */
+    uint8_t free;       /* free places */
+    uint8_t state;      /* br_refq_state_t */
+    uint32_t dropped;   /* br_refq_counters_t */
+    uint32_t late;
+    uint32_t underruns;
+} br_link_ref_status_t;
 
 /* Validates cfg (budgets in range) and chan (both functions set). BR_OK, BR_E_NULL or BR_E_PARAM. */
 br_status_t br_link_init(br_link_t *l, const br_link_cfg_t *cfg, const br_byte_chan_t *chan);
@@ -189,6 +204,7 @@ br_status_t br_link_send_status(br_link_t *l, const br_link_status_t *s);
 br_status_t br_link_send_fault(br_link_t *l, uint8_t cause, uint32_t tick);
 /* st: the read's or write's status, sent as an i8 (BR_OK, or the refusal) */
 br_status_t br_link_send_param_value(br_link_t *l, uint16_t param, float value, br_status_t st);
+br_status_t br_link_send_ref_status(br_link_t *l, const br_link_ref_status_t *s);
 
 /* The payload length of message id sent in direction (BR_LINK_TO_HOST or
  * BR_LINK_TO_TARGET), from the table; -1 when there is no such message. */

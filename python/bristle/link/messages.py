@@ -96,6 +96,33 @@ MESSAGES = (
         Field("value", "f32", "the value now in force (a refused write: the value asked for)"),
         Field("status", "i8", "br_status_t of the read or write (0 BR_OK; negative: refused)"),
     ), "the answer to param_read and param_write"),
+    # the reference source (docs/link.md, "Setpoints and segments"); 0x40-0x5F are telemetry's
+    Message("setpoint", 0x30, TO_TARGET, (
+        Field("tick", "u32", "the control period it is the reference of"),
+        Field("counts", "i32", "reference position, whole encoder counts"),
+        Field("frac", "f32", "its fraction of a count, [0, 1)"),
+        Field("omega_radps", "f32", "reference velocity, motor side, rad/s"),
+        Field("flags", "u8", "bit 0: the stream's last item (then hold, no underrun)"),
+    ), "one timed setpoint into the reference queue (br_refq)"),
+    Message("segment", 0x31, TO_TARGET, (
+        Field("tick", "u32", "the control period it starts at"),
+        Field("periods", "u32", "its duration in control periods, >= 1"),
+        Field("counts", "i32", "start position, whole encoder counts"),
+        Field("frac", "f32", "its fraction of a count, [0, 1)"),
+        Field("v_cps", "f32", "start velocity, counts/s"),
+        Field("a_cps2", "f32", "start acceleration, counts/s^2"),
+        Field("j_cps3", "f32", "jerk, counts/s^3 (0: a constant-acceleration segment)"),
+        Field("flags", "u8", "bit 0: the stream's last item (then hold, no underrun)"),
+    ), "a cubic trajectory segment the target interpolates, one reference per period"),
+    Message("ref_status", 0x32, TO_HOST, (
+        Field("tick", "u32", "control period index of the report"),
+        Field("queued", "u8", "items in the reference queue"),
+        Field("free", "u8", "free places in it"),
+        Field("state", "u8", "br_refq_state_t: 0 idle, 1 streaming, 2 underrun hold, 3 underrun braking, 4 underrun fault"),
+        Field("dropped", "u32", "items refused: queue full (counted, not queued)"),
+        Field("late", "u32", "items refused or dropped: out of order, or over before their time came"),
+        Field("underruns", "u32", "underruns begun"),
+    ), "the reference queue's state, sent with each periodic status"),
     # telemetry and the recorder: ids 0x40-0x5F (docs/link.md, "Telemetry", "The recorder")
     Message("tlm_sample", 0x40, TO_HOST, SAMPLE_FIELDS,
             "telemetry: one control period's sample, every N periods (br_tlm)"),

@@ -57,6 +57,38 @@
 #define BR_LINK_MSG_PARAM_VALUE_OFF_VALUE 2u /* f32 the value now in force (a refused write: the value asked for) */
 #define BR_LINK_MSG_PARAM_VALUE_OFF_STATUS 6u /* i8 br_status_t of the read or write (0 BR_OK; negative: refused) */
 
+/* one timed setpoint into the reference queue (br_refq) (BR_LINK_TO_TARGET) */
+#define BR_LINK_MSG_SETPOINT 0x30u
+#define BR_LINK_MSG_SETPOINT_LEN 17u
+#define BR_LINK_MSG_SETPOINT_OFF_TICK 0u /* u32 the control period it is the reference of */
+#define BR_LINK_MSG_SETPOINT_OFF_COUNTS 4u /* i32 reference position, whole encoder counts */
+#define BR_LINK_MSG_SETPOINT_OFF_FRAC 8u /* f32 its fraction of a count, [0, 1) */
+#define BR_LINK_MSG_SETPOINT_OFF_OMEGA_RADPS 12u /* f32 reference velocity, motor side, rad/s */
+#define BR_LINK_MSG_SETPOINT_OFF_FLAGS 16u /* u8 bit 0: the stream's last item (then hold, no underrun) */
+
+/* a cubic trajectory segment the target interpolates, one reference per period (BR_LINK_TO_TARGET) */
+#define BR_LINK_MSG_SEGMENT 0x31u
+#define BR_LINK_MSG_SEGMENT_LEN 29u
+#define BR_LINK_MSG_SEGMENT_OFF_TICK 0u /* u32 the control period it starts at */
+#define BR_LINK_MSG_SEGMENT_OFF_PERIODS 4u /* u32 its duration in control periods, >= 1 */
+#define BR_LINK_MSG_SEGMENT_OFF_COUNTS 8u /* i32 start position, whole encoder counts */
+#define BR_LINK_MSG_SEGMENT_OFF_FRAC 12u /* f32 its fraction of a count, [0, 1) */
+#define BR_LINK_MSG_SEGMENT_OFF_V_CPS 16u /* f32 start velocity, counts/s */
+#define BR_LINK_MSG_SEGMENT_OFF_A_CPS2 20u /* f32 start acceleration, counts/s^2 */
+#define BR_LINK_MSG_SEGMENT_OFF_J_CPS3 24u /* f32 jerk, counts/s^3 (0: a constant-acceleration segment) */
+#define BR_LINK_MSG_SEGMENT_OFF_FLAGS 28u /* u8 bit 0: the stream's last item (then hold, no underrun) */
+
+/* the reference queue's state, sent with each periodic status (BR_LINK_TO_HOST) */
+#define BR_LINK_MSG_REF_STATUS 0x32u
+#define BR_LINK_MSG_REF_STATUS_LEN 19u
+#define BR_LINK_MSG_REF_STATUS_OFF_TICK 0u /* u32 control period index of the report */
+#define BR_LINK_MSG_REF_STATUS_OFF_QUEUED 4u /* u8 items in the reference queue */
+#define BR_LINK_MSG_REF_STATUS_OFF_FREE 5u /* u8 free places in it */
+#define BR_LINK_MSG_REF_STATUS_OFF_STATE 6u /* u8 br_refq_state_t: 0 idle, 1 streaming, 2 underrun hold, 3 underrun braking, 4 underrun fault */
+#define BR_LINK_MSG_REF_STATUS_OFF_DROPPED 7u /* u32 items refused: queue full (counted, not queued) */
+#define BR_LINK_MSG_REF_STATUS_OFF_LATE 11u /* u32 items refused or dropped: out of order, or over before their time came */
+#define BR_LINK_MSG_REF_STATUS_OFF_UNDERRUNS 15u /* u32 underruns begun */
+
 /* telemetry: one control period's sample, every N periods (br_tlm) (BR_LINK_TO_HOST) */
 #define BR_LINK_MSG_TLM_SAMPLE 0x40u
 #define BR_LINK_MSG_TLM_SAMPLE_LEN 29u
@@ -119,6 +151,9 @@
     X(PARAM_READ, BR_LINK_MSG_PARAM_READ, BR_LINK_MSG_PARAM_READ_LEN, BR_LINK_TO_TARGET) \
     X(PARAM_WRITE, BR_LINK_MSG_PARAM_WRITE, BR_LINK_MSG_PARAM_WRITE_LEN, BR_LINK_TO_TARGET) \
     X(PARAM_VALUE, BR_LINK_MSG_PARAM_VALUE, BR_LINK_MSG_PARAM_VALUE_LEN, BR_LINK_TO_HOST) \
+    X(SETPOINT, BR_LINK_MSG_SETPOINT, BR_LINK_MSG_SETPOINT_LEN, BR_LINK_TO_TARGET) \
+    X(SEGMENT, BR_LINK_MSG_SEGMENT, BR_LINK_MSG_SEGMENT_LEN, BR_LINK_TO_TARGET) \
+    X(REF_STATUS, BR_LINK_MSG_REF_STATUS, BR_LINK_MSG_REF_STATUS_LEN, BR_LINK_TO_HOST) \
     X(TLM_SAMPLE, BR_LINK_MSG_TLM_SAMPLE, BR_LINK_MSG_TLM_SAMPLE_LEN, BR_LINK_TO_HOST) \
     X(REC_SAMPLE, BR_LINK_MSG_REC_SAMPLE, BR_LINK_MSG_REC_SAMPLE_LEN, BR_LINK_TO_HOST) \
     X(REC_END, BR_LINK_MSG_REC_END, BR_LINK_MSG_REC_END_LEN, BR_LINK_TO_HOST) \
