@@ -33,11 +33,6 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
-    /* the PF and the UKF do not predict with the Maxwell-slip elements yet
-     * (docs/modules/pf.md, ukf.md): refused rather than silently run as LuGre */
-    if (cfg->model.mslip.n != 0) {
-        return BR_E_PARAM;
-    }
     if (!br_finite_pos(cfg->rad_per_count) || !br_finite_pos(cfg->outlier_sigma) ||
         cfg->outlier_sigma > BR_EST_GATE_MAX_SIGMA || cfg->reanchor_after < 1u) {
         return BR_E_PARAM;

@@ -86,6 +86,11 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
+    /* the particles do not carry Maxwell-slip elements yet (docs/modules/pf.md):
+     * refused rather than silently run as LuGre */
+    if (cfg->est.model.mslip.n != 0) {
+        return BR_E_PARAM;
+    }
     /* the innovation-driven noise: off (nis_ref = 0) or a finite positive
      * reference with alpha in (0, 1] and max_scale in [1, BR_EST_VAR_MAX] */
     const br_pf_adapt_t *ad = &cfg->adapt;

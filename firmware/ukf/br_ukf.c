@@ -53,6 +53,11 @@ static br_status_t check_cfg(const br_ukf_cfg_t *cfg)
     } else if (!br_est_var_ok(ld->p0_N2, 0) || !br_est_var_ok(ld->q_N2, 1) || !br_finite_pos(ld->max_N)) {
         return BR_E_PARAM;
     }
+    /* the Maxwell-slip elements carry no prediction ahead (the model's
+     * look-ahead steps the LuGre state): comp_ahead_periods must be 0 */
+    if (cfg->est.model.mslip.n > 0 && cfg->est.comp_ahead_periods != 0.0f) {
+        return BR_E_PARAM;
+    }
     /* scaled UT: alpha in (0, 1], beta >= 0, n + lambda = alpha^2 (n + kappa) > 0 */
     const float n = (cfg->load.p0_N2 > 0.0f) ? (float)BR_UKF_NMAX : (float)BR_NX;
     if (!br_finite_pos(cfg->alpha) || cfg->alpha > 1.0f || !br_finite_nonneg(cfg->beta) || !isfinite(cfg->kappa) ||
@@ -129,7 +134,11 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->primed = 0;
     ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N},
                               {cfg->p0_var[0], cfg->p0_var[1], cfg->p0_var[2], cfg->p0_var[3]},
-                              0, 0.0f, 0.0f, 0.0f, 0.0f, cfg->load.p0_N2};
+                              0, 0.0f, 0.0f, 0.0f, 0.0f, cfg->load.p0_N2, {0.0f}};
+    for (int i = 0; i < BR_MSLIP_MAX; i++) {
+        ukf->el[i] = 0.0f;
+        ukf->el_m[i] = 0.0f;
+    }
     ukf->ready = 1;
     return BR_OK;
 }
@@ -239,16 +248,23 @@ static br_status_t sigma_points(br_ukf_t *ukf, const float x[NM], float P[NM][NM
  * With the external force (cfg.load) the compensation is friction + F_d, the
  * force a position measurement can tell (docs/modules/ukf.md, "External
  * force"), clamped to +-max_N. */
-static float fnl_unscented(const br_ukf_t *ukf, int32_t origin_counts)
+static float fnl_unscented(const br_ukf_t *ukf, int32_t origin_counts, const float el[])
 {
-    /* the force to compensate: f_nl for the thesis model (eq. 6), the extended model's otherwise */
-    const float p0 = (float)origin_counts * ukf->m_per_count;
-    const float f0 = br_model_fcomp_N(&ukf->model, ukf->X[0], p0);
-    float df = 0.0f;
-    for (int s = 1; s < 2 * ukf->n + 1; s++) {
-        df += br_model_fcomp_N(&ukf->model, ukf->X[s], p0) - f0;
+    float F;
+    if (ukf->model.cfg.mslip.n > 0) {
+        /* Maxwell-slip: the elements' force sum_i k_i z_i (they are the
+         * sigma points' unscented mean already) */
+        F = br_model_ms_fnl_N(&ukf->model, el);
+    } else {
+        /* the force to compensate: f_nl for the thesis model (eq. 6), the extended model's otherwise */
+        const float p0 = (float)origin_counts * ukf->m_per_count;
+        const float f0 = br_model_fcomp_N(&ukf->model, ukf->X[0], p0);
+        float df = 0.0f;
+        for (int s = 1; s < 2 * ukf->n + 1; s++) {
+            df += br_model_fcomp_N(&ukf->model, ukf->X[s], p0) - f0;
+        }
+        F = f0 + ukf->wi * df;
     }
-    const float F = f0 + ukf->wi * df;
     if (ukf->n == BR_NX) {
         return F;
     }
@@ -266,6 +282,9 @@ static void set_estimate(br_ukf_t *ukf, float F_hat_N, float innov, float innov_
     }
     ukf->est.load_N = (ukf->n > BR_NX) ? ukf->x[BR_UKF_X_LOAD] : 0.0f;
     ukf->est.load_var_N2 = (ukf->n > BR_NX) ? ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD] : 0.0f;
+    for (int i = 0; i < BR_MSLIP_MAX; i++) {
+        ukf->est.elem_m[i] = ukf->el[i];
+    }
     ukf->est.origin_counts = ukf->origin_counts;
     ukf->est.innov_rad = innov;
     ukf->est.innov_var_rad2 = innov_var;
@@ -282,9 +301,12 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
     ukf->x[BR_X_Z] = 0.0f;
     ukf->x[BR_X_GP] = ukf->cfg.est.gp0_N;
     ukf->x[BR_UKF_X_LOAD] = 0.0f;
+    for (int i = 0; i < BR_MSLIP_MAX; i++) {
+        ukf->el[i] = 0.0f; /* the elements relaxed */
+    }
     reset_cov(ukf, ukf->P);
     (void)sigma_points(ukf, ukf->x, ukf->P); /* diagonal with P0 > 0: cannot fail */
-    set_estimate(ukf, fnl_unscented(ukf, ukf->origin_counts), 0.0f, 0.0f);
+    set_estimate(ukf, fnl_unscented(ukf, ukf->origin_counts, ukf->el), 0.0f, 0.0f);
     ukf->primed = 1;
     return BR_OK;
 }
@@ -303,14 +325,37 @@ static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[NM], float Pm[NM][NM
     const float L = ukf->cfg.est.model.lead_mprad;
     br_model_tick(&ukf->model); /* the model's clock moves on by one period (friction_drift) */
     *chol_reset = sigma_points(ukf, ukf->x, ukf->P) != BR_OK;
+    const int ne = ukf->model.cfg.mslip.n;
+    float e0[BR_MSLIP_MAX], de[BR_MSLIP_MAX], es[BR_MSLIP_MAX];
+    for (int i = 0; i < ne; i++) {
+        de[i] = 0.0f;
+    }
     for (int s = 0; s < nsig; s++) {
         /* the torque on the axis: u, less L F_d with the external force */
         const float u = (n > BR_NX) ? u_prev_Nm - L * ukf->X[s][BR_UKF_X_LOAD] : u_prev_Nm;
-        if (br_model_step_at(&ukf->model, ukf->X[s], p0, u, ukf->Y[s]) != BR_OK) {
+        if (ne > 0) {
+            /* Maxwell-slip: the sigma point and its elements, the committed
+             * ones offset by its z (the elements' common error), one step on
+             * (br_model_ms_step; z is carried unchanged) */
+            float ej[BR_MSLIP_MAX];
+            for (int i = 0; i < ne; i++) {
+                ej[i] = ukf->el[i] + ukf->X[s][BR_X_Z];
+            }
+            if (br_model_ms_step(&ukf->model, ukf->X[s], ej, u, ukf->Y[s], (s == 0) ? e0 : es) != BR_OK) {
+                return 0;
+            }
+            /* the elements' unscented mean e- = E_0 + W sum_{j>=1} (E_j - E_0) */
+            for (int i = 0; s > 0 && i < ne; i++) {
+                de[i] += es[i] - e0[i];
+            }
+        } else if (br_model_step_at(&ukf->model, ukf->X[s], p0, u, ukf->Y[s]) != BR_OK) {
             return 0;
         }
         /* F_d' = 0 (its random walk is in Q) */
         ukf->Y[s][BR_UKF_X_LOAD] = ukf->X[s][BR_UKF_X_LOAD];
+    }
+    for (int i = 0; i < ne; i++) {
+        ukf->el_m[i] = e0[i] + ukf->wi * de[i];
     }
     /* predicted mean x- = sum_j Wm_j Y_j = Y_0 + m, m = sum_{j>=1} W (Y_j - Y_0) (sum Wm = 1) */
     float mdev[NM];
@@ -348,7 +393,7 @@ static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[NM], float Pm[NM][NM
             Pm[j][i] = Pm[i][j];
         }
     }
-    return vec_finite(xm, n) && mat_finite((const float(*)[NM])Pm, n);
+    return vec_finite(xm, n) && mat_finite((const float(*)[NM])Pm, n) && vec_finite(ukf->el_m, ne);
 }
 
 /* A step whose prediction or update is not finite: the mean and origin are
@@ -371,9 +416,20 @@ static int posterior(br_ukf_t *ukf, const float xm[NM], float Pm[NM][NM], int32_
     if (sigma_points(ukf, xm, Pm) != BR_OK) {
         *chol_reset = 1;
     }
-    *F_hat = fnl_unscented(ukf, origin_counts);
+    /* Maxwell-slip: the predicted elements within their slip bounds at the
+     * posterior's g_p, |z_i| <= c_i g_p */
+    const int ne = ukf->model.cfg.mslip.n;
+    float el[BR_MSLIP_MAX];
+    for (int i = 0; i < ne; i++) {
+        const float d = ukf->model.ms_c_mpN[i] * xm[BR_X_GP];
+        el[i] = br_clampf(ukf->el_m[i], -d, d);
+    }
+    *F_hat = fnl_unscented(ukf, origin_counts, el);
     if (!isfinite(*F_hat)) {
         return 0;
+    }
+    for (int i = 0; i < ne; i++) {
+        ukf->el[i] = el[i];
     }
     for (int i = 0; i < ukf->n; i++) {
         ukf->x[i] = xm[i];
@@ -382,6 +438,15 @@ static int posterior(br_ukf_t *ukf, const float xm[NM], float Pm[NM][NM], int32_
         }
     }
     return 1;
+}
+
+/* Maxwell-slip: the predicted elements moved by dx_m (a correction of the
+ * position; clamped at the posterior's g_p in posterior) */
+static void elements_shift(br_ukf_t *ukf, float dx_m)
+{
+    for (int i = 0; i < ukf->model.cfg.mslip.n; i++) {
+        ukf->el_m[i] += dx_m;
+    }
 }
 
 /* P <- (P + P^T) / 2 */
@@ -517,6 +582,8 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
             xm[BR_X_THETA] = y->frac * rpc;
             const float periods = (float)ukf->n_predicted + 1.0f;
             xm[BR_X_OMEGA] = (dcounts + (y->frac - ukf->prev_frac)) * rpc / (periods * ukf->cfg.est.model.dt_s);
+            /* the elements with the position's jump to the measurement, L nu */
+            elements_shift(ukf, ukf->cfg.est.model.lead_mprad * nu);
             reset_cov(ukf, Pm);
             origin_new = y->counts;
             if (!vec_finite(xm, n)) {
@@ -532,6 +599,13 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
         xm[BR_X_THETA] = theta_new;
         for (int i = 0; i < n; i++) {
             xm[i] += K[i] * nu;
+        }
+        if (ukf->model.cfg.mslip.n > 0) {
+            /* Maxwell-slip: the elements' common error z, estimated, goes
+             * into the elements and its mean back to 0 (an error state: its
+             * covariance stays) */
+            elements_shift(ukf, xm[BR_X_Z]);
+            xm[BR_X_Z] = 0.0f;
         }
         /* Joseph form P+ = A P- A^T + R K K^T, A = I - K H, H = e_0^T:
          *   (A P-)_ij = P-_ij - K_i P-_0j,  (A P- A^T)_ij = (A P-)_ij - (A P-)_i0 K_j */

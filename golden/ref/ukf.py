@@ -47,6 +47,19 @@ posterior's P_dd is increased by dF^2, step 2 is repeated from it and the gate
 applied to the new innovation; passing, it is an ordinary update (BR_OK,
 counted in n_load_acq) of that prediction. Failing, the step is the outlier
 of the first prediction (P_dd not inflated).
+
+Maxwell-slip elements (cfg.mslip, docs/modules/ukf.md "Maxwell-slip
+elements"; None: LuGre): the friction is that of element deflections e
+(golden/ref/mslip.py, clamp form) carried beside x, and z is the elements'
+common error (an error state, its mean 0 between steps):
+    step 2: each sigma point stepped by the Maxwell-slip model
+      (mslip.model_step) from the elements e + X_j[z], giving Y_j and E_j;
+      e- = sum Wm_j E_j; Y_j's z = X_j's;
+    step 5: e- += x+[z], x+[z] = 0; a re-anchoring moves e- by L nu (the
+      position's jump to the measurement);
+    step 6: e = clip(e-, -Delta(g_p), Delta(g_p)) at the new mean's g_p,
+      F_hat = sum k_i e_i (+ F_d as above);
+    priming: e = 0.
 """
 import math
 from dataclasses import dataclass
@@ -54,6 +67,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import model as rmodel
+from . import mslip as rmslip
 
 BR_OK = 0
 BR_E_INPUT = -3
@@ -80,6 +94,8 @@ class UkfCfg:
     beta: float
     kappa: float
     load: object = None   # LoadCfg: the external-force state F_d; None: off (n = 4)
+    mslip: object = None  # mslip.MslipParams (sigma2 0): the Maxwell-slip elements; None: LuGre
+    ms_passes: int = 2    # the Maxwell-slip step's fixed-point passes (BR_MODEL_MS_PASSES)
 
 
 @dataclass(frozen=True)
@@ -138,6 +154,7 @@ class Ukf:
         self.Pm_diag = list(self.p0)   # diag of the last prediction's P- (P0 when priming)
         self.reanchored = False
         self.load_acq = False          # this step re-acquired a load
+        self.el = np.zeros(0 if cfg.mslip is None else len(cfg.mslip.k))   # the elements e
 
     def _P0(self):
         return [[self.p0[i] if i == j else 0.0 for j in range(self.n)] for i in range(self.n)]
@@ -167,8 +184,11 @@ class Ukf:
             Xj[3] = self._clamp_gp(Xj[3])
         return X, P, ok
 
-    def _fhat(self, X):
-        F = sum(w * rmodel.fnl(self.cfg.model, np.array(Xj[:NX])) for w, Xj in zip(self.wm, X))
+    def _fhat(self, X, el):
+        if self.cfg.mslip is None:
+            F = sum(w * rmodel.fnl(self.cfg.model, np.array(Xj[:NX])) for w, Xj in zip(self.wm, X))
+        else:
+            F = rmslip.force(self.cfg.mslip, el, 0.0)    # sum k_i e_i
         if self.cfg.load is None:
             return F
         # friction + the external force's unscented mean, within the actuator's force
@@ -176,25 +196,35 @@ class Ukf:
         return min(max(F, -self.cfg.load.max_N), self.cfg.load.max_N)
 
     def _predict(self, x, P, u):
-        """Steps 1-2 from (x, P): (xm, Pm, Cholesky ok), or None when a model
-        step fails or the prediction is not finite."""
+        """Steps 1-2 from (x, P): (xm, Pm, Cholesky ok, e-), or None when a
+        model step fails or the prediction is not finite (e-: the elements'
+        prediction, empty for LuGre)."""
         c, n = self.cfg, self.n
         X, P, ok = self._sigma(x, P)
-        Y = []
+        Y, E = [], []
         for Xj in X:
             # the torque on the axis: u, less L F_d with the external force (eq. 1 with the load)
             uj = u if c.load is None else u - c.model.L * Xj[NX]
-            st, y1, _ = rmodel.step(c.model, np.array(Xj[:NX]), uj, c.dt)
-            if st != rmodel.BR_OK:
-                return None
+            if c.mslip is None:
+                st, y1, _ = rmodel.step(c.model, np.array(Xj[:NX]), uj, c.dt)
+                if st != rmodel.BR_OK:
+                    return None
+            else:
+                # the Maxwell-slip step from the elements offset by the point's z
+                th1, om1, e1 = rmslip.model_step(c.model, c.mslip, Xj[0], Xj[1], Xj[3], self.el + Xj[2], uj,
+                                                 c.dt, c.ms_passes)
+                y1 = [th1, om1, Xj[2], Xj[3]]
+                E.append(e1)
             # F_d' = 0: carried over (its random walk is Q_dd)
             Y.append([float(v) for v in y1] + Xj[NX:])
+        em = sum(self.wm[j] * E[j] for j in range(self.nsig)) if E else np.zeros(0)
         xm = [sum(self.wm[j] * Y[j][r] for j in range(self.nsig)) for r in range(n)]
         Pm = [[sum(self.wc[j] * (Y[j][r] - xm[r]) * (Y[j][s] - xm[s]) for j in range(self.nsig))
                + (self.q[r] if r == s else 0.0) for s in range(n)] for r in range(n)]
-        if not all(math.isfinite(v) for v in xm) or not all(math.isfinite(v) for row in Pm for v in row):
+        if not all(math.isfinite(v) for v in xm) or not all(math.isfinite(v) for row in Pm for v in row) \
+                or not np.all(np.isfinite(em)):
             return None
-        return xm, Pm, ok
+        return xm, Pm, ok, em
 
     def _innovate(self, xm, Pm, counts, frac):
         """Step 3 and the gate: (theta- in the new origin's frame, nu, S, passes)."""
@@ -237,7 +267,8 @@ class Ukf:
             self.x = [frac * rpc, 0.0, 0.0, c.gp0] + [0.0] * (n - NX)
             self.P = self._P0()
             X, self.P, _ = self._sigma(self.x, self.P)
-            self.F_hat = self._fhat(X)
+            self.el = np.zeros(len(self.el))   # the elements relaxed
+            self.F_hat = self._fhat(X, self.el)
             self.nu = self.S = 0.0
             self.Pm_diag = list(self.p0)
             self.primed = True
@@ -247,7 +278,7 @@ class Ukf:
         pred = self._predict(self.x, self.P, u)
         if pred is None:
             return BR_E_NUMERIC
-        xm, Pm, ok = pred
+        xm, Pm, ok, em = pred
         if not ok:
             status = BR_E_NUMERIC
             self.n_recover += 1
@@ -256,7 +287,7 @@ class Ukf:
         if not passes:
             acq = self._reacquire(nu, u, counts, frac)
             if acq is not None:
-                (xm, Pm, ok), (th_new, nu, S, passes), self.P = acq
+                (xm, Pm, ok, em), (th_new, nu, S, passes), self.P = acq
                 self.load_acq = True
                 self.n_load_acq += 1
                 if not ok and status == BR_OK:
@@ -273,6 +304,7 @@ class Ukf:
                 P_new = self._P0()
                 origin_new = int(counts)
                 self.reanchored = True
+                em = em + c.model.L * nu   # the elements with the position's jump to the measurement
         else:
             # 5. update
             status_o = BR_OK
@@ -288,6 +320,10 @@ class Ukf:
                    for s in range(n)] for r in range(n)]
             P_new = [[0.5 * (Pj[r][s] + Pj[s][r]) for s in range(n)] for r in range(n)]
             origin_new = int(counts)
+            if c.mslip is not None:
+                # the elements' common error into the elements, its mean back to 0
+                em = em + x_new[2]
+                x_new[2] = 0.0
         if not all(math.isfinite(v) for v in x_new) or not all(math.isfinite(v) for row in P_new for v in row):
             return BR_E_NUMERIC
         # 6. estimate over the sigma points of the new (x, P)
@@ -295,10 +331,13 @@ class Ukf:
         if not ok:
             status = BR_E_NUMERIC
             self.n_recover += 1
-        F = self._fhat(X)
+        # the elements within their slip bounds at the new mean's g_p
+        el = np.clip(em, -rmslip.bounds(c.mslip, x_new[3]), rmslip.bounds(c.mslip, x_new[3])) \
+            if c.mslip is not None else em
+        F = self._fhat(X, el)
         if not math.isfinite(F):
             return BR_E_NUMERIC
-        self.x, self.P, self.origin, self.F_hat = x_new, P_new, origin_new, F
+        self.x, self.P, self.origin, self.F_hat, self.el = x_new, P_new, origin_new, F, el
         self.nu, self.S = nu, S
         self.Pm_diag = [Pm[i][i] for i in range(n)]
         self.prev_counts, self.prev_frac = int(counts), frac

@@ -150,6 +150,8 @@ typedef struct {
     long pf_prop; /* -1: the machine's */
     double ahead; /* < 0: the machine's */
     double ukf_load; /* the UKF's external force's random walk, N^2/s (0: the machine's) */
+    int ukf_mslip;   /* the UKF predicts with the hardware-like plant's element set */
+    float ukf_qs[2]; /* factors on the UKF's z and g_p process noise (0: 1) */
     br_circle_path_t path; /* the circle (default the thesis's) */
     int hw_clamp;          /* the hardware-like plant's clamp limit instead of the slip law */
     double hw_c_mps;       /* its slip law's C (<= 0: BR_CIRCLE_HW_C_MPS) */
@@ -159,7 +161,9 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
-            "       [--ahead P] [--ukf-load Q_N2_PER_S] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
+            "       [--ahead P] [--ukf-load Q_N2_PER_S] [--ukf-mslip] [--ukf-q-scale FZ,FG] [--radius-m R]\n"
+            "       [--feed-mm-min F]\n"
+            "       [--dir cw|ccw|both]\n"
             "       [--hw-law slip|clamp] [--hw-c-mps C]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
@@ -171,6 +175,9 @@ static int usage(const char *argv0, FILE *to)
             "  --ahead P           the estimators' compensation lead, periods past the delay\n"
             "                      (est.comp_ahead_periods, 0 .. %g; docs/modules/est.md)\n"
             "  --ukf-load Q        the UKF's external-force state, random walk Q N^2/s (0 .. 1e9; docs/modules/ukf.md)\n"
+            "  --ukf-mslip         on the hardware-like plant, the UKF predicts with its Maxwell-slip\n"
+            "                      elements (clamp form, docs/modules/ukf.md)\n"
+            "  --ukf-q-scale FZ,FG the UKF's z and g_p process noise times FZ and FG (1e-6 .. 1e6)\n"
             BR_CIRCLE_USAGE("--dir cw|ccw|both  ") "                      (both: each controller both ways, the ISO 230-4 pair; --direction the same)\n"
             "  --hw-law slip|clamp the hardware-like plant's Maxwell-slip law (default slip, docs/demo.md)\n"
             "  --hw-c-mps C        its slip law's attraction rate C, m/s (default %g, %g .. %g)\n"
@@ -203,6 +210,8 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"pf-proposal", required_argument, NULL, 'p'},
                                          {"ahead", required_argument, NULL, 'a'},
                                          {"ukf-load", required_argument, NULL, 'l'},
+                                         {"ukf-mslip", no_argument, NULL, 'e'},
+                                         {"ukf-q-scale", required_argument, NULL, 'q'},
                                          {"hw-law", required_argument, NULL, 'w'},
                                          {"hw-c-mps", required_argument, NULL, 'c'},
                                          BR_CIRCLE_LONGOPTS BR_CIRCLE_LONGOPT_DIR{NULL, 0, NULL, 0}};
@@ -226,6 +235,14 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'p': bad = br_arg_long(TOOL, p.opt, val, 0, (long)BR_PF_PROPOSAL_OPT_HELD, &o->pf_prop); break;
         case 'a': bad = br_arg_double(TOOL, p.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &o->ahead); break;
         case 'l': bad = br_arg_double(TOOL, p.opt, val, 0.0, 1.0e9, &o->ukf_load); break;
+        case 'e': o->ukf_mslip = 1; break;
+        case 'q': {
+            int used = 0;
+            bad = sscanf(val, "%f,%f%n", &o->ukf_qs[0], &o->ukf_qs[1], &used) != 2 || val[used] != '\0' ||
+                  !(o->ukf_qs[0] >= 1e-6f && o->ukf_qs[0] <= 1e6f && o->ukf_qs[1] >= 1e-6f && o->ukf_qs[1] <= 1e6f);
+            if (bad) fprintf(stderr, "%s: --ukf-q-scale %s: two comma-separated factors in [1e-6, 1e6]\n", TOOL, val);
+            break;
+        }
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, p.opt, val, 1, &o->path); break;
         case 'w':
             o->hw_clamp = strcmp(val, "clamp") == 0;
@@ -291,6 +308,8 @@ static br_circle_cfg_t plant_cfg(int pl, br_circle_ctrl_t ctrl, const opts_t *o)
     br_circle_cfg_t c = br_circle_cfg_hardware_like(ctrl);
     if (o->hw_clamp) c.plant.gms.clamp = 1;
     if (o->hw_c_mps > 0.0) c.plant.gms.C_mps = o->hw_c_mps;
+    /* the UKF's model with the plant's own element set (this plant only) */
+    br_circle_use_ukf_mslip(&c, o->ukf_mslip);
     return c;
 }
 
@@ -324,7 +343,7 @@ static void hw_describe(FILE *js, const opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, {0.0f, 0.0f}, BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -435,6 +454,10 @@ int main(int argc, char **argv)
                 if (opt.pf_prop >= 0) cfg.pf.proposal = (uint32_t)opt.pf_prop;
                 br_circle_use_ahead(&cfg, opt.ahead);
                 br_circle_use_ukf_load(&cfg, opt.ukf_load);
+                if (opt.ukf_qs[0] > 0.0f) {
+                    cfg.ukf.est.q_var[BR_X_Z] *= opt.ukf_qs[0];
+                    cfg.ukf.est.q_var[BR_X_GP] *= opt.ukf_qs[1];
+                }
                 sinks_t k = {o.trace[pl][d][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl][d].f : NULL};
                 br_circle_csv_header(k.trace);
                 if (k.hist)

@@ -72,16 +72,33 @@ br_circle_cfg_t br_circle_cfg_realistic(br_circle_ctrl_t controller)
     return c;
 }
 
+/* The hardware-like plant's elements (docs/demo.md, "Hardware-like plant",
+ * the choice and its sources): four equal elements breaking away at 2, 5,
+ * 10, 20 um at Fs (inside presliding.md's 0.3-30 um): initial stiffness
+ * sum k_i = 0.85 Fs / 1 um = 3.8e6 N/m against the machine's sigma0 4e6 N/m;
+ * presliding 24 um */
+static const double k_hw_d_m[BR_CIRCLE_HW_N] = {2.0e-6, 5.0e-6, 10.0e-6, 20.0e-6};
+static const double k_hw_share[BR_CIRCLE_HW_N] = {0.25, 0.25, 0.25, 0.25};
+
+void br_circle_use_ukf_mslip(br_circle_cfg_t *c, int on)
+{
+    if (!on) return;
+    br_mslip_cfg_t *ms = &c->ukf.est.model.mslip;
+    const double Fs = (double)c->ukf.est.model.lugre.Fs_N;
+    ms->n = BR_CIRCLE_HW_N;
+    for (int i = 0; i < BR_CIRCLE_HW_N; i++) {
+        /* k_i = share_i Fs / d_i (docs/modules/mslip.md) */
+        ms->k_Npm[i] = (float)(k_hw_share[i] * Fs / k_hw_d_m[i]);
+        ms->share[i] = (float)k_hw_share[i];
+    }
+    ms->sigma2_Nspm = 0.0f; /* the viscous friction stays the model's sigma2 (eq. 6) */
+    c->ukf.est.comp_ahead_periods = 0.0f;
+}
+
 br_circle_cfg_t br_circle_cfg_hardware_like(br_circle_ctrl_t controller)
 {
     br_circle_cfg_t c = br_circle_cfg_thesis(controller);
-    /* the choice and its sources: docs/demo.md, "Hardware-like plant". Four
-     * equal elements breaking away at 2, 5, 10, 20 um at Fs (inside
-     * presliding.md's 0.3-30 um): initial stiffness sum k_i = 0.85 Fs / 1 um
-     * = 3.8e6 N/m against the machine's sigma0 4e6 N/m; presliding 24 um */
-    static const double d_m[4] = {2.0e-6, 5.0e-6, 10.0e-6, 20.0e-6};
-    static const double share[4] = {0.25, 0.25, 0.25, 0.25};
-    br_gms_from_breakaway(&c.plant.gms, 4, d_m, share, c.plant.Fs_N, BR_CIRCLE_HW_SIGMA1_NSPM);
+    br_gms_from_breakaway(&c.plant.gms, BR_CIRCLE_HW_N, k_hw_d_m, k_hw_share, c.plant.Fs_N, BR_CIRCLE_HW_SIGMA1_NSPM);
     c.plant.gms.clamp = 0;                  /* the finite-C slip law: not the estimators' clamp form */
     c.plant.gms.C_mps = BR_CIRCLE_HW_C_MPS;
     c.plant.gms.delta = 1.0;                /* the machine's Stribeck curve, g itself */

@@ -95,6 +95,14 @@ br_circle_cfg_t br_circle_cfg_hardware_like(br_circle_ctrl_t controller);
  * rate C, m/s (docs/demo.md, "Hardware-like plant", says why) */
 #define BR_CIRCLE_HW_SIGMA1_NSPM 2000.0
 #define BR_CIRCLE_HW_C_MPS 3.0e-3
+/* its number of elements */
+#define BR_CIRCLE_HW_N 4
+
+/* The tools' --ukf-mslip: the UKF predicts with the hardware-like plant's
+ * element set (breakaways and shares, k_i = share_i Fs / d_i at the model's
+ * Fs) in the clamp form (docs/modules/ukf.md, "Maxwell-slip elements"), its
+ * look-ahead off; on = 0 leaves the machine's model. */
+void br_circle_use_ukf_mslip(br_circle_cfg_t *c, int on);
 
 /* The estimators' and the feedforward's model from an identified one (a
  * diagnosis's model.json loaded as a plant configuration): its mass, LuGre

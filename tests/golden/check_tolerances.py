@@ -25,6 +25,8 @@ CHECKS = [
      rf"tolerance \(C = [0-9]+ one step, {NUM} free run\)"),
     ("test_golden_ukf.c", "ukf_load free run from", rf"#define FREE_LOAD_FROM {NUM}", "### ukf",
      rf"FREE_LOAD_FROM = {NUM}"),
+    ("test_golden_ukf.c", "ukf_ms free-run factor", rf"#define C_FREE_RUN_MS \({NUM} \* C_FREE_RUN\)", "### ukf",
+     rf"C_FREE_RUN_MS = {NUM} × C_FREE_RUN"),
     # model
     ("test_golden_model.c", "theta_1", rf"#define C_THETA {NUM}", "### model (", rf"\| θ₁ \| {NUM}u·S_θ"),
     ("test_golden_model.c", "omega_1", rf"#define C_OMEGA {NUM}", "### model (", rf"\| ω₁ \| {NUM}u·S_ω"),

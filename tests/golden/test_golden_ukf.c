@@ -4,8 +4,10 @@
  * closed-loop input, shared with the PF test) and ukf.csv (status, origin,
  * mean, covariance, F_hat, innovation per step), and with the external force
  * F_d (cfg.load, n = 5) through ukf_load.csv (its own input columns: the
- * same input with a load step; plus F_d and the load re-acquisitions). The
- * configuration comes from the trace header. Tolerances: docs/golden.md.
+ * same input with a load step; plus F_d and the load re-acquisitions), and
+ * with Maxwell-slip elements (cfg.est.model.mslip) through ukf_ms.csv (its
+ * own input columns; plus the elements). The configuration comes from the
+ * trace header. Tolerances: docs/golden.md.
  *
  * One-step: before every step the filter's state (x, P, origin, outlier
  * count, last measurement; public fields of br_ukf_t) is set to the
@@ -33,6 +35,12 @@
  * state is the random-walk g_p, measured at <= 9x its one-step error: 8 x 32. */
 #define C_ONE_STEP 32.0
 #define C_FREE_RUN 256.0
+/* The free run with Maxwell-slip elements: an element sums the travel while
+ * it sticks (no gain corrects it directly, only the common error z), so its
+ * rounding accumulates over a stick phase, and g_p and the innovation follow
+ * it: measured at 1.78 x C_FREE_RUN at the worst (g_p), 4 x keeps a 2.2 x
+ * margin (docs/golden.md). */
+#define C_FREE_RUN_MS (4.0 * C_FREE_RUN)
 /* The free run with the external force starts from the reference's row
  * FREE_LOAD_FROM - 1: its first update shrinks P_dd from P0 = F_act^2 to
  * ~29 N^2 (a factor 8.7e3), and the float32 rounding of that cancellation
@@ -42,23 +50,31 @@
 #define FREE_LOAD_FROM 50
 
 #define NM BR_UKF_NMAX
+#define NE BR_MSLIP_MAX
+
+/* the traces: the thesis's filter, with the external force, with the elements */
+enum { V_UKF = 0, V_LOAD = 1, V_MS = 2 };
 
 typedef struct {
     br_trace_t in, u;
     br_ukf_cfg_t cfg;
-    int n; /* BR_NX, or BR_UKF_NMAX with the external force */
+    int n;  /* BR_NX, or BR_UKF_NMAX with the external force */
+    int ne; /* Maxwell-slip elements (0: LuGre) */
     int nsteps;
     int c_counts, c_frac, c_uprev;
-    int c_st, c_org, c_nout, c_ra, c_acq, c_x[NM], c_P[NM][NM], c_Pm[NM], c_F, c_nu, c_S;
+    int c_st, c_org, c_nout, c_ra, c_acq, c_x[NM], c_P[NM][NM], c_Pm[NM], c_F, c_nu, c_S, c_e[NE];
 } ukf_golden_t;
 
 /* ukf: est_input.csv's input and ukf.csv, n = 4; ukf_load: the input
- * columns and the filter of ukf_load.csv, n = 5 (cfg.load from its header) */
-static void load_all(ukf_golden_t *g, int load)
+ * columns and the filter of ukf_load.csv, n = 5 (cfg.load from its header);
+ * ukf_ms: those of ukf_ms.csv, n = 4 and the elements (ms_* in its header) */
+static void load_all(ukf_golden_t *g, int variant)
 {
+    static const char *in_name[3] = {"est_input", "ukf_load", "ukf_ms"}, *u_name[3] = {"ukf", "ukf_load", "ukf_ms"};
+    const int load = variant == V_LOAD;
     g->n = load ? BR_UKF_NMAX : BR_NX;
-    br_trace_load(&g->in, load ? "ukf_load" : "est_input");
-    br_trace_load(&g->u, load ? "ukf_load" : "ukf");
+    br_trace_load(&g->in, in_name[variant]);
+    br_trace_load(&g->u, u_name[variant]);
     const br_trace_t *t = &g->u;
     double p0[BR_NX];
     br_trace_meta_nums(t, "p0_var", p0, BR_NX);
@@ -73,6 +89,24 @@ static void load_all(ukf_golden_t *g, int load)
         c.load.q_N2 = (float)br_trace_meta_num(t, "load_q_N2");
         c.load.p0_N2 = (float)br_trace_meta_num(t, "load_p0_N2");
         c.load.max_N = (float)br_trace_meta_num(t, "load_max_N");
+    }
+    g->ne = 0;
+    if (variant == V_MS) {
+        g->ne = (int)br_trace_meta_num(t, "ms_n");
+        assert_true(g->ne >= 1 && g->ne <= NE);
+        /* the reference's fixed-point passes are the firmware's */
+        assert_int_equal((int)br_trace_meta_num(t, "ms_passes"), BR_MODEL_MS_PASSES);
+        double k[NE], a[NE];
+        br_trace_meta_nums(t, "ms_k_Npm", k, g->ne);
+        br_trace_meta_nums(t, "ms_share", a, g->ne);
+        c.est.model.mslip.n = g->ne;
+        for (int i = 0; i < g->ne; i++) {
+            c.est.model.mslip.k_Npm[i] = (float)k[i];
+            c.est.model.mslip.share[i] = (float)a[i];
+            char name[8];
+            snprintf(name, sizeof name, "e%d", i);
+            g->c_e[i] = br_trace_col(t, name);
+        }
     }
     g->cfg = c;
     g->nsteps = g->u.nrows;
@@ -126,6 +160,9 @@ static void seed(br_ukf_t *f, const ukf_golden_t *g, int k)
             f->P[i][j] = (float)br_trace_get(&g->u, k, g->c_P[i][j]);
         }
     }
+    for (int i = 0; i < g->ne; i++) {
+        f->el[i] = (float)br_trace_get(&g->u, k, g->c_e[i]);
+    }
     f->origin_counts = (int32_t)br_trace_get(&g->u, k, g->c_org);
     f->n_outliers = (uint32_t)br_trace_get(&g->u, k, g->c_nout);
     const br_meas_t y = meas(g, k);
@@ -135,7 +172,7 @@ static void seed(br_ukf_t *f, const ukf_golden_t *g, int k)
 }
 
 typedef struct {
-    br_errstat_t x[NM], P[NM][NM], F, nu, S;
+    br_errstat_t x[NM], P[NM][NM], F, nu, S, e[NE];
     long bad_status, bad_exact;
     uint32_t n_acq; /* the filter's n_load_acq after the last compared step */
 } ukf_err_t;
@@ -153,6 +190,11 @@ static void err_init(ukf_err_t *e)
             br_errstat_init(&e->P[i][j], pn[i][j], "");
         }
     }
+    static char en[NE][8];
+    for (int i = 0; i < NE; i++) {
+        snprintf(en[i], sizeof en[i], "e%d", i);
+        br_errstat_init(&e->e[i], en[i], "m");
+    }
     br_errstat_init(&e->F, "F_hat", "N");
     br_errstat_init(&e->nu, "innov", "rad");
     br_errstat_init(&e->S, "innov_var", "rad^2");
@@ -161,7 +203,8 @@ static void err_init(ukf_err_t *e)
 
 /* Compares the filter after step k with the reference row k. */
 static void compare_step(const br_ukf_t *f, const ukf_golden_t *g, int k, br_status_t st, ukf_err_t *e,
-                         const double tol_x[NM], double tol_P[NM][NM], double tol_F, double tol_nu, double tol_S)
+                         const double tol_x[NM], double tol_P[NM][NM], double tol_F, double tol_nu, double tol_S,
+                         const double tol_e[NE])
 {
     const br_trace_t *t = &g->u;
     const int st_exp = (int)br_trace_get(t, k, g->c_st);
@@ -195,6 +238,9 @@ static void compare_step(const br_ukf_t *f, const ukf_golden_t *g, int k, br_sta
             br_errstat_add(&e->P[i][j], t, k, (double)f->P[i][j], br_trace_get(t, k, g->c_P[i][j]), tol_P[i][j]);
         }
     }
+    for (int i = 0; i < g->ne; i++) {
+        br_errstat_add(&e->e[i], t, k, (double)f->est.elem_m[i], br_trace_get(t, k, g->c_e[i]), tol_e[i]);
+    }
     br_errstat_add(&e->F, t, k, (double)f->est.F_hat_N, br_trace_get(t, k, g->c_F), tol_F);
     if (k > 0) {
         br_errstat_add(&e->nu, t, k, (double)f->est.innov_rad, br_trace_get(t, k, g->c_nu), tol_nu);
@@ -215,6 +261,10 @@ static long err_print(const ukf_err_t *e, const ukf_golden_t *g, const char *wha
             fails += e->P[i][j].n_fail;
         }
     }
+    for (int i = 0; i < g->ne; i++) {
+        br_errstat_print(&e->e[i], &g->u, what);
+        fails += e->e[i].n_fail;
+    }
     br_errstat_print(&e->F, &g->u, what);
     br_errstat_print(&e->nu, &g->u, what);
     br_errstat_print(&e->S, &g->u, what);
@@ -227,13 +277,15 @@ static long err_print(const ukf_err_t *e, const ukf_golden_t *g, const char *wha
  * the normalised innovation (the update moves x_i by at most sqrt(Pm_ii) r).
  * tol = C u scale, C the rounding-chain factor. With the external force the
  * fifth state's scale D = |F_d| + sp_d (1 + r) joins the force on the axis
- * (S_omega) and F_hat = f_nl + F_d. */
+ * (S_omega) and F_hat = f_nl + F_d. With the elements, element i's scale is
+ * E_i = Delta_i + Z + h L Om (its span share_i g_p / k_i, the common error
+ * z's spread, the period's travel) and F_hat = sum k_i e_i's is sum k_i E_i. */
 typedef struct {
     double h, L, Jeff, s0, s1, s2, c, R;
 } ukf_consts_t;
 
 static void tolerances(const ukf_golden_t *g, const ukf_consts_t *uc, int k, double C, double tol_x[NM],
-                       double tol_P[NM][NM], double *tol_F, double *tol_nu, double *tol_S)
+                       double tol_P[NM][NM], double *tol_F, double *tol_nu, double *tol_S, double tol_e[NE])
 {
     const br_trace_t *t = &g->u;
     const int st = (int)br_trace_get(t, k, g->c_st);
@@ -273,6 +325,21 @@ static void tolerances(const ukf_golden_t *g, const ukf_consts_t *uc, int k, dou
     if (g->n > BR_NX) {
         *tol_F += C * U32 * (x[BR_NX] + spp[BR_NX]) + tol_x[BR_NX];
     }
+    if (g->ne > 0) {
+        double kE = 0.0;
+        for (int i = 0; i < g->ne; i++) {
+            /* the element's span Delta_i = share_i g_p / k_i: its deflection is
+             * the travel summed while it sticks, so its rounding is that of
+             * its span, not of its value (which crosses 0) */
+            const double span = (double)g->cfg.est.model.mslip.share[i] * x[3] /
+                                (double)g->cfg.est.model.mslip.k_Npm[i];
+            const double E = span + Z + uc->h * uc->L * Om;
+            tol_e[i] = C * U32 * E;
+            kE += (double)g->cfg.est.model.mslip.k_Npm[i] * E;
+        }
+        /* sum k_i e_i: its own rounding and the elements' errors */
+        *tol_F = 2.0 * C * U32 * kE;
+    }
     *tol_nu = C * U32 * (fabs(nu) + S[0]);
     *tol_S = C * U32 * (2.0 * sp[0] * S[0] + sp[0] * sp[0] + uc->R);
 }
@@ -293,15 +360,15 @@ static ukf_consts_t consts(const ukf_golden_t *g)
     return uc;
 }
 
-static void run_one_step(int load, const char *what)
+static void run_one_step(int variant, const char *what)
 {
     ukf_golden_t g;
-    load_all(&g, load);
+    load_all(&g, variant);
     br_ukf_t f;
     assert_int_equal(br_ukf_init(&f, &g.cfg), BR_OK);
     ukf_err_t e;
     err_init(&e);
-    double tx[NM], tP[NM][NM], tF, tnu, tS;
+    double tx[NM], tP[NM][NM], tF, tnu, tS, te[NE];
     const ukf_consts_t uc = consts(&g);
     for (int k = 0; k < g.nsteps; k++) {
         if (k > 0) {
@@ -309,8 +376,8 @@ static void run_one_step(int load, const char *what)
         }
         const br_meas_t y = meas(&g, k);
         const br_status_t st = br_ukf_step(&f, &y, (float)br_trace_get(&g.in, k, g.c_uprev));
-        tolerances(&g, &uc, k, C_ONE_STEP, tx, tP, &tF, &tnu, &tS);
-        compare_step(&f, &g, k, st, &e, tx, tP, tF, tnu, tS);
+        tolerances(&g, &uc, k, C_ONE_STEP, tx, tP, &tF, &tnu, &tS, te);
+        compare_step(&f, &g, k, st, &e, tx, tP, tF, tnu, tS, te);
     }
     const long fails = err_print(&e, &g, what);
     free_all(&g);
@@ -321,15 +388,15 @@ static void run_one_step(int load, const char *what)
     }
 }
 
-static void run_free(int load, const char *what, int k0)
+static void run_free(int variant, const char *what, int k0)
 {
     ukf_golden_t g;
-    load_all(&g, load);
+    load_all(&g, variant);
     br_ukf_t f;
     assert_int_equal(br_ukf_init(&f, &g.cfg), BR_OK);
     ukf_err_t e;
     err_init(&e);
-    double tx[NM], tP[NM][NM], tF, tnu, tS;
+    double tx[NM], tP[NM][NM], tF, tnu, tS, te[NE];
     const ukf_consts_t uc = consts(&g);
     if (k0 > 0) {
         seed(&f, &g, k0 - 1);
@@ -337,8 +404,8 @@ static void run_free(int load, const char *what, int k0)
     for (int k = k0; k < g.nsteps; k++) {
         const br_meas_t y = meas(&g, k);
         const br_status_t st = br_ukf_step(&f, &y, (float)br_trace_get(&g.in, k, g.c_uprev));
-        tolerances(&g, &uc, k, C_FREE_RUN, tx, tP, &tF, &tnu, &tS);
-        compare_step(&f, &g, k, st, &e, tx, tP, tF, tnu, tS);
+        tolerances(&g, &uc, k, (variant == V_MS) ? C_FREE_RUN_MS : C_FREE_RUN, tx, tP, &tF, &tnu, &tS, te);
+        compare_step(&f, &g, k, st, &e, tx, tP, tF, tnu, tS, te);
     }
     long n_out = 0, n_ra = 0, n_acq = 0;
     for (int k = k0; k < g.nsteps; k++) {
@@ -361,26 +428,39 @@ static void run_free(int load, const char *what, int k0)
 static void test_ukf_one_step(void **state)
 {
     (void)state;
-    run_one_step(0, "ukf1");
+    run_one_step(V_UKF, "ukf1");
 }
 
 static void test_ukf_free_run(void **state)
 {
     (void)state;
-    run_free(0, "ukf", 0);
+    run_free(V_UKF, "ukf", 0);
 }
 
 /* the external force F_d (cfg.load) and the load re-acquisition */
 static void test_ukf_load_one_step(void **state)
 {
     (void)state;
-    run_one_step(1, "ukf_load1");
+    run_one_step(V_LOAD, "ukf_load1");
 }
 
 static void test_ukf_load_free_run(void **state)
 {
     (void)state;
-    run_free(1, "ukf_load", FREE_LOAD_FROM);
+    run_free(V_LOAD, "ukf_load", FREE_LOAD_FROM);
+}
+
+/* the Maxwell-slip elements (cfg.est.model.mslip) */
+static void test_ukf_ms_one_step(void **state)
+{
+    (void)state;
+    run_one_step(V_MS, "ukf_ms1");
+}
+
+static void test_ukf_ms_free_run(void **state)
+{
+    (void)state;
+    run_free(V_MS, "ukf_ms", 0);
 }
 
 int main(void)
@@ -390,6 +470,8 @@ int main(void)
         cmocka_unit_test(test_ukf_free_run),
         cmocka_unit_test(test_ukf_load_one_step),
         cmocka_unit_test(test_ukf_load_free_run),
+        cmocka_unit_test(test_ukf_ms_one_step),
+        cmocka_unit_test(test_ukf_ms_free_run),
     };
     return cmocka_run_group_tests_name("golden_ukf", tests, NULL, NULL);
 }

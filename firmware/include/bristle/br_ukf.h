@@ -74,6 +74,8 @@ typedef struct {
     float innov_var_rad2;    /* its predicted variance S = P-_00 + R */
     float load_N;            /* the external force's mean F_d (0 without cfg.load) */
     float load_var_N2;       /* its variance */
+    float elem_m[BR_MSLIP_MAX]; /* the Maxwell-slip elements' deflections (model.mslip.n of
+                                   them; 0 for LuGre) */
 } br_ukf_est_t;
 
 typedef struct {
@@ -95,6 +97,11 @@ typedef struct {
     float S[BR_UKF_NMAX][BR_UKF_NMAX];   /* scratch: Cholesky factor of the last factorised P (lower) */
     float X[BR_UKF_NSIG_MAX][BR_UKF_NMAX]; /* sigma points (scratch; after a step without error, the posterior's) */
     float Y[BR_UKF_NSIG_MAX][BR_UKF_NMAX]; /* scratch: propagated sigma points of the last step */
+    /* The Maxwell-slip elements (cfg.est.model.mslip.n >= 1; docs/modules/ukf.md,
+     * "Maxwell-slip elements"): deflections beside the state, propagated with
+     * the sigma points and carried as their unscented mean */
+    float el[BR_MSLIP_MAX];          /* the committed elements */
+    float el_m[BR_MSLIP_MAX];        /* scratch: the last prediction's */
     int32_t origin_counts;
     int32_t prev_counts;             /* last measurement (accepted or not): the measured */
     float prev_frac;                 /*   velocity for a re-anchoring */
