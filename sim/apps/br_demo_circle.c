@@ -149,6 +149,8 @@ typedef struct {
     long pf_prop; /* -1: the machine's */
     double ahead; /* < 0: the machine's */
     double ukf_load; /* the UKF's external force's random walk, N^2/s (0: the machine's) */
+    double pf_load;  /* the PF's shared external force's random walk, N^2/s (0: the machine's) */
+    double pf_gp_tau; /* the PF's g_p along the Stribeck curve, time constant s (0: the machine's) */
     br_circle_path_t path; /* the circle (default the thesis's) */
     int hw_clamp;          /* the hardware-like plant's clamp limit instead of the slip law */
     double hw_c_mps;       /* its slip law's C (<= 0: BR_CIRCLE_HW_C_MPS) */
@@ -158,7 +160,7 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
-            "       [--ahead P] [--ukf-load Q_N2_PER_S] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
+            "       [--ahead P] [--ukf-load Q_N2_PER_S] [--pf-load Q_N2_PER_S] [--pf-gp-curve TAU_S] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
             "       [--hw-law slip|clamp] [--hw-c-mps C]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
@@ -170,6 +172,8 @@ static int usage(const char *argv0, FILE *to)
             "  --ahead P           the estimators' compensation lead, periods past the delay\n"
             "                      (est.comp_ahead_periods, 0 .. %g; docs/modules/est.md)\n"
             "  --ukf-load Q        the UKF's external-force state, random walk Q N^2/s (0 .. 1e9; docs/modules/ukf.md)\n"
+            "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9; docs/modules/pf.md)\n"
+            "  --pf-gp-curve TAU   the PF's g_p along the Stribeck curve, time constant TAU s (0 .. 100; docs/modules/pf.md)\n"
             BR_CIRCLE_USAGE("--dir cw|ccw|both  ") "                      (both: each controller both ways, the ISO 230-4 pair; --direction the same)\n"
             "  --hw-law slip|clamp the hardware-like plant's Maxwell-slip law (default slip, docs/demo.md)\n"
             "  --hw-c-mps C        its slip law's attraction rate C, m/s (default %g, %g .. %g)\n"
@@ -202,6 +206,8 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"pf-proposal", required_argument, NULL, 'p'},
                                          {"ahead", required_argument, NULL, 'a'},
                                          {"ukf-load", required_argument, NULL, 'l'},
+                                         {"pf-load", required_argument, NULL, 'L'},
+                                         {"pf-gp-curve", required_argument, NULL, 'G'},
                                          {"hw-law", required_argument, NULL, 'w'},
                                          {"hw-c-mps", required_argument, NULL, 'c'},
                                          BR_CIRCLE_LONGOPTS BR_CIRCLE_LONGOPT_DIR{NULL, 0, NULL, 0}};
@@ -225,6 +231,8 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'p': bad = br_arg_long(TOOL, p.opt, val, 0, (long)BR_PF_PROPOSAL_OPT_HELD, &o->pf_prop); break;
         case 'a': bad = br_arg_double(TOOL, p.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &o->ahead); break;
         case 'l': bad = br_arg_double(TOOL, p.opt, val, 0.0, 1.0e9, &o->ukf_load); break;
+        case 'L': bad = br_arg_double(TOOL, p.opt, val, 0.0, 1.0e9, &o->pf_load); break;
+        case 'G': bad = br_arg_double(TOOL, p.opt, val, 0.0, 100.0, &o->pf_gp_tau); break;
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, p.opt, val, 1, &o->path); break;
         case 'w':
             o->hw_clamp = strcmp(val, "clamp") == 0;
@@ -323,7 +331,7 @@ static void hw_describe(FILE *js, const opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0.0, 0.0, BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -434,6 +442,8 @@ int main(int argc, char **argv)
                 if (opt.pf_prop >= 0) cfg.pf.proposal = (uint32_t)opt.pf_prop;
                 br_circle_use_ahead(&cfg, opt.ahead);
                 br_circle_use_ukf_load(&cfg, opt.ukf_load);
+                br_circle_use_pf_load(&cfg, opt.pf_load);
+                br_circle_use_pf_gp_curve(&cfg, opt.pf_gp_tau);
                 sinks_t k = {o.trace[pl][d][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl][d].f : NULL};
                 br_circle_csv_header(k.trace);
                 if (k.hist)
