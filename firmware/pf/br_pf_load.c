@@ -10,19 +10,31 @@
 #include "br_model_kernel.h"
 #include "br_pf_kernel.h"
 
+/* the common error's covariance at rest: theta and omega as the particles have them, F_d
+ * unknown within the actuator's force */
+static void cov_reset(br_pf_t *pf)
+{
+    for (int i = 0; i < 6; i++) {
+        pf->load_P[i] = 0.0f;
+    }
+    pf->load_P[5] = pf->cfg.load.max_N * pf->cfg.load.max_N;
+}
+
 br_status_t br_pf_load_init(br_pf_t *pf)
 {
     const br_pf_load_t *ld = &pf->cfg.load;
     pf->load_N = 0.0f;
-    pf->load_P_N2 = 0.0f;
     pf->load_g_radpN = 0.0f;
     pf->n_load_acq = 0u;
+    for (int i = 0; i < 6; i++) {
+        pf->load_P[i] = 0.0f;
+    }
     if (ld->q_N2 == 0.0f && ld->max_N == 0.0f) {
         return BR_OK; /* off */
     }
-    /* on: q a normal float, max_N > 0 with max_N^2 and 4 max_N^2 finite; the thesis
-     * model with the bootstrap proposal (the cloud is moved and weighed again with
-     * eq. 6's f_nl and the Gaussian likelihood) */
+    /* on: q a normal float, max_N > 0 with 4 max_N^2 finite; the thesis model with the
+     * bootstrap proposal (the cloud is moved and weighed again with eq. 6's f_nl and the
+     * Gaussian likelihood) */
     if (!br_est_var_ok(ld->q_N2, 0) || !br_est_var_ok(4.0f * ld->max_N * ld->max_N, 0) || !(ld->max_N > 0.0f) ||
         pf->model.extended || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR) {
         return BR_E_PARAM;
@@ -30,7 +42,7 @@ br_status_t br_pf_load_init(br_pf_t *pf)
     const float h = pf->cfg.est.model.dt_s;
     /* g = L h^2 / (2 J_eff): theta's change over one period under one newton on the load side */
     pf->load_g_radpN = 0.5f * pf->model.cfg.lead_mprad * h * h * pf->model.inv_Jeff;
-    pf->load_P_N2 = ld->max_N * ld->max_N;
+    cov_reset(pf);
     return (isfinite(pf->load_g_radpN) && pf->load_g_radpN > 0.0f) ? BR_OK : BR_E_PARAM;
 }
 
@@ -42,18 +54,37 @@ float br_pf_load_torque(const br_pf_t *pf, float u_Nm)
 
 void br_pf_load_tick(br_pf_t *pf)
 {
-    if (br_pf_load_on(pf)) {
-        /* F_d' = 0 + a random walk: P <- P + q, at most max_N^2 (its prior) */
-        const float p = pf->load_P_N2 + pf->cfg.load.q_N2;
-        const float p0 = pf->cfg.load.max_N * pf->cfg.load.max_N;
-        pf->load_P_N2 = (p < p0) ? p : p0;
+    if (!br_pf_load_on(pf)) {
+        return;
+    }
+    /* the common error e = [dtheta, domega, dF] over one period (the cloud predicted with F_d):
+     *   e <- Phi e + [0, 0, w],  Phi = [1 h -g; 0 1 -a; 0 0 1],  a = 2 g / h,  var w = q
+     * P <- Phi P Phi^T + diag(0, 0, q) */
+    const float h = pf->cfg.est.model.dt_s, g = pf->load_g_radpN, a = 2.0f * g / h;
+    float *P = pf->load_P;
+    const float p00 = P[0], p01 = P[1], p02 = P[2], p11 = P[3], p12 = P[4], p22 = P[5];
+    /* rows of Phi P: r0 = [p00 + h p01 - g p02, p01 + h p11 - g p12, p02 + h p12 - g p22],
+     * r1 = [p01 - a p02, p11 - a p12, p12 - a p22], r2 = [p02, p12, p22] */
+    const float r00 = p00 + h * p01 - g * p02, r01 = p01 + h * p11 - g * p12, r02 = p02 + h * p12 - g * p22;
+    const float r11 = p11 - a * p12, r12 = p12 - a * p22;
+    P[0] = r00 + h * r01 - g * r02;
+    P[1] = r01 - a * r02;
+    P[2] = r02;
+    P[3] = r11 - a * r12;
+    P[4] = r12;
+    P[5] = p22 + pf->cfg.load.q_N2;
+    for (int i = 0; i < 6; i++) {
+        if (!isfinite(P[i])) {
+            cov_reset(pf);
+            return;
+        }
     }
 }
 
-/* The cloud moved by a change dF of the load over the last k periods: theta by
- * dth, omega by dom, each valid particle's f_nl (eqs. 3, 4) and log-weight made
- * again, with cfg.adapt's sums; returns the largest log-weight. A particle whose
- * moved state is not finite keeps its predicted one and becomes invalid. */
+/* The cloud moved by the common error's correction: theta by dth, omega by dom, each
+ * valid particle's f_nl (eqs. 3, 4) and log-weight made again, with cfg.adapt's sums;
+ * returns the largest log-weight. A particle whose moved state is not finite keeps its
+ * predicted one and becomes invalid. */
 static float move_cloud(br_pf_t *pf, float y_rel, float dth, float dom, float sums[2])
 {
     const br_model_k_t mk = br_model_k(&pf->model);
@@ -92,42 +123,56 @@ float br_pf_load_update(br_pf_t *pf, float y_rel, float lmax, float sums[2], uin
         return lmax;
     }
     const float max_N = pf->cfg.load.max_N;
-    const float k = (float)pf->n_predicted + 1.0f; /* periods since the last measurement */
-    /* a constant change dF over k periods moves theta by -g k^2 dF: H = -g k^2 */
-    const float gk2 = pf->load_g_radpN * k * k;
+    float *P = pf->load_P;
     /* the cloud's mean innovation and spread: d = mean theta_j - y, var theta_j */
     const float n = (float)n_valid;
     const float d = sums[0] / n;
     const float v = sums[1] / n - d * d;
     const float s0 = ((v > 0.0f) ? v : 0.0f) + pf->r_gate;
-    float p = pf->load_P_N2;
     if (!(lmax >= pf->outlier_l)) {
-        /* gated: re-acquired as a load when a change of at most 2 max_N explains it,
-         * its variance inflated by that change squared; an outlier otherwise */
-        const float df_raw = d / gk2;
+        /* gated: re-acquired as a load when a change of at most 2 max_N over the k periods
+         * since the last measurement (theta moved by -g k^2 dF) explains it, F_d's variance
+         * inflated by that change squared; an outlier otherwise */
+        const float k = (float)pf->n_predicted + 1.0f;
+        const float df_raw = d / (pf->load_g_radpN * k * k);
         if (!(fabsf(df_raw) <= 2.0f * max_N)) {
             return lmax;
         }
-        p += df_raw * df_raw;
+        /* as if F_d's variance had been larger by df_raw^2 k periods ago: P += df_raw^2 b b^T,
+         * b = [-g k^2, -2 g k / h, 1] the error a change of F_d then makes now */
+        const float b[3] = {-pf->load_g_radpN * k * k, -2.0f * pf->load_g_radpN * k / pf->cfg.est.model.dt_s, 1.0f};
+        const float dv = df_raw * df_raw;
+        P[0] += dv * b[0] * b[0];
+        P[1] += dv * b[0] * b[1];
+        P[2] += dv * b[0] * b[2];
+        P[3] += dv * b[1] * b[1];
+        P[4] += dv * b[1] * b[2];
+        P[5] += dv;
         pf->n_load_acq++;
     }
-    /* the scalar Kalman update: S = g^2 k^4 P + var + R + rpc^2/12, dF = (g k^2 P / S) d,
-     * P <- P (var + R + rpc^2/12) / S */
-    const float s = gk2 * gk2 * p + s0;
-    const float inc = (gk2 * p / s) * d;
-    const float p_new = p * (s0 / s);
-    if (!isfinite(inc) || !isfinite(p_new)) {
+    /* the Kalman update of the common error on theta's innovation nu = y - mean theta = -d
+     * (H = [1 0 0], variance var + R + rpc^2/12): S = P00 + s0, K = P[:, 0] / S,
+     * e = K nu, P <- P - K P[0, :] */
+    const float s = P[0] + s0;
+    const float k0 = P[0] / s, k1 = P[1] / s, k2 = P[2] / s;
+    const float nu = -d;
+    const float p00 = P[0], p01 = P[1], p02 = P[2], p11 = P[3], p12 = P[4], p22 = P[5];
+    const float dF = k2 * nu;
+    const float np[6] = {p00 - k0 * p00, p01 - k0 * p01, p02 - k0 * p02,
+                         p11 - k1 * p01, p12 - k1 * p02, p22 - k2 * p02};
+    if (!isfinite(dF) || !isfinite(k0 * nu) || !isfinite(k1 * nu)) {
         return lmax; /* kept: no change */
     }
-    const float f = br_clampf(pf->load_N + inc, -max_N, max_N);
-    const float df = f - pf->load_N;
+    for (int i = 0; i < 6; i++) {
+        if (!isfinite(np[i])) {
+            return lmax;
+        }
+        P[i] = np[i];
+    }
+    const float f = br_clampf(pf->load_N + dF, -max_N, max_N);
     pf->load_N = f;
-    pf->load_P_N2 = (p_new < max_N * max_N) ? p_new : max_N * max_N;
-    /* the period predicted again with F_d + dF, to first order: theta by -g k^2 dF, omega by
-     * BR_PF_LOAD_OMEGA_SHARE of -L h k dF / J_eff = -(2 g k / h) dF (docs/modules/pf.md: the
-     * whole of it makes the closed loop ring at the PF's period) */
-    return move_cloud(pf, y_rel, -gk2 * df,
-                      -BR_PF_LOAD_OMEGA_SHARE * 2.0f * pf->load_g_radpN * k / pf->cfg.est.model.dt_s * df, sums);
+    /* the cloud carries theta and omega: moved by the correction's share of them */
+    return move_cloud(pf, y_rel, k0 * nu, k1 * nu, sums);
 }
 
 float br_pf_load_comp_N(const br_pf_t *pf, float F_N)

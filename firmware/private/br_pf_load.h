@@ -9,11 +9,6 @@
 
 #include "bristle/br_pf.h"
 
-/* The share of the load change's velocity the cloud is moved by (docs/modules/pf.md,
- * "External force": 1, the whole first-order effect, rings at the PF's period in
- * closed loop; 0.5 and 0.75 measured stable, 0.25 not) */
-#define BR_PF_LOAD_OMEGA_SHARE 0.5f
-
 /* 1 when cfg.load is on */
 static inline int br_pf_load_on(const br_pf_t *pf) { return pf->cfg.load.max_N > 0.0f; }
 

@@ -160,9 +160,10 @@ typedef struct {
      * S = Q_theta' + R, and the prior's coupling h/2 sqrt(Q_omega) of omega's
      * sample into theta (OPT_HELD; 0 otherwise) */
     float prop_k_th, prop_k_om, prop_l00, prop_l10, prop_l11, prop_inv_2s, prop_hold;
-    /* cfg.load: the shared external force's estimate F_d (N) and variance (N^2), g = L h^2 / (2 J_eff)
-     * (rad per N over one period), and the re-acquisitions counted */
-    float load_N, load_P_N2, load_g_radpN;
+    /* cfg.load: the shared external force's estimate F_d (N); the covariance of the cloud's common
+     * error [theta, omega, F_d] (rad, rad/s, N), its upper triangle P00 P01 P02 P11 P12 P22;
+     * g = L h^2 / (2 J_eff) (rad per N over one period); the re-acquisitions counted */
+    float load_N, load_P[6], load_g_radpN;
     uint32_t n_load_acq;
     int primed;                   /* particles drawn around the first measurement */
     /* particles as a structure of arrays: x[i][j] is state i of particle j.
