@@ -100,7 +100,7 @@ static void test_load_step_followed(void **st)
     /* without it the same push is a run of outliers (the lock monitor's trip) */
     br_pf_cfg_t off = br_circle_pf_cfg_tuned(DT_F);
     assert_int_equal(init_with(off), BR_OK);
-    assert_true(run_pushed(F, n, &comp) > 10);
+    assert_true(run_pushed(F, 250, &comp) > 10);
 }
 
 static void test_load_bounded(void **st)
