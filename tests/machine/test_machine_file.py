@@ -53,6 +53,14 @@ def expect_errors(work, name, obj, wanted):
               "%s: %s exits 1 with the messages, no traceback (rc %d)" % (name, script, rc))
 
 
+def est_header(work, name, obj):
+    """gen_machine.py on obj written as NAME.json: its exit status and the br_est_machine.h it wrote."""
+    path = write(work, name + ".json", obj)
+    rc, _ = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, name + "_gen"))
+    with open(os.path.join(work, name + "_gen", "bristle_gen", "est", "br_est_machine.h")) as f:
+        return rc, f.read()
+
+
 def friction_model_cases(work, good):
     """friction_model (docs/machine-file.md): the Maxwell-slip element set, each
     refusal the firmware's br_mslip_cfg_check / br_model_init would make, and a
@@ -277,17 +285,11 @@ def main():
     # q_N2_per_s * estimator.pf.period_s, the bound the actuator's force
     withp = copy.deepcopy(good)
     withp["estimator"]["pf"]["load"] = {"q_N2_per_s": 1.0e4}
-    path = write(work, "pf_load.json", withp)
-    rc, err = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, "pf_load_gen"))
-    with open(os.path.join(work, "pf_load_gen", "bristle_gen", "est", "br_est_machine.h")) as f:
-        hdr = f.read()
+    rc, hdr = est_header(work, "pf_load", withp)
     check(rc == 0 and "#define BR_EST_PF_LOAD_Q_N2_F (%s)" % machine.c_float(1.0e4 * good["estimator"]["pf"]["period_s"])
           in hdr and "#define BR_EST_PF_LOAD_MAX_N_F (%s)" % machine.c_float(F_act) in hdr,
           "pf_load.json: gen_machine.py writes the PF's external force (q per PF step, the actuator's force)")
-    path = write(work, "pf_noload.json", good)
-    rc, err = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, "pf_noload_gen"))
-    with open(os.path.join(work, "pf_noload_gen", "bristle_gen", "est", "br_est_machine.h")) as f:
-        hdr = f.read()
+    rc, hdr = est_header(work, "pf_noload", good)
     check(rc == 0 and machine.pf_load(good) is None and "BR_EST_PF_LOAD" not in hdr,
           "no estimator.pf.load: the PF's external force is off, nothing in the header")
     withp["estimator"]["pf"]["load"] = {"q_N2_per_s": 0.0}
