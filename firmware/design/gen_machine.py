@@ -132,6 +132,19 @@ def render_qec(m):
         ("BR_MACHINE_QEC_TAU_S", r["tau_s"], "the pulse's decay time constant")])
 
 
+def render_pf_load(m):
+    """BR_EST_PF_LOAD_*, the PF's shared external force (estimator.pf.load,
+    docs/modules/pf.md, "External force"); nothing without the block, so a file
+    without it gives the header it gave before the block existed
+    (br_machine_cfg.h: off)."""
+    ld = machine.pf_load(m)
+    if ld is None:
+        return []
+    return [""] + render_defines([
+        ("BR_EST_PF_LOAD_Q_N2", ld["q_N2"], "the PF's shared external force: random walk per step"),
+        ("BR_EST_PF_LOAD_MAX_N", ld["max_N"], "its bound, and the compensation's (the actuator's force)")])
+
+
 def est_fields(m):
     """The estimators' settings as the firmware takes them: per step, in its
     state's units, from the file's physical ones (machine.est_per_step)."""
@@ -247,6 +260,7 @@ def render_est(m):
         "",
     ]
     out += render_defines(est_fields(m))
+    out += render_pf_load(m)
     out += ["", "#endif", ""]
     return "\n".join(out)
 

@@ -317,6 +317,13 @@ SCHEMA = {
                 "tau_s": Num(0.0, 100.0, "time constant of g_p's offset from the Stribeck curve g(v): "
                              "per step the offset is multiplied by exp(-period_s / tau_s)", lo_open=True),
             }),
+            # the shared external force (docs/modules/pf.md, "External force"); absent = off,
+            # the thesis filter
+            "load": Optional({
+                "q_N2_per_s": Num(0.0, 1.0e9, "random walk of the shared external force F_d, variance per "
+                                  "second (N^2/s); its initial variance and bound are the actuator's force "
+                                  "(control.torque_limit_Nm / L), squared and itself", lo_open=True),
+            }),
         }, **_gates()),
         "ukf": dict({
             "process_noise": _process_noise(),
@@ -741,8 +748,25 @@ def ukf_load(m):
     ld = m["estimator"]["ukf"].get("load")
     if not ld:
         return {"q_N2": 0.0, "p0_N2": 0.0, "max_N": 0.0}
-    F_act = m["control"]["torque_limit_Nm"] * 2.0 * math.pi / m["mechanics"]["lead_m_per_rev"]
+    F_act = actuator_force_N(m)
     return {"q_N2": ld["q_N2_per_s"] * m["control"]["period_s"], "p0_N2": F_act * F_act, "max_N": F_act}
+
+
+def actuator_force_N(m):
+    """The actuator's force on the table, control.torque_limit_Nm / L (N): the
+    external-force states' bound."""
+    return m["control"]["torque_limit_Nm"] * 2.0 * math.pi / m["mechanics"]["lead_m_per_rev"]
+
+
+def pf_load(m):
+    """The PF's shared external force as the firmware takes it (br_pf_load_t,
+    docs/modules/pf.md, "External force"): {"q_N2" per step (q_N2_per_s times
+    estimator.pf.period_s), "max_N" the actuator's force}; None (off: the
+    generated header leaves it out) when estimator.pf.load is absent."""
+    ld = m["estimator"]["pf"].get("load")
+    if not ld:
+        return None
+    return {"q_N2": ld["q_N2_per_s"] * m["estimator"]["pf"]["period_s"], "max_N": actuator_force_N(m)}
 
 
 def pf_gp_curve_rho(m):
@@ -871,6 +895,18 @@ def _per_step_checks(m, errors):
             if not FLOAT32_MIN_NORMAL <= x <= 1.0e12:
                 errors.append(("estimator.ukf.load.q_N2_per_s", "gives %s = %.6g per step on this machine, "
                                "outside the firmware's (0 excluded) [%g, %g]" % (key, x, FLOAT32_MIN_NORMAL, 1.0e12)))
+    pld = pf_load(m)
+    if pld:
+        # br_pf_init: q a normal float <= BR_EST_VAR_MAX, 4 max_N^2 finite (max_N is the
+        # actuator's force, bounded by the schema)
+        if not FLOAT32_MIN_NORMAL <= pld["q_N2"] <= 1.0e12:
+            errors.append(("estimator.pf.load.q_N2_per_s", "gives q_N2 = %.6g per step on this machine, "
+                           "outside the firmware's (0 excluded) [%g, %g]" % (pld["q_N2"], FLOAT32_MIN_NORMAL, 1.0e12)))
+        # br_pf_init: the thesis model only (the cloud is moved and weighed again with eq. 6)
+        extended = sorted(c for c, v in m.get("causes", {}).items() if c != "actuator_delay" and any(v.values()))
+        if extended:
+            errors.append(("estimator.pf.load", "needs the thesis model; the causes %s make the estimators' "
+                           "model the extended one" % ", ".join(extended)))
     for est in ("pf", "ukf"):
         v = est_per_step(m, est)
         for key, field, lo, hi, zero_ok in _PER_STEP_BOUNDS[est] + _PER_STEP_BOUNDS["both"]:

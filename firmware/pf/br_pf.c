@@ -13,6 +13,7 @@
 #include "br_math.h"
 #include "br_model_kernel.h"
 #include "br_pf_kernel.h"
+#include "br_pf_load.h"
 
 /* br_pf.c orchestrates one step; the hot loops of steps 1-5 are the kernel's
  * (br_pf_kernel.h: br_pf_kernel_* of the target, chosen by
@@ -131,6 +132,10 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     pf->nis_avg = 0.0f;
     pf->q_scale_std = 1.0f;
     if (cfg->proposal != BR_PF_PROPOSAL_PRIOR && proposal_init(pf) != BR_OK) {
+        return BR_E_PARAM;
+    }
+    /* cfg.load: the shared external force (off: all 0) */
+    if (br_pf_load_init(pf) != BR_OK) {
         return BR_E_PARAM;
     }
     pf->noise_pos = 0u;
@@ -595,12 +600,16 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     const float shift = (float)br_counts_delta(y->counts, pf->origin_counts) * rpc;
     const float y_rel = y->frac * rpc;
     float lmax, sums[2];
-    const uint32_t n_valid = predict_and_weigh(pf, u_a, shift, y_rel, 1, &lmax, sums);
+    br_pf_load_tick(pf);
+    /* with cfg.load the particles are predicted with u - L F_d */
+    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), shift, y_rel, 1, &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         pf->weighed = BR_PF_WEIGHED_NONE;
         return BR_E_NUMERIC; /* nothing usable: the previous set is kept */
     }
+    /* cfg.load: F_d's update on the cloud's innovation, the cloud moved by its change */
+    lmax = br_pf_load_update(pf, y_rel, lmax, sums, n_valid);
     /* an outlier also when every valid particle's log-weight overflowed to -inf
      * (the max-shift needs a finite lmax) */
     const br_status_t verdict = (lmax < pf->outlier_l || lmax == -INFINITY) ? BR_W_OUTLIER : BR_OK;
@@ -647,7 +656,8 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     pf->origin_counts = y->counts;
     pf->prev_frac = y->frac;
     pf->n_predicted = 0u;
-    pf->est.F_hat_N = sf * inv_m;
+    /* the compensation: the mean f_nl, with cfg.load plus F_d */
+    pf->est.F_hat_N = br_pf_load_comp_N(pf, sf * inv_m);
     pf->est.origin_counts = y->counts;
     return verdict;
 }
@@ -668,8 +678,9 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     float lmax, sums[2];
     /* no measurement: the delay's identification starts again at the next one */
     pf->dlyid.primed = 0;
-    const uint32_t n_valid = predict_and_weigh(pf, br_est_delay_apply(&pf->delay, u_prev_Nm), 0.0f, 0.0f, 0, &lmax,
-                                               sums);
+    br_pf_load_tick(pf);
+    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, br_est_delay_apply(&pf->delay, u_prev_Nm)),
+                                               0.0f, 0.0f, 0, &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         pf->weighed = BR_PF_WEIGHED_NONE;
@@ -679,7 +690,7 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     for (uint32_t j = 0; j < m; j++) {
         pf->idx[j] = (uint16_t)j;
     }
-    pf->est.F_hat_N = sum_set(pf) * (1.0f / (float)m);
+    pf->est.F_hat_N = br_pf_load_comp_N(pf, sum_set(pf) * (1.0f / (float)m));
     pf->weighed = BR_PF_WEIGHED_EQUAL;
     if (pf->n_predicted < UINT32_MAX) {
         pf->n_predicted++;

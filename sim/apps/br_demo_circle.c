@@ -152,6 +152,8 @@ typedef struct {
     double ukf_load; /* the UKF's external force's random walk, N^2/s (0: the machine's) */
     int ukf_mslip;   /* the UKF predicts with the hardware-like plant's element set */
     float ukf_qs[2]; /* factors on the UKF's z and g_p process noise (0: 1) */
+    double pf_load;  /* the PF's shared external force's random walk, N^2/s (0: the machine's) */
+    double pf_gp_tau; /* the PF's g_p along the Stribeck curve, time constant s (0: the machine's) */
     br_circle_path_t path; /* the circle (default the thesis's) */
     int hw_clamp;          /* the hardware-like plant's clamp limit instead of the slip law */
     double hw_c_mps;       /* its slip law's C (<= 0: BR_CIRCLE_HW_C_MPS) */
@@ -161,9 +163,8 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
-            "       [--ahead P] [--ukf-load Q_N2_PER_S] [--ukf-mslip] [--ukf-q-scale FZ,FG] [--radius-m R]\n"
-            "       [--feed-mm-min F]\n"
-            "       [--dir cw|ccw|both]\n"
+            "       [--ahead P] [--ukf-load Q_N2_PER_S] [--ukf-mslip] [--ukf-q-scale FZ,FG] [--pf-load Q_N2_PER_S]\n"
+            "       [--pf-gp-curve TAU_S] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
             "       [--hw-law slip|clamp] [--hw-c-mps C]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
@@ -178,6 +179,8 @@ static int usage(const char *argv0, FILE *to)
             "  --ukf-mslip         on the hardware-like plant, the UKF predicts with its Maxwell-slip\n"
             "                      elements (clamp form, docs/modules/ukf.md)\n"
             "  --ukf-q-scale FZ,FG the UKF's z and g_p process noise times FZ and FG (1e-6 .. 1e6)\n"
+            "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9; docs/modules/pf.md)\n"
+            "  --pf-gp-curve TAU   the PF's g_p along the Stribeck curve, time constant TAU s (0 .. 100; docs/modules/pf.md)\n"
             BR_CIRCLE_USAGE("--dir cw|ccw|both  ") "                      (both: each controller both ways, the ISO 230-4 pair; --direction the same)\n"
             "  --hw-law slip|clamp the hardware-like plant's Maxwell-slip law (default slip, docs/demo.md)\n"
             "  --hw-c-mps C        its slip law's attraction rate C, m/s (default %g, %g .. %g)\n"
@@ -212,6 +215,8 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"ukf-load", required_argument, NULL, 'l'},
                                          {"ukf-mslip", no_argument, NULL, 'e'},
                                          {"ukf-q-scale", required_argument, NULL, 'q'},
+                                         {"pf-load", required_argument, NULL, 'L'},
+                                         {"pf-gp-curve", required_argument, NULL, 'G'},
                                          {"hw-law", required_argument, NULL, 'w'},
                                          {"hw-c-mps", required_argument, NULL, 'c'},
                                          BR_CIRCLE_LONGOPTS BR_CIRCLE_LONGOPT_DIR{NULL, 0, NULL, 0}};
@@ -243,6 +248,8 @@ static int parse(int argc, char **argv, opts_t *o)
             if (bad) fprintf(stderr, "%s: --ukf-q-scale %s: two comma-separated factors in [1e-6, 1e6]\n", TOOL, val);
             break;
         }
+        case 'L': bad = br_arg_double(TOOL, p.opt, val, 0.0, 1.0e9, &o->pf_load); break;
+        case 'G': bad = br_arg_double(TOOL, p.opt, val, 0.0, 100.0, &o->pf_gp_tau); break;
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, p.opt, val, 1, &o->path); break;
         case 'w':
             o->hw_clamp = strcmp(val, "clamp") == 0;
@@ -343,7 +350,8 @@ static void hw_describe(FILE *js, const opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, {0.0f, 0.0f}, BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, {0.0f, 0.0f}, 0.0, 0.0,
+                  BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -458,6 +466,8 @@ int main(int argc, char **argv)
                     cfg.ukf.est.q_var[BR_X_Z] *= opt.ukf_qs[0];
                     cfg.ukf.est.q_var[BR_X_GP] *= opt.ukf_qs[1];
                 }
+                br_circle_use_pf_load(&cfg, opt.pf_load);
+                br_circle_use_pf_gp_curve(&cfg, opt.pf_gp_tau);
                 sinks_t k = {o.trace[pl][d][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl][d].f : NULL};
                 br_circle_csv_header(k.trace);
                 if (k.hist)

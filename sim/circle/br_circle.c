@@ -123,6 +123,22 @@ void br_circle_use_ukf_load(br_circle_cfg_t *c, double q_N2ps)
     }
 }
 
+void br_circle_use_pf_load(br_circle_cfg_t *c, double q_N2ps)
+{
+    if (q_N2ps > 0.0) {
+        c->pf.load.q_N2 = (float)(q_N2ps * (double)c->pf.est.model.dt_s);
+        c->pf.load.max_N = (float)((double)BR_MACHINE_TORQUE_LIMIT_NM_F / c->plant.lead_mprad);
+    }
+}
+
+void br_circle_use_pf_gp_curve(br_circle_cfg_t *c, double tau_s)
+{
+    if (tau_s > 0.0) {
+        c->pf.gp_curve.on = 1u;
+        c->pf.gp_curve.rho = (float)exp(-(double)c->pf.est.model.dt_s / tau_s);
+    }
+}
+
 double br_circle_feed_mps(const br_circle_cfg_t *c)
 {
     return 2.0 * BR_PI * c->radius_m / c->period_s;

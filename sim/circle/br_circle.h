@@ -121,6 +121,17 @@ void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods);
  * machine file's. */
 void br_circle_use_ukf_load(br_circle_cfg_t *c, double q_N2ps);
 
+/* The tools' --pf-load: the PF's shared external force (docs/modules/pf.md,
+ * "External force") with the random walk q_N2ps (N^2/s) at the PF's period
+ * and |F_d| <= the actuator's force, as machine.py derives them from
+ * estimator.pf.load; q_N2ps <= 0 leaves the machine file's. */
+void br_circle_use_pf_load(br_circle_cfg_t *c, double q_N2ps);
+
+/* The tools' --pf-gp-curve: the PF's g_p along the Stribeck curve
+ * (docs/modules/pf.md, "Fast moves") with the time constant tau_s at the PF's
+ * period; tau_s <= 0 leaves the machine file's. */
+void br_circle_use_pf_gp_curve(br_circle_cfg_t *c, double tau_s);
+
 /* The tools' --delay-id: 0 turns both estimators' delay identification off
  * (est.delay_id, docs/modules/dlyid.md); any other value leaves the machine's. */
 void br_circle_use_delay_id(br_circle_cfg_t *c, long on);

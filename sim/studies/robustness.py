@@ -97,7 +97,7 @@ def run(cmd, env=None):
 
 
 def one_plant(job):
-    i, seed, binp, out, diagnose, only, pf_proposal, ahead, delay_id = job
+    i, seed, binp, out, diagnose, only, pf_proposal, ahead, delay_id, pf_load = job
     ref = reference()
     p = draw(seed, ref)
     d = os.path.join(out, "plants", f"{i:04d}")
@@ -137,6 +137,8 @@ def one_plant(job):
         cmd += ["--pf-proposal", str(pf_proposal)]
     if ahead is not None:
         cmd += ["--ahead", repr(ahead)]
+    if pf_load is not None:
+        cmd += ["--pf-load", repr(pf_load)]
     if delay_id is not None:
         cmd += ["--delay-id", str(delay_id)]
     rc, _, err = run(cmd)
@@ -385,6 +387,8 @@ def main():
     ap.add_argument("--from-summary", help="recompute the statistics from an earlier summary.json's plants")
     ap.add_argument("--pf-proposal", type=int, choices=(0, 1, 2),
                     help="the PF runs' proposal (br_robust_run --pf-proposal; docs/modules/pf.md)")
+    ap.add_argument("--pf-load", type=float,
+                    help="the PF's shared external force, random walk N^2/s (br_robust_run --pf-load; docs/modules/pf.md)")
     ap.add_argument("--ahead", type=float,
                     help="the estimators' compensation lead (br_robust_run --ahead; docs/modules/est.md)")
     ap.add_argument("--delay-id", type=int, choices=(0, 1),
@@ -415,7 +419,7 @@ def main():
         if bad_names:
             ap.error(f"--only: unknown controllers {bad_names}")
         only = ",".join(["hinf_only"] + [k for k in names if k != "hinf_only"])
-    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only, a.pf_proposal, a.ahead, a.delay_id) for i in range(a.n)]
+    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only, a.pf_proposal, a.ahead, a.delay_id, a.pf_load) for i in range(a.n)]
     recs, t0 = [], time.time()
     progress(0, a.n, t0)
     with Pool(a.jobs) as pool:

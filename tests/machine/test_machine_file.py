@@ -53,6 +53,14 @@ def expect_errors(work, name, obj, wanted):
               "%s: %s exits 1 with the messages, no traceback (rc %d)" % (name, script, rc))
 
 
+def est_header(work, name, obj):
+    """gen_machine.py on obj written as NAME.json: its exit status and the br_est_machine.h it wrote."""
+    path = write(work, name + ".json", obj)
+    rc, _ = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, name + "_gen"))
+    with open(os.path.join(work, name + "_gen", "bristle_gen", "est", "br_est_machine.h")) as f:
+        return rc, f.read()
+
+
 def friction_model_cases(work, good):
     """friction_model (docs/machine-file.md): the Maxwell-slip element set, each
     refusal the firmware's br_mslip_cfg_check / br_model_init would make, and a
@@ -279,6 +287,37 @@ def main():
     expect_errors(work, "load_sub.json", withl, [
         "field estimator.ukf.load.q_N2_per_s: gives q_N2 = 1e-43 per step on this machine, outside the "
         "firmware's (0 excluded) [1.17549e-38, 1e+12]"])
+
+    # the PF's shared external force (estimator.pf.load, docs/modules/pf.md): absent = no
+    # BR_EST_PF_LOAD_* (br_machine_cfg.h: off) and the header of before; present: q per step =
+    # q_N2_per_s * estimator.pf.period_s, the bound the actuator's force
+    withp = copy.deepcopy(good)
+    withp["estimator"]["pf"]["load"] = {"q_N2_per_s": 1.0e4}
+    rc, hdr = est_header(work, "pf_load", withp)
+    check(rc == 0 and "#define BR_EST_PF_LOAD_Q_N2_F (%s)" % machine.c_float(1.0e4 * good["estimator"]["pf"]["period_s"])
+          in hdr and "#define BR_EST_PF_LOAD_MAX_N_F (%s)" % machine.c_float(F_act) in hdr,
+          "pf_load.json: gen_machine.py writes the PF's external force (q per PF step, the actuator's force)")
+    rc, hdr = est_header(work, "pf_noload", good)
+    check(rc == 0 and machine.pf_load(good) is None and "BR_EST_PF_LOAD" not in hdr,
+          "no estimator.pf.load: the PF's external force is off, nothing in the header")
+    withp["estimator"]["pf"]["load"] = {"q_N2_per_s": 0.0}
+    expect_errors(work, "pf_load0.json", withp, ["field estimator.pf.load.q_N2_per_s: 0 is outside (0, 1e+09]"])
+    withp["estimator"]["pf"]["load"] = {"q_N2_per_s": 2.0e9}
+    expect_errors(work, "pf_load_big.json", withp,
+                  ["field estimator.pf.load.q_N2_per_s: 2e+09 is outside (0, 1e+09]"])
+    withp["estimator"]["pf"]["load"] = {"q_N2_per_s": 1.0e-40}
+    expect_errors(work, "pf_load_sub.json", withp, [
+        "field estimator.pf.load.q_N2_per_s: gives q_N2 = 1.5e-43 per step on this machine, outside the "
+        "firmware's (0 excluded) [1.17549e-38, 1e+12]"])
+    withp["estimator"]["pf"]["load"] = {"q_N2_per_s": 1.0e4}
+    withp["causes"] = {"offset": {"offset_N": -1.5}}
+    expect_errors(work, "pf_load_ext.json", withp, [
+        "field estimator.pf.load: needs the thesis model; the causes offset make the estimators' model the "
+        "extended one"])
+    withp["causes"] = {"actuator_delay": {"delay_s": 1.0e-3}}
+    path = write(work, "pf_load_delay.json", withp)
+    rc, err = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, "pf_load_delay_gen"))
+    check(rc == 0, "pf_load_delay.json: an actuator delay keeps the thesis model (%r)" % err.strip())
 
     # weights that make the sampled loop unstable: no design, a clear message
     bad = copy.deepcopy(good)

@@ -5,6 +5,7 @@
  * compensation of friction + load within the bound, and a counter jump no
  * load can explain still rejected. */
 #include "br_test.h"
+#include "br_test_push.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -67,20 +68,9 @@ static void test_load_guards(void **st)
 static int run_pushed(br_ukf_t *u, double F_N, int n, float *F_comp)
 {
     const br_model_cfg_t *m = &u->cfg.est.model;
-    const double L = m->lead_mprad, Jeff = m->J_kgm2 + L * L * m->M_kg, rpc = u->cfg.est.rad_per_count;
+    const double rpc = u->cfg.est.rad_per_count;
     const br_est_t e = br_ukf_est(u);
-    int outliers = 0;
-    for (int k = 0; k < n; k++) {
-        const double t = (double)k * m->dt_s - 0.1;
-        const double th = (t > 0.0) ? -L * F_N * t * t / (2.0 * Jeff) : 0.0;
-        const double cts = th / rpc + 0.5;
-        const double whole = floor(cts);
-        const br_meas_t y = {(int32_t)whole, (float)(cts - whole)};
-        const br_status_t st = e.step(e.ctx, &y, 0.0f, F_comp);
-        assert_true(st == BR_OK || st == BR_W_OUTLIER);
-        outliers += st == BR_W_OUTLIER;
-    }
-    return outliers;
+    return br_test_run_pushed(&e, m, rpc, F_N, n, F_comp);
 }
 
 static void test_load_step_followed(void **st)

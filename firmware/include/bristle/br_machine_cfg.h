@@ -50,6 +50,13 @@
         .switch_ratio = BR_EST_##E##_DELAY_ID_SWITCH_RATIO_F                                       \
     }
 
+/* the PF's shared external force: the machine file's estimator.pf.load (BR_EST_PF_LOAD_*,
+ * written only with the block); without it off, both 0 (docs/modules/pf.md, "External force") */
+#ifndef BR_EST_PF_LOAD_Q_N2_F
+#define BR_EST_PF_LOAD_Q_N2_F 0.0f
+#define BR_EST_PF_LOAD_MAX_N_F 0.0f
+#endif
+
 /* the eq. 6 estimation model of the machine at period dt (float) */
 #define BR_MACHINE_MODEL_CFG(dt)                                                                   \
     {                                                                                              \
@@ -85,7 +92,8 @@
         .noise = br_noise_table, .noise_len = BR_NOISE_LEN, .noise_skip = BR_EST_PF_NOISE_SKIP,    \
         .adapt = {.nis_ref = BR_EST_PF_ADAPT_NIS_REF_F, .alpha = BR_EST_PF_ADAPT_ALPHA_F,            \
                   .max_scale = BR_EST_PF_ADAPT_MAX_SCALE_F},                                       \
-        .gp_curve = {.on = BR_EST_PF_GP_CURVE_ON, .rho = BR_EST_PF_GP_CURVE_RHO_F}                 \
+        .gp_curve = {.on = BR_EST_PF_GP_CURVE_ON, .rho = BR_EST_PF_GP_CURVE_RHO_F},                \
+        .load = {BR_EST_PF_LOAD_Q_N2_F, BR_EST_PF_LOAD_MAX_N_F}                                    \
     }
 
 /* the machine file's (hand-tuned) variances: the start of the tuning */

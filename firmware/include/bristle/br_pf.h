@@ -75,6 +75,24 @@ typedef struct {
  * period (it moves theta by h/2 of it), so theta and omega are correlated in
  * Q and the proposal corrects both. A measured step only; the scalar path
  * runs it (the vector path's loops are the prior's). */
+/* cfg.load (docs/modules/pf.md, "External force"): one load force F_d (N,
+ * load side, against +x as friction is) shared by every particle, estimated
+ * by a scalar Kalman filter beside the particles. Off (the thesis filter, bit
+ * for bit) when both fields are 0. On, each step predicts the particles with
+ * the torque u - L F_d, takes the cloud's mean innovation as a measurement of
+ * F_d's change over the period (theta moves by -g k^2 dF, g = L h^2 / (2 J_eff),
+ * k the periods since the last measurement), moves the cloud by what the
+ * change explains (theta by -g k^2 dF, omega by -(2 g k / h) dF) before
+ * weighing, and compensates f_nl + F_d. A gated innovation that a change of
+ * at most 2 max_N explains is re-acquired as a load (the variance of F_d
+ * inflated by the change squared), not rejected. The kernels are untouched:
+ * only the torque they are given changes. */
+typedef struct {
+    float q_N2;  /* random walk of F_d per step, N^2: a normal float <= BR_EST_VAR_MAX when on, 0: off */
+    float max_N; /* |F_d| and the compensation kept <= max_N (the actuator's force); its initial
+                    variance is max_N^2; > 0 when on, 0: off */
+} br_pf_load_t;
+
 #define BR_PF_PROPOSAL_PRIOR 0u
 #define BR_PF_PROPOSAL_OPT 1u
 #define BR_PF_PROPOSAL_OPT_HELD 2u
@@ -94,6 +112,7 @@ typedef struct {
     br_pf_adapt_t adapt;     /* innovation-driven process noise of omega, z and g_p (all 0: off) */
     uint32_t proposal;       /* BR_PF_PROPOSAL_*: 0 (default) the thesis's bootstrap filter */
     br_pf_gp_curve_t gp_curve; /* g_p along the model's Stribeck curve (on = 0: off, g_p' = 0) */
+    br_pf_load_t load;       /* the shared external force (all 0: off) */
 } br_pf_cfg_t;
 
 /* What each step makes: the force to compensate and theta's origin. */
@@ -141,6 +160,11 @@ typedef struct {
      * S = Q_theta' + R, and the prior's coupling h/2 sqrt(Q_omega) of omega's
      * sample into theta (OPT_HELD; 0 otherwise) */
     float prop_k_th, prop_k_om, prop_l00, prop_l10, prop_l11, prop_inv_2s, prop_hold;
+    /* cfg.load: the shared external force's estimate F_d (N); the covariance of the cloud's common
+     * error [theta, omega, F_d] (rad, rad/s, N), its upper triangle P00 P01 P02 P11 P12 P22;
+     * g = L h^2 / (2 J_eff) (rad per N over one period); the re-acquisitions counted */
+    float load_N, load_P[6], load_g_radpN;
+    uint32_t n_load_acq;
     int primed;                   /* particles drawn around the first measurement */
     /* particles as a structure of arrays: x[i][j] is state i of particle j.
      * One set, predicted and resampled in place (docs/modules/pf.md). */
