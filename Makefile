@@ -177,8 +177,8 @@ demo: deps
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_demo.py $(DEMO_OUT)
 
 # Nelder-Mead tuning of the PF's and the UKF's noise variances on the circle
-# (thesis section 3.2) and on the Maxwell-slip guard plants (the UKF, docs/tuning.md,
-# "Presliding that is not LuGre"): regenerates firmware/gen/bristle_gen/est/br_{pf,ukf}_tuned.h
+# (thesis section 3.2; br_tune_est --mslip-target adds the Maxwell-slip guard plants,
+# docs/tuning.md, "Presliding that is not LuGre"): regenerates firmware/gen/bristle_gen/est/br_{pf,ukf}_tuned.h
 # with the whole search (ctest regen_*_tuned checks only its checkpoint), the
 # progress logs and thesis Fig. 1 in $(TUNE_OUT). docs/tuning.md.
 # `make tune MACHINE=<file>` tunes another machine (docs/tuning.md, "Another

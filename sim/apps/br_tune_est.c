@@ -143,13 +143,14 @@ static int cmp_double(const void *a, const void *b)
  * the noisy guard plants (the robustness set loses no plant with it, against
  * 84 with the nominal objective alone, K = 0; docs/tuning.md) */
 #define BR_TUNE_GUARD_OUTLIERS_PF 0.01
-/* --mslip-target's defaults: the UKF's is issue 30's goal on the demo's
- * hardware-like plant (H-inf + UKF <= 4.0e-7 m) over H-inf only's 2.947e-6 m
- * there (docs/demo.md), a ratio that holds on any machine. The PF's goal
- * (2.0e-7 m, 0.068) is not its default yet: its search with these guards
- * (six 8 s runs an evaluation) was not run to the end (docs/tuning.md), so
- * the PF's objective stays the LuGre guards' until it is */
-#define BR_TUNE_MSLIP_TARGET_UKF 0.136
+/* --mslip-target's defaults. The goals are issue 30's on the demo's
+ * hardware-like plant over H-inf only's 2.947e-6 m there (docs/demo.md),
+ * ratios that hold on any machine: UKF 4.0e-7 m, 0.136; PF 2.0e-7 m, 0.068.
+ * Neither is the default yet (docs/tuning.md, "Presliding that is not
+ * LuGre"): the UKF tuned with 0.136 loses lock on the 2 ms delay plant of
+ * test_circle's test_delay_identified, and the PF's search with the guards
+ * was not run to the end */
+#define BR_TUNE_MSLIP_TARGET_UKF 0.0
 #define BR_TUNE_MSLIP_TARGET_PF 0.0
 
 /* The PF's guard plants, each without a safe stop: 0 when all pass, otherwise
