@@ -177,7 +177,9 @@ demo: deps
 	$(Q)MPLBACKEND=Agg $(PYTHON) sim/plots/plot_demo.py $(DEMO_OUT)
 
 # Nelder-Mead tuning of the PF's and the UKF's noise variances on the circle
-# (thesis section 3.2): regenerates firmware/gen/bristle_gen/est/br_{pf,ukf}_tuned.h, with the
+# (thesis section 3.2; br_tune_est --mslip-target adds the Maxwell-slip guard plants,
+# docs/tuning.md, "Presliding that is not LuGre"): regenerates firmware/gen/bristle_gen/est/br_{pf,ukf}_tuned.h
+# with the whole search (ctest regen_*_tuned checks only its checkpoint), the
 # progress logs and thesis Fig. 1 in $(TUNE_OUT). docs/tuning.md.
 # `make tune MACHINE=<file>` tunes another machine (docs/tuning.md, "Another
 # machine"): a host-release build for it in its build folder (build_dir.py),
@@ -345,7 +347,7 @@ regen: deps
 	$(Q)$(PYTHON) tests/rec/gen_rec_golden.py
 	$(call configure,host-release)
 	$(call build,host-release)
-	$(Q)echo "== regen: tuned estimator variances (about 3 min)"
+	$(Q)echo "== regen: tuned estimator variances (about 5 min)"
 	$(Q)build/host-release/sim/br_tune_est --est ukf --out firmware/gen/bristle_gen/est/br_ukf_tuned.h > /dev/null
 	$(Q)build/host-release/sim/br_tune_est --est pf --out firmware/gen/bristle_gen/est/br_pf_tuned.h > /dev/null
 	$(Q)echo "== regen: golden traces"

@@ -5,7 +5,7 @@
  *
  * Usage: br_tune_est --est pf|ukf --out HEADER [--log CSV] [--max-fev N]
  *                    [--plants P1.json,P2.json,... [--stat median|p90]] [--guard-noise F]
- *                    [--guard-outliers K]
+ *                    [--guard-outliers K] [--mslip-target R]
  * --plants: the robust objective (docs/robustness.md, "Robust tuning"): the
  * penalised contour RMS on each plant (model.json files, e.g. the robustness
  * study's plant.json), and its median or 90th percentile (nearest rank) over
@@ -16,7 +16,10 @@
  * The objective is penalised by the outlier steps (lost lock); with
  * --guard-outliers K (PF; default BR_TUNE_GUARD_OUTLIERS_PF, what `make tune`
  * runs) also by those on the guard plants (docs/tuning.md, "A noise-aware
- * objective"). The start is
+ * objective"); and, unless --mslip-target 0, by the settings' contour RMS on
+ * the Maxwell-slip guard plants (tune/br_tune_mslip.h; docs/tuning.md,
+ * "Presliding that is not LuGre"). A run that stops the axis, on the nominal
+ * plant or a guard plant, counts as a failure of the setting. The start is
  * the hand-tuned default of the machine file's estimator section; each log-variance may move 3 decades
  * either way (bounds by the change of variables of br_nm). The outputs are
  * written beside their names and renamed once the tuning succeeded
@@ -30,6 +33,7 @@
 #include "circle/br_circle_est.h"
 #include "plant/br_plant_json.h"
 #include "tune/br_nm.h"
+#include "tune/br_tune_mslip.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "tools/br_args.h"
 #include "tools/br_outfile.h"
@@ -49,12 +53,27 @@ typedef struct {
     int p90;                /* 1: the 90th percentile over the plants, 0: the median */
     double guard_noise_N;   /* the PF's second guard plant's force noise (--guard-noise) */
     double guard_outliers;  /* the PF's objective x (1 + this x the guard plants' outlier steps) */
+    double mslip_target;    /* the objective x (1 + the Maxwell-slip guards' worst RMS / H-inf only's / this);
+                               0: no Maxwell-slip guard */
+    br_tune_mslip_t mslip;  /* those guard plants */
     /* the searches before this one (several starts): their iterations,
      * evaluations, best value and point, so that the log runs on monotonically */
     int iter0, nfev0;
     double f_prev;
     double x_prev[MAX_P];
+    /* the checkpoint: the first search's best after its last iteration within
+     * BR_TUNE_CHECKPOINT_FEV evaluations (ck_iter 0: none yet) */
+    int ck_iter, ck_nfev;
+    double ck_f;
+    double ck_x[MAX_P];
 } tune_t;
+
+/* The checkpoint's budget: a search cut there (--checkpoint, ctest
+ * regen_<est>_tuned) passes through the same points as the full one up to
+ * its last iteration within it, so the header's checkpoint line shows that
+ * it came from this objective and start without rerunning the whole search
+ * (make tune and make regen run that). */
+#define BR_TUNE_CHECKPOINT_FEV 30
 
 /* The PF's further start (its variances: q_omega (rad/s)^2, q_z m^2, q_gp N^2,
  * R in counts^2): the point an earlier, unpenalised Nelder-Mead run found
@@ -84,14 +103,19 @@ static const char *param_name(int pf, int i)
 
 /* objective: contour RMS (m) of the circle with the variances e^x, times
  * (1 + outlier steps): a filter that loses lock and has to re-anchor is not an
- * acceptable tuning, however small its RMS */
-static double one_plant(const br_circle_cfg_t *c, int robust)
+ * acceptable tuning, however small its RMS. A run that stops the axis (a
+ * fault) is no tuning either: INFINITY, and with stopped != NULL (the nominal
+ * plant) 0 with *stopped += 1 + the share of the run lost, so that the
+ * search can leave such a region (BR_TUNE_GUARD_PENALTY_M) */
+static double one_plant(const br_circle_cfg_t *c, double *stopped)
 {
     br_circle_result_t r;
-    if (br_circle_run(c, NULL, NULL, &r) != 0) return INFINITY;
-    /* over a plant set a safe stop (fault) is no tuning either (the nominal
-     * objective is kept as make tune has always computed it) */
-    if (robust && r.fault_status != 0) return INFINITY;
+    if (br_circle_run(c, NULL, NULL, &r) < 0) return INFINITY;
+    if (r.fault_status != 0) {
+        if (!stopped) return INFINITY;
+        *stopped += 1.0 + (c->duration_s - r.fault_t_s) / c->duration_s;
+        return 0.0;
+    }
     return r.contour_rms_m * (1.0 + (double)r.outlier_steps);
 }
 
@@ -119,9 +143,18 @@ static int cmp_double(const void *a, const void *b)
  * the noisy guard plants (the robustness set loses no plant with it, against
  * 84 with the nominal objective alone, K = 0; docs/tuning.md) */
 #define BR_TUNE_GUARD_OUTLIERS_PF 0.01
+/* --mslip-target's defaults. The goals are issue 30's on the demo's
+ * hardware-like plant over H-inf only's 2.947e-6 m there (docs/demo.md),
+ * ratios that hold on any machine: UKF 4.0e-7 m, 0.136; PF 2.0e-7 m, 0.068.
+ * Neither is the default yet (docs/tuning.md, "Presliding that is not
+ * LuGre"): the UKF tuned with 0.136 loses lock on the 2 ms delay plant of
+ * test_circle's test_delay_identified, and the PF's search with the guards
+ * was not run to the end */
+#define BR_TUNE_MSLIP_TARGET_UKF 0.0
+#define BR_TUNE_MSLIP_TARGET_PF 0.0
 
 /* The PF's guard plants, each without a safe stop: 0 when all pass, otherwise
- * BR_TUNE_GUARD_PENALTY_M times (failed guards + the share of the run lost);
+ * failed guards + the share of the run lost (times BR_TUNE_GUARD_PENALTY_M: the objective);
  * *outliers gets the outlier steps of the three runs together.
  * 1. the demo's realistic plant (docs/demo.md): a tuning that only the exact
  *    model tolerates is none (make demo runs both plants);
@@ -131,7 +164,7 @@ static int cmp_double(const void *a, const void *b)
  * 3. the same with bristles at the top of the study's stiffness and damping
  *    range (a factor 2 on the reference's): a tuning that holds lock only on
  *    soft bristles is none either. */
-static double guard_penalty(const br_circle_cfg_t *c, double noise_N, double *outliers)
+static double guard_stops(const br_circle_cfg_t *c, double noise_N, double *outliers)
 {
     const br_circle_cfg_t ref = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     double failed = 0.0;
@@ -153,7 +186,7 @@ static double guard_penalty(const br_circle_cfg_t *c, double noise_N, double *ou
             failed += 1.0 + (T - r.fault_t_s) / T;
         }
     }
-    return failed * BR_TUNE_GUARD_PENALTY_M;
+    return failed;
 }
 
 static double objective(void *user, const double *x, int n)
@@ -162,22 +195,27 @@ static double objective(void *user, const double *x, int n)
     br_circle_cfg_t c = t->base;
     for (int i = 0; i < n; i++) *param_ptr(&c, t->pf, i) = (float)exp(x[i]);
     if (t->n_plants == 0) {
-        const double f = one_plant(&c, 0);
-        if (t->pf && isfinite(f)) {
-            double outliers;
-            const double g = guard_penalty(&c, t->guard_noise_N, &outliers);
-            if (g > 0.0) return g;
-            /* --guard-outliers: a filter that loses lock on the guard plants
-             * now and then counts too (0: the nominal objective alone) */
-            return f * (1.0 + t->guard_outliers * outliers);
+        double stopped = 0.0, outliers = 0.0, worst = 0.0;
+        const double f = one_plant(&c, &stopped);
+        if (t->pf) stopped += guard_stops(&c, t->guard_noise_N, &outliers);
+        if (t->mslip_target > 0.0) {
+            double ms;
+            worst = br_tune_mslip_worst(&t->mslip, &c, &ms);
+            stopped += ms;
         }
-        return f;
+        if (!isfinite(f) || !isfinite(stopped) || !isfinite(worst)) return INFINITY;
+        if (stopped > 0.0) return stopped * BR_TUNE_GUARD_PENALTY_M;
+        /* --guard-outliers: a filter that loses lock on the guard plants
+         * now and then counts too (0: the nominal objective alone);
+         * --mslip-target: so does its figure where presliding is not LuGre */
+        const double ms_factor = t->mslip_target > 0.0 ? 1.0 + worst / t->mslip_target : 1.0;
+        return f * (1.0 + t->guard_outliers * outliers) * ms_factor;
     }
     /* the robust objective: median or p90 (nearest rank) over the plants */
     double v[MAX_PLANTS];
     for (int j = 0; j < t->n_plants; j++) {
         c.plant = t->plants[j];
-        v[j] = one_plant(&c, 1);
+        v[j] = one_plant(&c, NULL);
     }
     qsort(v, (size_t)t->n_plants, sizeof v[0], cmp_double);
     const int k = t->p90 ? (int)ceil(0.9 * t->n_plants) - 1 : (t->n_plants - 1) / 2;
@@ -187,6 +225,12 @@ static double objective(void *user, const double *x, int n)
 static void progress(void *user, int iter, int nfev, const double *xb, double fb, int n)
 {
     tune_t *t = user;
+    if (t->iter0 == 0 && t->nfev0 == 0 && nfev <= BR_TUNE_CHECKPOINT_FEV) {
+        t->ck_iter = iter;
+        t->ck_nfev = nfev;
+        t->ck_f = fb;
+        memcpy(t->ck_x, xb, sizeof(double) * (size_t)n);
+    }
     /* the best over every search so far */
     if (t->f_prev < fb) {
         fb = t->f_prev;
@@ -203,23 +247,46 @@ static void progress(void *user, int iter, int nfev, const double *xb, double fb
     }
 }
 
+/* the header's checkpoint line (BR_TUNE_CHECKPOINT_FEV) */
+static void write_checkpoint(FILE *f, const tune_t *t)
+{
+    fprintf(f, "/* checkpoint (--checkpoint): first search, iteration %d, %d evaluations: %.6e m at", t->ck_iter,
+            t->ck_nfev, t->ck_f);
+    for (int i = 0; i < n_params(t); i++) fprintf(f, " %s=%.6e", param_name(t->pf, i), exp(t->ck_x[i]));
+    fprintf(f, " */\n");
+}
+
+/* the header (and the log) renamed into place: the exit status */
+static int commit_outputs(br_outfile_t *header, br_outfile_t *log, const char *log_path)
+{
+    int rc = br_outfile_commit(header, TOOL);
+    if (rc == 0 && log_path) rc = br_outfile_commit(log, TOOL);
+    br_outfile_discard(header);
+    br_outfile_discard(log);
+    return rc == 0 ? 0 : 1;
+}
+
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s --est pf|ukf --out HEADER [--log CSV] [--max-fev N]\n"
+            "usage: %s --est pf|ukf --out HEADER [--log CSV] [--max-fev N | --checkpoint]\n"
             "       [--plants P1.json,P2.json,... [--stat median|p90]]\n" BR_ARGS_COMMON_USAGE
             "  --est pf|ukf        the estimator whose noise variances are tuned\n"
             "  --out HEADER        the tuned header (br_<est>_tuned.h)\n"
             "  --log CSV           every evaluation, one row each\n"
             "  --max-fev N         evaluation budget of the Nelder-Mead search\n"
+            "  --checkpoint        the first search up to %d evaluations; HEADER gets only its checkpoint line\n"
+            "                      (a full tuning's header has the same line)\n"
             "  --plants LIST       model.json files, comma-separated: tune for a set of plants (robust objective)\n"
             "  --stat median|p90   the set's statistic the objective takes (default median)\n"
             "  --guard-noise F     PF: the force noise of the noisy guard plant, N (default %g)\n"
             "  --guard-outliers K  PF: the objective x (1 + K x the guard plants' outlier steps) (default %g)\n"
+            "  --mslip-target R    the objective x (1 + the Maxwell-slip guard plants' worst contour RMS\n"
+            "                      / H-inf only's / R) (default UKF %g, PF %g; 0: no such guard; the PF's goal: 0.068)\n"
             "bounds: --max-fev 1 .. %d (docs/tools.md), at most %d plants, --guard-noise 0 .. %g,\n"
-            "        --guard-outliers 0 .. %g\n",
-            argv0, argv0, BR_TUNE_GUARD_FORCE_NOISE_N, BR_TUNE_GUARD_OUTLIERS_PF, BR_TOOL_MAX_FEV, MAX_PLANTS, BR_TUNE_GUARD_NOISE_MAX_N,
-            BR_TUNE_GUARD_OUTLIERS_MAX);
+            "        --guard-outliers 0 .. %g, --mslip-target 0 .. 1\n",
+            argv0, argv0, BR_TUNE_CHECKPOINT_FEV, BR_TUNE_GUARD_FORCE_NOISE_N, BR_TUNE_GUARD_OUTLIERS_PF, BR_TUNE_MSLIP_TARGET_UKF,
+            BR_TUNE_MSLIP_TARGET_PF, BR_TOOL_MAX_FEV, MAX_PLANTS, BR_TUNE_GUARD_NOISE_MAX_N, BR_TUNE_GUARD_OUTLIERS_MAX);
     return 2;
 }
 
@@ -229,6 +296,8 @@ int main(int argc, char **argv)
     long max_fev = 0;
     double guard_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N, guard_outliers = BR_TUNE_GUARD_OUTLIERS_PF;
     int guard_opt = 0; /* --guard-noise or --guard-outliers given */
+    double mslip_target = -1.0; /* --mslip-target; < 0: the estimator's default */
+    int checkpoint = 0;         /* --checkpoint */
     static const struct option opts[] = {{"est", required_argument, NULL, 'e'},
                                          {"out", required_argument, NULL, 'o'},
                                          {"log", required_argument, NULL, 'l'},
@@ -237,6 +306,8 @@ int main(int argc, char **argv)
                                          {"stat", required_argument, NULL, 's'},
                                          {"guard-noise", required_argument, NULL, 'g'},
                                          {"guard-outliers", required_argument, NULL, 'k'},
+                                         {"mslip-target", required_argument, NULL, 'm'},
+                                         {"checkpoint", no_argument, NULL, 'c'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -257,6 +328,8 @@ int main(int argc, char **argv)
             bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_TUNE_GUARD_OUTLIERS_MAX, &guard_outliers);
             guard_opt = 1;
             break;
+        case 'c': checkpoint = 1; break;
+        case 'm': bad = br_arg_double(TOOL, p.opt, v, 0.0, 1.0, &mslip_target); break;
         case 's':
             if (strcmp(v, "median") == 0 || strcmp(v, "p90") == 0) {
                 stat = v;
@@ -275,6 +348,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: --guard-noise and --guard-outliers need --est pf without --plants\n", TOOL);
         return 2;
     }
+    /* the Maxwell-slip guards belong to the nominal objective too */
+    if (mslip_target >= 0.0 && plants) {
+        fprintf(stderr, "%s: --mslip-target needs the nominal objective (no --plants)\n", TOOL);
+        return 2;
+    }
+    if (checkpoint && max_fev > 0) {
+        fprintf(stderr, "%s: --checkpoint has its own budget (%d): no --max-fev\n", TOOL, BR_TUNE_CHECKPOINT_FEV);
+        return 2;
+    }
     if (log_path && strcmp(log_path, out) == 0) {
         fprintf(stderr, "%s: --log and --out name the same file\n", TOOL);
         return 2;
@@ -291,6 +373,14 @@ int main(int argc, char **argv)
     t.p90 = strcmp(stat, "p90") == 0;
     t.guard_noise_N = guard_noise_N;
     t.guard_outliers = guard_outliers;
+    t.mslip_target = plants ? 0.0
+                   : mslip_target >= 0.0 ? mslip_target
+                   : t.pf ? BR_TUNE_MSLIP_TARGET_PF : BR_TUNE_MSLIP_TARGET_UKF;
+    if (t.mslip_target > 0.0 && br_tune_mslip_init(&t.mslip, t.pf ? BR_CTRL_HINF_PF : BR_CTRL_HINF_UKF) != 0) {
+        br_outfile_discard(&header_file);
+        br_outfile_discard(&log_file);
+        return 1;
+    }
     t.n_plants = 0;
     if (plants) {
         const br_plant_cfg_t ref = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY).plant;
@@ -347,13 +437,14 @@ int main(int argc, char **argv)
     cfg.init_step = 0.25; /* about 0.7 decade of each variance from the start */
     cfg.xatol = 0.01;     /* about 3 % of each variance */
     cfg.fatol = 1e-12;    /* 1 pm of contour RMS */
-    cfg.max_fev = max_fev > 0 ? (int)max_fev : (t.pf ? 120 : 400);
+    cfg.max_fev = checkpoint ? BR_TUNE_CHECKPOINT_FEV : max_fev > 0 ? (int)max_fev : (t.pf ? 120 : 400);
     cfg.lo = lo;
     cfg.hi = hi;
     cfg.progress = progress;
     /* one search from each start (the PF on the nominal plant: the hand-tuned one, then pf_start2);
      * the better result wins, the first on a tie */
-    const int n_starts = (t.pf && t.n_plants == 0) ? 2 : 1; /* the robust objective: one start */
+    /* the robust objective and the checkpoint: one start */
+    const int n_starts = (t.pf && t.n_plants == 0 && !checkpoint) ? 2 : 1;
     const double rpc2 = (double)t.base.pf.est.rad_per_count * (double)t.base.pf.est.rad_per_count;
     br_nm_result_t r;
     int ok = isfinite(f0), win = 0, nfev_all = 0;
@@ -384,6 +475,11 @@ int main(int argc, char **argv)
         t.f_prev = r.f;
         memcpy(t.x_prev, r.x, sizeof(double) * (size_t)n);
     }
+    if (ok && checkpoint) {
+        /* the checkpoint line alone, whatever the search reached */
+        write_checkpoint(header_file.f, &t);
+        return commit_outputs(&header_file, &log_file, log_path);
+    }
     if (ok && r.f >= BR_TUNE_GUARD_PENALTY_M) {
         fprintf(stderr, "%s: no variances found that pass the guard plants (best %.4e m); nothing written\n", TOOL, r.f);
         ok = 0;
@@ -403,9 +499,20 @@ int main(int argc, char **argv)
         printf("per plant:");
         for (int j = 0; j < t.n_plants; j++) {
             c.plant = t.plants[j];
-            printf(" %.4e", one_plant(&c, 1));
+            printf(" %.4e", one_plant(&c, NULL));
         }
         printf("\n");
+    }
+    /* the result's two figures (the objective multiplies them) */
+    double res_nominal_m = NAN, res_worst = NAN;
+    if (t.mslip_target > 0.0) {
+        br_circle_cfg_t c = t.base;
+        for (int i = 0; i < n; i++) *param_ptr(&c, t.pf, i) = (float)exp(r.x[i]);
+        double stopped = 0.0, ms = 0.0;
+        res_nominal_m = one_plant(&c, &stopped);
+        res_worst = br_tune_mslip_worst(&t.mslip, &c, &ms);
+        printf("nominal contour RMS %.4e m (x (1 + outliers)); Maxwell-slip guards: worst %.4f of H-inf only\n",
+               res_nominal_m, res_worst);
     }
     FILE *h = header_file.f;
     const char *E = t.pf ? "PF" : "UKF";
@@ -423,14 +530,17 @@ int main(int argc, char **argv)
     if (t.pf && t.n_plants == 0 && guard_outliers > 0.0) {
         fprintf(h, "/* objective x (1 + %g x the guard plants' outlier steps) (--guard-outliers) */\n", guard_outliers);
     }
+    if (t.mslip_target > 0.0) {
+        fprintf(h, "/* objective x (1 + the Maxwell-slip guard plants' worst RMS / H-inf only's / %g) (--mslip-target): */\n",
+                t.mslip_target);
+        fprintf(h, "/* the result's nominal contour RMS %.4e m, worst Maxwell-slip guard %.4f of H-inf only */\n",
+                res_nominal_m, res_worst);
+    }
+    write_checkpoint(h, &t);
     fprintf(h, "#ifndef BR_%s_TUNED_H\n#define BR_%s_TUNED_H\n\n", E, E);
     for (int i = 0; i < n; i++) {
         fprintf(h, "#define BR_%s_TUNED_%s (%.9ef)\n", E, param_name(t.pf, i), (double)(float)exp(r.x[i]));
     }
     fprintf(h, "\n#endif\n");
-    int rc = br_outfile_commit(&header_file, TOOL);
-    if (rc == 0 && log_path) rc = br_outfile_commit(&log_file, TOOL);
-    br_outfile_discard(&header_file);
-    br_outfile_discard(&log_file);
-    return rc == 0 ? 0 : 1;
+    return commit_outputs(&header_file, &log_file, log_path);
 }

@@ -338,6 +338,14 @@ class ToolsTest(unittest.TestCase):
                            ("pf", ["--guard-outliers", "0.1", "--plants", os.path.join(self.w, "none.json")])):
             r = run("br_tune_est", "--est", est, "--out", header, "--max-fev", "6", *extra)
             self.assert_refused(r, 2, "--guard-noise and --guard-outliers")
+        # the Maxwell-slip guards' target: bounded, the nominal objective only; the checkpoint has its budget
+        for bad in (["--mslip-target", "-0.1"], ["--mslip-target", "1.5"], ["--mslip-target", "nan"]):
+            self.assert_refused(run("br_tune_est", "--est", "ukf", "--out", header, *bad), 2)
+        r = run("br_tune_est", "--est", "ukf", "--out", header, "--mslip-target", "0.1", "--plants",
+                os.path.join(self.w, "none.json"))
+        self.assert_refused(r, 2, "--mslip-target needs the nominal objective")
+        r = run("br_tune_est", "--est", "ukf", "--out", header, "--checkpoint", "--max-fev", "6")
+        self.assert_refused(r, 2, "--checkpoint has its own budget")
         self.assert_untouched(header, log)
 
 

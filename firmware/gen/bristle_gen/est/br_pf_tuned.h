@@ -5,6 +5,7 @@
 /* the result of start 2, the better of the 2 searches (251 evaluations in all) */
 /* Nelder-Mead on the H-inf + PF circle: contour RMS 3.0853e-08 m (start 6.3752e-08 m), 125 evaluations, budget reached */
 /* objective x (1 + 0.01 x the guard plants' outlier steps) (--guard-outliers) */
+/* checkpoint (--checkpoint): first search, iteration 13, 29 evaluations: 3.775213e-08 m at q_omega=3.608677e-07 q_z=8.678040e-16 q_gp=1.688157e+00 r=1.438318e-11 */
 #ifndef BR_PF_TUNED_H
 #define BR_PF_TUNED_H
 
