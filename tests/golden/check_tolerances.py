@@ -45,6 +45,9 @@ CHECKS = [
     ("pf_bounds.h", "f_nl in F-hat", rf"#define C_FNL {NUM}", "### pf", rf"\+ {NUM}u S_f,j"),
     ("pf_bounds.h", "float32 sums", rf"#define C_SUM {NUM}", "### pf", rf"D_i \+ {NUM}m·u"),
     ("pf_bounds.h", "br_exp_neg error", rf"#define EXP_REL {NUM}", "### pf", rf"ρ = {NUM} \+"),
+    # pf_load: the common error's Kalman filter
+    ("test_golden_pf_load.c", "Kalman rounding factor", rf"#define C_KF {NUM}", "### pf_load",
+     rf"\(C_KF = {NUM}\)"),
     # mslip
     ("test_golden_mslip.c", "element bound factor", rf"#define C_Z {NUM}", "### mslip",
      rf"\| z_i \| {NUM}·E_i"),
