@@ -67,6 +67,22 @@ def run(cfg, inputs):
     return rows
 
 
+def load_inputs(rows_in, gt, L, F_step):
+    """The filter's input (k, counts, frac, u_prev) from est_input's rows
+    rows_in: the counts without the injected encoder faults, the torque
+    raised by L F_step over steps [LOAD_ON_K, LOAD_OFF_K) (float32-exact)."""
+    inputs = []
+    for r in rows_in:
+        k, counts, frac, u_prev, fault = r[0], r[2], r[3], r[4], r[5]
+        # the encoder without the injected faults (est_input's fault 1: the spike, 2: the slip)
+        counts = gt.rctrl.to_int32(counts - {0: 0, 1: gest.SPIKE_COUNTS, 2: gest.SLIP_COUNTS}[fault])
+        # the torque the filter is told: the applied one, plus L F_step while the load is on
+        if LOAD_ON_K <= k < LOAD_OFF_K:
+            u_prev = gt.f32(u_prev + L * F_step)
+        inputs.append((k, counts, frac, u_prev))
+    return inputs
+
+
 def generate(out_dir, m, gt, rows_in):
     """Writes ukf_load.csv from the recorded input rows_in (gen_est_traces's
     est_input rows); gt is the gen_traces module. Returns the path."""
@@ -74,16 +90,7 @@ def generate(out_dir, m, gt, rows_in):
     ld = load_cfg(f32)
     cfg = dataclasses.replace(gest.ukf_cfg(m, f32), load=ld)
     F_step = LOAD_STEP_FRAC * ld.max_N
-    inputs = []
-    for r in rows_in:
-        k, counts, frac, u_prev, fault = r[0], r[2], r[3], r[4], r[5]
-        # the encoder without the injected faults (est_input's fault 1: the spike, 2: the slip)
-        counts = gt.rctrl.to_int32(counts - {0: 0, 1: gest.SPIKE_COUNTS, 2: gest.SLIP_COUNTS}[fault])
-        # the torque the filter is told: the applied one, plus L F_step while the load is on (float32-exact)
-        if LOAD_ON_K <= k < LOAD_OFF_K:
-            u_prev = f32(u_prev + cfg.model.L * F_step)
-        inputs.append((k, counts, frac, u_prev))
-    rows = run(cfg, inputs)
+    rows = run(cfg, load_inputs(rows_in, gt, cfg.model.L, F_step))
     meta = gest.ukf_meta(cfg) + [
         ("load_q_N2", ld.q_N2), ("load_p0_N2", ld.p0_N2), ("load_max_N", ld.max_N),
         ("load_q_N2_per_s", LOAD_Q_N2_PER_S), ("load_on_k", LOAD_ON_K), ("load_off_k", LOAD_OFF_K),

@@ -35,6 +35,25 @@ One step with y_k = (counts, frac) and the torque u_{k-1} of the last period:
     No valid particle at all: BR_E_NUMERIC, the previous set (and origin) kept.
     Then origin = counts, frac_prev = frac.
 A non-finite u or a frac outside [0, 1]: BR_E_INPUT, nothing changes.
+
+External force (cfg.load, docs/modules/pf.md "External force"; None: off):
+one load force F_d shared by every particle (N, load side, against +x as
+friction is; 0 when priming) and the covariance P (3 x 3) of the cloud's
+common error e = [dtheta, domega, dF], P0 = diag(0, 0, max_N^2).
+g = L h^2 / (2 J_eff), Phi = [1 h -g; 0 1 -2g/h; 0 0 1].
+    0. before the prediction:  P <- Phi P Phi^T + diag(0, 0, q_N2)
+    1. the particles are predicted with the torque u - L F_d
+    after 2. (the valid predicted particles, n of them, theta relative to the
+    new origin): d = mean(theta_j) - y, v = max(0, mean((theta_j - mean)^2))
+       gated (max l below the outlier threshold): dF = d / (g k^2), k = 1
+         (the periods since the last measurement); |dF| > 2 max_N: nothing
+         more, the step goes on as an outlier; otherwise P += dF^2 b b^T,
+         b = [-g k^2, -2 g k / h, 1], a re-acquisition (n_load_acq + 1)
+       S = P00 + v + R + rpc^2/12, K = P[:, 0] / S, nu = -d,
+       theta_j += K0 nu, omega_j += K1 nu (each valid particle; f_nl and l_j
+       made again), F_d <- clamp(F_d + K2 nu, +-max_N), P <- P - K P[0, :]
+       The outlier decision and steps 3-5 then take the moved cloud.
+    F_hat = clamp(mean f_nl + F_d, +-max_N).
 """
 import bisect
 import math
@@ -69,6 +88,13 @@ class PfCfg:
     rad_per_count: float
     noise: tuple          # the ROM table, float values
     noise_skip: int
+    load: object = None   # LoadCfg: the shared external force F_d; None: off
+
+
+@dataclass(frozen=True)
+class LoadCfg:
+    q_N2: float    # random walk of F_d per step, N^2
+    max_N: float   # |F_d| and |F_hat| bound (and sqrt P0 of F_d), N; re-acquisition up to |dF| <= 2 max_N
 
 
 def wrapdiff(now, prev):
@@ -113,6 +139,18 @@ class Pf:
         self.ess = float(cfg.m)
         self.reanchored = False
         self.l = None           # log-weights of the last step
+        # cfg.load: F_d, the common error's covariance, re-acquisitions
+        self.Fd = 0.0
+        self.n_load_acq = 0
+        self.load_acq = False   # the last step re-acquired
+        self.d = 0.0            # the last step's mean innovation mean(theta_j) - y (before the move)
+        self.v = 0.0            # and the spread var(theta_j)
+        self.Pm = None          # P before the last update (after the tick and any inflation)
+        if cfg.load is not None:
+            h = cfg.dt
+            self.g = cfg.model.L * h * h / (2.0 * cfg.model.Jeff)
+            self.Phi = np.array([[1.0, h, -self.g], [0.0, 1.0, -2.0 * self.g / h], [0.0, 0.0, 1.0]])
+            self.P = np.diag([0.0, 0.0, cfg.load.max_N ** 2])
 
     def _n(self, j, i):
         c = self.cfg
@@ -135,6 +173,8 @@ class Pf:
             sf += rmodel.fnl(c.model, xj)
         self.mean = s / c.m
         self.F_hat = sf / c.m
+        if c.load is not None:
+            self.F_hat = min(max(self.F_hat + self.Fd, -c.load.max_N), c.load.max_N)
 
     def _prime(self, counts, frac):
         c = self.cfg
@@ -162,6 +202,10 @@ class Pf:
         rpc = c.rad_per_count
         shift = wrapdiff(counts, self.origin) * rpc
         y = frac * rpc
+        if c.load is not None:
+            # the common error's covariance over the period; the torque with the load
+            self.P = self.Phi @ self.P @ self.Phi.T + np.diag([0.0, 0.0, c.load.q_N2])
+            u = u - c.model.L * self.Fd
         xp, fn, l = [], [], []
         for j in range(c.m):
             st, xn, _ = rmodel.step(c.model, self.x[j], u, c.dt)
@@ -180,7 +224,10 @@ class Pf:
         if lmax == -math.inf:
             self.W = self.idx = None
             return BR_E_NUMERIC
-        outlier = lmax < -0.5 * c.outlier_sigma ** 2 * (c.r_var + rpc * rpc / 12.0) / c.r_var
+        l_gate = -0.5 * c.outlier_sigma ** 2 * (c.r_var + rpc * rpc / 12.0) / c.r_var
+        if c.load is not None:
+            lmax = self._load_update(xp, fn, l, y, lmax < l_gate)
+        outlier = lmax < l_gate
         w = [0.0 if lj == -math.inf else (1.0 if outlier else math.exp(lj - lmax)) for lj in l]
         W = [int(math.floor(wj * 2.0 ** W_BITS)) for wj in w]
         idx = resample_idx(W)
@@ -203,3 +250,39 @@ class Pf:
         self._estimate()
         self.ess = sum(w) ** 2 / sum(wj * wj for wj in w)
         return BR_W_OUTLIER if outlier else BR_OK
+
+    def _load_update(self, xp, fn, l, y, gated):
+        """cfg.load after the weighing: F_d's Kalman update on the cloud's mean
+        innovation (a re-acquisition when gated and explained by a load), the
+        valid particles of xp moved, fn and l made again in place. Returns the
+        largest log-weight."""
+        c = self.cfg
+        ld = c.load
+        valid = [j for j in range(c.m) if l[j] != -math.inf]
+        th = np.array([xp[j][0] for j in valid])
+        self.d = float(np.mean(th)) - y
+        self.v = float(np.mean((th - np.mean(th)) ** 2))
+        self.load_acq = False
+        if gated:
+            k = 1.0  # periods since the last measurement (this reference measures every period)
+            dF = self.d / (self.g * k * k)
+            if not abs(dF) <= 2.0 * ld.max_N:
+                self.Pm = self.P.copy()
+                return max(l)
+            b = np.array([-self.g * k * k, -2.0 * self.g * k / c.dt, 1.0])
+            self.P = self.P + dF * dF * np.outer(b, b)
+            self.load_acq = True
+            self.n_load_acq += 1
+        self.Pm = self.P.copy()
+        S = self.P[0, 0] + self.v + c.r_var + c.rad_per_count ** 2 / 12.0
+        K = self.P[:, 0] / S
+        nu = -self.d
+        self.P = self.P - np.outer(K, self.P[0, :])
+        self.Fd = min(max(self.Fd + K[2] * nu, -ld.max_N), ld.max_N)
+        for j in valid:
+            xj = xp[j]
+            xj[0] += K[0] * nu
+            xj[1] += K[1] * nu
+            fn[j] = rmodel.fnl(c.model, xj)
+            l[j] = -((xj[0] - y) ** 2) / (2.0 * c.r_var)
+        return max(l)

@@ -40,23 +40,8 @@
 #include "bristle/br_encoder.h"
 #include "bristle/br_model.h"
 #include "bristle/br_pf.h"
+#include "pf_bounds.h"
 #include "trace_reader.h"
-
-#define U32 5.9604644775390625e-08 /* float32 unit roundoff 2^-24 */
-
-/* Rounding-chain factors (docs/golden.md): one prediction step as the model
- * golden test (32 u, 64 u for z), the noise addition and clamp of g_p, a
- * log-weight (a difference, a square, a product), one f_nl evaluation, and a
- * float32 sum of m terms (<= m u of the largest). */
-#define C_THETA 32.0
-#define C_OMEGA 32.0
-#define C_Z 64.0
-#define C_GP 2.0
-#define C_L 8.0
-#define C_FNL 32.0
-#define C_SUM 2.0
-/* br_exp_neg: relative error < 5e-6 over [-87, 0] (br_math.h) */
-#define EXP_REL 5.0e-6
 
 typedef struct {
     br_trace_t in, pf, w, x;
@@ -65,45 +50,15 @@ typedef struct {
     int nsteps;
 } pf_golden_t;
 
-static uint32_t fnv1a_table(const float *t, uint32_t n)
-{
-    uint32_t h = 2166136261u;
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t w;
-        memcpy(&w, &t[i], sizeof w);
-        for (int s = 0; s < 32; s += 8) {
-            h ^= (w >> s) & 0xFFu;
-            h *= 16777619u;
-        }
-    }
-    return h;
-}
-
 static void load_all(pf_golden_t *g)
 {
     br_trace_load(&g->in, "est_input");
     br_trace_load(&g->pf, "pf");
     br_trace_load(&g->w, "pf_w");
     br_trace_load(&g->x, "pf_x");
-    const br_trace_t *t = &g->pf;
-    double s0[BR_NX];
-    br_trace_meta_nums(t, "x0_std", s0, BR_NX);
-    br_pf_cfg_t c;
-    memset(&c, 0, sizeof c);
-    c.est = br_trace_est_cfg(t);
-    c.n_particles = (uint32_t)br_trace_meta_num(t, "n_particles");
-    for (int i = 0; i < BR_NX; i++) c.x0_std[i] = (float)s0[i];
-    c.noise = br_noise_table;
-    c.noise_len = BR_NOISE_LEN;
-    c.noise_skip = (uint32_t)br_trace_meta_num(t, "noise_skip");
-    g->cfg = c;
-    g->m = c.n_particles;
+    g->cfg = pf_golden_cfg(&g->pf);
+    g->m = g->cfg.n_particles;
     g->nsteps = g->pf.nrows;
-    assert_true(g->m >= 1u && g->m <= BR_PF_MAX_PARTICLES);
-    assert_int_equal((int)br_trace_meta_num(t, "w_bits"), (int)BR_PF_W_BITS);
-    /* the ROM table the reference used is the one linked here */
-    assert_int_equal((uint32_t)br_trace_meta_num(t, "noise_len"), BR_NOISE_LEN);
-    assert_int_equal((uint32_t)br_trace_meta_num(t, "noise_fnv1a"), fnv1a_table(br_noise_table, BR_NOISE_LEN));
     /* one input row and one pf row per step, (steps - 1) m / block W rows */
     assert_int_equal(g->in.nrows, g->nsteps);
     const int block = (g->w.ncols - 2) / 2;
@@ -173,7 +128,7 @@ static void test_pf_noise_table(void **state)
     pf_golden_t g;
     load_all(&g);
     print_message("golden pf         %d steps, %u particles, ROM table %u samples (FNV-1a %u)\n", g.nsteps,
-                  g.m, (unsigned)BR_NOISE_LEN, fnv1a_table(br_noise_table, BR_NOISE_LEN));
+                  g.m, (unsigned)BR_NOISE_LEN, pf_fnv1a_table(br_noise_table, BR_NOISE_LEN));
     free_all(&g);
 }
 
@@ -241,79 +196,6 @@ static void predicted_set(br_pf_t *pred, const br_meas_t *y, float u)
     }
 }
 
-/* Model constants for the error bounds (double, from the trace header). */
-typedef struct {
-    double h, L, Jeff, s0, s1, s2, R, sig_R, gp_max;
-    double m;
-} pf_consts_t;
-
-/* Bound on |x_C - x_ref| of every particle, per state, n steps after the C
- * set was last re-synchronised to the reference (docs/golden.md). */
-typedef struct {
-    double d[BR_NX];
-    int n;
-} drift_t;
-
-/* Scales of one prediction step, from the reference's mean state xm (before
- * and after the step: the larger), the torque and the origin shift. */
-static void step_scales(const pf_consts_t *c, const double *xa, const double *xb, double u, double shift,
-                        double S[BR_NX])
-{
-    double x[BR_NX];
-    for (int i = 0; i < BR_NX; i++) {
-        x[i] = fmax(fabs(xa[i]), fabs(xb[i]));
-    }
-    /* theta: the particles lie within a few sqrt(R) of the measurement */
-    S[0] = x[0] + 5.0 * c->sig_R + c->h * x[1] + fabs(shift);
-    /* omega: as the model golden test, with the largest g_p of any particle */
-    S[1] = x[1] + c->h / c->Jeff *
-                      (fabs(u) + c->L * (fmax(c->s0 * x[2], c->gp_max) + (2.0 * c->s1 + c->s2) * c->L * x[1]));
-    S[2] = fmax(x[2], c->gp_max / c->s0);
-    S[3] = c->gp_max;
-}
-
-/* Rounding of a float32 copy of the reference set (and of priming). */
-static void drift_seed(drift_t *d, const double S[BR_NX])
-{
-    for (int i = 0; i < BR_NX; i++) {
-        d->d[i] = 4.0 * U32 * S[i];
-    }
-    d->n = 0;
-}
-
-/* One prediction step: the model step's own rounding (the constants of the
- * model golden test), the noise addition, and the propagation of the
- * previous errors (theta integrates omega; z follows L omega). */
-static void drift_advance(drift_t *d, const pf_consts_t *c, const double S[BR_NX])
-{
-    const double dth = d->d[0], dom = d->d[1], dz = d->d[2], dgp = d->d[3];
-    d->d[0] = dth + c->h * dom + C_THETA * U32 * S[0];
-    d->d[1] = dom + C_OMEGA * U32 * S[1];
-    d->d[2] = dz + 2.0 * c->h * c->L * dom + C_Z * U32 * S[2];
-    d->d[3] = dgp + C_GP * U32 * S[3];
-    d->n++;
-}
-
-/* Bound on the error of a log-weight l = -e^2 / (2R) whose particle's theta
- * is off by at most dth: |e| dth / R + dth^2 / (2R), plus its own rounding. */
-static double dlog_bound(const pf_consts_t *c, double l, double dth)
-{
-    const double e = sqrt(2.0 * c->R * fabs(l));
-    return (2.0 * e * dth + dth * dth) / (2.0 * c->R) + C_L * U32 * fabs(l);
-}
-
-/* Bound on |f_nl(x_C) - f_nl(x_ref)| for a particle x, given the state bounds:
- * the partial derivatives of f_nl = s0 z + s1 L w (1 - s0 sgn(w) z / g_p)
- * times the bounds, plus the rounding of the evaluation (model test). */
-static double dfnl_bound(const pf_consts_t *c, const float *x, const double *d)
-{
-    const double w = fabs(x[1]), z = fabs(x[2]), gp = x[3];
-    const double a = c->s0 * c->L * w / gp;
-    const double S_f = c->s0 * z + c->s1 * c->L * w * (1.0 + c->s0 * z / gp);
-    return (c->s0 + c->s1 * a) * d[2] + c->s1 * c->L * (1.0 + c->s0 * z / gp) * d[1] + c->s1 * a * z / gp * d[3] +
-           C_FNL * U32 * S_f;
-}
-
 static br_pf_t g_pf, g_pred; /* ~70 KiB each: static */
 
 /* (b) and (c) */
@@ -326,17 +208,7 @@ static void test_pf_forced_run(void **state)
     assert_int_equal(br_pf_init(pf, &g.cfg), BR_OK);
     const uint32_t m = g.m;
     const double rpc = g.cfg.est.rad_per_count;
-    pf_consts_t c;
-    c.h = g.cfg.est.model.dt_s;
-    c.L = br_trace_meta_num(&g.pf, "L_mprad");
-    c.Jeff = br_trace_meta_num(&g.pf, "J_kgm2") + c.L * c.L * br_trace_meta_num(&g.pf, "M_kg");
-    c.s0 = br_trace_meta_num(&g.pf, "sigma0_Npm");
-    c.s1 = br_trace_meta_num(&g.pf, "sigma1_Nspm");
-    c.s2 = br_trace_meta_num(&g.pf, "sigma2_Nspm");
-    c.R = g.cfg.est.r_var_rad2;
-    c.sig_R = sqrt(c.R);
-    c.gp_max = g.cfg.est.gp_max_N;
-    c.m = m;
+    const pf_consts_t c = pf_golden_consts(&g.pf, &g.cfg);
 
     const int c_counts = br_trace_col(&g.in, "counts"), c_frac = br_trace_col(&g.in, "frac");
     const int c_u = br_trace_col(&g.in, "u_prev_Nm"), c_kin = br_trace_col(&g.in, "k");

@@ -79,14 +79,16 @@ typedef struct {
  * load side, against +x as friction is) shared by every particle, estimated
  * by a scalar Kalman filter beside the particles. Off (the thesis filter, bit
  * for bit) when both fields are 0. On, each step predicts the particles with
- * the torque u - L F_d, takes the cloud's mean innovation as a measurement of
- * F_d's change over the period (theta moves by -g k^2 dF, g = L h^2 / (2 J_eff),
- * k the periods since the last measurement), moves the cloud by what the
- * change explains (theta by -g k^2 dF, omega by -(2 g k / h) dF) before
- * weighing, and compensates f_nl + F_d. A gated innovation that a change of
- * at most 2 max_N explains is re-acquired as a load (the variance of F_d
- * inflated by the change squared), not rejected. The kernels are untouched:
- * only the torque they are given changes. */
+ * the torque u - L F_d; a Kalman filter of the cloud's common error
+ * [theta, omega, F_d] (g = L h^2 / (2 J_eff): theta's change over a period
+ * per newton) takes the predicted cloud's mean innovation, moves the cloud's
+ * theta and omega by its gain and F_d by its third component, and the
+ * moved cloud is then weighed and resampled; the compensation is f_nl + F_d.
+ * A gated innovation that a change of at most 2 max_N over the k periods
+ * since the last measurement explains (theta moved by -g k^2 dF) is
+ * re-acquired as a load (the covariance inflated as if F_d's variance had
+ * been larger by the change squared), not rejected. The kernels are
+ * untouched: only the torque they are given changes. */
 typedef struct {
     float q_N2;  /* random walk of F_d per step, N^2: a normal float <= BR_EST_VAR_MAX when on, 0: off */
     float max_N; /* |F_d| and the compensation kept <= max_N (the actuator's force); its initial
