@@ -16,6 +16,9 @@ BR_G4_LAYOUT_CHECK(rcc_ahb2enr, offsetof(br_stm32g4_rcc_t, AHB2ENR) == 0x4Cu);
 BR_G4_LAYOUT_CHECK(rcc_apb1enr1, offsetof(br_stm32g4_rcc_t, APB1ENR1) == 0x58u);
 BR_G4_LAYOUT_CHECK(rcc_apb2enr, offsetof(br_stm32g4_rcc_t, APB2ENR) == 0x60u);
 BR_G4_LAYOUT_CHECK(rcc_csr, offsetof(br_stm32g4_rcc_t, CSR) == 0x94u);
+BR_G4_LAYOUT_CHECK(rcc_ahb1enr, offsetof(br_stm32g4_rcc_t, AHB1ENR) == 0x48u);
+BR_G4_LAYOUT_CHECK(dma_ccr1, offsetof(br_stm32g4_dma_t, C) == 0x08u);
+BR_G4_LAYOUT_CHECK(dma_ccr8, offsetof(br_stm32g4_dma_t, C[7]) == 0x94u);
 BR_G4_LAYOUT_CHECK(pwr_cr5, offsetof(br_stm32g4_pwr_t, CR5) == 0x80u);
 
 /* ---- board helpers -------------------------------------------------------- */
@@ -32,6 +35,45 @@ br_status_t br_stm32g4_rcc_enable(br_stm32g4_rcc_t *rcc)
     rcc->APB2ENR |= BR_G4_RCC_APB2ENR_TIM1EN;
     readback = rcc->APB2ENR; /* the enable takes effect before the first access */
     (void)readback;
+    return BR_OK;
+}
+
+br_status_t br_stm32g4_rcc_enable_usart2(br_stm32g4_rcc_t *rcc)
+{
+    uint32_t readback;
+
+    if (rcc == NULL) {
+        return BR_E_NULL;
+    }
+    rcc->AHB1ENR |= BR_G4_RCC_AHB1ENR_DMA1EN | BR_G4_RCC_AHB1ENR_DMAMUX1EN;
+    rcc->APB1ENR1 |= BR_G4_RCC_APB1ENR1_USART2EN;
+    readback = rcc->APB1ENR1;
+    (void)readback;
+    return BR_OK;
+}
+
+/* ---- the USART channel's DMA ---------------------------------------------- */
+
+br_status_t br_stm32g4_usart_dma(br_stm32g4_dma_t *dma, br_stm32g4_dmamux_t *mux, uint32_t mux_base,
+                                 uint32_t rx_ch, uint32_t tx_ch, uint32_t rx_req, uint32_t tx_req,
+                                 br_stm32_usart_cfg_t *cfg)
+{
+    if (dma == NULL || mux == NULL || cfg == NULL) {
+        return BR_E_NULL;
+    }
+    if (rx_ch >= BR_G4_DMA_CHANNELS || tx_ch >= BR_G4_DMA_CHANNELS || rx_ch == tx_ch ||
+        (mux_base != 0u && mux_base != BR_G4_DMA_CHANNELS) || rx_req == 0u || tx_req == 0u ||
+        rx_req > BR_G4_DMAMUX_REQ_MAX || tx_req > BR_G4_DMAMUX_REQ_MAX) {
+        return BR_E_PARAM;
+    }
+    mux->CCR[mux_base + rx_ch] = rx_req;
+    mux->CCR[mux_base + tx_ch] = tx_req;
+    cfg->rx_dma = &dma->C[rx_ch].ch;
+    cfg->tx_dma = &dma->C[tx_ch].ch;
+    cfg->tx_dma_ifcr = &dma->IFCR;
+    cfg->tx_dma_ifcr_mask = BR_G4_DMA_IFCR_CHANNEL << (4u * tx_ch);
+    cfg->rx_dma_cr = BR_G4_DMA_CCR_CIRC | BR_G4_DMA_CCR_MINC;
+    cfg->tx_dma_cr = BR_G4_DMA_CCR_DIR_M2P | BR_G4_DMA_CCR_MINC;
     return BR_OK;
 }
 

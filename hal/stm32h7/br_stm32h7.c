@@ -22,6 +22,10 @@ BR_LAYOUT_CHECK(rcc_rsr, offsetof(br_stm32h7_rcc_t, RSR) == 0x0D0u);
 BR_LAYOUT_CHECK(rcc_apb4enr, offsetof(br_stm32h7_rcc_t, APB4ENR) == 0x0F4u);
 BR_LAYOUT_CHECK(pwr_cr3, offsetof(br_stm32h7_pwr_t, CR3) == 0x0Cu);
 BR_LAYOUT_CHECK(pwr_d3cr, offsetof(br_stm32h7_pwr_t, D3CR) == 0x18u);
+BR_LAYOUT_CHECK(rcc_ahb1enr, offsetof(br_stm32h7_rcc_t, AHB1ENR) == 0x0D8u);
+BR_LAYOUT_CHECK(dma_s0cr, offsetof(br_stm32h7_dma_t, S) == 0x10u);
+BR_LAYOUT_CHECK(dma_stream, sizeof(br_stm32h7_dma_stream_t) == 0x18u);
+BR_LAYOUT_CHECK(dma_s7fcr, offsetof(br_stm32h7_dma_t, S[7].FCR) == 0xCCu);
 BR_LAYOUT_CHECK(syscfg_pwrcr, offsetof(br_stm32h7_syscfg_t, PWRCR) == 0x2Cu);
 
 /* ---- board helpers -------------------------------------------------------- */
@@ -39,6 +43,56 @@ br_status_t br_stm32h7_rcc_enable(br_stm32h7_rcc_t *rcc)
     /* Read back: the enable takes effect before the first peripheral access. */
     readback = rcc->APB2ENR;
     (void)readback;
+    return BR_OK;
+}
+
+br_status_t br_stm32h7_rcc_enable_usart3(br_stm32h7_rcc_t *rcc)
+{
+    uint32_t readback;
+
+    if (rcc == NULL) {
+        return BR_E_NULL;
+    }
+    rcc->AHB4ENR |= BR_RCC_AHB4ENR_GPIODEN;
+    rcc->AHB1ENR |= BR_RCC_AHB1ENR_DMA1EN;
+    rcc->APB1LENR |= BR_RCC_APB1LENR_USART3EN;
+    readback = rcc->APB1LENR;
+    (void)readback;
+    return BR_OK;
+}
+
+/* ---- the USART channel's DMA ----------------------------------------------- */
+
+/* A stream's clear bits: streams 0..3 in LIFCR, 4..7 in HIFCR, each at 0, 6,
+ * 16 or 22 of its register. */
+static uint32_t dma_ifcr_shift(uint32_t stream)
+{
+    static const uint8_t shift[4] = {0u, 6u, 16u, 22u};
+    return shift[stream % 4u];
+}
+
+br_status_t br_stm32h7_usart_dma(br_stm32h7_dma_t *dma, br_stm32h7_dmamux_t *mux, uint32_t mux_base,
+                                 uint32_t rx_stream, uint32_t tx_stream, uint32_t rx_req, uint32_t tx_req,
+                                 br_stm32_usart_cfg_t *cfg)
+{
+    if (dma == NULL || mux == NULL || cfg == NULL) {
+        return BR_E_NULL;
+    }
+    if (rx_stream >= BR_H7_DMA_STREAMS || tx_stream >= BR_H7_DMA_STREAMS || rx_stream == tx_stream ||
+        (mux_base != 0u && mux_base != BR_H7_DMA_STREAMS) || rx_req == 0u || tx_req == 0u ||
+        rx_req > BR_H7_DMAMUX_REQ_MAX || tx_req > BR_H7_DMAMUX_REQ_MAX) {
+        return BR_E_PARAM;
+    }
+    mux->CCR[mux_base + rx_stream] = rx_req;
+    mux->CCR[mux_base + tx_stream] = tx_req;
+    dma->S[rx_stream].FCR = 0u;
+    dma->S[tx_stream].FCR = 0u;
+    cfg->rx_dma = &dma->S[rx_stream].ch;
+    cfg->tx_dma = &dma->S[tx_stream].ch;
+    cfg->tx_dma_ifcr = (tx_stream < 4u) ? &dma->LIFCR : &dma->HIFCR;
+    cfg->tx_dma_ifcr_mask = BR_H7_DMA_IFCR_STREAM << dma_ifcr_shift(tx_stream);
+    cfg->rx_dma_cr = BR_H7_DMA_SxCR_DIR_P2M | BR_H7_DMA_SxCR_CIRC | BR_H7_DMA_SxCR_MINC;
+    cfg->tx_dma_cr = BR_H7_DMA_SxCR_DIR_M2P | BR_H7_DMA_SxCR_MINC;
     return BR_OK;
 }
 

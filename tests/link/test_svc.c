@@ -297,6 +297,26 @@ static void test_fault_once_and_reset(void **st)
 }
 
 /* the enable input: its rising edge arms, low disarms, an arm request needs it high */
+/* the period's request stays readable after the step (svc.cmd): the
+ * recorder's, which the service does not act on, reach the caller; a period
+ * without a request reads NONE */
+static void test_request_exposed(void **st)
+{
+    (void)st;
+    rig_t *g = test_malloc(sizeof *g);
+    rig_init(g, 0, 0);
+    assert_int_equal(g->svc.cmd.kind, BR_LINK_CMD_NONE);
+    const uint8_t p[BR_LINK_MSG_REC_DUMP_LEN] = {37u, 0u};
+    host_send(&g->wire, BR_LINK_MSG_REC_DUMP, p, sizeof p);
+    steps(g, 1u);
+    assert_int_equal(g->svc.cmd.kind, BR_LINK_CMD_REC_DUMP);
+    assert_int_equal(g->svc.cmd.first, 37);
+    assert_int_equal(g->app.fault, BR_APP_FAULT_DISARMED);
+    steps(g, 1u);
+    assert_int_equal(g->svc.cmd.kind, BR_LINK_CMD_NONE);
+    test_free(g);
+}
+
 static void test_enable_input(void **st)
 {
     (void)st;
@@ -506,6 +526,7 @@ int main(void)
         cmocka_unit_test(test_init_guards),
         cmocka_unit_test(test_arm_disarm),
         cmocka_unit_test(test_fault_once_and_reset),
+        cmocka_unit_test(test_request_exposed),
         cmocka_unit_test(test_enable_input),
         cmocka_unit_test(test_enable_high_at_start),
         cmocka_unit_test(test_underrun_faults),

@@ -203,6 +203,79 @@ static void test_clock_170(void **st)
     assert_int_equal(br_stm32g4_clock_170(&r), BR_E_NULL);
 }
 
+/* the G4's side of the USART channel: DMAMUX routing, the channels' CR
+ * words, IFCR and the TX channel's clear bits; the clock enables; then the
+ * shared driver over those fake channels starting the RX channel */
+static void test_usart_dma(void **st)
+{
+    (void)st;
+    br_stm32g4_dma_t dma;
+    br_stm32g4_dmamux_t mux;
+    br_stm32_usart_cfg_t c;
+    memset(&dma, 0, sizeof dma);
+    memset(&mux, 0, sizeof mux);
+    memset(&c, 0, sizeof c);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 0u, 0u, 1u, BR_G4_DMAREQ_USART2_RX, BR_G4_DMAREQ_USART2_TX, &c),
+                     BR_OK);
+    assert_int_equal(mux.CCR[0], 26u);
+    assert_int_equal(mux.CCR[1], 27u);
+    assert_ptr_equal(c.rx_dma, &dma.C[0].ch);
+    assert_ptr_equal(c.tx_dma, &dma.C[1].ch);
+    assert_ptr_equal(c.tx_dma_ifcr, &dma.IFCR);
+    assert_int_equal(c.tx_dma_ifcr_mask, 0xFu << 4);
+    /* RX: CIRC, MINC, DIR 0; TX: DIR 1, MINC; bytes, EN clear */
+    assert_int_equal(c.rx_dma_cr, (1u << 5) | (1u << 7));
+    assert_int_equal(c.tx_dma_cr, (1u << 4) | (1u << 7));
+    /* DMA2 channels 8 (RX) and 3 (TX): DMAMUX channels 15 and 10 */
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 8u, 7u, 2u, 5u, 6u, &c), BR_OK);
+    assert_int_equal(mux.CCR[15], 5u);
+    assert_int_equal(mux.CCR[10], 6u);
+    assert_int_equal(c.tx_dma_ifcr_mask, 0xFu << 8);
+    br_stm32g4_dmamux_t mux0;
+    memcpy(&mux0, &mux, sizeof mux);
+    assert_int_equal(br_stm32g4_usart_dma(NULL, &mux, 0u, 0u, 1u, 26u, 27u, &c), BR_E_NULL);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, NULL, 0u, 0u, 1u, 26u, 27u, &c), BR_E_NULL);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 0u, 0u, 1u, 26u, 27u, NULL), BR_E_NULL);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 0u, 8u, 1u, 26u, 27u, &c), BR_E_PARAM);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 0u, 0u, 8u, 26u, 27u, &c), BR_E_PARAM);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 0u, 3u, 3u, 26u, 27u, &c), BR_E_PARAM);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 1u, 0u, 1u, 26u, 27u, &c), BR_E_PARAM);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 0u, 0u, 1u, 0u, 27u, &c), BR_E_PARAM);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 0u, 0u, 1u, 26u, 128u, &c), BR_E_PARAM);
+    assert_memory_equal(&mux0, &mux, sizeof mux);
+
+    br_stm32g4_rcc_t rcc;
+    memset(&rcc, 0, sizeof rcc);
+    assert_int_equal(br_stm32g4_rcc_enable_usart2(NULL), BR_E_NULL);
+    assert_int_equal(br_stm32g4_rcc_enable_usart2(&rcc), BR_OK);
+    assert_int_equal(rcc.AHB1ENR, (1u << 0) | (1u << 2));
+    assert_int_equal(rcc.APB1ENR1, 1u << 17);
+
+    /* the board's USART2: 170 MHz, 921 600 baud -> BRR 184; the RX channel
+     * running circular, the TX channel prepared */
+    br_stm32_usart_t usart;
+    uint8_t rx[256]; /* 1 ms at 921 600 baud is 93 bytes: at least 186 */
+    uint8_t tx[16];
+    memset(&usart, 0, sizeof usart);
+    memset(&dma, 0, sizeof dma);
+    assert_int_equal(br_stm32g4_usart_dma(&dma, &mux, 0u, 0u, 1u, 26u, 27u, &c), BR_OK);
+    c.usart = &usart;
+    c.rx_buf = rx;
+    c.rx_len = sizeof rx;
+    c.tx_buf = tx;
+    c.tx_len = sizeof tx;
+    c.kernel_clock_hz = 170000000u;
+    c.baud = 921600u;
+    c.poll_period_ns = 1000000u;
+    br_stm32_usart_chan_t u;
+    assert_int_equal(br_stm32_usart_init(&u, &c), BR_OK);
+    assert_int_equal(usart.BRR, 184u);
+    assert_int_equal(dma.C[0].ch.CR, (1u << 5) | (1u << 7) | 1u);
+    assert_int_equal(dma.C[0].ch.NDTR, sizeof rx);
+    assert_int_equal(dma.C[1].ch.CR, (1u << 4) | (1u << 7));
+    assert_int_equal(dma.IFCR, 0xFu << 4);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -210,6 +283,7 @@ int main(void)
         cmocka_unit_test(test_app_on_port),
         cmocka_unit_test(test_rcc_enable),
         cmocka_unit_test(test_clock_170),
+        cmocka_unit_test(test_usart_dma),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -67,6 +67,9 @@ typedef struct {
     uint8_t send_fault;       /* a fault report waiting for room */
     uint8_t send_status;      /* a status waiting for room (a change) */
     int enable_last;          /* the enable input last period */
+    br_link_cmd_t cmd;        /* the period's request (kind NONE: none): after br_svc_step, the
+                                 caller's to read; the recorder's (REC_ARM, REC_TRIGGER,
+                                 REC_DUMP) are not acted on here but by br_rec_command */
     br_svc_counters_t cnt;
     int ready;
 } br_svc_t;

@@ -46,6 +46,33 @@ br_status_t br_stm32h7_board_init(br_stm32_t *port, uint32_t control_period_ns, 
     return (st != BR_OK) ? st : br_stm32_hal(port, hal);
 }
 
+br_status_t br_stm32h7_board_usart_init(br_stm32_usart_chan_t *u, uint8_t *rx, uint32_t rx_len, uint8_t *tx,
+                                        uint32_t tx_len, uint32_t poll_period_ns)
+{
+    br_stm32_gpio_t *gpiod = (br_stm32_gpio_t *)BR_STM32H7_GPIOD_BASE;
+    br_stm32_usart_cfg_t cfg = {
+        .usart = (br_stm32_usart_t *)BR_STM32H7_USART3_BASE,
+        .rx_buf = rx,
+        .rx_len = rx_len,
+        .tx_buf = tx,
+        .tx_len = tx_len,
+        .kernel_clock_hz = BR_BOARD_USART_HZ,
+        .baud = BR_BOARD_USART_BAUD,
+        .poll_period_ns = poll_period_ns,
+    };
+    br_status_t st = br_stm32h7_rcc_enable_usart3((br_stm32h7_rcc_t *)BR_STM32H7_RCC_BASE);
+    if (st == BR_OK) {
+        st = br_stm32h7_usart_dma((br_stm32h7_dma_t *)BR_STM32H7_DMA1_BASE, (br_stm32h7_dmamux_t *)BR_STM32H7_DMAMUX1_BASE,
+                                  0u, 0u, 1u, BR_H7_DMAREQ_USART3_RX, BR_H7_DMAREQ_USART3_TX, &cfg);
+    }
+    if (st == BR_OK) {
+        (void)br_stm32_gpio_af(gpiod, 8u, BR_BOARD_PIN_AF_USART3); /* USART3_TX */
+        (void)br_stm32_gpio_af(gpiod, 9u, BR_BOARD_PIN_AF_USART3); /* USART3_RX */
+        st = br_stm32_usart_init(u, &cfg);
+    }
+    return st;
+}
+
 int br_stm32h7_board_reset_by_watchdog(void)
 {
     br_stm32h7_rcc_t *rcc = (br_stm32h7_rcc_t *)BR_STM32H7_RCC_BASE;

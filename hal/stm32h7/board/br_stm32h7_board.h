@@ -7,7 +7,11 @@
  * 64 MHz) to 480 MHz (VOS0, flash 4 WS, PLL1 = HSI / 4 * 60 / 2), AXI/AHB
  * 240 MHz, APB 120 MHz, timer kernel clocks 240 MHz. PWM 20 kHz
  * centre-aligned with 500 ns dead time, encoder input filter f_CK_INT with
- * N = 8. Watchdog IWDG1: 10 ms. docs/modules/hal.md. */
+ * N = 8. Watchdog IWDG1: 10 ms. The link: USART3 on PD8 (TX) / PD9 (RX), AF7
+ * (the ST-LINK's virtual COM port on a Nucleo-144 board), 921 600 baud 8N1
+ * from its reset kernel clock (rcc_pclk1, 120 MHz: BRR 130, 0.16 % fast), by
+ * DMA1 stream 0 (RX, circular) and stream 1 (TX). No enable input.
+ * docs/modules/hal.md, docs/porting.md. */
 #ifndef BR_STM32H7_BOARD_H
 #define BR_STM32H7_BOARD_H
 
@@ -21,6 +25,9 @@
 #define BR_BOARD_PWM_HZ     20000u
 #define BR_BOARD_DEADTIME   120u      /* timer ticks: 500 ns at 240 MHz */
 #define BR_BOARD_ENC_FILTER 3u        /* f_CK_INT, N = 8 */
+#define BR_BOARD_USART_BAUD 921600u
+#define BR_BOARD_USART_HZ   BR_STM32H7_APB_HZ /* USART3's kernel clock: rcc_pclk1 */
+#define BR_BOARD_PIN_AF_USART3 7u
 /* IWDG1 on the LSI (32 kHz): prescaler /4 (PR = 0), 80 ticks -> 10 ms */
 #define BR_BOARD_IWDG_PR    0u
 #define BR_BOARD_IWDG_RLR   79u
@@ -35,6 +42,13 @@ br_stm32_cfg_t br_stm32h7_board_cfg(uint32_t control_period_ns);
  * br_stm32_init validates the configuration before writing a timer
  * register) and its br_hal_t. The first failing status. */
 br_status_t br_stm32h7_board_init(br_stm32_t *port, uint32_t control_period_ns, br_hal_t *hal);
+
+/* The link's byte channel: USART3's clocks and pins, DMA1 streams 0 (RX) and
+ * 1 (TX) routed by DMAMUX1, then br_stm32_usart_init over rx (rx_len bytes,
+ * circular) and tx (tx_len), both in RAM DMA1 reaches (AXI SRAM, not DTCM),
+ * read at least every poll_period_ns. The first failing status. */
+br_status_t br_stm32h7_board_usart_init(br_stm32_usart_chan_t *u, uint8_t *rx, uint32_t rx_len, uint8_t *tx,
+                                        uint32_t tx_len, uint32_t poll_period_ns);
 
 /* 1 when the last reset came from IWDG1 (a hung or faulted control loop);
  * clears the reset flags (RMVF) so that the next pin or power-on reset reads

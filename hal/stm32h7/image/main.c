@@ -1,36 +1,45 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The bristle firmware image for the STM32H743: one axis tracking a
- * sinusoidal (circle-test) reference with the H-infinity gains of
+/* The bristle firmware image for the STM32H743: one axis under the command
+ * service (bristle/br_svc.h, docs/link.md), with the H-infinity gains of
  * firmware/gen/bristle_gen/ctrl/br_hinf_gains.h and the friction compensation
  * of the machine file's estimator (control.estimator): the particle filter
  * (1500 particles for the reference machine) in a loop at its period (1.5 ms),
- * as the simulator's H-inf + PF circle runs it, or the UKF or H-infinity only
- * at the control period (bristle/br_machine_cfg.h: the same generated
- * headers, one home).
+ * or the UKF or H-infinity only at the control period
+ * (bristle/br_machine_cfg.h: the same generated headers, one home).
  *
- * main: board bring-up (hal/stm32h7/board: 480 MHz, outputs off) -> after a
- * watchdog reset, park with the outputs off -> IWDG1 started -> br_app_init
- * (outputs off) -> br_app_arm (the explicit arm, after bring-up) -> per tick:
- * the deadline (missed ticks), the reference, br_app_step (the same as the
- * replay's and the simulator's), and the watchdog refresh, only after a
- * healthy period. Any fault: the application latches (duty 0, TIM1 outputs
- * off), the board parks without refreshing, IWDG1 resets the part, which
- * then stays off (br_stm32h7_board_reset_by_watchdog) until a pin or
- * power-on reset re-arms it.
+ * main: board bring-up (hal/stm32h7/board: 480 MHz, outputs off; USART3 by
+ * DMA, 921 600 baud) -> after a watchdog reset, park with the outputs off ->
+ * IWDG1 started -> br_app_init (DISARMED: duty 0, outputs off) -> the
+ * service, the recorder and telemetry -> per tick: the deadline (while
+ * armed), br_svc_step (the host's request, the reference from the setpoint /
+ * segment queue, br_app_step, the reports), the recorder's request, the
+ * period's sample to telemetry (every BR_IMAGE_TLM_EVERY periods) and to the
+ * recorder's ring, the dump's frames, and the watchdog refresh. The axis
+ * moves only after the host's arm; a fault latches (duty 0, TIM1 outputs
+ * off), is reported and captured by the recorder, and the loop goes on
+ * disarmed so the host can read it and dump the capture; a fault_reset and
+ * an arm restart it. A tick that never comes parks the board without
+ * refreshing: IWDG1 resets the part, which then stays off
+ * (br_stm32h7_board_reset_by_watchdog) until a pin or power-on reset.
  *
- * State: the configurations are const (flash); the port, the application and
- * the reference are on main's stack. The one static is the particle filter's
- * state (br_pf_t, ~94 KB at BR_PF_MAX_PARTICLES): the documented exception to
- * "no mutable globals", placed in AXI SRAM by the linker script's NOLOAD
- * section .axisram (zeroed by Reset_Handler; br_pf_init initialises it), as
- * it does not belong on the 16 KiB stack. docs/modules/hal.md. */
+ * State: the configurations are const (flash); the port, the application,
+ * the service, the recorder's state and telemetry are on main's stack. The
+ * statics are the documented exceptions to "no mutable globals", in AXI SRAM
+ * (the linker script's NOLOAD section .axisram, zeroed by Reset_Handler):
+ * the particle filter's state (br_pf_t, ~71 KB: not for the 16 KiB stack),
+ * the recorder's ring (BR_IMAGE_REC_SAMPLES samples) and the USART's DMA
+ * buffers (DMA1 does not reach the DTCM that holds the stack).
+ * docs/modules/hal.md, docs/porting.md. */
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #include "br_stm32h7_board.h"
 #include "bristle/br_app.h"
 #include "bristle/br_machine_cfg.h"
-#include "bristle/br_refgen.h"
+#include "bristle/br_rec.h"
+#include "bristle/br_svc.h"
+#include "bristle/br_tlm.h"
 #include "bristle_gen/ctrl/br_hinf_gains.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
@@ -57,10 +66,33 @@
 #define BR_IMAGE_PERIOD_NS BR_MACHINE_CTRL_PERIOD_NS
 #endif
 
-/* Reference: circle of radius 5 mm in 2 s, this axis is the sine. */
-#define BR_IMAGE_REF_AMPLITUDE_M 5.0e-3f
-#define BR_IMAGE_REF_PERIOD_S    2.0f
-#define BR_IMAGE_REF_PHASE_RAD   0.0f
+/* The link (docs/link.md): a tlm_sample frame is 39 bytes on the wire, so
+ * every BR_IMAGE_TLM_EVERY periods it takes 39 / (N T) bytes/s; kept below
+ * half of the line's baud / 10 bytes/s (the rest for the reports, the
+ * recorder's dump and the gaps between DMA transfers). */
+#define BR_IMAGE_TLM_EVERY      2u
+#define BR_IMAGE_TLM_FRAME_BYTES 39u
+typedef char br_image_tlm_fits[(2ull * BR_IMAGE_TLM_FRAME_BYTES * 1000000000ull * 10ull <=
+                                (unsigned long long)BR_BOARD_USART_BAUD * BR_IMAGE_TLM_EVERY * BR_IMAGE_PERIOD_NS)
+                                   ? 1
+                                   : -1];
+/* the link's budgets: bytes decoded per period, the transmit queue */
+#define BR_IMAGE_RX_BUDGET      64u
+/* the USART's DMA buffers: RX 1024 bytes (11 ms at 921 600 baud: the host's
+ * bursts between two periods), TX one transmit queue */
+#define BR_IMAGE_UART_RX_BYTES  1024u
+#define BR_IMAGE_UART_TX_BYTES  BR_LINK_TX_BUF_BYTES
+/* status and ref_status every 100 periods */
+#define BR_IMAGE_STATUS_PERIODS 100u
+/* the reference queue: its length, and the periods an underrun holds the
+ * last reference before braking */
+#define BR_IMAGE_REFQ_LEN       BR_REFQ_MAX
+#define BR_IMAGE_HOLD_PERIODS   20u
+/* The recorder: 8000 samples (232 000 bytes of the 512 KiB AXI SRAM; 8 s at
+ * 1 ms), 6000 of them before the trigger; one dump frame per period. */
+#define BR_IMAGE_REC_SAMPLES    8000u
+#define BR_IMAGE_REC_PRE        6000u
+#define BR_IMAGE_REC_DUMP_FRAMES 1u
 
 /* Deadline: more missed ticks than this since the arm turn the outputs off. */
 #define BR_IMAGE_MAX_MISSED 2u
@@ -80,27 +112,36 @@ static const br_pf_cfg_t br_image_pf_cfg = BR_MACHINE_PF_CFG_TUNED(BR_IMAGE_DT_S
 static const br_ukf_cfg_t br_image_ukf_cfg = BR_MACHINE_UKF_CFG_TUNED(BR_IMAGE_DT_S);
 #endif
 
-static const br_refgen_cfg_t br_image_ref = {
-    .amplitude_m = BR_IMAGE_REF_AMPLITUDE_M,
-    .period_s = BR_IMAGE_REF_PERIOD_S,
-    .phase_rad = BR_IMAGE_REF_PHASE_RAD,
-    .dt_s = BR_IMAGE_DT_S,
-    .lead_mprad = BR_MACHINE_LEAD_MPRAD_F,
-    .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,
-};
-
 #if BR_IMAGE_USES_PF
 /* The documented exception: the PF's state, in AXI SRAM (see above). */
 static br_pf_t br_image_pf __attribute__((section(".axisram")));
 #endif
+/* The recorder's ring and the USART's DMA buffers (see above). */
+static br_rec_slot_t br_image_ring[BR_IMAGE_REC_SAMPLES] __attribute__((section(".axisram")));
+static uint8_t br_image_uart_rx[BR_IMAGE_UART_RX_BYTES] __attribute__((section(".axisram")));
+static uint8_t br_image_uart_tx[BR_IMAGE_UART_TX_BYTES] __attribute__((section(".axisram")));
+
+/* The reference queue with the machine's limits; the underrun's fault comes
+ * one period after the braking from the top speed (br_refq_init's rule). */
+static br_refq_cfg_t br_image_refq(const br_app_motion_cfg_t *m)
+{
+    br_refq_cfg_t c = {BR_IMAGE_REFQ_LEN, BR_IMAGE_DT_S, BR_MACHINE_RAD_PER_COUNT_F, m->counts_per_m,
+                       m->max_speed_mps, m->max_accel_mps2, BR_IMAGE_HOLD_PERIODS, 0u};
+    c.fault_periods = BR_IMAGE_HOLD_PERIODS + (uint32_t)ceilf(c.max_speed_mps / (c.max_accel_mps2 * c.dt_s)) + 1u;
+    return c;
+}
 
 int main(void)
 {
     br_stm32_t port = {0};
     br_hal_t hal = {0};
     br_app_t app = {0};
-    br_refgen_t refgen = {0};
-    br_ref_t ref = {0};
+    br_stm32_usart_chan_t uart = {0};
+    br_byte_chan_t chan = {0};
+    br_svc_t svc = {0};
+    br_rec_t rec = {0};
+    br_tlm_t tlm = {0};
+    br_rec_sample_t sample = {0};
     uint32_t tick = 0u;
 #if BR_IMAGE_USES_UKF
     br_ukf_t ukf = {0};
@@ -123,10 +164,20 @@ int main(void)
 #else
     const br_app_mem_t mem = {0};
 #endif
+    /* no enable input on this board: armed by the host's request only */
+    const br_svc_cfg_t svc_cfg = {BR_IMAGE_RX_BUDGET, BR_LINK_TX_BUF_BYTES, br_image_refq(&app_cfg.motion),
+                                  BR_IMAGE_STATUS_PERIODS, NULL, NULL};
+    const br_rec_cfg_t rec_cfg = {br_image_ring, BR_IMAGE_REC_SAMPLES, BR_IMAGE_REC_PRE, 0.0f,
+                                  BR_IMAGE_REC_DUMP_FRAMES};
+    const br_tlm_cfg_t tlm_cfg = {BR_IMAGE_TLM_EVERY};
 
     if (br_stm32h7_board_init(&port, BR_IMAGE_PERIOD_NS, &hal) != BR_OK || br_stm32h7_board_reset_by_watchdog() ||
-        br_stm32h7_board_watchdog_start() != BR_OK || br_app_init(&app, &app_cfg, &hal, &mem) != BR_OK ||
-        br_refgen_init(&refgen, &br_image_ref) != BR_OK || br_app_arm(&app) != BR_OK) {
+        br_stm32h7_board_usart_init(&uart, br_image_uart_rx, BR_IMAGE_UART_RX_BYTES, br_image_uart_tx,
+                                    BR_IMAGE_UART_TX_BYTES, BR_IMAGE_PERIOD_NS) != BR_OK ||
+        br_stm32_usart_chan(&uart, &chan) != BR_OK || br_stm32h7_board_watchdog_start() != BR_OK ||
+        br_app_init(&app, &app_cfg, &hal, &mem) != BR_OK ||
+        br_svc_init(&svc, &svc_cfg, &app, &app_cfg, &mem, &chan) != BR_OK || br_rec_init(&rec, &rec_cfg) != BR_OK ||
+        br_tlm_init(&tlm, &tlm_cfg) != BR_OK) {
         br_stm32h7_board_halt(&port);
     }
     for (;;) {
@@ -134,18 +185,19 @@ int main(void)
             (void)br_app_fault(&app, BR_APP_FAULT_HAL);
             br_stm32h7_board_halt(&port);
         }
-        if (br_stm32_deadline_check(&port, BR_IMAGE_MAX_MISSED) != BR_OK) {
+        /* missed ticks since the arm: the outputs off (by the check), the
+         * fault latched, reported by the service this period */
+        if (app.fault == BR_APP_FAULT_NONE && br_stm32_deadline_check(&port, BR_IMAGE_MAX_MISSED) != BR_OK) {
             (void)br_app_fault(&app, BR_APP_FAULT_DEADLINE);
-            br_stm32h7_board_halt(&port);
         }
-        if (br_refgen_step(&refgen, &ref) != BR_OK) {
-            (void)br_app_fault(&app, BR_APP_FAULT_CTRL_INPUT);
-            br_stm32h7_board_halt(&port);
-        }
-        /* BR_OK or BR_W_OUTLIER (a skipped measurement, control went on) */
-        if (BR_FAILED(br_app_step(&app, &ref))) {
-            br_stm32h7_board_halt(&port); /* latched: outputs already off */
-        }
+        /* BR_OK, BR_W_OUTLIER, or BR_E_FAULT while disarmed or faulted: the
+         * loop goes on, the outputs off, the link alive */
+        const br_status_t st = br_svc_step(&svc);
+        (void)br_rec_command(&rec, &svc.cmd);
+        (void)br_rec_sample_take(&sample, &app, tick, st);
+        (void)br_tlm_step(&tlm, &svc.link, &sample);
+        (void)br_rec_push(&rec, &sample);
+        (void)br_rec_dump_step(&rec, &svc.link);
         br_stm32h7_board_watchdog_refresh();
     }
 }

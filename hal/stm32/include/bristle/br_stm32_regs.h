@@ -121,4 +121,51 @@ typedef struct {
 #define BR_SYSTICK_CTRL_COUNTFLAG (1u << 16) /* set on reload, cleared by reading CTRL */
 #define BR_SYSTICK_LOAD_MAX       0x00FFFFFFu
 
+/* ---- USART (RM0433 / RM0440: the same block on both, with the FIFO) ----- */
+typedef struct {
+    volatile uint32_t CR1;   /* 0x00 UE, RE, TE, FIFOEN */
+    volatile uint32_t CR2;   /* 0x04 stop bits (00: 1) */
+    volatile uint32_t CR3;   /* 0x08 DMAR, DMAT, OVRDIS */
+    volatile uint32_t BRR;   /* 0x0C baud rate: kernel clock / baud (oversampling 16) */
+    volatile uint32_t GTPR;  /* 0x10 */
+    volatile uint32_t RTOR;  /* 0x14 */
+    volatile uint32_t RQR;   /* 0x18 */
+    volatile uint32_t ISR;   /* 0x1C PE, FE, NE, ORE, ..., TC, TXE */
+    volatile uint32_t ICR;   /* 0x20 the ISR flags' clear bits */
+    volatile uint32_t RDR;   /* 0x24 received byte (the RX DMA's source) */
+    volatile uint32_t TDR;   /* 0x28 byte to send (the TX DMA's destination) */
+    volatile uint32_t PRESC; /* 0x2C kernel clock prescaler (0: /1) */
+} br_stm32_usart_t;
+
+#define BR_USART_CR1_UE      (1u << 0)
+#define BR_USART_CR1_RE      (1u << 2)
+#define BR_USART_CR1_TE      (1u << 3)
+#define BR_USART_CR3_DMAR    (1u << 6)
+#define BR_USART_CR3_DMAT    (1u << 7)
+#define BR_USART_ISR_FE      (1u << 1)
+#define BR_USART_ISR_NE      (1u << 2)
+#define BR_USART_ISR_ORE     (1u << 3)
+#define BR_USART_ICR_FECF    (1u << 1)
+#define BR_USART_ICR_NECF    (1u << 2)
+#define BR_USART_ICR_ORECF   (1u << 3)
+#define BR_USART_BRR_MIN     16u      /* oversampling 16: BRR >= 16 */
+#define BR_USART_BRR_MAX     0xFFFFu
+
+/* ---- DMA: one stream (H7) or channel (G4), its first four registers ------ */
+/* The H7's DMA1/DMA2 stream (SxCR, SxNDTR, SxPAR, SxM0AR, then M1AR, FCR) and
+ * the G4's DMA channel (CCRx, CNDTRx, CPARx, CMARx) begin with the same four
+ * registers at the same offsets, with EN at bit 0 of the first. Their other
+ * bits differ (direction, circular, increment): the part's port gives the
+ * configuration words (bristle/br_stm32_usart.h), and its register map holds
+ * the whole block. */
+typedef struct {
+    volatile uint32_t CR;   /* 0x00 configuration; EN bit 0 */
+    volatile uint32_t NDTR; /* 0x04 items left to transfer (circular: reloaded at 0) */
+    volatile uint32_t PAR;  /* 0x08 peripheral address */
+    volatile uint32_t MAR;  /* 0x0C memory address (the H7's M0AR) */
+} br_stm32_dma_ch_t;
+
+#define BR_DMA_CR_EN        (1u << 0)
+#define BR_DMA_NDTR_MAX     0xFFFFu
+
 #endif

@@ -13,10 +13,28 @@
 
 #include "bristle/br_status.h"
 #include "bristle/br_stm32.h"
+#include "bristle/br_stm32_usart.h"
 #include "bristle/br_stm32g4_regs.h"
 
 /* Board helper: clock enables for GPIOA, GPIOB, TIM1, TIM2. */
 br_status_t br_stm32g4_rcc_enable(br_stm32g4_rcc_t *rcc);
+
+/* Board helper (the link): clock enables for DMA1, DMAMUX1 and USART2 (its
+ * pins PA2 TX, PA3 RX are on GPIOA, enabled above). USART2's kernel clock
+ * stays the reset's (PCLK1, 170 MHz). BR_E_NULL. */
+br_status_t br_stm32g4_rcc_enable_usart2(br_stm32g4_rcc_t *rcc);
+
+/* The G4's side of a USART channel (bristle/br_stm32_usart.h) on DMA1 or DMA2:
+ * channels rx_ch and tx_ch as indices 0..7 (channel 1..8), rx_req and tx_req
+ * routed to their DMAMUX channels (mux_base 0 for DMA1, 8 for DMA2), and
+ * cfg's DMA fields filled: the channels, IFCR and the TX channel's clear
+ * bits, the CR words (RX peripheral to memory, circular; TX memory to
+ * peripheral; memory increment, bytes). Checks first (BR_E_NULL; BR_E_PARAM:
+ * a channel above 7, the same twice, mux_base not 0 or 8, a request of 0 or
+ * above 127), then writes. */
+br_status_t br_stm32g4_usart_dma(br_stm32g4_dma_t *dma, br_stm32g4_dmamux_t *mux, uint32_t mux_base,
+                                 uint32_t rx_ch, uint32_t tx_ch, uint32_t rx_req, uint32_t tx_req,
+                                 br_stm32_usart_cfg_t *cfg);
 
 /* Clock tree from the reset clock (HSI16) to 170 MHz (docs/modules/hal.md,
  * "STM32G474"): PWR clock on, range 1 boost (PWR_CR5.R1MODE = 0), flash 4

@@ -28,6 +28,9 @@
 #define BR_STM32G4_GPIOA_BASE    0x48000000u  /* AHB2 */
 #define BR_STM32G4_GPIOB_BASE    0x48000400u
 #define BR_STM32G4_SYSTICK_BASE  BR_STM32_SYSTICK_BASE  /* Cortex-M4 system timer */
+#define BR_STM32G4_USART2_BASE   0x40004400u  /* APB1 */
+#define BR_STM32G4_DMA1_BASE     0x40020000u  /* AHB1 */
+#define BR_STM32G4_DMAMUX1_BASE  0x40020800u  /* AHB1: request routing of DMA1 and DMA2 */
 
 /* ---- RCC ------------------------------------------------------------------ */
 typedef struct {
@@ -79,6 +82,9 @@ typedef struct {
 #define BR_G4_RCC_AHB2ENR_GPIOAEN   (1u << 0)
 #define BR_G4_RCC_AHB2ENR_GPIOBEN   (1u << 1)
 #define BR_G4_RCC_APB1ENR1_TIM2EN   (1u << 0)
+#define BR_G4_RCC_APB1ENR1_USART2EN (1u << 17)
+#define BR_G4_RCC_AHB1ENR_DMA1EN    (1u << 0)
+#define BR_G4_RCC_AHB1ENR_DMAMUX1EN (1u << 2)
 #define BR_G4_RCC_APB1ENR1_PWREN    (1u << 28)
 #define BR_G4_RCC_APB2ENR_TIM1EN    (1u << 11)
 #define BR_G4_RCC_CSR_RMVF          (1u << 23)
@@ -102,5 +108,37 @@ typedef struct {
 #define BR_G4_FLASH_ACR_PRFTEN      (1u << 8)
 #define BR_G4_FLASH_ACR_ICEN        (1u << 9)
 #define BR_G4_FLASH_ACR_DCEN        (1u << 10)
+
+/* ---- DMA1 / DMA2 (RM0440 "DMA registers") and DMAMUX ------------------- */
+/* One channel: the four registers every STM32 port's DMA shares
+ * (br_stm32_dma_ch_t: CCRx, CNDTRx, CPARx, CMARx), then a reserved word. */
+typedef struct {
+    br_stm32_dma_ch_t ch;       /* 0x08 + 0x14 (x - 1), x = 1..8 */
+    volatile uint32_t RESERVED; /* 0x18 + 0x14 (x - 1) */
+} br_stm32g4_dma_channel_t;
+
+typedef struct {
+    volatile uint32_t ISR;  /* 0x00 */
+    volatile uint32_t IFCR; /* 0x04 CGIFx, CTCIFx, CHTIFx, CTEIFx at 4 (x - 1) */
+    br_stm32g4_dma_channel_t C[8]; /* C[0] is channel 1 */
+} br_stm32g4_dma_t;
+
+/* CCRx */
+#define BR_G4_DMA_CCR_DIR_M2P   (1u << 4) /* 1: read from memory */
+#define BR_G4_DMA_CCR_CIRC      (1u << 5)
+#define BR_G4_DMA_CCR_MINC      (1u << 7) /* PSIZE, MSIZE 00: bytes */
+#define BR_G4_DMA_IFCR_CHANNEL  0xFu
+#define BR_G4_DMA_CHANNELS      8u
+
+/* DMAMUX: channel k routes a request to DMA1 channel k + 1 (k = 0..7) and
+ * DMA2 channel k - 7 (8..15); DMAREQ_ID in bits 6:0 of CkCR. */
+typedef struct {
+    volatile uint32_t CCR[16]; /* 0x00 + 4 k */
+} br_stm32g4_dmamux_t;
+
+#define BR_G4_DMAMUX_REQ_MAX    0x7Fu
+/* RM0440 table "DMAMUX: assignment of multiplexer inputs to resources" */
+#define BR_G4_DMAREQ_USART2_RX  26u
+#define BR_G4_DMAREQ_USART2_TX  27u
 
 #endif

@@ -27,6 +27,10 @@
 #define BR_STM32H7_SYSCFG_BASE   0x58000400u  /* D3 APB4 */
 #define BR_STM32H7_IWDG1_BASE    0x58004800u  /* D3 APB4, independent watchdog 1 */
 #define BR_STM32H7_FLASH_BASE    0x52002000u  /* D1 AHB3, flash interface registers */
+#define BR_STM32H7_GPIOD_BASE    0x58020C00u  /* D3 AHB4 */
+#define BR_STM32H7_USART3_BASE   0x40004800u  /* D2 APB1 */
+#define BR_STM32H7_DMA1_BASE     0x40020000u  /* D2 AHB1 */
+#define BR_STM32H7_DMAMUX1_BASE  0x40020800u  /* D2 AHB1: request routing of DMA1 and DMA2 */
 
 /* ---- RCC (clock control, the kernel-clock configuration and the enables) - */
 typedef struct {
@@ -46,7 +50,9 @@ typedef struct {
     volatile uint32_t PLL1FRACR; /* 0x034 */
     volatile uint32_t RESERVED3[38]; /* 0x038..0x0CC */
     volatile uint32_t RSR;       /* 0x0D0 reset status: the reset's cause flags, RMVF clears them */
-    volatile uint32_t RESERVED4[3]; /* 0x0D4..0x0DC */
+    volatile uint32_t AHB3ENR;  /* 0x0D4 */
+    volatile uint32_t AHB1ENR;  /* 0x0D8 DMA1EN, DMA2EN */
+    volatile uint32_t AHB2ENR;  /* 0x0DC */
     volatile uint32_t AHB4ENR;  /* 0x0E0 GPIOx, ... */
     volatile uint32_t APB3ENR;  /* 0x0E4 */
     volatile uint32_t APB1LENR; /* 0x0E8 TIM2..TIM7, TIM12..14, ... */
@@ -58,6 +64,9 @@ typedef struct {
 #define BR_RCC_AHB4ENR_GPIOAEN  (1u << 0)
 #define BR_RCC_AHB4ENR_GPIOBEN  (1u << 1)
 #define BR_RCC_APB1LENR_TIM2EN  (1u << 0)
+#define BR_RCC_AHB4ENR_GPIODEN  (1u << 3)
+#define BR_RCC_AHB1ENR_DMA1EN   (1u << 0)
+#define BR_RCC_APB1LENR_USART3EN (1u << 18)
 #define BR_RCC_APB2ENR_TIM1EN   (1u << 0)
 #define BR_RCC_APB4ENR_SYSCFGEN (1u << 1)
 /* RSR */
@@ -137,5 +146,43 @@ typedef struct {
 #define BR_FLASH_ACR_LATENCY_Msk   0xFu
 #define BR_FLASH_ACR_WRHIGHFREQ_Pos 4u
 #define BR_FLASH_ACR_WRHIGHFREQ_Msk (3u << 4)
+
+/* ---- DMA1 / DMA2 (RM0433 "DMA registers") and DMAMUX1 ------------------ */
+/* One stream: the four registers every STM32 port's DMA shares
+ * (br_stm32_dma_ch_t: SxCR, SxNDTR, SxPAR, SxM0AR), then M1AR and FCR. */
+typedef struct {
+    br_stm32_dma_ch_t ch;   /* 0x10 + 0x18 x: SxCR, SxNDTR, SxPAR, SxM0AR */
+    volatile uint32_t M1AR; /* 0x20 + 0x18 x */
+    volatile uint32_t FCR;  /* 0x24 + 0x18 x: FIFO control; 0 = direct mode */
+} br_stm32h7_dma_stream_t;
+
+typedef struct {
+    volatile uint32_t LISR;  /* 0x00 streams 0..3's flags */
+    volatile uint32_t HISR;  /* 0x04 streams 4..7's */
+    volatile uint32_t LIFCR; /* 0x08 their clear bits, streams 0..3 */
+    volatile uint32_t HIFCR; /* 0x0C streams 4..7 */
+    br_stm32h7_dma_stream_t S[8];
+} br_stm32h7_dma_t;
+
+/* SxCR */
+#define BR_H7_DMA_SxCR_DIR_P2M   (0u << 6)
+#define BR_H7_DMA_SxCR_DIR_M2P   (1u << 6)
+#define BR_H7_DMA_SxCR_CIRC      (1u << 8)
+#define BR_H7_DMA_SxCR_MINC      (1u << 10) /* PSIZE, MSIZE 00: bytes */
+/* LIFCR / HIFCR: a stream's six clear bits (CFEIF, CDMEIF, CTEIF, CHTIF,
+ * CTCIF at 0, 2..5 of its field) at 0, 6, 16, 22 for streams 0..3 (4..7) */
+#define BR_H7_DMA_IFCR_STREAM    0x3Du
+#define BR_H7_DMA_STREAMS        8u
+
+/* DMAMUX1: channel x routes a request to DMA1 stream x (x = 0..7) and DMA2
+ * stream x - 8 (8..15); DMAREQ_ID in bits 7:0 of CxCR. */
+typedef struct {
+    volatile uint32_t CCR[16]; /* 0x00 + 4 x */
+} br_stm32h7_dmamux_t;
+
+#define BR_H7_DMAMUX_REQ_MAX     0xFFu
+/* RM0433 table "DMAMUX1: assignment of multiplexer inputs to resources" */
+#define BR_H7_DMAREQ_USART3_RX   45u
+#define BR_H7_DMAREQ_USART3_TX   46u
 
 #endif
