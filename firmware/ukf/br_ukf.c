@@ -326,7 +326,7 @@ static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[NM], float Pm[NM][NM
     br_model_tick(&ukf->model); /* the model's clock moves on by one period (friction_drift) */
     *chol_reset = sigma_points(ukf, ukf->x, ukf->P) != BR_OK;
     const int ne = ukf->model.cfg.mslip.n;
-    float e0[BR_MSLIP_MAX], de[BR_MSLIP_MAX], es[BR_MSLIP_MAX];
+    float e0[BR_MSLIP_MAX] = {0.0f}, de[BR_MSLIP_MAX] = {0.0f}, es[BR_MSLIP_MAX] = {0.0f};
     for (int i = 0; i < ne; i++) {
         de[i] = 0.0f;
     }
@@ -337,7 +337,7 @@ static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[NM], float Pm[NM][NM
             /* Maxwell-slip: the sigma point and its elements, the committed
              * ones offset by its z (the elements' common error), one step on
              * (br_model_ms_step; z is carried unchanged) */
-            float ej[BR_MSLIP_MAX];
+            float ej[BR_MSLIP_MAX] = {0.0f};
             for (int i = 0; i < ne; i++) {
                 ej[i] = ukf->el[i] + ukf->X[s][BR_X_Z];
             }

@@ -103,7 +103,7 @@ static void load_all(ukf_golden_t *g, int variant)
         for (int i = 0; i < g->ne; i++) {
             c.est.model.mslip.k_Npm[i] = (float)k[i];
             c.est.model.mslip.share[i] = (float)a[i];
-            char name[8];
+            char name[16];
             snprintf(name, sizeof name, "e%d", i);
             g->c_e[i] = br_trace_col(t, name);
         }
@@ -190,7 +190,7 @@ static void err_init(ukf_err_t *e)
             br_errstat_init(&e->P[i][j], pn[i][j], "");
         }
     }
-    static char en[NE][8];
+    static char en[NE][16];
     for (int i = 0; i < NE; i++) {
         snprintf(en[i], sizeof en[i], "e%d", i);
         br_errstat_init(&e->e[i], en[i], "m");
