@@ -70,6 +70,7 @@ br_status_t br_svc_init(br_svc_t *s, const br_svc_cfg_t *cfg, br_app_t *app, con
     s->send_status = 1u; /* the first state */
     s->enable_last = cfg->enable != NULL ? (cfg->enable(cfg->enable_ctx) != 0) : 0;
     s->cnt = (br_svc_counters_t){0u, 0u, 0u};
+    s->cmd.kind = BR_LINK_CMD_NONE;
     s->ready = 1;
     return BR_OK;
 }
@@ -227,9 +228,8 @@ br_status_t br_svc_step(br_svc_t *s)
     if (!s->ready) {
         return BR_E_STATE;
     }
-    br_link_cmd_t cmd;
-    const br_status_t lst = br_link_step(&s->link, &cmd);
-    svc_command(s, &cmd);
+    const br_status_t lst = br_link_step(&s->link, &s->cmd);
+    svc_command(s, &s->cmd);
     svc_enable(s);
     br_app_t *app = s->app;
     br_ref_t r = {s->ref.pos_counts, s->ref.pos_frac, 0.0f};

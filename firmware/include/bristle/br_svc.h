@@ -68,6 +68,8 @@ typedef struct {
     uint8_t send_status;      /* a status waiting for room (a change) */
     int enable_last;          /* the enable input last period */
     br_svc_counters_t cnt;
+    br_link_cmd_t cmd;        /* the last period's request (kind NONE: none): the ones the service does
+                                 not act on (the recorder's) are the caller's, br_rec_command */
     int ready;
 } br_svc_t;
 
