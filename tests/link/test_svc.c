@@ -520,6 +520,25 @@ static void test_arm_restores_params(void **st)
     test_free(g);
 }
 
+/* the recorder's requests are the caller's: the service leaves them in
+ * svc.cmd for br_rec_command (a dump over a service's link needs it), and the
+ * next period without a request leaves kind NONE there */
+static void test_rec_request_to_caller(void **st)
+{
+    (void)st;
+    rig_t *g = test_malloc(sizeof *g);
+    rig_init(g, 0, 0);
+    assert_int_equal(g->svc.cmd.kind, BR_LINK_CMD_NONE);
+    uint8_t p[BR_LINK_MSG_REC_DUMP_LEN] = {37u, 0u};
+    host_send(&g->wire, BR_LINK_MSG_REC_DUMP, p, sizeof p);
+    steps(g, 1u);
+    assert_int_equal(g->svc.cmd.kind, BR_LINK_CMD_REC_DUMP);
+    assert_int_equal(g->svc.cmd.first, 37u);
+    steps(g, 1u);
+    assert_int_equal(g->svc.cmd.kind, BR_LINK_CMD_NONE);
+    test_free(g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -532,6 +551,7 @@ int main(void)
         cmocka_unit_test(test_underrun_faults),
         cmocka_unit_test(test_params),
         cmocka_unit_test(test_arm_restores_params),
+        cmocka_unit_test(test_rec_request_to_caller),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -75,6 +75,15 @@ f = decode_frame(encode_frame(0x21, 7, pack("param_write", param=3, value=0.5)))
 assert unpack(f.id, f.payload) == ("param_write", {"param": 3, "value": 0.5}), f
 print("bristle.link installed: a param_write frame round-trips")
 PY
+link="$work/venv/bin/bristle-link"
+[[ -x $link ]] || fail "the install made no console command bristle-link"
+"$link" --help > link.help || fail "bristle-link --help exits non-zero"
+grep -q "stream" link.help || fail "bristle-link --help names no stream subcommand"
+set +e
+"$link" --port /dev/null status 2> link.err; rc=$?
+set -e
+[[ $rc -eq 2 ]] || fail "bristle-link without --machine exits $rc, want 2"
+"$work/venv/bin/python" -c "import serial" || fail "pyserial (bristle-link's port) is not installed"
 "$cmd" validate --model diag/model.json --log log.csv > val.out 2> val.err || fail "validate failed: $(cat val.err)"
 grep -q "relerr [0-9.e+-]* % over" val.out || fail "validate printed no relerr line on stdout: $(cat val.out)"
 "$cmd" diagnose --log log.csv --out diag2 --no-plots --quiet 2> quiet.err || fail "diagnose --quiet failed"

@@ -15,10 +15,10 @@ import unittest
 
 ARGS = None
 TOOLS = ("br_simlog", "br_demo_circle", "br_circle_ext", "br_pf_study", "br_dt_study", "br_tune_est", "br_track",
-         "br_robust_run", "bench/br_bench")
+         "br_robust_run", "bench/br_bench", "br_link_sim")
 VALUED = {"br_simlog": "--out", "br_demo_circle": "--out", "br_circle_ext": "--json", "br_pf_study": "--table",
           "br_dt_study": "--seeds", "br_tune_est": "--out", "br_track": "--json", "br_robust_run": "--json",
-          "bench/br_bench": "--json"}  # an option that takes a value
+          "bench/br_bench": "--json", "br_link_sim": "--pty-path"}  # an option that takes a value
 VERSION_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "VERSION")
 OLD = b"an existing file\r\nwith two lines\n"
 
@@ -294,6 +294,24 @@ class ToolsTest(unittest.TestCase):
         r = subprocess.run(["make", "-s", "-C", root, "--eval", argv_rule, "br-demo-argv"], capture_output=True,
                            text=True, env=env, timeout=120)
         self.assertEqual(r.stdout, "")  # without them: the thesis's circle
+
+    def test_link_sim_bounds(self):
+        """br_link_sim (docs/link.md): each bound named, nothing written, no pty path file"""
+        for a, word in ((["--speed", "1001"], "--speed 1001"), (["--duration", "0.01"], "--duration 0.01"),
+                        (["--queue", "65"], "--queue 65"), (["--tlm-every", "0"], "--tlm-every 0"),
+                        (["--rec-capacity", "65536"], "--rec-capacity 65536"),
+                        (["--rec-capacity", "10", "--rec-pre", "10"], "--rec-pre 10: must be below --rec-capacity 10"),
+                        (["--est", "kalman"], "--est kalman: must be none, ukf or pf"),
+                        (["--plant", "x"], "--plant x: must be thesis or hardware_like")):
+            r = run("br_link_sim", *a, "--pty-path", "pty.txt", cwd=self.w)
+            self.assert_refused(r, 2, word, "usage:")
+        self.assertEqual(os.listdir(self.w), [])
+        # a run: the path of a pty that exists while it runs, the summary at the end
+        r = run("br_link_sim", "--speed", "0", "--duration", "0.5", "--pty-path", "pty.txt", cwd=self.w)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(self.w, "pty.txt")) as f:
+            self.assertRegex(f.read(), r"^/dev/pts/[0-9]+\n$")
+        self.assertIn("br_link_sim: 500 periods (0.500 s simulated)", r.stderr)
 
     def test_pf_study_bounds(self):
         table = os.path.join(self.w, "t.bin")

@@ -1,0 +1,136 @@
+# SPDX-License-Identifier: Apache-2.0
+"""A session with a target over a byte port (docs/link.md, "The host tool"):
+requests framed with the host's sequence numbers, the reports decoded as
+they come, the latest status and ref_status kept, telemetry and dump frames
+collected for the caller.
+
+The port is pyserial's (`serial.serial_for_url`: a serial port such as
+/dev/ttyACM0, or the simulator's pseudo-terminal, /dev/pts/N, which
+br_link_sim prints), opened non-blocking; its input is flushed at the open,
+so what a target sent before the session is not taken for a reply.
+
+The session's start: the target accepts a frame only when its seq is
+1..32767 ahead of the last one it accepted (modulo 2^16), and it keeps that
+last seq across host sessions (a hello message that resets it is not in the
+protocol yet). So the session first sends three harmless requests (a
+param_read) at seq s, s + 0x5555 and s + 0xAAAA: the three split the circle of
+2^16 into gaps of at most 21846, and the target's window of 32767 seqs holds
+at least one of them, whatever its last seq; each one after it is 0x5555
+ahead, inside the window, and so is every later frame. The ones the target
+refused are counted there as replayed (rx_replayed)."""
+import time
+
+from . import messages, params
+from .frame import Decoder, encode_frame
+
+SYNC_STEP = 0x5555
+# the parameter the session's start reads (every estimator has it; an image
+# without an estimator answers its status, which the start ignores)
+SYNC_PARAM = params.BY_NAME["comp_ahead_periods"].id
+
+
+class LinkError(RuntimeError):
+    """A reply that did not come in time, or a refusal."""
+
+
+def open_port(port, baud):
+    """pyserial's port for a path or URL, non-blocking, its input flushed."""
+    import serial  # the host tool's dependency (pyproject.toml); only the port needs it
+    try:
+        ser = serial.serial_for_url(port, baudrate=baud, timeout=0, write_timeout=2.0)
+    except (serial.SerialException, ValueError) as e:
+        raise LinkError("cannot open %s: %s" % (port, e)) from e
+    ser.reset_input_buffer()
+    return ser
+
+
+class Session:
+    """One host session on an open port (an object with read(n), write(b),
+    in_waiting: pyserial's, or a test's)."""
+
+    def __init__(self, port, start_seq=0):
+        self.port = port
+        self.dec = Decoder()
+        self.seq = start_seq & 0xFFFF
+        self.status = None       # the latest status report (dict)
+        self.ref_status = None   # the latest ref_status (dict)
+        self.tick = None         # the latest period index any report carried
+        self.faults = []         # fault reports (dict) in arrival order
+        self.param_values = []   # param_value reports
+        self.tlm = []            # tlm_sample rows, when collect_tlm
+        self.dump = []           # rec_sample / rec_end frames, when collect_dump
+        self.collect_tlm = False
+        self.collect_dump = False
+
+    def send(self, name, **fields):
+        self.port.write(encode_frame(messages.BY_NAME[name].id, self.seq, messages.pack(name, **fields)))
+        self.seq = (self.seq + 1) & 0xFFFF
+
+    def start(self, timeout_s=2.0, settle_s=0.05):
+        """The session's start (above): three param_reads SYNC_STEP apart;
+        waits for an answer (LinkError: the target does not answer), then
+        settle_s for the others, and forgets them."""
+        self.param_values = []
+        for k in range(3):
+            self.seq = (self.seq + (SYNC_STEP if k else 0)) & 0xFFFF
+            self.port.write(encode_frame(messages.BY_NAME["param_read"].id, self.seq,
+                                         messages.pack("param_read", param=SYNC_PARAM)))
+        self.seq = (self.seq + 1) & 0xFFFF
+        self.wait("answer from the target", lambda: self.param_values, timeout_s)
+        end = time.monotonic() + settle_s
+        while time.monotonic() < end:
+            self.poll()
+        self.param_values = []
+
+    def _take(self, fr):
+        name, v = messages.unpack(fr.id, fr.payload)
+        if name in ("status", "ref_status", "tlm_sample"):
+            self.tick = v["tick"] if self.tick is None else max(self.tick, v["tick"])
+        if name == "status":
+            self.status = v
+        elif name == "ref_status":
+            self.ref_status = v
+        elif name == "fault":
+            self.faults.append(v)
+        elif name == "param_value":
+            self.param_values.append(v)
+        elif name == "tlm_sample" and self.collect_tlm:
+            self.tlm.append(v)
+        elif name in ("rec_sample", "rec_end") and self.collect_dump:
+            self.dump.append(fr)
+
+    def poll(self, wait_s=0.002):
+        """Takes what the port holds (waiting at most wait_s for a first
+        byte) and decodes it; the number of frames taken."""
+        n = self.port.in_waiting
+        if not n:
+            time.sleep(wait_s)
+            n = self.port.in_waiting
+        frames = self.dec.feed(self.port.read(n)) if n else []
+        for fr in frames:
+            self._take(fr)
+        return len(frames)
+
+    def wait(self, what, cond, timeout_s):
+        """Polls until cond() is true; LinkError naming what after timeout_s."""
+        end = time.monotonic() + timeout_s
+        while not cond():
+            if time.monotonic() > end:
+                raise LinkError("no %s within %g s" % (what, timeout_s))
+            self.poll()
+
+    def wait_status(self, timeout_s, cond=lambda s: True):
+        """A status report that arrives from now on and satisfies cond."""
+        self.status = None
+        self.wait("status", lambda: self.status is not None and cond(self.status), timeout_s)
+        return self.status
+
+    def param(self, pid, value=None, timeout_s=2.0):
+        """param_read (value None) or param_write: the param_value answer."""
+        self.param_values = []
+        if value is None:
+            self.send("param_read", param=pid)
+        else:
+            self.send("param_write", param=pid, value=value)
+        self.wait("param_value for %d" % pid, lambda: any(p["param"] == pid for p in self.param_values), timeout_s)
+        return next(p for p in self.param_values if p["param"] == pid)
