@@ -59,20 +59,20 @@ static int take_byte(br_pil_port_t *p, uint8_t b)
 static br_status_t pil_tick_wait(void *ctx, uint32_t *tick)
 {
     br_pil_port_t *p = ctx;
-    int have_tick = 0;
     for (uint32_t i = 0u; i < p->cfg.wait_polls; ++i) {
         br_cmsdk_uart_poll(p->cfg.link);
         uint8_t b;
         /* the plant port's bytes up to the tick's frame (the host sends no more before our answer) */
-        while (!have_tick && p->cfg.plant_chan.read(p->cfg.plant_chan.ctx, &b, 1u) == 1u) {
-            have_tick = take_byte(p, b);
+        while (!p->have_tick && p->cfg.plant_chan.read(p->cfg.plant_chan.ctx, &b, 1u) == 1u) {
+            p->have_tick = (uint8_t)take_byte(p, b);
         }
-        if (!have_tick) {
+        if (!p->have_tick) {
             continue;
         }
         /* every link byte the host wrote before the tick is in */
         if ((int32_t)(p->cfg.link->cnt.rx_bytes - p->tick.link_bytes) >= 0) {
             ++p->n_ticks;
+            p->have_tick = 0u;
             if (tick != NULL) {
                 *tick = p->tick.tick;
             }
@@ -97,6 +97,7 @@ br_status_t br_pil_port_init(br_pil_port_t *p, const br_pil_port_cfg_t *cfg, br_
     p->tick = (br_link_pil_tick_t){0u, 0, 0u};
     p->duty = 0.0f;
     p->on = 0u;
+    p->have_tick = 0u;
     p->seq = 1u;
     p->n_ticks = p->n_unexpected = p->n_report_short = 0u;
     *hal = (br_hal_t){p, pil_encoder_read, pil_pwm_write, pil_tick_wait, pil_pwm_disable, pil_pwm_enable};

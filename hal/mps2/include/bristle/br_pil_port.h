@@ -40,6 +40,7 @@ typedef struct {
     br_link_pil_tick_t tick; /* the last tick */
     float duty;              /* the PWM port's duty */
     uint8_t on;              /* the outputs on */
+    uint8_t have_tick;       /* a tick came and waits for its link bytes (kept across a wait that gave up) */
     uint16_t seq;            /* the next pil_out's sequence number */
     uint32_t n_ticks;        /* ticks taken */
     uint32_t n_unexpected;   /* frames on the plant port that were not a pil_tick (dropped) */
