@@ -257,10 +257,12 @@ static int send_setpoint(pil_t *p, int axis, uint32_t tick)
     pil_axis_t *a = &p->ax[axis];
     double x;
     const long k = (long)tick - (long)SETUP_PERIODS;
-    const br_ref_t r = br_circle_axis_ref(p->c, axis, (double)k * p->c->dt_s, &x);
+    br_ref_t r = br_circle_axis_ref(p->c, axis, (double)k * p->c->dt_s, &x);
     if (!(r.ref_frac_counts < 1.0f)) {
-        fprintf(stderr, "%s: the reference of period %ld rounds to a fraction of 1: not a setpoint\n", TOOL, k);
-        return -1;
+        /* a fraction that rounded to 1 (a setpoint's is in [0, 1)): the same position as the next
+         * whole count; --compare holds the application to the simulator's duty all the same */
+        r.ref_counts += 1;
+        r.ref_frac_counts = 0.0f;
     }
     const br_refq_item_t it = {BR_REFQ_SETPOINT, k == p->n ? BR_REFQ_FLAG_LAST : 0u, tick, 1u, r.ref_counts,
                                r.ref_frac_counts, r.ref_omega_radps, 0.0f, 0.0f};
