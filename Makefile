@@ -110,7 +110,7 @@ define print_size
 	done
 endef
 
-.PHONY: fuzz help deps build test demo bench target-bench diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet
+.PHONY: fuzz help deps build test demo bench target-bench pil diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet
 
 help:
 	@echo "bristle targets:"
@@ -131,6 +131,7 @@ help:
 	@echo "  make fleet [N=200] [SEED=s]  N axes across the machine files a user may bring, each through the chain, every controller -> $(FLEET_OUT), docs/fleet.md"
 	@echo "  make faults                 the fault campaign on the simulator (production guards) -> docs/reliability-faults.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
+	@echo "  make pil       the circle with each estimator on QEMU's Cortex-M7 in lockstep with the host plant, compared bit for bit with the simulator (docs/link.md)"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune [MACHINE=<json>] [MAX_FEV=n]  Nelder-Mead tuning of the PF and UKF noise (the reference: regenerates firmware/gen/bristle_gen/est/; another machine: its build folder's tune/, with tune/machine.json; docs/tuning.md)"
 	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
@@ -243,6 +244,18 @@ target-bench: deps
 	$(Q)echo "== target-bench on the Cortex-M4 (mps2-an386) -> $(TARGET_BENCH_OUT)/m4"
 	$(Q)BR_QEMU_MACHINE=mps2-an386 BR_BENCH_CPU=Cortex-M4 BR_BENCH_MHZ=170 \
 	  target/mps2/target_bench.sh build/host-release build/cm4-release $(TARGET_BENCH_OUT)/m4
+
+# The image in the loop (docs/link.md, "The image in the loop"): the thesis
+# circle with each estimator, each axis's production application on QEMU's
+# Cortex-M7 (br_pil_mps2) in lockstep with the host plant (br_pil), the duty
+# sequences compared bit for bit with the simulator's same run; the demo's table.
+pil: deps
+	$(call configure,host-release)
+	$(Q)cmake --build --preset host-release --target br_pil $(NINJA_QUIET)
+	$(call configure,cm7-release)
+	$(Q)cmake --build --preset cm7-release --target br_pil_mps2 $(NINJA_QUIET)
+	$(Q)echo "== the circle in the loop (about 10 min)"
+	$(Q)build/host-release/sim/br_pil --image build/cm7-release/target/mps2/br_pil_mps2.elf --est all --compare
 
 # Measured logs (docs/diagnose.md): diagnose one, validate a saved model on
 # another, and the hidden-cause suite that writes docs/diagnose-hidden.md.

@@ -278,6 +278,17 @@ static br_ref_t axis_ref(const br_circle_cfg_t *c, double phase, double t, doubl
     return r;
 }
 
+/* the axes' phases: x = A sin(w t), y = A sin(w t + pi/2) */
+static double axis_phase(int axis)
+{
+    return axis == 0 ? 0.0 : 0.5 * BR_PI;
+}
+
+br_ref_t br_circle_axis_ref(const br_circle_cfg_t *c, int axis, double t, double *x_ref)
+{
+    return axis_ref(c, axis_phase(axis), t, x_ref);
+}
+
 br_ctrl_cfg_t br_circle_ctrl_cfg(const br_circle_cfg_t *c)
 {
     br_ctrl_cfg_t cc;
@@ -384,6 +395,31 @@ void br_circle_csv_sink(void *user, const br_circle_sample_t *s)
 
 int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, br_circle_result_t *res)
 {
+    return br_circle_run_remote(c, NULL, sink, user, res);
+}
+
+/* one period of axis a's application, here (br_app_step) or remote */
+static int axis_step(axis_sim_t *a, const br_circle_remote_t *remote, int i, long k, const br_ref_t *r,
+                     br_circle_remote_out_t *o)
+{
+    if (remote == NULL) {
+        o->status = (int)br_app_step(&a->app, r);
+        o->fault = (int)a->app.fault;
+        o->duty = a->app.last.duty;
+        o->F_hat_N = a->app.F_hat_N;
+        o->saturated = a->app.last.saturated;
+        return 0;
+    }
+    int32_t counts = 0;
+    (void)a->hal.encoder_read(a->hal.ctx, &counts); /* what the application would read */
+    if (remote->step(remote->user, i, k, counts, o) != 0) return -1;
+    (void)a->hal.pwm_write(a->hal.ctx, o->port_duty); /* a non-finite one holds 0 */
+    return 0;
+}
+
+int br_circle_run_remote(const br_circle_cfg_t *c, const br_circle_remote_t *remote, br_circle_sink_t sink,
+                         void *user, br_circle_result_t *res)
+{
     if (!(c->radius_m > 0.0 && c->period_s > 0.0 && c->duration_s > 0.0 && c->dt_s > 0.0)) {
         fprintf(stderr, "br_circle: radius, period, duration and dt must be > 0\n");
         return -1;
@@ -401,7 +437,7 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
     axis_sim_t ax[2];
     ax[0].mem = ax[1].mem = (br_app_mem_t){NULL, NULL};
     int rc = -1;
-    if (axis_init(&ax[0], c, 0.0, 0) != 0 || axis_init(&ax[1], c, 0.5 * BR_PI, 1) != 0) goto done;
+    if (axis_init(&ax[0], c, axis_phase(0), 0) != 0 || axis_init(&ax[1], c, axis_phase(1), 1) != 0) goto done;
     const long n = lround(c->duration_s / c->dt_s);
     double sum2 = 0.0, emax = 0.0, fe2 = 0.0, track_max = 0.0, lost_t = 0.0;
     int nsat = 0, nout = 0;
@@ -433,27 +469,29 @@ int br_circle_run(const br_circle_cfg_t *c, br_circle_sink_t sink, void *user, b
                 if (c->controller == BR_CTRL_HINF_FF) br_ff_set_ref(&ax[i].ff, &in);
                 else br_qec_set_ref(&ax[i].qec, &in);
             }
-            br_status_t st = br_app_step(&ax[i].app, &r);
+            br_circle_remote_out_t o;
+            if (axis_step(&ax[i], remote, i, k, &r, &o) != 0) goto done;
+            const int st = o.status;
             if (st == BR_W_OUTLIER) {
                 nout++; /* the estimator skipped the update; control went on */
                 res->last_outlier_t_s = t;
             } else if (st != BR_OK) {
                 /* the firmware zeroed the drive: the axis stops safe; so does the run */
-                res->fault_status = (int)st;
+                res->fault_status = st;
                 res->fault_t_s = t;
-                res->fault_cause = (int)ax[i].app.fault;
+                res->fault_cause = o.fault;
                 res->fault_duty = ax[i].port.duty;
                 k_end = k;
                 break;
             }
-            sat |= ax[i].app.last.saturated;
-            s.duty[i] = (double)ax[i].app.last.duty;
-            s.F_hat_N[i] = (double)ax[i].app.F_hat_N;
+            sat |= o.saturated;
+            s.duty[i] = (double)o.duty;
+            s.F_hat_N[i] = (double)o.F_hat_N;
             /* against the force a perfect estimator hands over (the oracle's) */
             const double f_true = br_plant_comp_force_N(&ax[i].plant);
             fe2 += (s.F_hat_N[i] - f_true) * (s.F_hat_N[i] - f_true);
-            s.pf[i] = ax[i].mem.pf;
-            s.ukf[i] = ax[i].mem.ukf;
+            s.pf[i] = remote == NULL ? ax[i].mem.pf : NULL; /* a remote's filter is not here */
+            s.ukf[i] = remote == NULL ? ax[i].mem.ukf : NULL;
         }
         if (res->fault_status != 0) {
             break;

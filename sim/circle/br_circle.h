@@ -12,6 +12,7 @@
 #include "bristle/br_ff.h"
 #include "bristle/br_pf.h"
 #include "bristle/br_qec.h"
+#include "bristle/br_ref.h"
 #include "bristle/br_ukf.h"
 #include "plant/br_sim_plant.h"
 
@@ -173,6 +174,36 @@ typedef void (*br_circle_sink_t)(void *user, const br_circle_sample_t *s);
  * in res->fault_status, fault_t_s; the results cover the periods before it);
  * -1 with a message on stderr on an invalid configuration. */
 int br_circle_run(const br_circle_cfg_t *cfg, br_circle_sink_t sink, void *user, br_circle_result_t *res);
+
+/* The application elsewhere: the image in the loop (sim/apps/br_pil.c, docs/link.md,
+ * "The image in the loop"). br_circle_run_remote calls step once per axis and
+ * period in place of br_app_step, with the encoder count the application would
+ * read; step answers with what the remote application did, and the run applies
+ * port_duty to the plant through the simulator's PWM port. step returns 0, or
+ * -1 (with a message on stderr) when the remote cannot answer, which ends the
+ * run with -1. */
+typedef struct {
+    float port_duty;  /* what the remote's PWM port holds: the amplifier's input */
+    int status;       /* the period's status (br_app_step's) */
+    int fault;        /* br_app_fault_t after the period */
+    float duty;       /* the controller's duty (br_app_t.last.duty) */
+    float F_hat_N;    /* the compensation used */
+    int saturated;    /* the torque saturated */
+} br_circle_remote_out_t;
+
+typedef struct {
+    int (*step)(void *user, int axis, long k, int32_t counts, br_circle_remote_out_t *out);
+    void *user;
+} br_circle_remote_t;
+
+/* br_circle_run with each axis's application remote (NULL: br_circle_run). The
+ * configuration must be one the remote runs (the caller's to check). */
+int br_circle_run_remote(const br_circle_cfg_t *cfg, const br_circle_remote_t *remote, br_circle_sink_t sink,
+                         void *user, br_circle_result_t *res);
+
+/* The circle's reference of axis (0 x, 1 y) at t: what br_circle_run hands
+ * br_app_step, and the position in metres in *x_ref. */
+br_ref_t br_circle_axis_ref(const br_circle_cfg_t *c, int axis, double t, double *x_ref);
 
 /* A sink writing CSV rows t,x_ref,y_ref,x,y,radial_err,duty_x,duty_y,fnl_x,fnl_y,
  * fhat_x,fhat_y,gp_x,gp_y (gp: the PF's mean g_p, else empty) to the FILE *

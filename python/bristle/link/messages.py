@@ -144,6 +144,17 @@ MESSAGES = (
     Message("rec_dump", 0x52, TO_TARGET, (
         Field("first", "u16", "the first index to send (0: the whole capture)"),
     ), "recorder: send the capture from index first, then rec_end"),
+    # the image in the loop (docs/link.md, "The image in the loop"): ids 0x60-0x6F, on
+    # the emulated board's plant port (a UART of its own), never on the link
+    Message("pil_tick", 0x60, TO_TARGET, (
+        Field("tick", "u32", "the host's period index"),
+        Field("counts", "i32", "the encoder count of the period (the host plant's)"),
+        Field("link_bytes", "u32", "bytes the host has written on the link since the start, modulo 2^32"),
+    ), "image in the loop: one control period's tick and encoder count; the period runs once the link's bytes are in"),
+    Message("pil_out", 0x61, TO_HOST, (
+        Field("port_duty", "f32", "the duty the PWM port holds after the period, [-1, 1]: what the amplifier gets"),
+        Field("on", "u8", "1 the outputs are on, 0 off"),
+    ) + SAMPLE_FIELDS, "image in the loop: the period's output and its sample (tick: the pil_tick's)"),
 )
 
 BY_ID = {m.id: m for m in MESSAGES}

@@ -141,6 +141,29 @@
 #define BR_LINK_MSG_REC_DUMP_LEN 2u
 #define BR_LINK_MSG_REC_DUMP_OFF_FIRST 0u /* u16 the first index to send (0: the whole capture) */
 
+/* image in the loop: one control period's tick and encoder count; the period runs once the link's bytes are in (BR_LINK_TO_TARGET) */
+#define BR_LINK_MSG_PIL_TICK 0x60u
+#define BR_LINK_MSG_PIL_TICK_LEN 12u
+#define BR_LINK_MSG_PIL_TICK_OFF_TICK 0u /* u32 the host's period index */
+#define BR_LINK_MSG_PIL_TICK_OFF_COUNTS 4u /* i32 the encoder count of the period (the host plant's) */
+#define BR_LINK_MSG_PIL_TICK_OFF_LINK_BYTES 8u /* u32 bytes the host has written on the link since the start, modulo 2^32 */
+
+/* image in the loop: the period's output and its sample (tick: the pil_tick's) (BR_LINK_TO_HOST) */
+#define BR_LINK_MSG_PIL_OUT 0x61u
+#define BR_LINK_MSG_PIL_OUT_LEN 34u
+#define BR_LINK_MSG_PIL_OUT_OFF_PORT_DUTY 0u /* f32 the duty the PWM port holds after the period, [-1, 1]: what the amplifier gets */
+#define BR_LINK_MSG_PIL_OUT_OFF_ON 4u /* u8 1 the outputs are on, 0 off */
+#define BR_LINK_MSG_PIL_OUT_OFF_TICK 5u /* u32 the control period's index (the caller's) */
+#define BR_LINK_MSG_PIL_OUT_OFF_COUNTS 9u /* i32 the encoder count the period used */
+#define BR_LINK_MSG_PIL_OUT_OFF_REF_COUNTS 13u /* i32 the limited reference the controller tracked: whole counts ... */
+#define BR_LINK_MSG_PIL_OUT_OFF_REF_FRAC 17u /* f32 ... and the fraction of a count, in [0, 1) */
+#define BR_LINK_MSG_PIL_OUT_OFF_DUTY 21u /* f32 PWM duty written, [-1, 1] */
+#define BR_LINK_MSG_PIL_OUT_OFF_F_HAT_N 25u /* f32 the compensation force used (N, load side) */
+#define BR_LINK_MSG_PIL_OUT_OFF_N_OUTLIERS 29u /* u16 outlier periods in the lock monitor's window */
+#define BR_LINK_MSG_PIL_OUT_OFF_STATUS 31u /* i8 br_app_step's status (1 BR_W_OUTLIER: the measurement was skipped) */
+#define BR_LINK_MSG_PIL_OUT_OFF_FAULT 32u /* u8 br_app_fault_t (0 none, 1 disarmed) */
+#define BR_LINK_MSG_PIL_OUT_OFF_FLAGS 33u /* u8 bit 0 reference limited, 1 torque saturated, 2 encoder read held, 3-4 br_app_stop_t */
+
 /* X(NAME, id, payload length, direction) for every message */
 #define BR_LINK_MSG_TABLE(X) \
     X(STATUS, BR_LINK_MSG_STATUS, BR_LINK_MSG_STATUS_LEN, BR_LINK_TO_HOST) \
@@ -159,6 +182,8 @@
     X(REC_END, BR_LINK_MSG_REC_END, BR_LINK_MSG_REC_END_LEN, BR_LINK_TO_HOST) \
     X(REC_ARM, BR_LINK_MSG_REC_ARM, BR_LINK_MSG_REC_ARM_LEN, BR_LINK_TO_TARGET) \
     X(REC_TRIGGER, BR_LINK_MSG_REC_TRIGGER, BR_LINK_MSG_REC_TRIGGER_LEN, BR_LINK_TO_TARGET) \
-    X(REC_DUMP, BR_LINK_MSG_REC_DUMP, BR_LINK_MSG_REC_DUMP_LEN, BR_LINK_TO_TARGET)
+    X(REC_DUMP, BR_LINK_MSG_REC_DUMP, BR_LINK_MSG_REC_DUMP_LEN, BR_LINK_TO_TARGET) \
+    X(PIL_TICK, BR_LINK_MSG_PIL_TICK, BR_LINK_MSG_PIL_TICK_LEN, BR_LINK_TO_TARGET) \
+    X(PIL_OUT, BR_LINK_MSG_PIL_OUT, BR_LINK_MSG_PIL_OUT_LEN, BR_LINK_TO_HOST)
 
 #endif
