@@ -107,14 +107,7 @@ typedef char br_image_tlm_fits[(2ull * BR_IMAGE_TLM_FRAME_BYTES * 1000000000ull 
 /* Deadline: more missed ticks than this since the arm turn the outputs off. */
 #define BR_IMAGE_MAX_MISSED 2u
 
-static const br_ctrl_cfg_t br_image_ctrl = {
-    .K = BR_HINF_K,
-    .dt_s = BR_IMAGE_DT_S,
-    .tau_max_Nm = BR_MACHINE_TORQUE_LIMIT_NM_F,
-    .tau_per_duty_Nm = BR_MACHINE_TAU_PER_DUTY_NM_F,
-    .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,
-    .lead_mprad = BR_MACHINE_LEAD_MPRAD_F,
-};
+static const br_ctrl_cfg_t br_image_ctrl = BR_MACHINE_CTRL_CFG(BR_IMAGE_DT_S);
 
 #if BR_IMAGE_USES_PF
 static const br_pf_cfg_t br_image_pf_cfg = BR_MACHINE_PF_CFG_TUNED(BR_IMAGE_DT_S);

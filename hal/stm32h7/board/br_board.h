@@ -54,6 +54,29 @@
 #define BR_BOARD_IRQ_PARKED  BR_DEF_X50, BR_DEF_X50, BR_DEF_X50
 #define BR_BOARD_ICACHE      1
 
+/* The table's values (hal/stm32/image/br_board_table.c): the blocks, the
+ * timers' pins (TIM2_CH1, TIM2_CH2, TIM1_CH1, TIM1_CH2, TIM1_CH1N, TIM1_CH2N)
+ * and the link's (TX, RX) */
+#define BR_BOARD_GPIO(port) ((br_stm32_gpio_t *)BR_STM32H7_GPIO##port##_BASE)
+#define BR_BOARD_PWM_TIM_BASE BR_STM32H7_TIM1_BASE
+#define BR_BOARD_ENC_TIM_BASE BR_STM32H7_TIM2_BASE
+#define BR_BOARD_TIM_PINS                                                                                 \
+    {BR_BOARD_GPIO(A), 0u, BR_BOARD_PIN_AF_TIM}, {BR_BOARD_GPIO(A), 1u, BR_BOARD_PIN_AF_TIM},                     \
+    {BR_BOARD_GPIO(A), 8u, BR_BOARD_PIN_AF_TIM}, {BR_BOARD_GPIO(A), 9u, BR_BOARD_PIN_AF_TIM},                     \
+    {BR_BOARD_GPIO(B), 13u, BR_BOARD_PIN_AF_TIM}, {BR_BOARD_GPIO(B), 14u, BR_BOARD_PIN_AF_TIM}
+#define BR_BOARD_N_TIM_PINS 6u
+#define BR_BOARD_USART_BASE BR_STM32H7_USART3_BASE
+#define BR_BOARD_USART_PINS {BR_BOARD_GPIO(D), 8u, BR_BOARD_PIN_AF_USART3}, {BR_BOARD_GPIO(D), 9u, BR_BOARD_PIN_AF_USART3}
+#define BR_BOARD_IWDG_BASE BR_STM32H7_IWDG1_BASE
+
+/* the board's part functions (its board/br_<part>_board.c), named in the
+ * table (hal/stm32/image/br_board_table.c): the clock tree and the timers'
+ * and pins' clock enables; the USART's clock enables and DMA routing; 1 when
+ * the last reset came from the watchdog (the reset flags then cleared) */
+br_status_t br_board_clocks(void);
+br_status_t br_board_usart_dma(br_stm32_usart_cfg_t *cfg);
+int br_board_reset_by_watchdog(void);
+
 /* the board's table */
 extern const br_stm32_board_t br_board;
 
