@@ -221,8 +221,8 @@ int main(void)
     host.rd = host.wr = host.tx_bytes = 0u;
     host.seq = 1u;
     const br_byte_chan_t chan = {&host, chan_read, chan_write};
-    const br_svc_cfg_t sc = {BR_IMAGE_RX_BUDGET, BR_LINK_TX_BUF_BYTES, br_image_refq(&mc), BR_IMAGE_STATUS_PERIODS, 0,
-                             0};
+    const br_svc_cfg_t sc = {BR_IMAGE_RX_BUDGET, BR_LINK_TX_BUF_BYTES, br_image_refq(&mc), BR_IMAGE_STATUS_PERIODS, 0, 0,
+                             BR_MACHINE_NAME};
     br_rec_slot_t slots[BENCH_REC_CAPACITY];
     const br_rec_cfg_t rc = {slots, BENCH_REC_CAPACITY, BENCH_REC_PRE, 0.0f, BR_IMAGE_REC_DUMP_FRAMES};
     const br_tlm_cfg_t tc = {tlm_every};

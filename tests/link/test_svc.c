@@ -13,6 +13,7 @@
 #include "bristle/br_param.h"
 #include "bristle/br_svc.h"
 #include "link_support.h"
+#include "bristle_gen/machine/br_machine.h"
 
 #define DT BR_MACHINE_CTRL_PERIOD_S_F
 #define HOLD 3u
@@ -165,7 +166,8 @@ static void rig_init(rig_t *g, int with_enable, int enable0)
                             BR_TEST_WIDE_MOTION};
     g->cfg = c;
     assert_int_equal(br_app_init(&g->app, &g->cfg, &g->hal, &g->mem), BR_OK);
-    const br_svc_cfg_t s = {64u, BR_LINK_TX_BUF_BYTES, refq_cfg(), 10u, with_enable ? hw_enable : NULL, &g->hw};
+    const br_svc_cfg_t s = {64u, BR_LINK_TX_BUF_BYTES, refq_cfg(), 10u, with_enable ? hw_enable : NULL, &g->hw,
+                            BR_MACHINE_NAME};
     g->scfg = s;
     const br_byte_chan_t ch = {&g->wire, wire_read, wire_write};
     assert_int_equal(br_svc_init(&g->svc, &g->scfg, &g->app, &g->cfg, &g->mem, &ch), BR_OK);

@@ -109,7 +109,7 @@ int main(void)
 #endif
     /* no enable input on this board: armed by the host's request only */
     const br_svc_cfg_t svc_cfg = {BR_IMAGE_RX_BUDGET, BR_LINK_TX_BUF_BYTES, br_image_refq(&app_cfg.motion),
-                                  BR_IMAGE_STATUS_PERIODS, NULL, NULL};
+                                  BR_IMAGE_STATUS_PERIODS, NULL, NULL, BR_MACHINE_NAME};
     const br_rec_cfg_t rec_cfg = {br_image_ring, BR_IMAGE_REC_SAMPLES, BR_IMAGE_REC_PRE, 0.0f,
                                   BR_IMAGE_REC_DUMP_FRAMES};
     const br_tlm_cfg_t tlm_cfg = {BR_IMAGE_TLM_EVERY};
