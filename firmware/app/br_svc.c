@@ -5,6 +5,10 @@
 #include <stddef.h>
 
 #include "bristle/br_param.h"
+#include "bristle/br_version.h"
+
+/* the firmware version hello_reply carries: major << 16 | minor << 8 | patch */
+#define BR_SVC_FW_VERSION (((uint32_t)BR_VERSION_MAJOR << 16) | ((uint32_t)BR_VERSION_MINOR << 8) | (uint32_t)BR_VERSION_PATCH)
 
 /* the link's param_write hook: the machine file's range, the estimators' own
  * check on the RAM copy it would make, and the armed rule */
@@ -148,9 +152,26 @@ static void svc_param(br_svc_t *s, const br_link_cmd_t *cmd)
     }
 }
 
+/* queues one report; 1 when it found no room (to retry) */
+static int svc_sent(br_svc_t *s, br_status_t st)
+{
+    if (st == BR_E_BUSY) {
+        ++s->cnt.tx_deferred;
+        return 1;
+    }
+    return 0;
+}
+
 static void svc_command(br_svc_t *s, const br_link_cmd_t *cmd)
 {
     switch (cmd->kind) {
+    case BR_LINK_CMD_HELLO:
+        /* the link restarted its window at the hello; a reply that finds no room
+         * waits for it (svc_reports), answering the newest hello */
+        s->hello_session = cmd->session;
+        s->send_hello = (uint8_t)svc_sent(s, br_link_send_hello_reply(&s->link, cmd->session, BR_SVC_FW_VERSION,
+                                                                      s->cfg.machine));
+        break;
     case BR_LINK_CMD_ARM:
         svc_arm(s);
         break;
@@ -192,18 +213,12 @@ static void svc_enable(br_svc_t *s)
     s->enable_last = e;
 }
 
-/* queues one report; 1 when it found no room (to retry) */
-static int svc_sent(br_svc_t *s, br_status_t st)
-{
-    if (st == BR_E_BUSY) {
-        ++s->cnt.tx_deferred;
-        return 1;
-    }
-    return 0;
-}
-
 static void svc_reports(br_svc_t *s)
 {
+    if (s->send_hello) {
+        s->send_hello = (uint8_t)svc_sent(
+            s, br_link_send_hello_reply(&s->link, s->hello_session, BR_SVC_FW_VERSION, s->cfg.machine));
+    }
     if (s->send_fault) {
         s->send_fault = (uint8_t)svc_sent(s, br_link_send_fault(&s->link, s->fault_cause, s->fault_tick));
     }

@@ -237,6 +237,8 @@ def render_machine(m):
         " * outside [A-Za-z0-9 ._+,:=@%~/-] replaced by _, for a generated comment */",
         "#define BR_MACHINE_FILE %s" % machine.c_string_literal(m["file"]),
         "#define BR_MACHINE_FILE_COMMENT %s" % machine.c_string_literal(machine.c_comment_text(m["file"])),
+        "/* the machine file's name ([a-z0-9][a-z0-9_-]*), which the link's hello_reply carries */",
+        "#define BR_MACHINE_NAME %s" % machine.c_string_literal(m["name"]),
     ]
     out += render_defines(machine_fields(m, machine.params(m)))
     out += render_causes(m)

@@ -5,6 +5,8 @@
 
 #include <string.h>
 
+#include "br_le.h"
+
 uint16_t br_link_crc16(uint16_t crc, const uint8_t *data, size_t n)
 {
     if (data == NULL) {
@@ -127,11 +129,20 @@ static int dec_check(br_link_dec_t *d, br_link_frame_t *f)
         return 0;
     }
     const uint16_t seq = (uint16_t)(b[3] | (uint16_t)((uint16_t)b[4] << 8));
+    /* a hello of another session than the one in force opens a session: accepted
+     * with any seq, the window restarts there (docs/link.md, "The session") */
+    const int hello = b[2] == BR_LINK_MSG_HELLO && b[0] == BR_LINK_MSG_HELLO_LEN;
+    const uint32_t session = hello ? br_le_get(&b[BR_LINK_HEADER_BYTES + BR_LINK_MSG_HELLO_OFF_SESSION], 4u) : 0u;
+    const int opens = hello && (!d->have_session || session != d->session);
     /* new: 1..BR_LINK_SEQ_WINDOW ahead of the last accepted, modulo 2^16 */
     const uint16_t ahead = (uint16_t)(seq - d->last_seq);
-    if (d->have_seq && (ahead == 0u || ahead > BR_LINK_SEQ_WINDOW)) {
+    if (!opens && d->have_seq && (ahead == 0u || ahead > BR_LINK_SEQ_WINDOW)) {
         ++d->cnt.rx_replayed;
         return 0;
+    }
+    if (opens) {
+        d->have_session = 1u;
+        d->session = session;
     }
     d->have_seq = 1u;
     d->last_seq = seq;

@@ -92,6 +92,22 @@ br_status_t br_link_send_ref_status(br_link_t *l, const br_link_ref_status_t *s)
     return br_link_send(l, BR_LINK_MSG_REF_STATUS, p, sizeof p);
 }
 
+br_status_t br_link_send_hello_reply(br_link_t *l, uint32_t session, uint32_t fw_version, const char *machine)
+{
+    uint8_t p[BR_LINK_MSG_HELLO_REPLY_LEN];
+    memset(p, 0, sizeof p);
+    put_u32(&p[BR_LINK_MSG_HELLO_REPLY_OFF_SESSION], session);
+    p[BR_LINK_MSG_HELLO_REPLY_OFF_VERSION] = (uint8_t)BR_LINK_VERSION;
+    put_u32(&p[BR_LINK_MSG_HELLO_REPLY_OFF_FW_VERSION], fw_version);
+    /* c16: at most 16 bytes of the name, the rest NUL (bounded by the field) */
+    for (size_t i = 0u; machine != NULL && i < BR_LINK_MSG_HELLO_REPLY_LEN - BR_LINK_MSG_HELLO_REPLY_OFF_MACHINE &&
+                        machine[i] != '\0';
+         ++i) {
+        p[BR_LINK_MSG_HELLO_REPLY_OFF_MACHINE + i] = (uint8_t)machine[i];
+    }
+    return br_link_send(l, BR_LINK_MSG_HELLO_REPLY, p, sizeof p);
+}
+
 /* the payloads of setpoint and segment as a queue item */
 static void get_setpoint(const uint8_t *p, br_refq_item_t *r)
 {
@@ -137,6 +153,9 @@ br_status_t br_link_cmd_decode(const br_link_frame_t *f, br_link_cmd_t *cmd)
     cmd->seq = f->seq;
     br_link_cmd_kind_t kind = BR_LINK_CMD_NONE;
     switch (f->id) {
+    case BR_LINK_MSG_HELLO:
+        kind = BR_LINK_CMD_HELLO;
+        break;
     case BR_LINK_MSG_ARM:
         kind = BR_LINK_CMD_ARM;
         break;
@@ -182,6 +201,8 @@ br_status_t br_link_cmd_decode(const br_link_frame_t *f, br_link_cmd_t *cmd)
         get_setpoint(f->payload, &cmd->ref);
     } else if (kind == BR_LINK_CMD_SEGMENT) {
         get_segment(f->payload, &cmd->ref);
+    } else if (kind == BR_LINK_CMD_HELLO) {
+        cmd->session = get_u32(&f->payload[BR_LINK_MSG_HELLO_OFF_SESSION]);
     } else if (kind == BR_LINK_CMD_REC_DUMP) {
         cmd->first = get_u16(&f->payload[BR_LINK_MSG_REC_DUMP_OFF_FIRST]);
     }

@@ -51,6 +51,7 @@
 #include "tools/br_args.h"
 #include "tools/br_outfile.h"
 #include "tools/br_tool_limits.h"
+#include "bristle_gen/machine/br_machine.h"
 
 #define TOOL "br_link_sim"
 /* the bounds of the options (docs/tools.md) */
@@ -277,7 +278,8 @@ static int axis_init(axis_t *a, const opts_t *o, const br_byte_chan_t *chan)
                        mc.max_accel_mps2, (uint32_t)o->hold_periods, 0u};
     /* the fault after the braking from the machine's top speed (refq.md) */
     q.fault_periods = q.hold_periods + (uint32_t)ceil((double)mc.max_speed_mps / ((double)mc.max_accel_mps2 * dt)) + 1u;
-    const br_svc_cfg_t sc = {BR_LINK_RX_BUDGET_MAX, BR_LINK_TX_BUF_BYTES, q, (uint32_t)o->status_periods, NULL, NULL};
+    const br_svc_cfg_t sc = {BR_LINK_RX_BUDGET_MAX, BR_LINK_TX_BUF_BYTES, q, (uint32_t)o->status_periods, NULL, NULL,
+                             BR_MACHINE_NAME};
     const br_tlm_cfg_t tc = {(uint32_t)o->tlm_every};
     a->slots = calloc((size_t)o->rec_capacity, sizeof *a->slots);
     if (a->slots == NULL) return -1;

@@ -108,7 +108,7 @@ int main(void)
     const uint32_t brake = (uint32_t)(mc.max_speed_mps / (mc.max_accel_mps2 * dt)) + 1u;
     const br_refq_cfg_t q = {BR_REFQ_MAX, dt, BR_MACHINE_RAD_PER_COUNT_F, mc.counts_per_m, mc.max_speed_mps,
                              mc.max_accel_mps2, BR_PIL_HOLD_PERIODS, BR_PIL_HOLD_PERIODS + brake + 1u};
-    const br_svc_cfg_t sc = {BR_LINK_RX_BUDGET_MAX, BR_LINK_TX_BUF_BYTES, q, BR_PIL_STATUS_PERIODS, 0, 0};
+    const br_svc_cfg_t sc = {BR_LINK_RX_BUDGET_MAX, BR_LINK_TX_BUF_BYTES, q, BR_PIL_STATUS_PERIODS, 0, 0, BR_MACHINE_NAME};
     const br_tlm_cfg_t tc = {BR_PIL_TLM_EVERY};
     br_rec_slot_t slots[BR_PIL_REC_CAPACITY];
     const br_rec_cfg_t rc = {slots, BR_PIL_REC_CAPACITY, BR_PIL_REC_CAPACITY / 2u, 0.0f, 2u};

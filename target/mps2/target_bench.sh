@@ -96,6 +96,15 @@ awk -v n="$un" -v s="$usum" -v mx="$umax" -v ci="$uci" -v ct="$uct" -v sz="$usz"
   printf "    at 1 instruction/cycle and %d MHz: %.1f%% of the 1 ms period; br_ukf_t %d bytes\n", mhz, 100 * mean / (mhz * 1e3), sz
 }'
 
+# The STM32H743 image's production period with the link, telemetry and the
+# recorder (docs/link.md, "Cost on the M7"): each part's cost, and the worst
+# period with telemetry at the control rate against the deadline budget
+# (budget.txt's deadline-share); exits 1 over it, after the rest of the report.
+link_rc=0
+if [[ $cpu == Cortex-M7 ]]; then
+  bash "$(dirname "$0")/link_bench.sh" "$cm7" "$out/link" "${BR_LINK_BENCH_PERIODS:-2000}" || link_rc=1
+fi
+
 # Profile: a 0.03 s stream (20 periods after the priming period k = 0), one
 # execution trace at m_hi, then the log is deleted.
 # Long instructions (the cycle estimate's): the executed vdiv.f32 / vsqrt.f32
@@ -222,6 +231,7 @@ awk -v szr="$sz_replay" -v szp="$sz_pf" '
     printf "      on the stack: br_replay_t %d bytes, of which br_pf_t %d bytes (BR_PF_MAX_PARTICLES 2048)\n", szr, szp
   }' "$map"
 
+[[ $link_rc -eq 0 ]] || { echo "target-bench: FAIL: the link bench (above)" >&2; exit 1; }
 # The budget: exit 1 when the slope is above the core's budget
 if awk -v s="$slope" -v b="$budget" 'BEGIN { exit !(s > b) }'; then
   printf "target-bench: FAIL: %.2f instructions per PF particle-step on the %s, over its budget of %s (target/mps2/budget.txt)\n" "$slope" "$cpu" "$budget" >&2

@@ -12,7 +12,9 @@
  *   - every accepted frame is in the input whole: its canonical encoding
  *     (br_link_encode of what was accepted) occurs in the stream, so its CRC,
  *     length and version were right and nothing was skipped;
- *   - accepted sequence numbers advance (1..BR_LINK_SEQ_WINDOW, modulo 2^16);
+ *   - accepted sequence numbers advance (1..BR_LINK_SEQ_WINDOW, modulo 2^16),
+ *     except a hello that opens a session (its session number not the one in
+ *     force): any seq;
  *   - every non-empty segment between delimiters is counted exactly once;
  *   - a step takes at most K bytes and returns at most one valid command;
  *   - after any input, a valid frame with the next sequence number is decoded
@@ -129,6 +131,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         const uint16_t last = d.last_seq;
         const int had = d.have_seq;
+        const int had_session = d.have_session;
+        const uint32_t session = d.session;
         if (br_link_dec_push(&d, s[i], &f)) {
             uint8_t w[BR_LINK_FRAME_MAX];
             size_t wl = 0;
@@ -136,7 +140,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (br_link_encode(w, sizeof w, f.id, f.seq, f.payload, f.len, &wl) != BR_OK) abort();
             if (!occurs(s, n, &w[1], wl - 1u)) abort();
             const uint16_t ahead = (uint16_t)(f.seq - last);
-            if (had && (ahead == 0u || ahead > BR_LINK_SEQ_WINDOW)) abort();
+            const uint32_t fs = (uint32_t)f.payload[0] | ((uint32_t)f.payload[1] << 8) |
+                                ((uint32_t)f.payload[2] << 16) | ((uint32_t)f.payload[3] << 24);
+            const int opens = f.id == BR_LINK_MSG_HELLO && f.len == BR_LINK_MSG_HELLO_LEN &&
+                              (!had_session || fs != session);
+            if (!opens && had && (ahead == 0u || ahead > BR_LINK_SEQ_WINDOW)) abort();
         }
     }
     if (drops(&d.cnt) != segments) abort();

@@ -16,6 +16,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "python"))
 
 from bristle.link import encode_frame, messages, pack  # noqa: E402
+from bristle.link.frame import VERSION  # noqa: E402
 
 # (message, seq, fields): values chosen to put 0x00 bytes inside payloads (the
 # stuffing), sequence numbers that advance across the wrap (each direction's
@@ -39,15 +40,21 @@ CASES = (
     ("segment", 0x000E, dict(tick=7, periods=400, counts=0x7FFFFFFF, frac=0.0, v_cps=2.0e4, a_cps2=-3.0e4,
                              j_cps3=struct.unpack("<f", struct.pack("<f", 2.5e5 / 3.0))[0], flags=1)),
     ("ref_status", 0x0004, dict(tick=99, queued=3, free=5, state=2, dropped=0, late=0x00FF00FF, underruns=1)),
+    ("hello", 0x0010, dict(session=0x00C0FFEE)),
+    ("hello_reply", 0x0005, dict(session=0x00C0FFEE, version=VERSION, fw_version=0x00000100,
+                                 machine=b"reference".ljust(16, b"\0"))),
 )
 FIELDS_MAX = 8
 
 
-def field_word(ftype, v):
-    """a field as the u32 the C table holds: an f32 as its bits, an i8 sign-extended"""
+def field_words(ftype, v):
+    """a field as the u32s the C table holds: an f32 as its bits, an i8
+    sign-extended, a c16 as four words (its bytes little-endian)"""
     if ftype == "f32":
-        return struct.unpack("<I", struct.pack("<f", v))[0]
-    return v & 0xFFFFFFFF
+        return [struct.unpack("<I", struct.pack("<f", v))[0]]
+    if ftype == "c16":
+        return list(struct.unpack("<4I", v))
+    return [v & 0xFFFFFFFF]
 
 
 def render():
@@ -60,7 +67,7 @@ def render():
            "    uint8_t id;",
            "    uint16_t seq;",
            "    unsigned to_target; /* 1: a host's request, 0: a target's report */",
-           "    uint32_t f[%d]; /* the fields in table order: an f32 as its bits, an i8 sign-extended */" % FIELDS_MAX,
+           "    uint32_t f[%d]; /* the fields in table order: an f32 as its bits, an i8 sign-extended, a c16 four words */" % FIELDS_MAX,
            "    const uint8_t *wire;",
            "    size_t wire_len;",
            "} br_link_golden_t;", ""]
@@ -70,7 +77,8 @@ def render():
         wire = encode_frame(m.id, seq, pack(name, **values))
         out.append("static const uint8_t br_link_golden_wire_%d[%d] = {%s};"
                    % (i, len(wire), ", ".join("0x%02x" % b for b in wire)))
-        words = [field_word(f.type, values[f.name]) for f in m.fields] + [0] * (FIELDS_MAX - len(m.fields))
+        words = [w for f in m.fields for w in field_words(f.type, values[f.name])]
+        words += [0] * (FIELDS_MAX - len(words))
         rows.append("    {0x%02xu, 0x%04xu, %du, {%s}, br_link_golden_wire_%d, %d}, /* %s */"
                     % (m.id, seq, m.direction == messages.TO_TARGET, ", ".join("0x%08xu" % w for w in words),
                        i, len(wire), name))

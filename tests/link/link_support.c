@@ -60,6 +60,14 @@ br_status_t golden_send(br_link_t *l, const br_link_golden_t *g)
         st = br_link_send_ref_status(l, &r);
         break;
     }
+    case BR_LINK_MSG_HELLO_REPLY: {
+        /* f[1] the version: the link writes its own, BR_LINK_VERSION */
+        char name[17];
+        for (size_t i = 0u; i < 16u; ++i) name[i] = (char)(g->f[3u + i / 4u] >> (8u * (i % 4u)));
+        name[16] = '\0';
+        st = g->f[1] == BR_LINK_VERSION ? br_link_send_hello_reply(l, g->f[0], g->f[2], name) : BR_E_INPUT;
+        break;
+    }
     default:
         return BR_E_INPUT;
     }

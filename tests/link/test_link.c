@@ -266,6 +266,46 @@ static void test_replay_dropped(void **s)
     assert_int_equal(l.dec.cnt.rx_frames, 4);
 }
 
+/* one frame of id (hello: session number `session`) at seq: the kind the step hands on */
+static br_link_cmd_kind_t hello_step(br_link_t *l, chan_t *c, uint8_t id, uint16_t seq, uint32_t session)
+{
+    const uint8_t p[4] = {(uint8_t)session, (uint8_t)(session >> 8), (uint8_t)(session >> 16),
+                          (uint8_t)(session >> 24)};
+    host_frame(c, id, seq, id == BR_LINK_MSG_HELLO ? p : NULL, id == BR_LINK_MSG_HELLO ? sizeof p : 0u);
+    br_link_cmd_t cmd;
+    assert_int_equal(br_link_step(l, &cmd), BR_OK);
+    if (cmd.kind == BR_LINK_CMD_HELLO) assert_int_equal(cmd.session, session);
+    return cmd.kind;
+}
+
+/* A hello of a new session is accepted whatever its seq and restarts the
+ * window there; within the session a repeated or old frame is still dropped,
+ * and so is the session's own hello repeated (a replay of it must not reopen
+ * the window). */
+static void test_hello_opens_a_session(void **s)
+{
+    (void)s;
+    br_link_t l;
+    chan_t c;
+    link_up(&l, &c, 256);
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_ARM, 0x4000, 0), BR_LINK_CMD_ARM);
+    /* a host restarted from seq 0: its arm is old, its hello opens a session */
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_ARM, 0x0000, 0), BR_LINK_CMD_NONE);
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_HELLO, 0x0000, 7), BR_LINK_CMD_HELLO);
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_ARM, 0x0001, 0), BR_LINK_CMD_ARM);
+    /* within the session: the same frame again, an older one, the hello again */
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_ARM, 0x0001, 0), BR_LINK_CMD_NONE);
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_ARM, 0x0000, 0), BR_LINK_CMD_NONE);
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_HELLO, 0x0000, 7), BR_LINK_CMD_NONE);
+    assert_int_equal(l.dec.cnt.rx_replayed, 4);
+    /* the session's hello inside the window is an ordinary frame; a new session reopens */
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_HELLO, 0x0002, 7), BR_LINK_CMD_HELLO);
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_HELLO, 0x9000, 8), BR_LINK_CMD_HELLO);
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_ARM, 0x8FFF, 0), BR_LINK_CMD_NONE);
+    assert_int_equal(hello_step(&l, &c, BR_LINK_MSG_ARM, 0x9001, 0), BR_LINK_CMD_ARM);
+    assert_int_equal(l.dec.cnt.rx_replayed, 5);
+}
+
 static void test_resync_after_garbage(void **s)
 {
     (void)s;
@@ -466,6 +506,7 @@ int main(void)
         cmocka_unit_test(test_commands_decoded),
         cmocka_unit_test(test_each_drop_counted),
         cmocka_unit_test(test_replay_dropped),
+        cmocka_unit_test(test_hello_opens_a_session),
         cmocka_unit_test(test_resync_after_garbage),
         cmocka_unit_test(test_step_bounded),
         cmocka_unit_test(test_channel_claiming_more_refused),

@@ -35,6 +35,10 @@ static void test_requests_decode(void **s)
         br_link_cmd_t cmd;
         assert_int_equal(br_link_cmd_decode(&f, &cmd), BR_OK);
         assert_int_equal(cmd.seq, g->seq);
+        if (g->id == BR_LINK_MSG_HELLO) {
+            assert_int_equal(cmd.kind, BR_LINK_CMD_HELLO);
+            assert_int_equal(cmd.session, g->f[0]);
+        }
         if (g->id == BR_LINK_MSG_ARM) assert_int_equal(cmd.kind, BR_LINK_CMD_ARM);
         if (g->id == BR_LINK_MSG_DISARM) assert_int_equal(cmd.kind, BR_LINK_CMD_DISARM);
         if (g->id == BR_LINK_MSG_FAULT_RESET) assert_int_equal(cmd.kind, BR_LINK_CMD_FAULT_RESET);
@@ -71,7 +75,7 @@ static void test_requests_decode(void **s)
         }
         ++n;
     }
-    assert_int_equal(n, 8);
+    assert_int_equal(n, 9);
 }
 
 /* the reports: the firmware's bytes are the Python's */
@@ -90,7 +94,7 @@ static void test_reports_encode_equal(void **s)
         assert_memory_equal(sink.buf, g->wire, g->wire_len);
         ++n;
     }
-    assert_int_equal(n, 7);
+    assert_int_equal(n, 8);
 }
 
 int main(void)

@@ -34,7 +34,7 @@ def emitted(name, argv=None):
 def main():
     wire = emitted("reports.bin")
     reports = [c for c in gen_golden.CASES if messages.BY_NAME[c[0]].direction == messages.TO_HOST]
-    assert len(reports) == 7, reports
+    assert len(reports) == 8, reports
     dec = Decoder()
     frames = dec.feed(wire)
     assert len(frames) == len(reports), (len(frames), dec.counters)

@@ -23,8 +23,8 @@ ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "python"))
 
 from bristle.link import cli, messages, params  # noqa: E402
-from bristle.link.frame import Decoder, encode_frame  # noqa: E402
-from bristle.link.session import Session  # noqa: E402
+from bristle.link.frame import VERSION, Decoder, encode_frame  # noqa: E402
+from bristle.link.session import LinkError, Session  # noqa: E402
 from bristle.link.trajectory import (FLAG_LAST, TrajectoryError, check_limits, counts_per_m,  # noqa: E402
                                      read_trajectory, segments, setpoints)
 
@@ -102,10 +102,12 @@ class Trajectory(unittest.TestCase):
 class Port:
     """A fake port: read() hands out the stream in the pieces given; write()
     decodes the host's frames as a target with last accepted seq `last`
-    would, and answers an accepted param_read with a param_value."""
+    would, and answers an accepted param_read with a param_value and an
+    accepted hello with its hello_reply (protocol `version`)."""
 
-    def __init__(self, pieces=(), last=None):
+    def __init__(self, pieces=(), last=None, version=VERSION):
         self.pieces = list(pieces)
+        self.version = version
         self.target = Decoder()
         self.target.last_seq = last
         self.accepted = []
@@ -125,6 +127,11 @@ class Port:
             if name == "param_read":
                 self.pieces.append(encode_frame(messages.BY_NAME["param_value"].id, self.out_seq,
                                                 messages.pack("param_value", param=v["param"], value=0.0, status=0)))
+                self.out_seq += 1
+            elif name == "hello":
+                self.pieces.append(encode_frame(messages.BY_NAME["hello_reply"].id, self.out_seq,
+                                                messages.pack("hello_reply", session=v["session"], version=self.version,
+                                                              fw_version=0x000102, machine=b"reference")))
                 self.out_seq += 1
 
     def flush(self):
@@ -178,14 +185,35 @@ class SessionDecoding(unittest.TestCase):
             self.assertEqual(sess.dec.counters["replayed"], 0)
 
     def test_start_whatever_the_targets_last_seq(self):
+        """The hello opens the session whatever seq the target accepted last
+        (the host starts from 0 again, as after a restart), and every frame
+        after it is accepted; the reply is kept."""
         arm = messages.BY_NAME["arm"].id
         for last in list(range(0, 65536, 331)) + [None, 0xFFFF, 0x5555, 0xAAAA, 0x7FFF, 0x8000]:
             port = Port(last=last)
             sess = Session(port, start_seq=0)
-            sess.start(timeout_s=0.5, settle_s=0.0)
+            hello = sess.start(timeout_s=0.5, session=7)
+            self.assertEqual((hello["session"], hello["machine"].rstrip(b"\0")), (7, b"reference"))
             sess.send("arm")
-            self.assertGreaterEqual(len(port.accepted), 2, "last seq %s" % last)
-            self.assertEqual(port.accepted[-1].id, arm, "last seq %s" % last)
+            self.assertEqual([f.id for f in port.accepted], [messages.BY_NAME["hello"].id, arm], "last seq %s" % last)
+
+    def test_start_refuses_another_version(self):
+        with self.assertRaises(LinkError):
+            Session(Port(version=VERSION + 1)).start(timeout_s=0.5)
+
+    def test_replay_within_a_session_dropped(self):
+        """A frame repeated after the hello, or the hello itself repeated,
+        does not pass: the session opens the window, it does not remove it."""
+        port = Port(last=0x1234)
+        sess = Session(port, start_seq=0)
+        sess.start(timeout_s=0.5, session=9)
+        hello_wire = encode_frame(messages.BY_NAME["hello"].id, 0, messages.pack("hello", session=9))
+        arm_wire = encode_frame(messages.BY_NAME["arm"].id, 1, b"")
+        port.write(arm_wire)
+        port.write(arm_wire)
+        port.write(hello_wire)
+        self.assertEqual(len(port.accepted), 2)
+        self.assertEqual(port.target.counters["replayed"], 2)
 
 
 class LivePlotSeries(unittest.TestCase):

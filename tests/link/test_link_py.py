@@ -52,7 +52,8 @@ def test_roundtrip_every_message():
         for f in m.fields:
             vals[f.name] = {"u8": rng.randrange(256), "i8": rng.randrange(-128, 128), "u16": rng.randrange(65536),
                             "u32": rng.randrange(1 << 32), "i32": rng.randrange(-(1 << 31), 1 << 31),
-                            "f32": struct.unpack("<f", struct.pack("<f", rng.uniform(-1e3, 1e3)))[0]}[f.type]
+                            "f32": struct.unpack("<f", struct.pack("<f", rng.uniform(-1e3, 1e3)))[0],
+                            "c16": bytes(rng.randrange(256) for _ in range(16))}[f.type]
         seq = rng.randrange(65536)
         fr = decode_frame(encode_frame(m.id, seq, pack(m.name, **vals)))
         assert (fr.id, fr.seq) == (m.id, seq) and unpack(fr.id, fr.payload) == (m.name, vals)

@@ -13,6 +13,7 @@
 #include "bristle/br_param.h"
 #include "bristle/br_svc.h"
 #include "link_support.h"
+#include "bristle_gen/machine/br_machine.h"
 
 #define DT BR_MACHINE_CTRL_PERIOD_S_F
 #define HOLD 3u
@@ -30,6 +31,7 @@ typedef struct {
     uint8_t tx[16384]; /* target to host */
     size_t tx_len;
     uint16_t host_seq;
+    int tx_blocked; /* 1: the host reads nothing, the target's transmit queue fills */
 } wire_t;
 
 static br_status_t hw_enc(void *ctx, int32_t *c)
@@ -74,6 +76,7 @@ static size_t wire_read(void *ctx, uint8_t *buf, size_t n)
 static size_t wire_write(void *ctx, const uint8_t *buf, size_t n)
 {
     wire_t *w = ctx;
+    if (w->tx_blocked) return 0u;
     const size_t k = n < sizeof w->tx - w->tx_len ? n : sizeof w->tx - w->tx_len;
     memcpy(&w->tx[w->tx_len], buf, k);
     w->tx_len += k;
@@ -165,7 +168,8 @@ static void rig_init(rig_t *g, int with_enable, int enable0)
                             BR_TEST_WIDE_MOTION};
     g->cfg = c;
     assert_int_equal(br_app_init(&g->app, &g->cfg, &g->hal, &g->mem), BR_OK);
-    const br_svc_cfg_t s = {64u, BR_LINK_TX_BUF_BYTES, refq_cfg(), 10u, with_enable ? hw_enable : NULL, &g->hw};
+    const br_svc_cfg_t s = {64u, BR_LINK_TX_BUF_BYTES, refq_cfg(), 10u, with_enable ? hw_enable : NULL, &g->hw,
+                            BR_MACHINE_NAME};
     g->scfg = s;
     const br_byte_chan_t ch = {&g->wire, wire_read, wire_write};
     assert_int_equal(br_svc_init(&g->svc, &g->scfg, &g->app, &g->cfg, &g->mem, &ch), BR_OK);
@@ -539,6 +543,31 @@ static void test_rec_request_to_caller(void **st)
     test_free(g);
 }
 
+/* A hello_reply that finds the transmit queue full waits for room: the host
+ * that opened the session gets its answer, never silence (it is not retried
+ * by a host that already sent its hello). */
+static void test_hello_reply_waits_for_room(void **st)
+{
+    (void)st;
+    static rig_t g;
+    rig_init(&g, 0, 0);
+    g.wire.tx_blocked = 1;
+    steps(&g, 300u); /* the periodic reports fill the queue */
+    const uint32_t deferred = g.svc.cnt.tx_deferred;
+    assert_true(deferred > 0u);
+    uint8_t p[BR_LINK_MSG_HELLO_LEN];
+    put32(&p[BR_LINK_MSG_HELLO_OFF_SESSION], 0xCAFE5u);
+    host_send(&g.wire, BR_LINK_MSG_HELLO, p, sizeof p);
+    steps(&g, 5u);
+    br_link_frame_t f[4];
+    assert_int_equal(g.wire.tx_len, 0u);
+    assert_true(g.svc.cnt.tx_deferred > deferred);
+    g.wire.tx_blocked = 0;
+    steps(&g, 40u);
+    assert_int_equal(host_frames(&g, BR_LINK_MSG_HELLO_REPLY, f, 4u), 1u);
+    assert_int_equal(get32(&f[0].payload[BR_LINK_MSG_HELLO_REPLY_OFF_SESSION]), 0xCAFE5u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -552,6 +581,7 @@ int main(void)
         cmocka_unit_test(test_params),
         cmocka_unit_test(test_arm_restores_params),
         cmocka_unit_test(test_rec_request_to_caller),
+        cmocka_unit_test(test_hello_reply_waits_for_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

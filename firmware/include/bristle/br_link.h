@@ -88,6 +88,8 @@ typedef struct {
     uint8_t overflow;  /* the body went past BR_LINK_BODY_MAX: dropped at the delimiter */
     uint8_t have_seq;  /* a frame was accepted: last_seq is valid */
     uint16_t last_seq;
+    uint8_t have_session; /* a hello was accepted: session is valid */
+    uint32_t session;     /* the session in force (the last hello's number) */
     br_link_counters_t cnt;
 } br_link_dec_t;
 
@@ -139,13 +141,15 @@ typedef enum {
     BR_LINK_CMD_REC_TRIGGER,
     BR_LINK_CMD_REC_DUMP,
     BR_LINK_CMD_SETPOINT,    /* ref: a setpoint (kind BR_REFQ_SETPOINT, periods 1) */
-    BR_LINK_CMD_SEGMENT      /* ref: a segment (kind BR_REFQ_SEGMENT) */
+    BR_LINK_CMD_SEGMENT,     /* ref: a segment (kind BR_REFQ_SEGMENT) */
+    BR_LINK_CMD_HELLO        /* session: a session opened (the window restarted at its seq) */
 } br_link_cmd_kind_t;
 
 typedef struct {
     br_link_cmd_kind_t kind;
     uint16_t seq;   /* the frame's sequence number */
     uint16_t param; /* PARAM_READ, PARAM_WRITE */
+    uint32_t session; /* HELLO: the host's session number */
     float value;    /* PARAM_WRITE */
     uint16_t first; /* REC_DUMP: the first sample index to send */
     br_refq_item_t ref; /* SETPOINT, SEGMENT: the item as received (br_refq_push checks it) */
@@ -205,6 +209,9 @@ br_status_t br_link_send_fault(br_link_t *l, uint8_t cause, uint32_t tick);
 /* st: the read's or write's status, sent as an i8 (BR_OK, or the refusal) */
 br_status_t br_link_send_param_value(br_link_t *l, uint16_t param, float value, br_status_t st);
 br_status_t br_link_send_ref_status(br_link_t *l, const br_link_ref_status_t *s);
+/* hello's answer: the session number, BR_LINK_VERSION, fw_version and the
+ * machine's name (its first 16 bytes, NUL-padded; NULL: empty) */
+br_status_t br_link_send_hello_reply(br_link_t *l, uint32_t session, uint32_t fw_version, const char *machine);
 
 /* The payload length of message id sent in direction (BR_LINK_TO_HOST or
  * BR_LINK_TO_TARGET), from the table; -1 when there is no such message. */

@@ -4,7 +4,8 @@
  * period, after the tick, in place of br_app_step: it takes at most one
  * request from the link (arm, disarm, fault reset, a parameter, a setpoint or
  * a segment), reads the enable input, makes the period's reference
- * (br_refq), runs br_app_step with it and queues the reports (status
+ * (br_refq), runs br_app_step with it and queues the reports (hello_reply
+ * to a hello: the protocol and firmware versions, the machine's name) (status
  * periodically and on a change, fault once when one latches, ref_status with
  * the periodic status). Never waits: the link's work is bounded
  * (br_link_step), the rest is a fixed amount per period.
@@ -40,6 +41,7 @@ typedef struct {
     uint32_t status_periods;  /* a status (and ref_status) every so many periods, 1..2^24 */
     br_svc_enable_fn enable;  /* NULL: no enable input (arm by request only) */
     void *enable_ctx;
+    const char *machine;      /* the machine's name hello_reply carries (BR_MACHINE_NAME); NULL: empty */
 } br_svc_cfg_t;
 
 /* what the service refused or could not send (wraps modulo 2^32) */
@@ -66,6 +68,8 @@ typedef struct {
     uint8_t fault_cause;      /* the last fault latched (the fault report's cause) */
     uint8_t send_fault;       /* a fault report waiting for room */
     uint8_t send_status;      /* a status waiting for room (a change) */
+    uint8_t send_hello;       /* a hello_reply waiting for room */
+    uint32_t hello_session;   /* the session number it answers */
     int enable_last;          /* the enable input last period */
     br_link_cmd_t cmd;        /* the period's request (kind NONE: none): after br_svc_step, the
                                  caller's to read; the recorder's (REC_ARM, REC_TRIGGER,

@@ -39,11 +39,11 @@
  * recorder's ring (BR_BOARD_REC_SAMPLES samples) and the USART's DMA buffers
  * (the DMA does not reach the tightly coupled RAM that holds the stack).
  * docs/modules/hal.md, docs/porting.md. */
-#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #include "br_board.h"
+#include "br_image_cfg.h"
 #include "bristle/br_app.h"
 #include "bristle/br_machine_cfg.h"
 #include "bristle/br_rec.h"
@@ -53,59 +53,7 @@
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 
-/* The estimator is the first of the machine file's control.estimator that
- * the board runs: the PF in a loop at its own period (estimator.pf.period_s)
- * where BR_BOARD_RUNS_PF, the UKF and H-infinity only at control.period_s
- * (bristle_gen/machine/br_machine.h: each rank 1 first, 0 not listed). */
-#if BR_BOARD_RUNS_PF && BR_MACHINE_EST_RANK_PF == 1
-#define BR_IMAGE_USES_PF 1
-#define BR_IMAGE_USES_UKF 0
-#define BR_IMAGE_EST BR_APP_EST_PF
-#define BR_IMAGE_DT_S BR_EST_PF_PERIOD_S_F
-#define BR_IMAGE_PERIOD_NS BR_EST_PF_PERIOD_NS
-#else
-#define BR_IMAGE_USES_PF 0
-#if BR_MACHINE_EST_RANK_UKF && (!BR_MACHINE_EST_RANK_NONE || BR_MACHINE_EST_RANK_UKF < BR_MACHINE_EST_RANK_NONE)
-#define BR_IMAGE_USES_UKF 1
-#define BR_IMAGE_EST BR_APP_EST_UKF
-#elif BR_MACHINE_EST_RANK_NONE
-#define BR_IMAGE_USES_UKF 0
-#define BR_IMAGE_EST BR_APP_EST_NONE
-#else
-#error "control.estimator lists only pf: this board cannot run the PF in its period (BR_BOARD_RUNS_PF 0; docs/target.md); add ukf or none to the list, or build BOARD=stm32h7"
-#endif
-#define BR_IMAGE_DT_S BR_MACHINE_CTRL_PERIOD_S_F
-#define BR_IMAGE_PERIOD_NS BR_MACHINE_CTRL_PERIOD_NS
-#endif
-
-/* The link (docs/link.md): a tlm_sample frame is 39 bytes on the wire, so
- * every BR_IMAGE_TLM_EVERY periods it takes 39 / (N T) bytes/s; kept below
- * half of the line's baud / 10 bytes/s (the rest for the reports, the
- * recorder's dump and the gaps between DMA transfers). */
-#define BR_IMAGE_TLM_EVERY      2u
-#define BR_IMAGE_TLM_FRAME_BYTES 39u
-typedef char br_image_tlm_fits[(2ull * BR_IMAGE_TLM_FRAME_BYTES * 1000000000ull * 10ull <=
-                                (unsigned long long)BR_BOARD_USART_BAUD * BR_IMAGE_TLM_EVERY * BR_IMAGE_PERIOD_NS)
-                                   ? 1
-                                   : -1];
-/* the link's budgets: bytes decoded per period, the transmit queue */
-#define BR_IMAGE_RX_BUDGET      64u
-/* the USART's DMA buffers: RX 1024 bytes (11 ms at 921 600 baud: the host's
- * bursts between two periods), TX one transmit queue */
-#define BR_IMAGE_UART_RX_BYTES  1024u
-#define BR_IMAGE_UART_TX_BYTES  BR_LINK_TX_BUF_BYTES
-/* status and ref_status every 100 periods */
-#define BR_IMAGE_STATUS_PERIODS 100u
-/* the reference queue: its length, and the periods an underrun holds the
- * last reference before braking */
-#define BR_IMAGE_REFQ_LEN       BR_REFQ_MAX
-#define BR_IMAGE_HOLD_PERIODS   20u
-/* The recorder: the board's ring (BR_BOARD_REC_SAMPLES, BR_BOARD_REC_PRE
- * before the trigger); one dump frame per period. */
-#define BR_IMAGE_REC_DUMP_FRAMES 1u
-
-/* Deadline: more missed ticks than this since the arm turn the outputs off. */
-#define BR_IMAGE_MAX_MISSED 2u
+/* the one home of the settings: br_image_cfg.h */
 
 static const br_ctrl_cfg_t br_image_ctrl = BR_MACHINE_CTRL_CFG(BR_IMAGE_DT_S);
 
@@ -123,16 +71,6 @@ static br_pf_t br_image_pf BR_BOARD_XRAM;
 static br_rec_slot_t br_image_ring[BR_BOARD_REC_SAMPLES] BR_BOARD_XRAM;
 static uint8_t br_image_uart_rx[BR_IMAGE_UART_RX_BYTES] BR_BOARD_XRAM;
 static uint8_t br_image_uart_tx[BR_IMAGE_UART_TX_BYTES] BR_BOARD_XRAM;
-
-/* The reference queue with the machine's limits; the underrun's fault comes
- * one period after the braking from the top speed (br_refq_init's rule). */
-static br_refq_cfg_t br_image_refq(const br_app_motion_cfg_t *m)
-{
-    br_refq_cfg_t c = {BR_IMAGE_REFQ_LEN, BR_IMAGE_DT_S, BR_MACHINE_RAD_PER_COUNT_F, m->counts_per_m,
-                       m->max_speed_mps, m->max_accel_mps2, BR_IMAGE_HOLD_PERIODS, 0u};
-    c.fault_periods = BR_IMAGE_HOLD_PERIODS + (uint32_t)ceilf(c.max_speed_mps / (c.max_accel_mps2 * c.dt_s)) + 1u;
-    return c;
-}
 
 /* Motor stopped and outputs off (br_stm32_pwm_disable); then park without
  * refreshing the watchdog: a running watchdog resets the part, which comes
@@ -181,7 +119,7 @@ int main(void)
 #endif
     /* no enable input on this board: armed by the host's request only */
     const br_svc_cfg_t svc_cfg = {BR_IMAGE_RX_BUDGET, BR_LINK_TX_BUF_BYTES, br_image_refq(&app_cfg.motion),
-                                  BR_IMAGE_STATUS_PERIODS, NULL, NULL};
+                                  BR_IMAGE_STATUS_PERIODS, NULL, NULL, BR_MACHINE_NAME};
     const br_rec_cfg_t rec_cfg = {br_image_ring, BR_BOARD_REC_SAMPLES, BR_BOARD_REC_PRE, 0.0f,
                                   BR_IMAGE_REC_DUMP_FRAMES};
     const br_tlm_cfg_t tlm_cfg = {BR_IMAGE_TLM_EVERY};

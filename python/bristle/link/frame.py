@@ -17,6 +17,8 @@ sequence number does not advance (1..32767 ahead of the last accepted one,
 modulo 2^16)."""
 from dataclasses import dataclass
 
+from .messages import BY_NAME
+
 VERSION = 1
 PAYLOAD_MAX = 64
 HEADER_BYTES = 5            # length, version, id, seq
@@ -25,6 +27,7 @@ BODY_MIN = HEADER_BYTES + CRC_BYTES
 BODY_MAX = BODY_MIN + PAYLOAD_MAX
 DELIM = 0x00
 SEQ_WINDOW = 0x7FFF         # a sequence number 1..SEQ_WINDOW ahead of the last is new
+HELLO = BY_NAME["hello"]     # opens a session (Decoder)
 
 
 class FrameError(ValueError):
@@ -115,6 +118,7 @@ class Decoder:
     def __init__(self):
         self.counters = dict.fromkeys(COUNTERS, 0)
         self.last_seq = None
+        self.session = None  # the session in force (the last hello's number)
         self._body = bytearray()
         self._code = 0
         self._left = 0
@@ -141,9 +145,15 @@ class Decoder:
         except FrameError as e:
             self.counters[e.reason] += 1
             return None
-        if self.last_seq is not None and not 1 <= ((f.seq - self.last_seq) & 0xFFFF) <= SEQ_WINDOW:
+        # a hello of another session than the one in force opens a session: any
+        # seq, the window restarts there (docs/link.md, "The session")
+        opens = (f.id == HELLO.id and len(f.payload) == HELLO.size
+                 and int.from_bytes(f.payload, "little") != self.session)
+        if not opens and self.last_seq is not None and not 1 <= ((f.seq - self.last_seq) & 0xFFFF) <= SEQ_WINDOW:
             self.counters["replayed"] += 1
             return None
+        if opens:
+            self.session = int.from_bytes(f.payload, "little")
         self.last_seq = f.seq
         self.counters["frames"] += 1
         return f

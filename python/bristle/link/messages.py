@@ -9,7 +9,8 @@ run time, which is why the table lives in Python: an installed bristle.link
 has no C header to read.
 
 A payload is its fields in order, packed, little-endian, without padding.
-Field types: u8, i8, u16, u32, i32, f32 (IEEE 754 binary32)."""
+Field types: u8, i8, u16, u32, i32, f32 (IEEE 754 binary32), c16 (16 bytes
+of ASCII text, NUL-padded; a bytes value)."""
 import struct
 from dataclasses import dataclass
 
@@ -18,7 +19,7 @@ TO_HOST = "to_host"
 TO_TARGET = "to_target"
 
 # struct codes of the field types (little-endian, "<" in pack/unpack)
-TYPES = {"u8": "B", "i8": "b", "u16": "H", "u32": "I", "i32": "i", "f32": "f"}
+TYPES = {"u8": "B", "i8": "b", "u16": "H", "u32": "I", "i32": "i", "f32": "f", "c16": "16s"}
 
 
 @dataclass(frozen=True)
@@ -81,6 +82,16 @@ MESSAGES = (
         Field("cause", "u8", "the latched cause (br_app_fault_t)"),
         Field("tick", "u32", "period index at which it latched"),
     ), "a fault latched: sent once, when it happens"),
+    # the session (docs/link.md, "The session"): 0x08-0x0F
+    Message("hello", 0x08, TO_TARGET, (
+        Field("session", "u32", "the host's session number (any value but the session in force)"),
+    ), "opens a session: the target accepts it with any seq, restarts its replay window there, and answers hello_reply"),
+    Message("hello_reply", 0x09, TO_HOST, (
+        Field("session", "u32", "the hello's session number"),
+        Field("version", "u8", "the protocol version the target speaks (BR_LINK_VERSION)"),
+        Field("fw_version", "u32", "the firmware's version (major << 16 | minor << 8 | patch, bristle/br_version.h)"),
+        Field("machine", "c16", "the machine file's name the image was built for (first 16 bytes, NUL-padded)"),
+    ), "the answer to hello"),
     Message("arm", 0x10, TO_TARGET, (), "arm request: outputs on, control runs"),
     Message("disarm", 0x11, TO_TARGET, (), "disarm request: duty 0, outputs off"),
     Message("fault_reset", 0x12, TO_TARGET, (), "clear a latched fault (the axis stays disarmed)"),

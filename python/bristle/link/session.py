@@ -9,25 +9,17 @@ The port is pyserial's (`serial.serial_for_url`: a serial port such as
 br_link_sim prints), opened non-blocking; its input is flushed at the open,
 so what a target sent before the session is not taken for a reply.
 
-The session's start: the target accepts a frame only when its seq is
-1..32767 ahead of the last one it accepted (modulo 2^16), and it keeps that
-last seq across host sessions (a hello message that resets it is not in the
-protocol yet). So the session first sends three harmless requests (a
-param_read) at seq s, s + 0x5555 and s + 0xAAAA: the three split the circle of
-2^16 into gaps of at most 21846, and the target's window of 32767 seqs holds
-at least one of them, whatever its last seq; each one after it is 0x5555
-ahead, inside the window, and so is every later frame. The ones the target
-refused are counted there as replayed (rx_replayed)."""
+The session's start (`start`): a hello with a session number of its own;
+the target accepts it whatever its last seq, restarts its replay window at
+the hello's seq and answers hello_reply (the session number, its protocol
+and firmware versions, its machine's name), which `start` waits for and
+keeps in `hello`. Within the session a repeated or old frame is still
+dropped."""
+import os
 import time
 
-from . import messages, params
-from .frame import Decoder, encode_frame
-
-SYNC_STEP = 0x5555
-# the parameter the session's start reads (every estimator has it; an image
-# without an estimator answers its status, which the start ignores)
-SYNC_PARAM = params.BY_NAME["comp_ahead_periods"].id
-
+from . import messages
+from .frame import VERSION, Decoder, encode_frame
 
 class LinkError(RuntimeError):
     """A reply that did not come in time, or a refusal."""
@@ -61,26 +53,25 @@ class Session:
         self.dump = []           # rec_sample / rec_end frames, when collect_dump
         self.collect_tlm = False
         self.collect_dump = False
+        self.session = None      # this session's number (start)
+        self.hello = None        # its hello_reply (dict)
 
     def send(self, name, **fields):
         self.port.write(encode_frame(messages.BY_NAME[name].id, self.seq, messages.pack(name, **fields)))
         self.seq = (self.seq + 1) & 0xFFFF
 
-    def start(self, timeout_s=2.0, settle_s=0.05):
-        """The session's start (above): three param_reads SYNC_STEP apart;
-        waits for an answer (LinkError: the target does not answer), then
-        settle_s for the others, and forgets them."""
-        self.param_values = []
-        for k in range(3):
-            self.seq = (self.seq + (SYNC_STEP if k else 0)) & 0xFFFF
-            self.port.write(encode_frame(messages.BY_NAME["param_read"].id, self.seq,
-                                         messages.pack("param_read", param=SYNC_PARAM)))
-        self.seq = (self.seq + 1) & 0xFFFF
-        self.wait("answer from the target", lambda: self.param_values, timeout_s)
-        end = time.monotonic() + settle_s
-        while time.monotonic() < end:
-            self.poll()
-        self.param_values = []
+    def start(self, timeout_s=2.0, session=None):
+        """Opens the session (above): a hello with a session number (random
+        unless given), then waits for its hello_reply (LinkError: the target
+        does not answer, or speaks another protocol version); returns it."""
+        self.hello = None
+        self.session = int.from_bytes(os.urandom(4), "little") if session is None else session & 0xFFFFFFFF
+        self.send("hello", session=self.session)
+        self.wait("hello_reply from the target", lambda: self.hello is not None, timeout_s)
+        if self.hello["version"] != VERSION:
+            raise LinkError("the target speaks protocol version %d, this host %d"
+                            % (self.hello["version"], VERSION))
+        return self.hello
 
     def _take(self, fr):
         name, v = messages.unpack(fr.id, fr.payload)
@@ -92,6 +83,8 @@ class Session:
             self.ref_status = v
         elif name == "fault":
             self.faults.append(v)
+        elif name == "hello_reply" and v["session"] == self.session:
+            self.hello = v
         elif name == "param_value":
             self.param_values.append(v)
         elif name == "tlm_sample" and self.collect_tlm:

@@ -27,6 +27,19 @@
 #define BR_LINK_MSG_FAULT_OFF_CAUSE 0u /* u8 the latched cause (br_app_fault_t) */
 #define BR_LINK_MSG_FAULT_OFF_TICK 1u /* u32 period index at which it latched */
 
+/* opens a session: the target accepts it with any seq, restarts its replay window there, and answers hello_reply (BR_LINK_TO_TARGET) */
+#define BR_LINK_MSG_HELLO 0x08u
+#define BR_LINK_MSG_HELLO_LEN 4u
+#define BR_LINK_MSG_HELLO_OFF_SESSION 0u /* u32 the host's session number (any value but the session in force) */
+
+/* the answer to hello (BR_LINK_TO_HOST) */
+#define BR_LINK_MSG_HELLO_REPLY 0x09u
+#define BR_LINK_MSG_HELLO_REPLY_LEN 25u
+#define BR_LINK_MSG_HELLO_REPLY_OFF_SESSION 0u /* u32 the hello's session number */
+#define BR_LINK_MSG_HELLO_REPLY_OFF_VERSION 4u /* u8 the protocol version the target speaks (BR_LINK_VERSION) */
+#define BR_LINK_MSG_HELLO_REPLY_OFF_FW_VERSION 5u /* u32 the firmware's version (major << 16 | minor << 8 | patch, bristle/br_version.h) */
+#define BR_LINK_MSG_HELLO_REPLY_OFF_MACHINE 9u /* c16 the machine file's name the image was built for (first 16 bytes, NUL-padded) */
+
 /* arm request: outputs on, control runs (BR_LINK_TO_TARGET) */
 #define BR_LINK_MSG_ARM 0x10u
 #define BR_LINK_MSG_ARM_LEN 0u
@@ -168,6 +181,8 @@
 #define BR_LINK_MSG_TABLE(X) \
     X(STATUS, BR_LINK_MSG_STATUS, BR_LINK_MSG_STATUS_LEN, BR_LINK_TO_HOST) \
     X(FAULT, BR_LINK_MSG_FAULT, BR_LINK_MSG_FAULT_LEN, BR_LINK_TO_HOST) \
+    X(HELLO, BR_LINK_MSG_HELLO, BR_LINK_MSG_HELLO_LEN, BR_LINK_TO_TARGET) \
+    X(HELLO_REPLY, BR_LINK_MSG_HELLO_REPLY, BR_LINK_MSG_HELLO_REPLY_LEN, BR_LINK_TO_HOST) \
     X(ARM, BR_LINK_MSG_ARM, BR_LINK_MSG_ARM_LEN, BR_LINK_TO_TARGET) \
     X(DISARM, BR_LINK_MSG_DISARM, BR_LINK_MSG_DISARM_LEN, BR_LINK_TO_TARGET) \
     X(FAULT_RESET, BR_LINK_MSG_FAULT_RESET, BR_LINK_MSG_FAULT_RESET_LEN, BR_LINK_TO_TARGET) \

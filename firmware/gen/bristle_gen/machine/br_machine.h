@@ -11,6 +11,8 @@
  * outside [A-Za-z0-9 ._+,:=@%~/-] replaced by _, for a generated comment */
 #define BR_MACHINE_FILE "machines/reference.json"
 #define BR_MACHINE_FILE_COMMENT "machines/reference.json"
+/* the machine file's name ([a-z0-9][a-z0-9_-]*), which the link's hello_reply carries */
+#define BR_MACHINE_NAME "reference"
 /* L = lead / (2 pi), m/rad */
 #define BR_MACHINE_LEAD_MPRAD (0.0012732395447351628)
 #define BR_MACHINE_LEAD_MPRAD_F (1.273239497e-03f)
