@@ -687,9 +687,35 @@ def params(m):
 #   q_theta  = theta_m2_per_s T / L^2                       (rad^2; the PF: / mpc^2 in counts^2)
 #   q_omega  = force_Fs2_s Fs^2 L^2 T / Jeff^2               (a white force on the table, eq. 6)
 #   q_z      = z_zs2_per_s zs^2 T,   q_gp = gp_Fs2_per_s Fs^2 T
-#   R        = 1/12 + position_noise_m2 / mpc^2              (counts^2: the quantisation plus the rest)
+#   R        = 1/12 + max(position_noise_m2, ((d - zs)+ / 8)^2) / mpc^2
+#                                                            (counts^2: the quantisation plus the rest)
+#   with d = Fc T^2 / (2 Meff), Meff = Jeff / L^2: the friction transient's displacement over one
+#   period (docs/fleet.md, "Holding on the fleet's axes"); the floor is 0 where d <= zs (the reference)
+#   and at most R_COUNTS2_MAX
 #   g_p      = gp0_Fs Fs in [gp_min_Fc Fc, gp_max_Fs Fs]
 QUANT_COUNTS2 = 1.0 / 12.0  # variance of a uniform quantisation of one count
+TRANSIENT_STD_SHARE = 1.0 / 8.0  # R's floor: the std of the position's prediction error, this share of
+                                 # the friction transient beyond the bristles' zone (docs/fleet.md)
+R_COUNTS2_MAX = 1.0e6       # the firmware's bound on R (br_est_cfg_check; _PER_STEP_BOUNDS)
+
+
+def transient_m(m, est):
+    """(d, zs): the friction transient's displacement over estimator est's period,
+    d = Fc T^2 / (2 Meff) (how far a force error of Coulomb's size moves the axis in one
+    period), and the bristles' zone zs = Fs / sigma0 (m)."""
+    p, T, _, zs = _scales(m, est)
+    meff = p["Jeff_kgm2"] / (p["L_mprad"] * p["L_mprad"])
+    return p["Fc_N"] * T * T / (2.0 * meff), zs
+
+
+def position_var_floor_m2(m, est):
+    """The floor on the position's measurement variance beyond the quantisation: where the
+    friction transient over a period d goes beyond the bristles' zone zs, the model's
+    prediction over the period misses by up to d - zs (its bristle state cannot follow a
+    reversal or a breakaway within the step), so the measurement model carries
+    ((d - zs) TRANSIENT_STD_SHARE)^2; 0 where d <= zs."""
+    d, zs = transient_m(m, est)
+    return (max(0.0, d - zs) * TRANSIENT_STD_SHARE) ** 2
 
 
 def _scales(m, est):
@@ -715,7 +741,8 @@ def est_per_step(m, est):
         "q_omega_rad2ps2": q["force_Fs2_s"] * Fs * Fs * L * L * T / (p["Jeff_kgm2"] * p["Jeff_kgm2"]),
         "q_z_m2": q["z_zs2_per_s"] * zs * zs * T,
         "q_gp_N2": q["gp_Fs2_per_s"] * Fs * Fs * T,
-        "r_counts2": QUANT_COUNTS2 + e["position_noise_m2"] / (mpc * mpc),
+        "r_counts2": min(QUANT_COUNTS2 + max(e["position_noise_m2"], position_var_floor_m2(m, est)) / (mpc * mpc),
+                         max(R_COUNTS2_MAX, QUANT_COUNTS2 + e["position_noise_m2"] / (mpc * mpc))),
         "gp0_N": e["gp0_Fs"] * Fs, "gp_min_N": e["gp_min_Fc"] * Fc, "gp_max_N": e["gp_max_Fs"] * Fs,
         "dlyid_q_force_N2ps": (e.get("delay_id") or {}).get("q_force_Fs2_per_s", 0.0) * Fs * Fs,
     }

@@ -215,7 +215,8 @@ def distribute(a, args):
     try:
         # the workers import fleet_runs and its neighbours from this folder (the same path on every worker)
         client.run(_add_path, HERE)
-        futures = client.map(fleet_runs.one_axis, [args] * a.n, range(a.n), pure=False)
+        idx = a.axes if a.axes is not None else list(range(a.n))
+        futures = client.map(fleet_runs.one_axis, [args] * len(idx), idx, pure=False)
         progress(futures)
         sys.stdout.write("\n")
         recs = client.gather(futures)
@@ -233,6 +234,8 @@ def main():
     ap.add_argument("--seed", type=int, default=20261201)
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="the local cluster's worker processes")
     ap.add_argument("--scheduler", help="an existing Dask scheduler's address (tcp://host:port) instead")
+    ap.add_argument("--axes", help="run only these axis indices of the seed's draw, comma-separated "
+                    "(a fleet's subset: its axes are the same as in the full run; --n is ignored)")
     ap.add_argument("--kinds", default=",".join(KINDS), help="the trajectory kinds, comma-separated")
     ap.add_argument("--md", help="docs page: its part after <!-- fleet:begin --> is rewritten")
     ap.add_argument("--command", default="make fleet")
@@ -256,6 +259,14 @@ def main():
         print("wrote %s from %s/summary.json" % (a.md, a.out))
         return unexpected_faults(summ_md, a)
     kinds = [k for k in a.kinds.split(",") if k]
+    try:
+        a.axes = sorted({int(x) for x in a.axes.split(",") if x}) if a.axes else None
+    except ValueError:
+        ap.error("--axes: comma-separated axis indices")
+    if a.axes is not None:
+        if not a.axes or a.axes[0] < 0:
+            ap.error("--axes: indices >= 0")
+        a.n = len(a.axes)
     if not (1 <= a.n <= 100000) or a.workers < 1 or not kinds or set(kinds) - set(KINDS):
         ap.error("--n in 1..100000, --workers >= 1, --kinds from %s" % ",".join(KINDS))
     os.makedirs(a.out, exist_ok=True)
@@ -266,6 +277,7 @@ def main():
     errors = [r for r in recs if "error" in r]
     good = [r for r in recs if "error" not in r]
     summ = {"generator": "sim/studies/fleet.py", "n_axes": a.n, "seed": a.seed, "kinds_run": kinds,
+            **({"axes_run": a.axes} if a.axes is not None else {}),
             "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],
             "controllers": summarise(good),
             "kinds": {k: summarise(good, (k,)) for k in kinds},

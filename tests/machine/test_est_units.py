@@ -106,6 +106,25 @@ def main():
           "twice the period: twice every variance per step (per-second noise), twice the NIS smoothing")
     check(close(Pt["r_counts2"], P["r_counts2"]), "twice the period: R unchanged")
 
+    # R's floor from the friction transient over a period (docs/fleet.md, "Holding on the
+    # fleet's axes"): d = Fc T^2 / (2 Meff) beyond the bristles' zone zs = Fs / sigma0
+    Meff = Jeff / L ** 2
+    for est, T in (("pf", Tp), ("ukf", Tu)):
+        check(Fc * T ** 2 / (2.0 * Meff) < Fs / good["friction"]["sigma0_Npm"],
+              "the reference's %s: the transient over a period within the bristles' zone (no floor)" % est)
+    stiff = copy.deepcopy(good)
+    stiff["friction"]["sigma0_Npm"] *= 100.0
+    Pk = machine.est_per_step(loaded(stiff, work, "stiff.json"), "pf")
+    d, zs = Fc * Tp ** 2 / (2.0 * Meff), Fs / stiff["friction"]["sigma0_Npm"]
+    floor = ((d - zs) / 8.0) ** 2
+    check(floor > ep["position_noise_m2"] and close(Pk["r_counts2"], 1.0 / 12.0 + floor / m_per_count ** 2),
+          "100x the bristle stiffness: R = 1/12 + ((d - zs) / 8)^2 in counts^2, above the file's")
+    rough = copy.deepcopy(stiff)
+    rough["friction"]["Fs_N"] = rough["friction"]["Fc_N"] = 10.0 * Fs
+    rough["estimator"]["pf"]["period_s"] = 10.0 * Tp
+    check(machine.est_per_step(rough, "pf")["r_counts2"] == machine.R_COUNTS2_MAX,
+          "a floor beyond the firmware's bound on R: R at the bound")
+
     # est_physical inverts est_per_step
     for est, vals in (("pf", P), ("ukf", U)):
         phys = machine.est_physical(ref, est, vals)
