@@ -137,3 +137,9 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
     br_pf_kref_copy_back(pf);
     return sf;
 }
+
+uint32_t br_pf_kernel_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                                 br_pf_lsum_t *ls)
+{
+    return br_pf_kref_predict_ms(pf, c, j0, j1, nz, ls);
+}
