@@ -703,10 +703,6 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     /* the kernel's (the reference's on the scalar reference path) */
     const int outlier = verdict == BR_W_OUTLIER;
     float sf = pf->cfg.scalar_path ? br_pf_kref_resample(pf, lmax, outlier) : br_pf_kernel_resample(pf, lmax, outlier);
-    if (has_elements(pf)) {
-        /* the elements follow their particles (the same indices, in place) */
-        br_pf_kref_copy_ms(pf);
-    }
     const float inv_m = 1.0f / (float)m;
     pf->n_outliers = (verdict == BR_W_OUTLIER) ? pf->n_outliers + 1u : 0u;
     if (pf->n_outliers >= pf->cfg.est.reanchor_after) {

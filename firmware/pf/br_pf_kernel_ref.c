@@ -211,38 +211,88 @@ BR_NO_IVOPTS static void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t
     }
 }
 
+/* With elements: the same passes moving each particle's elements with it
+ * (a[e][j]: element e of particle j); states = 0: the elements alone. Four
+ * elements (the common set) moved written out, any other number by a loop. */
+static inline void move_elements(uint32_t i, uint32_t k, float *const a[BR_MSLIP_MAX], int ne)
+{
+    if (ne == 4) {
+        memcpy(&a[0][i], &a[0][k], sizeof a[0][i]);
+        memcpy(&a[1][i], &a[1][k], sizeof a[1][i]);
+        memcpy(&a[2][i], &a[2][k], sizeof a[2][i]);
+        memcpy(&a[3][i], &a[3][k], sizeof a[3][i]);
+        return;
+    }
+    for (int e = 0; e < ne; e++) {
+        memcpy(&a[e][i], &a[e][k], sizeof a[e][i]);
+    }
+}
+
+static void ms_arrays(br_pf_t *pf, float *a[BR_MSLIP_MAX])
+{
+    for (int e = 0; e < pf->model.cfg.mslip.n; e++) {
+        a[e] = pf->ms + (uint32_t)e * pf->cfg.n_particles;
+    }
+}
+
+/* the forward pass with the elements: i = 0 .. m - 2 */
+BR_NO_IVOPTS static void copy_fwd_ms(br_pf_t *pf, int states)
+{
+    const uint32_t last = pf->cfg.n_particles - 1u;
+    const int ne = pf->model.cfg.mslip.n;
+    const uint16_t *BR_RESTRICT idx = pf->idx;
+    float *a[BR_MSLIP_MAX];
+    ms_arrays(pf, a);
+    float *th = pf->x[BR_X_THETA], *om = pf->x[BR_X_OMEGA], *zz = pf->x[BR_X_Z], *gg = pf->x[BR_X_GP];
+    for (uint32_t i = 0u; i < last; i++) {
+        const uint32_t k = idx[i];
+        if (k > i) {
+            if (states) {
+                move_particle(i, k, th, om, zz, gg, pf->kgp);
+            }
+            move_elements(i, k, a, ne);
+        }
+    }
+}
+
+/* the backward pass with the elements: i = m - 1 down to 1 */
+BR_NO_IVOPTS static void copy_back_ms(br_pf_t *pf)
+{
+    const int ne = pf->model.cfg.mslip.n;
+    const uint16_t *BR_RESTRICT idx = pf->idx;
+    float *a[BR_MSLIP_MAX];
+    ms_arrays(pf, a);
+    float *th = pf->x[BR_X_THETA], *om = pf->x[BR_X_OMEGA], *zz = pf->x[BR_X_Z], *gg = pf->x[BR_X_GP];
+    for (uint32_t i = pf->cfg.n_particles - 1u; i > 0u; i--) {
+        const uint32_t k = idx[i];
+        if (k < i) {
+            move_particle(i, k, th, om, zz, gg, pf->kgp);
+            move_elements(i, k, a, ne);
+        }
+    }
+}
+
 void br_pf_kref_copy_fwd(br_pf_t *pf)
 {
+    if (pf->model.cfg.mslip.n > 0) {
+        copy_fwd_ms(pf, 1);
+        return;
+    }
     copy_fwd_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
                  pf->x[BR_X_GP], pf->kgp);
 }
 
 void br_pf_kref_copy_back(br_pf_t *pf)
 {
+    if (pf->model.cfg.mslip.n > 0) {
+        copy_back_ms(pf);
+        return;
+    }
     copy_back_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
                   pf->x[BR_X_GP], pf->kgp);
 }
 
-void br_pf_kref_copy_ms(br_pf_t *pf)
-{
-    const uint32_t m = pf->cfg.n_particles;
-    const uint16_t *const idx = pf->idx;
-    for (int e = 0; e < pf->model.cfg.mslip.n; e++) {
-        float *const a = pf->ms + (uint32_t)e * m;
-        /* forward: every i with idx_i > i from a later, not yet overwritten one */
-        for (uint32_t i = 0u; i + 1u < m; i++) {
-            if (idx[i] > i) {
-                memcpy(&a[i], &a[idx[i]], sizeof a[i]);
-            }
-        }
-        /* backward: every i with idx_i < i from an earlier one the forward pass left */
-        for (uint32_t i = m - 1u; i > 0u; i--) {
-            if (idx[i] < i) {
-                memcpy(&a[i], &a[idx[i]], sizeof a[i]);
-            }
-        }
-    }
-}
+void br_pf_kref_copy_ms_fwd(br_pf_t *pf) { copy_fwd_ms(pf, 0); }
 
 float br_pf_kref_resample(br_pf_t *pf, float lmax, int outlier)
 {

@@ -216,6 +216,10 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
         resample_count(pf->W, m, total, pf->idx, 1);
     }
     const float sf = resample_forward(pf);
+    if (pf->model.cfg.mslip.n > 0) {
+        /* the elements' forward pass (the states' is resample_forward's) */
+        br_pf_kref_copy_ms_fwd(pf);
+    }
     br_pf_kref_copy_back(pf);
     return sf;
 }

@@ -194,8 +194,8 @@ uint32_t br_pf_kernel_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, 
 /* Steps 3, 4 and step 5's sum, over pf's m predicted particles with their
  * log-weights pf->l (NaN: invalid) and lmax, the largest valid one (finite
  * unless outlier): the weights W_j (outlier: 2^16 for every valid particle),
- * systematic resampling's indices idx, the set copied in place (state and
- * k_p), and the sum of f_nl over the resampled set in particle order, which
+ * systematic resampling's indices idx, the set copied in place (state, k_p
+ * and, with elements, the elements), and the sum of f_nl over the resampled set in particle order, which
  * it returns. */
 float br_pf_kref_resample(br_pf_t *pf, float lmax, int outlier);
 float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier);
@@ -206,8 +206,10 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier);
 uint32_t br_pf_kref_weights(br_pf_t *pf, float lmax, int outlier);
 void br_pf_kref_copy_fwd(br_pf_t *pf);
 void br_pf_kref_copy_back(br_pf_t *pf);
-/* the elements' copy in place (est.model.mslip.n >= 1) with the final
- * indices pf->idx: the same forward and backward passes, per element */
-void br_pf_kref_copy_ms(br_pf_t *pf);
+/* With elements (est.model.mslip.n >= 1) the two passes move each
+ * particle's elements with it; br_pf_kref_copy_ms_fwd: the forward pass of
+ * the elements alone (the SIMD kernel's, whose forward pass of the states is
+ * its own) */
+void br_pf_kref_copy_ms_fwd(br_pf_t *pf);
 
 #endif

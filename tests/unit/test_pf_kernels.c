@@ -180,9 +180,6 @@ static void resample_both(br_pf_t *a, br_pf_t *b, float lmax, int outlier, int k
 {
     const float sa = br_pf_kref_resample(a, lmax, outlier);
     const float sb = br_pf_kernel_resample(b, lmax, outlier);
-    /* the elements follow with the final indices (br_pf.c's call after every kernel's resampling) */
-    br_pf_kref_copy_ms(a);
-    br_pf_kref_copy_ms(b);
     if (!same_f(sa, sb)) {
         fail_msg("step %d: the sum of f_nl %.9g differs from the reference's %.9g", k, (double)sb, (double)sa);
     }
