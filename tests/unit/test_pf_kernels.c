@@ -275,14 +275,21 @@ static void put_edges_ms(br_pf_t *a, br_pf_t *b, int k, edges_t *n)
     }
 }
 
-static void test_stream_ms(void **st)
+/* the element stream with the hardware-like set (ne = 4, the M7's written-out
+ * path) or its first three elements with equal shares (the loops' path) */
+static void stream_ms(int ne)
 {
-    (void)st;
     br_pf_t *src = calloc(1, sizeof *src);
     assert_non_null(src);
     br_pf_cfg_t cfg = br_circle_pf_cfg_default(1.5e-3f);
     cfg.n_particles = M;
     br_circle_est_mslip(&cfg.est);
+    if (ne != cfg.est.model.mslip.n) {
+        cfg.est.model.mslip.n = ne;
+        for (int i = 0; i < ne; i++) {
+            cfg.est.model.mslip.share[i] = 1.0f / (float)ne;
+        }
+    }
     assert_int_equal(br_pf_init(src, &cfg), BR_OK);
     const float rpc = src->cfg.est.rad_per_count;
     edges_t n = {0, 0, 0, 0, 0};
@@ -324,6 +331,13 @@ static void test_stream_ms(void **st)
     assert_true(n.nan > 0 && n.bounded > 0 && n.overflow > 0 && n.gp_out > 0 && n.l_inf > 0);
     assert_true(n_left >= n.nan && n_outlier > 0 && n_bound > 0 && n_steps == 47);
     free(src);
+}
+
+static void test_stream_ms(void **st)
+{
+    (void)st;
+    stream_ms(4);
+    stream_ms(3);
 }
 
 /* resampling on weights made for it: log-weights with ties of the
