@@ -255,19 +255,7 @@ static void test_pf_ms_one_step(void **state)
     for (int i = 0; i < G.ne; i++) {
         all[n_all++] = &e_el[i];
     }
-    long fails = 0;
-    for (int i = 0; i < n_all; i++) {
-        br_errstat_print(all[i], &G.t, "pf_ms");
-        fails += all[i]->n_fail;
-    }
-    br_trace_free(&G.t);
-    br_trace_free(&G.x);
-    if (bad_exact != 0) {
-        fail_msg("pf_ms: %ld steps with a wrong status / origin / noise position / outlier run", bad_exact);
-    }
-    if (fails != 0) {
-        fail_msg("pf_ms: %ld comparisons outside tolerance (first lines printed above)", fails);
-    }
+    pf_golden_report(all, n_all, &G.t, &G.x, "pf_ms", bad_exact, "status / origin / noise position / outlier run");
     /* the trace must exercise what it is for */
     assert_true(n_reanch >= 1);
     assert_true(n_own_equal * 2 > n_steps);

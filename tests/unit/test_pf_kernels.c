@@ -186,6 +186,24 @@ static void resample_both(br_pf_t *a, br_pf_t *b, float lmax, int outlier, int k
     assert_sets_equal(a, b, k, "resampling");
 }
 
+/* the step's largest valid log-weight, by hand, and its outlier verdict (also
+ * every fifth step); both copies resampled. Returns 1 on an outlier step. */
+static int resample_step(br_pf_t *a, br_pf_t *b, int k)
+{
+    float lmax = -INFINITY;
+    uint32_t n_valid = 0u;
+    for (uint32_t j = 0; j < a->cfg.n_particles; j++) {
+        if (a->l[j] == a->l[j]) {
+            lmax = (a->l[j] > lmax) ? a->l[j] : lmax;
+            n_valid++;
+        }
+    }
+    assert_true(n_valid > 0u);
+    const int outlier = lmax < a->outlier_l || lmax == -INFINITY || k % 5 == 0;
+    resample_both(a, b, lmax, outlier, k);
+    return outlier;
+}
+
 static void test_stream(void **st)
 {
     (void)st;
@@ -209,18 +227,7 @@ static void test_stream(void **st)
                 n_clamped += b->x[BR_X_GP][j] == c.gp_max || b->x[BR_X_GP][j] == c.gp_min;
             }
             /* the step's largest valid log-weight, by hand */
-            float lmax = -INFINITY;
-            uint32_t n_valid = 0u;
-            for (uint32_t j = 0; j < M; j++) {
-                if (a->l[j] == a->l[j]) {
-                    lmax = (a->l[j] > lmax) ? a->l[j] : lmax;
-                    n_valid++;
-                }
-            }
-            assert_true(n_valid > 0u);
-            const int outlier = lmax < a->outlier_l || lmax == -INFINITY || k % 5 == 0;
-            n_outlier += outlier;
-            resample_both(a, b, lmax, outlier, k);
+            n_outlier += resample_step(a, b, k);
             n_steps++;
             free(a);
             free(b);
@@ -309,18 +316,7 @@ static void stream_ms(int ne)
             for (uint32_t j = 0; j < M; j++) {
                 n_bound += b->ms[j] == b->model.ms_c_mpN[0] * b->x[BR_X_GP][j];
             }
-            float lmax = -INFINITY;
-            uint32_t n_valid = 0u;
-            for (uint32_t j = 0; j < M; j++) {
-                if (a->l[j] == a->l[j]) {
-                    lmax = (a->l[j] > lmax) ? a->l[j] : lmax;
-                    n_valid++;
-                }
-            }
-            assert_true(n_valid > 0u);
-            const int outlier = lmax < a->outlier_l || lmax == -INFINITY || k % 5 == 0;
-            n_outlier += outlier;
-            resample_both(a, b, lmax, outlier, k);
+            n_outlier += resample_step(a, b, k);
             n_steps++;
             free(a);
             free(b);
