@@ -40,6 +40,7 @@ import gen_load_traces  # noqa: E402
 import gen_qec_traces  # noqa: E402
 import gen_ukf_ms_traces  # noqa: E402
 import gen_pf_load_traces  # noqa: E402
+import gen_pf_ms_traces  # noqa: E402
 
 SEED = 20240611  # base seed; trace i uses SEED + i (recorded in each header)
 SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
@@ -48,6 +49,7 @@ SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                "ukf_load": 6,  # gen_load_traces.py: the same input, no random draw of its own
                "ukf_ms": 6,    # gen_ukf_ms_traces.py: the same input, no random draw of its own
                "pf_load": 6, "pf_load_x": 6,  # gen_pf_load_traces.py: likewise
+               "pf_ms": 6, "pf_ms_x": 6,  # gen_pf_ms_traces.py: likewise
                # the extended model (gen_ext_traces.py)
                "model_ext": 7,
                # the Maxwell-slip plant (gen_gms_traces.py)
@@ -460,6 +462,7 @@ def main(argv=None):
     paths.append(gen_load_traces.generate(args.out, m, sys.modules[__name__], est_input))
     paths.append(gen_ukf_ms_traces.generate(args.out, m, sys.modules[__name__], est_input))
     paths += gen_pf_load_traces.generate(args.out, m, sys.modules[__name__], est_input)
+    paths += gen_pf_ms_traces.generate(args.out, m, sys.modules[__name__], est_input)
     paths.append(gen_ext_traces.generate(args.out, m, sys.modules[__name__]))
     paths += gen_gms_traces.generate(args.out, m, sys.modules[__name__])
     paths.append(gen_mslip_traces.generate(args.out, m, sys.modules[__name__]))

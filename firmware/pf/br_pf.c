@@ -87,9 +87,11 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
-    /* the particles do not carry Maxwell-slip elements yet (docs/modules/pf.md):
-     * refused rather than silently run as LuGre */
-    if (cfg->est.model.mslip.n != 0) {
+    /* Maxwell-slip elements (docs/modules/pf.md): each particle's n deflections
+     * must fit the storage (n m <= BR_PF_MS_SLOTS), and the look-ahead, which
+     * steps the LuGre state, must be off (br_model_init checks the set itself) */
+    const uint32_t n_el = (cfg->est.model.mslip.n > 0) ? (uint32_t)cfg->est.model.mslip.n : 0u;
+    if (n_el > 0u && (n_el * cfg->n_particles > BR_PF_MS_SLOTS || cfg->est.comp_ahead_periods != 0.0f)) {
         return BR_E_PARAM;
     }
     /* the innovation-driven noise: off (nis_ref = 0) or a finite positive
@@ -175,8 +177,29 @@ static void particle_get(const br_pf_t *pf, uint32_t j, float x[BR_NX])
     }
 }
 
-/* Estimate of the freshly drawn set: the mean of f_nl (eq. 6) (its weights
- * all alike: pf->weighed as init left it) */
+/* the particles carry Maxwell-slip elements (est.model.mslip.n >= 1) */
+static int has_elements(const br_pf_t *pf) { return pf->model.cfg.mslip.n > 0; }
+
+/* Particle j's elements moved by the travel dx_m and clamped at its g_p
+ * (eq. MS1); its force sum_i k_i e_ji (eq. MS2) kept in kgp and returned */
+static float elements_move(br_pf_t *pf, uint32_t j, float dx_m)
+{
+    const br_model_km_t km = br_model_km(&pf->model);
+    const uint32_t m = pf->cfg.n_particles;
+    float e[BR_MSLIP_MAX];
+    for (int i = 0; i < km.n; i++) {
+        e[i] = pf->ms[(uint32_t)i * m + j];
+    }
+    const float f = br_pf_ms_noise(&km, e, dx_m, pf->x[BR_X_GP][j]);
+    for (int i = 0; i < km.n; i++) {
+        pf->ms[(uint32_t)i * m + j] = e[i];
+    }
+    pf->kgp[j] = f;
+    return f;
+}
+
+/* Estimate of the freshly drawn set: the mean of f_nl (eq. 6; with elements
+ * sum_i k_i e_ji, eq. MS2) (its weights all alike: pf->weighed as init left it) */
 static void estimate_current(br_pf_t *pf)
 {
     const uint32_t m = pf->cfg.n_particles;
@@ -185,7 +208,7 @@ static void estimate_current(br_pf_t *pf)
         float xj[BR_NX];
         particle_get(pf, j, xj);
         /* thesis estimate: the mean of f_nl (eq. 6) over the particles */
-        sf += br_model_fcomp_N(&pf->model, xj, origin_pos_m(pf));
+        sf += has_elements(pf) ? pf->kgp[j] : br_model_fcomp_N(&pf->model, xj, origin_pos_m(pf));
     }
     pf->est.F_hat_N = sf * (1.0f / (float)m);
     pf->est.origin_counts = pf->origin_counts;
@@ -202,6 +225,15 @@ static void prime(br_pf_t *pf, const br_meas_t *y)
         }
         pf->x[BR_X_GP][j] = br_clampf(pf->x[BR_X_GP][j], pf->cfg.est.gp_min_N, pf->cfg.est.gp_max_N);
         pf->kgp[j] = br_model_kp_of(&pf->model, pf->x[BR_X_GP][j]);
+        if (has_elements(pf)) {
+            /* the elements drawn relaxed but for z's draw, their common deflection
+             * (clamped at the particle's g_p, eq. MS1); z itself stays 0 */
+            for (int i = 0; i < pf->model.cfg.mslip.n; i++) {
+                pf->ms[(uint32_t)i * m + j] = 0.0f;
+            }
+            (void)elements_move(pf, j, pf->x[BR_X_Z][j]);
+            pf->x[BR_X_Z][j] = 0.0f;
+        }
     }
     noise_advance(pf);
     pf->origin_counts = y->counts;
@@ -318,16 +350,30 @@ static inline void lsum_skip(br_pf_lsum_t *s, float th, float y_rel)
  * invalid prediction). n: its BR_NX standard-normal samples. The particle is
  * overwritten by its prediction when that is valid and added to *ls
  * (lsum_add); otherwise it keeps its state, f_nl = 0, l = NaN (lsum_skip).
- * ext: the extended model's kernel (a constant at each call site). */
-static void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j, const float n[BR_NX],
+ * kind: the model's kernel, MODEL_THESIS, MODEL_EXT or MODEL_MS (a constant
+ * at each call site). */
+#define MODEL_THESIS 0
+#define MODEL_EXT 1
+#define MODEL_MS 2
+static void particle_one(br_pf_t *pf, const pred_t *c, const int kind, uint32_t j, const float n[BR_NX],
                          br_pf_lsum_t *ls)
 {
+    const int ext = kind == MODEL_EXT, ms = kind == MODEL_MS;
+    const uint32_t m = pf->cfg.n_particles;
     float x[BR_NX], xn[BR_NX];
+    float el[BR_MSLIP_MAX], e1[BR_MSLIP_MAX];
     particle_get(pf, j, x);
     /* 1. predict: eq. 6 by RK4 (the PF's form with k_p, or the extended
      * model's), or the bounded scheme beyond the a h limit; the particles are
-     * finite with g_p >= gp_min > 0 */
-    if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_rk4(&c->k.kp, x, pf->kgp[j], xn)) {
+     * finite with g_p >= gp_min > 0. With elements the trapezoidal step with
+     * the clamps (eqs. MS1, MS2; the particle's force f0 in kgp) */
+    if (ms) {
+        for (int i = 0; i < c->k.km.n; i++) {
+            el[i] = pf->ms[(uint32_t)i * m + j];
+        }
+        memcpy(xn, x, sizeof xn);
+        br_pf_ms_det(&c->k.km, c->k.uh, &xn[BR_X_THETA], &xn[BR_X_OMEGA], x[BR_X_GP], pf->kgp[j], el, e1);
+    } else if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_rk4(&c->k.kp, x, pf->kgp[j], xn)) {
         if (ext) {
             br_model_bounded_step_x(&c->mx, x, c->u, xn);
         } else {
@@ -361,16 +407,23 @@ static void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j
         om = xn[BR_X_OMEGA] + c->k.q[1] * n[1];
         th_a = th;
     }
-    const float z = xn[BR_X_Z] + c->k.q[2] * n[2];
+    /* z's noise (with elements z stays 0: its sample moves the elements, below) */
+    const float z = ms ? xn[BR_X_Z] : xn[BR_X_Z] + c->k.q[2] * n[2];
     /* g_p's random walk (g_p' = 0), or with cfg.gp_curve on its offset from the Stribeck curve */
     const float gp0 = pf->cfg.gp_curve.on ? gp_along_curve(pf, xn[BR_X_GP], x[BR_X_OMEGA], om, pf->cfg.gp_curve.rho) : xn[BR_X_GP];
     const float gp = clamp_sel(gp0 + c->k.q[3] * n[3], c->k.gp_min, c->k.gp_max);
-    /* the particle's one division, k_p = sigma0 L / g_p for eq. 4 here and in the next step */
-    const float kg = c->k.s0L / gp;
+    /* the particle's one division, k_p = sigma0 L / g_p for eq. 4 here and in the next step
+     * (with elements, the element force instead: below) */
+    float kg = ms ? 0.0f : c->k.s0L / gp;
     /* the force to compensate of the predicted particle: eq. 6's f_nl, or
-     * the extended model's (at its position relative to the last origin) */
+     * the extended model's (at its position relative to the last origin), or
+     * with elements z's sample on every element, clamped at the new g_p,
+     * f_nl = sum k_i e_i (eqs. MS1, MS2) */
     float fnl;
-    if (ext) {
+    if (ms) {
+        fnl = br_pf_ms_noise(&c->k.km, e1, c->k.q[2] * n[2], gp);
+        kg = fnl;
+    } else if (ext) {
         const float xe[BR_NX] = {th_old, om, z, gp};
         fnl = br_model_kx_fcomp_N(&c->mx, xe);
     } else {
@@ -378,13 +431,20 @@ static void particle_one(br_pf_t *pf, const pred_t *c, const int ext, uint32_t j
     }
     /* Validity: x - x is 0 for finite x and NaN otherwise. g_p is finite after
      * the clamp; a non-finite omega or z makes f_nl non-finite (inf - inf,
-     * 0 * inf or inf in eqs. 3-4), so theta and f_nl tell all four states. */
-    if ((th - th) + (fnl - fnl) == 0.0f) {
+     * 0 * inf or inf in eqs. 3-4), so theta and f_nl tell all four states.
+     * With elements f_nl does not depend on omega: omega is tested too. */
+    const float v_om = ms ? (om - om) : 0.0f;
+    if ((th - th) + v_om + (fnl - fnl) == 0.0f) {
         pf->x[BR_X_THETA][j] = th;
         pf->x[BR_X_OMEGA][j] = om;
         pf->x[BR_X_Z][j] = z;
         pf->x[BR_X_GP][j] = gp;
         pf->kgp[j] = kg;
+        if (ms) {
+            for (int i = 0; i < c->k.km.n; i++) {
+                pf->ms[(uint32_t)i * m + j] = e1[i];
+            }
+        }
         pf->fnl[j] = fnl;
         /* 2. Gaussian log-likelihood of the measurement, -(theta_j - y)^2 / (2 R);
          * may be -inf for a particle far from y: still valid (NaN marks invalid) */
@@ -445,6 +505,9 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     c.k.s0L = pf->model.cfg.lugre.sigma0_Npm * pf->model.cfg.lead_mprad;
     /* the extended kernel's constants (a few operations per step; unused by the thesis model) */
     c.mx = br_model_kx(&pf->model, origin_pos_m(pf));
+    /* with elements: the clamp model's constants and u h (eqs. MS1, MS2, 6) */
+    c.k.km = br_model_km(&pf->model);
+    c.k.uh = u_prev_Nm * c.k.km.h;
     for (int i = 0; i < BR_NX; i++) {
         c.k.q[i] = pf->q_std[i];
     }
@@ -467,6 +530,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     const uint32_t m = pf->cfg.n_particles, mask = pf->cfg.noise_len - 1u;
     br_pf_lsum_t ls = {-INFINITY, 0u, 0.0f, 0.0f};
     float n[BR_NX];
+    const int ms = has_elements(pf);
     if (pf->model.extended || pf->cfg.scalar_path || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR ||
         pf->cfg.gp_curve.on) {
         /* one particle at a time (the extended model always: its kernel branches;
@@ -475,9 +539,11 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
         for (uint32_t j = 0; j < m; j++) {
             noise_wrapped(pf, j, n);
             if (pf->model.extended) {
-                particle_one(pf, &c, 1, j, n, &ls);
+                particle_one(pf, &c, MODEL_EXT, j, n, &ls);
+            } else if (ms) {
+                particle_one(pf, &c, MODEL_MS, j, n, &ls);
             } else {
-                particle_one(pf, &c, 0, j, n, &ls);
+                particle_one(pf, &c, MODEL_THESIS, j, n, &ls);
             }
         }
     } else {
@@ -489,18 +555,28 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             const uint32_t room = (mask + 1u - p) / BR_NX; /* particles before the wrap */
             if (room == 0u) {
                 noise_wrapped(pf, j, n);
-                particle_one(pf, &c, 0, j, n, &ls);
+                if (ms) {
+                    particle_one(pf, &c, MODEL_MS, j, n, &ls);
+                } else {
+                    particle_one(pf, &c, MODEL_THESIS, j, n, &ls);
+                }
                 j++;
                 continue;
             }
             const uint32_t j1 = (m - j < room) ? m : j + room;
             const float *const nz = pf->cfg.noise + p;
             const float s1 = ls.s1, s2 = ls.s2;
-            if (br_pf_kernel_predict(pf, &c.k, j, j1, nz, &ls) > 0u) {
+            const uint32_t left = ms ? br_pf_kernel_predict_ms(pf, &c.k, j, j1, nz, &ls)
+                                     : br_pf_kernel_predict(pf, &c.k, j, j1, nz, &ls);
+            if (left > 0u) {
                 /* the fix-up: the particles the kernel left (l = NaN), one at a time */
                 for (uint32_t k = j; k < j1; k++) {
                     if (pf->l[k] != pf->l[k]) {
-                        particle_one(pf, &c, 0, k, nz + BR_NX * (k - j), &ls);
+                        if (ms) {
+                            particle_one(pf, &c, MODEL_MS, k, nz + BR_NX * (k - j), &ls);
+                        } else {
+                            particle_one(pf, &c, MODEL_THESIS, k, nz + BR_NX * (k - j), &ls);
+                        }
                     }
                 }
                 /* cfg.adapt's sums over the run again, in particle order */
@@ -647,6 +723,11 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
                 pf->kgp[j] = br_model_kp_of(&pf->model, pf->x[BR_X_GP][j]);
             }
             pf->x[BR_X_OMEGA][j] += d_om;
+            if (has_elements(pf)) {
+                /* the elements moved by the position's jump L d_theta (eq. MS1) */
+                sf += elements_move(pf, j, pf->model.cfg.lead_mprad * d_th);
+                continue;
+            }
             /* f_nl depends on omega: the estimate is that of the moved cloud */
             float xj[BR_NX];
             particle_get(pf, j, xj);

@@ -127,3 +127,12 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
     br_pf_kref_copy_back(pf);
     return sf;
 }
+
+/* Steps 1 and 2 with elements: the reference's element path (FPv4 has no
+ * vmaxnm; the reference's select clamps are what the M4 runs). Not tuned for
+ * the M4: its cost with elements is not measured (docs/modules/pf.md). */
+uint32_t br_pf_kernel_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                                 br_pf_lsum_t *ls)
+{
+    return br_pf_kref_predict_ms(pf, c, j0, j1, nz, ls);
+}

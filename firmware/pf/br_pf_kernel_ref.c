@@ -90,6 +90,65 @@ uint32_t br_pf_kref_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint3
     return left;
 }
 
+uint32_t br_pf_kref_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                               br_pf_lsum_t *ls)
+{
+    const br_model_km_t km = c->km;
+    const float uh = c->uh;
+    const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
+    const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
+    const float shift = c->shift, y_rel = c->y_rel;
+    const uint32_t m = pf->cfg.n_particles;
+    float *const th = pf->x[BR_X_THETA], *const om = pf->x[BR_X_OMEGA], *const gg = pf->x[BR_X_GP];
+    float *const ka = pf->kgp, *const ms = pf->ms;
+    float lmax = ls->lmax, s1 = ls->s1, s2 = ls->s2;
+    uint32_t left = 0u;
+    for (uint32_t j = j0; j < j1; j++) {
+        const float *const nj = nz + BR_NX * (j - j0);
+        float e[BR_MSLIP_MAX], e1[BR_MSLIP_MAX];
+        for (int i = 0; i < km.n; i++) {
+            e[i] = ms[(uint32_t)i * m + j];
+        }
+        /* 1. predict: the trapezoidal step of eq. 6 with the elements (eqs. MS1, MS2) */
+        float t = th[j], w = om[j];
+        br_pf_ms_det(&km, uh, &t, &w, gg[j], ka[j], e, e1);
+        /* process noise sqrt(Q) n; theta relative to the new origin */
+        t = (t + q0 * nj[0]) - shift;
+        w = w + q1 * nj[1];
+        const float g = clamp_gp(gg[j] + q3 * nj[3], gp_min, gp_max);
+        /* z's sample moves every element, clamped at the new g_p; f_nl = sum k_i e_i (eqs. MS1, MS2) */
+        const float f = br_pf_ms_noise(&km, e1, q2 * nj[2], g);
+        /* 2. Gaussian log-likelihood, l = -(theta - y)^2 / (2 R) */
+        const float e_th = t - y_rel;
+        const float l = br_pf_loglik(e_th, inv_2r);
+        s1 += e_th;
+        s2 += e_th * e_th;
+        /* validity: theta, omega and f_nl finite (f_nl does not depend on
+         * omega here; the elements are finite after the clamps) */
+        if (!((t - t) + (w - w) + (f - f) == 0.0f)) {
+            pf->fnl[j] = 0.0f;
+            pf->l[j] = NAN;
+            left++;
+            continue;
+        }
+        th[j] = t;
+        om[j] = w;
+        gg[j] = g;
+        ka[j] = f;
+        for (int i = 0; i < km.n; i++) {
+            ms[(uint32_t)i * m + j] = e1[i];
+        }
+        pf->fnl[j] = f;
+        pf->l[j] = l;
+        lmax = (l > lmax) ? l : lmax;
+    }
+    ls->lmax = lmax;
+    ls->n_valid += (j1 - j0) - left;
+    ls->s1 = s1;
+    ls->s2 = s2;
+    return left;
+}
+
 uint32_t br_pf_kref_weights(br_pf_t *pf, float lmax, int outlier)
 {
     const uint32_t m = pf->cfg.n_particles;
@@ -152,17 +211,88 @@ BR_NO_IVOPTS static void copy_back_soa(const uint16_t *BR_RESTRICT idx, uint32_t
     }
 }
 
+/* With elements: the same passes moving each particle's elements with it
+ * (a[e][j]: element e of particle j); states = 0: the elements alone. Four
+ * elements (the common set) moved written out, any other number by a loop. */
+static inline void move_elements(uint32_t i, uint32_t k, float *const a[BR_MSLIP_MAX], int ne)
+{
+    if (ne == 4) {
+        memcpy(&a[0][i], &a[0][k], sizeof a[0][i]);
+        memcpy(&a[1][i], &a[1][k], sizeof a[1][i]);
+        memcpy(&a[2][i], &a[2][k], sizeof a[2][i]);
+        memcpy(&a[3][i], &a[3][k], sizeof a[3][i]);
+        return;
+    }
+    for (int e = 0; e < ne; e++) {
+        memcpy(&a[e][i], &a[e][k], sizeof a[e][i]);
+    }
+}
+
+static void ms_arrays(br_pf_t *pf, float *a[BR_MSLIP_MAX])
+{
+    for (int e = 0; e < pf->model.cfg.mslip.n; e++) {
+        a[e] = pf->ms + (uint32_t)e * pf->cfg.n_particles;
+    }
+}
+
+/* the forward pass with the elements: i = 0 .. m - 2 */
+BR_NO_IVOPTS static void copy_fwd_ms(br_pf_t *pf, int states)
+{
+    const uint32_t last = pf->cfg.n_particles - 1u;
+    const int ne = pf->model.cfg.mslip.n;
+    const uint16_t *BR_RESTRICT idx = pf->idx;
+    float *a[BR_MSLIP_MAX];
+    ms_arrays(pf, a);
+    float *th = pf->x[BR_X_THETA], *om = pf->x[BR_X_OMEGA], *zz = pf->x[BR_X_Z], *gg = pf->x[BR_X_GP];
+    for (uint32_t i = 0u; i < last; i++) {
+        const uint32_t k = idx[i];
+        if (k > i) {
+            if (states) {
+                move_particle(i, k, th, om, zz, gg, pf->kgp);
+            }
+            move_elements(i, k, a, ne);
+        }
+    }
+}
+
+/* the backward pass with the elements: i = m - 1 down to 1 */
+BR_NO_IVOPTS static void copy_back_ms(br_pf_t *pf)
+{
+    const int ne = pf->model.cfg.mslip.n;
+    const uint16_t *BR_RESTRICT idx = pf->idx;
+    float *a[BR_MSLIP_MAX];
+    ms_arrays(pf, a);
+    float *th = pf->x[BR_X_THETA], *om = pf->x[BR_X_OMEGA], *zz = pf->x[BR_X_Z], *gg = pf->x[BR_X_GP];
+    for (uint32_t i = pf->cfg.n_particles - 1u; i > 0u; i--) {
+        const uint32_t k = idx[i];
+        if (k < i) {
+            move_particle(i, k, th, om, zz, gg, pf->kgp);
+            move_elements(i, k, a, ne);
+        }
+    }
+}
+
 void br_pf_kref_copy_fwd(br_pf_t *pf)
 {
+    if (pf->model.cfg.mslip.n > 0) {
+        copy_fwd_ms(pf, 1);
+        return;
+    }
     copy_fwd_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
                  pf->x[BR_X_GP], pf->kgp);
 }
 
 void br_pf_kref_copy_back(br_pf_t *pf)
 {
+    if (pf->model.cfg.mslip.n > 0) {
+        copy_back_ms(pf);
+        return;
+    }
     copy_back_soa(pf->idx, pf->cfg.n_particles, pf->x[BR_X_THETA], pf->x[BR_X_OMEGA], pf->x[BR_X_Z],
                   pf->x[BR_X_GP], pf->kgp);
 }
+
+void br_pf_kref_copy_ms_fwd(br_pf_t *pf) { copy_fwd_ms(pf, 0); }
 
 float br_pf_kref_resample(br_pf_t *pf, float lmax, int outlier)
 {

@@ -216,6 +216,144 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
         resample_count(pf->W, m, total, pf->idx, 1);
     }
     const float sf = resample_forward(pf);
+    if (pf->model.cfg.mslip.n > 0) {
+        /* the elements' forward pass (the states' is resample_forward's) */
+        br_pf_kref_copy_ms_fwd(pf);
+    }
     br_pf_kref_copy_back(pf);
     return sf;
+}
+
+/* Particles per block of the element path: its locals (about 1.3 KiB per
+ * element) stay on the stack */
+#define MS_BLOCK 64u
+
+/* Steps 1 and 2 with elements for the particles j0 .. j0 + n - 1 (n <=
+ * MS_BLOCK), the reference's operations in the same order per particle,
+ * arranged as loops over the block's particles (vectorised) inside loops
+ * over the elements, the particle-dependent values in block arrays. */
+static uint32_t predict_ms_block(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t n, const float *nz,
+                                 int32_t *kmin, float *s1p, float *s2p)
+{
+    const br_model_km_t km = c->km;
+    const uint32_t m = pf->cfg.n_particles;
+    const float uh = c->uh, h = km.h, L = km.L, visc = km.visc, Lh_half = km.Lh_half, inv_Jeff = km.inv_Jeff;
+    const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
+    const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
+    const float shift = c->shift, y_rel = c->y_rel;
+    float *BR_RESTRICT th = pf->x[BR_X_THETA] + j0;
+    float *BR_RESTRICT om = pf->x[BR_X_OMEGA] + j0;
+    float *BR_RESTRICT gg = pf->x[BR_X_GP] + j0;
+    float *BR_RESTRICT ka = pf->kgp + j0;
+    float *BR_RESTRICT fo = pf->fnl + j0;
+    float *BR_RESTRICT lo = pf->l + j0;
+    const float *BR_RESTRICT nn = nz;
+    float w1[MS_BLOCK], wm[MS_BLOCK], dth[MS_BLOCK], dx[MS_BLOCK], fs[MS_BLOCK], gn[MS_BLOCK], dz[MS_BLOCK];
+    int ok[MS_BLOCK];
+    float e1[BR_MSLIP_MAX][MS_BLOCK];
+    for (uint32_t j = 0; j < n; j++) {
+        wm[j] = om[j];
+    }
+    /* 1. predict: the trapezoidal step (eqs. MS1, MS2, 6), pass by pass */
+    for (int pass = 0; pass < BR_MODEL_MS_PASSES; pass++) {
+        for (uint32_t j = 0; j < n; j++) {
+            dth[j] = wm[j] * h; /* dtheta = omega_m h, the travel L dtheta */
+            dx[j] = L * dth[j];
+            fs[j] = 0.0f;
+        }
+        for (int i = 0; i < km.n; i++) {
+            const float ki = km.k[i], ci = km.c[i];
+            const float *BR_RESTRICT e = pf->ms + (uint32_t)i * m + j0;
+            float *BR_RESTRICT z1 = e1[i];
+            for (uint32_t j = 0; j < n; j++) {
+                /* e1_i = clamp(e_i + L dtheta, +-c_i g_p) (eq. MS1); f1 += k_i e1_i (eq. MS2) */
+                z1[j] = br_pf_ms_clamp(e[j] + dx[j], ci * gg[j]);
+                fs[j] += ki * z1[j];
+            }
+        }
+        for (uint32_t j = 0; j < n; j++) {
+            /* eq. 6, trapezoidal: omega1 = omega0 + (u h - L^2 s2 dtheta - L h (f0 + f1) / 2) / Jeff */
+            const float w0 = om[j];
+            w1[j] = w0 + (uh - visc * dth[j] - Lh_half * (ka[j] + fs[j])) * inv_Jeff;
+            wm[j] = 0.5f * (w0 + w1[j]);
+        }
+    }
+    /* process noise: theta, omega, g_p; z's sample on every element at the new g_p */
+    for (uint32_t j = 0; j < n; j++) {
+        const float *const nj = nn + BR_NX * j;
+        const float ga = gg[j] + q3 * nj[3];
+        const float gl = (ga > gp_min) ? ga : gp_min;
+        gn[j] = (gl < gp_max) ? gl : gp_max;
+        dz[j] = q2 * nj[2];
+        fs[j] = 0.0f;
+    }
+    for (int i = 0; i < km.n; i++) {
+        const float ki = km.k[i], ci = km.c[i];
+        float *BR_RESTRICT z1 = e1[i];
+        for (uint32_t j = 0; j < n; j++) {
+            z1[j] = br_pf_ms_clamp(z1[j] + dz[j], ci * gn[j]);
+            fs[j] += ki * z1[j];
+        }
+    }
+    uint32_t n_ok = 0u;
+    float s1 = *s1p, s2 = *s2p;
+    int32_t kn = *kmin;
+    for (uint32_t j = 0; j < n; j++) {
+        const float *const nj = nn + BR_NX * j;
+        const float t = ((th[j] + dth[j]) + q0 * nj[0]) - shift;
+        const float w = w1[j] + q1 * nj[1];
+        const float f = fs[j];
+        /* 2. Gaussian log-likelihood */
+        const float e = t - y_rel;
+        const float l = br_pf_loglik(e, inv_2r);
+        s1 += e;
+        s2 += e * e;
+        /* validity: theta, omega and f_nl finite; a particle that fails keeps its state */
+        const int v = ((t - t) + (w - w) + (f - f) == 0.0f);
+        ok[j] = v;
+        th[j] = v ? t : th[j];
+        om[j] = v ? w : om[j];
+        gg[j] = v ? gn[j] : gg[j];
+        ka[j] = v ? f : ka[j];
+        const float lk = v ? l : NAN;
+        fo[j] = v ? f : 0.0f;
+        lo[j] = lk;
+        /* the largest l by an integer min (the thesis path's, above) */
+        int32_t key;
+        memcpy(&key, &lk, sizeof key);
+        kn = (key < kn) ? key : kn;
+        n_ok += (uint32_t)v;
+    }
+    for (int i = 0; i < km.n; i++) {
+        float *BR_RESTRICT e = pf->ms + (uint32_t)i * m + j0;
+        const float *BR_RESTRICT z1 = e1[i];
+        for (uint32_t j = 0; j < n; j++) {
+            e[j] = ok[j] ? z1[j] : e[j];
+        }
+    }
+    *kmin = kn;
+    *s1p = s1;
+    *s2p = s2;
+    return n_ok;
+}
+
+uint32_t br_pf_kernel_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                                 br_pf_lsum_t *ls)
+{
+    int32_t kmin = INT32_MAX;
+    uint32_t n_ok = 0u;
+    float s1 = ls->s1, s2 = ls->s2;
+    for (uint32_t j = j0; j < j1; j += MS_BLOCK) {
+        const uint32_t n = (j1 - j < MS_BLOCK) ? j1 - j : MS_BLOCK;
+        n_ok += predict_ms_block(pf, c, j, n, nz + BR_NX * (j - j0), &kmin, &s1, &s2);
+    }
+    ls->s1 = s1;
+    ls->s2 = s2;
+    if (n_ok > 0u) {
+        float lm;
+        memcpy(&lm, &kmin, sizeof lm);
+        ls->lmax = (lm > ls->lmax) ? lm : ls->lmax;
+        ls->n_valid += n_ok;
+    }
+    return (j1 - j0) - n_ok;
 }

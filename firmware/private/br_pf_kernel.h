@@ -38,6 +38,8 @@ typedef struct {
     float gp_min, gp_max, inv_2r;
     float shift;      /* theta of the new origin relative to the old one, rad */
     float y_rel;      /* the measurement relative to the new origin, rad */
+    br_model_km_t km; /* with elements (est.model.mslip.n >= 1): the clamp model's constants */
+    float uh;         /* with elements: u h, the trapezoidal step's torque impulse */
 } br_pf_kc_t;
 
 /* What a prediction pass adds up: the largest log-weight of the valid
@@ -62,6 +64,59 @@ static inline float br_pf_fnl_kp(const br_model_k_t *k, float om, float z, float
  * by integer keys (the SIMD and Cortex-M4 kernels) holds only while that is
  * so (docs/modules/pf.md, "Changing the likelihood"). */
 static inline float br_pf_loglik(float e, float inv_2r) { return -(e * e) * inv_2r; }
+
+/* Maxwell-slip elements (docs/modules/pf.md, "Maxwell-slip elements"): one
+ * clamp of element i at the level g, by selects (fmaxf / fminf's result for
+ * every input, the bound d = c_i g > 0: a NaN gives -d, as fmaxf):
+ *   e_i <- clamp(e_i + dx, -c_i g, c_i g)                       (eq. MS1) */
+static inline float br_pf_ms_clamp(float e, float d)
+{
+    const float a = (e > -d) ? e : -d;
+    return (a < d) ? a : d;
+}
+
+/* The deterministic part of step 1 with elements: br_model_km_step's
+ * trapezoidal step (BR_MODEL_MS_PASSES fixed-point passes) with f0 =
+ * sum_i k_i e_i carried by the particle (the same value br_msk_force makes):
+ *   dtheta = omega_m h;  e1_i = clamp(e_i + L dtheta, +-c_i g)   (eq. MS1)
+ *   f1 = sum_i k_i e1_i (i = 0..n-1, from 0)                       (eq. MS2)
+ *   omega1 = omega0 + (u h - L^2 sigma2 dtheta - L h (f0 + f1) / 2) / Jeff   (eq. 6, trapezoidal)
+ *   omega_m = (omega0 + omega1) / 2
+ * e1 must not be e. Writes theta + dtheta and omega1 to *th, *om. */
+static inline void br_pf_ms_det(const br_model_km_t *k, float uh, float *th, float *om, float g, float f0,
+                                const float e[], float e1[])
+{
+    const float w0 = *om;
+    float wm = w0, w1 = w0, dth = 0.0f;
+    for (int pass = 0; pass < BR_MODEL_MS_PASSES; pass++) {
+        dth = wm * k->h;
+        const float dx = k->L * dth;
+        float f1 = 0.0f;
+        for (int i = 0; i < k->n; i++) {
+            e1[i] = br_pf_ms_clamp(e[i] + dx, k->c[i] * g);
+            f1 += k->k[i] * e1[i];
+        }
+        w1 = w0 + (uh - k->visc * dth - k->Lh_half * (f0 + f1)) * k->inv_Jeff;
+        wm = 0.5f * (w0 + w1);
+    }
+    *th += dth;
+    *om = w1;
+}
+
+/* The elements' process noise and the force of the predicted particle: z's
+ * sample moves every element by the same dz (z is their common error), then
+ * each is clamped at the new level g:
+ *   e_i <- clamp(e_i + dz, +-c_i g)                                (eq. MS1)
+ *   f_nl = sum_i k_i e_i                                            (eq. MS2) */
+static inline float br_pf_ms_noise(const br_model_km_t *k, float e[], float dz, float g)
+{
+    float f = 0.0f;
+    for (int i = 0; i < k->n; i++) {
+        e[i] = br_pf_ms_clamp(e[i] + dz, k->c[i] * g);
+        f += k->k[i] * e[i];
+    }
+    return f;
+}
 
 /* 1 for a valid particle (its log-weight l is not NaN), 0 for one kept at its state */
 static inline float br_pf_valid_weight(float l) { return (l == l) ? 1.0f : 0.0f; }
@@ -123,11 +178,24 @@ uint32_t br_pf_kref_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint3
 uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                               br_pf_lsum_t *ls);
 
+/* Steps 1 and 2 with elements (est.model.mslip.n >= 1; docs/modules/pf.md,
+ * "Maxwell-slip elements"), bootstrap proposal, for particles j0 .. j1 - 1:
+ * br_pf_ms_det, the process noise (theta, omega, g_p as the thesis model;
+ * z's sample on the elements, br_pf_ms_noise), the log-likelihood. The
+ * same contract as *_predict, with the elements pf->ms (stride m) and the
+ * force kept in pf->kgp: a valid prediction (theta, omega and f_nl finite)
+ * overwrites the particle, any other keeps it (f_nl = 0, l = NaN) for the
+ * fix-up. There is no RK4 limit: only an invalid particle is left. */
+uint32_t br_pf_kref_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                               br_pf_lsum_t *ls);
+uint32_t br_pf_kernel_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
+                                 br_pf_lsum_t *ls);
+
 /* Steps 3, 4 and step 5's sum, over pf's m predicted particles with their
  * log-weights pf->l (NaN: invalid) and lmax, the largest valid one (finite
  * unless outlier): the weights W_j (outlier: 2^16 for every valid particle),
- * systematic resampling's indices idx, the set copied in place (state and
- * k_p), and the sum of f_nl over the resampled set in particle order, which
+ * systematic resampling's indices idx, the set copied in place (state, k_p
+ * and, with elements, the elements), and the sum of f_nl over the resampled set in particle order, which
  * it returns. */
 float br_pf_kref_resample(br_pf_t *pf, float lmax, int outlier);
 float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier);
@@ -138,5 +206,10 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier);
 uint32_t br_pf_kref_weights(br_pf_t *pf, float lmax, int outlier);
 void br_pf_kref_copy_fwd(br_pf_t *pf);
 void br_pf_kref_copy_back(br_pf_t *pf);
+/* With elements (est.model.mslip.n >= 1) the two passes move each
+ * particle's elements with it; br_pf_kref_copy_ms_fwd: the forward pass of
+ * the elements alone (the SIMD kernel's, whose forward pass of the states is
+ * its own) */
+void br_pf_kref_copy_ms_fwd(br_pf_t *pf);
 
 #endif

@@ -36,6 +36,21 @@ One step with y_k = (counts, frac) and the torque u_{k-1} of the last period:
     Then origin = counts, frac_prev = frac.
 A non-finite u or a frac outside [0, 1]: BR_E_INPUT, nothing changes.
 
+Maxwell-slip elements (cfg.mslip, docs/modules/pf.md "Maxwell-slip
+elements"; None: LuGre): each particle carries its own N element deflections
+e_j (golden/ref/mslip.py, clamp form); z is not a state of the model (kept 0)
+and its noise sample moves every element of the particle alike.
+    priming:  e_j = clamp(0 + x0_std_z n_j2, +-Delta(g_pj)),  z_j = 0
+    predict:  (theta, omega, e) = mslip.model_step (the trapezoidal step with
+              `ms_passes` passes at the particle's g_p), then theta += q0 n0,
+              omega += q1 n1, g_p = clamp(g_p + q3 n3), e = clamp(e + q2 n2,
+              +-Delta(g_p)) at the new g_p; f_nl = sum k_i e_i. Valid: theta,
+              omega and f_nl finite.
+    resample: the elements with their particles.
+    re-anchor: each particle's elements moved by L (y - mean theta), clamped
+              at its g_p.
+    estimate: F_hat = mean over the set of sum k_i e_ji.
+
 External force (cfg.load, docs/modules/pf.md "External force"; None: off):
 one load force F_d shared by every particle (N, load side, against +x as
 friction is; 0 when priming) and the covariance P (3 x 3) of the cloud's
@@ -62,6 +77,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import model as rmodel
+from . import mslip as rmslip
 
 BR_OK = 0
 BR_E_INPUT = -3
@@ -89,6 +105,8 @@ class PfCfg:
     noise: tuple          # the ROM table, float values
     noise_skip: int
     load: object = None   # LoadCfg: the shared external force F_d; None: off
+    mslip: object = None  # mslip.MslipParams (sigma2 0): the particles' elements; None: LuGre
+    ms_passes: int = 2    # the trapezoidal step's fixed-point passes
 
 
 @dataclass(frozen=True)
@@ -129,6 +147,9 @@ class Pf:
         self.n_outliers = 0
         self.primed = False
         self.x = [np.zeros(NX) for _ in range(cfg.m)]
+        n_el = 0 if cfg.mslip is None else len(cfg.mslip.k)
+        assert cfg.mslip is None or cfg.load is None, "elements with the external force: not in this reference"
+        self.e = [np.zeros(n_el) for _ in range(cfg.m)]   # each particle's element deflections
         # outputs of the last step
         self.xp = None          # predicted set (before resampling)
         self.W = None           # quantised weights
@@ -168,9 +189,9 @@ class Pf:
         c = self.cfg
         s = np.zeros(NX)
         sf = 0.0
-        for xj in self.x:
+        for xj, ej in zip(self.x, self.e):
             s = s + xj
-            sf += rmodel.fnl(c.model, xj)
+            sf += rmodel.fnl(c.model, xj) if c.mslip is None else rmslip.force(c.mslip, ej, 0.0)
         self.mean = s / c.m
         self.F_hat = sf / c.m
         if c.load is not None:
@@ -182,6 +203,10 @@ class Pf:
         for j in range(c.m):
             xj = np.array([mu[i] + c.x0_std[i] * self._n(j, i) for i in range(NX)])
             xj[3] = self._clamp_gp(xj[3])
+            if c.mslip is not None:
+                # the elements relaxed but for z's draw, their common deflection
+                self.e[j] = rmslip.move(c.mslip, np.zeros(len(c.mslip.k)), xj[2], xj[3])
+                xj[2] = 0.0
             self.x[j] = xj
         self._advance()
         self.origin = int(counts)
@@ -206,16 +231,31 @@ class Pf:
             # the common error's covariance over the period; the torque with the load
             self.P = self.Phi @ self.P @ self.Phi.T + np.diag([0.0, 0.0, c.load.q_N2])
             u = u - c.model.L * self.Fd
-        xp, fn, l = [], [], []
+        xp, ep, fn, l = [], [], [], []
         for j in range(c.m):
-            st, xn, _ = rmodel.step(c.model, self.x[j], u, c.dt)
-            xn = np.array([xn[i] + self.q_std[i] * self._n(j, i) for i in range(NX)])
-            xn[3] = self._clamp_gp(xn[3])
+            if c.mslip is None:
+                st, xn, _ = rmodel.step(c.model, self.x[j], u, c.dt)
+                xn = np.array([xn[i] + self.q_std[i] * self._n(j, i) for i in range(NX)])
+                xn[3] = self._clamp_gp(xn[3])
+                en = self.e[j]
+            else:
+                x0 = self.x[j]
+                th1, om1, e1 = rmslip.model_step(c.model, c.mslip, x0[0], x0[1], x0[3], self.e[j], u, c.dt,
+                                                 c.ms_passes)
+                st = rmodel.BR_OK
+                xn = np.array([th1 + self.q_std[0] * self._n(j, 0), om1 + self.q_std[1] * self._n(j, 1), x0[2],
+                               self._clamp_gp(x0[3] + self.q_std[3] * self._n(j, 3))])
+                # z's sample moves every element; each clamped at the new g_p
+                en = rmslip.move(c.mslip, e1, self.q_std[2] * self._n(j, 2), xn[3])
             xn[0] -= shift
             valid = st == rmodel.BR_OK and all(math.isfinite(v) for v in xn)
-            f = rmodel.fnl(c.model, xn) if valid else 0.0
+            if c.mslip is None:
+                f = rmodel.fnl(c.model, xn) if valid else 0.0
+            else:
+                f = rmslip.force(c.mslip, en, 0.0) if valid else 0.0
             valid = valid and math.isfinite(f)
             xp.append(xn if valid else self.x[j].copy())
+            ep.append(en if valid else self.e[j].copy())
             fn.append(f)
             l.append(-((xn[0] - y) ** 2) / (2.0 * c.r_var) if valid else -math.inf)
         self._advance()
@@ -233,6 +273,7 @@ class Pf:
         idx = resample_idx(W)
         self.W, self.idx = W, idx
         self.x = [xp[k].copy() for k in idx]
+        self.e = [ep[k].copy() for k in idx]
         # mean f_nl over the resampled set before any re-anchoring (a diagnostic
         # column of the trace: F_hat differs from it only on re-anchoring steps)
         self.F_hat_pred = sum(fn[k] for k in idx) / c.m
@@ -242,9 +283,12 @@ class Pf:
             w_meas = (shift + (frac - self.prev_frac) * rpc) / c.dt
             th = sum(xj[0] for xj in self.x) / c.m
             om = sum(xj[1] for xj in self.x) / c.m
-            for xj in self.x:
+            for j, xj in enumerate(self.x):
                 xj[0] += y - th
                 xj[1] += w_meas - om
+                if c.mslip is not None:
+                    # the elements moved by the position's jump
+                    self.e[j] = rmslip.move(c.mslip, self.e[j], c.model.L * (y - th), xj[3])
         self.origin = int(counts)
         self.prev_frac = frac
         self._estimate()

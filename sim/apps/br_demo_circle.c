@@ -151,7 +151,9 @@ typedef struct {
     double ahead; /* < 0: the machine's */
     double ukf_load; /* the UKF's external force's random walk, N^2/s (0: the machine's) */
     int ukf_mslip;   /* the UKF predicts with the hardware-like plant's element set */
+    int pf_mslip;    /* the PF's particles carry the hardware-like plant's element set (every plant) */
     float ukf_qs[2]; /* factors on the UKF's z and g_p process noise (0: 1) */
+    float pf_qs[2];  /* factors on the PF's z and g_p process noise (0: 1) */
     double pf_load;  /* the PF's shared external force's random walk, N^2/s (0: the machine's) */
     double pf_gp_tau; /* the PF's g_p along the Stribeck curve, time constant s (0: the machine's) */
     br_circle_path_t path; /* the circle (default the thesis's) */
@@ -164,7 +166,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
             "       [--ahead P] [--ukf-load Q_N2_PER_S] [--ukf-mslip] [--ukf-q-scale FZ,FG] [--pf-load Q_N2_PER_S]\n"
-            "       [--pf-gp-curve TAU_S] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
+            "       [--pf-mslip] [--pf-q-scale FZ,FG] [--pf-gp-curve TAU_S] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
             "       [--hw-law slip|clamp] [--hw-c-mps C]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
@@ -180,6 +182,9 @@ static int usage(const char *argv0, FILE *to)
             "                      elements (clamp form, docs/modules/ukf.md)\n"
             "  --ukf-q-scale FZ,FG the UKF's z and g_p process noise times FZ and FG (1e-6 .. 1e6)\n"
             "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9; docs/modules/pf.md)\n"
+            "  --pf-mslip          on every plant, the PF's particles carry the hardware-like plant's\n"
+            "                      Maxwell-slip elements (clamp form, docs/modules/pf.md)\n"
+            "  --pf-q-scale FZ,FG  the PF's z and g_p process noise times FZ and FG (1e-6 .. 1e6)\n"
             "  --pf-gp-curve TAU   the PF's g_p along the Stribeck curve, time constant TAU s (0 .. 100; docs/modules/pf.md)\n"
             BR_CIRCLE_USAGE("--dir cw|ccw|both  ") "                      (both: each controller both ways, the ISO 230-4 pair; --direction the same)\n"
             "  --hw-law slip|clamp the hardware-like plant's Maxwell-slip law (default slip, docs/demo.md)\n"
@@ -191,6 +196,16 @@ static int usage(const char *argv0, FILE *to)
             BR_TOOL_GAIN_MAX, BR_TOOL_RADIUS_MIN_M, BR_TOOL_RADIUS_MAX_M, BR_TOOL_FEED_MIN_MM_MIN,
             BR_TOOL_FEED_MAX_MM_MIN, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S);
     return 2;
+}
+
+/* --ukf-q-scale / --pf-q-scale FZ,FG: two factors in [1e-6, 1e6] */
+static int parse_q_scale(const char *opt, const char *val, float qs[2])
+{
+    int used = 0;
+    const int bad = sscanf(val, "%f,%f%n", &qs[0], &qs[1], &used) != 2 || val[used] != '\0' ||
+                    !(qs[0] >= 1e-6f && qs[0] <= 1e6f && qs[1] >= 1e-6f && qs[1] <= 1e6f);
+    if (bad) fprintf(stderr, "%s: %s %s: two comma-separated factors in [1e-6, 1e6]\n", TOOL, opt, val);
+    return bad;
 }
 
 static int parse_gains(const char *val, float K[3])
@@ -216,6 +231,8 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"ukf-mslip", no_argument, NULL, 'e'},
                                          {"ukf-q-scale", required_argument, NULL, 'q'},
                                          {"pf-load", required_argument, NULL, 'L'},
+                                         {"pf-mslip", no_argument, NULL, 'M'},
+                                         {"pf-q-scale", required_argument, NULL, 'Q'},
                                          {"pf-gp-curve", required_argument, NULL, 'G'},
                                          {"hw-law", required_argument, NULL, 'w'},
                                          {"hw-c-mps", required_argument, NULL, 'c'},
@@ -241,13 +258,9 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'a': bad = br_arg_double(TOOL, p.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &o->ahead); break;
         case 'l': bad = br_arg_double(TOOL, p.opt, val, 0.0, 1.0e9, &o->ukf_load); break;
         case 'e': o->ukf_mslip = 1; break;
-        case 'q': {
-            int used = 0;
-            bad = sscanf(val, "%f,%f%n", &o->ukf_qs[0], &o->ukf_qs[1], &used) != 2 || val[used] != '\0' ||
-                  !(o->ukf_qs[0] >= 1e-6f && o->ukf_qs[0] <= 1e6f && o->ukf_qs[1] >= 1e-6f && o->ukf_qs[1] <= 1e6f);
-            if (bad) fprintf(stderr, "%s: --ukf-q-scale %s: two comma-separated factors in [1e-6, 1e6]\n", TOOL, val);
-            break;
-        }
+        case 'M': o->pf_mslip = 1; break;
+        case 'q': bad = parse_q_scale(p.opt, val, o->ukf_qs); break;
+        case 'Q': bad = parse_q_scale(p.opt, val, o->pf_qs); break;
         case 'L': bad = br_arg_double(TOOL, p.opt, val, 0.0, 1.0e9, &o->pf_load); break;
         case 'G': bad = br_arg_double(TOOL, p.opt, val, 0.0, 100.0, &o->pf_gp_tau); break;
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, p.opt, val, 1, &o->path); break;
@@ -310,9 +323,11 @@ static void json_g(char *buf, size_t n, double v)
 /* the configuration of one run on plant pl */
 static br_circle_cfg_t plant_cfg(int pl, br_circle_ctrl_t ctrl, const opts_t *o)
 {
-    if (pl == 0) return br_circle_cfg_thesis(ctrl);
-    if (pl == 1) return br_circle_cfg_realistic(ctrl);
-    br_circle_cfg_t c = br_circle_cfg_hardware_like(ctrl);
+    br_circle_cfg_t c = (pl == 0) ? br_circle_cfg_thesis(ctrl)
+                        : (pl == 1) ? br_circle_cfg_realistic(ctrl) : br_circle_cfg_hardware_like(ctrl);
+    /* the PF's particles with the hardware-like element set (every plant) */
+    br_circle_use_pf_mslip(&c, o->pf_mslip);
+    if (pl != PLANT_HW) return c;
     if (o->hw_clamp) c.plant.gms.clamp = 1;
     if (o->hw_c_mps > 0.0) c.plant.gms.C_mps = o->hw_c_mps;
     /* the UKF's model with the plant's own element set (this plant only) */
@@ -350,7 +365,7 @@ static void hw_describe(FILE *js, const opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, {0.0f, 0.0f}, 0.0, 0.0,
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, 0, {0.0f, 0.0f}, {0.0f, 0.0f}, 0.0, 0.0,
                   BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
@@ -462,6 +477,10 @@ int main(int argc, char **argv)
                 if (opt.pf_prop >= 0) cfg.pf.proposal = (uint32_t)opt.pf_prop;
                 br_circle_use_ahead(&cfg, opt.ahead);
                 br_circle_use_ukf_load(&cfg, opt.ukf_load);
+                if (opt.pf_qs[0] > 0.0f) {
+                    cfg.pf.est.q_var[BR_X_Z] *= opt.pf_qs[0];
+                    cfg.pf.est.q_var[BR_X_GP] *= opt.pf_qs[1];
+                }
                 if (opt.ukf_qs[0] > 0.0f) {
                     cfg.ukf.est.q_var[BR_X_Z] *= opt.ukf_qs[0];
                     cfg.ukf.est.q_var[BR_X_GP] *= opt.ukf_qs[1];
@@ -491,9 +510,10 @@ int main(int argc, char **argv)
                 }
                 char fname[256];
                 snprintf(fname, sizeof fname, "trace_%s%s%s.csv", plant_prefix[pl], dir_prefix[d], name);
-                if (pl == PLANT_HW) {
-                    /* a plant outside the estimators' model class: a run may stop, and is then a
-                     * fault with its time and cause, never a figure (br_run_report.h) */
+                if (pl == PLANT_HW || opt.pf_mslip) {
+                    /* a plant outside the estimators' model class (or, with --pf-mslip, a model
+                     * outside the plant's): a run may stop, and is then a fault with its time and
+                     * cause, never a figure (br_run_report.h) */
                     const br_run_report_t rep = {res.contour_rms_m, res.max_err_m, res.fault_status,
                                                  res.fault_cause, res.fault_t_s};
                     fprintf(js, "%s\n%s\"%s\": {\"dt_s\": %.6g, ", sep, ind, name, cfg.dt_s);

@@ -675,7 +675,8 @@ int main(int argc, char **argv)
     /* 3. memory (host sizes; see docs/bench.md for the Cortex-M7 ones) */
     const size_t per_particle = (sizeof(((br_pf_t *)0)->x) + sizeof(((br_pf_t *)0)->kgp) +
                                  sizeof(((br_pf_t *)0)->fnl) + sizeof(((br_pf_t *)0)->l) +
-                                 sizeof(((br_pf_t *)0)->W) + sizeof(((br_pf_t *)0)->idx)) /
+                                 sizeof(((br_pf_t *)0)->W) + sizeof(((br_pf_t *)0)->idx) +
+                                 sizeof(((br_pf_t *)0)->ms)) / /* the element slots, BR_PF_MS_SLOTS / m_max each */
                                 BR_PF_MAX_PARTICLES;
     const size_t pf_bytes = sizeof(br_pf_t), pf_fixed = pf_bytes - per_particle * BR_PF_MAX_PARTICLES;
     const size_t pf_used = pf_fixed + per_particle * m;

@@ -96,11 +96,10 @@ br_circle_cfg_t br_circle_cfg_realistic(br_circle_ctrl_t controller)
 static const double k_hw_d_m[BR_CIRCLE_HW_N] = {2.0e-6, 5.0e-6, 10.0e-6, 20.0e-6};
 static const double k_hw_share[BR_CIRCLE_HW_N] = {0.25, 0.25, 0.25, 0.25};
 
-void br_circle_use_ukf_mslip(br_circle_cfg_t *c, int on)
+void br_circle_est_mslip(br_est_cfg_t *est)
 {
-    if (!on) return;
-    br_mslip_cfg_t *ms = &c->ukf.est.model.mslip;
-    const double Fs = (double)c->ukf.est.model.lugre.Fs_N;
+    br_mslip_cfg_t *ms = &est->model.mslip;
+    const double Fs = (double)est->model.lugre.Fs_N;
     ms->n = BR_CIRCLE_HW_N;
     for (int i = 0; i < BR_CIRCLE_HW_N; i++) {
         /* k_i = share_i Fs / d_i (docs/modules/mslip.md) */
@@ -108,7 +107,17 @@ void br_circle_use_ukf_mslip(br_circle_cfg_t *c, int on)
         ms->share[i] = (float)k_hw_share[i];
     }
     ms->sigma2_Nspm = 0.0f; /* the viscous friction stays the model's sigma2 (eq. 6) */
-    c->ukf.est.comp_ahead_periods = 0.0f;
+    est->comp_ahead_periods = 0.0f;
+}
+
+void br_circle_use_ukf_mslip(br_circle_cfg_t *c, int on)
+{
+    if (on) br_circle_est_mslip(&c->ukf.est);
+}
+
+void br_circle_use_pf_mslip(br_circle_cfg_t *c, int on)
+{
+    if (on) br_circle_est_mslip(&c->pf.est);
 }
 
 br_circle_cfg_t br_circle_cfg_hardware_like(br_circle_ctrl_t controller)

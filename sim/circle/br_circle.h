@@ -108,6 +108,12 @@ br_circle_cfg_t br_circle_cfg_hardware_like(br_circle_ctrl_t controller);
  * Fs) in the clamp form (docs/modules/ukf.md, "Maxwell-slip elements"), its
  * look-ahead off; on = 0 leaves the machine's model. */
 void br_circle_use_ukf_mslip(br_circle_cfg_t *c, int on);
+/* The same for the PF (--pf-mslip; docs/modules/pf.md, "Maxwell-slip
+ * elements"): its particles carry the element set. */
+void br_circle_use_pf_mslip(br_circle_cfg_t *c, int on);
+/* The hardware-like plant's element set written into an estimator's model
+ * (k_i = share_i Fs / d_i at the model's Fs), its look-ahead off. */
+void br_circle_est_mslip(br_est_cfg_t *est);
 
 /* The estimators' and the feedforward's model from an identified one (a
  * diagnosis's model.json loaded as a plant configuration): its mass, LuGre

@@ -70,6 +70,11 @@ void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WOR
     w[i++] = f2w(c->pf.est.delay_id.memory_s);
     w[i++] = f2w(c->pf.est.delay_id.warmup_s);
     w[i++] = f2w(c->pf.est.delay_id.switch_ratio);
+    /* the Maxwell-slip elements (zeros in a stream without them: the thesis's LuGre) */
+    w[i++] = (uint32_t)m->mslip.n;
+    for (uint32_t j = 0u; j < BR_MSLIP_MAX; ++j) w[i++] = f2w(m->mslip.k_Npm[j]);
+    for (uint32_t j = 0u; j < BR_MSLIP_MAX; ++j) w[i++] = f2w(m->mslip.share[j]);
+    w[i++] = f2w(m->mslip.sigma2_Nspm);
     while (i < BR_REPLAY_HDR_WORDS) w[i++] = 0u;
 }
 
@@ -121,6 +126,12 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
     c->pf.est.delay_id.memory_s = w2f(w[i++]);
     c->pf.est.delay_id.warmup_s = w2f(w[i++]);
     c->pf.est.delay_id.switch_ratio = w2f(w[i++]);
+    /* n beyond BR_MSLIP_MAX is refused by br_pf_init (br_mslip_cfg_check) */
+    const uint32_t n_el = w[i++];
+    m->mslip.n = (n_el <= (uint32_t)BR_MSLIP_MAX) ? (int)n_el : BR_MSLIP_MAX + 1;
+    for (uint32_t j = 0u; j < BR_MSLIP_MAX; ++j) m->mslip.k_Npm[j] = w2f(w[i++]);
+    for (uint32_t j = 0u; j < BR_MSLIP_MAX; ++j) m->mslip.share[j] = w2f(w[i++]);
+    m->mslip.sigma2_Nspm = w2f(w[i++]);
     if (c->pf.noise_len != BR_NOISE_LEN) return BR_E_PARAM;
     c->pf.noise = br_noise_table;
     return BR_OK;

@@ -27,6 +27,9 @@ CHECKS = [
      rf"FREE_LOAD_FROM = {NUM}"),
     ("test_golden_ukf.c", "ukf_ms free-run factor", rf"#define C_FREE_RUN_MS \({NUM} \* C_FREE_RUN\)", "### ukf",
      rf"C_FREE_RUN_MS = {NUM} × C_FREE_RUN"),
+    # pf_ms
+    ("test_golden_pf_ms.c", "one particle-step factor C_MS", rf"#define C_MS {NUM}", "### pf_ms",
+     rf"C_MS = {NUM} u"),
     # model
     ("test_golden_model.c", "theta_1", rf"#define C_THETA {NUM}", "### model (", rf"\| θ₁ \| {NUM}u·S_θ"),
     ("test_golden_model.c", "omega_1", rf"#define C_OMEGA {NUM}", "### model (", rf"\| ω₁ \| {NUM}u·S_ω"),

@@ -111,3 +111,21 @@ double dfnl_bound(const pf_consts_t *c, const float *x, const double *d)
     return (c->s0 + c->s1 * a) * d[2] + c->s1 * c->L * (1.0 + c->s0 * z / gp) * d[1] + c->s1 * a * z / gp * d[3] +
            C_FNL * U32 * S_f;
 }
+
+void pf_golden_report(br_errstat_t *const *all, int n, br_trace_t *t, br_trace_t *x, const char *trace,
+                      long bad_exact, const char *what)
+{
+    long fails = 0;
+    for (int i = 0; i < n; i++) {
+        br_errstat_print(all[i], t, trace);
+        fails += all[i]->n_fail;
+    }
+    br_trace_free(t);
+    br_trace_free(x);
+    if (bad_exact != 0) {
+        fail_msg("%s: %ld steps with a wrong %s", trace, bad_exact, what);
+    }
+    if (fails != 0) {
+        fail_msg("%s: %ld comparisons outside tolerance (first lines printed above)", trace, fails);
+    }
+}

@@ -71,4 +71,11 @@ double dlog_bound(const pf_consts_t *c, double l, double dth);
  * evaluation (model test). */
 double dfnl_bound(const pf_consts_t *c, const float *x, const double *d);
 
+/* The one-step PF golden tests' end: prints every statistic of all[0..n-1],
+ * frees the two traces and fails the test when a step's exact values were
+ * wrong (bad_exact, what: their names) or a comparison was outside its
+ * tolerance. */
+void pf_golden_report(br_errstat_t *const *all, int n, br_trace_t *t, br_trace_t *x, const char *trace,
+                      long bad_exact, const char *what);
+
 #endif

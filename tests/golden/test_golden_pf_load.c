@@ -299,20 +299,8 @@ static void test_pf_load_one_step(void **state)
                   n_steps, n_acq, n_outlier, m, n_own_equal);
     br_errstat_t *all[] = {&e_Fd, &e_P[0], &e_P[1], &e_P[2], &e_P[3], &e_P[4], &e_P[5], &e_lmax,
                            &e_mean[0], &e_mean[1], &e_mean[2], &e_mean[3], &e_F};
-    long fails = 0;
-    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) {
-        br_errstat_print(all[i], &G.t, "pf_load");
-        fails += all[i]->n_fail;
-    }
-    br_trace_free(&G.t);
-    br_trace_free(&G.x);
-    if (bad_exact != 0) {
-        fail_msg("pf_load: %ld steps with a wrong status / origin / noise position / outlier run / re-acquisition",
-                 bad_exact);
-    }
-    if (fails != 0) {
-        fail_msg("pf_load: %ld comparisons outside tolerance (first lines printed above)", fails);
-    }
+    pf_golden_report(all, (int)(sizeof all / sizeof all[0]), &G.t, &G.x, "pf_load", bad_exact,
+                     "status / origin / noise position / outlier run / re-acquisition");
     /* the trace must exercise what it is for */
     assert_true(n_acq >= 2);
     assert_true(n_own_equal * 2 > n_steps);

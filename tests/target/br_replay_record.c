@@ -7,7 +7,9 @@
  * which the host replay must reproduce.
  *
  *   br_replay_record --out stream.bin [--expect expect.bin] [--duration 1.0] [--axes 1|2] [--ahead L]
- *                    [--delay-id 0|1]
+ *                    [--delay-id 0|1] [--mslip]
+ * --mslip: the PF's particles carry the hardware-like plant's Maxwell-slip elements
+ * (docs/modules/pf.md), in the circle and the stream (on the thesis plant).
  * --ahead: the PF's est.comp_ahead_periods (docs/modules/est.md), in the circle and the stream.
  * --delay-id 0: the PF without the machine's delay identification (est.delay_id,
  * docs/modules/dlyid.md), in the circle and the stream; 1 (default): the machine's. A stream
@@ -74,6 +76,7 @@ int main(int argc, char **argv)
     uint32_t n_axes = 1u;
     double ahead = 0.0;
     int delay_id = 1;
+    int mslip = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
         else if (!strcmp(argv[i], "--expect") && i + 1 < argc) expect = argv[++i];
@@ -81,9 +84,10 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--axes") && i + 1 < argc) n_axes = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--ahead") && i + 1 < argc) ahead = atof(argv[++i]);
         else if (!strcmp(argv[i], "--delay-id") && i + 1 < argc) delay_id = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--mslip")) mslip = 1;
         else {
             fprintf(stderr, "usage: br_replay_record --out FILE [--expect FILE] [--duration S] [--axes 1|2] "
-                            "[--ahead L] [--delay-id 0|1]\n");
+                            "[--ahead L] [--delay-id 0|1] [--mslip]\n");
             return 2;
         }
     }
@@ -96,6 +100,7 @@ int main(int argc, char **argv)
     c.duration_s = duration;
     br_circle_use_ahead(&c, ahead);
     br_circle_use_delay_id(&c, delay_id);
+    br_circle_use_pf_mslip(&c, mslip);
     rec_t r = {&c, tmpfile(), NULL, 0u, n_axes};
     if (r.steps == NULL) return 1;
     if (expect && (r.expect = fopen(expect, "wb")) == NULL) {

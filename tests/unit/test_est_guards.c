@@ -68,9 +68,8 @@ static void test_pf_needs_gp_noise(void **st)
     free(pf);
 }
 
-/* an element set in the model is refused by the PF (its particles carry no
- * elements yet); the UKF takes it, but not with a look-ahead of the
- * compensation (comp_ahead_periods steps the LuGre state) */
+/* an element set in the model: the PF and the UKF take it, but not with a
+ * look-ahead of the compensation (comp_ahead_periods steps the LuGre state) */
 static void test_mslip_refused(void **st)
 {
     (void)st;
@@ -83,6 +82,9 @@ static void test_mslip_refused(void **st)
     const br_mslip_cfg_t ms = {.n = 1, .k_Npm = {1.0e6f}, .share = {1.0f}};
     c.est.model.mslip = ms;
     u.est.model.mslip = ms;
+    c.est.comp_ahead_periods = 0.0f;
+    assert_int_equal(br_pf_init(pf, &c), BR_OK);
+    c.est.comp_ahead_periods = 1.0f;
     assert_int_equal(br_pf_init(pf, &c), BR_E_PARAM);
     u.est.comp_ahead_periods = 0.0f;
     assert_int_equal(br_ukf_init(ukf, &u), BR_OK);

@@ -10,7 +10,11 @@
  * [gp_min, gp_max], a log-weight of -inf, outlier steps; runs of every
  * length from one particle up, at offsets. Then the resampling on the
  * predicted set, and on weights made for it (ties, one valid particle, the
- * largest m). Everything the kernels write is compared as bits. */
+ * largest m). Everything the kernels write is compared as bits. The same
+ * with Maxwell-slip elements (br_pf_kref_predict_ms against the kernel's
+ * element path; the elements' copy in place): NaN and infinite theta and
+ * omega, non-finite element deflections, g_p outside its range, l = -inf,
+ * outlier steps. */
 #include "br_test.h"
 
 #include <stdlib.h>
@@ -18,6 +22,7 @@
 
 #include "bristle/br_pf.h"
 #include "br_pf_kernel.h"
+#include "circle/br_circle.h"
 #include "circle/br_circle_est.h"
 
 #ifndef BR_TEST_KERNEL
@@ -60,6 +65,11 @@ static void assert_sets_equal(const br_pf_t *a, const br_pf_t *b, int k, const c
     assert_memory_equal(a->l, b->l, m * sizeof a->l[0]);
     assert_memory_equal(a->W, b->W, m * sizeof a->W[0]);
     assert_memory_equal(a->idx, b->idx, m * sizeof a->idx[0]);
+    /* the elements, when the particles carry them */
+    const size_t ne = (a->model.cfg.mslip.n > 0) ? (size_t)a->model.cfg.mslip.n : 0u;
+    if (memcmp(a->ms, b->ms, ne * m * sizeof a->ms[0]) != 0) {
+        fail_msg("%s, step %d: the elements differ from the reference (kernel %s)", what, k, BR_TEST_KERNEL);
+    }
 }
 
 /* the constants of a prediction pass, as br_pf.c makes them (any finite
@@ -78,6 +88,8 @@ static br_pf_kc_t consts(br_pf_t *pf, float u, float shift, float y_rel)
     c.inv_2r = pf->inv_2r;
     c.shift = shift;
     c.y_rel = y_rel;
+    c.km = br_model_km(&pf->model);
+    c.uh = u * c.km.h;
     return c;
 }
 
@@ -125,7 +137,7 @@ static void put_edges(br_pf_t *a, br_pf_t *b, int k, edges_t *n)
 /* the prediction of both copies over runs of particles in one block of the
  * noise table, of lengths 1, 2, 3, ... (then the rest of the block);
  * returns the number of particles the kernel left */
-static uint32_t predict_both(br_pf_t *a, br_pf_t *b, const br_pf_kc_t *c, int k)
+static uint32_t predict_both(br_pf_t *a, br_pf_t *b, const br_pf_kc_t *c, int k, int ms)
 {
     const uint32_t m = a->cfg.n_particles, mask = a->cfg.noise_len - 1u;
     br_pf_lsum_t la = {-INFINITY, 0u, 0.0f, 0.0f}, lb = la;
@@ -144,8 +156,8 @@ static uint32_t predict_both(br_pf_t *a, br_pf_t *b, const br_pf_kc_t *c, int k)
         len++;
         const float *nz = a->cfg.noise + p;
         const float s1a = la.s1, s2a = la.s2, s1b = lb.s1, s2b = lb.s2;
-        const uint32_t left_a = br_pf_kref_predict(a, c, j, j1, nz, &la);
-        const uint32_t lk = br_pf_kernel_predict(b, c, j, j1, nz, &lb);
+        const uint32_t left_a = ms ? br_pf_kref_predict_ms(a, c, j, j1, nz, &la) : br_pf_kref_predict(a, c, j, j1, nz, &la);
+        const uint32_t lk = ms ? br_pf_kernel_predict_ms(b, c, j, j1, nz, &lb) : br_pf_kernel_predict(b, c, j, j1, nz, &lb);
         assert_int_equal(lk, left_a);
         assert_true(same_f(la.lmax, lb.lmax));
         assert_int_equal(la.n_valid, lb.n_valid);
@@ -174,6 +186,24 @@ static void resample_both(br_pf_t *a, br_pf_t *b, float lmax, int outlier, int k
     assert_sets_equal(a, b, k, "resampling");
 }
 
+/* the step's largest valid log-weight, by hand, and its outlier verdict (also
+ * every fifth step); both copies resampled. Returns 1 on an outlier step. */
+static int resample_step(br_pf_t *a, br_pf_t *b, int k)
+{
+    float lmax = -INFINITY;
+    uint32_t n_valid = 0u;
+    for (uint32_t j = 0; j < a->cfg.n_particles; j++) {
+        if (a->l[j] == a->l[j]) {
+            lmax = (a->l[j] > lmax) ? a->l[j] : lmax;
+            n_valid++;
+        }
+    }
+    assert_true(n_valid > 0u);
+    const int outlier = lmax < a->outlier_l || lmax == -INFINITY || k % 5 == 0;
+    resample_both(a, b, lmax, outlier, k);
+    return outlier;
+}
+
 static void test_stream(void **st)
 {
     (void)st;
@@ -192,23 +222,12 @@ static void test_stream(void **st)
             put_edges(a, b, k, &n);
             const float shift = (float)(counts - prev) * rpc, y_rel = y.frac * rpc;
             const br_pf_kc_t c = consts(a, u, shift, y_rel);
-            n_left += (int)predict_both(a, b, &c, k);
+            n_left += (int)predict_both(a, b, &c, k, 0);
             for (uint32_t j = 0; j < M; j++) {
                 n_clamped += b->x[BR_X_GP][j] == c.gp_max || b->x[BR_X_GP][j] == c.gp_min;
             }
             /* the step's largest valid log-weight, by hand */
-            float lmax = -INFINITY;
-            uint32_t n_valid = 0u;
-            for (uint32_t j = 0; j < M; j++) {
-                if (a->l[j] == a->l[j]) {
-                    lmax = (a->l[j] > lmax) ? a->l[j] : lmax;
-                    n_valid++;
-                }
-            }
-            assert_true(n_valid > 0u);
-            const int outlier = lmax < a->outlier_l || lmax == -INFINITY || k % 5 == 0;
-            n_outlier += outlier;
-            resample_both(a, b, lmax, outlier, k);
+            n_outlier += resample_step(a, b, k);
             n_steps++;
             free(a);
             free(b);
@@ -222,6 +241,99 @@ static void test_stream(void **st)
     assert_true(n_left >= n.nan + n.bounded);
     assert_true(n_outlier > 0 && n_clamped > 0 && n_steps == 47);
     free(src);
+}
+
+/* the element path's edge cases of step k, in both copies the same way */
+static void put_edges_ms(br_pf_t *a, br_pf_t *b, int k, edges_t *n)
+{
+    const uint32_t m = a->cfg.n_particles;
+    if (k % 3 == 1) {
+        const uint32_t j = (uint32_t)(7 * k) % m;
+        a->x[BR_X_THETA][j] = b->x[BR_X_THETA][j] = NAN;
+        a->x[BR_X_OMEGA][(j + 1u) % m] = b->x[BR_X_OMEGA][(j + 1u) % m] = NAN; /* f_nl stays finite */
+        a->x[BR_X_OMEGA][(j + 2u) % m] = b->x[BR_X_OMEGA][(j + 2u) % m] = INFINITY;
+        n->nan += 3;
+    }
+    if (k % 4 == 2) {
+        /* element deflections not finite: the clamps take them to a bound */
+        for (uint32_t j = (uint32_t)k % 37u; j < m; j += 37u) {
+            const uint32_t i = j % (uint32_t)a->model.cfg.mslip.n;
+            const float v = (j % 3u == 0u) ? NAN : (j % 3u == 1u) ? INFINITY : -INFINITY;
+            a->ms[i * m + j] = b->ms[i * m + j] = v;
+            n->overflow++;
+        }
+    }
+    if (k % 5 == 3) {
+        /* the force f0 overflowing: omega infinite, the particle left */
+        for (uint32_t j = 5u; j < m; j += 211u) {
+            a->kgp[j] = b->kgp[j] = 3.0e38f;
+            n->bounded++;
+        }
+    }
+    for (uint32_t j = (uint32_t)k % 53u; j < m; j += 53u) {
+        const float g = (j % 2u) ? 4.0f * a->cfg.est.gp_max_N : 0.25f * a->cfg.est.gp_min_N;
+        a->x[BR_X_GP][j] = b->x[BR_X_GP][j] = g;
+        n->gp_out++;
+    }
+    if (k % 6 == 0) {
+        const uint32_t j = (uint32_t)(11 * k + 3) % m;
+        a->x[BR_X_THETA][j] = b->x[BR_X_THETA][j] = 1.0e30f;
+        n->l_inf++;
+    }
+}
+
+/* the element stream with the hardware-like set (ne = 4, the M7's written-out
+ * path) or its first three elements with equal shares (the loops' path) */
+static void stream_ms(int ne)
+{
+    br_pf_t *src = calloc(1, sizeof *src);
+    assert_non_null(src);
+    br_pf_cfg_t cfg = br_circle_pf_cfg_default(1.5e-3f);
+    cfg.n_particles = M;
+    br_circle_est_mslip(&cfg.est);
+    if (ne != cfg.est.model.mslip.n) {
+        cfg.est.model.mslip.n = ne;
+        for (int i = 0; i < ne; i++) {
+            cfg.est.model.mslip.share[i] = 1.0f / (float)ne;
+        }
+    }
+    assert_int_equal(br_pf_init(src, &cfg), BR_OK);
+    const float rpc = src->cfg.est.rad_per_count;
+    edges_t n = {0, 0, 0, 0, 0};
+    int n_left = 0, n_outlier = 0, n_steps = 0, n_bound = 0;
+    int32_t prev = 0;
+    for (int k = 0; k < 48; k++) {
+        /* a back-and-forth of 60 counts (elements at their bounds and between), a jump at 30 .. 33 */
+        const int32_t counts = (int32_t)(60.0f * sinf(0.25f * (float)k)) + (k >= 30 && k < 34 ? 5000 : 0);
+        const br_meas_t y = {counts, 0.25f + 0.01f * (float)(k % 7)};
+        const float u = 0.3f * cosf(0.25f * (float)k);
+        if (k > 0) {
+            br_pf_t *a = clone(src), *b = clone(src);
+            put_edges_ms(a, b, k, &n);
+            const float shift = (float)(counts - prev) * rpc, y_rel = y.frac * rpc;
+            const br_pf_kc_t c = consts(a, u, shift, y_rel);
+            n_left += (int)predict_both(a, b, &c, k, 1);
+            for (uint32_t j = 0; j < M; j++) {
+                n_bound += b->ms[j] == b->model.ms_c_mpN[0] * b->x[BR_X_GP][j];
+            }
+            n_outlier += resample_step(a, b, k);
+            n_steps++;
+            free(a);
+            free(b);
+        }
+        assert_false(BR_FAILED(br_pf_step(src, &y, u)));
+        prev = counts;
+    }
+    assert_true(n.nan > 0 && n.bounded > 0 && n.overflow > 0 && n.gp_out > 0 && n.l_inf > 0);
+    assert_true(n_left >= n.nan && n_outlier > 0 && n_bound > 0 && n_steps == 47);
+    free(src);
+}
+
+static void test_stream_ms(void **st)
+{
+    (void)st;
+    stream_ms(4);
+    stream_ms(3);
 }
 
 /* resampling on weights made for it: log-weights with ties of the
@@ -279,6 +391,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_stream),
+        cmocka_unit_test(test_stream_ms),
         cmocka_unit_test(test_made_weights),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -10,6 +10,10 @@
  *                 C_{j-1} <= xi_i C_m < C_j, C_j = W_0 + ... + W_j, in integers
  *   5. estimate   F_hat = mean of f_nl(x_j) (eq. 6); the particle mean and the
  *                 ESS on request (br_pf_stats), not in the step
+ * With a Maxwell-slip element set in the model (est.model.mslip.n = N >= 1)
+ * each particle carries its own N element deflections e_j, stepped by the
+ * clamp model (br_model_ms_step's trapezoidal step), z's noise their common
+ * perturbation, f_nl = sum_i k_i e_ji (docs/modules/pf.md).
  * theta is stored relative to the latest measured count (an integer origin),
  * so float32 keeps sub-nanometre resolution at any travel.
  * See docs/modules/pf.md. */
@@ -30,6 +34,15 @@
 #define BR_PF_W_BITS 16u
 #if BR_PF_MAX_PARTICLES > 32767u
 #error "BR_PF_MAX_PARTICLES must keep 2^17 m inside uint32 (m < 2^15)"
+#endif
+/* Maxwell-slip element deflections the particles carry (est.model.mslip.n
+ * >= 1; docs/modules/pf.md, "Maxwell-slip elements"): n m <= BR_PF_MS_SLOTS,
+ * by default four elements at the largest m (32 KiB; eight at m <= 1024) */
+#ifndef BR_PF_MS_SLOTS
+#define BR_PF_MS_SLOTS (4u * BR_PF_MAX_PARTICLES)
+#endif
+#if BR_PF_MS_SLOTS < 1u
+#error "BR_PF_MS_SLOTS must be at least 1"
 #endif
 
 /* cfg.adapt: nis_ref below this is refused (E / nis_ref stays finite:
@@ -172,7 +185,10 @@ typedef struct {
      * One set, predicted and resampled in place (docs/modules/pf.md). */
     float x[BR_NX][BR_PF_MAX_PARTICLES];
     float kgp[BR_PF_MAX_PARTICLES];   /* k_p = sigma0 L / g_p of each particle, 1/rad: the
-                                          particle-step's one division (docs/modules/pf.md) */
+                                          particle-step's one division (docs/modules/pf.md); with
+                                          elements, the particle's element force sum_i k_i e_ji, N
+                                          (the next trapezoidal step's f0) */
+    float ms[BR_PF_MS_SLOTS];         /* with elements: deflection i of particle j at ms[i m + j], m */
     float fnl[BR_PF_MAX_PARTICLES];   /* f_nl of the predicted particles (by predicted index) */
     float l[BR_PF_MAX_PARTICLES];     /* log-weights; NaN marks an invalid particle */
     uint32_t W[BR_PF_MAX_PARTICLES];  /* quantised weights */
