@@ -92,9 +92,10 @@ typedef struct {
 #define BR_TUNE_R_FLOOR_MARGIN (1.0 + 1.0e-6)
 /* The delayed guard plants and R's floor for the PF: 0 for now. Its committed
  * variances pass both (test_tune_delay; R 0.72 count^2), but both move its
- * search's path, and its retune with them was not run to the end
- * (docs/tuning.md): with 0 `make tune` still gives the committed PF header.
- * The UKF's tuning always has them. */
+ * search's path, and its one retune with them (and --mslip-target 0.068)
+ * was worse than the committed PF on every demo plant (docs/tuning.md, "A
+ * plant with an actuator delay, and R's floor"): with 0 `make tune` still
+ * gives the committed PF header. The UKF's tuning always has them. */
 #define BR_TUNE_DELAY_GUARD_PF 0
 
 /* The PF's further start (its variances: q_omega (rad/s)^2, q_z m^2, q_gp N^2,
@@ -171,7 +172,7 @@ static int cmp_double(const void *a, const void *b)
  * The UKF's is the default since the delayed guard plants and R's floor keep
  * its tuning from the setting that lost lock on test_circle's 2 ms delay
  * plant (docs/tuning.md, "A plant with an actuator delay, and R's floor");
- * the PF's search with the guards was not run to the end */
+ * the PF's search with the guards missed its goal (4.17e-7 m; same section) */
 #define BR_TUNE_MSLIP_TARGET_UKF 0.136
 #define BR_TUNE_MSLIP_TARGET_PF 0.0
 
