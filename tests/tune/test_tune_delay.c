@@ -7,7 +7,9 @@
 
 static br_tune_delay_t g; /* large: static */
 
-/* the committed tunings run every delayed plant to the end */
+/* the committed tunings run every delayed plant to the end, given as the
+ * tuner gives them (the identification off): the guard turns the machine's
+ * identification on, without which the same settings stop */
 static void test_committed_runs(void **st)
 {
     (void)st;
@@ -15,8 +17,16 @@ static void test_committed_runs(void **st)
     for (int e = 0; e < 2; e++) {
         br_tune_delay_init(&g, ests[e]);
         for (int k = 0; k < BR_TUNE_DELAY_N; k++) assert_true(g.plant[k].plant.delay_s > 0.0);
-        const br_circle_cfg_t c = br_circle_cfg_thesis(ests[e]);
+        br_circle_cfg_t c = br_circle_cfg_thesis(ests[e]);
+        br_circle_use_delay_id(&c, 0);
         assert_true(br_tune_delay_failed(&g, &c) == 0.0);
+        /* the same settings without the identification on the first delayed plant */
+        br_circle_cfg_t p = g.plant[0];
+        p.pf = c.pf;
+        p.ukf = c.ukf;
+        br_circle_result_t r;
+        assert_int_equal(br_circle_run(&p, NULL, NULL, &r), 1);
+        assert_true(r.fault_status != 0);
     }
 }
 
