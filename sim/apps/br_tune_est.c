@@ -569,9 +569,10 @@ int main(int argc, char **argv)
                 res_nominal_m, res_worst);
     }
     if (t.n_plants == 0 && t.delay_guard) {
-        fprintf(h, "/* guards: the thesis circle with a %g ms plant delay and the delay identification", t.delay.plant[0].plant.delay_s * 1e3);
-        for (int k = 1; k < BR_TUNE_DELAY_N; k++) fprintf(h, ", %g ms", t.delay.plant[k].plant.delay_s * 1e3);
-        fprintf(h, " (no stop); R >= 1/12 count^2 */\n");
+        /* the delayed guard plants and R's floor */
+        fprintf(h, "/* no stop on the thesis circle with the delay identification and a plant delay of");
+        for (int k = 0; k < BR_TUNE_DELAY_N; k++) fprintf(h, "%s %g ms", k ? "," : "", t.delay.plant[k].plant.delay_s * 1e3);
+        fprintf(h, "; R >= 1/12 count^2 */\n");
     }
     write_checkpoint(h, &t);
     fprintf(h, "#ifndef BR_%s_TUNED_H\n#define BR_%s_TUNED_H\n\n", E, E);

@@ -4,7 +4,7 @@
 /* Nelder-Mead on the H-inf + UKF circle: contour RMS 2.2201e-08 m (start 3.3018e-08 m), 278 evaluations */
 /* objective x (1 + the Maxwell-slip guard plants' worst RMS / H-inf only's / 0.136) (--mslip-target): */
 /* the result's nominal contour RMS 1.3951e-08 m, worst Maxwell-slip guard 0.0804 of H-inf only */
-/* guards: the thesis circle with a 2 ms plant delay and the delay identification, 3 ms (no stop); R >= 1/12 count^2 */
+/* no stop on the thesis circle with the delay identification and a plant delay of 2 ms, 3 ms; R >= 1/12 count^2 */
 /* checkpoint (--checkpoint): first search, iteration 17, 30 evaluations: 2.321218e-08 m at q_theta=1.791483e-13 q_omega=1.531482e-06 q_z=2.330256e-15 q_gp=3.931611e-01 r=3.051618e-12 */
 #ifndef BR_UKF_TUNED_H
 #define BR_UKF_TUNED_H
