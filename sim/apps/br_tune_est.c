@@ -446,8 +446,8 @@ int main(int argc, char **argv)
         lo[i] = x0[i] - 3.0 * log(10.0);
         hi[i] = x0[i] + 3.0 * log(10.0);
     }
-    /* R (the last parameter) not below the quantisation, nor above the start (a
-     * machine file's R at the quantisation itself, position_noise_m2 0, is its start) */
+    /* R (the last parameter) not below the quantisation; the bound never above the start
+     * (a machine file's R at the quantisation itself, position_noise_m2 0, is its start) */
     const double rpc = (double)(t.pf ? t.base.pf.est.rad_per_count : t.base.ukf.est.rad_per_count);
     const double r_floor = log(BR_TUNE_QUANT_COUNTS2 * BR_TUNE_R_FLOOR_MARGIN * rpc * rpc);
     if (t.delay_guard) lo[n - 1] = fmax(lo[n - 1], fmin(r_floor, x0[n - 1]));
@@ -568,11 +568,15 @@ int main(int argc, char **argv)
         fprintf(h, "/* the result's nominal contour RMS %.4e m, worst Maxwell-slip guard %.4f of H-inf only */\n",
                 res_nominal_m, res_worst);
     }
-    if (t.n_plants == 0 && t.delay_guard) {
-        /* the delayed guard plants and R's floor */
-        fprintf(h, "/* no stop on the thesis circle with the delay identification and a plant delay of");
-        for (int k = 0; k < BR_TUNE_DELAY_N; k++) fprintf(h, "%s %g ms", k ? "," : "", t.delay.plant[k].plant.delay_s * 1e3);
-        fprintf(h, "; R >= 1/12 count^2 */\n");
+    if (t.delay_guard) {
+        /* the delayed guard plants (the nominal objective's) and R's floor */
+        fprintf(h, "/* ");
+        if (t.n_plants == 0) {
+            fprintf(h, "no stop on the thesis circle with the delay identification and a plant delay of");
+            for (int k = 0; k < BR_TUNE_DELAY_N; k++) fprintf(h, "%s %g ms", k ? "," : "", t.delay.plant[k].plant.delay_s * 1e3);
+            fprintf(h, "; ");
+        }
+        fprintf(h, "R >= 1/12 count^2 */\n");
     }
     write_checkpoint(h, &t);
     fprintf(h, "#ifndef BR_%s_TUNED_H\n#define BR_%s_TUNED_H\n\n", E, E);
