@@ -119,7 +119,7 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
         switch (c) {
         case 'e':
             o->est = v;
-            if (strcmp(v, "none") != 0 && strcmp(v, "ukf") != 0 && strcmp(v, "pf") != 0) {
+            if (br_circle_ctrl_of_est(v, &(br_circle_ctrl_t){BR_CTRL_HINF_ONLY}) != 0) {
                 fprintf(stderr, "%s: --est %s: must be none, ukf or pf\n", TOOL, v);
                 bad = 1;
             }
@@ -248,9 +248,8 @@ typedef struct {
 /* the axis: plant, HAL, application (disarmed), service, telemetry, recorder */
 static int axis_init(axis_t *a, const opts_t *o, const br_byte_chan_t *chan)
 {
-    const br_circle_ctrl_t ctrl = strcmp(o->est, "pf") == 0    ? BR_CTRL_HINF_PF
-                                  : strcmp(o->est, "ukf") == 0 ? BR_CTRL_HINF_UKF
-                                                               : BR_CTRL_HINF_ONLY;
+    br_circle_ctrl_t ctrl = BR_CTRL_HINF_ONLY;
+    (void)br_circle_ctrl_of_est(o->est, &ctrl); /* checked by parse */
     a->c = strcmp(o->plant, "thesis") == 0 ? br_circle_cfg_thesis(ctrl) : br_circle_cfg_hardware_like(ctrl);
     const br_app_machine_t mm = BR_MACHINE_APP_MACHINE;
     const br_app_motion_cfg_t mc = br_app_motion_cfg(&mm);

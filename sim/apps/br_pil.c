@@ -89,7 +89,7 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
         case 'i': o->image = v; break;
         case 'e':
             o->est = v;
-            if (strcmp(v, "none") != 0 && strcmp(v, "ukf") != 0 && strcmp(v, "pf") != 0 && strcmp(v, "all") != 0) {
+            if (strcmp(v, "all") != 0 && br_circle_ctrl_of_est(v, &(br_circle_ctrl_t){BR_CTRL_HINF_ONLY}) != 0) {
                 fprintf(stderr, "%s: --est %s: must be none, ukf, pf or all\n", TOOL, v);
                 bad = 1;
             }

@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "br_circle_est.h"
 #include "hal/br_hal_sim.h"
@@ -29,6 +30,21 @@ const char *br_circle_ctrl_name(br_circle_ctrl_t c)
     case BR_CTRL_HINF_QEC: return "hinf_qec";
     }
     return "unknown";
+}
+
+int br_circle_ctrl_of_est(const char *est, br_circle_ctrl_t *c)
+{
+    static const struct {
+        const char *est;
+        br_circle_ctrl_t ctrl;
+    } k[] = {{"none", BR_CTRL_HINF_ONLY}, {"ukf", BR_CTRL_HINF_UKF}, {"pf", BR_CTRL_HINF_PF}};
+    for (unsigned i = 0; i < sizeof k / sizeof k[0]; i++) {
+        if (strcmp(est, k[i].est) == 0) {
+            *c = k[i].ctrl;
+            return 0;
+        }
+    }
+    return -1;
 }
 
 br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)

@@ -40,6 +40,10 @@ typedef struct {
 /* Name used in summary.json and file names: "hinf_only", "hinf_pf", ... */
 const char *br_circle_ctrl_name(br_circle_ctrl_t c);
 
+/* The controller of the tools' --est (none, ukf, pf: H-inf alone or with
+ * that estimator) into *c; -1 for any other name (*c untouched). */
+int br_circle_ctrl_of_est(const char *est, br_circle_ctrl_t *c);
+
 typedef struct {
     double radius_m;     /* A */
     double period_s;     /* T */
