@@ -13,16 +13,22 @@ void br_tune_delay_init(br_tune_delay_t *g, br_circle_ctrl_t ctrl)
     }
 }
 
+br_circle_cfg_t br_tune_delay_run_cfg(const br_tune_delay_t *g, const br_circle_cfg_t *c, int k)
+{
+    br_circle_cfg_t p = g->plant[k];
+    p.pf = c->pf;
+    p.ukf = c->ukf;
+    /* the machine's delay identification, which the tuner's other runs leave off */
+    p.pf.est.delay_id = g->plant[k].pf.est.delay_id;
+    p.ukf.est.delay_id = g->plant[k].ukf.est.delay_id;
+    return p;
+}
+
 double br_tune_delay_failed(const br_tune_delay_t *g, const br_circle_cfg_t *c)
 {
     double failed = 0.0;
     for (int k = 0; k < BR_TUNE_DELAY_N; k++) {
-        br_circle_cfg_t p = g->plant[k];
-        p.pf = c->pf;
-        p.ukf = c->ukf;
-        /* the machine's delay identification, which the tuner's other runs leave off */
-        p.pf.est.delay_id = g->plant[k].pf.est.delay_id;
-        p.ukf.est.delay_id = g->plant[k].ukf.est.delay_id;
+        const br_circle_cfg_t p = br_tune_delay_run_cfg(g, c, k);
         br_circle_result_t r;
         /* 1: the firmware stopped the axis (a fault, its time in r.fault_t_s) */
         if (br_circle_run(&p, NULL, NULL, &r) < 0) return INFINITY;

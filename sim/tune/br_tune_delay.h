@@ -23,10 +23,14 @@ typedef struct {
 /* The guard plants for the controller ctrl (BR_CTRL_HINF_UKF or BR_CTRL_HINF_PF). */
 void br_tune_delay_init(br_tune_delay_t *g, br_circle_ctrl_t ctrl);
 
-/* The estimator settings of c (its pf and ukf, their delay identification
- * replaced by the machine's) on every guard plant: the sum over the plants
- * that stopped of 1 + the share of the run lost (0 when none stopped),
- * INFINITY on an invalid configuration. */
+/* The run on guard plant k (0 .. BR_TUNE_DELAY_N - 1): the estimator
+ * settings of c (its pf and ukf), their delay identification replaced by
+ * the machine's. */
+br_circle_cfg_t br_tune_delay_run_cfg(const br_tune_delay_t *g, const br_circle_cfg_t *c, int k);
+
+/* That run on every guard plant: the sum over the plants that stopped of
+ * 1 + the share of the run lost (0 when none stopped), INFINITY on an
+ * invalid configuration. */
 double br_tune_delay_failed(const br_tune_delay_t *g, const br_circle_cfg_t *c);
 
 #endif
