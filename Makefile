@@ -110,7 +110,7 @@ define print_size
 	done
 endef
 
-.PHONY: fuzz help deps build test demo bench target-bench pil diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet
+.PHONY: fuzz help deps build test demo bench target-bench pil diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet mslip-plants
 
 help:
 	@echo "bristle targets:"
@@ -128,6 +128,7 @@ help:
 	@echo "  make firmware [MACHINE=<json>] [BOARD=stm32g4]  cross build (cm7-release; BOARD=stm32g4: cm4-release; another machine: build/<preset>-<name>-<hash>), print the image's flash / RAM use (BOARD=$(BOARD))"
 	@echo "  make emps      the EMPS drive through the chain: its log -> diagnose -> machine.json -> image -> tracking in the simulator -> $(EMPS_OUT), docs/machines/emps.md"
 	@echo "  make robustness [N=200] [DIAGNOSE_FIRST=K]  Monte Carlo over N plants around the reference machine -> $(ROBUST_OUT), docs/robustness-results.md"
+	@echo "  make mslip-plants [N=200]  every controller on N drawn Maxwell-slip plants -> $(MSLIP_OUT), docs/presliding-plants.md"
 	@echo "  make fleet [N=200] [SEED=s]  N axes across the machine files a user may bring, each through the chain, every controller -> $(FLEET_OUT), docs/fleet.md"
 	@echo "  make faults                 the fault campaign on the simulator (production guards) -> docs/reliability-faults.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
@@ -398,6 +399,17 @@ faults: deps
 	$(call build,host-release)
 	$(Q)echo "== fault campaign -> docs/reliability-faults.md"
 	$(Q)bash sim/studies/faults.sh build/host-release/sim/br_faults docs/reliability-faults.md
+
+# The drawn Maxwell-slip plants (docs/presliding-plants.md, issue 30 item 5):
+# every controller as shipped on N plants whose presliding is drawn; a stop is
+# listed with its time and cause (the study's subject, hence --expect-faults).
+MSLIP_OUT := out/mslip-plants
+mslip-plants: deps
+	$(call configure,host-release)
+	$(call build,host-release)
+	$(Q)echo "== drawn Maxwell-slip plants, $(N) plants -> $(MSLIP_OUT), docs/presliding-plants.md"
+	$(Q)OPENBLAS_NUM_THREADS=1 $(PYTHON) sim/studies/mslip_plants.py --bin build/host-release/sim --out $(MSLIP_OUT) \
+	  --n $(N) --jobs 2 --md docs/presliding-plants.md --command "make mslip-plants N=$(N)" --expect-faults
 
 # The fleet study (docs/fleet.md): N axes drawn across the machine files a user
 # may bring, each through the user's chain, every controller on its trajectory

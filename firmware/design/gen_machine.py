@@ -52,7 +52,7 @@ def machine_fields(m, p):
         ("BR_MACHINE_CTRL_PERIOD_NS", int(round(ctl["period_s"] * 1e9)), "the same in whole nanoseconds (an MCU tick)"),
         ("BR_MACHINE_TORQUE_LIMIT_NM", ctl["torque_limit_Nm"], "controller torque saturation"),
         ("BR_MACHINE_EST_RANK_PF", est_rank(m, "pf"), "control.estimator: the image's order of preference,\n"
-         " * 1 first, 0 not listed; each board runs the first it can (hal/<board>/image/main.c): the PF"),
+         " * 1 first, 0 not listed; each board runs the first it can (hal/stm32/image/br_image_main.c): the PF"),
         ("BR_MACHINE_EST_RANK_UKF", est_rank(m, "ukf"), "the UKF"),
         ("BR_MACHINE_EST_RANK_NONE", est_rank(m, "none"), "none: H-infinity only"),
         ("BR_MACHINE_MAX_SPEED_MPS", lim["max_speed_mps"], "largest table speed the axis is used at"),

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """What a board's firmware image runs for a machine file (docs/configure.md,
 "The image's estimator"): the estimator (the first of control.estimator the
-board can run, the rule of hal/<board>/image/main.c), its loop period, and its
+board can run, the rule of hal/stm32/image/br_image_main.c), its loop period, and its
 share of the period from the costs make target-bench measured
 (target/mps2/measured_cost.json).
 
@@ -16,7 +16,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import machine  # noqa: E402
 
-# what each board's image can run (hal/<board>/image/main.c) and its core
+# what each board's image can run (hal/stm32/image/br_image_main.c) and its core
 BOARDS = {"stm32h7": (("pf", "ukf", "none"), "cortex_m7"), "stm32g4": (("ukf", "none"), "cortex_m4")}
 COST = os.path.join(HERE, "..", "..", "target", "mps2", "measured_cost.json")
 

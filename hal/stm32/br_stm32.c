@@ -27,14 +27,11 @@ BR_LAYOUT_CHECK(iwdg_winr, offsetof(br_stm32_iwdg_t, WINR) == 0x10u);
 /* Centre-aligned: one PWM period is 2 (PSC + 1) ARR timer-clock ticks. */
 static br_status_t br_stm32_pwm_timing(const br_stm32_cfg_t *cfg, uint32_t *psc, uint32_t *arr)
 {
-    uint32_t half_period_ticks;
-    uint32_t div;
-
     if (cfg->pwm_hz > cfg->tim_clock_hz) {
         return BR_E_PARAM;
     }
-    half_period_ticks = (cfg->tim_clock_hz / cfg->pwm_hz) / 2u;
-    div = half_period_ticks / (BR_STM32_PWM_ARR_MAX + 1u) + 1u; /* PSC + 1 */
+    const uint32_t half_period_ticks = (cfg->tim_clock_hz / cfg->pwm_hz) / 2u;
+    const uint32_t div = half_period_ticks / (BR_STM32_PWM_ARR_MAX + 1u) + 1u; /* PSC + 1 */
     *psc = div - 1u;
     *arr = half_period_ticks / div;
     if (*arr < BR_STM32_PWM_MIN_STEPS) {
@@ -46,8 +43,6 @@ static br_status_t br_stm32_pwm_timing(const br_stm32_cfg_t *cfg, uint32_t *psc,
 static br_status_t br_stm32_cfg_check(const br_stm32_cfg_t *cfg, uint32_t *psc, uint32_t *arr,
                                         uint32_t *reload)
 {
-    uint32_t cycles;
-
     if (cfg->pwm_tim == NULL || cfg->enc_tim == NULL || cfg->systick == NULL) {
         return BR_E_NULL;
     }
@@ -64,6 +59,7 @@ static br_status_t br_stm32_cfg_check(const br_stm32_cfg_t *cfg, uint32_t *psc, 
         return BR_E_PARAM;
     }
     /* exact tick, exactly one of control_hz and control_period_ns (bristle/br_port.h) */
+    uint32_t cycles;
     if (br_tick_cycles(cfg->cpu_clock_hz, cfg->control_hz, cfg->control_period_ns, BR_STM32_TICK_MIN_CYCLES,
                        BR_SYSTICK_LOAD_MAX + 1u, &cycles) != BR_OK) {
         return BR_E_PARAM;
@@ -110,14 +106,12 @@ br_status_t br_stm32_init(br_stm32_t *port, const br_stm32_cfg_t *cfg)
     uint32_t psc = 0u;
     uint32_t arr = 0u;
     uint32_t reload = 0u;
-    uint32_t enc_mask;
-    br_status_t st;
 
     if (port == NULL || cfg == NULL) {
         return BR_E_NULL;
     }
     port->ready = 0;
-    st = br_stm32_cfg_check(cfg, &psc, &arr, &reload);
+    br_status_t st = br_stm32_cfg_check(cfg, &psc, &arr, &reload);
     if (st != BR_OK) {
         return st;
     }
@@ -129,7 +123,7 @@ br_status_t br_stm32_init(br_stm32_t *port, const br_stm32_cfg_t *cfg)
     port->overruns = 0u;
     port->overruns_armed = 0u;
 
-    enc_mask = (cfg->enc_counter_bits == 32u) ? 0xFFFFFFFFu : 0xFFFFu;
+    const uint32_t enc_mask = (cfg->enc_counter_bits == 32u) ? 0xFFFFFFFFu : 0xFFFFu;
     br_stm32_enc_setup(cfg->enc_tim, cfg, enc_mask);
     st = br_count_ext_init(&port->enc, cfg->enc_counter_bits, cfg->enc_tim->CNT);
     if (st != BR_OK) {
@@ -171,18 +165,15 @@ br_status_t br_stm32_encoder_read(br_stm32_t *port, int32_t *counts)
 
 br_status_t br_stm32_pwm_write(br_stm32_t *port, float duty)
 {
-    br_stm32_tim_t *t;
-    uint32_t ccr_a;
-    uint32_t ccr_b;
-    br_status_t st;
-
     const br_status_t use = port_usable(port, 1);
     if (use != BR_OK) {
         return use;
     }
-    t = port->cfg.pwm_tim;
+    br_stm32_tim_t *const t = port->cfg.pwm_tim;
     /* the core's split: clamp, round, sign to leg A or B; both 0 on a NaN */
-    st = br_duty_split(duty, port->pwm_arr, &ccr_a, &ccr_b);
+    uint32_t ccr_a;
+    uint32_t ccr_b;
+    const br_status_t st = br_duty_split(duty, port->pwm_arr, &ccr_a, &ccr_b);
     /* Release the idle leg first, then drive the active one. */
     if (ccr_a == 0u) {
         BR_STM32_REG_WRITE(t->CCR1, 0u);
@@ -196,13 +187,11 @@ br_status_t br_stm32_pwm_write(br_stm32_t *port, float duty)
 
 br_status_t br_stm32_pwm_disable(br_stm32_t *port)
 {
-    br_stm32_tim_t *t;
-
     const br_status_t use = port_usable(port, 1);
     if (use != BR_OK) {
         return use;
     }
-    t = port->cfg.pwm_tim;
+    br_stm32_tim_t *const t = port->cfg.pwm_tim;
     t->CCR1 = 0u;
     t->CCR2 = 0u;
     t->BDTR &= ~BR_TIM_BDTR_MOE;
@@ -212,13 +201,11 @@ br_status_t br_stm32_pwm_disable(br_stm32_t *port)
 
 br_status_t br_stm32_pwm_enable(br_stm32_t *port)
 {
-    br_stm32_tim_t *t;
-
     const br_status_t use = port_usable(port, 1);
     if (use != BR_OK) {
         return use;
     }
-    t = port->cfg.pwm_tim;
+    br_stm32_tim_t *const t = port->cfg.pwm_tim;
     t->CCR1 = 0u;
     t->CCR2 = 0u;
     t->CCER = BR_TIM_CCER_CC1E | BR_TIM_CCER_CC1NE | BR_TIM_CCER_CC2E | BR_TIM_CCER_CC2NE;
@@ -242,22 +229,19 @@ br_status_t br_stm32_deadline_check(br_stm32_t *port, uint32_t max_missed)
 
 br_status_t br_stm32_tick_wait(br_stm32_t *port, uint32_t *tick)
 {
-    br_stm32_systick_t *st;
-    uint32_t polls;
-    int seen = 0;
-
     const br_status_t use = port_usable(port, tick != NULL);
     if (use != BR_OK) {
         return use;
     }
-    st = port->cfg.systick;
+    br_stm32_systick_t *const st = port->cfg.systick;
+    int seen = 0;
     if ((st->CTRL & BR_SYSTICK_CTRL_COUNTFLAG) != 0u) {
         port->overruns++; /* the tick came while the last period was still running */
         seen = 1;
     }
     /* Each poll takes more than one processor cycle, so LOAD + 1 polls span
      * more than one period: a missing tick means SysTick is not running. */
-    for (polls = 0u; !seen && polls <= port->tick_reload; ++polls) {
+    for (uint32_t polls = 0u; !seen && polls <= port->tick_reload; ++polls) {
         if ((st->CTRL & BR_SYSTICK_CTRL_COUNTFLAG) != 0u) {
             seen = 1;
         }
@@ -316,19 +300,15 @@ br_status_t br_stm32_hal(br_stm32_t *port, br_hal_t *hal)
 
 br_status_t br_stm32_gpio_af(br_stm32_gpio_t *gpio, uint32_t pin, uint32_t af)
 {
-    uint32_t sh2;
-    uint32_t sh4;
-    uint32_t idx;
-
     if (gpio == NULL) {
         return BR_E_NULL;
     }
     if (pin > 15u || af > 15u) {
         return BR_E_PARAM;
     }
-    sh2 = 2u * pin;
-    idx = pin / 8u;
-    sh4 = 4u * (pin % 8u);
+    const uint32_t sh2 = 2u * pin;
+    const uint32_t idx = pin / 8u;
+    const uint32_t sh4 = 4u * (pin % 8u);
     /* AF number first, then the mode, so the pin never outputs another AF. */
     gpio->AFR[idx] = (gpio->AFR[idx] & ~(0xFu << sh4)) | (af << sh4);
     gpio->OSPEEDR = (gpio->OSPEEDR & ~(3u << sh2)) | (BR_GPIO_SPEED_HI << sh2);
@@ -341,9 +321,7 @@ br_status_t br_stm32_gpio_af(br_stm32_gpio_t *gpio, uint32_t pin, uint32_t af)
 /* 1 when (*reg & mask) == want within BR_STM32_WAIT_POLLS reads. */
 int br_stm32_wait(const volatile uint32_t *reg, uint32_t mask, uint32_t want)
 {
-    uint32_t polls;
-
-    for (polls = 0u; polls < BR_STM32_WAIT_POLLS; ++polls) {
+    for (uint32_t polls = 0u; polls < BR_STM32_WAIT_POLLS; ++polls) {
         if ((*reg & mask) == want) {
             return 1;
         }

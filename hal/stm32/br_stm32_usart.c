@@ -29,20 +29,16 @@ static uint32_t bus_addr(const volatile void *p)
 /* BRR at oversampling 16: round(kernel / baud), within the tolerance. */
 static br_status_t usart_brr(uint32_t kernel_hz, uint32_t baud, uint32_t *brr)
 {
-    uint64_t b;
-    uint64_t err;
-    uint64_t want;
-
     if (kernel_hz == 0u || baud == 0u) {
         return BR_E_PARAM;
     }
-    b = ((uint64_t)kernel_hz + baud / 2u) / baud;
+    const uint64_t b = ((uint64_t)kernel_hz + baud / 2u) / baud;
     if (b < BR_USART_BRR_MIN || b > BR_USART_BRR_MAX) {
         return BR_E_PARAM;
     }
     /* |kernel / b - baud| <= tol % of baud, multiplied through by b */
-    want = b * baud;
-    err = (want > kernel_hz) ? want - kernel_hz : kernel_hz - want;
+    const uint64_t want = b * baud;
+    const uint64_t err = (want > kernel_hz) ? want - kernel_hz : kernel_hz - want;
     if (err * 100u > (uint64_t)BR_STM32_USART_BAUD_TOL_PCT * want) {
         return BR_E_PARAM;
     }
@@ -52,8 +48,6 @@ static br_status_t usart_brr(uint32_t kernel_hz, uint32_t baud, uint32_t *brr)
 
 static br_status_t usart_cfg_check(const br_stm32_usart_cfg_t *c, uint32_t *brr)
 {
-    uint64_t per_poll;
-
     if (c->usart == NULL || c->rx_dma == NULL || c->tx_dma == NULL || c->tx_dma_ifcr == NULL ||
         c->rx_buf == NULL || c->tx_buf == NULL) {
         return BR_E_NULL;
@@ -66,7 +60,7 @@ static br_status_t usart_cfg_check(const br_stm32_usart_cfg_t *c, uint32_t *brr)
         return BR_E_PARAM; /* the driver starts the streams itself */
     }
     /* 10 bits per byte (8N1); the bytes of one poll period, rounded up */
-    per_poll = ((uint64_t)c->baud * c->poll_period_ns + 9999999999u) / 10000000000u;
+    const uint64_t per_poll = ((uint64_t)c->baud * c->poll_period_ns + 9999999999u) / 10000000000u;
     if ((uint64_t)c->rx_len < 2u * per_poll) {
         return BR_E_PARAM;
     }
@@ -75,22 +69,19 @@ static br_status_t usart_cfg_check(const br_stm32_usart_cfg_t *c, uint32_t *brr)
 
 br_status_t br_stm32_usart_init(br_stm32_usart_chan_t *u, const br_stm32_usart_cfg_t *cfg)
 {
-    uint32_t brr = 0u;
-    br_status_t st;
-    br_stm32_usart_t *us;
-
     if (u == NULL || cfg == NULL) {
         return BR_E_NULL;
     }
     u->ready = 0;
-    st = usart_cfg_check(cfg, &brr);
+    uint32_t brr = 0u;
+    const br_status_t st = usart_cfg_check(cfg, &brr);
     if (st != BR_OK) {
         return st;
     }
     u->cfg = *cfg;
     u->rx_pos = 0u;
     memset(&u->cnt, 0, sizeof u->cnt);
-    us = cfg->usart;
+    br_stm32_usart_t *const us = cfg->usart;
 
     /* everything stopped before it is reprogrammed */
     us->CR1 = 0u;
@@ -125,7 +116,7 @@ br_status_t br_stm32_usart_init(br_stm32_usart_chan_t *u, const br_stm32_usart_c
 /* the line's error flags: counted, then cleared */
 static void usart_errors(br_stm32_usart_chan_t *u)
 {
-    br_stm32_usart_t *us = u->cfg.usart;
+    br_stm32_usart_t *const us = u->cfg.usart;
     const uint32_t isr = us->ISR;
 
     if ((isr & BR_USART_ISR_ORE) != 0u) {
@@ -140,27 +131,20 @@ static void usart_errors(br_stm32_usart_chan_t *u)
 
 size_t br_stm32_usart_read(br_stm32_usart_chan_t *u, uint8_t *buf, size_t n)
 {
-    uint32_t left;
-    uint32_t wr;
-    uint32_t avail;
-    uint32_t take;
-    uint32_t first;
-    uint32_t len;
-
     if (u == NULL || buf == NULL || !u->ready) {
         return 0u;
     }
     usart_errors(u);
-    len = u->cfg.rx_len;
-    left = u->cfg.rx_dma->NDTR;
+    const uint32_t len = u->cfg.rx_len;
+    const uint32_t left = u->cfg.rx_dma->NDTR;
     if (left == 0u || left > len) {
         return 0u; /* not a count a running circular stream shows */
     }
     /* the DMA's write position; the bytes from the read position up to it */
-    wr = len - left;
-    avail = (wr >= u->rx_pos) ? wr - u->rx_pos : len - u->rx_pos + wr;
-    take = (n < (size_t)avail) ? (uint32_t)n : avail;
-    first = len - u->rx_pos; /* up to the buffer's end, then from its start */
+    const uint32_t wr = len - left;
+    const uint32_t avail = (wr >= u->rx_pos) ? wr - u->rx_pos : len - u->rx_pos + wr;
+    const uint32_t take = (n < (size_t)avail) ? (uint32_t)n : avail;
+    uint32_t first = len - u->rx_pos; /* up to the buffer's end, then from its start */
     if (first > take) {
         first = take;
     }
@@ -173,20 +157,17 @@ size_t br_stm32_usart_read(br_stm32_usart_chan_t *u, uint8_t *buf, size_t n)
 
 size_t br_stm32_usart_write(br_stm32_usart_chan_t *u, const uint8_t *buf, size_t n)
 {
-    br_stm32_dma_ch_t *d;
-    uint32_t take;
-
     if (u == NULL || buf == NULL || !u->ready || n == 0u) {
         return 0u;
     }
-    d = u->cfg.tx_dma;
+    br_stm32_dma_ch_t *const d = u->cfg.tx_dma;
     /* a transfer running: EN set and items left (the H7 clears EN at the
      * end, the G4 leaves it set with NDTR 0) */
     if ((d->CR & BR_DMA_CR_EN) != 0u && d->NDTR != 0u) {
         u->cnt.tx_busy++;
         return 0u;
     }
-    take = (n < (size_t)u->cfg.tx_len) ? (uint32_t)n : u->cfg.tx_len;
+    const uint32_t take = (n < (size_t)u->cfg.tx_len) ? (uint32_t)n : u->cfg.tx_len;
     if ((size_t)take < n) {
         u->cnt.tx_short++;
     }

@@ -25,29 +25,25 @@ BR_G4_LAYOUT_CHECK(pwr_cr5, offsetof(br_stm32g4_pwr_t, CR5) == 0x80u);
 
 br_status_t br_stm32g4_rcc_enable(br_stm32g4_rcc_t *rcc)
 {
-    uint32_t readback;
-
     if (rcc == NULL) {
         return BR_E_NULL;
     }
     rcc->AHB2ENR |= BR_G4_RCC_AHB2ENR_GPIOAEN | BR_G4_RCC_AHB2ENR_GPIOBEN;
     rcc->APB1ENR1 |= BR_G4_RCC_APB1ENR1_TIM2EN;
     rcc->APB2ENR |= BR_G4_RCC_APB2ENR_TIM1EN;
-    readback = rcc->APB2ENR; /* the enable takes effect before the first access */
+    const uint32_t readback = rcc->APB2ENR; /* the enable takes effect before the first access */
     (void)readback;
     return BR_OK;
 }
 
 br_status_t br_stm32g4_rcc_enable_usart2(br_stm32g4_rcc_t *rcc)
 {
-    uint32_t readback;
-
     if (rcc == NULL) {
         return BR_E_NULL;
     }
     rcc->AHB1ENR |= BR_G4_RCC_AHB1ENR_DMA1EN | BR_G4_RCC_AHB1ENR_DMAMUX1EN;
     rcc->APB1ENR1 |= BR_G4_RCC_APB1ENR1_USART2EN;
-    readback = rcc->APB1ENR1;
+    const uint32_t readback = rcc->APB1ENR1;
     (void)readback;
     return BR_OK;
 }
@@ -81,18 +77,14 @@ br_status_t br_stm32g4_usart_dma(br_stm32g4_dma_t *dma, br_stm32g4_dmamux_t *mux
 
 br_status_t br_stm32g4_clock_170(const br_stm32g4_clock_regs_t *r)
 {
-    br_stm32g4_rcc_t *rcc;
-    uint32_t readback;
-    uint32_t polls;
-
     if (r == NULL || r->rcc == NULL || r->pwr == NULL || r->flash == NULL) {
         return BR_E_NULL;
     }
-    rcc = r->rcc;
+    br_stm32g4_rcc_t *const rcc = r->rcc;
     /* 1. PWR's clock, then range 1 boost mode (needed above 150 MHz), with
      *    HCLK = SYSCLK / 2 until the new clock has run for 1 us */
     rcc->APB1ENR1 |= BR_G4_RCC_APB1ENR1_PWREN;
-    readback = rcc->APB1ENR1;
+    uint32_t readback = rcc->APB1ENR1;
     (void)readback;
     rcc->CFGR = (rcc->CFGR & ~BR_G4_RCC_CFGR_HPRE_Msk) | BR_G4_RCC_CFGR_HPRE_DIV2;
     r->pwr->CR5 &= ~BR_G4_PWR_CR5_R1MODE;
@@ -119,7 +111,7 @@ br_status_t br_stm32g4_clock_170(const br_stm32g4_clock_regs_t *r)
         return BR_E_STATE;
     }
     /* 5. at least 1 us at HCLK / 2, then AHB, APB1, APB2 /1 */
-    for (polls = 0u; polls < BR_STM32G4_HPRE_HOLD_POLLS; ++polls) {
+    for (uint32_t polls = 0u; polls < BR_STM32G4_HPRE_HOLD_POLLS; ++polls) {
         readback = rcc->CFGR;
     }
     (void)readback;

@@ -32,8 +32,6 @@ BR_LAYOUT_CHECK(syscfg_pwrcr, offsetof(br_stm32h7_syscfg_t, PWRCR) == 0x2Cu);
 
 br_status_t br_stm32h7_rcc_enable(br_stm32h7_rcc_t *rcc)
 {
-    uint32_t readback;
-
     if (rcc == NULL) {
         return BR_E_NULL;
     }
@@ -41,22 +39,20 @@ br_status_t br_stm32h7_rcc_enable(br_stm32h7_rcc_t *rcc)
     rcc->APB1LENR |= BR_RCC_APB1LENR_TIM2EN;
     rcc->APB2ENR |= BR_RCC_APB2ENR_TIM1EN;
     /* Read back: the enable takes effect before the first peripheral access. */
-    readback = rcc->APB2ENR;
+    const uint32_t readback = rcc->APB2ENR;
     (void)readback;
     return BR_OK;
 }
 
 br_status_t br_stm32h7_rcc_enable_usart3(br_stm32h7_rcc_t *rcc)
 {
-    uint32_t readback;
-
     if (rcc == NULL) {
         return BR_E_NULL;
     }
     rcc->AHB4ENR |= BR_RCC_AHB4ENR_GPIODEN;
     rcc->AHB1ENR |= BR_RCC_AHB1ENR_DMA1EN;
     rcc->APB1LENR |= BR_RCC_APB1LENR_USART3EN;
-    readback = rcc->APB1LENR;
+    const uint32_t readback = rcc->APB1LENR;
     (void)readback;
     return BR_OK;
 }
@@ -100,15 +96,11 @@ br_status_t br_stm32h7_usart_dma(br_stm32h7_dma_t *dma, br_stm32h7_dmamux_t *mux
 
 br_status_t br_stm32h7_clock_480(const br_stm32h7_clock_regs_t *r)
 {
-    br_stm32h7_rcc_t *rcc;
-    br_stm32h7_pwr_t *pwr;
-    uint32_t readback;
-
     if (r == NULL || r->rcc == NULL || r->pwr == NULL || r->syscfg == NULL || r->flash == NULL) {
         return BR_E_NULL;
     }
-    rcc = r->rcc;
-    pwr = r->pwr;
+    br_stm32h7_rcc_t *const rcc = r->rcc;
+    br_stm32h7_pwr_t *const pwr = r->pwr;
     /* 1. supply: LDO (the part has no SMPS); the configuration is taken once
      *    after reset, then wait until the voltage levels are ready */
     pwr->CR3 = (pwr->CR3 & ~(BR_PWR_CR3_SCUEN | BR_PWR_CR3_LDOEN | BR_PWR_CR3_BYPASS)) | BR_PWR_CR3_LDOEN;
@@ -121,7 +113,7 @@ br_status_t br_stm32h7_clock_480(const br_stm32h7_clock_regs_t *r)
         return BR_E_STATE;
     }
     rcc->APB4ENR |= BR_RCC_APB4ENR_SYSCFGEN;
-    readback = rcc->APB4ENR;
+    const uint32_t readback = rcc->APB4ENR;
     (void)readback;
     r->syscfg->PWRCR |= BR_SYSCFG_PWRCR_ODEN;
     if (!br_stm32_wait(&pwr->D3CR, BR_PWR_D3CR_VOSRDY, BR_PWR_D3CR_VOSRDY)) {

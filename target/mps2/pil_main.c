@@ -76,8 +76,7 @@ int main(void)
     const est_t est = parse_est();
     /* the circle's period: the PF's own (thesis section 5), the machine's for the others */
     const float dt = (est == EST_PF) ? (float)BR_EST_PF_PERIOD_S : BR_MACHINE_CTRL_PERIOD_S_F;
-    const br_ctrl_cfg_t cc = {BR_HINF_K, dt, BR_MACHINE_TORQUE_LIMIT_NM_F, BR_MACHINE_TAU_PER_DUTY_NM_F,
-                              BR_MACHINE_RAD_PER_COUNT_F, BR_MACHINE_LEAD_MPRAD_F};
+    const br_ctrl_cfg_t cc = BR_MACHINE_CTRL_CFG(dt);
     br_pf_cfg_t pfc = BR_MACHINE_PF_CFG_TUNED(dt);
     br_ukf_cfg_t ukc = BR_MACHINE_UKF_CFG_TUNED(dt);
     pfc.est.model.causes = (br_causes_t){0}; /* the thesis model, as the circle's (sim/circle/br_circle_est.c) */

@@ -100,14 +100,7 @@ static void say_u32(const char *label, uint32_t v)
     br_sh_puts(b);
 }
 
-static const br_ctrl_cfg_t bench_ctrl = {
-    .K = BR_HINF_K,
-    .dt_s = BR_UKF_BENCH_DT_S,
-    .tau_max_Nm = BR_MACHINE_TORQUE_LIMIT_NM_F,
-    .tau_per_duty_Nm = BR_MACHINE_TAU_PER_DUTY_NM_F,
-    .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,
-    .lead_mprad = BR_MACHINE_LEAD_MPRAD_F,
-};
+static const br_ctrl_cfg_t bench_ctrl = BR_MACHINE_CTRL_CFG(BR_UKF_BENCH_DT_S);
 
 static const br_ukf_cfg_t bench_ukf_cfg = BR_MACHINE_UKF_CFG_TUNED(BR_UKF_BENCH_DT_S);
 

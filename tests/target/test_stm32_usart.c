@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The USART byte channel (hal/stm32, bristle/br_stm32_usart.h) against fake
- * register blocks in RAM, with the STM32H743's DMA side (br_stm32h7_usart_dma)
- * and the link over it (docs/porting.md, "The USART channel").
+ * register blocks in RAM, and the link over it (docs/porting.md, "The USART
+ * channel"); each part's DMA side is a case of the port suite
+ * (test_stm32_port.c, port_<part>.c).
  *
  * A fake block is plain memory: the DMA does not run, so the test plays it:
  * it writes received bytes into the circular buffer and lowers NDTR as the
@@ -12,7 +13,6 @@
 
 #include "bristle/br_link.h"
 #include "bristle/br_stm32_usart.h"
-#include "bristle/br_stm32h7.h"
 
 #define RX_LEN 32u
 #define TX_LEN 16u
@@ -336,61 +336,6 @@ static void test_link_over_usart(void **st)
     assert_int_equal(frames, 1);
 }
 
-/* the H7's DMA side: DMAMUX routing, direct mode, the streams' CR words and
- * the flag-clear register of the TX stream (LIFCR for 0..3, HIFCR for 4..7) */
-static void test_h7_usart_dma(void **st)
-{
-    (void)st;
-    br_stm32h7_dma_t dma;
-    br_stm32h7_dmamux_t mux;
-    br_stm32_usart_cfg_t c;
-    memset(&dma, 0xFF, sizeof dma);
-    memset(&mux, 0, sizeof mux);
-    memset(&c, 0, sizeof c);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 0u, 0u, 1u, BR_H7_DMAREQ_USART3_RX, BR_H7_DMAREQ_USART3_TX, &c),
-                     BR_OK);
-    assert_int_equal(mux.CCR[0], 45u);
-    assert_int_equal(mux.CCR[1], 46u);
-    assert_int_equal(dma.S[0].FCR, 0u);
-    assert_int_equal(dma.S[1].FCR, 0u);
-    assert_ptr_equal(c.rx_dma, &dma.S[0].ch);
-    assert_ptr_equal(c.tx_dma, &dma.S[1].ch);
-    assert_ptr_equal(c.tx_dma_ifcr, &dma.LIFCR);
-    assert_int_equal(c.tx_dma_ifcr_mask, 0x3Du << 6);
-    /* RX: DIR 00, CIRC, MINC; TX: DIR 01, MINC; bytes, EN clear */
-    assert_int_equal(c.rx_dma_cr, (1u << 8) | (1u << 10));
-    assert_int_equal(c.tx_dma_cr, (1u << 6) | (1u << 10));
-    /* DMA2, streams 7 (RX) and 6 (TX): DMAMUX channels 15, 14; HIFCR bits 16.. */
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 8u, 7u, 6u, 3u, 4u, &c), BR_OK);
-    assert_int_equal(mux.CCR[15], 3u);
-    assert_int_equal(mux.CCR[14], 4u);
-    assert_ptr_equal(c.tx_dma_ifcr, &dma.HIFCR);
-    assert_int_equal(c.tx_dma_ifcr_mask, 0x3Du << 16);
-
-    /* guards: nothing written */
-    br_stm32h7_dmamux_t mux0;
-    memcpy(&mux0, &mux, sizeof mux);
-    assert_int_equal(br_stm32h7_usart_dma(NULL, &mux, 0u, 0u, 1u, 45u, 46u, &c), BR_E_NULL);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, NULL, 0u, 0u, 1u, 45u, 46u, &c), BR_E_NULL);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 0u, 0u, 1u, 45u, 46u, NULL), BR_E_NULL);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 0u, 8u, 1u, 45u, 46u, &c), BR_E_PARAM);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 0u, 0u, 8u, 45u, 46u, &c), BR_E_PARAM);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 0u, 2u, 2u, 45u, 46u, &c), BR_E_PARAM);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 4u, 0u, 1u, 45u, 46u, &c), BR_E_PARAM);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 0u, 0u, 1u, 0u, 46u, &c), BR_E_PARAM);
-    assert_int_equal(br_stm32h7_usart_dma(&dma, &mux, 0u, 0u, 1u, 45u, 256u, &c), BR_E_PARAM);
-    assert_memory_equal(&mux0, &mux, sizeof mux);
-
-    /* the clock enables */
-    br_stm32h7_rcc_t rcc;
-    memset(&rcc, 0, sizeof rcc);
-    assert_int_equal(br_stm32h7_rcc_enable_usart3(NULL), BR_E_NULL);
-    assert_int_equal(br_stm32h7_rcc_enable_usart3(&rcc), BR_OK);
-    assert_int_equal(rcc.AHB1ENR, 1u << 0);
-    assert_int_equal(rcc.AHB4ENR, 1u << 3);
-    assert_int_equal(rcc.APB1LENR, 1u << 18);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -401,7 +346,6 @@ int main(void)
         cmocka_unit_test(test_line_errors_counted),
         cmocka_unit_test(test_write_never_blocks),
         cmocka_unit_test(test_link_over_usart),
-        cmocka_unit_test(test_h7_usart_dma),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -15,10 +15,10 @@ import unittest
 
 ARGS = None
 TOOLS = ("br_simlog", "br_demo_circle", "br_circle_ext", "br_pf_study", "br_dt_study", "br_tune_est", "br_track",
-         "br_robust_run", "bench/br_bench", "br_link_sim")
+         "br_robust_run", "bench/br_bench", "br_link_sim", "br_mslip_plants")
 VALUED = {"br_simlog": "--out", "br_demo_circle": "--out", "br_circle_ext": "--json", "br_pf_study": "--table",
           "br_dt_study": "--seeds", "br_tune_est": "--out", "br_track": "--json", "br_robust_run": "--json",
-          "bench/br_bench": "--json", "br_link_sim": "--pty-path"}  # an option that takes a value
+          "bench/br_bench": "--json", "br_link_sim": "--pty-path", "br_mslip_plants": "--json"}  # an option that takes a value
 VERSION_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "VERSION")
 OLD = b"an existing file\r\nwith two lines\n"
 

@@ -7,7 +7,7 @@
  *   as compensation) -> PWM
  *
  * over the HAL the caller binds: the one home of the control period. The
- * production images (hal/stm32h7/image, hal/stm32g4/image), the replay image
+ * production images (hal/stm32/image, one for every STM32 board), the replay image
  * (target/mps2) and the simulator's circle experiment (sim/circle) all run
  * br_app_step. docs/modules/app.md.
  *

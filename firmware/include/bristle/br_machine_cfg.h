@@ -3,7 +3,7 @@
  * (bristle_gen/: br_machine.h, br_est_machine.h, br_pf_tuned.h, br_ukf_tuned.h,
  * br_noise_table.h; docs/machine-file.md): one home for the simulator's
  * circle (sim/circle/br_circle_est.c) and the STM32H743 image
- * (hal/stm32h7/image/main.c), which holds them const, in flash.
+ * (hal/stm32/image/br_image_main.c), which holds them const, in flash.
  *
  * Initialisers, not functions, so that a program can place the result in
  * flash (static const ... = BR_MACHINE_PF_CFG_TUNED(dt)). Every value is a
@@ -18,11 +18,23 @@
 #include "bristle/br_app.h"
 #include "bristle/br_pf.h"
 #include "bristle/br_ukf.h"
+#include "bristle_gen/ctrl/br_hinf_gains.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/est/br_noise_table.h"
 #include "bristle_gen/est/br_pf_tuned.h"
 #include "bristle_gen/est/br_ukf_tuned.h"
 #include "bristle_gen/machine/br_machine.h"
+
+/* the machine's H-infinity controller at period dt (float): the synthesised
+ * gains (bristle_gen/ctrl/br_hinf_gains.h), the actuator's torque limit and
+ * torque per duty, the encoder's resolution and the screw's lead */
+#define BR_MACHINE_CTRL_CFG(dt)                                                                    \
+    {.K = BR_HINF_K,                                                                               \
+     .dt_s = (dt),                                                                                 \
+     .tau_max_Nm = BR_MACHINE_TORQUE_LIMIT_NM_F,                                                   \
+     .tau_per_duty_Nm = BR_MACHINE_TAU_PER_DUTY_NM_F,                                              \
+     .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,                                                  \
+     .lead_mprad = BR_MACHINE_LEAD_MPRAD_F}
 
 /* the machine's values the drive protections derive from (br_app_motion_cfg) */
 #define BR_MACHINE_APP_MACHINE                                                                     \

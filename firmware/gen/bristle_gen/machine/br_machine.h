@@ -61,7 +61,7 @@
 #define BR_MACHINE_TORQUE_LIMIT_NM (0.64)
 #define BR_MACHINE_TORQUE_LIMIT_NM_F (6.399999857e-01f)
 /* control.estimator: the image's order of preference,
- * 1 first, 0 not listed; each board runs the first it can (hal/<board>/image/main.c): the PF */
+ * 1 first, 0 not listed; each board runs the first it can (hal/stm32/image/br_image_main.c): the PF */
 #define BR_MACHINE_EST_RANK_PF 1u
 /* the UKF */
 #define BR_MACHINE_EST_RANK_UKF 2u

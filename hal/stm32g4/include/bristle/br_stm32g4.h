@@ -51,6 +51,7 @@ typedef struct {
 
 #define BR_STM32G4_SYSCLK_HZ  170000000u
 #define BR_STM32G4_TIMCLK_HZ  170000000u
+#define BR_STM32G4_APB_HZ     170000000u  /* PCLK1 = PCLK2 = SYSCLK: USART2's kernel clock */
 #define BR_STM32G4_PLL_M      4u
 #define BR_STM32G4_PLL_N      85u
 #define BR_STM32G4_FLASH_WS   4u

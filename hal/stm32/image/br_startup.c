@@ -1,14 +1,21 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Startup for the STM32H743 (Cortex-M7): vector table and Reset_Handler.
+/* Startup of every STM32 board's image (Cortex-M4F, Cortex-M7): vector table
+ * and Reset_Handler; the board's br_board.h gives the number of interrupt
+ * lines (BR_BOARD_IRQ_VECTORS) and whether the core has an instruction cache
+ * to enable (BR_BOARD_ICACHE).
  *
  * Reset_Handler, in order: enables the FPU (CPACR CP10/CP11 full access, with
  * DSB/ISB so no floating-point instruction can execute before it takes
- * effect), enables the instruction cache, copies .data from flash to DTCM,
- * zeroes .bss and .axisram (AXI SRAM: the PF's state), and calls main. Every other exception and interrupt goes to
- * br_default_handler, which parks the core (a debugger shows where).
- * Symbols come from stm32h743.ld. No interrupt is used by the image: the
- * control tick is polled. */
+ * effect), enables the instruction cache (the M7), copies .data from flash to
+ * the tightly coupled RAM (the H7's DTCM, the G4's CCM SRAM), zeroes .bss and
+ * .xram (the board's DMA-reachable RAM: the PF's state, the recorder's ring,
+ * the USART's buffers), and calls main. Every other exception and interrupt
+ * goes to br_default_handler, which parks the core (a debugger shows where).
+ * Symbols come from the board's linker script (stm32h743.ld, stm32g474.ld). No interrupt
+ * is used by the image: the control tick is polled. */
 #include <stdint.h>
+
+#include "br_board.h"
 
 /* Linker script symbols (addresses only; never read as values). The region
  * bounds are declared as arrays, so that copying through them indexes an
@@ -19,8 +26,8 @@ extern uint32_t _sdata[];
 extern uint32_t _edata[];
 extern uint32_t _sbss[];
 extern uint32_t _ebss[];
-extern uint32_t _saxisram[];
-extern uint32_t _eaxisram[];
+extern uint32_t _sxram[];
+extern uint32_t _exram[];
 
 int main(void);
 void Reset_Handler(void);
@@ -32,9 +39,9 @@ void br_default_handler(void);
 #define BR_CPACR_CP10_CP11_FULL (0xFu << 20)
 #define BR_SCB_CCR_IC  (1u << 17)
 
-/* Cortex-M7 core exceptions + the 150 STM32H743 interrupt lines (RM0433). */
+/* the core's exceptions + the part's interrupt lines */
 #define BR_N_CORE_VECTORS 16
-#define BR_N_IRQ_VECTORS 150
+#define BR_N_IRQ_VECTORS BR_BOARD_IRQ_VECTORS
 
 typedef union {
     void (*handler)(void);
@@ -43,6 +50,7 @@ typedef union {
 
 #define BR_DEF {.handler = br_default_handler}
 #define BR_DEF_X10 BR_DEF, BR_DEF, BR_DEF, BR_DEF, BR_DEF, BR_DEF, BR_DEF, BR_DEF, BR_DEF, BR_DEF
+#define BR_DEF_X50 BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, BR_DEF_X10
 
 static inline void br_barrier(void)
 {
@@ -67,11 +75,13 @@ void Reset_Handler(void)
     BR_SCB_CPACR |= BR_CPACR_CP10_CP11_FULL;
     br_barrier();
 
+#if BR_BOARD_ICACHE
     /* Instruction cache: invalidate, then enable. */
     BR_SCB_ICIALLU = 0u;
     br_barrier();
     BR_SCB_CCR |= BR_SCB_CCR_IC;
     br_barrier();
+#endif
 
     /* Word loops through volatile pointers: no call to memcpy/memset here. */
     src = _sidata;
@@ -85,9 +95,9 @@ void Reset_Handler(void)
     for (i = 0u; i < n; ++i) {
         dst[i] = 0u;
     }
-    /* AXI SRAM (clocked from reset): the NOLOAD statics placed there */
-    dst = _saxisram;
-    n = ((uintptr_t)_eaxisram - (uintptr_t)_saxisram) / sizeof(uint32_t);
+    /* the board's DMA-reachable RAM (clocked from reset): the NOLOAD statics placed there */
+    dst = _sxram;
+    n = ((uintptr_t)_exram - (uintptr_t)_sxram) / sizeof(uint32_t);
     for (i = 0u; i < n; ++i) {
         dst[i] = 0u;
     }
@@ -99,7 +109,7 @@ void Reset_Handler(void)
 /* Vector table at the start of flash (0x08000000, the boot address and the
  * reset value of VTOR). Entry 0 is the initial stack pointer. */
 __attribute__((section(".isr_vector"), used))
-const br_vector_t br_vector_table[BR_N_CORE_VECTORS + BR_N_IRQ_VECTORS] = {
+const br_vector_t br_vector_table[] = {
     [0] = {.stack_top = &_estack},
     [1] = {.handler = Reset_Handler},
     [2] = {.handler = br_default_handler},  /* NMI */
@@ -113,8 +123,13 @@ const br_vector_t br_vector_table[BR_N_CORE_VECTORS + BR_N_IRQ_VECTORS] = {
     /* 13 reserved */
     [14] = {.handler = br_default_handler}, /* PendSV */
     [15] = {.handler = br_default_handler}, /* SysTick (not enabled: polled) */
-    /* 16..165: the interrupt lines, in order after [15] */
-    BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, /*  0..49  */
-    BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, /* 50..99  */
-    BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, BR_DEF_X10, /* 100..149 */
+    /* 16..: the interrupt lines in order after [15], every one parked
+     * (the board's list of BR_DEF: BR_BOARD_IRQ_PARKED) */
+    BR_BOARD_IRQ_PARKED
 };
+/* the board's list holds exactly its BR_BOARD_IRQ_VECTORS lines (C99 has no
+ * static_assert: a negative array size fails the build) */
+typedef char br_vector_count_check[(sizeof br_vector_table == (BR_N_CORE_VECTORS + BR_N_IRQ_VECTORS) *
+                                                                  sizeof(br_vector_t))
+                                       ? 1
+                                       : -1];

@@ -1,7 +1,12 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* STM32H743 port logic against fake register blocks in RAM: register
- * programming at init, encoder counts across counter wraps (32-bit TIM2 and
- * the 16-bit extension), PWM duty mapping, SysTick polling, init guards.
+/* The STM32 port test suite, one for every board (port_board.h): the shared
+ * driver against fake register blocks in RAM with the board's clocks
+ * (register programming at init, init guards, encoder counts across counter
+ * wraps: 32-bit TIM2 and the 16-bit extension, PWM duty mapping, SysTick
+ * polling, the deadline, the watchdog, br_app over the port), the board
+ * bring-up from a table (bristle/br_stm32_board.h) over fake blocks, and the
+ * part's own cases the board's row names (clock enables, clock tree, the
+ * USART's DMA side).
  *
  * A fake block is plain memory: COUNTFLAG is not cleared by a read and
  * counters do not run, so each test sets the registers a real peripheral
@@ -12,7 +17,8 @@
 
 #include "bristle/br_app.h"
 #include "bristle/br_encoder.h"
-#include "bristle/br_stm32h7.h"
+#include "bristle/br_stm32_board.h"
+#include "port_board.h"
 
 typedef struct {
     br_stm32_tim_t tim1;
@@ -20,22 +26,30 @@ typedef struct {
     br_stm32_systick_t systick;
 } fake_regs_t;
 
-/* 480 MHz core, 240 MHz timer clock, 20 kHz PWM, 1 kHz control. */
+/* The board's clocks, 20 kHz PWM, 1 kHz control, 500 ns dead time. */
 static br_stm32_cfg_t cfg_for(fake_regs_t *f)
 {
+    const port_board_t *b = &port_board;
     br_stm32_cfg_t c;
     memset(&c, 0, sizeof c);
     c.pwm_tim = &f->tim1;
     c.enc_tim = &f->tim2;
     c.systick = &f->systick;
-    c.cpu_clock_hz = 480000000u;
-    c.tim_clock_hz = 240000000u;
+    c.cpu_clock_hz = b->cpu_hz;
+    c.tim_clock_hz = b->tim_hz;
     c.pwm_hz = 20000u;
     c.control_hz = 1000u;
     c.enc_counter_bits = 32u;
     c.enc_filter = 3u;
-    c.deadtime_ticks = 48u;
+    c.deadtime_ticks = b->deadtime_ticks;
     return c;
+}
+
+/* TIM1's outputs off: no duty, channels and main output disabled */
+static int pwm_off(const fake_regs_t *f)
+{
+    return (f->tim1.BDTR & BR_TIM_BDTR_MOE) == 0u && f->tim1.CCER == 0u && f->tim1.CCR1 == 0u &&
+           f->tim1.CCR2 == 0u;
 }
 
 static void fake_fill(fake_regs_t *f, unsigned char pattern)
@@ -73,29 +87,26 @@ static void test_init_programs_registers(void **st)
     assert_int_equal(f.tim2.CNT, 0u);
     assert_true((f.tim2.CR1 & BR_TIM_CR1_CEN) != 0u);
 
-    /* PWM: centre-aligned 20 kHz at 240 MHz -> ARR = 240e6 / (2 * 20e3) = 6000 */
+    /* PWM: centre-aligned 20 kHz -> ARR = tim_hz / (2 * 20e3) (the row's) */
     assert_int_equal(f.tim1.PSC, 0u);
-    assert_int_equal(f.tim1.ARR, 6000u);
-    assert_int_equal(port.pwm_arr, 6000u);
-    assert_int_equal(f.tim1.CR1 & BR_TIM_CR1_CMS_Msk, BR_TIM_CR1_CMS_CENTER1);
-    assert_true((f.tim1.CR1 & BR_TIM_CR1_ARPE) != 0u);
-    assert_true((f.tim1.CR1 & BR_TIM_CR1_CEN) != 0u);
+    assert_int_equal(f.tim1.ARR, port_board.arr_20k);
+    assert_int_equal(port.pwm_arr, port_board.arr_20k);
+    assert_int_equal(f.tim1.CR1, BR_TIM_CR1_CMS_CENTER1 | BR_TIM_CR1_ARPE | BR_TIM_CR1_CEN);
     assert_int_equal(f.tim1.CCMR1, 0x6868u); /* OC1M = OC2M = PWM1, preload on */
     /* outputs off until the arm: channels and MOE cleared at init ... */
-    assert_int_equal(f.tim1.CCER, 0u);
-    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_MOE, 0u);
-    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, 48u);
+    assert_true(pwm_off(&f));
+    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, port_board.deadtime_ticks);
     /* ... and on, complementary pairs, at pwm_enable */
     assert_int_equal(br_stm32_pwm_enable(&port), BR_OK);
     assert_int_equal(f.tim1.CCER, BR_TIM_CCER_CC1E | BR_TIM_CCER_CC1NE | BR_TIM_CCER_CC2E | BR_TIM_CCER_CC2NE);
     assert_true((f.tim1.BDTR & BR_TIM_BDTR_MOE) != 0u);
-    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, 48u);
+    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, port_board.deadtime_ticks);
     assert_int_equal(f.tim1.CCR1, 0u);
     assert_int_equal(f.tim1.CCR2, 0u);
     assert_true((f.tim1.EGR & BR_TIM_EGR_UG) != 0u);
 
-    /* SysTick: processor clock, 480000 cycles per tick, polled (no interrupt) */
-    assert_int_equal(f.systick.LOAD, 479999u);
+    /* SysTick: processor clock, cpu_hz / 1000 cycles per tick, polled (no interrupt) */
+    assert_int_equal(f.systick.LOAD, port_board.load_1ms);
     assert_int_equal(f.systick.CTRL, BR_SYSTICK_CTRL_CLKSOURCE | BR_SYSTICK_CTRL_ENABLE);
 
     /* 16-bit encoder timer: ARR = 0xFFFF */
@@ -110,11 +121,11 @@ static void test_init_pwm_prescaler(void **st)
     br_stm32_t port;
     fake_fill(&f, 0);
     br_stm32_cfg_t c = cfg_for(&f);
-    c.pwm_hz = 1000u; /* 120000 ticks per half period > 16 bits: PSC = 1, ARR = 60000 */
+    c.pwm_hz = 1000u; /* tim_hz / 2000 ticks per half period > 16 bits: PSC = 1 */
     assert_int_equal(br_stm32_init(&port, &c), BR_OK);
     assert_int_equal(f.tim1.PSC, 1u);
-    assert_int_equal(f.tim1.ARR, 60000u);
-    /* reset clock of the image: 64 MHz timers, 20 kHz -> ARR 1600 */
+    assert_int_equal(f.tim1.ARR, port_board.arr_1k);
+    /* a 64 MHz reset clock (the H7's HSI): 64 MHz timers, 20 kHz -> ARR 1600 */
     c.cpu_clock_hz = 64000000u;
     c.tim_clock_hz = 64000000u;
     c.pwm_hz = 20000u;
@@ -160,16 +171,16 @@ static void test_init_guards(void **st)
     c = cfg_for(&f); c.tim_clock_hz = 0u;     expect_rejected(&c, &f, BR_E_PARAM);
     c = cfg_for(&f); c.pwm_hz = 0u;           expect_rejected(&c, &f, BR_E_PARAM);
     c = cfg_for(&f); c.control_hz = 0u;       expect_rejected(&c, &f, BR_E_PARAM);
-    /* PWM too fast for the timer clock: 240 MHz / (2 * 1.5 MHz) = 80 steps < 100 */
-    c = cfg_for(&f); c.pwm_hz = 1500000u;     expect_rejected(&c, &f, BR_E_PARAM);
-    c = cfg_for(&f); c.pwm_hz = 1200000u;     /* exactly 100 steps: accepted */
+    /* PWM too fast for the timer clock: fewer than 100 steps */
+    c = cfg_for(&f); c.pwm_hz = port_board.pwm_hz_too_fast; expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.pwm_hz = port_board.pwm_hz_100_steps; /* exactly 100 steps: accepted */
     assert_int_equal(br_stm32_init(&port, &c), BR_OK);
     fake_fill(&f, 0xA5);
     c = cfg_for(&f); c.pwm_hz = 300000000u;   expect_rejected(&c, &f, BR_E_PARAM); /* > clock */
     /* tick: the period must be a whole number of cycles, >= 1000, <= 2^24 */
     c = cfg_for(&f); c.control_hz = 7u;       expect_rejected(&c, &f, BR_E_PARAM);
-    c = cfg_for(&f); c.control_hz = 10u;      expect_rejected(&c, &f, BR_E_PARAM); /* 48e6 > 2^24 */
-    c = cfg_for(&f); c.control_hz = 960000u;  expect_rejected(&c, &f, BR_E_PARAM); /* 500 cycles */
+    c = cfg_for(&f); c.control_hz = port_board.tick_hz_over_2p24;  expect_rejected(&c, &f, BR_E_PARAM);
+    c = cfg_for(&f); c.control_hz = port_board.tick_hz_500_cycles; expect_rejected(&c, &f, BR_E_PARAM);
     c = cfg_for(&f); c.enc_counter_bits = 24u; expect_rejected(&c, &f, BR_E_PARAM);
     c = cfg_for(&f); c.enc_counter_bits = 0u; expect_rejected(&c, &f, BR_E_PARAM);
     c = cfg_for(&f); c.enc_filter = 16u;      expect_rejected(&c, &f, BR_E_PARAM);
@@ -196,7 +207,6 @@ static void test_null_and_state(void **st)
     assert_int_equal(br_stm32_tick_wait(&port, NULL), BR_E_NULL);
     assert_int_equal(br_stm32_hal(NULL, &hal), BR_E_NULL);
     assert_int_equal(br_stm32_hal(&port, NULL), BR_E_NULL);
-    assert_int_equal(br_stm32h7_rcc_enable(NULL), BR_E_NULL);
     assert_int_equal(br_stm32_gpio_af(NULL, 0u, 1u), BR_E_NULL);
 }
 
@@ -276,18 +286,20 @@ static void test_pwm_duty_mapping(void **st)
     (void)st;
     fake_regs_t f;
     br_stm32_t port;
-    port_up(&port, &f, 32u); /* ARR = 6000 */
+    port_up(&port, &f, 32u);
+    const uint32_t arr = port_board.arr_20k; /* even on every board: duty 0.5 is ARR / 2 */
     expect_duty(&port, &f, 0.0f, BR_OK, 0u, 0u);
     expect_duty(&port, &f, -0.0f, BR_OK, 0u, 0u);
-    expect_duty(&port, &f, 0.5f, BR_OK, 3000u, 0u);
-    expect_duty(&port, &f, -0.5f, BR_OK, 0u, 3000u);
-    expect_duty(&port, &f, 1.0f, BR_OK, 6000u, 0u);
-    expect_duty(&port, &f, -1.0f, BR_OK, 0u, 6000u);
-    expect_duty(&port, &f, 0.25f, BR_OK, 1500u, 0u);
-    expect_duty(&port, &f, 1.0e-4f, BR_OK, 1u, 0u);     /* 0.6 steps rounds to 1 */
-    expect_duty(&port, &f, 1.7f, BR_OK, 6000u, 0u);     /* clamped */
-    expect_duty(&port, &f, -1.7f, BR_OK, 0u, 6000u);
-    expect_duty(&port, &f, 1.0e30f, BR_OK, 6000u, 0u);
+    expect_duty(&port, &f, 0.5f, BR_OK, arr / 2u, 0u);
+    expect_duty(&port, &f, -0.5f, BR_OK, 0u, arr / 2u);
+    expect_duty(&port, &f, 1.0f, BR_OK, arr, 0u);
+    expect_duty(&port, &f, -1.0f, BR_OK, 0u, arr);
+    expect_duty(&port, &f, 0.25f, BR_OK, port_board.ccr_quarter, 0u);
+    expect_duty(&port, &f, 0.6f / (float)arr, BR_OK, 1u, 0u); /* 0.6 steps rounds to 1 */
+    expect_duty(&port, &f, 0.4f / (float)arr, BR_OK, 0u, 0u); /* 0.4 steps to 0 */
+    expect_duty(&port, &f, 1.7f, BR_OK, arr, 0u);             /* clamped */
+    expect_duty(&port, &f, -1.7f, BR_OK, 0u, arr);
+    expect_duty(&port, &f, 1.0e30f, BR_OK, arr, 0u);
     expect_duty(&port, &f, NAN, BR_E_INPUT, 0u, 0u);    /* rejected: output 0 */
     expect_duty(&port, &f, INFINITY, BR_E_INPUT, 0u, 0u);
     expect_duty(&port, &f, -INFINITY, BR_E_INPUT, 0u, 0u);
@@ -297,7 +309,7 @@ static void test_pwm_duty_mapping(void **st)
     assert_int_equal(br_stm32_pwm_disable(&port), BR_OK);
     assert_int_equal(f.tim1.CCR1, 0u);
     assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_MOE, 0u);
-    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, 48u);
+    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, port_board.deadtime_ticks);
 }
 
 /* ---- tick ------------------------------------------------------------------ */
@@ -350,25 +362,17 @@ static void test_hal_adapter(void **st)
     assert_int_equal(hal.encoder_read(hal.ctx, &counts), BR_OK);
     assert_int_equal(counts, -2);
     assert_int_equal(hal.pwm_write(hal.ctx, -0.5f), BR_OK);
-    assert_int_equal(f.tim1.CCR2, 3000u);
+    assert_int_equal(f.tim1.CCR2, port_board.arr_20k / 2u);
     assert_int_equal(hal.pwm_write(hal.ctx, NAN), BR_E_INPUT);
     assert_int_equal(f.tim1.CCR2, 0u);
     f.systick.CTRL |= BR_SYSTICK_CTRL_COUNTFLAG;
     assert_int_equal(hal.tick_wait(hal.ctx, &tick), BR_OK);
 }
 
-static void test_rcc_and_gpio(void **st)
+static void test_gpio_af(void **st)
 {
     (void)st;
-    br_stm32h7_rcc_t rcc;
     br_stm32_gpio_t gpio;
-    memset(&rcc, 0, sizeof rcc);
-    rcc.APB2ENR = 0x100u; /* other enables are kept */
-    assert_int_equal(br_stm32h7_rcc_enable(&rcc), BR_OK);
-    assert_int_equal(rcc.AHB4ENR, BR_RCC_AHB4ENR_GPIOAEN | BR_RCC_AHB4ENR_GPIOBEN);
-    assert_int_equal(rcc.APB1LENR, BR_RCC_APB1LENR_TIM2EN);
-    assert_int_equal(rcc.APB2ENR, 0x100u | BR_RCC_APB2ENR_TIM1EN);
-
     memset(&gpio, 0, sizeof gpio);
     gpio.MODER = 0xFFFFFFFFu; /* reset state of most ports: analog */
     gpio.AFR[1] = 0xFFFFFFFFu;
@@ -384,12 +388,6 @@ static void test_rcc_and_gpio(void **st)
 }
 
 /* ---- fail-safe: the PWM goes off (docs/reliability.md) --------------------- */
-
-static int pwm_off(const fake_regs_t *f)
-{
-    return (f->tim1.BDTR & BR_TIM_BDTR_MOE) == 0u && f->tim1.CCER == 0u && f->tim1.CCR1 == 0u &&
-           f->tim1.CCR2 == 0u;
-}
 
 static void test_deadline_disables_pwm(void **st)
 {
@@ -441,7 +439,7 @@ static void app_up(app_rig_t *g)
     /* a large position error: a large duty */
     const br_ref_t r = {120000, 0.0f, 0.0f};
     assert_int_equal(br_app_step(&g->app, &r), BR_OK);
-    assert_true(g->f.tim1.CCR1 > 3000u);
+    assert_true(g->f.tim1.CCR1 > port_board.arr_20k / 2u);
     assert_false(pwm_off(&g->f));
 }
 
@@ -498,9 +496,9 @@ static void test_control_period_ns(void **st)
     fake_fill(&f, 0);
     br_stm32_cfg_t c = cfg_for(&f);
     c.control_hz = 0u;
-    c.control_period_ns = 1500000u; /* the PF's 1.5 ms: 720000 cycles at 480 MHz */
+    c.control_period_ns = 1500000u; /* the PF's 1.5 ms: cpu_hz * 1.5e-3 cycles */
     assert_int_equal(br_stm32_init(&port, &c), BR_OK);
-    assert_int_equal(f.systick.LOAD, 719999u);
+    assert_int_equal(f.systick.LOAD, port_board.load_1500us);
     c.control_hz = 1000u; /* both */
     assert_int_equal(br_stm32_init(&port, &c), BR_E_PARAM);
     c.control_hz = 0u;
@@ -508,7 +506,7 @@ static void test_control_period_ns(void **st)
     assert_int_equal(br_stm32_init(&port, &c), BR_E_PARAM);
     c.control_period_ns = 1500001u; /* not a whole number of cycles */
     assert_int_equal(br_stm32_init(&port, &c), BR_E_PARAM);
-    c.control_period_ns = 40000000u; /* 19.2e6 cycles > 2^24 */
+    c.control_period_ns = port_board.period_ns_over_2p24; /* more than 2^24 cycles */
     assert_int_equal(br_stm32_init(&port, &c), BR_E_PARAM);
 }
 
@@ -537,79 +535,150 @@ static void test_iwdg(void **st)
     assert_int_equal(w.KR, 0x5555u);
 }
 
-/* ---- clocks: HSI 64 MHz -> PLL1 480 MHz ------------------------------------ */
+/* ---- the board's bring-up from its table (bristle/br_stm32_board.h) ------------ */
 
 typedef struct {
-    br_stm32h7_rcc_t rcc;
-    br_stm32h7_pwr_t pwr;
-    br_stm32h7_syscfg_t syscfg;
-    br_stm32h7_flash_t flash;
-} fake_clock_t;
+    fake_regs_t t;
+    br_stm32_gpio_t gpioa;
+    br_stm32_gpio_t gpiob;
+    br_stm32_usart_t usart;
+    br_stm32_iwdg_t iwdg;
+} fake_board_t;
 
-/* reset values where they matter (RM0433), with the ready flags a running
- * part would raise already set (a fake register does not change by itself) */
-static br_stm32h7_clock_regs_t clock_up(fake_clock_t *k, int pll_locks)
+/* the clock tree as the board's clocks function sees it: a test-set status */
+static br_status_t fake_clocks_status;
+static int fake_clocks_calls;
+static br_status_t fake_clocks(void)
 {
-    memset(k, 0, sizeof *k);
-    k->rcc.CR = BR_RCC_CR_HSION | BR_RCC_CR_HSIRDY | (pll_locks ? BR_RCC_CR_PLL1RDY : 0u);
-    k->rcc.CFGR = BR_RCC_CFGR_SWS_PLL1; /* the switch "completes" */
-    k->rcc.PLLCKSELR = 0x02020200u;     /* DIVM1..3 = 32, HSI */
-    k->rcc.PLLCFGR = 0x01FF0000u;       /* every DIVxyEN set */
-    k->pwr.CR3 = BR_PWR_CR3_SCUEN | BR_PWR_CR3_LDOEN;
-    k->pwr.CSR1 = BR_PWR_CSR1_ACTVOSRDY;
-    k->pwr.D3CR = (1u << 14) | BR_PWR_D3CR_VOSRDY; /* VOS3 after reset */
-    k->flash.ACR = 0x37u;                          /* 7 WS, WRHIGHFREQ 3 */
-    const br_stm32h7_clock_regs_t r = {&k->rcc, &k->pwr, &k->syscfg, &k->flash};
-    return r;
+    ++fake_clocks_calls;
+    return fake_clocks_status;
+}
+static int fake_reset_by_watchdog(void)
+{
+    return 0;
 }
 
-static void test_clock_480(void **st)
+/* a table like hal/<part>/board's, over fake blocks, with the board's clocks
+ * and its part's USART DMA side (port_board.usart_dma) */
+static br_stm32_board_t board_for(fake_board_t *f)
+{
+    memset(f, 0, sizeof *f);
+    fake_clocks_status = BR_OK;
+    fake_clocks_calls = 0;
+    br_stm32_board_t b;
+    memset(&b, 0, sizeof b);
+    b.clocks = fake_clocks;
+    b.port = cfg_for(&f->t);
+    b.port.control_hz = 0u;
+    const br_stm32_pin_t pins[6] = {{&f->gpioa, 0u, 1u}, {&f->gpioa, 1u, 1u},  {&f->gpioa, 8u, 6u},
+                                    {&f->gpioa, 9u, 6u}, {&f->gpiob, 13u, 6u}, {&f->gpiob, 14u, 6u}};
+    memcpy(b.pins, pins, sizeof pins);
+    b.n_pins = 6u;
+    b.usart_dma = port_board.usart_dma;
+    b.usart = &f->usart;
+    b.usart_clock_hz = port_board.usart_hz;
+    b.baud = 921600u;
+    b.usart_pins[0] = (br_stm32_pin_t){&f->gpioa, 2u, 7u};
+    b.usart_pins[1] = (br_stm32_pin_t){&f->gpioa, 3u, 7u};
+    b.iwdg = &f->iwdg;
+    b.iwdg_pr = 0u;
+    b.iwdg_rlr = 79u;
+    b.reset_by_watchdog = fake_reset_by_watchdog;
+    return b;
+}
+
+static void test_board_bringup(void **st)
 {
     (void)st;
-    fake_clock_t k;
-    br_stm32h7_clock_regs_t r = clock_up(&k, 1);
-    assert_int_equal(br_stm32h7_clock_480(&r), BR_OK);
-    /* supply LDO, VOS1 + ODEN = VOS0 */
-    assert_int_equal(k.pwr.CR3 & 7u, BR_PWR_CR3_LDOEN);
-    assert_int_equal(k.pwr.D3CR & BR_PWR_D3CR_VOS_Msk, 3u << 14);
-    assert_int_equal(k.rcc.APB4ENR & BR_RCC_APB4ENR_SYSCFGEN, BR_RCC_APB4ENR_SYSCFGEN);
-    assert_int_equal(k.syscfg.PWRCR & 1u, 1u);
-    /* flash: 4 WS, WRHIGHFREQ = 2 */
-    assert_int_equal(k.flash.ACR & 0x3Fu, 0x24u);
-    /* PLL1: HSI, M = 4; range 8..16 MHz, wide VCO, integer; P on, Q/R off */
-    assert_int_equal(k.rcc.PLLCKSELR, 0x02020040u);
-    /* reset 0x01FF0000 with PLL1's Q and R enables cleared, RGE = 11 */
-    assert_int_equal(k.rcc.PLLCFGR, 0x01F9000Cu);
-    /* N - 1 = 59, P - 1 = 1, Q - 1 = R - 1 = 3 */
-    assert_int_equal(k.rcc.PLL1DIVR, 59u | (1u << 9) | (3u << 16) | (3u << 24));
-    assert_true((k.rcc.CR & BR_RCC_CR_PLL1ON) != 0u);
-    /* D1CPRE /1, HPRE /2, D1PPRE /2; APB1, APB2, APB4 /2 */
-    assert_int_equal(k.rcc.D1CFGR, 0x0048u);
-    assert_int_equal(k.rcc.D2CFGR, 0x0440u);
-    assert_int_equal(k.rcc.D3CFGR, 0x0040u);
-    /* SYSCLK = PLL1, TIMPRE 0 */
-    assert_int_equal(k.rcc.CFGR & 7u, 3u);
-    assert_int_equal(k.rcc.CFGR & BR_RCC_CFGR_TIMPRE, 0u);
-    /* the frequencies the board's constants state */
-    assert_int_equal(64000000u / BR_STM32H7_PLL1_DIVM * BR_STM32H7_PLL1_DIVN / BR_STM32H7_PLL1_DIVP,
-                     BR_STM32H7_SYSCLK_HZ);
+    fake_board_t f;
+    br_stm32_board_t b = board_for(&f);
+    br_stm32_t port;
+    br_hal_t hal;
+    /* the control period is the caller's: the PF's 1.5 ms */
+    assert_int_equal(br_stm32_board_init(&b, 1500000u, &port, &hal), BR_OK);
+    assert_int_equal(fake_clocks_calls, 1);
+    assert_int_equal(f.t.systick.LOAD, port_board.load_1500us);
+    assert_int_equal(f.t.tim1.ARR, port_board.arr_20k);
+    assert_true(pwm_off(&f.t));
+    assert_ptr_equal(hal.ctx, &port);
+    /* the pins on their functions: PA8 AF6 (AFRH nibble 0), PB14 AF6 (nibble 6) */
+    assert_int_equal((f.gpioa.MODER >> 16) & 3u, 2u);
+    assert_int_equal(f.gpioa.AFR[1] & 0xFu, 6u);
+    assert_int_equal((f.gpiob.AFR[1] >> 24) & 0xFu, 6u);
+    assert_int_equal(f.gpioa.AFR[0] & 0xFFu, 0x11u);
 
-    /* PLL1 never locks: bounded wait, the system clock stays on HSI */
-    r = clock_up(&k, 0);
-    k.rcc.CFGR = 0u;
-    assert_int_equal(br_stm32h7_clock_480(&r), BR_E_STATE);
-    assert_int_equal(k.rcc.CFGR & 7u, 0u);
-    assert_int_equal(k.rcc.D1CFGR, 0u);
-    /* the voltage never ready: nothing past it written */
-    r = clock_up(&k, 1);
-    k.pwr.D3CR = 1u << 14;
-    assert_int_equal(br_stm32h7_clock_480(&r), BR_E_STATE);
-    assert_int_equal(k.flash.ACR, 0x37u);
-    assert_int_equal(k.rcc.CR & BR_RCC_CR_PLL1ON, 0u);
-    r.flash = NULL;
-    assert_int_equal(br_stm32h7_clock_480(&r), BR_E_NULL);
+    /* a clock tree that fails: its status, no timer register written */
+    b = board_for(&f);
+    fake_clocks_status = BR_E_STATE;
+    fake_board_t before;
+    memcpy(&before, &f, sizeof before);
+    assert_int_equal(br_stm32_board_init(&b, 1000000u, &port, &hal), BR_E_STATE);
+    assert_memory_equal(&before, &f, sizeof before);
+    /* a pin that does not exist: refused before the port */
+    b = board_for(&f);
+    b.pins[2].pin = 16u;
+    assert_int_equal(br_stm32_board_init(&b, 1000000u, &port, &hal), BR_E_PARAM);
+    assert_int_equal(f.t.tim1.ARR, 0u);
+    b = board_for(&f);
+    b.n_pins = BR_STM32_BOARD_PINS_MAX + 1u;
+    assert_int_equal(br_stm32_board_init(&b, 1000000u, &port, &hal), BR_E_PARAM);
+    assert_int_equal(fake_clocks_calls, 0);
+    b.n_pins = 6u;
+    b.clocks = NULL;
+    assert_int_equal(br_stm32_board_init(&b, 1000000u, &port, &hal), BR_E_NULL);
+    assert_int_equal(br_stm32_board_init(NULL, 1000000u, &port, &hal), BR_E_NULL);
+    b = board_for(&f);
+    assert_int_equal(br_stm32_board_init(&b, 1000000u, NULL, &hal), BR_E_NULL);
+    assert_int_equal(br_stm32_board_init(&b, 1000000u, &port, NULL), BR_E_NULL);
+    /* a period that is no whole number of cycles: the port's guard */
+    assert_int_equal(br_stm32_board_init(&b, 1000001u, &port, &hal), BR_E_PARAM);
 }
 
+/* the link's USART from the table: the part's DMA side, the pins, the baud
+ * rate from the board's kernel clock, the RX stream running */
+static void test_board_usart(void **st)
+{
+    (void)st;
+    fake_board_t f;
+    const br_stm32_board_t b = board_for(&f);
+    uint8_t rx[256]; /* 1 ms at 921 600 baud is 93 bytes: at least 186 */
+    uint8_t tx[16];
+    br_stm32_usart_chan_t u;
+    assert_int_equal(br_stm32_board_usart_init(&b, &u, rx, sizeof rx, tx, sizeof tx, 1000000u), BR_OK);
+    assert_int_equal(f.usart.BRR, port_board.usart_brr_921600);
+    assert_int_equal(f.usart.CR3, BR_USART_CR3_DMAR | BR_USART_CR3_DMAT);
+    assert_int_equal(u.cfg.rx_dma->NDTR, sizeof rx);
+    assert_true((u.cfg.rx_dma->CR & BR_DMA_CR_EN) != 0u);
+    assert_int_equal(u.cfg.tx_dma->CR & BR_DMA_CR_EN, 0u);
+    assert_int_equal((f.gpioa.AFR[0] >> 8) & 0xFFu, 0x77u); /* PA2, PA3 AF7 */
+    /* the channel's own guard (a buffer the line laps in two periods) comes through */
+    assert_int_equal(br_stm32_board_usart_init(&b, &u, rx, 185u, tx, sizeof tx, 1000000u), BR_E_PARAM);
+    br_stm32_board_t nodma = b;
+    nodma.usart_dma = NULL;
+    assert_int_equal(br_stm32_board_usart_init(&nodma, &u, rx, sizeof rx, tx, sizeof tx, 1000000u), BR_E_NULL);
+    assert_int_equal(br_stm32_board_usart_init(NULL, &u, rx, sizeof rx, tx, sizeof tx, 1000000u), BR_E_NULL);
+}
+
+/* the watchdog from the table: started with the board's prescaler and
+ * reload, refreshed */
+static void test_board_watchdog(void **st)
+{
+    (void)st;
+    fake_board_t f;
+    br_stm32_board_t b = board_for(&f);
+    assert_int_equal(br_stm32_board_watchdog_start(&b), BR_OK);
+    assert_int_equal(f.iwdg.RLR, 79u);
+    assert_int_equal(f.iwdg.KR, 0xAAAAu);
+    f.iwdg.KR = 0u;
+    br_stm32_board_watchdog_refresh(&b);
+    assert_int_equal(f.iwdg.KR, 0xAAAAu);
+    assert_int_equal(br_stm32_board_watchdog_start(NULL), BR_E_NULL);
+    br_stm32_board_watchdog_refresh(NULL); /* nothing to refresh: returns */
+    b.iwdg = NULL;
+    assert_int_equal(br_stm32_board_watchdog_start(&b), BR_E_NULL);
+}
+
+/* the suite's cases, then the board's own (port_board.h) */
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -622,12 +691,18 @@ int main(void)
         cmocka_unit_test(test_pwm_duty_mapping),
         cmocka_unit_test(test_tick_polling),
         cmocka_unit_test(test_hal_adapter),
-        cmocka_unit_test(test_rcc_and_gpio),
+        cmocka_unit_test(test_gpio_af),
         cmocka_unit_test(test_deadline_disables_pwm),
         cmocka_unit_test(test_app_faults_disable_pwm),
         cmocka_unit_test(test_control_period_ns),
         cmocka_unit_test(test_iwdg),
-        cmocka_unit_test(test_clock_480),
+        cmocka_unit_test(test_board_bringup),
+        cmocka_unit_test(test_board_usart),
+        cmocka_unit_test(test_board_watchdog),
+        {"rcc_enable", port_board.test_rcc_enable, NULL, NULL, NULL},
+        {"clock_tree", port_board.test_clock_tree, NULL, NULL, NULL},
+        {"usart_dma", port_board.test_usart_dma, NULL, NULL, NULL},
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    print_message("board %s\n", port_board.name);
+    return cmocka_run_group_tests_name(port_board.name, tests, NULL, NULL);
 }

@@ -1,141 +1,19 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* STM32G474 port against fake register blocks in RAM (docs/porting.md, "Test
- * a port on fake registers"): the shared STM32 driver programmed for the
- * G4's clocks (170 MHz: ARR, SysTick reload, prescaler), br_app over it
- * latching a fault with TIM1's outputs off, and what is the G4's own: the
- * clock enables (RM0440's RCC) and the clock tree to 170 MHz. The shared
- * driver's guards, wraps, duty table, tick and watchdog are tested in
- * test_stm32h7.c (the same code).
- *
- * A fake block is plain memory: COUNTFLAG is not cleared by a read and
- * counters do not run, so each test sets what a real peripheral would. */
+/* The STM32G474 board's row of the port suite (port_board.h,
+ * test_stm32_port.c): its clocks (hal/stm32g4/board/br_board.h: 170 MHz
+ * core, timers and USART2 kernel clock), the register values they give, and
+ * the part's own cases on fake blocks of RM0440's map: the clock enables, the
+ * clock tree to 170 MHz, the USART's DMA side (DMA1 channels, DMAMUX). */
 #include "br_test.h"
 
 #include <string.h>
 
-#include "bristle/br_app.h"
 #include "bristle/br_stm32g4.h"
+#include "port_board.h"
 
-typedef struct {
-    br_stm32_tim_t tim1;
-    br_stm32_tim_t tim2;
-    br_stm32_systick_t systick;
-} fake_regs_t;
+/* ---- clock enables ------------------------------------------------------------ */
 
-/* 170 MHz core and timer clock, 20 kHz PWM, 1 kHz control, 500 ns dead time. */
-static br_stm32_cfg_t cfg_for(fake_regs_t *f)
-{
-    br_stm32_cfg_t c;
-    memset(&c, 0, sizeof c);
-    c.pwm_tim = &f->tim1;
-    c.enc_tim = &f->tim2;
-    c.systick = &f->systick;
-    c.cpu_clock_hz = 170000000u;
-    c.tim_clock_hz = 170000000u;
-    c.pwm_hz = 20000u;
-    c.control_hz = 1000u;
-    c.enc_counter_bits = 32u;
-    c.enc_filter = 3u;
-    c.deadtime_ticks = 85u;
-    return c;
-}
-
-static void port_up(br_stm32_t *port, fake_regs_t *f, uint32_t enc_bits)
-{
-    memset(f, 0, sizeof *f);
-    br_stm32_cfg_t c = cfg_for(f);
-    c.enc_counter_bits = enc_bits;
-    assert_int_equal(br_stm32_init(port, &c), BR_OK);
-}
-
-static int pwm_off(const fake_regs_t *f)
-{
-    return (f->tim1.BDTR & BR_TIM_BDTR_MOE) == 0u && f->tim1.CCER == 0u && f->tim1.CCR1 == 0u &&
-           f->tim1.CCR2 == 0u;
-}
-
-/* ---- init ------------------------------------------------------------- */
-
-static void test_init_programs_registers(void **st)
-{
-    (void)st;
-    fake_regs_t f;
-    br_stm32_t port;
-    memset(&f, 0, sizeof f);
-    f.tim2.SMCR = 0x00010007u; /* stale SMS bits, incl. SMS[3], must be replaced */
-    br_stm32_cfg_t c = cfg_for(&f);
-    assert_int_equal(br_stm32_init(&port, &c), BR_OK);
-
-    /* encoder: mode 3, filter 3 on both inputs, full range, running */
-    assert_int_equal(f.tim2.SMCR & BR_TIM_SMCR_SMS_Msk, 3u);
-    assert_int_equal(f.tim2.CCMR1, 0x3131u);
-    assert_int_equal(f.tim2.ARR, 0xFFFFFFFFu);
-    assert_int_equal(f.tim2.PSC, 0u);
-    assert_true((f.tim2.CR1 & BR_TIM_CR1_CEN) != 0u);
-
-    /* PWM: centre-aligned 20 kHz at 170 MHz -> ARR = 170e6 / (2 * 20e3) = 4250 */
-    assert_int_equal(f.tim1.PSC, 0u);
-    assert_int_equal(f.tim1.ARR, 4250u);
-    assert_int_equal(f.tim1.CR1, BR_TIM_CR1_CMS_CENTER1 | BR_TIM_CR1_ARPE | BR_TIM_CR1_CEN);
-    assert_int_equal(f.tim1.CCMR1, 0x6868u); /* PWM mode 1, preload, both channels */
-    assert_true(pwm_off(&f));                /* outputs off until the arm */
-    assert_int_equal(f.tim1.BDTR & BR_TIM_BDTR_DTG_Msk, 85u);
-    assert_int_equal(br_stm32_pwm_enable(&port), BR_OK);
-    assert_int_equal(f.tim1.CCER,
-                     BR_TIM_CCER_CC1E | BR_TIM_CCER_CC1NE | BR_TIM_CCER_CC2E | BR_TIM_CCER_CC2NE);
-    assert_true((f.tim1.BDTR & BR_TIM_BDTR_MOE) != 0u);
-
-    /* SysTick: processor clock, 170000 cycles per 1 ms tick, no interrupt */
-    assert_int_equal(f.systick.LOAD, 169999u);
-    assert_int_equal(f.systick.CTRL, BR_SYSTICK_CTRL_CLKSOURCE | BR_SYSTICK_CTRL_ENABLE);
-
-    /* the PF's 1.5 ms as a period in ns: 255000 cycles */
-    c.control_hz = 0u;
-    c.control_period_ns = 1500000u;
-    assert_int_equal(br_stm32_init(&port, &c), BR_OK);
-    assert_int_equal(f.systick.LOAD, 254999u);
-    /* a slow PWM needs the prescaler: 1 kHz -> 85000 ticks per half period */
-    c = cfg_for(&f);
-    c.pwm_hz = 1000u;
-    assert_int_equal(br_stm32_init(&port, &c), BR_OK);
-    assert_int_equal(f.tim1.PSC, 1u);
-    assert_int_equal(f.tim1.ARR, 42500u);
-}
-
-/* ---- br_hal_t through br_app: a latched fault turns TIM1 off ----------------- */
-
-static void test_app_on_port(void **st)
-{
-    (void)st;
-    fake_regs_t f;
-    br_stm32_t port;
-    br_hal_t hal;
-    br_app_t app;
-    port_up(&port, &f, 32u);
-    assert_int_equal(br_stm32_hal(&port, &hal), BR_OK);
-    assert_ptr_equal(hal.ctx, &port);
-    const br_ctrl_cfg_t k = {{-0.5f, -0.01f, -10.0f}, 1e-3f, 0.64f, 0.64f, 6.0e-6f, 1.27e-3f};
-    const br_app_guard_cfg_t guard = {100u, 3u, 10u, 2u};
-    const br_app_cfg_t c = {&k, BR_APP_EST_NONE, NULL, NULL, NULL, guard, BR_TEST_WIDE_MOTION};
-    assert_int_equal(br_app_init(&app, &c, &hal, NULL), BR_OK);
-    assert_true(pwm_off(&f)); /* disarmed */
-    assert_int_equal(br_app_arm(&app), BR_OK);
-    const br_ref_t r = {120000, 0.0f, 0.0f};
-    assert_int_equal(br_app_step(&app, &r), BR_OK);
-    assert_true(f.tim1.CCR1 > 2125u); /* a large error: a large duty on leg A */
-    assert_false(pwm_off(&f));
-    /* the encoder leaps 101 counts in one period: latched, outputs off */
-    f.tim2.CNT += 101u;
-    assert_int_equal(br_app_step(&app, &r), BR_E_FAULT);
-    assert_int_equal(app.fault, BR_APP_FAULT_ENC_JUMP);
-    assert_true(pwm_off(&f));
-    assert_int_equal(br_app_step(&app, &r), BR_E_FAULT); /* stays off */
-    assert_true(pwm_off(&f));
-}
-
-/* ---- board helpers ------------------------------------------------------------ */
-
-static void test_rcc_enable(void **st)
+static void g4_test_rcc_enable(void **st)
 {
     (void)st;
     br_stm32g4_rcc_t rcc;
@@ -170,7 +48,7 @@ static br_stm32g4_clock_regs_t clock_up(fake_clock_t *k, int pll_locks)
     return r;
 }
 
-static void test_clock_170(void **st)
+static void g4_test_clock_tree(void **st)
 {
     (void)st;
     fake_clock_t k;
@@ -206,7 +84,7 @@ static void test_clock_170(void **st)
 /* the G4's side of the USART channel: DMAMUX routing, the channels' CR
  * words, IFCR and the TX channel's clear bits; the clock enables; then the
  * shared driver over those fake channels starting the RX channel */
-static void test_usart_dma(void **st)
+static void g4_test_usart_dma(void **st)
 {
     (void)st;
     br_stm32g4_dma_t dma;
@@ -276,14 +154,37 @@ static void test_usart_dma(void **st)
     assert_int_equal(dma.IFCR, 0xFu << 4);
 }
 
-int main(void)
+/* the board table's usart_dma over fake DMA1 and DMAMUX blocks: USART2's
+ * requests on channels 1 (RX) and 2 (TX), as hal/stm32g4/board does */
+static br_stm32g4_dma_t g4_fake_dma;
+static br_stm32g4_dmamux_t g4_fake_mux;
+static br_status_t g4_fake_usart_dma(br_stm32_usart_cfg_t *cfg)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_init_programs_registers),
-        cmocka_unit_test(test_app_on_port),
-        cmocka_unit_test(test_rcc_enable),
-        cmocka_unit_test(test_clock_170),
-        cmocka_unit_test(test_usart_dma),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    memset(&g4_fake_dma, 0, sizeof g4_fake_dma);
+    memset(&g4_fake_mux, 0, sizeof g4_fake_mux);
+    return br_stm32g4_usart_dma(&g4_fake_dma, &g4_fake_mux, 0u, 0u, 1u, BR_G4_DMAREQ_USART2_RX,
+                                BR_G4_DMAREQ_USART2_TX, cfg);
 }
+
+const port_board_t port_board = {
+    .name = "stm32g4",
+    .cpu_hz = 170000000u,
+    .tim_hz = 170000000u,
+    .deadtime_ticks = 85u,
+    .usart_hz = 170000000u,
+    .arr_20k = 4250u,
+    .ccr_quarter = 1063u,          /* 1062.5 rounds up */
+    .arr_1k = 42500u,
+    .load_1ms = 169999u,
+    .load_1500us = 254999u,
+    .usart_brr_921600 = 184u,      /* 170e6 / 921 600 = 184.5 */
+    .pwm_hz_100_steps = 850000u,
+    .pwm_hz_too_fast = 1000000u,   /* 85 steps */
+    .tick_hz_500_cycles = 340000u,
+    .tick_hz_over_2p24 = 10u,      /* 17e6 cycles */
+    .period_ns_over_2p24 = 100000000u, /* 17e6 cycles */
+    .usart_dma = g4_fake_usart_dma,
+    .test_rcc_enable = g4_test_rcc_enable,
+    .test_clock_tree = g4_test_clock_tree,
+    .test_usart_dma = g4_test_usart_dma,
+};

@@ -1,0 +1,200 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* br_mslip_plants: every controller on drawn Maxwell-slip plants (docs/presliding-plants.md;
+ * docs/modules/qec.md, "On drawn Maxwell-slip plants"). Plants drawn like the hardware-like
+ * one (br_circle_cfg_hardware_like) with another presliding: 2-6 elements, each breaking
+ * away at Fs at a displacement log-uniform in 0.3-30 um, shares uniform in [0.5, 1.5]
+ * normalised to 1, element damping uniform in 300-4000 N s/m (the ranges of issue 30's
+ * random plants), the slip law and C of the hardware-like plant; the rest of the machine as
+ * it is. On each, the thesis circle with H-inf only, + static feedforward, + the reversal
+ * pulse tuned once on the hardware-like plant (the machine file's), + UKF, + PF, all as
+ * shipped, and the true friction at t_k (the limit). A run the firmware stopped is a fault
+ * with its time and cause, never a figure (br_run_report.h); medians over the plants where
+ * a controller ran.
+ *
+ * Plant j is the j-th draw of the seed's stream whatever --first and --n: a study runs
+ * plants in any split (sim/studies/mslip_plants.py).
+ *
+ * Usage: br_mslip_plants [--n N] [--first J] [--seed S] [--json OUT]
+ * Prints one line per plant (contour RMS in m, or FAULT) and the medians; --json writes
+ * each plant's elements and runs (br_outfile.h: nothing is written unless every run was
+ * made). Exit 0, 1 (a run could not be made, or the output), 2 (usage). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "circle/br_circle.h"
+#include "tools/br_args.h"
+#include "tools/br_outfile.h"
+#include "tools/br_rng.h"
+#include "tools/br_run_report.h"
+
+#define TOOL "br_mslip_plants"
+#define MAX_N 200
+#define MAX_FIRST 100000
+#define N_CTRL 6
+#define QEC 2 /* ctrls[QEC]: the baseline of the paired line */
+
+static const br_circle_ctrl_t ctrls[N_CTRL] = {BR_CTRL_HINF_ONLY, BR_CTRL_HINF_FF, BR_CTRL_HINF_QEC,
+                                               BR_CTRL_HINF_UKF,  BR_CTRL_HINF_PF, BR_CTRL_HINF_TRUE};
+
+/* the next plant's Maxwell-slip presliding into c (the draw described above) */
+static void draw_plant(br_circle_cfg_t *c, br_rng_t *r)
+{
+    const int n = 2 + (int)floor(5.0 * br_rng_uniform(r)); /* 2..6 */
+    double d[BR_GMS_MAX] = {0}, a[BR_GMS_MAX] = {0}, sum = 0.0;
+    for (int i = 0; i < n; i++) {
+        d[i] = 0.3e-6 * pow(100.0, br_rng_uniform(r)); /* log-uniform 0.3-30 um */
+        a[i] = 0.5 + br_rng_uniform(r);
+        sum += a[i];
+    }
+    for (int i = 0; i < n; i++) a[i] /= sum;
+    br_gms_from_breakaway(&c->plant.gms, n, d, a, c->plant.Fs_N, 0.0);
+    for (int i = 0; i < n; i++) c->plant.gms.sigma1_Nspm[i] = 300.0 + 3700.0 * br_rng_uniform(r);
+}
+
+static int cmp_double(const void *x, const void *y)
+{
+    const double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static int usage(const char *argv0, FILE *f)
+{
+    fprintf(f,
+            "usage: %s [--n N] [--first J] [--seed S] [--json OUT]\n"
+            "  --n N       how many plants (1 .. %d; default 10)\n"
+            "  --first J   the first plant's index in the seed's stream (0 .. %d; default 0)\n"
+            "  --seed S    the draw's seed (0 .. 1000000000; default 1)\n"
+            "  --json OUT  each plant's elements and runs as JSON\n" BR_ARGS_COMMON_USAGE,
+            argv0, MAX_N, MAX_FIRST, argv0);
+    return f == stdout ? 0 : 2;
+}
+
+static void json_plant(FILE *f, long idx, int comma, const br_gms_cfg_t *g, double Fs_N, const br_run_report_t *rep)
+{
+    fprintf(f, "%s\n    {\"plant\": %ld, \"elements\": [", comma ? "," : "", idx);
+    for (int i = 0; i < g->n; i++)
+        fprintf(f, "%s{\"breakaway_m\": %.6e, \"share\": %.6f, \"k_Npm\": %.6e, \"sigma1_Nspm\": %.6g}",
+                i ? ", " : "", g->alpha[i] * Fs_N / g->k_Npm[i], g->alpha[i], g->k_Npm[i], g->sigma1_Nspm[i]);
+    fprintf(f, "],\n     \"runs\": {");
+    for (int k = 0; k < N_CTRL; k++) {
+        fprintf(f, "%s\"%s\": {", k ? ", " : "", br_circle_ctrl_name(ctrls[k]));
+        br_run_json(f, "contour_rms_m", "max_err_m", &rep[k]);
+        fprintf(f, "}");
+    }
+    fprintf(f, "}}");
+}
+
+int main(int argc, char **argv)
+{
+    long n = 10, first = 0, seed = 1;
+    const char *json = NULL;
+    static const struct option opts[] = {{"n", required_argument, NULL, 'n'},
+                                         {"first", required_argument, NULL, 'f'},
+                                         {"seed", required_argument, NULL, 's'},
+                                         {"json", required_argument, NULL, 'j'},
+                                         {NULL, 0, NULL, 0}};
+    br_args_t p;
+    const int st = br_args_begin(&p, TOOL, argc, argv);
+    if (st == BR_ARGS_HELP) return usage(argv[0], stdout);
+    if (st == BR_ARGS_VERSION) {
+        br_args_print_version(TOOL, stdout);
+        return 0;
+    }
+    const char *val;
+    for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
+        int bad = 1;
+        if (c == 'n') bad = br_arg_long(TOOL, p.opt, val, 1, MAX_N, &n);
+        else if (c == 'f') bad = br_arg_long(TOOL, p.opt, val, 0, MAX_FIRST, &first);
+        else if (c == 's') bad = br_arg_long(TOOL, p.opt, val, 0, 1000000000L, &seed);
+        else if (c == 'j') {
+            json = val;
+            bad = 0;
+        }
+        if (bad) return usage(argv[0], stderr);
+    }
+    br_outfile_t js = {0};
+    if (json && br_outfile_open(&js, TOOL, json) != 0) return 1;
+    if (js.f) fprintf(js.f, "{\"seed\": %ld, \"first\": %ld, \"n\": %ld, \"plants\": [", seed, first, n);
+    static double rms[N_CTRL][MAX_N];
+    static int ok[N_CTRL][MAX_N];
+    int n_ok[N_CTRL] = {0};
+    br_rng_t r = {(uint64_t)seed * 0x9E3779B97F4A7C15ull + 12345u, 0, 0.0};
+    for (long j = 0; j < first; j++) { /* the draws before the first plant, dropped */
+        br_circle_cfg_t skip = br_circle_cfg_hardware_like(BR_CTRL_HINF_ONLY);
+        draw_plant(&skip, &r);
+    }
+    printf("%-5s %-3s %-28s", "plant", "n", "breakaway [um]");
+    for (int k = 0; k < N_CTRL; k++) printf(" %12s", br_circle_ctrl_name(ctrls[k]));
+    printf("\n");
+    for (int j = 0; j < n; j++) {
+        br_circle_cfg_t base = br_circle_cfg_hardware_like(BR_CTRL_HINF_ONLY);
+        draw_plant(&base, &r);
+        char el[64] = "";
+        int w = 0;
+        for (int i = 0; i < base.plant.gms.n && w < (int)sizeof el - 8; i++)
+            w += snprintf(el + w, sizeof el - (size_t)w, "%s%.2g", i ? "," : "",
+                          1e6 * base.plant.gms.alpha[i] * base.plant.Fs_N / base.plant.gms.k_Npm[i]);
+        printf("%-5ld %-3d %-28s", first + j, base.plant.gms.n, el);
+        br_run_report_t rep[N_CTRL];
+        for (int k = 0; k < N_CTRL; k++) {
+            br_circle_cfg_t c = br_circle_cfg_hardware_like(ctrls[k]);
+            c.plant.gms = base.plant.gms;
+            br_circle_result_t res;
+            const int rc = br_circle_run(&c, NULL, NULL, &res);
+            if (rc < 0) {
+                fprintf(stderr, "%s: plant %ld, %s: the run could not be made\n", TOOL, first + j,
+                        br_circle_ctrl_name(ctrls[k]));
+                br_outfile_discard(&js);
+                return 1;
+            }
+            rep[k] = (br_run_report_t){res.contour_rms_m, res.max_err_m, res.fault_status, res.fault_cause,
+                                       res.fault_t_s};
+            ok[k][j] = rc == 0;
+            rms[k][j] = res.contour_rms_m;
+            if (rc == 0) printf(" %12.3e", res.contour_rms_m);
+            else printf(" %12s", "FAULT");
+            n_ok[k] += ok[k][j];
+        }
+        printf("\n");
+        for (int k = 0; k < N_CTRL; k++) /* a stop's time and cause, never a figure */
+            if (!ok[k][j]) br_run_print(stdout, br_circle_ctrl_name(ctrls[k]), "contour", &rep[k]);
+        if (js.f) json_plant(js.f, first + j, j > 0, &base.plant.gms, base.plant.Fs_N, rep);
+        fflush(stdout);
+    }
+    if (js.f) {
+        fprintf(js.f, "\n  ]}\n");
+        if (br_outfile_commit(&js, TOOL) != 0) return 1;
+    }
+    printf("%-38s", "median over the plants it ran on");
+    for (int k = 0; k < N_CTRL; k++) {
+        double v[MAX_N];
+        int m = 0;
+        for (int j = 0; j < n; j++)
+            if (ok[k][j]) v[m++] = rms[k][j];
+        if (m > 0) printf(" %12.3e", median(v, m));
+        else printf(" %12s", "-");
+    }
+    printf("\n%-38s", "ran to the end (of N)");
+    for (int k = 0; k < N_CTRL; k++) printf(" %9d/%-2ld", n_ok[k], n);
+    /* paired: the reversal pulse against each other controller where both ran */
+    printf("\n%-38s", "better than + QEC where both ran");
+    for (int k = 0; k < N_CTRL; k++) {
+        int both = 0, better = 0;
+        for (int j = 0; j < n; j++)
+            if (ok[k][j] && ok[QEC][j]) {
+                both++;
+                better += rms[k][j] < rms[QEC][j];
+            }
+        if (k == QEC) printf(" %12s", "-");
+        else printf(" %9d/%-2d", better, both);
+    }
+    printf("\n");
+    return 0;
+}

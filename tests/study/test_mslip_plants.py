@@ -1,0 +1,78 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The drawn Maxwell-slip plants study (docs/presliding-plants.md), small:
+3 plants on 2 processes and again on 1. Checks that the summary is the same
+for any split, that every count is the per-plant runs' own, that a faulted
+run is listed with its time and cause and has no figure, and that the page
+writer exits 1 on a fault it was not told to expect (docs/tools.md).
+
+Usage: test_mslip_plants.py --bin BUILD/sim --work DIR"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+STUDY = os.path.join(ROOT, "sim", "studies", "mslip_plants.py")
+N = 3
+
+
+def study(a, out, jobs, *extra):
+    return subprocess.run([sys.executable, STUDY, "--bin", a.bin, "--out", out, "--n", str(N), "--jobs", str(jobs)]
+                          + list(extra), capture_output=True, text=True)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--work", required=True)
+    a = ap.parse_args()
+    shutil.rmtree(a.work, ignore_errors=True)
+    os.makedirs(a.work)
+    fails = []
+
+    def check(cond, what):
+        if not cond:
+            fails.append(what)
+
+    page = os.path.join(a.work, "page.md")
+    with open(page, "w", encoding="utf-8") as f:
+        f.write("# hand-written head\n\nkept\n")
+    r2 = study(a, os.path.join(a.work, "j2"), 2, "--md", page, "--command", "test")
+    r1 = study(a, os.path.join(a.work, "j1"), 1)
+    check(r1.returncode == 0, "without --md the study exits 0: %s" % r1.stderr)
+    s1 = json.load(open(os.path.join(a.work, "j1", "summary.json")))
+    s2 = json.load(open(os.path.join(a.work, "j2", "summary.json")))
+    check(s1 == s2, "the summary depends on --jobs")
+    plants = [json.load(open(os.path.join(a.work, "j1", "plants", "plant_%04d.json" % j)))["plants"][0]
+              for j in range(N)]
+    check([p["plant"] for p in plants] == list(range(N)), "plant indices")
+    n_faults = 0
+    text = open(page, encoding="utf-8").read()
+    check(text.startswith("# hand-written head\n\nkept\n"), "the page's hand-written head was not kept")
+    for c, v in s1["controllers"].items():
+        runs = [p["runs"][c] for p in plants]
+        faulted = [(p["plant"], p["runs"][c]) for p in plants if p["runs"][c]["faulted"]]
+        n_faults += len(faulted)
+        check(v["faulted"] == len(faulted) and v["ran"] == N - len(faulted), "%s: counts" % c)
+        for j, run_ in faulted:
+            check(run_["contour_rms_m"] is None, "%s plant %d: a faulted run has a figure" % (c, j))
+            check("%d: %.3f s (%s)" % (j, run_["fault_t_s"], run_["fault_cause"]) in text,
+                  "%s plant %d: the fault is not listed with time and cause" % (c, j))
+        ok = sorted(x["contour_rms_m"] for x in runs if not x["faulted"])
+        if ok:
+            check(abs(v["max_m"] - ok[-1]) <= 1e-15, "%s: max" % c)
+    check(n_faults > 0, "the first %d plants of seed 1 are expected to hold a stop (docs/presliding-plants.md)" % N)
+    check(r2.returncode == (1 if n_faults else 0), "a fault not expected must fail the page writer: rc %d"
+          % r2.returncode)
+    r3 = study(a, os.path.join(a.work, "j3"), 2, "--md", page, "--command", "test", "--expect-faults")
+    check(r3.returncode == 0, "--expect-faults: %s" % r3.stderr)
+    for f in fails:
+        print("FAIL:", f)
+    print("%d checks failed" % len(fails) if fails else "ok")
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
