@@ -3,8 +3,9 @@
  * force F_N (toward -x: a force against +x, as friction) with no torque:
  * theta(t) = -L F_N t^2 / (2 J_eff) from t0, frictionless (the model's
  * friction and the load then share the force a filter sees). Period k of the
- * model m, encoder resolution rpc (rad per count). The load tests of the UKF
- * and the PF (test_ukf_load, test_pf_load). */
+ * model m, encoder resolution rpc (rad per count). And an axis at rest whose
+ * counter glitches. The load tests of the UKF and the PF (test_ukf_load,
+ * test_pf_load). */
 #ifndef BR_TEST_PUSH_H
 #define BR_TEST_PUSH_H
 
@@ -36,6 +37,25 @@ static inline int br_test_run_pushed(const br_est_t *e, const br_model_cfg_t *m,
         const br_status_t st = e->step(e->ctx, &y, 0.0f, F_comp);
         assert_true(st == BR_OK || st == BR_W_OUTLIER);
         outliers += st == BR_W_OUTLIER;
+    }
+    return outliers;
+}
+
+/* An axis at rest (count 100, no torque) whose counter reads +off counts at
+ * period 200 only (slip 0: a spike) or from period 200 on (slip 1: a slip),
+ * n periods through e; returns the number of outlier steps, *F_max the
+ * largest |compensation| from period 200 on */
+static inline int br_test_run_glitch(const br_est_t *e, int32_t off, int slip, int n, float *F_max)
+{
+    int outliers = 0;
+    *F_max = 0.0f;
+    for (int k = 0; k < n; k++) {
+        const br_meas_t y = {100 + ((k == 200 || (slip && k > 200)) ? off : 0), 0.5f};
+        float F = 0.0f;
+        const br_status_t st = e->step(e->ctx, &y, 0.0f, &F);
+        assert_true(st == BR_OK || st == BR_W_OUTLIER);
+        outliers += st == BR_W_OUTLIER;
+        *F_max = (k >= 200) ? fmaxf(*F_max, fabsf(F)) : 0.0f;
     }
     return outliers;
 }
