@@ -10,6 +10,7 @@
 #define BR_TEST_PUSH_H
 
 #include <math.h>
+#include <stdio.h>
 
 #include "br_test.h"
 #include "bristle/br_est.h"
@@ -58,6 +59,20 @@ static inline int br_test_run_glitch(const br_est_t *e, int32_t off, int slip, i
         *F_max = (k >= 200) ? fmaxf(*F_max, fabsf(F)) : 0.0f;
     }
     return outliers;
+}
+
+/* What a glitch must leave (test_glitch_not_a_load): no load re-acquired, the
+ * compensation the friction's (< 2 % of the actuator's force max_N), a spike
+ * one outlier step and a slip the re-anchoring's reanchor_after */
+static inline void br_test_assert_glitch(int slip, int n_out, float F_max, uint32_t n_acq, uint32_t n_held,
+                                         float max_N, uint32_t reanchor_after)
+{
+    printf("  %s: %d outlier steps, %u held, %u re-acquisitions, max |compensation| %.2f N\n", slip ? "slip" : "spike",
+           n_out, n_held, n_acq, (double)F_max);
+    assert_int_equal(n_acq, 0u);
+    assert_true(n_held >= 1u);
+    assert_true(F_max < 0.02f * max_N);
+    assert_int_equal(n_out, slip ? (int)reanchor_after : 1);
 }
 
 #endif
