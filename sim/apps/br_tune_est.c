@@ -83,7 +83,7 @@ typedef struct {
 static const double pf_start2[4] = {2.2e-6, 9.71e-17, 2.46, 0.23};
 
 /* The tuned parameters: PF (q_omega, q_z, q_gp, R); UKF (q_theta, q_omega, q_z, q_gp, R). */
-static int n_params(const tune_t *t) { return t->pf ? 4 : 5; }
+static int n_params(int pf) { return pf ? 4 : 5; }
 
 static float *param_ptr(br_circle_cfg_t *c, int pf, int i)
 {
@@ -252,7 +252,7 @@ static void write_checkpoint(FILE *f, const tune_t *t)
 {
     fprintf(f, "/* checkpoint (--checkpoint): first search, iteration %d, %d evaluations: %.6e m at", t->ck_iter,
             t->ck_nfev, t->ck_f);
-    for (int i = 0; i < n_params(t); i++) fprintf(f, " %s=%.6e", param_name(t->pf, i), exp(t->ck_x[i]));
+    for (int i = 0; i < n_params(t->pf); i++) fprintf(f, " %s=%.6e", param_name(t->pf, i), exp(t->ck_x[i]));
     fprintf(f, " */\n");
 }
 
@@ -353,6 +353,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: --mslip-target needs the nominal objective (no --plants)\n", TOOL);
         return 2;
     }
+    /* Nelder-Mead's first simplex takes n + 1 evaluations (br_nm.c refuses less) */
+    if (max_fev > 0 && max_fev < n_params(strcmp(est, "pf") == 0) + 1) {
+        fprintf(stderr, "%s: --max-fev %ld: the search needs at least %d evaluations for --est %s\n", TOOL,
+                max_fev, n_params(strcmp(est, "pf") == 0) + 1, est);
+        return 2;
+    }
     if (checkpoint && max_fev > 0) {
         fprintf(stderr, "%s: --checkpoint has its own budget (%d): no --max-fev\n", TOOL, BR_TUNE_CHECKPOINT_FEV);
         return 2;
@@ -412,7 +418,7 @@ int main(int argc, char **argv)
      * have no delay, would be tuned around (the PF's settings switch there) */
     br_circle_use_delay_id(&t.base, 0);
     t.log = log_file.f;
-    const int n = n_params(&t);
+    const int n = n_params(t.pf);
     double x0[MAX_P], lo[MAX_P], hi[MAX_P];
     for (int i = 0; i < n; i++) {
         x0[i] = log((double)*param_ptr(&t.base, t.pf, i));

@@ -13,7 +13,7 @@ then DIR/summary.json ("controllers": median_m, p90_m, max_m, lost per
 controller; the paired tests; the regime analysis) and DIR/cdf.png.
 --diagnose-first K: the identified-model runs for the first K plants only
 (all by default). --check: exit 1 when an estimator on the nominal model is
-lost on any plant (docs/robustness.md, "Goals"). --check-safe (CI): exit 1
+lost on any plant (docs/robustness.md, "Results"). --check-safe (CI): exit 1
 when an estimator leaves the axis worse than H-inf only without a safe stop,
 or its median is not below a tenth of H-inf only's. --only: the controllers
 to run (hinf_only always), e.g. --only hinf_ukf,hinf_pf.

@@ -362,6 +362,10 @@ class ToolsTest(unittest.TestCase):
         r = run("br_tune_est", "--est", "ukf", "--out", header, "--mslip-target", "0.1", "--plants",
                 os.path.join(self.w, "none.json"))
         self.assert_refused(r, 2, "--mslip-target needs the nominal objective")
+        # below Nelder-Mead's first simplex (n + 1: 5 for the PF, 6 for the UKF): refused up front
+        for est, fev in (("pf", "4"), ("ukf", "5")):
+            self.assert_refused(run("br_tune_est", "--est", est, "--out", header, "--max-fev", fev), 2,
+                                "at least")
         r = run("br_tune_est", "--est", "ukf", "--out", header, "--checkpoint", "--max-fev", "6")
         self.assert_refused(r, 2, "--checkpoint has its own budget")
         self.assert_untouched(header, log)
