@@ -14,7 +14,11 @@
  *            (br_app_motion_cfg_t.stop_bound_m; the coast bound
  *            BR_MACHINE_COAST_M for the faults that switch the outputs
  *            off); standstill inside the stroke;
- *   an ordinary condition: nothing latches.
+ *   an ordinary condition: nothing latches; an encoder glitch (a spike or
+ *            a slip under the jump limit) moves the table by no more than
+ *            GLITCH_SPEED_SHARE of max_speed_mps over its cruise speed
+ *            (a glitch taken for a load puts the compensation on the
+ *            axis: docs/reliability.md, "Glitch or load").
  * Exit 1 when a bound is broken that --expect does not name, or a named one
  * holds (the list is out of date). */
 #include <math.h>
@@ -37,6 +41,12 @@
  * INJECT_AFTER_S into the cruise, then at most RUN_AFTER_S */
 #define INJECT_AFTER_S 0.2
 #define RUN_AFTER_S 3.0
+/* an ordinary encoder glitch: the peak table speed after it at most the
+ * cruise speed plus this share of max_speed_mps (5 mm/s on the reference
+ * machine; H-inf alone adds under 1e-3 m/s, the load states with the
+ * single-innovation rule 9e-3 to 2.4e-2 m/s: docs/reliability.md) */
+#define GLITCH_SPEED_SHARE 0.05
+
 /* standstill: the table slower than this for STILL_S, outputs off */
 #define STILL_MPS 1.0e-4
 #define STILL_S 0.05
@@ -290,6 +300,12 @@ static double stop_bound(int cause, const br_app_motion_cfg_t *mc)
     return (double)mc->stop_bound_m;
 }
 
+/* an ordinary encoder glitch: a one-read spike or a slip below the jump limit */
+static int glitch(const scenario_t *s)
+{
+    return s->ordinary && (s->kind == K_ENC_SPIKE || s->kind == K_ENC_OFFSET);
+}
+
 /* the bounds of the campaign (above); "" when they hold */
 static void judge(const scenario_t *s, const br_app_motion_cfg_t *mc, double dt_s, outcome_t *o)
 {
@@ -303,6 +319,8 @@ static void judge(const scenario_t *s, const br_app_motion_cfg_t *mc, double dt_
     else if (!s->ordinary && !o->latched) snprintf(o->broken, sizeof o->broken, "not detected");
     else if (o->latched && !o->still) snprintf(o->broken, sizeof o->broken, "no standstill");
     else if (!s->ordinary && o->peak_mps > v_lim) snprintf(o->broken, sizeof o->broken, "peak speed");
+    else if (glitch(s) && o->peak_mps > (s->speed_share + GLITCH_SPEED_SHARE) * (double)mc->max_speed_mps)
+        snprintf(o->broken, sizeof o->broken, "glitch moved the axis");
     else if (o->latched && o->stop_m > stop_bound(o->cause, mc)) snprintf(o->broken, sizeof o->broken, "stopping distance");
     else if (!(o->end_m >= lo && o->end_m <= hi)) snprintf(o->broken, sizeof o->broken, "beyond the stroke");
     else o->broken[0] = '\0';

@@ -42,6 +42,28 @@ static inline int br_test_run_pushed(const br_est_t *e, const br_model_cfg_t *m,
     return outliers;
 }
 
+/* The push of br_test_pushed_meas through e, the counter reading +500
+ * counts (a spike) at the period `after` periods after the first load
+ * re-acquisition (n_acq: the filter's count; after 0: no spike), n periods.
+ * Returns 1 when the spike's period re-acquired a load; *F_end the last
+ * compensation (the window of docs/modules/est.md, "Glitch or load") */
+static inline int br_test_run_push_spike(const br_est_t *e, const uint32_t *n_acq, const br_model_cfg_t *m,
+                                         double rpc, double F_N, int after, int n, float *F_end)
+{
+    int k_acq = -1, spike_acq = 0;
+    for (int k = 0; k < n; k++) {
+        br_meas_t y = br_test_pushed_meas(m, rpc, F_N, k);
+        const int spike = after > 0 && k_acq >= 0 && k == k_acq + after;
+        y.counts += spike ? 500 : 0;
+        const uint32_t acq0 = *n_acq;
+        const br_status_t st = e->step(e->ctx, &y, 0.0f, F_end);
+        assert_true(st == BR_OK || st == BR_W_OUTLIER);
+        k_acq = (k_acq < 0 && *n_acq > acq0) ? k : k_acq;
+        spike_acq |= spike && *n_acq > acq0;
+    }
+    return spike_acq;
+}
+
 /* An axis at rest (count 100, no torque) whose counter reads +off counts at
  * period 200 only (slip 0: a spike) or from period 200 on (slip 1: a slip),
  * n periods through e; returns the number of outlier steps, *F_max the
@@ -73,6 +95,28 @@ static inline void br_test_assert_glitch(int slip, int n_out, float F_max, uint3
     assert_true(n_held >= 1u);
     assert_true(F_max < 0.02f * max_N);
     assert_int_equal(n_out, slip ? (int)reanchor_after : 1);
+}
+
+/* test_glitch_in_window: acq[a] and F_end[a] of br_test_run_push_spike with
+ * after = a (0: no spike) under a push of F_N */
+static inline void br_test_assert_window(const int acq[4], const float F_end[4], double F_N)
+{
+    for (int a = 0; a < 4; a++) {
+        printf("  spike %d periods after the re-acquisition: re-acquired %d, compensation at top speed %.2f N (push %.1f N)\n",
+               a, acq[a], (double)F_end[a], F_N);
+    }
+    /* the window's limit (documented): a spike in the two periods after a re-acquisition is
+     * taken for a load */
+    assert_int_equal(acq[1], 1);
+    assert_int_equal(acq[2], 1);
+}
+
+/* periods of the push of F_N from rest until the machine's top speed v_max:
+ * 0.1 s still, then v_max J_eff / (L^2 F_N) */
+static inline int br_test_push_periods(const br_model_cfg_t *m, double F_N, double v_max)
+{
+    const double L = m->lead_mprad, Jeff = m->J_kgm2 + L * L * m->M_kg;
+    return 100 + (int)ceil(v_max * Jeff / (L * L * F_N) / m->dt_s);
 }
 
 #endif

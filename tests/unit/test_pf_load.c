@@ -148,6 +148,25 @@ static void test_glitch_not_a_load(void **st)
     }
 }
 
+/* A spike 1, 2 and 3 periods after a load's re-acquisition (the window of
+ * docs/modules/est.md, "Glitch or load") */
+static void test_glitch_in_window(void **st)
+{
+    (void)st;
+    br_pf_cfg_t c = load_cfg();
+    const double F = 0.5 * (double)c.load.max_N;
+    const int n = br_test_push_periods(&c.est.model, F, (double)BR_MACHINE_MAX_SPEED_MPS_F);
+    float F_end[4];
+    int acq[4];
+    for (int after = 0; after < 4; after++) {
+        assert_int_equal(init_with(c), BR_OK);
+        const br_est_t e = br_pf_est(&g_pf);
+        acq[after] = br_test_run_push_spike(&e, &g_pf.n_load_acq, &c.est.model, c.est.rad_per_count, F, after, n,
+                                            &F_end[after]);
+    }
+    br_test_assert_window(acq, F_end, F);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -156,6 +175,7 @@ int main(void)
         cmocka_unit_test(test_load_bounded),
         cmocka_unit_test(test_jump_not_a_load),
         cmocka_unit_test(test_glitch_not_a_load),
+        cmocka_unit_test(test_glitch_in_window),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
