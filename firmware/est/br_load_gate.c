@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Glitch or load (docs/modules/ukf.md, "Glitch or load"): see br_load_gate.h. */
+/* Glitch or load (docs/modules/est.md, "Glitch or load"): see br_load_gate.h. */
 #include "br_load_gate.h"
 
 #include <math.h>

@@ -133,7 +133,7 @@ float br_pf_load_update(br_pf_t *pf, float y_rel, float lmax, float sums[2], uin
     const float v = sums[1] / n - d * d;
     const float s0 = ((v > 0.0f) ? v : 0.0f) + pf->r_gate;
     if (!(lmax >= pf->outlier_l)) {
-        /* gated: re-acquired as a load when br_load_gate_gated (docs/modules/pf.md, "Glitch
+        /* gated: re-acquired as a load when br_load_gate_gated (docs/modules/est.md, "Glitch
          * or load") finds a change of at most 2 max_N over the k periods since the last
          * update (theta moved by -g k^2 dF) that explains it, F_d's variance inflated by that
          * change squared; an outlier otherwise (the first such innovation held as the

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Glitch or load: the discrimination the PF's and the UKF's external-force
  * states share (private to the firmware; br_load_gate_t in bristle/br_est.h;
- * docs/modules/ukf.md, "Glitch or load"). */
+ * docs/modules/est.md, "Glitch or load"). */
 #ifndef BR_LOAD_GATE_H
 #define BR_LOAD_GATE_H
 
