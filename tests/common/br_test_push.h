@@ -116,7 +116,7 @@ static inline void br_test_assert_window(const int acq[4], const float F_end[4],
 static inline int br_test_push_periods(const br_model_cfg_t *m, double F_N, double v_max)
 {
     const double L = m->lead_mprad, Jeff = m->J_kgm2 + L * L * m->M_kg;
-    return 100 + (int)ceil(v_max * Jeff / (L * L * F_N) / m->dt_s);
+    return (int)ceil(0.1 / m->dt_s) + (int)ceil(v_max * Jeff / (L * L * F_N) / m->dt_s);
 }
 
 #endif
