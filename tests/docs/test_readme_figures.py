@@ -11,7 +11,10 @@ figures are checked"):
 - the robustness medians and lost counts: docs/robustness-results.md, which
   sim/studies/robustness.py writes (`make robustness N=200`);
 - the fleet's ratios and run counts: docs/fleet.md's generated part, which
-  sim/studies/fleet.py --md writes (`make fleet N=200`).
+  sim/studies/fleet.py --md writes (`make fleet N=200`);
+- the drawn Maxwell-slip plants' stops and medians: docs/presliding-plants.md's
+  generated part, which sim/studies/mslip_plants.py --md writes
+  (`make mslip-plants N=200`).
 
 A README figure that disagrees fails the test; so does a README whose
 sentences or tables the parser no longer finds. Then every checked figure
@@ -201,6 +204,20 @@ def check_fleet(c, root):
         c.figure(m, 3, int(every["hinf_ukf"][2]), "fleet went to the end hinf_ukf")
 
 
+def check_mslip_plants(c, root):
+    page = os.path.join(root, "docs", "presliding-plants.md")
+    rows = table_rows(page, r"H-inf only|\+ UKF|\+ PF", "<!-- mslip-plants:begin -->")
+    m = c.find(r"the\s+UKF\s+on\s+" + NUM + r"\s+and\s+the\s+PF\s+on\s+" + NUM + r",.*?their\s+medians\s+are\s+"
+               + NUM + r"\s+m\s+\(UKF\)\s+and\s+" + NUM + r"\s+m\s+\(PF\)\s+against\s+" + NUM
+               + r"\s+m\s+for\s+H-inf\s+only", "the drawn Maxwell-slip plants' figures")
+    if m:
+        c.figure(m, 1, int(rows["+ UKF"][2]), "mslip plants hinf_ukf faulted")
+        c.figure(m, 2, int(rows["+ PF"][2]), "mslip plants hinf_pf faulted")
+        c.figure(m, 3, float(rows["+ UKF"][4]), "mslip plants hinf_ukf median")
+        c.figure(m, 4, float(rows["+ PF"][4]), "mslip plants hinf_pf median")
+        c.figure(m, 5, float(rows["H-inf only"][4]), "mslip plants hinf_only median")
+
+
 def check(text, summary, root, n_particles):
     c = Checks(text)
     check_demo_tables(c, summary, n_particles)
@@ -208,6 +225,7 @@ def check(text, summary, root, n_particles):
     check_iso_g(c, summary)
     check_robustness(c, root)
     check_fleet(c, root)
+    check_mslip_plants(c, root)
     return c
 
 
