@@ -25,6 +25,13 @@ at least GRID_MIN_QUANTA position steps, to GRID_MAX_M), whose coefficients
 Fc alpha_i are solved by bounded least squares (>= 0, model.COEF_LOWER):
 the weights that stay above MIN_SHARE of their sum are the element set.
 
+What a log pins: the elements' stiffnesses k_i = alpha_i Fs / d_i (the
+force-travel curve after a reversal) and the sliding level; the breakaway
+displacements at Fs, and so presliding_m, scale with the Fs the fit finds,
+which a log with little sliding near the Stribeck velocity does not fix
+(d_i / Fs is what the curve shows). On such a log presliding_m is as good
+as Fs (docs/diagnose.md, "presliding_hysteresis").
+
 The clamp recursion along the measured path is a composition of clamps:
 with y_k = z_k - x_k (x the path), y_k = clamp(y_k-1, -Delta_k - x_k,
 Delta_k - x_k), and the composition of two clamps is a clamp, so
@@ -56,7 +63,7 @@ GRID_N = 8                 # firmware/include/bristle/br_mslip.h's BR_MSLIP_MAX
 GRID_MIN_M = 0.3e-6        # presliding.md's range of breakaway displacements: 0.3 .. 30 um
 GRID_MAX_M = 30e-6
 GRID_MIN_QUANTA = 2.0      # a breakaway shorter than two position steps is not seen in a log
-MIN_SHARE = 1e-3
+MIN_SHARE = 0.01          # an element carrying less of the level is not worth its cycles in the estimator
 ELEMENT_COLS = tuple(f"ps_el{i}" for i in range(GRID_N))
 OWN_SHAPE = True           # the base's Stribeck shape was fitted with a bristle: searched again (model.add_with_shape)
 SHAPE_UNUSED = (0,)        # rho, in model.fit_shape's (log rho, beta, log vs)
@@ -114,7 +121,7 @@ def presliding_phi(prep, shape, ratio, nl):
     if nl.get("ps_grid"):
         key = ("ps_split", shape, ratio, nl["ps_grid"])
         u, rate = prep.memo(key, lambda: element_states(prep.dx, prep.dt, nl["ps_grid"], beta, vs, ratio))
-        return {c: beta * u[i] for i, c in enumerate(ELEMENT_COLS)}, rate.mean(axis=0)
+        return {c: beta * ui for c, ui in zip(ELEMENT_COLS, u)}, rate.mean(axis=0)
     d, a = np.asarray(nl["ps_breakaway"]), np.asarray(nl["ps_share"])
 
     def make():
@@ -126,6 +133,8 @@ def presliding_phi(prep, shape, ratio, nl):
 
 
 def search(prep, base, fit_with):
+    """The element set: the grid's weights by bounded least squares, the
+    elements above MIN_SHARE of their sum kept. None when none carries weight."""
     g = grid(prep)
     split = fit_with({"ps_grid": g, "ps_breakaway": None, "ps_share": None})
     w = np.array([max(split.coef.get(c, 0.0), 0.0) for c in ELEMENT_COLS])
