@@ -254,7 +254,9 @@ def markdown_extra(extras):
     L = ["## Pairs, triples, unexplained forces, other machines (EXTRA)", "",
          "Generator `axis` is tests/diagnose/axis_sim.py (cosine moves between random targets, 20 substeps, "
          "its own machines), `simlog` br_simlog. A case passes when the findings are exactly the hidden causes "
-         "(for none / unexplained: no finding and that verdict) with every parameter within 20 %.", "",
+         "(for none / unexplained: no finding and that verdict) with every parameter within 20 % (presliding_m: "
+         "35 %, PARAM_TOL_BY_NAME), and names no cause ABSENT lists for it (presliding_hysteresis on the "
+         "LuGre circle).", "",
          "| case | what | generator, machine | hidden | verdict, findings | parameter errors | held-out relerr "
          "nominal → extended (floor) | noise [N] |", "|---|---|---|---|---|---|---|---|"]
     for r in sorted(extras, key=lambda r: r["case"]):
