@@ -9,6 +9,7 @@ docs/diagnose.md, "presliding_hysteresis") without a simulated log:
   from a force made of it (the model's own force along a path with
   reversals of 5 to 60 um): its initial stiffness, and presliding_m when Fs
   is known;
+- a log with too few samples near reversals does not test the cause;
 - model.json's "presliding" object: every guard of its loader refuses
   what it should, and a model with it loads back to the same force;
 - machine.json: the element set becomes friction_model (maxwell_slip), which
@@ -88,12 +89,12 @@ TRUTH = {"Meff_kg": 35.0, "sigma2_Nspm": 50.0, "Fc_N": 7.0, "Fs_N": 18.0, "vs_mp
          "sigma1_Nspm": 0.0}
 
 
-def synthetic(elements, noise):
+def synthetic(elements, noise, n=20000):
     """A Prepared log of the path whose filtered force is the model's own with
     these elements (TRUTH's other parameters), plus white noise."""
     # sliding to 2 mm/s (100 vs): a log that shows the Stribeck curve, so that Fs, at which
     # presliding_m is defined, is identified (a presliding-only path leaves Fs and sigma2 free)
-    t, x = path(n=12000, slide_m=2.5e-3)
+    t, x = path(n=n, slide_m=2.5e-3)
     prep = signals.Prepared(Log("synthetic.csv", t, x, x, np.zeros(len(t)), DT, len(t)))
     truth = model.from_params(TRUTH, (ps.NAME,), nl=ps.from_elements(elements))
     prep.y = truth.predict(prep) + noise * np.random.default_rng(1).standard_normal(prep.n)
@@ -107,11 +108,18 @@ class SearchTest(unittest.TestCase):
         """The initial stiffness sum k_i (what the force-travel curve shows)
         within 10 %, and the held-out error well below the nominal's."""
         prep = synthetic(self.truth, noise=0.02)
+        self.assertGreaterEqual(ps.presliding_samples(prep), ps.MIN_PRESLIDING_SAMPLES)  # the log can show it
         nominal = model.fit_nominal(prep)
         fit = model.add_cause(prep, nominal, ps.NAME)
         k0 = TRUTH["Fs_N"] * sum(a / d for d, a in zip(self.truth["breakaway_m"], self.truth["share"]))
         self.assertLess(abs(fit.params()["sigma0_Npm"] / k0 - 1.0), 0.1, fit.params())
         self.assertLess(fit.relerr(prep, prep.test), 0.5 * nominal.relerr(prep, prep.test))
+
+    def test_not_tested_on_a_log_that_cannot_show_it(self):
+        """Under MIN_PRESLIDING_SAMPLES presliding samples the search gives None."""
+        prep = synthetic(self.truth, noise=0.02, n=12000)
+        self.assertLess(ps.presliding_samples(prep), ps.MIN_PRESLIDING_SAMPLES)
+        self.assertIsNone(model.add_cause(prep, model.fit_nominal(prep), ps.NAME))
 
     def test_presliding_m_with_fs_known(self):
         """Fs held (a machine file's, identify.py): presliding_m within 10 %."""

@@ -64,7 +64,7 @@ GRID_MIN_M = 0.3e-6        # presliding.md's range of breakaway displacements: 0
 GRID_MAX_M = 30e-6
 GRID_MIN_QUANTA = 2.0      # a breakaway shorter than two position steps is not seen in a log
 # a log with fewer presliding samples (moving, within GRID_MAX_M of a reversal, in the
-# training part) cannot show the cause: the identification run has 423, the 5 mm/s
+# training part) cannot show the cause: the identification run has 415, the 5 mm/s
 # back-and-forth 47, EMPS 45, and on each the element set lost to (or tied with) the
 # bristle on held-out data; the thesis circle has 4000 (docs/diagnose.md)
 MIN_PRESLIDING_SAMPLES = 500
@@ -139,7 +139,8 @@ def presliding_phi(prep, shape, ratio, nl):
 
 def presliding_samples(prep):
     """The training part's intervals that move within GRID_MAX_M of travel
-    after a reversal: where an element set and a bristle differ."""
+    after a reversal (the measured path steps): where an element set and a
+    bristle differ."""
     s = since_reversal(prep)[prep.train]
     return int(np.count_nonzero((s < GRID_MAX_M) & (prep.dx[prep.train] != 0.0)))
 
@@ -224,9 +225,11 @@ def report_nl(nl):
 
 
 def since_reversal(prep):
-    """The travel since the last reversal of the measured path, per interval, m."""
-    x = np.cumsum(prep.dx)
-    s = np.sign(prep.dx)
+    """The travel since the last reversal of the filtered path, per interval,
+    m (the filtered path: an encoder's count flickering at rest is no reversal)."""
+    dx = np.diff(prep.xf)
+    x = np.cumsum(dx)
+    s = np.sign(dx)
     # the direction of the last nonzero step, carried over the steps of zero
     idx = np.where(s != 0, np.arange(len(s)), 0)
     np.maximum.accumulate(idx, out=idx)
@@ -235,7 +238,7 @@ def since_reversal(prep):
     start = np.zeros(len(s), dtype=int)
     start[turn] = turn
     np.maximum.accumulate(start, out=start)
-    return np.abs(x - x[start] + prep.dx[start])
+    return np.abs(x - x[start] + dx[start])
 
 
 def evidence(r, p):
@@ -245,10 +248,11 @@ def evidence(r, p):
     near = s < L
     far = (s > 3.0 * L) & r.moving
     e_near = float(np.sqrt(np.mean(r.e[near] ** 2))) if near.any() else 0.0
-    e_far = float(np.sqrt(np.mean(r.e[far] ** 2))) if far.any() else 0.0
+    beyond = (f"against {float(np.sqrt(np.mean(r.e[far] ** 2))):.2f} N in sliding beyond {3e6 * L:.3g} um"
+              if far.any() else f"(the log slides nowhere beyond {3e6 * L:.3g} um)")
     els = ", ".join(f"{1e6 * q['breakaway_m']:.3g} um ({100 * q['share']:.0f} %)" for q in p["elements"])
     return (f"The nominal model's residual goes with the travel since the last reversal: RMS {e_near:.2f} N within "
-            f"{1e6 * L:.3g} um of a reversal against {e_far:.2f} N in steady sliding (residual vs time since a "
+            f"{1e6 * L:.3g} um of a reversal {beyond} (residual vs time since a "
             f"reversal); a Maxwell-slip element set (breakaway {els}) covers 90 % of the swing in "
             f"{1e6 * L:.3g} um with the elements' piecewise-linear curve, which one LuGre bristle cannot.")
 
