@@ -90,7 +90,8 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--duration S] [--seed N]\n"
             "          [--force-noise N] [--model MODEL.json] [--offset F] [--asym DFC,DFV]\n"
-            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--drift R] [--machine-out FILE] [--truth]\n"
+            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--drift R] [--gms D1,..,DN]\n"
+            "          [--machine-out FILE] [--truth]\n"
             BR_ARGS_COMMON_USAGE
             "  --out FILE          the log (CSV t,ref,pos,force; with --truth the plant's truth too)\n"
             "  --traj T            ident: an identification run (default); circle: the circle's x axis;\n"
@@ -102,6 +103,8 @@ static int usage(const char *argv0, FILE *to)
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
             "  --machine-out FILE  the run's machine file (not with circle)\n"
             "  cause options       switch causes on in the plant (docs/simlog.md)\n"
+            "  --gms D1,..,DN      the plant's friction Maxwell-slip: N <= 8 equal elements breaking away at\n"
+            "                      D1..DN m at Fs (the slip law and damping of the demo's hardware-like plant)\n"
             "bounds: --cycles 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N (docs/tools.md)\n",
             argv0, argv0, BR_TOOL_CYCLES_MAX, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
     return 2;
@@ -124,7 +127,44 @@ typedef struct {
     int truth;
     double duration, noise;
     br_plant_cfg_t causes;
+    int gms_n;                     /* --gms: elements, 0 = the LuGre plant */
+    double gms_d_m[BR_GMS_MAX];    /* their breakaway displacements at Fs */
 } opts_t;
+
+/* --gms D1,..,DN: N in 1..BR_GMS_MAX breakaway displacements, each in (0, 1e-2] m */
+static int parse_gms(const char *val, opts_t *o)
+{
+    double d[BR_GMS_MAX + 1];
+    const int n = br_parse_numbers(val, d, BR_GMS_MAX + 1);
+    if (n < 1 || n > BR_GMS_MAX) {
+        fprintf(stderr, "%s: bad value for --gms: %s (1 to %d breakaway displacements in m, comma-separated)\n",
+                TOOL, val, BR_GMS_MAX);
+        return 1;
+    }
+    for (int i = 0; i < n; i++) {
+        if (!(d[i] > 0.0 && d[i] <= 1e-2)) {
+            fprintf(stderr, "%s: bad value for --gms: %s (each breakaway displacement must be in (0, 0.01] m)\n",
+                    TOOL, val);
+            return 1;
+        }
+        o->gms_d_m[i] = d[i];
+    }
+    o->gms_n = n;
+    return 0;
+}
+
+/* the Maxwell-slip elements of --gms on the plant: equal shares, k_i = Fs / (N d_i),
+ * the hardware-like plant's slip law (C, element damping, docs/demo.md) */
+static void apply_gms(br_plant_cfg_t *plant, const opts_t *o)
+{
+    if (o->gms_n == 0) return;
+    double share[BR_GMS_MAX];
+    for (int i = 0; i < o->gms_n; i++) share[i] = 1.0 / o->gms_n;
+    br_gms_from_breakaway(&plant->gms, o->gms_n, o->gms_d_m, share, plant->Fs_N, BR_CIRCLE_HW_SIGMA1_NSPM);
+    plant->gms.clamp = 0;
+    plant->gms.C_mps = BR_CIRCLE_HW_C_MPS;
+    plant->gms.delta = 1.0;
+}
 
 /* every option checked: 0, 1 (--help), 3 (--version) or 2 (usage error, message printed) */
 static int parse(int argc, char **argv, opts_t *o)
@@ -138,6 +178,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"seed", required_argument, NULL, 's'},
                                          {"duration", required_argument, NULL, 'd'},
                                          {"force-noise", required_argument, NULL, 'n'},
+                                         {"gms", required_argument, NULL, 'g'},
                                          BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
     const int st = br_args_begin(&p, TOOL, argc, argv);
@@ -158,6 +199,7 @@ static int parse(int argc, char **argv, opts_t *o)
             bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &o->duration);
             break;
         case 'n': bad = br_arg_double(TOOL, p.opt, val, 0.0, BR_TOOL_NOISE_MAX_N, &o->noise); break;
+        case 'g': bad = parse_gms(val, o); break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
@@ -208,7 +250,7 @@ static void apply_causes(br_plant_cfg_t *plant, const br_plant_cfg_t *causes)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 8.0, 0.0, br_plant_cfg_reference()};
+    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 8.0, 0.0, br_plant_cfg_reference(), 0, {0.0}};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -227,6 +269,7 @@ int main(int argc, char **argv)
         return 1;
     }
     apply_causes(&plant, &opt.causes);
+    apply_gms(&plant, &opt);
 
     /* the outputs: temporary files beside their names until the run succeeded */
     br_outfile_t log_file, machine_file = {0};

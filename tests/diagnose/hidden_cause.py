@@ -41,8 +41,12 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import axis_sim  # noqa: E402
 
 CAUSES = ("none",) + causes.NAMES
+# the causes the seeded draw hides in identification logs of the reference machine (its order
+# fixes every case's seed); presliding_hysteresis is a plant whose presliding is not LuGre's:
+# its logs are EXTRA's circles of a Maxwell-slip plant (br_simlog --gms)
+DRAWN = tuple(c for c in CAUSES if c != "presliding_hysteresis")
 MASTER_SEED = 20261121
-DEFAULT_CASES = 42  # 6 per class: none and each of the six causes
+DEFAULT_CASES = 42  # 6 per class: none and each of the six drawn causes (DRAWN)
 PARAM_TOL = 0.20
 # the reference machine's friction, which br_simlog's plant has (through the
 # machine file's loader, firmware/design/machine.py)
@@ -55,7 +59,7 @@ FC_N, SIGMA2_NSPM = _REF["Fc_N"], _REF["sigma2_Nspm"]
 def draw(i, n_cases, master=MASTER_SEED):
     """Case i of n: its cause, hidden parameters, br_simlog flags, noise, seed."""
     order = np.random.default_rng(master).permutation(n_cases)
-    cause = CAUSES[int(order[i]) % len(CAUSES)]
+    cause = DRAWN[int(order[i]) % len(DRAWN)]
     rng = np.random.default_rng([master, i])
     sign = lambda: 1.0 if rng.random() < 0.5 else -1.0  # noqa: E731
     noise = float(rng.uniform(0.0, 0.2))
@@ -129,7 +133,22 @@ EXTRA = (
     # a pair that hides each other: no cause significant alone (selection.py, Pairs)
     ("pair", "axis", "reference", {"offset": -1.0, "gradient": 3.0}, 0.1,
      {"offset": {"force_N": -1.0}, "position_gradient": {"relative_slope_per_m": 3.0}}),
+    # presliding that is not LuGre's: the thesis circle (x axis, H-inf only) of the reference
+    # machine with a Maxwell-slip friction (br_simlog --gms: equal elements, the demo's slip
+    # law); presliding_m of presliding.md's formula for the element set. And the same circle
+    # on the LuGre plant, where presliding_hysteresis must not be named (ABSENT).
+    ("presliding, circle", "simlog", None, ["--traj", "circle", "--gms", "2e-6,5e-6,1e-5,2e-5"], 0.05,
+     {"presliding_hysteresis": {"presliding_m": 24e-6}}),
+    ("presliding, circle", "simlog", None, ["--traj", "circle", "--gms", "3e-6,1e-5,3e-5"], 0.1,
+     {"presliding_hysteresis": {"presliding_m": 42e-6}}),
+    ("LuGre circle", "simlog", None, ["--traj", "circle"], 0.05, {"unexplained": {}}),
 )
+# causes a case must not name (beside judge_extra's rules): presliding_hysteresis on a LuGre plant
+ABSENT = {"LuGre circle": ("presliding_hysteresis",)}
+# presliding_m's tolerance (docs/diagnose-hidden.md): on the circle the Stribeck level Fs, at which
+# presliding_m is defined, is weakly determined, and the diagnosis's clamp form is not the plant's
+# finite-C slip law (docs/modules/plant.md, "The clamp and the slip law")
+PARAM_TOL_BY_NAME = {"presliding_m": 0.35}
 
 
 def draw_extra(j):
@@ -180,6 +199,9 @@ def judge_extra(case, rep, secs):
     verdict = rep["verdict"]
     found = {f["cause"]: f["params"] for f in rep["findings"]}
     exp = case["expect"]
+    for c in ABSENT.get(case["label"], ()):
+        if c in found:
+            reasons.append(f"{c} named on a log whose plant does not have it")
     if exp == ["none"]:
         if verdict != "none" or found:
             reasons.append(f"verdict {verdict}, findings {sorted(found)}; hidden none")
@@ -194,7 +216,7 @@ def judge_extra(case, rep, secs):
                 if c in found:
                     e = (found[c][k] - v) / abs(v)
                     errs[f"{c}.{k}"] = e
-                    if not abs(e) <= PARAM_TOL:
+                    if not abs(e) <= PARAM_TOL_BY_NAME.get(k, PARAM_TOL):
                         reasons.append(f"{c}.{k} = {found[c][k]:.4g}, hidden {v:.4g} ({100 * e:+.1f} %)")
     return dict(case, verdict=verdict, ok=not reasons, reasons=reasons, param_errors=errs,
                 relerr_nominal=rep["nominal"]["relerr_percent"], relerr_extended=rep["extended"]["relerr_percent"],
@@ -232,7 +254,9 @@ def markdown_extra(extras):
     L = ["## Pairs, triples, unexplained forces, other machines (EXTRA)", "",
          "Generator `axis` is tests/diagnose/axis_sim.py (cosine moves between random targets, 20 substeps, "
          "its own machines), `simlog` br_simlog. A case passes when the findings are exactly the hidden causes "
-         "(for none / unexplained: no finding and that verdict) with every parameter within 20 %.", "",
+         "(for none / unexplained: no finding and that verdict) with every parameter within 20 % (presliding_m: "
+         "35 %, PARAM_TOL_BY_NAME), and names no cause ABSENT lists for it (presliding_hysteresis on the "
+         "LuGre circle).", "",
          "| case | what | generator, machine | hidden | verdict, findings | parameter errors | held-out relerr "
          "nominal → extended (floor) | noise [N] |", "|---|---|---|---|---|---|---|---|"]
     for r in sorted(extras, key=lambda r: r["case"]):
@@ -254,9 +278,9 @@ def markdown(results, command):
     extras = [r for r in results if "expect" in r]
     results = [r for r in results if "expect" not in r]
     n = len(results)
-    idx = {c: k for k, c in enumerate(CAUSES)}
+    idx = {c: k for k, c in enumerate(DRAWN)}
     cols = list(CAUSES) + ["error"]
-    m = np.zeros((len(CAUSES), len(cols)), dtype=int)
+    m = np.zeros((len(DRAWN), len(cols)), dtype=int)
     for r in results:
         m[idx[r["cause"]], cols.index(r["verdict"]) if r["verdict"] in cols else len(cols) - 1] += 1
     ok = sum(r["ok"] for r in results)
@@ -268,12 +292,12 @@ def markdown(results, command):
          f"{ok} cases passing every check (verdict, parameters within {100 * PARAM_TOL:.0f} %, held-out gain).", "",
          "## Confusion matrix (rows: hidden cause, columns: verdict)", "",
          "| hidden \\ verdict | " + " | ".join(cols) + " |", "|---" * (len(cols) + 1) + "|"]
-    for i, c in enumerate(CAUSES):
+    for i, c in enumerate(DRAWN):
         L.append(f"| {c} | " + " | ".join(str(x) for x in m[i]) + " |")
     L += ["", "## Parameter errors (verdict's finding against the hidden value)", "",
           "| case | cause | hidden | found error | held-out relerr nominal → extended | noise [N] |",
           "|---|---|---|---|---|---|"]
-    for r in sorted(results, key=lambda r: (CAUSES.index(r["cause"]), r["case"])):
+    for r in sorted(results, key=lambda r: (DRAWN.index(r["cause"]), r["case"])):
         hid = ", ".join(f"{k} = {v:.4g}" for k, v in r["truth"].items()) or "—"
         er = ", ".join(f"{k} {100 * v:+.2f} %" for k, v in r.get("param_errors", {}).items()) or "—"
         if not r["ok"]:
@@ -285,7 +309,7 @@ def markdown(results, command):
         for k, v in r.get("param_errors", {}).items():
             worst[(r["cause"], k)] = max(worst.get((r["cause"], k), 0.0), abs(v))
     L += ["", "## Largest parameter error per cause", "", "| cause | parameter | max abs error |", "|---|---|---|"]
-    for (c, k), v in sorted(worst.items(), key=lambda x: (CAUSES.index(x[0][0]), x[0][1])):
+    for (c, k), v in sorted(worst.items(), key=lambda x: (DRAWN.index(x[0][0]), x[0][1])):
         L.append(f"| {c} | {k} | {100 * v:.2f} % |")
     L.append("")
     if extras:
@@ -316,6 +340,7 @@ def main():
             with open(p) as f:
                 results += json.load(f)
         covered = {r["cause"] for r in results if "expect" not in r}
+        covered |= {c for r in results if "expect" in r for c in r["expect"] if c in CAUSES}
         bad = [r for r in results if not r["ok"]]
         if a.md:
             with open(a.md, "w") as f:

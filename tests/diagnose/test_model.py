@@ -230,18 +230,26 @@ class RegistryTest(unittest.TestCase):
              "sigma1_Nspm": 500.0, "offset_N": 1.5, "dFc_neg_N": 1.5, "dsigma2_neg_Nspm": 20.0, "ripple_amp_N": 0.8,
              "ripple_period_m": 0.006, "ripple_phase_rad": 0.4, "grad_per_m": 3.0, "delay_s": 0.002,
              "drift_per_s": 0.01}
+    # presliding_hysteresis's element set (model.json's "presliding"); with it the
+    # model's sigma0_Npm is the elements' initial stiffness Fs sum(share / breakaway)
+    elements = {"breakaway_m": [2e-6, 5e-6, 1e-5, 2e-5], "share": [0.25, 0.25, 0.25, 0.25]}
+    truth["sigma0_Npm"] = truth["Fs_N"] * sum(a / d for d, a in zip(elements["breakaway_m"], elements["share"]))
+
+    def fit(self):
+        nl = causes.get("presliding_hysteresis").from_elements(self.elements)
+        return model.from_params(self.truth, causes.NAMES, nl=nl)
 
     def test_every_parameter_round_trips(self):
         names = [q.name for q in causes.MODEL_PARAMS]
         self.assertEqual(len(names), len(set(names)))
         self.assertEqual(set(names), set(self.truth))
-        p = model.from_params(self.truth, causes.NAMES).params()
+        p = self.fit().params()
         self.assertEqual(list(p), names)  # nominal first, then each cause in registry order
         for k, v in self.truth.items():
             self.assertAlmostEqual(p[k], v, delta=1e-12 * abs(v), msg=k)
 
     def test_each_cause_module_is_complete(self):
-        f = model.from_params(self.truth, causes.NAMES)
+        f = self.fit()
         for m in causes.REGISTRY:
             for attr in ("NAME", "MEANING", "OPTION", "PARAMS", "NL", "search", "params", "from_params",
                          "report_params", "evidence", "closed_loop"):
@@ -253,10 +261,16 @@ class RegistryTest(unittest.TestCase):
         """The names ../shared/spec/measured-log.md gives each cause's findings."""
         spec = {"offset": {"force_N"}, "asymmetric_friction": {"Fc_pos_N", "Fc_neg_N", "Fv_pos_Nspm", "Fv_neg_Nspm"},
                 "position_ripple": {"period_m", "amplitude_N"}, "position_gradient": {"relative_slope_per_m"},
-                "actuator_delay": {"delay_s"}, "friction_drift": {"relative_rate_per_s"}}
+                "actuator_delay": {"delay_s"}, "friction_drift": {"relative_rate_per_s"},
+                "presliding_hysteresis": {"presliding_m", "elements"}}
         self.assertEqual(set(spec), set(causes.NAMES))
+        f = self.fit()
         for m in causes.REGISTRY:
-            self.assertLessEqual(spec[m.NAME], set(m.report_params(self.truth)), m.NAME)
+            self.assertLessEqual(spec[m.NAME], set(f.cause_params(m.NAME)), m.NAME)
+        ps = f.cause_params("presliding_hysteresis")
+        # presliding.md: four equal elements breaking away at 1, 3, 8, 20 um give 24 um; these 2, 5, 10, 20 um too
+        self.assertAlmostEqual(ps["presliding_m"], 24e-6, delta=1e-12)
+        self.assertEqual([e["breakaway_m"] for e in ps["elements"]], self.elements["breakaway_m"])
         a = causes.get("asymmetric_friction").report_params(self.truth)
         self.assertEqual((a["Fc_neg_N"], a["Fv_neg_Nspm"]), (9.5, 80.0))
 

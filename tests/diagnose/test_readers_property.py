@@ -135,9 +135,15 @@ def valid_models(draw):
         if all(k in p for k in names) and not holds(p):
             p[names[-1]] = 0.0  # 0 satisfies every relation (Fc_N > 0, sigma2_Nspm >= 0)
     nominal = {q.name: draw(in_bounds(q)) for q in params.NOMINAL}
-    return {"format": modelfile.MODEL_FORMAT, "causes": [c for c in causes.NAMES if c in listed],
-            "filter": {"order": 4, "fc_hz": draw(st.floats(min_value=1.0, max_value=500.0))},
-            "params": p, "nominal_params": nominal}
+    m = {"format": modelfile.MODEL_FORMAT, "causes": [c for c in causes.NAMES if c in listed],
+         "filter": {"order": 4, "fc_hz": draw(st.floats(min_value=1.0, max_value=500.0))},
+         "params": p, "nominal_params": nominal}
+    if modelfile.PRESLIDING in listed:
+        # its element set: 1..8 breakaway displacements in (0, 1e-2] m, shares summing to 1
+        d = draw(st.lists(st.floats(min_value=1e-9, max_value=1e-2), min_size=1, max_size=modelfile.ELEMENTS_MAX))
+        w = draw(st.lists(st.integers(1, 1000), min_size=len(d), max_size=len(d)))
+        m["presliding"] = {"breakaway_m": d, "share": [x / sum(w) for x in w]}
+    return m
 
 
 def mutate(data, text):

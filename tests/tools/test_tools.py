@@ -103,6 +103,11 @@ class ToolsTest(unittest.TestCase):
         r = run("br_simlog", "--out", out, "--machine-out", os.path.join(self.w, "m.json"), "--traj", "circle")
         self.assert_refused(r, 2, "does not apply to --traj circle")
         self.assert_untouched(out)
+        # --gms: 1..8 breakaway displacements, each in (0, 0.01] m
+        for bad in ("0", "-1e-6", "0.02", "nan", "1e-6,", "1e-6,2e-6,3e-6,4e-6,5e-6,6e-6,7e-6,8e-6,9e-6"):
+            r = run("br_simlog", "--out", out, "--traj", "circle", "--gms", bad)
+            self.assert_refused(r, 2, "bad value for --gms")
+            self.assert_untouched(out)
 
     def test_simlog_failed_run_writes_nothing(self):
         out, machine = self.existing("log.csv"), self.existing("log.machine.json")

@@ -141,7 +141,7 @@ def cmd_validate(args):
     m = modelfile.load(args.model)
     lg = logreader.read_log(args.log)
     prep = signals.Prepared(lg, fc_hz=m.get("filter", {}).get("fc_hz", signals.FC_HZ))
-    fit = model.from_params(m["params"], m.get("causes", []))
+    fit = modelfile.fit_of(m)
     w = prep.whole
     rel = fit.relerr(prep, w)
     if not math.isfinite(rel):

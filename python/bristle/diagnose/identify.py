@@ -40,6 +40,7 @@ import math
 
 import numpy as np
 
+from . import causes as causes_
 from . import model, selection
 
 Z = 1.96
@@ -77,7 +78,10 @@ def prior(machine):
 
 
 def _assessed(fit):
-    return [k for k in SCALE if k in fit.params()]
+    """The parameters assessed: SCALE's that the fit has and uses (an element
+    set replaces sigma0 and sigma1: causes' UNUSED_PARAMS)."""
+    unused = {k for m in causes_.of(fit.causes) for k in getattr(m, "UNUSED_PARAMS", ())}
+    return [k for k in SCALE if k in fit.params() and k not in unused]
 
 
 def sensitivity(prep, fit, p0):
@@ -89,7 +93,7 @@ def sensitivity(prep, fit, p0):
     tr = prep.train
 
     def pred(p):
-        return model.from_params(p, fit.causes).predict(prep)[tr]
+        return model.from_params(p, fit.causes, nl=fit.nl).predict(prep)[tr]
 
     y0 = pred(point)
     out = {}

@@ -61,6 +61,8 @@ def jackknife(prep, fit):
         full.update({f"{c}.{k}": v for k, v in fit.cause_params(c).items()})
     out = {}
     for k, v in full.items():
+        if not isinstance(v, float):
+            continue  # an element set (a list): its presliding_m has the interval
         th = np.array([e.get(k, np.nan) for e in ests])
         if not np.all(np.isfinite(th)):
             continue

@@ -23,6 +23,8 @@ marked "assumed"; what follows from the log and the rest is "derived". The
                    these keep the base's values ("assumed"; Fs_N scaled by the
                    base's Fs/Fc if the base's would be below Fc)
   causes           model.json's causes and their parameters, same names ("identified")
+  friction_model   presliding_hysteresis's element set as maxwell_slip ("identified"),
+                   when the other causes are ones the estimators combine with it
   estimator        the base's, as they are: format 2 states them in the
                    machine's own units (per second, in metres, in Fs, Fc and
                    Fs/sigma0), so they follow the identified friction and
@@ -40,7 +42,7 @@ import re
 import numpy as np
 
 from . import causes as causes_
-from . import closedloop, jsonfile, output, params
+from . import closedloop, jsonfile, modelfile, output, params
 from .logreader import LogError
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", ".."))
@@ -49,6 +51,9 @@ PRESLIDING_MIN_QUANTA = 2.0
 # the PF's g_p offset from an identified Stribeck curve relaxes with this time
 # constant (docs/modules/pf.md, "Fast moves": measured 10 periods of 1.5 ms)
 GP_CURVE_TAU_S = 0.015
+# the causes the firmware's estimation model takes beside a Maxwell-slip friction
+# (firmware/design/machine.py's friction_model check)
+MSLIP_COMBINES = ("actuator_delay",)
 
 
 def _loader():
@@ -236,6 +241,8 @@ def build(prep, diag, given=None, log_path=None):
             _set(m, path, p[q.name], prov, kind(path) if q.name in held and path in base_causes else
                  "assumed" if q.name in held else "identified")
 
+    _friction_model(m, diag, prov, notes)
+
     log_name = os.path.basename(log_path or prep.path)
     if given is None:
         m["name"] = re.sub(r"[^a-z0-9_-]+", "-", os.path.splitext(log_name)[0].lower()).strip("-_") or "machine"
@@ -247,6 +254,32 @@ def build(prep, diag, given=None, log_path=None):
                       "machines/reference.json, assumed)"))
     m["provenance"] = {k: prov[k] for k in sorted(prov) if prov[k] != "given"}
     return m, notes
+
+
+def _friction_model(m, diag, prov, notes):
+    """presliding_hysteresis found: the element set as the estimators'
+    Maxwell-slip friction (friction_model, docs/machine-file.md), which the
+    firmware's estimation model combines with actuator_delay only (the
+    loader's check): with another cause the file keeps LuGre, and says so."""
+    ps = causes_.get(modelfile.PRESLIDING)
+    others = sorted(c for c in m["causes"] if c not in MSLIP_COMBINES)
+    if modelfile.PRESLIDING in diag.extended.causes:
+        if others:
+            m.pop("friction_model", None)
+            notes.append("presliding_hysteresis: the element set is not written (friction_model): the firmware's "
+                         "estimation model does not combine maxwell_slip with %s yet; model.json has it"
+                         % ", ".join(others))
+            return
+        el = modelfile.presliding_elements(diag.extended.nl)
+        m["friction_model"] = {"model": "maxwell_slip", "breakaway_m": el["breakaway_m"], "share": el["share"]}
+        for f in ("model", "breakaway_m", "share"):
+            prov["friction_model." + f] = "identified"
+        notes.append("presliding_hysteresis: friction_model maxwell_slip with %d elements, presliding_m %.3g m"
+                     % (len(el["share"]), ps.presliding_m(el["breakaway_m"], el["share"])))
+    elif (m.get("friction_model") or {}).get("model") == "maxwell_slip" and others:
+        m.pop("friction_model")
+        notes.append("the given friction_model maxwell_slip is dropped: the log shows %s, which the firmware's "
+                     "estimation model does not combine with it yet" % ", ".join(others))
 
 
 def write(out_dir, prep, diag, given=None, log_path=None, say=print):

@@ -75,19 +75,28 @@ class Fit:
         }
         for m in causes_.of(self.causes):
             p.update(m.params(c, self.nl, p))
+        for adjust in causes_.hooks(causes_.of(self.causes), "adjust_nominal"):
+            adjust(p, self.nl)
         return {k: float(v) for k, v in p.items()}
 
     def cause_params(self, cause):
-        """The parameters the spec asks a finding of this cause to report."""
-        return causes_.get(cause).report_params(self.params())
+        """The parameters the spec asks a finding of this cause to report
+        (and what a cause reports from its nonlinear parameters: a list)."""
+        m = causes_.get(cause)
+        out = m.report_params(self.params())
+        if hasattr(m, "report_nl"):
+            out.update(m.report_nl(self.nl))
+        return out
 
 
-def from_params(p, causes):
-    """A Fit from physical parameters (a saved model)."""
+def from_params(p, causes, nl=None):
+    """A Fit from physical parameters (a saved model); nl: nonlinear
+    parameters that p does not hold (model.json's element set), taken where
+    the causes' own do not give them."""
     Fc = p["Fc_N"]
     shape = (p["sigma0_Npm"] / Fc, p["Fs_N"] / Fc, p["vs_mps"])
     coef = {"Meff": p["Meff_kg"], "sigma2": p["sigma2_Nspm"], "Fc": Fc, "sigma1": p["sigma1_Nspm"]}
-    nl = {}
+    nl = dict(nl or {})
     for m in causes_.of(causes):
         c, n = m.from_params(p)
         coef.update(c)
@@ -103,25 +112,37 @@ def _neg_ratio(mods, nl):
     return ratio
 
 
-FRICTION_HOOKS = ("stribeck_neg_ratio", "friction_scale", "friction_columns")
+FRICTION_HOOKS = ("stribeck_neg_ratio", "friction_scale", "friction_columns", "presliding_phi")
 
 
 def _friction_columns(prep, shape, mods, nl):
     """The friction columns (viscous, LuGre level, sigma1) with what the
-    causes do to the friction."""
+    causes do to the friction; a presliding cause replaces the bristle's
+    level and rate columns by its own (causes/presliding_hysteresis.py)."""
     fmods = [m for m in mods if any(hasattr(m, h) for h in FRICTION_HOOKS)]
 
     def make():
         rho, beta, vs = shape
         ratio = _neg_ratio(fmods, nl)
-        phi, zd = prep.memo(("bristle", shape, ratio),
-                            lambda: lugre.bristle_columns(prep.dx, prep.dt, rho, beta, vs, neg_ratio=ratio))
+        presliding = causes_.hooks(fmods, "presliding_phi")
+        if presliding:
+            phis, zd = presliding[0](prep, shape, ratio, nl)
+        else:
+            phi, zd = prep.memo(("bristle", shape, ratio),
+                                lambda: lugre.bristle_columns(prep.dx, prep.dt, rho, beta, vs, neg_ratio=ratio))
+            phis = {"Fc": phi}
         v = prep.v
         for scale in causes_.hooks(fmods, "friction_scale"):
             k = scale(prep, nl)
-            phi, zd, v = k * phi, k * zd, k * v
+            phis = {name: k * phi for name, phi in phis.items()}
+            zd, v = k * zd, k * v
         split = causes_.hooks(fmods, "friction_columns")
-        cols = split[0](prep, nl, v, phi) if split else {"sigma2": v, "Fc": prep.lp(phi)}
+        level = phis.get("Fc", np.zeros(prep.n))
+        cols = split[0](prep, nl, v, level) if split else {"sigma2": v, "Fc": prep.lp(level)}
+        if "Fc" not in phis:   # the split form of the element set: one level column per element
+            for name in ("Fc", "Fc_neg_split"):
+                cols.pop(name, None)
+            cols.update({name: prep.lp(phi) for name, phi in phis.items()})
         cols["sigma1"] = prep.lp(zd)
         return cols
 
@@ -151,6 +172,8 @@ def target(prep, causes, nl):
 # asymmetric cause's sigma2 + dsigma2_neg >= 0): a solution outside them is
 # solved again with the bounds (docs/diagnose.md, "Identifiability")
 COEF_LOWER = {"Meff": 1e-9, "sigma2": 0.0, "Fc": 1e-9, "sigma1": 0.0, "sigma2_neg": 0.0}
+# the split form of a presliding element set: each element's Fc alpha_i >= 0
+COEF_LOWER.update({name: 0.0 for m in causes_.REGISTRY for name in getattr(m, "ELEMENT_COLS", ())})
 
 # a parameter held at a value (prep.fixed, identify.py) as a linear
 # constraint on one coefficient: coef = value + sum(a * other coef)
@@ -229,6 +252,9 @@ def fit_shape(prep, causes, nl, starts=SHAPE_STARTS, max_nfev=40):
     hi = np.array([math.log(RHO_BOUNDS[1]), BETA_BOUNDS[1], math.log(VS_BOUNDS[1])])
     ratio = _neg_ratio(causes_.of(causes), nl)
     held = _held_shape(prep)
+    # a shape parameter the causes' friction does not use (rho with a Maxwell-slip element set)
+    for i in {i for m in causes_.of(causes) for i in getattr(m, "SHAPE_UNUSED", ())}:
+        held.setdefault(i, math.log(starts[0][0]) if i != 1 else starts[0][1])
     free = [i for i in range(3) if i not in held]
 
     def unpack(uf):
@@ -266,12 +292,36 @@ def search_cause(prep, base, cause, causes, nl):
 
 def add_cause(prep, base, cause):
     """base + cause with base's shape held: the cause's nonlinear parameters
-    searched, the coefficients solved. None if the cause cannot be fitted."""
+    searched, the coefficients solved. None if the cause cannot be fitted.
+    A cause that replaces the bristle (OWN_SHAPE: an element set) has its
+    shape searched with it (add_with_shape)."""
+    if getattr(causes_.get(cause), "OWN_SHAPE", False):
+        return add_with_shape(prep, base, cause)
     causes = base.causes + (cause,)
     extra = search_cause(prep, base, cause, causes, base.nl)
     if extra is None:
         return None
     return solve(prep, base.shape, causes, dict(base.nl, **extra))
+
+
+def add_with_shape(prep, base, cause, max_nfev=20):
+    """base + cause when the cause replaces the friction the base's shape was
+    fitted with: from the base's shape and each of SHAPE_STARTS, the cause's
+    search at that shape, the shape searched with it, the cause searched again
+    at the shape found; the lowest training error. None if it cannot be fitted."""
+    causes = base.causes + (cause,)
+    best = None
+    for start in (base.shape,) + SHAPE_STARTS:
+        at = solve(prep, start, base.causes, base.nl)
+        extra = search_cause(prep, at, cause, causes, base.nl)
+        if extra is None:
+            continue
+        fit = fit_shape(prep, causes, dict(base.nl, **extra), starts=(start,), max_nfev=max_nfev)
+        extra = search_cause(prep, fit, cause, causes, fit.nl)
+        fit = solve(prep, fit.shape, causes, dict(fit.nl, **extra))
+        if best is None or fit.train_sse < best.train_sse:
+            best = fit
+    return best
 
 
 def refine(prep, fit, rounds=2, max_nfev=40):

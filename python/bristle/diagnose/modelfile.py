@@ -7,17 +7,41 @@ loading (docs/diagnose.md, "Outputs" and "Parameters").
   params          its load-side parameters: params.NOMINAL and each cause's PARAMS
   nominal_params  the nominal model's
   filter          the low-pass the fit used (validate applies the same)
+  presliding      with the cause presliding_hysteresis: its element set,
+                  {"breakaway_m": [d_i at Fs_N, m], "share": [alpha_i, sum 1]}
 
 The plant simulator reads the same "params" (sim/plant/br_plant_json.c).
 Format 1 (older names: M_kg, Fv_Nspm, Fc_neg_N, Fv_neg_Nspm) is not read."""
+import math
+
 from . import causes as causes_
-from . import jsonfile, output, params, signals
+from . import jsonfile, model, output, params, signals
 from .logreader import LogError, short
 
 MODEL_FORMAT = "bristle-model/2"
+PRESLIDING = "presliding_hysteresis"
+SHARE_TOL = 1e-6   # firmware/design/machine.py's MSLIP_SHARE_TOL
+ELEMENTS_MAX = 8   # BR_MSLIP_MAX
 
 
 def build(prep, diag, log_path=None):
+    out = _build(prep, diag, log_path)
+    if PRESLIDING in diag.extended.causes:
+        out["presliding"] = presliding_elements(diag.extended.nl)
+    return out
+
+
+def presliding_elements(nl):
+    """The element set as model.json and machine.json write it: breakaway
+    displacements to 6 digits, shares to 6 decimals with the last one making
+    the sum 1 (the machine file's loader accepts 1e-6)."""
+    el = causes_.get(PRESLIDING).elements(nl)
+    share = [round(a, 6) for a in el["share"][:-1]]
+    share.append(round(1.0 - sum(share), 6))
+    return {"breakaway_m": output.rounded(el["breakaway_m"]), "share": share}
+
+
+def _build(prep, diag, log_path):
     return output.rounded({
         "generator": output.GENERATOR,
         "format": MODEL_FORMAT,
@@ -75,9 +99,42 @@ def load(path):
             problem = q.check(nom[q.name])
             if problem:
                 raise LogError(*where, "\"nominal_params\": " + problem)
+    _check_presliding(path, text, m, listed)
     filt = m.get("filter", {})
     fc = filt.get("fc_hz", signals.FC_HZ) if isinstance(filt, dict) else None
     problem = signals.FC_PARAM.check(fc)
     if problem:
         raise LogError(path, jsonfile.line_of(text, "fc_hz"), f"\"filter\": {problem}")
     return m
+
+
+def _check_presliding(path, text, m, listed):
+    """"presliding" is there exactly when the causes list presliding_hysteresis:
+    1..8 breakaway displacements in (0, 1e-2] m and as many shares in (0, 1]
+    summing to 1 within SHARE_TOL."""
+    ps = m.get("presliding")
+    where = path, jsonfile.line_of(text, "presliding")
+    if PRESLIDING not in listed:
+        if ps is not None:
+            raise LogError(*where, f"\"presliding\" given but \"causes\" does not list {PRESLIDING}")
+        return
+    if not isinstance(ps, dict) or set(ps) != {"breakaway_m", "share"}:
+        raise LogError(*where, f"{PRESLIDING} needs \"presliding\": {{\"breakaway_m\": [...], \"share\": [...]}}")
+    d, a = ps["breakaway_m"], ps["share"]
+    for name, v, hi in (("breakaway_m", d, 1e-2), ("share", a, 1.0)):
+        if not isinstance(v, list) or not 1 <= len(v) <= ELEMENTS_MAX:
+            raise LogError(*where, f"\"presliding\": {name} must be a list of 1 to {ELEMENTS_MAX} numbers")
+        for x in v:
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not 0.0 < x <= hi:
+                raise LogError(*where, f"\"presliding\": {name} value {short(repr(x))} must be in (0, {hi:g}]")
+    if len(d) != len(a):
+        raise LogError(*where, f"\"presliding\": {len(a)} shares for {len(d)} breakaway displacements")
+    if abs(math.fsum(a) - 1.0) > SHARE_TOL:
+        raise LogError(*where, f"\"presliding\": the shares sum to {math.fsum(a):.9g}, must be 1 (within {SHARE_TOL:g})")
+
+
+def fit_of(m):
+    """The extended model of a checked model file as a Fit."""
+    causes = m.get("causes", [])
+    nl = causes_.get(PRESLIDING).from_elements(m["presliding"]) if PRESLIDING in causes else None
+    return model.from_params(m["params"], causes, nl=nl)

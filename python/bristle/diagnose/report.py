@@ -141,6 +141,13 @@ def build(prep, diag, machine=None, closed=None, log_path=None, floor=None):
     return output.rounded(rep)
 
 
+def _param(k, v):
+    """"name = value" of a report parameter; an element set as its (breakaway, share) pairs."""
+    if isinstance(v, list):
+        return f"{k} = " + ", ".join(f"({e['breakaway_m']:.3g} m, {e['share']:.3g})" for e in v)
+    return f"{k} = {v:.4g}"
+
+
 def _fmt(v, unit=""):
     if v is None:
         return "—"
@@ -179,7 +186,7 @@ def markdown(rep, figures):
                "No named cause improves the held-out error significantly, but the nominal model's residual is "
                "above the noise floor: see Unexplained."), ""]
     for i, f in enumerate(rep["findings"], 1):
-        ps = ", ".join(f"{k} = {v:.4g}" + (f" [{f['intervals_95'][k][0]:.4g} .. {f['intervals_95'][k][1]:.4g}]"
+        ps = ", ".join(_param(k, v) + (f" [{f['intervals_95'][k][0]:.4g} .. {f['intervals_95'][k][1]:.4g}]"
                                             if k in f.get("intervals_95", {}) else "")
                        for k, v in f["params"].items())
         L += [f"{i}. **{f['cause']}**: {f['meaning']}. Parameters of the joint model with 95 % intervals: {ps}. "
@@ -191,7 +198,7 @@ def markdown(rep, figures):
               f"{100 * selection.BORDERLINE_GAIN:g} %, p < {selection.BORDERLINE_P:g}; not findings, not in the "
               "model; worth a second log):", ""]
         for c in rep["borderline"]:
-            ps = ", ".join(f"{k} = {v:.4g}" for k, v in c["params"].items())
+            ps = ", ".join(_param(k, v) for k, v in c["params"].items())
             L.append(f"- {c['cause']} ({c['meaning']}; {ps}): held-out relerr {c['base_relerr_percent']:.4g} % → "
                      f"{c['relerr_percent']:.4g} % ({100 * c['relative_gain']:.3g} %, p = {c['p_value']:.2g})")
         L.append("")

@@ -35,11 +35,16 @@ and, for the force model (model.py), the hooks it needs of:
   friction_columns(prep, nl, v, phi) -> dict
                                       the viscous and LuGre-level columns, replacing the nominal ones
   target(prep, nl) -> array           the force the model is compared with, replacing the filtered log's
+  presliding_phi(prep, shape, ratio, nl) -> dict
+                                      the friction level column(s), replacing the LuGre bristle's (and sigma1's)
+  adjust_nominal(p, nl)               its effect on the nominal parameters it reports (sigma0 of an element set)
+  report_nl(nl) -> dict               report parameters from its nonlinear ones (an element set: a list)
 
 and FIGURES, ((file, what, function(path, prep, diag)), ...), if it draws any.
 """
 from .. import params
-from . import actuator_delay, asymmetric_friction, friction_drift, offset, position_gradient, position_ripple
+from . import (actuator_delay, asymmetric_friction, friction_drift, offset, position_gradient, position_ripple,
+               presliding_hysteresis)
 
 REGISTRY = (
     offset,
@@ -48,6 +53,7 @@ REGISTRY = (
     position_gradient,
     actuator_delay,
     friction_drift,
+    presliding_hysteresis,
 )
 
 NAMES = tuple(m.NAME for m in REGISTRY)
@@ -66,8 +72,8 @@ def of(names):
 
 
 def present(p):
-    """The modules whose every parameter p (model.json "params") holds."""
-    return tuple(m for m in REGISTRY if all(q.name in p for q in m.PARAMS))
+    """The modules with parameters, every one of which p (model.json "params") holds."""
+    return tuple(m for m in REGISTRY if m.PARAMS and all(q.name in p for q in m.PARAMS))
 
 
 def hooks(mods, name):
