@@ -362,13 +362,14 @@ static void particle_one(br_pf_t *pf, const pred_t *c, const int kind, uint32_t 
     const int ext = kind == MODEL_EXT, ms = kind == MODEL_MS;
     const uint32_t m = pf->cfg.n_particles;
     float x[BR_NX], xn[BR_NX];
-    float el[BR_MSLIP_MAX], e1[BR_MSLIP_MAX];
+    float e1[BR_MSLIP_MAX];
     particle_get(pf, j, x);
     /* 1. predict: eq. 6 by RK4 (the PF's form with k_p, or the extended
      * model's), or the bounded scheme beyond the a h limit; the particles are
      * finite with g_p >= gp_min > 0. With elements the trapezoidal step with
      * the clamps (eqs. MS1, MS2; the particle's force f0 in kgp) */
     if (ms) {
+        float el[BR_MSLIP_MAX];
         for (int i = 0; i < c->k.km.n; i++) {
             el[i] = pf->ms[(uint32_t)i * m + j];
         }
