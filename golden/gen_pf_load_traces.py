@@ -4,12 +4,11 @@
 (docs/golden.md, "pf_load"):
 
   pf_load.csv    golden/ref/pf.py with cfg.load on ukf_load.csv's input
-                 (est_input.csv's counts with its encoder faults, the
+                 (est_input.csv's counts without the encoder faults, the
                  torque raised by L F_step over [LOAD_ON_K, LOAD_OFF_K):
                  gen_load_traces.load_inputs), one row per step: the input,
                  status, origin, noise position, outliers, re-anchoring,
-                 re-acquisition, the glitch gate's state, max log-weight,
-                 mean state, F_hat, ESS, F_d,
+                 re-acquisition, max log-weight, mean state, F_hat, ESS, F_d,
                  P after the update and before it (Pm), the cloud's mean
                  innovation d and spread v
   pf_load_x.csv  the particle set after step k, float32-rounded, at every
@@ -36,8 +35,7 @@ SYNC_EVERY = 10
 
 P_NAMES = ["00", "01", "02", "11", "12", "22"]
 PF_LOAD_COLUMNS = (["k", "counts", "frac", "u_prev_Nm", "status", "origin_counts", "noise_pos", "n_outliers",
-                    "reanchored", "load_acq", "gate_nu", "gate_k", "gate_w", "lmax", "theta", "omega", "z", "gp",
-                    "F_hat", "ess", "Fd"]
+                    "reanchored", "load_acq", "lmax", "theta", "omega", "z", "gp", "F_hat", "ess", "Fd"]
                    + ["P" + n for n in P_NAMES] + ["Pm" + n for n in P_NAMES] + ["innov_d", "spread_v"])
 PF_LOAD_X_COLUMNS = ["k", "j", "theta", "omega", "z", "gp", "idx_next"]
 
@@ -69,8 +67,8 @@ def run(cfg, inputs):
         lmax = 0.0 if primed else max(pf.l)
         Pm = pf.P if primed else pf.Pm
         rows.append([k, counts, frac, u_prev, st, pf.origin, pf.noise_pos, pf.n_outliers, int(pf.reanchored),
-                     int(pf.load_acq), *pf.gate.columns(), lmax, *pf.mean, pf.F_hat, pf.ess, pf.Fd,
-                     *upper(pf.P), *upper(Pm), pf.d, pf.v])
+                     int(pf.load_acq), lmax, *pf.mean, pf.F_hat, pf.ess, pf.Fd, *upper(pf.P), *upper(Pm),
+                     pf.d, pf.v])
         sets.append([x.copy() for x in pf.x])
         idx.append(None if primed else list(pf.idx))
     return rows, sets, idx
@@ -102,13 +100,11 @@ def generate(out_dir, m, gt, rows_in):
         ("load_on_k", gload.LOAD_ON_K), ("load_off_k", gload.LOAD_OFF_K), ("load_step_N", F_step)]
     paths = [gt.write_trace(out_dir, "pf_load", meta, PF_LOAD_COLUMNS, rows, [
         "golden/gen_pf_load_traces.py: golden/ref/pf.py (float64) with the shared external",
-        "force F_d (cfg.load) on est_input.csv's counts (with its encoder faults) and",
+        "force F_d (cfg.load) on est_input.csv's counts (without its encoder faults) and",
         "frac, the torque u_prev_Nm raised by L load_step_N over steps [load_on_k,",
         "load_off_k) (a load the plant never got). One row per step (k = 0 primes): the",
         "input, status, origin, noise position, consecutive outliers, re-anchored (0/1),",
-        "load re-acquired (0/1), the glitch gate after the step (gate_nu, gate_k,",
-        "gate_w: the held candidate's innovation, 0 none, its periods, the window),",
-        "max log-weight of the moved cloud (0 when priming),",
+        "load re-acquired (0/1), max log-weight of the moved cloud (0 when priming),",
         "mean state, F_hat (mean f_nl + F_d within +-load_max_N), ESS, F_d, the common",
         "error's P after the update and Pm before it (after the period's growth and any",
         "re-acquisition; P0 when priming), the predicted cloud's d = mean theta_j - y",

@@ -14,7 +14,6 @@
 #include "br_model_kernel.h"
 #include "br_pf_kernel.h"
 #include "br_pf_load.h"
-#include "br_load_gate.h"
 
 /* br_pf.c orchestrates one step; the hot loops of steps 1-5 are the kernel's
  * (br_pf_kernel.h: br_pf_kernel_* of the target, chosen by
@@ -714,7 +713,6 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         const float omega_meas = (shift + (y->frac - pf->prev_frac) * rpc) / (periods * pf->cfg.est.model.dt_s);
         const float d_th = y_rel - sum_state(pf, BR_X_THETA) * inv_m;
         const float d_om = omega_meas - sum_state(pf, BR_X_OMEGA) * inv_m;
-        br_load_gate_pass(&pf->load_gate); /* a re-anchored step is no load candidate */
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
             pf->x[BR_X_THETA][j] += d_th;

@@ -7,7 +7,6 @@
 #include <math.h>
 
 #include "br_check.h"
-#include "br_load_gate.h"
 #include "br_model_kernel.h"
 #include "br_pf_kernel.h"
 
@@ -27,7 +26,6 @@ br_status_t br_pf_load_init(br_pf_t *pf)
     pf->load_N = 0.0f;
     pf->load_g_radpN = 0.0f;
     pf->n_load_acq = 0u;
-    br_load_gate_reset(&pf->load_gate);
     for (int i = 0; i < 6; i++) {
         pf->load_P[i] = 0.0f;
     }
@@ -59,7 +57,6 @@ void br_pf_load_tick(br_pf_t *pf)
     if (!br_pf_load_on(pf)) {
         return;
     }
-    br_load_gate_tick(&pf->load_gate);
     /* the common error e = [dtheta, domega, dF] over one period (the cloud predicted with F_d):
      *   e <- Phi e + [0, 0, w],  Phi = [1 h -g; 0 1 -a; 0 0 1],  a = 2 g / h,  var w = q
      * P <- Phi P Phi^T + diag(0, 0, q) */
@@ -133,17 +130,14 @@ float br_pf_load_update(br_pf_t *pf, float y_rel, float lmax, float sums[2], uin
     const float v = sums[1] / n - d * d;
     const float s0 = ((v > 0.0f) ? v : 0.0f) + pf->r_gate;
     if (!(lmax >= pf->outlier_l)) {
-        /* gated: re-acquired as a load when br_load_gate_gated (docs/modules/est.md, "Glitch
-         * or load") finds a change of at most 2 max_N over the k periods since the last
-         * update (theta moved by -g k^2 dF) that explains it, F_d's variance inflated by that
-         * change squared; an outlier otherwise (the first such innovation held as the
-         * candidate the next one must confirm) */
-        const uint32_t ku = br_load_gate_gated(&pf->load_gate, -d, pf->n_predicted + 1u, pf->load_g_radpN, max_N);
-        if (ku == 0u) {
+        /* gated: re-acquired as a load when a change of at most 2 max_N over the k periods
+         * since the last measurement (theta moved by -g k^2 dF) explains it, F_d's variance
+         * inflated by that change squared; an outlier otherwise */
+        const float k = (float)pf->n_predicted + 1.0f;
+        const float df_raw = d / (pf->load_g_radpN * k * k);
+        if (!(fabsf(df_raw) <= 2.0f * max_N)) {
             return lmax;
         }
-        const float k = (float)ku;
-        const float df_raw = d / (pf->load_g_radpN * k * k);
         /* as if F_d's variance had been larger by df_raw^2 k periods ago: P += df_raw^2 b b^T,
          * b = [-g k^2, -2 g k / h, 1] the error a change of F_d then makes now */
         const float b[3] = {-pf->load_g_radpN * k * k, -2.0f * pf->load_g_radpN * k / pf->cfg.est.model.dt_s, 1.0f};
@@ -155,8 +149,6 @@ float br_pf_load_update(br_pf_t *pf, float y_rel, float lmax, float sums[2], uin
         P[4] += dv * b[1] * b[2];
         P[5] += dv;
         pf->n_load_acq++;
-    } else {
-        br_load_gate_pass(&pf->load_gate);
     }
     /* the Kalman update of the common error on theta's innovation nu = y - mean theta = -d
      * (H = [1 0 0], variance var + R + rpc^2/12): S = P00 + s0, K = P[:, 0] / S,

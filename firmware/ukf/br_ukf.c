@@ -8,7 +8,6 @@
 
 #include "bristle/br_encoder.h"
 #include "br_check.h"
-#include "br_load_gate.h"
 
 #define NM BR_UKF_NMAX
 
@@ -132,7 +131,6 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->n_recover = 0u;
     ukf->n_predicted = 0u;
     ukf->n_load_acq = 0u;
-    br_load_gate_reset(&ukf->load_gate);
     ukf->primed = 0;
     ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N},
                               {cfg->p0_var[0], cfg->p0_var[1], cfg->p0_var[2], cfg->p0_var[3]},
@@ -487,18 +485,13 @@ static int innovate(const br_ukf_t *ukf, const br_meas_t *y, const float xm[NM],
     return !(*nu * *nu > ukf->out_s2 * (*S + ukf->quant_var_rad2));
 }
 
-/* Load re-acquisition (cfg.load; docs/modules/ukf.md, "External force" and
- * "Glitch or load"): a gated innovation nu that br_load_gate_gated calls a
- * change of the external force over k periods since the last update, dF =
- * nu / (g k^2), g = L dt^2 / (2 J_eff). The last posterior, j = k - k0
- * periods after that update (k0 = the periods since the last measurement;
- * j > 0 when that measurement was held as the candidate), gets the
- * covariance the change would have had from the update on,
- *   P <- P + dF^2 v v^T,  v = [-g j^2, -2 g j / dt, 0, 0, 1]
- * (theta's and omega's response to F_d over j periods, eq. 1; j = 0: P_dd
- * += dF^2), and the period is predicted again into xm, Pm (the model's clock
- * put back first). Returns 1 when that prediction's innovation passes the
- * gate (ukf->P keeps the inflation), 0 otherwise (ukf->P, xm and Pm
+/* Load re-acquisition (cfg.load; docs/modules/ukf.md, "External force"): a
+ * gated innovation nu that a change of the external force explains, the force
+ * dF = nu / (g k^2), g = L dt^2 / (2 J_eff), k the periods since the last
+ * measurement, with |dF| <= 2 max_N: the last posterior's F_d variance is
+ * inflated by dF^2 and the period predicted again into xm, Pm (the model's
+ * clock put back first). Returns 1 when that prediction's innovation passes
+ * the gate (ukf->P keeps the inflation), 0 otherwise (ukf->P, xm and Pm
  * untouched). */
 static int load_reacquire(br_ukf_t *ukf, const br_meas_t *y, float u_a, float nu, float xm[NM], float Pm[NM][NM],
                           int *chol_reset)
@@ -506,31 +499,22 @@ static int load_reacquire(br_ukf_t *ukf, const br_meas_t *y, float u_a, float nu
     if (ukf->n == BR_NX) {
         return 0;
     }
-    const float g = ukf->load_rad_per_N2;
-    const uint32_t k0 = ukf->n_predicted + 1u;
-    const uint32_t ku = br_load_gate_gated(&ukf->load_gate, nu, k0, g, ukf->cfg.load.max_N);
-    if (ku == 0u) {
-        return 0; /* an outlier (perhaps the held candidate) */
+    const float k = (float)ukf->n_predicted + 1.0f;
+    const float dF = nu / (ukf->load_rad_per_N2 * k * k);
+    if (!(fabsf(dF) <= 2.0f * ukf->cfg.load.max_N)) {
+        return 0;
     }
-    const float k = (float)ku, j = (float)(ku - k0);
-    const float dF = nu / (g * k * k);
-    const float v[NM] = {-g * j * j, -2.0f * g * j / ukf->cfg.est.model.dt_s, 0.0f, 0.0f, 1.0f};
-    float keep[NM][NM];
-    /* P += dF^2 v v^T (the last posterior's), then the period again from it */
-    for (int r = 0; r < NM; r++) {
-        for (int c = 0; c < NM; c++) {
-            keep[r][c] = ukf->P[r][c];
-            ukf->P[r][c] += dF * dF * v[r] * v[c];
-        }
-    }
+    const float keep = ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD];
+    /* P_dd += dF^2 (the last posterior's), then the period again from it */
+    ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD] = keep + dF * dF;
     br_model_set_clock(&ukf->model, ukf->model.n_steps - 1u);
     float xr[NM], Pr[NM][NM], th, nu_r, S_r;
     int reset = 0;
     if (predict(ukf, u_a, xr, Pr, &reset) && innovate(ukf, y, xr, (const float(*)[NM])Pr, &th, &nu_r, &S_r)) {
-        for (int r = 0; r < NM; r++) {
-            xm[r] = xr[r];
-            for (int c = 0; c < NM; c++) {
-                Pm[r][c] = Pr[r][c];
+        for (int i = 0; i < ukf->n; i++) {
+            xm[i] = xr[i];
+            for (int j = 0; j < ukf->n; j++) {
+                Pm[i][j] = Pr[i][j];
             }
         }
         *chol_reset = *chol_reset || reset;
@@ -540,11 +524,7 @@ static int load_reacquire(br_ukf_t *ukf, const br_meas_t *y, float u_a, float nu
         return 1;
     }
     /* not a load: the first prediction stands (its clock too: predict ticked again) */
-    for (int r = 0; r < NM; r++) {
-        for (int c = 0; c < NM; c++) {
-            ukf->P[r][c] = keep[r][c];
-        }
-    }
+    ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD] = keep;
     return 0;
 }
 
@@ -574,7 +554,6 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     /* 1.-2. sigma points of the last posterior, predicted mean and covariance */
     float xm[NM], Pm[NM][NM];
     int chol_reset;
-    br_load_gate_tick(&ukf->load_gate);
     if (!predict(ukf, u_a, xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }
@@ -607,13 +586,11 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
             elements_shift(ukf, ukf->cfg.est.model.lead_mprad * nu);
             reset_cov(ukf, Pm);
             origin_new = y->counts;
-            br_load_gate_pass(&ukf->load_gate); /* a re-anchored step is no candidate */
             if (!vec_finite(xm, n)) {
                 return fail_reset(ukf);
             }
         }
     } else {
-        br_load_gate_pass(&ukf->load_gate);
         /* gain K = P- H^T / S = P-_{:,0} / S; mean x+ = x- + K nu (theta in the new frame) */
         float K[NM];
         for (int i = 0; i < n; i++) {
@@ -690,7 +667,6 @@ br_status_t br_ukf_predict(br_ukf_t *ukf, float u_prev_Nm)
     int chol_reset;
     /* no measurement: the delay's identification starts again at the next one */
     ukf->dlyid.primed = 0;
-    br_load_gate_tick(&ukf->load_gate);
     if (!predict(ukf, br_est_delay_apply(&ukf->delay, u_prev_Nm), xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }

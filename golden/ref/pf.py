@@ -60,20 +60,15 @@ g = L h^2 / (2 J_eff), Phi = [1 h -g; 0 1 -2g/h; 0 0 1].
     1. the particles are predicted with the torque u - L F_d
     after 2. (the valid predicted particles, n of them, theta relative to the
     new origin): d = mean(theta_j) - y, v = max(0, mean((theta_j - mean)^2))
-       gated (max l below the outlier threshold): nu = -d goes to the gate
-         (docs/modules/est.md, "Glitch or load"; golden/ref/load_gate.py;
-         k0 = 1, this reference measures every period); it returns 0:
-         nothing more, the step goes on as an outlier (a held candidate or
-         none); k > 0: P += dF^2 b b^T, dF = d / (g k^2),
+       gated (max l below the outlier threshold): dF = d / (g k^2), k = 1
+         (the periods since the last measurement); |dF| > 2 max_N: nothing
+         more, the step goes on as an outlier; otherwise P += dF^2 b b^T,
          b = [-g k^2, -2 g k / h, 1], a re-acquisition (n_load_acq + 1)
-       not gated: the gate's candidate dropped
        S = P00 + v + R + rpc^2/12, K = P[:, 0] / S, nu = -d,
        theta_j += K0 nu, omega_j += K1 nu (each valid particle; f_nl and l_j
        made again), F_d <- clamp(F_d + K2 nu, +-max_N), P <- P - K P[0, :]
        The outlier decision and steps 3-5 then take the moved cloud.
     F_hat = clamp(mean f_nl + F_d, +-max_N).
-    The gate ticks at the start of every step after priming; a re-anchoring
-    drops its candidate.
 """
 import bisect
 import math
@@ -83,7 +78,6 @@ import numpy as np
 
 from . import model as rmodel
 from . import mslip as rmslip
-from .load_gate import LoadGate
 
 BR_OK = 0
 BR_E_INPUT = -3
@@ -169,7 +163,6 @@ class Pf:
         # cfg.load: F_d, the common error's covariance, re-acquisitions
         self.Fd = 0.0
         self.n_load_acq = 0
-        self.gate = LoadGate()
         self.load_acq = False   # the last step re-acquired
         self.d = 0.0            # the last step's mean innovation mean(theta_j) - y (before the move)
         self.v = 0.0            # and the spread var(theta_j)
@@ -235,7 +228,6 @@ class Pf:
         shift = wrapdiff(counts, self.origin) * rpc
         y = frac * rpc
         if c.load is not None:
-            self.gate.tick()
             # the common error's covariance over the period; the torque with the load
             self.P = self.Phi @ self.P @ self.Phi.T + np.diag([0.0, 0.0, c.load.q_N2])
             u = u - c.model.L * self.Fd
@@ -288,7 +280,6 @@ class Pf:
         self.n_outliers = self.n_outliers + 1 if outlier else 0
         self.reanchored = self.n_outliers >= c.reanchor_after
         if self.reanchored:
-            self.gate.passed()
             w_meas = (shift + (frac - self.prev_frac) * rpc) / c.dt
             th = sum(xj[0] for xj in self.x) / c.m
             om = sum(xj[1] for xj in self.x) / c.m
@@ -317,17 +308,15 @@ class Pf:
         self.v = float(np.mean((th - np.mean(th)) ** 2))
         self.load_acq = False
         if gated:
-            k = self.gate.gated(-self.d, 1, self.g, ld.max_N)
-            if k == 0:
+            k = 1.0  # periods since the last measurement (this reference measures every period)
+            dF = self.d / (self.g * k * k)
+            if not abs(dF) <= 2.0 * ld.max_N:
                 self.Pm = self.P.copy()
                 return max(l)
-            dF = self.d / (self.g * k * k)
             b = np.array([-self.g * k * k, -2.0 * self.g * k / c.dt, 1.0])
             self.P = self.P + dF * dF * np.outer(b, b)
             self.load_acq = True
             self.n_load_acq += 1
-        else:
-            self.gate.passed()
         self.Pm = self.P.copy()
         S = self.P[0, 0] + self.v + c.r_var + c.rad_per_count ** 2 / 12.0
         K = self.P[:, 0] / S

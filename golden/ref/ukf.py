@@ -39,19 +39,14 @@ load side, against +x as friction is:
     F_d' = 0, Q_dd = load.q_N2, P0_dd = load.p0_N2, F_d = 0 when priming,
     |F_d| <= load.max_N: the mean clamped after each update;
     F_hat = sum Wm_j (f_nl(X_j) + F_d_j), clamped to +-load.max_N.
-Re-acquisition (docs/modules/est.md and ukf.md, "Glitch or load";
-golden/ref/load_gate.py): a gated innovation nu (step 4) goes to the gate
-(k0 = 1 period since the last measurement: this reference measures every
-period); the gate ticks at the start of every step after priming, drops its
-candidate on an update or a re-anchoring. When it returns k > 0, the force
-change dF = nu / (g k^2), g = L dt^2 / (2 J_eff) (theta's response to a
-constant force over one period from rest: (L F / J_eff) dt^2 / 2), inflates
-the last posterior (j = k - k0 periods after the update):
-    P <- P + dF^2 v v^T,  v = [-g j^2, -2 g j / dt, 0, 0, 1],
-step 2 is repeated from it and the gate applied to the new innovation;
-passing, it is an ordinary update (BR_OK, counted in n_load_acq) of that
-prediction. Failing (or k = 0), the step is the outlier of the first
-prediction (P not inflated).
+Re-acquisition: a gated innovation nu (step 4) over k = 1 period since the
+last measurement is explained by a force change dF = nu / (g k^2),
+g = L dt^2 / (2 J_eff) (theta's response to a constant force over one
+period from rest: (L F / J_eff) dt^2 / 2). If |dF| <= 2 load.max_N, the last
+posterior's P_dd is increased by dF^2, step 2 is repeated from it and the gate
+applied to the new innovation; passing, it is an ordinary update (BR_OK,
+counted in n_load_acq) of that prediction. Failing, the step is the outlier
+of the first prediction (P_dd not inflated).
 
 Maxwell-slip elements (cfg.mslip, docs/modules/ukf.md "Maxwell-slip
 elements"; None: LuGre): the friction is that of element deflections e
@@ -73,7 +68,6 @@ import numpy as np
 
 from . import model as rmodel
 from . import mslip as rmslip
-from .load_gate import LoadGate
 
 BR_OK = 0
 BR_E_INPUT = -3
@@ -153,7 +147,6 @@ class Ukf:
         self.n_outliers = 0
         self.n_recover = 0
         self.n_load_acq = 0
-        self.gate = LoadGate()
         self.primed = False
         self.F_hat = 0.0
         self.nu = 0.0
@@ -245,21 +238,16 @@ class Ukf:
 
     def _reacquire(self, nu, u, counts, frac):
         """Load re-acquisition of a gated nu: the prediction from the posterior
-        inflated by a force change over the gate's k periods and its
-        innovation, or None when the gate holds nu or calls it an outlier, or
-        the new innovation is gated too."""
+        with P_dd + dF^2 and its innovation, or None when no force change
+        within 2 max_N explains nu or the new innovation is gated too."""
         c = self.cfg
         if c.load is None:
             return None
-        k0 = 1
-        k = self.gate.gated(nu, k0, self.g_load, c.load.max_N)
-        if k == 0:
+        dF = nu / (self.g_load * 1.0 * 1.0)    # k = 1 period since the last measurement
+        if not abs(dF) <= 2.0 * c.load.max_N:
             return None
-        dF = nu / (self.g_load * k * k)
-        # theta's and omega's response to F_d over the j periods from the update to the last posterior
-        j = k - k0
-        v = [-self.g_load * j * j, -2.0 * self.g_load * j / c.dt, 0.0, 0.0, 1.0]
-        P = [[self.P[r][s] + dF * dF * v[r] * v[s] for s in range(self.n)] for r in range(self.n)]
+        P = [list(row) for row in self.P]
+        P[NX][NX] = P[NX][NX] + dF * dF
         pred = self._predict(self.x, P, u)
         if pred is None:
             return None
@@ -286,7 +274,6 @@ class Ukf:
             self.primed = True
             return BR_OK
         status = BR_OK
-        self.gate.tick()
         # 1.-2. sigma points and prediction
         pred = self._predict(self.x, self.P, u)
         if pred is None:
@@ -317,13 +304,11 @@ class Ukf:
                 P_new = self._P0()
                 origin_new = int(counts)
                 self.reanchored = True
-                self.gate.passed()
                 em = em + c.model.L * nu   # the elements with the position's jump to the measurement
         else:
             # 5. update
             status_o = BR_OK
             n_out = 0
-            self.gate.passed()
             xm = [th_new] + xm[1:]
             K = [Pm[r][0] / S for r in range(n)]
             x_new = [xm[r] + K[r] * nu for r in range(n)]

@@ -163,9 +163,6 @@ static void seed(br_ukf_t *f, const ukf_golden_t *g, int k)
     for (int i = 0; i < g->ne; i++) {
         f->el[i] = (float)br_trace_get(&g->u, k, g->c_e[i]);
     }
-    if (g->c_acq >= 0) {
-        br_trace_load_gate(&g->u, k, &f->load_gate);
-    }
     f->origin_counts = (int32_t)br_trace_get(&g->u, k, g->c_org);
     f->n_outliers = (uint32_t)br_trace_get(&g->u, k, g->c_nout);
     const br_meas_t y = meas(g, k);
@@ -391,23 +388,6 @@ static void run_one_step(int variant, const char *what)
     }
 }
 
-/* With the external force, a step at which the glitch gate decides (the
- * reference's step k re-acquires or is an outlier) or whose gate is armed
- * (a held candidate or an open window after step k - 1): there the UKF can
- * ring in a period-2 cycle of re-acquisitions whose end is a close decision
- * (docs/golden.md, "ukf_load"), so the free run starts again from the
- * reference's row k - 1 */
-static int gate_busy(const ukf_golden_t *g, int k)
-{
-    if (g->c_acq < 0) {
-        return 0;
-    }
-    const br_trace_t *t = &g->u;
-    return br_trace_get(t, k, g->c_acq) != 0.0 || (int)br_trace_get(t, k, g->c_st) == BR_W_OUTLIER ||
-           br_trace_get(t, k - 1, br_trace_col(t, "gate_nu")) != 0.0 ||
-           br_trace_get(t, k - 1, br_trace_col(t, "gate_w")) != 0.0;
-}
-
 static void run_free(int variant, const char *what, int k0)
 {
     ukf_golden_t g;
@@ -421,12 +401,7 @@ static void run_free(int variant, const char *what, int k0)
     if (k0 > 0) {
         seed(&f, &g, k0 - 1);
     }
-    long n_reseed = 0;
     for (int k = k0; k < g.nsteps; k++) {
-        if (k > k0 && gate_busy(&g, k)) {
-            seed(&f, &g, k - 1);
-            n_reseed++;
-        }
         const br_meas_t y = meas(&g, k);
         const br_status_t st = br_ukf_step(&f, &y, (float)br_trace_get(&g.in, k, g.c_uprev));
         tolerances(&g, &uc, k, (variant == V_MS) ? C_FREE_RUN_MS : C_FREE_RUN, tx, tP, &tF, &tnu, &tS, te);
@@ -438,9 +413,9 @@ static void run_free(int variant, const char *what, int k0)
         n_ra += (int)br_trace_get(&g.u, k, g.c_ra);
         n_acq += (g.c_acq >= 0) ? (int)br_trace_get(&g.u, k, g.c_acq) : 0;
     }
-    print_message("golden %-10s %d steps from %d (%ld outlier, %ld re-anchoring, %ld load re-acquired, %ld re-seeded), "
-                  "statuses %s, origin, outlier and re-acquisition counts %s\n", what, g.nsteps - k0, k0, n_out, n_ra,
-                  n_acq, n_reseed, e.bad_status ? "DIFFER" : "identical", e.bad_exact ? "DIFFER" : "identical");
+    print_message("golden %-10s %d steps from %d (%ld outlier, %ld re-anchoring, %ld load re-acquired), statuses %s, "
+                  "origin, outlier and re-acquisition counts %s\n", what, g.nsteps - k0, k0, n_out, n_ra, n_acq,
+                  e.bad_status ? "DIFFER" : "identical", e.bad_exact ? "DIFFER" : "identical");
     const long fails = err_print(&e, &g, what);
     free_all(&g);
     assert_int_equal(e.bad_status, 0);

@@ -341,10 +341,3 @@ br_est_cfg_t br_trace_est_cfg(const br_trace_t *t)
     e.rad_per_count = (float)br_trace_meta_num(t, "rad_per_count");
     return e;
 }
-
-void br_trace_load_gate(const br_trace_t *t, int row, br_load_gate_t *g)
-{
-    g->pend_nu = (float)br_trace_get(t, row, br_trace_col(t, "gate_nu"));
-    g->pend_k = (uint32_t)br_trace_get(t, row, br_trace_col(t, "gate_k"));
-    g->live = (uint32_t)br_trace_get(t, row, br_trace_col(t, "gate_w"));
-}

@@ -78,9 +78,4 @@ br_model_cfg_t br_trace_model_cfg(const br_trace_t *t);
  * and the noise, g_p range and gates), from a trace's metadata. */
 br_est_cfg_t br_trace_est_cfg(const br_trace_t *t);
 
-/* The load's glitch gate after a row (columns gate_nu, gate_k, gate_w of
- * golden/ref/load_gate.py: the held candidate's innovation, 0 for none, its
- * periods, the window), as the filter's br_load_gate_t (n_held kept). */
-void br_trace_load_gate(const br_trace_t *t, int row, br_load_gate_t *g);
-
 #endif

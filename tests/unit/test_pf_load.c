@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The PF's shared external force (cfg.load; docs/modules/pf.md, "External
- * force"): its configuration guards, a load step followed with one outlier
- * step (its first period held; without the state, the outliers it causes),
- * the compensation of friction + load within the bound, a counter jump no
- * load can explain still rejected, and encoder glitches no load. */
+ * force"): its configuration guards, a load step followed without an outlier
+ * (and, without it, the outliers it causes), the compensation of friction +
+ * load within the bound, and a counter jump no load can explain still
+ * rejected. */
 #include "br_test.h"
 #include "br_test_push.h"
 
@@ -79,9 +79,7 @@ static void test_load_step_followed(void **st)
     const double L = m->lead_mprad, Jeff = m->J_kgm2 + L * L * m->M_kg;
     const int n = (int)ceil(0.1 / m->dt_s) + (int)ceil((double)BR_MACHINE_MAX_SPEED_MPS_F * Jeff / (L * L * F) / m->dt_s);
     assert_int_equal(init_with(c), BR_OK);
-    /* one outlier step: the push's first period, held as the candidate its second confirms */
-    assert_int_equal(run_pushed(F, n, &comp), 1);
-    assert_int_equal(g_pf.load_gate.n_held, 1u);
+    assert_int_equal(run_pushed(F, n, &comp), 0);
     assert_true(g_pf.n_load_acq >= 1u);
     printf("  load %.1f N: compensation %.2f N, F_d %.2f N, %u re-acquisitions\n", F, (double)comp,
            (double)g_pf.load_N, g_pf.n_load_acq);
@@ -126,45 +124,49 @@ static void test_jump_not_a_load(void **st)
     assert_int_equal(g_pf.n_load_acq, acq);
 }
 
-/* docs/modules/pf.md, "Glitch or load": a 500-count spike and a 1000-count
- * slip at rest are forces of 116 and 233 N over one period, within 2 max_N;
- * taken for loads (the single-innovation rule) F_d swung +-450 N for 90
- * periods. Held as candidates, neither is confirmed (the spike comes back,
- * the slip stays: its error does not grow as a force's): no re-acquisition,
- * the compensation stays the friction's (< 2 % of the actuator's force), the
- * spike costs one outlier step and the slip the re-anchoring's
- * reanchor_after. */
-static void test_glitch_not_a_load(void **st)
+/* An axis at rest whose counter reads +off counts for one period (slip 0) or
+ * from then on (slip 1) from step 200 of 600: the re-acquisitions from then on
+ * and in the last 300 steps, the largest |F_d| after it and in the last 300. */
+static void glitch(int32_t off, int slip, uint32_t acq[2], float fd[2])
+{
+    br_pf_cfg_t c = load_cfg();
+    assert_int_equal(init_with(c), BR_OK);
+    fd[0] = fd[1] = 0.0f;
+    uint32_t acq0 = 0u, acq1 = 0u;
+    for (int k = 0; k < 600; k++) {
+        const br_meas_t y = {100 + ((k == 200 || (slip && k > 200)) ? off : 0), 0.5f};
+        const br_status_t st = br_pf_step(&g_pf, &y, 0.0f);
+        assert_true(st == BR_OK || st == BR_W_OUTLIER);
+        acq0 = (k == 199) ? g_pf.n_load_acq : acq0;
+        acq1 = (k == 299) ? g_pf.n_load_acq : acq1;
+        fd[k >= 300] = (k >= 200) ? fmaxf(fd[k >= 300], fabsf(g_pf.load_N)) : 0.0f;
+    }
+    acq[0] = g_pf.n_load_acq - acq0;
+    acq[1] = g_pf.n_load_acq - acq1;
+}
+
+/* docs/modules/pf.md, "Encoder glitches": a 500-count spike and a 1000-count slip
+ * are forces of 187 and 375 N over one period, within 2 max_N, so they are
+ * re-acquired as loads and F_d swings +-450 N period by period (as the UKF's);
+ * unlike the UKF's the cycle dies out: no re-acquisition and F_d back under
+ * 2 % of the actuator's force within 100 periods (measured on the reference
+ * machine: 85 / 80 re-acquisitions, over by k = 290). */
+static void test_glitch_cycle_ends(void **st)
 {
     (void)st;
     static const int32_t off[2] = {500, 1000};
     for (int slip = 0; slip < 2; slip++) {
-        br_pf_cfg_t c = load_cfg();
-        assert_int_equal(init_with(c), BR_OK);
-        float F_max;
-        const br_est_t e = br_pf_est(&g_pf);
-        const int n_out = br_test_run_glitch(&e, off[slip], slip, 600, &F_max);
-        br_test_assert_glitch(slip, n_out, F_max, g_pf.n_load_acq, g_pf.load_gate.n_held, c.load.max_N, c.est.reanchor_after);
+        uint32_t acq[2];
+        float fd[2];
+        glitch(off[slip], slip, acq, fd);
+        printf("  %s %d: %u re-acquisitions, max |F_d| %.1f N; after 100 periods %u, %.2f N\n",
+               slip ? "slip" : "spike", (int)off[slip], acq[0], (double)fd[0], acq[1], (double)fd[1]);
+        assert_true(acq[0] >= 1u); /* taken for a load: the finding */
+        assert_int_equal(acq[1], 0u);
+        /* back under 2 % of the actuator's force (measured < 0.1 N on the reference
+         * machine, 12.8 N of 785 N on machines/heavy.json) */
+        assert_true(fd[1] < 0.02f * g_pf.cfg.load.max_N);
     }
-}
-
-/* A spike 1, 2 and 3 periods after a load's re-acquisition (the window of
- * docs/modules/est.md, "Glitch or load") */
-static void test_glitch_in_window(void **st)
-{
-    (void)st;
-    br_pf_cfg_t c = load_cfg();
-    const double F = 0.5 * (double)c.load.max_N;
-    const int n = br_test_push_periods(&c.est.model, F, (double)BR_MACHINE_MAX_SPEED_MPS_F);
-    float F_end[4];
-    int acq[4];
-    for (int after = 0; after < 4; after++) {
-        assert_int_equal(init_with(c), BR_OK);
-        const br_est_t e = br_pf_est(&g_pf);
-        acq[after] = br_test_run_push_spike(&e, &g_pf.n_load_acq, &c.est.model, c.est.rad_per_count, F, after, n,
-                                            &F_end[after]);
-    }
-    br_test_assert_window(acq, F_end, F);
 }
 
 int main(void)
@@ -174,8 +176,7 @@ int main(void)
         cmocka_unit_test(test_load_step_followed),
         cmocka_unit_test(test_load_bounded),
         cmocka_unit_test(test_jump_not_a_load),
-        cmocka_unit_test(test_glitch_not_a_load),
-        cmocka_unit_test(test_glitch_in_window),
+        cmocka_unit_test(test_glitch_cycle_ends),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -62,23 +62,6 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg);
  * or exactly 0 where zero_ok. */
 int br_est_var_ok(float v, int zero_ok);
 
-/* The external-force states' glitch discrimination (cfg.load of the PF and the
- * UKF; docs/modules/est.md, "Glitch or load"): a gated innovation a force
- * change explains is held as a candidate for one measurement and re-acquired
- * as a load only when the next one has grown as a force's error grows
- * (quadratically); a glitch comes back or stays constant. After a
- * re-acquisition the load is known to be changing: the window is set to
- * BR_LOAD_LIVE_PERIODS and counted down at the start of every period, so a
- * gated innovation in the next two periods is re-acquired at once. */
-#define BR_LOAD_LIVE_PERIODS 3u
-
-typedef struct {
-    float pend_nu;     /* the held candidate's innovation (measurement - prediction, rad); 0: none */
-    uint32_t pend_k;   /* periods from the last update to the candidate */
-    uint32_t live;     /* periods left in which a gated innovation is re-acquired at once */
-    uint32_t n_held;   /* candidates held as outliers */
-} br_load_gate_t;
-
 /* Commands the estimators keep for an actuator delay (model.causes.delay_s):
  * delays up to BR_EST_DELAY_HIST - 2 periods. */
 #define BR_EST_DELAY_HIST 64u

@@ -180,7 +180,6 @@ typedef struct {
      * g = L h^2 / (2 J_eff) (rad per N over one period); the re-acquisitions counted */
     float load_N, load_P[6], load_g_radpN;
     uint32_t n_load_acq;
-    br_load_gate_t load_gate;     /* cfg.load: glitch or load (bristle/br_est.h) */
     int primed;                   /* particles drawn around the first measurement */
     /* particles as a structure of arrays: x[i][j] is state i of particle j.
      * One set, predicted and resampled in place (docs/modules/pf.md). */

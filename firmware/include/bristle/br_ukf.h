@@ -110,7 +110,6 @@ typedef struct {
                                         non-finite prediction or update) */
     uint32_t n_predicted;            /* predict-only steps since the last measurement */
     uint32_t n_load_acq;             /* gated innovations re-acquired as a load (cfg.load) */
-    br_load_gate_t load_gate;        /* cfg.load: glitch or load (bristle/br_est.h) */
     int primed;                      /* x, P set from the first measurement */
     br_ukf_est_t est;
     int ready;
