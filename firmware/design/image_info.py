@@ -52,7 +52,9 @@ def substeps_line(m, board, est, s):
     rho_h, n = machine.model_substeps(m, est)
     line = "model step: rho h = %.2f (the presliding mode against the period), %d sub-step%s" % (
         rho_h, n, "" if n == 1 else "s")
-    if n > 1 and est == "pf" and s:
+    if n > machine.model_substep_bounds()[1]:
+        line += ": more than BR_MODEL_SUB_MAX, the firmware refuses the estimator (br_model_init, BR_E_PARAM)"
+    elif n > 1 and est == "pf" and s:
         # the PF's n > 1 pass runs the reference kernel's loop, not the core's own (not measured):
         # n times the measured particle-step is an estimate only
         with open(COST, encoding="utf-8") as f:

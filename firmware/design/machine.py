@@ -711,6 +711,14 @@ def transient_m(m, est):
 MODEL_H = os.path.join(HERE, "..", "include", "bristle", "br_model.h")
 
 
+def model_substep_bounds():
+    """(BR_MODEL_SUB_RH_MAX, BR_MODEL_SUB_MAX) as firmware/include/bristle/br_model.h defines them"""
+    with open(MODEL_H, encoding="utf-8") as f:
+        h = f.read()
+    return (float(re.search(r"#define BR_MODEL_SUB_RH_MAX ([0-9.eE+-]+)f", h).group(1)),
+            int(re.search(r"#define BR_MODEL_SUB_MAX ([0-9]+)", h).group(1)))
+
+
 def model_substeps(m, est):
     """(rho h, n): the estimation model's sub-steps at estimator est's period as
     br_model_init chooses them (docs/modules/model.md, "Sub-steps"; the
@@ -721,8 +729,7 @@ def model_substeps(m, est):
     with Maxwell-slip elements (the model keeps one step)."""
     if mslip_elements(m):
         return 0.0, 1
-    with open(MODEL_H, encoding="utf-8") as f:
-        c = float(re.search(r"#define BR_MODEL_SUB_RH_MAX ([0-9.eE+-]+)f", f.read()).group(1))
+    c = model_substep_bounds()[0]
     p, T, _, _ = _scales(m, est)
     meff = p["Jeff_kgm2"] / (p["L_mprad"] * p["L_mprad"])
     wn = math.sqrt(p["sigma0_Npm"] / meff)
