@@ -566,7 +566,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             const float *const nz = pf->cfg.noise + p;
             const float s1 = ls.s1, s2 = ls.s2;
             const uint32_t left = ms ? br_pf_kernel_predict_ms(pf, &c.k, j, j1, nz, &ls)
-                                     : br_pf_kernel_predict(pf, &c.k, j, j1, nz, &ls);
+                                     : br_pf_predict_run(pf, &c.k, j, j1, nz, &ls);
             if (left > 0u) {
                 /* the fix-up: the particles the kernel left (l = NaN), one at a time */
                 for (uint32_t k = j; k < j1; k++) {

@@ -19,10 +19,6 @@
 uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                               br_pf_lsum_t *ls)
 {
-    if (c->n_sub != 1) {
-        /* sub-steps (docs/modules/model.md): the reference kernel's loop */
-        return br_pf_kref_predict(pf, c, j0, j1, nz, ls);
-    }
     const br_model_kp_t kp = c->kp;
     /* f_nl's L taken from kp (the same value): one constant fewer in the loop */
     br_model_k_t mk = c->mk;

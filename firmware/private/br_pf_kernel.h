@@ -175,12 +175,22 @@ static inline float br_pf_select(br_pf_t *pf, uint32_t total)
  * in particle order when nothing is left (the caller makes them again
  * otherwise). Returns the number of particles left. With n_sub > 1 the
  * prediction is n_sub sub-steps of RK4 (br_model_kp_rk4_n), every one inside
- * the limit; the target kernels hand such a pass to the reference kernel
- * (their own loops are the single step's). */
+ * the limit; the target kernels' loops are the single step's, so
+ * br_pf_predict_run hands such a pass to the reference kernel. */
 uint32_t br_pf_kref_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                             br_pf_lsum_t *ls);
 uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                               br_pf_lsum_t *ls);
+
+/* The thesis model's pass over particles j0 .. j1 - 1 as br_pf.c runs it:
+ * the target's kernel for one step per period, the reference kernel's
+ * sub-step loop for n_sub > 1 (docs/modules/model.md, "Sub-steps"); the
+ * test outside the kernels keeps their loops as they were. */
+static inline uint32_t br_pf_predict_run(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1,
+                                         const float *nz, br_pf_lsum_t *ls)
+{
+    return (c->n_sub != 1) ? br_pf_kref_predict(pf, c, j0, j1, nz, ls) : br_pf_kernel_predict(pf, c, j0, j1, nz, ls);
+}
 
 /* Steps 1 and 2 with elements (est.model.mslip.n >= 1; docs/modules/pf.md,
  * "Maxwell-slip elements"), bootstrap proposal, for particles j0 .. j1 - 1:

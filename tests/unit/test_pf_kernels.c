@@ -164,7 +164,7 @@ static uint32_t predict_both(br_pf_t *a, br_pf_t *b, const br_pf_kc_t *c, int k,
         const float *nz = a->cfg.noise + p;
         const float s1a = la.s1, s2a = la.s2, s1b = lb.s1, s2b = lb.s2;
         const uint32_t left_a = ms ? br_pf_kref_predict_ms(a, c, j, j1, nz, &la) : br_pf_kref_predict(a, c, j, j1, nz, &la);
-        const uint32_t lk = ms ? br_pf_kernel_predict_ms(b, c, j, j1, nz, &lb) : br_pf_kernel_predict(b, c, j, j1, nz, &lb);
+        const uint32_t lk = ms ? br_pf_kernel_predict_ms(b, c, j, j1, nz, &lb) : br_pf_predict_run(b, c, j, j1, nz, &lb);
         assert_int_equal(lk, left_a);
         assert_true(same_f(la.lmax, lb.lmax));
         assert_int_equal(la.n_valid, lb.n_valid);
