@@ -47,6 +47,26 @@ def share(m, board, est, period_s):
     return None
 
 
+def substeps_line(m, board, est, s):
+    """the model's sub-steps at the estimator's period (docs/modules/model.md, "Sub-steps")"""
+    rho_h, n = machine.model_substeps(m, est)
+    line = "model step: rho h = %.2f (the presliding mode against the period), %d sub-step%s" % (
+        rho_h, n, "" if n == 1 else "s")
+    if n > machine.model_substep_bounds()[1]:
+        line += ": more than BR_MODEL_SUB_MAX, the firmware refuses the estimator (br_model_init, BR_E_PARAM)"
+    elif n > 1 and est == "pf" and s:
+        # the PF's n > 1 pass runs the reference kernel's loop, not the core's own (not measured):
+        # n times the measured particle-step is an estimate only
+        with open(COST, encoding="utf-8") as f:
+            per = json.load(f)[BOARDS[board][1]]["pf_per_particle_step"]
+        extra = (n - 1) * per * m["estimator"]["pf"]["n_particles"]
+        line += "; about %.0f %% of the period more if each sub-step cost a measured particle-step (not measured)" % (
+            100.0 * extra / (s[0] / s[1]))
+    elif n > 1:
+        line += " (cost not measured)"
+    return line
+
+
 def main():
     if len(sys.argv) != 3 or sys.argv[2] not in BOARDS:
         sys.exit("usage: image_info.py MACHINE.json stm32h7|stm32g4")
@@ -58,6 +78,8 @@ def main():
     cost = ("%.0f instructions per period, %.1f %% of it at 1 instruction per cycle (make target-bench's costs, "
             "target/mps2/measured_cost.json)" % (s[0], 100.0 * s[1])) if s else "its cost on this core not measured"
     print("  estimator: %s at %g ms; %s" % (est, period * 1e3, cost))
+    if est in ("pf", "ukf"):
+        print("  " + substeps_line(m, sys.argv[2], est, s))
     return 0
 
 

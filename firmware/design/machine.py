@@ -708,6 +708,36 @@ def transient_m(m, est):
     return p["Fc_N"] * T * T / (2.0 * meff), zs
 
 
+MODEL_H = os.path.join(HERE, "..", "include", "bristle", "br_model.h")
+
+
+def model_substep_bounds():
+    """(BR_MODEL_SUB_RH_MAX, BR_MODEL_SUB_MAX) as firmware/include/bristle/br_model.h defines them"""
+    with open(MODEL_H, encoding="utf-8") as f:
+        h = f.read()
+    return (float(re.search(r"#define BR_MODEL_SUB_RH_MAX ([0-9.eE+-]+)f", h).group(1)),
+            int(re.search(r"#define BR_MODEL_SUB_MAX ([0-9]+)", h).group(1)))
+
+
+def model_substeps(m, est):
+    """(rho h, n): the estimation model's sub-steps at estimator est's period as
+    br_model_init chooses them (docs/modules/model.md, "Sub-steps"; the
+    bound BR_MODEL_SUB_RH_MAX read from firmware/include/bristle/br_model.h):
+    rho the presliding mode's spectral radius, the largest |s| of
+    s^2 + b s + wn^2 = 0 with wn^2 = sigma0 / Meff, b = (sigma1 + sigma2) / Meff
+    (eq. S1), n = max(1, ceil(rho h / BR_MODEL_SUB_RH_MAX)) (eq. S2); (0, 1)
+    with Maxwell-slip elements (the model keeps one step)."""
+    if mslip_elements(m):
+        return 0.0, 1
+    c = model_substep_bounds()[0]
+    p, T, _, _ = _scales(m, est)
+    meff = p["Jeff_kgm2"] / (p["L_mprad"] * p["L_mprad"])
+    wn = math.sqrt(p["sigma0_Npm"] / meff)
+    b = (p["sigma1_Nspm"] + p["sigma2_Nspm"]) / meff
+    rho = wn if b <= 2.0 * wn else 0.5 * (b + math.sqrt(b * b - 4.0 * wn * wn))
+    return rho * T, max(1, math.ceil(rho * T / c))
+
+
 def position_var_floor_m2(m, est):
     """The floor on the position's measurement variance beyond the quantisation: where the
     friction transient over a period d goes beyond the bristles' zone zs, the model's

@@ -14,6 +14,38 @@
  * at the reference machine's parameters, docs/modules/model.md). */
 #define BR_MODEL_BOUNDED_PASSES 3
 
+/* The sub-steps of one step of dt (docs/modules/model.md, "Sub-steps").
+ * In presliding (a h small, dz/dt = v) eq. 6 on the load side is the
+ * spring-damper  Meff v' = -(sigma1 + sigma2) v - sigma0 z,  Meff = Jeff / L^2,
+ * whose eigenvalues solve s^2 + b s + wn^2 = 0 with wn^2 = sigma0 / Meff and
+ * b = (sigma1 + sigma2) / Meff; their largest modulus is
+ *   rho = wn                                 for b <= 2 wn (complex pair)
+ *   rho = (b + sqrt(b^2 - 4 wn^2)) / 2       for b > 2 wn  (the fast real one)  (eq. S1)
+ *   n   = max(1, ceil(rho dt / BR_MODEL_SUB_RH_MAX))                          (eq. S2)
+ * With elements the model keeps one step (n = 1, rho h reported as 0). */
+static br_status_t sub_steps(const br_model_cfg_t *cfg, float *rho_h, int *n)
+{
+    *rho_h = 0.0f;
+    *n = 1;
+    if (cfg->mslip.n > 0) {
+        return BR_OK;
+    }
+    const float L2 = cfg->lead_mprad * cfg->lead_mprad;
+    const float meff = (cfg->J_kgm2 + L2 * cfg->M_kg) / L2;
+    const float wn2 = cfg->lugre.sigma0_Npm / meff, b = (cfg->lugre.sigma1_Nspm + cfg->sigma2_Nspm) / meff;
+    const float wn = sqrtf(wn2);
+    /* eq. S1 */
+    const float rho = (b <= 2.0f * wn) ? wn : 0.5f * (b + sqrtf(b * b - 4.0f * wn2));
+    /* eq. S2; beyond BR_MODEL_SUB_MAX (or not finite) the configuration is refused */
+    const float r = ceilf(rho * cfg->dt_s / BR_MODEL_SUB_RH_MAX);
+    if (!(r <= (float)BR_MODEL_SUB_MAX)) {
+        return BR_E_PARAM;
+    }
+    *rho_h = rho * cfg->dt_s;
+    *n = (r >= 1.0f) ? (int)r : 1;
+    return BR_OK;
+}
+
 br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
 {
     if (m == NULL || cfg == NULL) {
@@ -53,7 +85,12 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
                              c->drift_per_s != 0.0f)) {
         return BR_E_PARAM;
     }
+    st = sub_steps(cfg, &m->rho_h, &m->n_sub);
+    if (st != BR_OK) {
+        return st;
+    }
     m->cfg = *cfg;
+    m->h_sub_s = cfg->dt_s / (float)m->n_sub;
     float L = cfg->lead_mprad;
     int i;
     for (i = 0; i < BR_MSLIP_MAX; i++) {
@@ -127,7 +164,7 @@ void br_model_deriv(const br_model_t *m, const float x[BR_NX], float u_Nm, float
 void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u, float out[BR_NX])
 {
     const br_lugre_cfg_t *c = &m->cfg.lugre;
-    float h = m->cfg.dt_s;
+    float h = m->h_sub_s;
     float L = m->cfg.lead_mprad;
     float w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z], gp = x[BR_X_GP];
     float wm = w0, dth = 0.0f, z1 = z0, w1 = w0;
@@ -180,6 +217,31 @@ void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float
     out[BR_X_GP] = gp;
 }
 
+void br_model_sub_steps(const br_model_t *m, const br_model_kx_t *kx, const br_model_kp_t *kp, float kp_p,
+                        const float x[BR_NX], float u_Nm, float out[BR_NX])
+{
+    const br_model_k_t k = br_model_k(m);
+    float xs[BR_NX] = {x[0], x[1], x[2], x[3]};
+    int s, i;
+    for (s = 0; s < m->n_sub; s++) {
+        /* RK4 only where both ends of the sub-step are inside its stability region */
+        if (kx != NULL) {
+            if (!br_model_kx_rk4(kx, xs, u_Nm, out)) {
+                br_model_bounded_step_x(kx, xs, u_Nm, out);
+            }
+        } else if (kp != NULL) {
+            if (!br_model_kp_rk4(kp, xs, kp_p, out)) {
+                br_model_bounded_step(m, xs, u_Nm, out);
+            }
+        } else if (!br_model_k_rk4(&k, xs, u_Nm, out)) {
+            br_model_bounded_step(m, xs, u_Nm, out);
+        }
+        for (i = 0; i < BR_NX; i++) {
+            xs[i] = out[i];
+        }
+    }
+}
+
 static int all_finite(const float x[BR_NX])
 {
     return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(x[3]);
@@ -209,15 +271,9 @@ br_status_t br_model_step_at(const br_model_t *m, const float x[BR_NX], float p0
     }
     if (m->extended) {
         const br_model_kx_t k = br_model_kx(m, p0_m);
-        if (!br_model_kx_rk4(&k, x, u_Nm, tmp)) {
-            br_model_bounded_step_x(&k, x, u_Nm, tmp);
-        }
+        br_model_sub_steps(m, &k, NULL, 0.0f, x, u_Nm, tmp);
     } else {
-        const br_model_k_t k = br_model_k(m);
-        /* RK4 only where both ends of the step are inside its stability region. */
-        if (!br_model_k_rk4(&k, x, u_Nm, tmp)) {
-            br_model_bounded_step(m, x, u_Nm, tmp);
-        }
+        br_model_sub_steps(m, NULL, NULL, 0.0f, x, u_Nm, tmp);
     }
     if (!all_finite(tmp)) {
         copy_state(x, x_next);

@@ -374,12 +374,9 @@ static void particle_one(br_pf_t *pf, const pred_t *c, const int kind, uint32_t 
         }
         memcpy(xn, x, sizeof xn);
         br_pf_ms_det(&c->k.km, c->k.uh, &xn[BR_X_THETA], &xn[BR_X_OMEGA], x[BR_X_GP], pf->kgp[j], el, e1);
-    } else if (ext ? !br_model_kx_rk4(&c->mx, x, c->u, xn) : !br_model_kp_rk4(&c->k.kp, x, pf->kgp[j], xn)) {
-        if (ext) {
-            br_model_bounded_step_x(&c->mx, x, c->u, xn);
-        } else {
-            br_model_bounded_step(&pf->model, x, c->u, xn);
-        }
+    } else {
+        /* n_sub sub-steps, each by RK4 or the bounded scheme (docs/modules/model.md, "Sub-steps") */
+        br_model_sub_steps(&pf->model, ext ? &c->mx : NULL, ext ? NULL : &c->k.kp, pf->kgp[j], x, c->u, xn);
     }
     float th_old, th, om, l_prop = 0.0f, th_a;
     if (c->prop) {
@@ -503,6 +500,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
     pred_t c;
     c.k.mk = br_model_k(&pf->model);
     c.k.kp = br_model_kp(&pf->model, u_prev_Nm);
+    c.k.n_sub = pf->model.n_sub;
     c.k.s0L = pf->model.cfg.lugre.sigma0_Npm * pf->model.cfg.lead_mprad;
     /* the extended kernel's constants (a few operations per step; unused by the thesis model) */
     c.mx = br_model_kx(&pf->model, origin_pos_m(pf));
@@ -568,7 +566,7 @@ static uint32_t predict_and_weigh(br_pf_t *pf, float u_prev_Nm, float shift, flo
             const float *const nz = pf->cfg.noise + p;
             const float s1 = ls.s1, s2 = ls.s2;
             const uint32_t left = ms ? br_pf_kernel_predict_ms(pf, &c.k, j, j1, nz, &ls)
-                                     : br_pf_kernel_predict(pf, &c.k, j, j1, nz, &ls);
+                                     : br_pf_predict_run(pf, &c.k, j, j1, nz, &ls);
             if (left > 0u) {
                 /* the fix-up: the particles the kernel left (l = NaN), one at a time */
                 for (uint32_t k = j; k < j1; k++) {

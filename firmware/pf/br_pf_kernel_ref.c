@@ -32,6 +32,7 @@ uint32_t br_pf_kref_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint3
     const float s0L = c->s0L, q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
     const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
     const float shift = c->shift, y_rel = c->y_rel;
+    const int n_sub = c->n_sub;
     float *BR_RESTRICT th = pf->x[BR_X_THETA] + j0;
     float *BR_RESTRICT om = pf->x[BR_X_OMEGA] + j0;
     float *BR_RESTRICT zz = pf->x[BR_X_Z] + j0;
@@ -46,9 +47,10 @@ uint32_t br_pf_kref_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint3
         const float *const nj = nz + BR_NX * j;
         const float x[BR_NX] = {th[j], om[j], zz[j], gg[j]};
         float xn[BR_NX];
-        /* 1. predict: eq. 6 by RK4 with the particle's k_p (br_model_kp_rk4);
-         * ok_rk = 0 beyond the RK4 limit a h <= 2 (the bounded scheme: the fix-up) */
-        const int ok_rk = br_model_kp_rk4(&kp, x, ka[j], xn);
+        /* 1. predict: eq. 6 by RK4 with the particle's k_p in n_sub sub-steps
+         * (br_model_kp_rk4_n); ok_rk = 0 beyond the RK4 limit a h <= 2 in any
+         * sub-step (the bounded scheme: the fix-up) */
+        const int ok_rk = br_model_kp_rk4_n(&kp, n_sub, x, ka[j], xn);
         /* process noise sqrt(Q) n; theta relative to the new origin */
         const float t = (xn[BR_X_THETA] + q0 * nj[0]) - shift;
         const float w = xn[BR_X_OMEGA] + q1 * nj[1];

@@ -36,12 +36,12 @@ static inline br_model_k_t br_model_k(const br_model_t *m)
     const br_model_k_t k = {m->cfg.lead_mprad,
                             m->cfg.lugre.sigma0_Npm,
                             m->cfg.lugre.sigma1_Nspm,
-                            m->cfg.lugre.sigma0_Npm * m->cfg.lead_mprad * m->cfg.dt_s,
+                            m->cfg.lugre.sigma0_Npm * m->cfg.lead_mprad * m->h_sub_s,
                             m->visc_Nmsprad,
                             m->inv_Jeff,
-                            m->cfg.dt_s,
-                            0.5f * m->cfg.dt_s,
-                            m->cfg.dt_s / 6.0f};
+                            m->h_sub_s,
+                            0.5f * m->h_sub_s,
+                            m->h_sub_s / 6.0f};
     return k;
 }
 
@@ -126,7 +126,7 @@ typedef struct {
 /* the constants for a step with torque u */
 static inline br_model_kp_t br_model_kp(const br_model_t *m, float u)
 {
-    const float L = m->cfg.lead_mprad, ij = m->inv_Jeff, h = m->cfg.dt_s;
+    const float L = m->cfg.lead_mprad, ij = m->inv_Jeff, h = m->h_sub_s;
     const br_model_kp_t k = {L,
                              u * ij,
                              m->visc_Nmsprad * ij,
@@ -192,6 +192,19 @@ static inline int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], 
     float ah0, ah1;
     br_model_kp_rk4_step(k, x, kp, out, &ah0, &ah1);
     return (ah0 <= k->ah_lim) && (ah1 <= k->ah_lim);
+}
+
+/* n sub-steps of br_model_kp_rk4 (n = the model's n_sub; docs/modules/model.md,
+ * "Sub-steps"); returns 1 when every sub-step is inside the RK4 limit. x may
+ * not be out. */
+static inline int br_model_kp_rk4_n(const br_model_kp_t *k, int n, const float x[BR_NX], float kp, float out[BR_NX])
+{
+    int ok = br_model_kp_rk4(k, x, kp, out);
+    for (int s = 1; s < n; s++) {
+        const float xs[BR_NX] = {out[0], out[1], out[2], out[3]};
+        ok &= br_model_kp_rk4(k, xs, kp, out);
+    }
+    return ok;
 }
 
 /* ---- The extended model (causes on; docs/modules/model.md, "Extended model") ----
@@ -312,6 +325,14 @@ static inline int br_model_kx_rk4(const br_model_kx_t *k, const float x[BR_NX], 
  * speeds), for the thesis model and for the extended one. */
 void br_model_bounded_step(const br_model_t *m, const float x[BR_NX], float u_Nm, float out[BR_NX]);
 void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float u_Nm, float out[BR_NX]);
+
+/* One step of dt_s as m->n_sub sub-steps of h_sub_s (docs/modules/model.md,
+ * "Sub-steps"), each by RK4 inside its a h limit, else by the bounded scheme:
+ * the extended model's (kx) when kx is given, else the PF's form with k_p
+ * (kp, the particle's kp_p) when kp is given, else br_model_k_rk4's. out
+ * must not be x. */
+void br_model_sub_steps(const br_model_t *m, const br_model_kx_t *kx, const br_model_kp_t *kp, float kp_p,
+                        const float x[BR_NX], float u_Nm, float out[BR_NX]);
 
 /* ---- The Maxwell-slip model's step (docs/modules/model.md, "Maxwell-slip model") ----
  * x = [theta, omega, (unused), g_p] and the element deflections z[0..n-1]:

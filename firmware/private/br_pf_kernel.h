@@ -32,7 +32,8 @@
  * bootstrap proposal), the same for every particle. */
 typedef struct {
     br_model_k_t mk;  /* the thesis model's kernel constants (f_nl) */
-    br_model_kp_t kp; /* the PF's RK4 constants (br_model_kp_rk4) */
+    br_model_kp_t kp; /* the PF's RK4 constants (br_model_kp_rk4), for one sub-step */
+    int n_sub;        /* the model's sub-steps per step (br_model_t.n_sub, docs/modules/model.md) */
     float s0L;        /* sigma0 L: k_p = s0L / g_p */
     float q[BR_NX];   /* process noise standard deviations */
     float gp_min, gp_max, inv_2r;
@@ -172,11 +173,24 @@ static inline float br_pf_select(br_pf_t *pf, uint32_t total)
  * particles than the reference does, never fewer, and only ones that the
  * fix-up predicts as the reference would. ls's s1 and s2 hold the run's sums
  * in particle order when nothing is left (the caller makes them again
- * otherwise). Returns the number of particles left. */
+ * otherwise). Returns the number of particles left. With n_sub > 1 the
+ * prediction is n_sub sub-steps of RK4 (br_model_kp_rk4_n), every one inside
+ * the limit; the target kernels' loops are the single step's, so
+ * br_pf_predict_run hands such a pass to the reference kernel. */
 uint32_t br_pf_kref_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                             br_pf_lsum_t *ls);
 uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                               br_pf_lsum_t *ls);
+
+/* The thesis model's pass over particles j0 .. j1 - 1 as br_pf.c runs it:
+ * the target's kernel for one step per period, the reference kernel's
+ * sub-step loop for n_sub > 1 (docs/modules/model.md, "Sub-steps"); the
+ * test outside the kernels keeps their loops as they were. */
+static inline uint32_t br_pf_predict_run(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1,
+                                         const float *nz, br_pf_lsum_t *ls)
+{
+    return (c->n_sub != 1) ? br_pf_kref_predict(pf, c, j0, j1, nz, ls) : br_pf_kernel_predict(pf, c, j0, j1, nz, ls);
+}
 
 /* Steps 1 and 2 with elements (est.model.mslip.n >= 1; docs/modules/pf.md,
  * "Maxwell-slip elements"), bootstrap proposal, for particles j0 .. j1 - 1:

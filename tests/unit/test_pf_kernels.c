@@ -33,15 +33,21 @@
 
 static int same_f(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
 
-static br_pf_t *new_pf(uint32_t m)
+/* the circle's PF with m particles; its bristle stiffness sigma0 times s0_k
+ * (s0_k = 16: omega_n h 4 times the reference's 0.51, so that the model steps
+ * in n_sub = 3 sub-steps, docs/modules/model.md "Sub-steps") */
+static br_pf_t *new_pf_s0(uint32_t m, float s0_k)
 {
     br_pf_t *pf = calloc(1, sizeof *pf);
     assert_non_null(pf);
     br_pf_cfg_t c = br_circle_pf_cfg_default(1.5e-3f);
     c.n_particles = m;
+    c.est.model.lugre.sigma0_Npm *= s0_k;
     assert_int_equal(br_pf_init(pf, &c), BR_OK);
     return pf;
 }
+
+static br_pf_t *new_pf(uint32_t m) { return new_pf_s0(m, 1.0f); }
 
 static br_pf_t *clone(const br_pf_t *pf)
 {
@@ -88,6 +94,7 @@ static br_pf_kc_t consts(br_pf_t *pf, float u, float shift, float y_rel)
     c.inv_2r = pf->inv_2r;
     c.shift = shift;
     c.y_rel = y_rel;
+    c.n_sub = pf->model.n_sub;
     c.km = br_model_km(&pf->model);
     c.uh = u * c.km.h;
     return c;
@@ -157,7 +164,7 @@ static uint32_t predict_both(br_pf_t *a, br_pf_t *b, const br_pf_kc_t *c, int k,
         const float *nz = a->cfg.noise + p;
         const float s1a = la.s1, s2a = la.s2, s1b = lb.s1, s2b = lb.s2;
         const uint32_t left_a = ms ? br_pf_kref_predict_ms(a, c, j, j1, nz, &la) : br_pf_kref_predict(a, c, j, j1, nz, &la);
-        const uint32_t lk = ms ? br_pf_kernel_predict_ms(b, c, j, j1, nz, &lb) : br_pf_kernel_predict(b, c, j, j1, nz, &lb);
+        const uint32_t lk = ms ? br_pf_kernel_predict_ms(b, c, j, j1, nz, &lb) : br_pf_predict_run(b, c, j, j1, nz, &lb);
         assert_int_equal(lk, left_a);
         assert_true(same_f(la.lmax, lb.lmax));
         assert_int_equal(la.n_valid, lb.n_valid);
@@ -204,10 +211,12 @@ static int resample_step(br_pf_t *a, br_pf_t *b, int k)
     return outlier;
 }
 
-static void test_stream(void **st)
+/* the stream of steps with the edge cases; n_sub: the sub-steps the model
+ * must have chosen */
+static void stream(float s0_k, int n_sub)
 {
-    (void)st;
-    br_pf_t *src = new_pf(M);
+    br_pf_t *src = new_pf_s0(M, s0_k);
+    assert_int_equal(src->model.n_sub, n_sub);
     const float rpc = src->cfg.est.rad_per_count;
     edges_t n = {0, 0, 0, 0, 0};
     int n_left = 0, n_outlier = 0, n_clamped = 0, n_steps = 0;
@@ -241,6 +250,20 @@ static void test_stream(void **st)
     assert_true(n_left >= n.nan + n.bounded);
     assert_true(n_outlier > 0 && n_clamped > 0 && n_steps == 47);
     free(src);
+}
+
+static void test_stream(void **st)
+{
+    (void)st;
+    stream(1.0f, 1);
+}
+
+/* the same with the model in sub-steps: every kernel gives the reference's
+ * sub-stepped prediction bit for bit */
+static void test_stream_sub(void **st)
+{
+    (void)st;
+    stream(16.0f, 3);
 }
 
 /* the element path's edge cases of step k, in both copies the same way */
@@ -391,6 +414,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_stream),
+        cmocka_unit_test(test_stream_sub),
         cmocka_unit_test(test_stream_ms),
         cmocka_unit_test(test_made_weights),
     };

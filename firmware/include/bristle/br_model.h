@@ -25,6 +25,15 @@ enum { BR_X_THETA = 0, BR_X_OMEGA = 1, BR_X_Z = 2, BR_X_GP = 3, BR_NX = 4 };
  * beyond it the step switches to the bounded displacement-exact scheme. */
 #define BR_MODEL_RK4_AH_MAX 2.0f
 
+/* Sub-steps (docs/modules/model.md, "Sub-steps"): one step of dt_s is made
+ * of n = ceil(rho dt_s / BR_MODEL_SUB_RH_MAX) equal sub-steps, rho the
+ * spectral radius of the presliding mode (the bristle spring sigma0 and the
+ * damping sigma1 + sigma2 on the effective mass), chosen once at init; n = 1
+ * (the thesis's single step) wherever rho dt_s <= BR_MODEL_SUB_RH_MAX. A
+ * configuration that needs more than BR_MODEL_SUB_MAX is refused. */
+#define BR_MODEL_SUB_RH_MAX 1.0f
+#define BR_MODEL_SUB_MAX 32
+
 /* What a diagnosis found beyond the thesis model (docs/modules/model.md,
  * "Extended model"; the causes of a measured log, docs/diagnose.md): all 0 is
  * eq. 6 exactly, bit for bit. The names are those of model.json and of the
@@ -75,6 +84,9 @@ typedef struct {
     uint32_t n_steps;      /* the model's clock: steps of dt_s since init (saturates) */
     float drift_k;         /* s(t) = max(0, 1 + drift n_steps dt_s): the friction scale now (1 without drift) */
     float ms_c_mpN[BR_MSLIP_MAX]; /* Maxwell-slip: share_i / k_i (Delta_i = c_i g_p) */
+    float rho_h;        /* the presliding mode's spectral radius times dt_s (0 with elements) */
+    int n_sub;          /* sub-steps per step of dt_s, 1 .. BR_MODEL_SUB_MAX (1 with elements) */
+    float h_sub_s;      /* dt_s / n_sub, the step of the kernels */
     int ready;
 } br_model_t;
 
@@ -104,7 +116,8 @@ float br_model_fnl_N(const br_model_t *m, const float x[BR_NX]);
 float br_model_fcomp_N(const br_model_t *m, const float x[BR_NX], float p0_m);
 
 /* One discretisation step of dt_s with the torque u_Nm held, theta absolute:
- * RK4 where a h <= BR_MODEL_RK4_AH_MAX, otherwise the bounded scheme.
+ * n_sub sub-steps of h = dt_s / n_sub, each by RK4 where a h <=
+ * BR_MODEL_RK4_AH_MAX, otherwise by the bounded scheme.
  * Non-finite input or g_p <= 0 gives BR_E_INPUT and x_next = x. */
 br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm, float x_next[BR_NX]);
 
