@@ -33,6 +33,9 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from runs import run_or_exit  # noqa: E402
+
 CAUSES = ("offset", "asym", "ripple", "gradient", "delay", "drift")
 SIM_START_S = 10.0  # the wait for br_link_sim's pty
 
@@ -49,11 +52,7 @@ def plant_args(spec):
 
 
 def run(cmd, **kw):
-    print("$ " + " ".join(cmd), flush=True)
-    r = subprocess.run(cmd, **kw)
-    if r.returncode != 0:
-        sys.exit("target_chain: failed (exit %d): %s" % (r.returncode, " ".join(cmd)))
-    return r
+    return run_or_exit("target_chain", cmd, **kw)
 
 
 def ident(a):
