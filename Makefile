@@ -41,6 +41,7 @@ override EMPS_LOG := $(value EMPS_LOG)
 override RADIUS_M := $(value RADIUS_M)
 override FEED     := $(value FEED)
 override DIR      := $(value DIR)
+override PLANT    := $(value PLANT)
 export BR_MK_MACHINE  := $(MACHINE)
 export BR_MK_LOG      := $(LOG)
 export BR_MK_OUT      := $(OUT)
@@ -49,6 +50,7 @@ export BR_MK_EMPS_LOG := $(EMPS_LOG)
 export BR_MK_RADIUS_M := $(RADIUS_M)
 export BR_MK_FEED     := $(FEED)
 export BR_MK_DIR      := $(DIR)
+export BR_MK_PLANT    := $(or $(PLANT),offset=2.5)
 export BR_MK_MAX_FEV  := $(value MAX_FEV)
 # the counts: digits only (they are written into recipes)
 _nodigits = $(subst 0,,$(subst 1,,$(subst 2,,$(subst 3,,$(subst 4,,$(subst 5,,$(subst 6,,$(subst 7,,$(subst 8,,$(subst 9,,$(1)))))))))))
@@ -110,7 +112,7 @@ define print_size
 	done
 endef
 
-.PHONY: fuzz help deps build test demo bench target-bench pil diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet mslip-plants
+.PHONY: fuzz help deps build test demo bench target-bench pil target-chain diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet mslip-plants
 
 help:
 	@echo "bristle targets:"
@@ -133,6 +135,7 @@ help:
 	@echo "  make faults                 the fault campaign on the simulator (production guards) -> docs/reliability-faults.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
 	@echo "  make pil       the circle with each estimator on QEMU's Cortex-M7 in lockstep with the host plant, compared bit for bit with the simulator (docs/link.md)"
+	@echo "  make target-chain [PLANT='offset=2.5']  identification run over the link -> its log -> diagnose -> machine.json -> the images -> the circle in the loop before / after -> $(TC_OUT) (docs/link.md)"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune [MACHINE=<json>] [MAX_FEV=n]  Nelder-Mead tuning of the PF and UKF noise (the reference: regenerates firmware/gen/bristle_gen/est/; another machine: its build folder's tune/, with tune/machine.json; docs/tuning.md)"
 	@echo "  make figures   thesis Figs. 1-8 into docs/figures/ and docs/results.md (~12 min)"
@@ -257,6 +260,31 @@ pil: deps
 	$(Q)cmake --build --preset cm7-release --target br_pil_mps2 $(NINJA_QUIET)
 	$(Q)echo "== the circle in the loop (about 10 min)"
 	$(Q)build/host-release/sim/br_pil --image build/cm7-release/target/mps2/br_pil_mps2.elf --est all --compare
+
+# The chain on a running target (docs/link.md): an identification run of the
+# production application over the link (br_link_sim, the plant with PLANT's
+# cause) recorded by bristle-link -> make diagnose -> machine.json -> make
+# firmware MACHINE= (the STM32H743 image and the image in the loop) -> the
+# circle in the loop with the nominal and the diagnosed image (about 6 min).
+TC_OUT := out/target-chain
+target-chain: deps
+	$(call configure,host-release)
+	$(Q)cmake --build --preset host-release --target br_link_sim br_simlog br_pil $(NINJA_QUIET)
+	$(call configure,cm7-release)
+	$(Q)cmake --build --preset cm7-release --target br_pil_mps2 $(NINJA_QUIET)
+	$(Q)rm -rf $(TC_OUT)
+	$(Q)echo "== 1-2. the identification run over the link, recorded -> $(TC_OUT)/ident.csv"
+	$(Q)PYTHONPATH=python $(PYTHON) sim/studies/target_chain.py ident --bin build/host-release/sim --work $(TC_OUT) \
+	  --plant "$$BR_MK_PLANT"
+	$(Q)echo "== 3. the diagnosis -> $(TC_OUT)/diagnose/machine.json"
+	$(Q)$(MAKE) diagnose LOG=$(TC_OUT)/ident.csv OUT=$(TC_OUT)/diagnose MACHINE=machines/reference.json
+	$(Q)echo "== 4. the images for the diagnosed machine"
+	$(Q)$(MAKE) firmware BOARD=stm32h7 MACHINE=$(TC_OUT)/diagnose/machine.json
+	$(Q)echo "== 5. the circle in the loop (H-inf + UKF): the nominal image, then the diagnosed one"
+	$(Q)dir="$$($(PYTHON) firmware/design/build_dir.py cm7-release $(TC_OUT)/diagnose/machine.json)"; \
+	PYTHONPATH=python $(PYTHON) sim/studies/target_chain.py circles --pil build/host-release/sim/br_pil \
+	  --before build/cm7-release/target/mps2/br_pil_mps2.elf --after "$$dir/target/mps2/br_pil_mps2.elf" \
+	  --work $(TC_OUT)/circle --plant "$$BR_MK_PLANT" --est ukf --diagnosis $(TC_OUT)/diagnose/machine.json
 
 # Measured logs (docs/diagnose.md): diagnose one, validate a saved model on
 # another, and the hidden-cause suite that writes docs/diagnose-hidden.md.

@@ -52,6 +52,7 @@
 #include "tools/br_outfile.h"
 #include "tools/br_tool_limits.h"
 #include "bristle_gen/machine/br_machine.h"
+#include "simlog/br_cause_args.h"
 
 #define TOOL "br_link_sim"
 /* the bounds of the options (docs/tools.md) */
@@ -71,6 +72,7 @@ typedef struct {
     const char *est, *plant, *pty_path;
     double speed, duration_s;
     long tlm_every, status_periods, queue, hold_periods, rec_capacity, rec_pre;
+    br_plant_cfg_t causes; /* the cause options (br_cause_args.h) on the reference machine */
 } opts_t;
 
 static int usage(const char *argv0, FILE *to)
@@ -78,7 +80,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s [--est none|ukf|pf] [--plant thesis|hardware_like] [--speed S] [--duration S]\n"
             "          [--pty-path FILE] [--tlm-every N] [--status-periods N] [--queue N]\n"
-            "          [--hold-periods N] [--rec-capacity N] [--rec-pre N]\n" BR_ARGS_COMMON_USAGE
+            "          [--hold-periods N] [--rec-capacity N] [--rec-pre N] [cause options]\n" BR_ARGS_COMMON_USAGE
             "  --est             the estimator of the application (default ukf; none: H-infinity only, no parameters)\n"
             "  --plant           the simulated plant (default thesis: the machine's LuGre; hardware_like: Maxwell-slip)\n"
             "  --speed           simulated periods per wall-clock period, 0 .. %g (default 1; 0: no pause)\n"
@@ -89,7 +91,9 @@ static int usage(const char *argv0, FILE *to)
             "  --queue           the reference queue's places, 1 .. %u (default %u)\n"
             "  --hold-periods    underrun: periods the last reference goes on before braking, 0 .. %ld (default 20)\n"
             "  --rec-capacity    the recorder's samples, 1 .. %u (default 2000)\n"
-            "  --rec-pre         of them before the trigger, 0 .. capacity - 1 (default capacity / 2)\n",
+            "  --rec-pre         of them before the trigger, 0 .. capacity - 1 (default capacity / 2)\n"
+            "  cause options     a cause in the plant: --offset F, --asym DFC,DFV, --ripple A,P[,PH], --gradient S,\n"
+            "                    --delay D, --drift R (docs/simlog.md; the application keeps the machine's model)\n",
             argv0, argv0, SPEED_MAX, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_DURATION_MAX_S,
             PERIODS_MAX, PERIODS_MAX, (unsigned)BR_REFQ_MAX, (unsigned)BR_REFQ_MAX, PERIODS_MAX,
             (unsigned)BR_REC_CAPACITY_MAX);
@@ -109,8 +113,9 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
                                          {"hold-periods", required_argument, NULL, 'H'},
                                          {"rec-capacity", required_argument, NULL, 'c'},
                                          {"rec-pre", required_argument, NULL, 'r'},
-                                         {0, 0, 0, 0}};
-    *o = (opts_t){"ukf", "thesis", NULL, 1.0, BR_TOOL_DURATION_MAX_S, 1, 10, BR_REFQ_MAX, 20, 2000, -1};
+                                         BR_CAUSE_LONGOPTS{0, 0, 0, 0}};
+    *o = (opts_t){"ukf", "thesis", NULL, 1.0, BR_TOOL_DURATION_MAX_S, 1, 10, BR_REFQ_MAX, 20, 2000, -1,
+                  br_plant_cfg_reference()};
     br_args_t p;
     *done = br_args_start(&p, TOOL, argc, argv, usage);
     if (*done) return 0;
@@ -143,6 +148,7 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
         case 'H': bad = br_arg_long(TOOL, p.opt, v, 0, PERIODS_MAX, &o->hold_periods); break;
         case 'c': bad = br_arg_long(TOOL, p.opt, v, 1, BR_REC_CAPACITY_MAX, &o->rec_capacity); break;
         case 'r': bad = br_arg_long(TOOL, p.opt, v, 0, BR_REC_CAPACITY_MAX - 1, &o->rec_pre); break;
+        case BR_CAUSE_OPT: bad = br_cause_arg(p.opt, v, &o->causes) < 0; break;
         default: return usage(argv[0], stderr);
         }
         if (bad) return usage(argv[0], stderr);
@@ -252,6 +258,7 @@ static int axis_init(axis_t *a, const opts_t *o, const br_byte_chan_t *chan)
     br_circle_ctrl_t ctrl = BR_CTRL_HINF_ONLY;
     (void)br_circle_ctrl_of_est(o->est, &ctrl); /* checked by parse */
     a->c = strcmp(o->plant, "thesis") == 0 ? br_circle_cfg_thesis(ctrl) : br_circle_cfg_hardware_like(ctrl);
+    br_causes_apply(&a->c.plant, &o->causes); /* the plant's truth only */
     const br_app_machine_t mm = BR_MACHINE_APP_MACHINE;
     const br_app_motion_cfg_t mc = br_app_motion_cfg(&mm);
     const double L = a->c.plant.lead_mprad, dt = a->c.dt_s;

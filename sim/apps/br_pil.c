@@ -37,6 +37,7 @@
 #include "bristle/br_link.h"
 #include "bristle/br_link_pil.h"
 #include "circle/br_circle.h"
+#include "simlog/br_cause_args.h"
 #include "tools/br_args.h"
 #include "tools/br_run_report.h"
 #include "tools/br_tool_limits.h"
@@ -49,20 +50,23 @@ typedef struct {
     const char *image, *est, *qemu, *work;
     double duration_s, timeout_s;
     int compare;
+    br_plant_cfg_t causes; /* the cause options (br_cause_args.h) on the reference machine */
 } opts_t;
 
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s --image ELF [--est none|ukf|pf|all] [--duration S] [--compare] [--qemu PATH]\n"
-            "          [--timeout S] [--work DIR]\n" BR_ARGS_COMMON_USAGE
+            "          [--timeout S] [--work DIR] [cause options]\n" BR_ARGS_COMMON_USAGE
             "  --image     the image in the loop (build/cm7-release/target/mps2/br_pil_mps2.elf)\n"
             "  --est       the estimator: none (H-inf only), ukf, pf, or all three (default all)\n"
             "  --duration  simulated seconds of the circle, %g .. %g (default: the thesis's, one turn)\n"
             "  --compare   also run the simulator's circle and compare the duty sequences bit for bit\n"
             "  --qemu      qemu-system-arm to run (default $BR_QEMU, else qemu-system-arm on PATH)\n"
             "  --timeout   seconds to wait for one answer of the image, 1 .. %g (default 60)\n"
-            "  --work      folder for the FIFOs and QEMU's logs (default a new one under /tmp, removed)\n",
+            "  --work      folder for the FIFOs and QEMU's logs (default a new one under /tmp, removed)\n"
+            "  cause options  a cause in the host's plant: --offset F, --asym DFC,DFV, --ripple A,P[,PH],\n"
+            "              --gradient S, --delay D, --drift R (docs/simlog.md; the image keeps its machine's model)\n",
             argv0, argv0, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, TIMEOUT_MAX_S);
     return 2;
 }
@@ -76,9 +80,10 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
                                          {"qemu", required_argument, NULL, 'q'},
                                          {"timeout", required_argument, NULL, 't'},
                                          {"work", required_argument, NULL, 'w'},
-                                         {0, 0, 0, 0}};
+                                         BR_CAUSE_LONGOPTS{0, 0, 0, 0}};
     const char *qe = getenv("BR_QEMU");
-    *o = (opts_t){NULL, "all", (qe != NULL && qe[0] != '\0') ? qe : "qemu-system-arm", NULL, 0.0, 60.0, 0};
+    *o = (opts_t){NULL, "all", (qe != NULL && qe[0] != '\0') ? qe : "qemu-system-arm", NULL, 0.0, 60.0, 0,
+                  br_plant_cfg_reference()};
     br_args_t p;
     *done = br_args_start(&p, TOOL, argc, argv, usage);
     if (*done) return 0;
@@ -101,6 +106,7 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
         case 'q': o->qemu = v; break;
         case 't': bad = br_arg_double(TOOL, p.opt, v, 1.0, TIMEOUT_MAX_S, &o->timeout_s); break;
         case 'w': o->work = v; break;
+        case BR_CAUSE_OPT: bad = br_cause_arg(p.opt, v, &o->causes) < 0; break;
         default: return usage(argv[0], stderr);
         }
         if (bad) return usage(argv[0], stderr);
@@ -370,6 +376,7 @@ static double now_s(void)
 static int run_one(const opts_t *o, br_circle_ctrl_t ctrl, const char *est, run_t *out)
 {
     br_circle_cfg_t c = br_circle_cfg_thesis(ctrl);
+    br_causes_apply(&c.plant, &o->causes); /* the plant's truth; --compare's simulator runs the same plant */
     if (o->duration_s > 0.0) c.duration_s = o->duration_s;
     pil_t p;
     memset(&p, 0, sizeof p);

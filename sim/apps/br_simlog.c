@@ -229,25 +229,6 @@ static int parse(int argc, char **argv, opts_t *o)
     return 0;
 }
 
-/* the plant: the reference machine or a saved model, then the cause options on top */
-static void apply_causes(br_plant_cfg_t *plant, const br_plant_cfg_t *causes)
-{
-    const br_plant_cfg_t ref = br_plant_cfg_reference();
-    if (causes->offset_N != 0.0) plant->offset_N = causes->offset_N;
-    if (causes->dFc_neg_N != ref.dFc_neg_N || causes->dsigma2_neg_Nspm != ref.dsigma2_neg_Nspm) {
-        plant->dFc_neg_N = causes->dFc_neg_N;
-        plant->dsigma2_neg_Nspm = causes->dsigma2_neg_Nspm;
-    }
-    if (causes->ripple_amp_N != 0.0) {
-        plant->ripple_amp_N = causes->ripple_amp_N;
-        plant->ripple_period_m = causes->ripple_period_m;
-        plant->ripple_phase_rad = causes->ripple_phase_rad;
-    }
-    if (causes->grad_per_m != 0.0) plant->grad_per_m = causes->grad_per_m;
-    if (causes->delay_s != 0.0) plant->delay_s = causes->delay_s;
-    if (causes->drift_per_s != 0.0) plant->drift_per_s = causes->drift_per_s;
-}
-
 int main(int argc, char **argv)
 {
     opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 8.0, 0.0, br_plant_cfg_reference(), 0, {0.0}};
@@ -268,7 +249,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: %s\n", TOOL, msg);
         return 1;
     }
-    apply_causes(&plant, &opt.causes);
+    /* the plant: the reference machine or a saved model, then the cause options on top */
+    br_causes_apply(&plant, &opt.causes);
     apply_gms(&plant, &opt);
 
     /* the outputs: temporary files beside their names until the run succeeded */

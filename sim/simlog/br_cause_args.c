@@ -71,3 +71,21 @@ int br_cause_arg(const char *opt, const char *val, br_plant_cfg_t *c)
     for (int i = 0; i < n; i++) *rows[i].field = v[i];
     return 1;
 }
+
+void br_causes_apply(br_plant_cfg_t *plant, const br_plant_cfg_t *causes)
+{
+    const br_plant_cfg_t ref = br_plant_cfg_reference();
+    if (causes->offset_N != 0.0) plant->offset_N = causes->offset_N;
+    if (causes->dFc_neg_N != ref.dFc_neg_N || causes->dsigma2_neg_Nspm != ref.dsigma2_neg_Nspm) {
+        plant->dFc_neg_N = causes->dFc_neg_N;
+        plant->dsigma2_neg_Nspm = causes->dsigma2_neg_Nspm;
+    }
+    if (causes->ripple_amp_N != 0.0) {
+        plant->ripple_amp_N = causes->ripple_amp_N;
+        plant->ripple_period_m = causes->ripple_period_m;
+        plant->ripple_phase_rad = causes->ripple_phase_rad;
+    }
+    if (causes->grad_per_m != 0.0) plant->grad_per_m = causes->grad_per_m;
+    if (causes->delay_s != 0.0) plant->delay_s = causes->delay_s;
+    if (causes->drift_per_s != 0.0) plant->drift_per_s = causes->drift_per_s;
+}

@@ -32,4 +32,10 @@ int br_parse_numbers(const char *s, double *v, int n);
  * a value is outside its parameter's bounds. */
 int br_cause_arg(const char *opt, const char *val, br_plant_cfg_t *c);
 
+/* The causes the options set in causes (a br_plant_cfg_reference() that
+ * br_cause_arg wrote into) put on plant: each cause whose parameters differ
+ * from the reference machine's replaces plant's; the others are left as
+ * plant has them. */
+void br_causes_apply(br_plant_cfg_t *plant, const br_plant_cfg_t *causes);
+
 #endif

@@ -37,7 +37,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from runs import fault_text, faulted  # noqa: E402
+from runs import fault_text, faulted, run_or_exit  # noqa: E402
 
 BEGIN, END = "<!-- chain:begin -->", "<!-- chain:end -->"
 TRACK = (("pd", "the log's PD controller"), ("hinf_only", "H-infinity only"),
@@ -46,11 +46,7 @@ TRACK = (("pd", "the log's PD controller"), ("hinf_only", "H-infinity only"),
 
 
 def run(cmd, **kw):
-    print("$ " + " ".join(cmd), flush=True)
-    r = subprocess.run(cmd, **kw)
-    if r.returncode != 0:
-        sys.exit("machine_chain: failed (exit %d): %s" % (r.returncode, " ".join(cmd)))
-    return r
+    return run_or_exit("machine_chain", cmd, **kw)
 
 
 def host_build(a, machine, bdir, target):

@@ -15,7 +15,7 @@
  *
  * EST: none (H-inf only), ukf or pf, with the simulator's circle's
  * configuration (sim/circle: the machine's H-inf gains at its period, the
- * tuned filter on the thesis model, 1.5 ms for the PF); the axis starts
+ * tuned filter on the machine file's model, 1.5 ms for the PF); the axis starts
  * disarmed, as the production image does. One period per pil_tick: tick_wait
  * (the lockstep), br_svc_step, the sample to telemetry and the recorder, the
  * recorder's requests and dump, then the pil_out. Exits (semihosting, status
@@ -79,8 +79,9 @@ int main(void)
     const br_ctrl_cfg_t cc = BR_MACHINE_CTRL_CFG(dt);
     br_pf_cfg_t pfc = BR_MACHINE_PF_CFG_TUNED(dt);
     br_ukf_cfg_t ukc = BR_MACHINE_UKF_CFG_TUNED(dt);
-    pfc.est.model.causes = (br_causes_t){0}; /* the thesis model, as the circle's (sim/circle/br_circle_est.c) */
-    ukc.est.model.causes = (br_causes_t){0};
+    /* the model's causes are the machine file's (BR_MACHINE_CAUSES), as the STM32H743 image's: none for
+     * the reference machine (the circle's thesis model, so --compare holds bit for bit), a diagnosis's
+     * for its machine.json (docs/link.md, "The chain on a running target") */
     br_pf_t pf;
     br_ukf_t ukf;
     const br_app_motion_cfg_t mc = br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE);

@@ -6,7 +6,7 @@ never shell, make or C text.
 
 - every make target that takes a path or a value (firmware MACHINE=, tune MACHINE=, diagnose
   LOG= OUT= MACHINE=, validate MODEL= LOG=, emps EMPS_LOG=, demo RADIUS_M=
-  FEED= DIR=) run as `make -n` with values that hold a double and a single
+  FEED= DIR=, target-chain PLANT=) run as `make -n` with values that hold a double and a single
   quote, a backtick, $(...), make's $(shell ...), "*/" and a newline, each
   trying to create a marker file: no marker appears, and the value is never
   printed as recipe text; diagnose and validate also run for real (they fail
@@ -56,7 +56,7 @@ def no_markers(markers, what):
 def make_env():
     env = dict(os.environ)
     for k in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "MAKEOVERRIDES", "MACHINE", "LOG", "OUT", "MODEL",
-              "EMPS_LOG", "RADIUS_M", "FEED", "DIR", "BOARD", "V", "N"):
+              "EMPS_LOG", "RADIUS_M", "FEED", "DIR", "PLANT", "BOARD", "V", "N"):
         env.pop(k, None)
     return env
 
@@ -81,7 +81,7 @@ def heavy_copy(folder, name=None):
 def check_make(markers):
     # what each target takes (a hostile value for each, one marker tag per variable)
     cases = [("firmware", ["MACHINE"]), ("tune", ["MACHINE"]), ("diagnose", ["LOG", "OUT", "MACHINE"]), ("validate", ["MODEL", "LOG"]),
-             ("emps", ["EMPS_LOG"]), ("demo", ["RADIUS_M", "FEED", "DIR"])]
+             ("emps", ["EMPS_LOG"]), ("demo", ["RADIUS_M", "FEED", "DIR"]), ("target-chain", ["PLANT"])]
     for target, names in cases:
         for extra in ([], ["BOARD=stm32g4"]) if target == "firmware" else ([],):
             vals = ["%s=%s" % (n, hostile(markers, n.lower())) for n in names]
