@@ -14,7 +14,7 @@
  *     -semihosting-config enable=on,target=native,arg=pil,arg=EST -kernel br_pil_mps2.elf
  *
  * EST: none (H-inf only), ukf or pf, with the simulator's circle's
- * configuration (sim/circle: the machine's H-inf gains at its period, the
+ * configuration (sim/lib/circle: the machine's H-inf gains at its period, the
  * tuned filter on the thesis model, 1.5 ms for the PF); the axis starts
  * disarmed, as the production image does. One period per pil_tick: tick_wait
  * (the lockstep), br_svc_step, the sample to telemetry and the recorder, the
@@ -79,7 +79,7 @@ int main(void)
     const br_ctrl_cfg_t cc = BR_MACHINE_CTRL_CFG(dt);
     br_pf_cfg_t pfc = BR_MACHINE_PF_CFG_TUNED(dt);
     br_ukf_cfg_t ukc = BR_MACHINE_UKF_CFG_TUNED(dt);
-    pfc.est.model.causes = (br_causes_t){0}; /* the thesis model, as the circle's (sim/circle/br_circle_est.c) */
+    pfc.est.model.causes = (br_causes_t){0}; /* the thesis model, as the circle's (sim/lib/circle/br_circle_est.c) */
     ukc.est.model.causes = (br_causes_t){0};
     br_pf_t pf;
     br_ukf_t ukf;

@@ -8,7 +8,7 @@ loading (docs/diagnose.md, "Outputs" and "Parameters").
   nominal_params  the nominal model's
   filter          the low-pass the fit used (validate applies the same)
 
-The plant simulator reads the same "params" (sim/plant/br_plant_json.c).
+The plant simulator reads the same "params" (sim/lib/plant/br_plant_json.c).
 Format 1 (older names: M_kg, Fv_Nspm, Fc_neg_N, Fv_neg_Nspm) is not read."""
 from . import causes as causes_
 from . import jsonfile, output, params, signals
