@@ -77,7 +77,7 @@ TUNE_OUT   := out/tune
 BENCH_OUT  := out/bench
 DIAG_BENCH_OUT := out/diagnose-bench
 TARGET_BENCH_OUT := out/target-bench
-BENCH      := build/host-release/sim/bench/br_bench
+BENCH      := build/host-release/sim/br_bench
 
 # $(call configure,<preset>): cmake --preset, output shown only on failure.
 # Always run: cheap when nothing changed, and it picks up edited presets.
@@ -227,7 +227,7 @@ bench: deps
 	$(Q)echo "== bench -> $(BENCH_OUT)"
 	$(Q)mkdir -p $(BENCH_OUT)
 	$(Q)$(BENCH) --json $(BENCH_OUT)/c.json --record $(BENCH_OUT)/pf_input.csv
-	$(Q)build/host-release/sim/bench/br_bench_link | tee $(BENCH_OUT)/link.txt
+	$(Q)build/host-release/sim/br_bench_link | tee $(BENCH_OUT)/link.txt
 	$(Q)$(PYTHON) sim/bench/pf_particles.py $(BENCH_OUT)/pf_input.csv --out $(BENCH_OUT)/particles.json
 	$(Q)$(PYTHON) sim/bench/pf_numpy.py $(BENCH_OUT)/pf_input.csv --c-json $(BENCH_OUT)/c.json \
 	  --particles-json $(BENCH_OUT)/particles.json --out $(BENCH_OUT)/bench.json

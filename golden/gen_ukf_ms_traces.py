@@ -12,7 +12,7 @@
               input columns (counts, frac, u_prev_Nm) are in the trace itself.
 
 The element set is the simulator's hardware-like plant's
-(sim/circle/br_circle.c), its truth side written out here again on purpose:
+(sim/lib/circle/br_circle.c), its truth side written out here again on purpose:
 the trace checks the filter's arithmetic, not the plant.
 Same conventions as gen_traces.py (write_trace, f32, '%.17g').
 """

@@ -256,7 +256,7 @@ def render_est(m):
         " * per step, converted from the file's physical units by machine.est_per_step:",
         " * double and exact float (_F) literals, counts as unsigned integers. Variances",
         " * in counts^2 and spreads in counts are multiplied by BR_MACHINE_RAD_PER_COUNT_F",
-        " * (squared) where the configuration is built (sim/circle/br_circle_est.c). */",
+        " * (squared) where the configuration is built (sim/lib/circle/br_circle_est.c). */",
         "#ifndef BR_GEN_EST_MACHINE_H",
         "#define BR_GEN_EST_MACHINE_H",
         "",

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Generalized Maxwell-slip friction and the plant that carries it, float64
-golden reference of sim/plant/br_gms.c and the Maxwell-slip path of
-sim/plant/br_sim_plant.c, written from ../shared/spec/presliding.md:
+golden reference of sim/lib/plant/br_gms.c and the Maxwell-slip path of
+sim/lib/plant/br_sim_plant.c, written from ../shared/spec/presliding.md:
 
     s(v)       = Fc + (Fs - Fc) exp(-(|v| / vs)^delta)
     Delta_i(v) = alpha_i s(v) / k_i

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """Double-precision plant of one ball-screw axis (thesis eqs. 1-5), float64
-golden reference of sim/plant.
+golden reference of sim/lib/plant.
 
     Jeff domega/dt = tau - L (sigma2 L omega + F_nl)
     F_nl  = sigma0 z + sigma1 dz/dt,  dz/dt = L omega - sigma0 L |omega| z / g(L omega)

@@ -17,13 +17,13 @@
 #include <string.h>
 
 #include "circle/br_circle.h"
-#include "circle/br_circle_args.h"
+#include "circle_args/br_circle_args.h"
 #include "plant/br_model_params.h"
 #include "plant/br_plant_json.h"
-#include "simlog/br_cause_args.h"
-#include "tools/br_args.h"
-#include "tools/br_outfile.h"
-#include "tools/br_run_report.h"
+#include "cause_args/br_cause_args.h"
+#include "tool/br_args.h"
+#include "tool/br_outfile.h"
+#include "tool/br_run_report.h"
 
 #define TOOL "br_circle_ext"
 

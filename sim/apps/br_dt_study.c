@@ -26,7 +26,7 @@
 #include "circle/br_circle.h"
 #include "circle/br_circle_est.h"
 #include "bristle_gen/est/br_est_machine.h"
-#include "tools/br_args.h"
+#include "tool/br_args.h"
 #include "bristle_gen/machine/br_machine.h"
 
 #define TOOL "br_dt_study"

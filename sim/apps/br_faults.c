@@ -25,10 +25,10 @@
 #include "bristle/br_app.h"
 #include "bristle/br_machine_cfg.h"
 #include "circle/br_circle.h"
-#include "hal/br_hal_sim.h"
-#include "tools/br_args.h"
-#include "tools/br_outfile.h"
-#include "tools/br_run_report.h"
+#include "hal_sim/br_hal_sim.h"
+#include "tool/br_args.h"
+#include "tool/br_outfile.h"
+#include "tool/br_run_report.h"
 
 #define TOOL "br_faults"
 #define BR_PI 3.14159265358979323846

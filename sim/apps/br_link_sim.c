@@ -47,12 +47,12 @@
 #include "bristle/br_svc.h"
 #include "bristle/br_tlm.h"
 #include "circle/br_circle.h"
-#include "hal/br_hal_sim.h"
-#include "tools/br_args.h"
-#include "tools/br_outfile.h"
-#include "tools/br_tool_limits.h"
+#include "hal_sim/br_hal_sim.h"
+#include "tool/br_args.h"
+#include "tool/br_outfile.h"
+#include "tool/br_tool_limits.h"
 #include "bristle_gen/machine/br_machine.h"
-#include "simlog/br_cause_args.h"
+#include "cause_args/br_cause_args.h"
 
 #define TOOL "br_link_sim"
 /* the bounds of the options (docs/tools.md) */

@@ -23,10 +23,10 @@
 #include <stdlib.h>
 
 #include "circle/br_circle.h"
-#include "tools/br_args.h"
-#include "tools/br_outfile.h"
-#include "tools/br_rng.h"
-#include "tools/br_run_report.h"
+#include "tool/br_args.h"
+#include "tool/br_outfile.h"
+#include "tool/br_rng.h"
+#include "tool/br_run_report.h"
 
 #define TOOL "br_mslip_plants"
 #define MAX_N 200

@@ -18,8 +18,8 @@
 #include <sys/stat.h>
 
 #include "circle/br_circle.h"
-#include "tools/br_args.h"
-#include "tools/br_tool_limits.h"
+#include "tool/br_args.h"
+#include "tool/br_tool_limits.h"
 
 #define TOOL "br_pf_study"
 

@@ -37,10 +37,10 @@
 #include "bristle/br_link.h"
 #include "bristle/br_link_pil.h"
 #include "circle/br_circle.h"
-#include "simlog/br_cause_args.h"
-#include "tools/br_args.h"
-#include "tools/br_run_report.h"
-#include "tools/br_tool_limits.h"
+#include "cause_args/br_cause_args.h"
+#include "tool/br_args.h"
+#include "tool/br_run_report.h"
+#include "tool/br_tool_limits.h"
 
 #define TOOL "br_pil"
 #define SETUP_PERIODS 8u /* D: setpoints queued before the arm (the image's queue holds 64) */

@@ -38,12 +38,12 @@
 #include <sys/stat.h>
 
 #include "circle/br_circle.h"
-#include "circle/br_circle_args.h"
+#include "circle_args/br_circle_args.h"
 #include "plant/br_plant_json.h"
-#include "tools/br_args.h"
-#include "tools/br_outfile.h"
-#include "tools/br_run_report.h"
-#include "tools/br_tool_limits.h"
+#include "tool/br_args.h"
+#include "tool/br_outfile.h"
+#include "tool/br_run_report.h"
+#include "tool/br_tool_limits.h"
 
 #define TOOL "br_robust_run"
 #define BR_HIST_BINS 60

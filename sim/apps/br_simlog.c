@@ -25,13 +25,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "simlog/br_cause_args.h"
+#include "cause_args/br_cause_args.h"
 #include "circle/br_circle.h"
-#include "simlog/br_ident.h"
-#include "tools/br_args.h"
-#include "tools/br_outfile.h"
-#include "tools/br_rng.h"
-#include "tools/br_tool_limits.h"
+#include "ident/br_ident.h"
+#include "tool/br_args.h"
+#include "tool/br_outfile.h"
+#include "tool/br_rng.h"
+#include "tool/br_tool_limits.h"
 #include "plant/br_plant_json.h"
 
 #define TOOL "br_simlog"

@@ -3,7 +3,7 @@
  * the plant of the machine this build is for (BR_MACHINE), or of a model.json
  * (--model: the identified plant with its causes), with each controller:
  *
- *   pd           the log's position loop (the EMPS form of sim/simlog/br_ident.h:
+ *   pd           the log's position loop (the EMPS form of sim/lib/ident/br_ident.h:
  *                u = kp kv (ref - q) - kv qdot, |u| <= u_max, F = gain u), --pd
  *   hinf_only    the firmware (br_app_step), H-infinity only, control period
  *   hinf_pf      the firmware with the PF on the nominal model, the PF's period
@@ -41,14 +41,14 @@
 #include "bristle/br_app.h"
 #include "bristle/br_machine_cfg.h"
 #include "circle/br_circle.h"
-#include "hal/br_hal_sim.h"
+#include "hal_sim/br_hal_sim.h"
 #include "plant/br_model_params.h"
 #include "plant/br_plant_json.h"
-#include "simlog/br_cause_args.h"
-#include "tools/br_args.h"
-#include "tools/br_logcsv.h"
-#include "tools/br_outfile.h"
-#include "tools/br_run_report.h"
+#include "cause_args/br_cause_args.h"
+#include "tool/br_args.h"
+#include "tool/br_logcsv.h"
+#include "tool/br_outfile.h"
+#include "tool/br_run_report.h"
 
 #define BR_PI 3.14159265358979323846
 
@@ -58,7 +58,7 @@ typedef struct {
     long n;
 } traj_t;
 
-/* the t and ref columns of a measured log, by the diagnosis's rules (tools/br_logcsv.h) */
+/* the t and ref columns of a measured log, by the diagnosis's rules (tool/br_logcsv.h) */
 static int read_traj(const char *path, traj_t *tr)
 {
     static const char *const names[] = {"t", "ref"};

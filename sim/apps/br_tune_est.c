@@ -11,15 +11,15 @@
  * study's plant.json), and its median or 90th percentile (nearest rank) over
  * them instead of the one nominal plant's.
  * Prints a progress line per iteration; writes the tuned variances as a
- * generated header (used by sim/circle/br_circle_est.c) and, with --log, the
+ * generated header (used by sim/lib/circle/br_circle_est.c) and, with --log, the
  * progress (iteration, evaluations, best contour RMS, parameters) for Fig. 1.
  * The objective is penalised by the outlier steps (lost lock); with
  * --guard-outliers K (PF; default BR_TUNE_GUARD_OUTLIERS_PF, what `make tune`
  * runs) also by those on the guard plants (docs/tuning.md, "A noise-aware
  * objective"); and, unless --mslip-target 0, by the settings' contour RMS on
- * the Maxwell-slip guard plants (tune/br_tune_mslip.h; docs/tuning.md,
+ * the Maxwell-slip guard plants (tune_mslip/br_tune_mslip.h; docs/tuning.md,
  * "Presliding that is not LuGre"). The UKF's nominal tuning runs the delayed
- * guard plants too (tune/br_tune_delay.h; docs/tuning.md, "A plant with an
+ * guard plants too (tune_delay/br_tune_delay.h; docs/tuning.md, "A plant with an
  * actuator delay, and R's floor"; the PF's: BR_TUNE_DELAY_GUARD_PF). A run that stops the axis, on the nominal plant or a
  * guard plant, counts as a failure of the setting. The start is
  * the hand-tuned default of the machine file's estimator section; each log-variance may move 3 decades
@@ -35,13 +35,13 @@
 #include "circle/br_circle.h"
 #include "circle/br_circle_est.h"
 #include "plant/br_plant_json.h"
-#include "tune/br_nm.h"
-#include "tune/br_tune_delay.h"
-#include "tune/br_tune_mslip.h"
+#include "nm/br_nm.h"
+#include "tune_delay/br_tune_delay.h"
+#include "tune_mslip/br_tune_mslip.h"
 #include "bristle_gen/machine/br_machine.h"
-#include "tools/br_args.h"
-#include "tools/br_outfile.h"
-#include "tools/br_tool_limits.h"
+#include "tool/br_args.h"
+#include "tool/br_outfile.h"
+#include "tool/br_tool_limits.h"
 
 #define TOOL "br_tune_est"
 #define MAX_P 5

@@ -6,7 +6,7 @@
  * stand-in for the real axis), the thesis circle and the same circle at
  * FAST_FEED times its feed (the acceleration at the reversals FAST_FEED^2
  * times the thesis's: without a second acceleration A1 is not identifiable),
- * Nelder-Mead (sim/tune/br_nm) over (A0_N, A1_kg, tau_s) minimises the sum of
+ * Nelder-Mead (sim/lib/nm/br_nm) over (A0_N, A1_kg, tau_s) minimises the sum of
  * the two circles' quadrant glitches (br_circle_quadrant.h), each divided by
  * H-inf only's on the same circle. A run the firmware stopped scores +inf.
  *
@@ -19,9 +19,9 @@
 
 #include "circle/br_circle.h"
 #include "circle/br_circle_quadrant.h"
-#include "tune/br_nm.h"
+#include "nm/br_nm.h"
 #include "bristle_gen/machine/br_machine.h"
-#include "tools/br_args.h"
+#include "tool/br_args.h"
 
 #define TOOL "br_tune_qec"
 /* the second circle's feed, times the thesis's */

@@ -44,7 +44,7 @@ PF_PERIOD_RATIO = 1.5      # the PF's period over the control period (the refere
 # trajectory set
 CIRCLES = 2                # circles at a drawn feed and radius, beside the thesis circle
 FEED_MM_MIN = (100.0, 5000.0)
-FEED_TOOL_MAX_MM_MIN = 3000.0   # the tools' bound (sim/tools/br_tool_limits.h BR_TOOL_FEED_MAX_MM_MIN)
+FEED_TOOL_MAX_MM_MIN = 3000.0   # the tools' bound (sim/lib/tool/br_tool_limits.h BR_TOOL_FEED_MAX_MM_MIN)
 RADIUS_M = (1e-3, 50e-3)
 MAX_REV_S = 12.0           # one revolution at most this long (the run's cost)
 P2P_MOVES = 4

@@ -14,7 +14,7 @@
  *     -semihosting-config enable=on,target=native,arg=pil,arg=EST -kernel br_pil_mps2.elf
  *
  * EST: none (H-inf only), ukf or pf, with the simulator's circle's
- * configuration (sim/circle: the machine's H-inf gains at its period, the
+ * configuration (sim/lib/circle: the machine's H-inf gains at its period, the
  * tuned filter on the machine file's model, 1.5 ms for the PF); the axis starts
  * disarmed, as the production image does. One period per pil_tick: tick_wait
  * (the lockstep), br_svc_step, the sample to telemetry and the recorder, the

@@ -8,7 +8,7 @@
 #include "br_test.h"
 
 #include "circle/br_circle.h"
-#include "tools/br_run_report.h"
+#include "tool/br_run_report.h"
 #include "bristle/br_app.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"

@@ -142,7 +142,7 @@ class CliTest(unittest.TestCase):
         self.assertIn("delay_s", r.stderr)
         r = simlog("--out", os.path.join(self.w, "x.csv"), "--ripple", "1")
         self.assertEqual(r.returncode, 2)
-        # the options set the parameters of sim/plant/br_model_params.h, by their names and bounds
+        # the options set the parameters of sim/lib/plant/br_model_params.h, by their names and bounds
         r = simlog("--out", os.path.join(self.w, "x.csv"), "--asym", "1")
         self.assertEqual(r.returncode, 2)
         self.assertIn("dFc_neg_N,dsigma2_neg_Nspm", r.stderr)

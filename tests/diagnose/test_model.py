@@ -277,7 +277,7 @@ class RegistryTest(unittest.TestCase):
 
 class OneTableTest(unittest.TestCase):
     """model.json's parameters have one name each: the Python table
-    (params.py, causes/) is the C table (sim/plant/br_model_params.h: the
+    (params.py, causes/) is the C table (sim/lib/plant/br_model_params.h: the
     model loader, the simulators' options, the plant configuration's fields)
     and the table of docs/diagnose.md, row by row."""
 
@@ -293,7 +293,7 @@ class OneTableTest(unittest.TestCase):
         if token in named:
             return named[token]
         if token == "BR_PLANT_DELAY_MAX_S":
-            with open(os.path.join(REPO, "sim", "plant", "br_sim_plant.h")) as f:
+            with open(os.path.join(REPO, "sim", "lib", "plant", "br_sim_plant.h")) as f:
                 return float(re.search(r"#define BR_PLANT_DELAY_MAX_S ([0-9.eE+-]+)", f.read()).group(1))
         return float(token)
 
@@ -301,7 +301,7 @@ class OneTableTest(unittest.TestCase):
         return next((m for m in causes.REGISTRY if any(q.name == name for q in m.PARAMS)), None)
 
     def test_the_c_table_is_the_python_table(self):
-        with open(os.path.join(REPO, "sim", "plant", "br_model_params.h")) as f:
+        with open(os.path.join(REPO, "sim", "lib", "plant", "br_model_params.h")) as f:
             rows = self.C_ROW.findall(f.read())
         self.assertEqual([r[0] for r in rows], [q.name for q in causes.MODEL_PARAMS])
         self.assertEqual(len(rows), len(causes.MODEL_PARAMS))

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* libFuzzer target: the model reader (sim/plant/br_plant_json.c: cJSON, then
+/* libFuzzer target: the model reader (sim/lib/plant/br_plant_json.c: cJSON, then
  * the checks of the parameter table), which reads a diagnosis's model.json,
  * outside data. (Debian's libcjson is not instrumented for coverage: the
  * fuzzer is guided by the checks' branches, and ASan still watches cJSON's

@@ -41,7 +41,7 @@ static uint32_t f2w(float f)
     return w;
 }
 
-/* The reference of axis a (x: phase 0, y: phase pi/2), as sim/circle/br_circle.c computes it. */
+/* The reference of axis a (x: phase 0, y: phase pi/2), as sim/lib/circle/br_circle.c computes it. */
 static void sink(void *user, const br_circle_sample_t *s)
 {
     rec_t *r = user;

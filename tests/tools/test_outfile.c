@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* br_outfile (sim/tools/br_outfile.h): an existing destination survives a
+/* br_outfile (sim/lib/tool/br_outfile.h): an existing destination survives a
  * discarded write byte for byte, a committed write replaces it whole, no
  * temporary file is left behind, and a destination that cannot be written
  * is refused at open. */
@@ -13,7 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "tools/br_outfile.h"
+#include "tool/br_outfile.h"
 #include "br_test.h"
 
 static char dir[256];

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """The host tools' command lines (docs/tools.md): every option checked
-against its bound (sim/tools/br_tool_limits.h) before a file is touched,
+against its bound (sim/lib/tool/br_tool_limits.h) before a file is touched,
 --help never taken as an option needing a value, an output that cannot be
 written refused before the run, and a failed run leaving any existing file
 byte for byte and no temporary file behind.
@@ -15,10 +15,10 @@ import unittest
 
 ARGS = None
 TOOLS = ("br_simlog", "br_demo_circle", "br_circle_ext", "br_pf_study", "br_dt_study", "br_tune_est", "br_track",
-         "br_robust_run", "bench/br_bench", "br_link_sim", "br_mslip_plants")
+         "br_robust_run", "br_bench", "br_link_sim", "br_mslip_plants")
 VALUED = {"br_simlog": "--out", "br_demo_circle": "--out", "br_circle_ext": "--json", "br_pf_study": "--table",
           "br_dt_study": "--seeds", "br_tune_est": "--out", "br_track": "--json", "br_robust_run": "--json",
-          "bench/br_bench": "--json", "br_link_sim": "--pty-path", "br_mslip_plants": "--json"}  # an option that takes a value
+          "br_bench": "--json", "br_link_sim": "--pty-path", "br_mslip_plants": "--json"}  # an option that takes a value
 VERSION_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "VERSION")
 OLD = b"an existing file\r\nwith two lines\n"
 
@@ -203,7 +203,7 @@ class ToolsTest(unittest.TestCase):
         self.assert_refused(r, 1, "cannot open")
         self.assert_untouched(keep)
 
-    # the circle's options (sim/circle/br_circle_args.h, docs/tools.md): each bound refused just beyond it,
+    # the circle's options (sim/lib/circle_args/br_circle_args.h, docs/tools.md): each bound refused just beyond it,
     # nothing written; the pair's bound (a revolution 0.1 .. 3600 s) likewise
     CIRCLE_BAD = tuple((b, " ".join(b) + ": must be") for b in (
         ["--radius-m", "0.9e-6"], ["--radius-m", "0.1501"], ["--radius-m", "0"], ["--radius-m", "nan"],
@@ -336,7 +336,7 @@ class ToolsTest(unittest.TestCase):
     def test_bench_plant_named(self):
         # br_bench --plant: thesis or realistic, anything else refused by name before any run
         for bad in ("nominal", "", "Realistic"):
-            r = run("bench/br_bench", "--plant", bad)
+            r = run("br_bench", "--plant", bad)
             self.assert_refused(r, 2, "--plant")
             self.assertNotIn("PF recording", r.stdout)
 

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""br_track reads its log by the diagnosis's rules (sim/tools/br_logcsv.h)
+"""br_track reads its log by the diagnosis's rules (sim/lib/tool/br_logcsv.h)
 and writes every output through br_outfile (docs/tools.md):
 
 - each bad log of the audit (an empty cell, 0.001abc, a hexadecimal float,
@@ -146,7 +146,7 @@ class BenchOutputs(unittest.TestCase):
             f.write(OLD)
         for extra, fragment in ((["--record", os.path.join(w, "rec")], "rec: is a directory"),
                                 (["--record", os.path.join(w, "none", "r.csv")], "No such file or directory")):
-            r = subprocess.run([os.path.join(ARGS.bin, "bench", "br_bench"), "--json", js, "--reps", "1", *extra],
+            r = subprocess.run([os.path.join(ARGS.bin, "br_bench"), "--json", js, "--reps", "1", *extra],
                                capture_output=True, text=True, timeout=600)
             self.assertEqual(r.returncode, 1, r.stderr)
             self.assertIn(fragment, r.stderr)

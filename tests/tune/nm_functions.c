@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "tune/br_nm.h"
+#include "nm/br_nm.h"
 
 /* Rosenbrock, 2-D: minimum 0 at (1, 1) */
 static double rosen(void *u, const double *x, int n)

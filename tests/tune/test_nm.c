@@ -4,7 +4,7 @@
 
 #include <string.h>
 
-#include "tune/br_nm.h"
+#include "nm/br_nm.h"
 
 typedef struct {
     int outside;

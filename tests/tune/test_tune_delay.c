@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The tuner's delayed guard plants (sim/tune/br_tune_delay.h): a setting that
+/* The tuner's delayed guard plants (sim/lib/tune_delay/br_tune_delay.h): a setting that
  * stops the axis on one counts as a failure, never as a figure. Every value
  * comes from the machine under test (its generated headers, through
  * br_circle_cfg_thesis), so the test holds on any machine file
@@ -7,7 +7,7 @@
 #include "br_test.h"
 
 #include "bristle_gen/machine/br_machine.h"
-#include "tune/br_tune_delay.h"
+#include "tune_delay/br_tune_delay.h"
 
 static br_tune_delay_t g; /* large: static */
 

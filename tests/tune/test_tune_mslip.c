@@ -1,11 +1,11 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The tuner's Maxwell-slip guard plants (sim/tune/br_tune_mslip.h): a setting
+/* The tuner's Maxwell-slip guard plants (sim/lib/tune_mslip/br_tune_mslip.h): a setting
  * that stops the axis on one counts as a failure, never as a figure. */
 #include "br_test.h"
 
 #include <math.h>
 
-#include "tune/br_tune_mslip.h"
+#include "tune_mslip/br_tune_mslip.h"
 
 static br_tune_mslip_t g; /* large: static */
 

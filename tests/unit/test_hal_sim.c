@@ -2,7 +2,7 @@
 /* Host HAL port bound to the plant. */
 #include "br_test.h"
 
-#include "hal/br_hal_sim.h"
+#include "hal_sim/br_hal_sim.h"
 
 static void test_port(void **st)
 {

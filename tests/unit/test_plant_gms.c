@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Plant simulator, the Maxwell-slip friction (sim/plant/br_gms.h,
+/* Plant simulator, the Maxwell-slip friction (sim/lib/plant/br_gms.h,
  * ../shared/spec/presliding.md): one guard test per configuration field,
  * the elements bounded at any step for both laws, the slip law tending to
  * the clamp at a large C, presliding_m against presliding.md's example, and

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* model.json -> plant configuration (sim/plant/br_plant_json.c, by the table
- * sim/plant/br_model_params.h): the mapping of the load-side parameters, and
+/* model.json -> plant configuration (sim/lib/plant/br_plant_json.c, by the table
+ * sim/lib/plant/br_model_params.h): the mapping of the load-side parameters, and
  * one test per rejected input, each checking the line the message names. */
 #define _POSIX_C_SOURCE 200809L /* mkstemp, fdopen, unlink */
 #include "br_test.h"

@@ -543,7 +543,7 @@ static void test_gp_clamped(void **st)
     assert_true(state_finite(&u));
 }
 
-/* ---- simulations on the double-precision plant (br_sim) ---- */
+/* ---- simulations on the double-precision plant (br_plant) ---- */
 
 typedef enum { SCEN_OPEN_LOOP = 0, SCEN_HINF_TRACKING = 1 } scen_t;
 

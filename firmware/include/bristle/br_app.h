@@ -8,7 +8,7 @@
  *
  * over the HAL the caller binds: the one home of the control period. The
  * production images (hal/stm32/image, one for every STM32 board), the replay image
- * (target/mps2) and the simulator's circle experiment (sim/circle) all run
+ * (target/mps2) and the simulator's circle experiment (sim/lib/circle) all run
  * br_app_step. docs/modules/app.md.
  *
  * Where the estimator's state lives: in storage the caller provides

@@ -2,7 +2,7 @@
 /* The firmware configurations of the machine the generated headers describe
  * (bristle_gen/: br_machine.h, br_est_machine.h, br_pf_tuned.h, br_ukf_tuned.h,
  * br_noise_table.h; docs/machine-file.md): one home for the simulator's
- * circle (sim/circle/br_circle_est.c) and the STM32H743 image
+ * circle (sim/lib/circle/br_circle_est.c) and the STM32H743 image
  * (hal/stm32/image/br_image_main.c), which holds them const, in flash.
  *
  * Initialisers, not functions, so that a program can place the result in

@@ -10,7 +10,7 @@ loading (docs/diagnose.md, "Outputs" and "Parameters").
   presliding      with the cause presliding_hysteresis: its element set,
                   {"breakaway_m": [d_i at Fs_N, m], "share": [alpha_i, sum 1]}
 
-The plant simulator reads the same "params" (sim/plant/br_plant_json.c).
+The plant simulator reads the same "params" (sim/lib/plant/br_plant_json.c).
 Format 1 (older names: M_kg, Fv_Nspm, Fc_neg_N, Fv_neg_Nspm) is not read."""
 import math
 

@@ -4,7 +4,7 @@ in it, the name of the br_plant_cfg_t field it sets), the unit, what it
 means, and its bounds [lo, hi] (lo = GT0: "> 0"). NOMINAL are the thesis
 model's, load side; each cause module (causes/) lists its own in PARAMS.
 The same names, units, causes and bounds are the C table
-sim/plant/br_model_params.h (test_model.py holds the two together);
+sim/lib/plant/br_model_params.h (test_model.py holds the two together);
 docs/diagnose.md, "Parameters", has the table.
 
 The same Param describes a machine file's controller keys (closedloop.py),

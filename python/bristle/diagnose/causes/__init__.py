@@ -10,7 +10,7 @@ What a cause module holds:
   NAME, MEANING        the spec's name; what it is physically (report.md)
   ACTION               what to check or do on the machine (report.md, with each finding)
   OPTION               br_simlog's / br_circle_ext's option that switches it on
-                       (the C table sim/plant/br_model_params.h)
+                       (the C table sim/lib/plant/br_model_params.h)
   PARAMS               its model.json parameters (params.Param), in the
                        option's order; the same names as br_plant_cfg_t's fields
   NL                   the names of its nonlinear parameters in a fit's `nl`

@@ -34,13 +34,13 @@
 
 #include "circle/br_circle.h"
 #include "circle/br_circle_est.h"
-#include "hal/br_hal_sim.h"
+#include "hal_sim/br_hal_sim.h"
 #include "bristle_gen/est/br_noise_table.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_machine_cfg.h"
 #include "bristle/br_app.h"
-#include "tools/br_args.h"
-#include "tools/br_outfile.h"
+#include "tool/br_args.h"
+#include "tool/br_outfile.h"
 
 #define TOOL "br_bench"
 
@@ -149,7 +149,7 @@ static int record_axis(const br_circle_cfg_t *c, br_est_t est, rec_t *rec)
         const double t = (double)k * c->dt_s;
         uint32_t tick;
         hal.tick_wait(hal.ctx, &tick);
-        /* reference in counts + fraction and its velocity, as in sim/circle */
+        /* reference in counts + fraction and its velocity, as in sim/lib/circle */
         const double counts = c->radius_m * sin(w * t) / L / rpc, whole = floor(counts);
         const br_ref_t r = {(int32_t)whole, (float)(counts - whole), (float)(c->radius_m * w * cos(w * t) / L)};
         const br_status_t st = br_app_step(&app, &r);

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* A closed-loop run's report: a faulted run is a fault, never an RMS (br_run_report.h). */
-#include "tools/br_run_report.h"
+#include "tool/br_run_report.h"
 
 #include "bristle/br_app.h"
 

@@ -2,7 +2,7 @@
 /* The parameters of a saved model, model.json's "params" (docs/diagnose.md,
  * "Parameters"): the one table of their names in C. The model loader
  * (br_plant_json.c) reads them by it, the simulators' cause options
- * (sim/simlog/br_cause_args.c) set them by it, and br_causes_from_model
+ * (sim/lib/cause_args/br_cause_args.c) set them by it, and br_causes_from_model
  * copies the causes' rows into the firmware's extended estimation model
  * (br_causes_t, the same field names). The diagnosis (python/bristle/diagnose: params.py, one
  * module per cause in causes/) uses the same names, units and causes;

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The tuner's Maxwell-slip guard plants (docs/tuning.md, "Presliding that is
  * not LuGre"): the thesis circle on plants whose presliding is a generalized
- * Maxwell-slip friction (sim/plant/br_gms.h), which the estimators' LuGre
+ * Maxwell-slip friction (sim/lib/plant/br_gms.h), which the estimators' LuGre
  * model does not contain. A setting is judged on each by its contour RMS over
  * H-inf only's on the same plant; a run that stops the axis is a failure of
  * the setting, never a figure.

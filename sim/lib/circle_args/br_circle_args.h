@@ -27,7 +27,7 @@ typedef struct {
 
 #define BR_CIRCLE_PATH_DEFAULT {0.0, 0.0, BR_CIRCLE_DIR_CW}
 
-/* getopt_long entries (sim/tools/br_args.h), all with the value
+/* getopt_long entries (sim/lib/tool/br_args.h), all with the value
  * BR_CIRCLE_OPT: put BR_CIRCLE_LONGOPTS in a tool's table and hand
  * BR_CIRCLE_OPT's option name and value to br_circle_arg. */
 #define BR_CIRCLE_OPT 0x200

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The host tools' command lines (sim/apps, sim/bench; docs/tools.md): GNU
+/* The host tools' command lines (sim/apps; docs/tools.md): GNU
  * getopt_long underneath, with what every tool shares on top:
  *
  *   --help / -h   anywhere, even where a value is expected ("--out --help"

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The cause options of the simulator's command lines (br_simlog,
  * br_circle_ext): docs/simlog.md. Each sets the br_plant_cfg_t fields of its
- * rows in sim/plant/br_model_params.h, its values in their order:
+ * rows in sim/lib/plant/br_model_params.h, its values in their order:
  *
  *   --offset F           offset_N: constant load force, N
  *   --asym DFC,DFV       dFc_neg_N, dsigma2_neg_Nspm: friction in -x, Coulomb (and stiction) + DFC N,
@@ -16,7 +16,7 @@
 #include "plant/br_model_params.h"
 #include "plant/br_sim_plant.h"
 
-/* The cause options as getopt_long entries (sim/tools/br_args.h), one per
+/* The cause options as getopt_long entries (sim/lib/tool/br_args.h), one per
  * row (an option of several rows appears as often; getopt_long takes the
  * first exact match), all with the value BR_CAUSE_OPT: put BR_CAUSE_LONGOPTS
  * in a tool's table and hand BR_CAUSE_OPT's option and value to br_cause_arg. */

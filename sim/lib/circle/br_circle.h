@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The thesis's X-Y circle experiment (section 5) on the simulator: two
- * identical axes, each a plant, the simulator's HAL (sim/hal) and the
+ * identical axes, each a plant, the simulator's HAL (sim/lib/hal_sim) and the
  * firmware application (br_app_step), tracking x_ref = A sin(2 pi t / T),
  * y_ref = A cos(2 pi t / T). */
 #ifndef BR_CIRCLE_H
@@ -69,7 +69,7 @@ typedef struct {
     int outlier_steps;      /* axis-periods whose measurement the estimator rejected */
     double fhat_rms_err_N;  /* RMS of (compensation - the plant's force, br_plant_comp_force_N) over both axes */
     int fault_status;       /* 0, or the negative status with which the firmware stopped an axis, or
-                               BR_RUN_NOT_FOLLOWED (tools/br_run_report.h): the table was farther than the
+                               BR_RUN_NOT_FOLLOWED (tool/br_run_report.h): the table was farther than the
                                radius from the reference point (it did not go round the circle) */
     double fault_t_s;       /* when it did */
     int fault_cause;        /* the latched br_app_fault_t of that axis (0 without a fault) */

@@ -5,8 +5,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "tools/br_args.h"
-#include "tools/br_tool_limits.h"
+#include "tool/br_args.h"
+#include "tool/br_tool_limits.h"
 
 #define MM_MIN_PER_MPS 60000.0
 

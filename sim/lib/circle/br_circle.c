@@ -7,15 +7,15 @@
 #include <string.h>
 
 #include "br_circle_est.h"
-#include "hal/br_hal_sim.h"
+#include "hal_sim/br_hal_sim.h"
 #include "bristle_gen/ctrl/br_hinf_gains.h"
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_machine_cfg.h"
 #include "bristle/br_app.h"
 #include "plant/br_model_params.h"
-#include "tools/br_rng.h"
-#include "tools/br_run_report.h"
+#include "tool/br_rng.h"
+#include "tool/br_run_report.h"
 
 #define BR_PI 3.14159265358979323846
 
