@@ -32,6 +32,10 @@ static br_status_t sub_steps(const br_model_cfg_t *cfg, float *rho_h, int *n)
     }
     const float L2 = cfg->lead_mprad * cfg->lead_mprad;
     const float meff = (cfg->J_kgm2 + L2 * cfg->M_kg) / L2;
+    /* an inertia at the load that rounds to 0 or beyond float range: no step to choose */
+    if (!br_finite_pos(meff)) {
+        return BR_E_PARAM;
+    }
     const float wn2 = cfg->lugre.sigma0_Npm / meff, b = (cfg->lugre.sigma1_Nspm + cfg->sigma2_Nspm) / meff;
     const float wn = sqrtf(wn2);
     /* eq. S1 */

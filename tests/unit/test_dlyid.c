@@ -112,9 +112,15 @@ static double modelled_s(const br_est_delay_t *d, const br_est_cfg_t *c)
 static br_est_cfg_t machine_ukf(void) { return br_circle_ukf_cfg_tuned(UKF_DT_S).est; }
 static br_est_cfg_t machine_pf(void) { return br_circle_pf_cfg_tuned(PF_DT_S).est; }
 
-/* c is refused, and the same configuration with the bank off is not */
+/* c is refused, and the same configuration with the bank off is not. The
+ * bristles are made so soft and undamped that the model's own sub-step bound
+ * (br_model.h, BR_MODEL_SUBSTEP_MAX) holds at these extreme periods and
+ * inertias: the refusal is the bank's alone. */
 static void refused_only_with_the_bank(br_est_cfg_t c)
 {
+    c.model.lugre.sigma0_Npm = 1e-38f;
+    c.model.lugre.sigma1_Nspm = 0.0f;
+    c.model.sigma2_Nspm = 0.0f;
     assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
     c.delay_id.n_cand = 0u;
     assert_int_equal(br_est_cfg_check(&c), BR_OK);
@@ -171,10 +177,17 @@ static void test_dlyid_bounds(void **st)
     c.model.M_kg = 0.0f;
     c.model.J_kgm2 = 1.0e-23f;
     assert_true(isfinite(-c.model.lead_mprad * (0.5f * c.model.dt_s * c.model.dt_s / c.model.J_kgm2)));
-    refused_only_with_the_bank(c);
+    /* the model refuses it first: its inertia at the load J / L^2 rounds to 0 (br_model_init's
+     * sub-step choice), with the bank on or off */
+    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c.delay_id.n_cand = 0u;
+    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
     /* the friction's variance per period q T beyond float range, at a 100 s period */
     c = ok;
     c.model.dt_s = 100.0f;
+    c.model.lugre.sigma0_Npm = 1.0f; /* the model's sub-steps hold at such a period (rho h ~ 20) */
+    c.model.lugre.sigma1_Nspm = 0.0f;
+    c.model.sigma2_Nspm = 0.0f;
     c.delay_id.q_force_N2ps = 1.0e37f;
     assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
     c.delay_id.q_force_N2ps = 1.0e35f;
