@@ -31,8 +31,12 @@ static br_status_t sub_steps(const br_model_cfg_t *cfg, float *rho_h, int *n)
         return BR_OK;
     }
     const float L2 = cfg->lead_mprad * cfg->lead_mprad;
+    /* a lead whose square rounds to 0, or an inertia at the load that rounds to 0 or
+     * beyond float range: no step to choose */
+    if (!br_finite_pos(L2)) {
+        return BR_E_PARAM;
+    }
     const float meff = (cfg->J_kgm2 + L2 * cfg->M_kg) / L2;
-    /* an inertia at the load that rounds to 0 or beyond float range: no step to choose */
     if (!br_finite_pos(meff)) {
         return BR_E_PARAM;
     }

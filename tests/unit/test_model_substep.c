@@ -89,6 +89,18 @@ static void test_sub_guard(void **st)
     c.dt_s = (float)((BR_MODEL_SUB_MAX + 0.5) / rho);
     assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
     assert_int_equal(m.ready, 0);
+    /* a lead whose square rounds to 0 in float (the sub-step choice divides by it; the
+     * host-debug build's sanitizer stops on that division: fuzz_replay found it) and an
+     * inertia at the load that rounds to 0: refused */
+    c = cfg_k(PF_H, 1.0f);
+    c.lead_mprad = 1.0e-23f;
+    assert_true(c.lead_mprad * c.lead_mprad == 0.0f);
+    assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
+    c = cfg_k(PF_H, 1.0f);
+    c.lead_mprad = 1.8e19f;
+    c.M_kg = 0.0f;
+    c.J_kgm2 = 1.0e-23f;
+    assert_int_equal(br_model_init(&m, &c), BR_E_PARAM);
 }
 
 /* Double-precision RK4 of eq. 6 over dt in n substeps: the accuracy reference */
