@@ -7,6 +7,20 @@
 
 #include "br_check.h"
 
+uint32_t br_refq_fault_periods_min(const br_refq_cfg_t *cfg)
+{
+    if (cfg == NULL || !br_finite_pos(cfg->dt_s) || !br_finite_pos(cfg->max_speed_mps) ||
+        !br_finite_pos(cfg->max_accel_mps2)) {
+        return 0u;
+    }
+    /* the fault comes after the braking: hold + the periods max_speed takes to stop at max_accel */
+    const float brake_periods = ceilf(cfg->max_speed_mps / (cfg->max_accel_mps2 * cfg->dt_s));
+    if (!(brake_periods < 1.0e9f) || cfg->hold_periods > 1000000000u) {
+        return 0u;
+    }
+    return cfg->hold_periods + (uint32_t)brake_periods + 1u;
+}
+
 br_status_t br_refq_init(br_refq_t *q, const br_refq_cfg_t *cfg)
 {
     if (q == NULL || cfg == NULL) {
@@ -18,10 +32,8 @@ br_status_t br_refq_init(br_refq_t *q, const br_refq_cfg_t *cfg)
         !br_finite_pos(cfg->max_speed_mps) || !br_finite_pos(cfg->max_accel_mps2)) {
         return BR_E_PARAM;
     }
-    /* the fault comes after the braking: hold + the periods max_speed takes to stop at max_accel */
-    const float brake_periods = ceilf(cfg->max_speed_mps / (cfg->max_accel_mps2 * cfg->dt_s));
-    if (!(brake_periods < 1.0e9f) || cfg->hold_periods > 1000000000u ||
-        (float)cfg->fault_periods <= (float)cfg->hold_periods + brake_periods) {
+    const uint32_t fault_min = br_refq_fault_periods_min(cfg);
+    if (fault_min == 0u || cfg->fault_periods < fault_min) {
         return BR_E_PARAM;
     }
     q->cfg = *cfg;

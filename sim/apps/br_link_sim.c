@@ -283,8 +283,8 @@ static int axis_init(axis_t *a, const opts_t *o, const br_byte_chan_t *chan)
     }
     br_refq_cfg_t q = {(uint32_t)o->queue, (float)dt, BR_MACHINE_RAD_PER_COUNT_F, mc.counts_per_m, mc.max_speed_mps,
                        mc.max_accel_mps2, (uint32_t)o->hold_periods, 0u};
-    /* the fault after the braking from the machine's top speed (refq.md) */
-    q.fault_periods = q.hold_periods + (uint32_t)ceil((double)mc.max_speed_mps / ((double)mc.max_accel_mps2 * dt)) + 1u;
+    /* the fault one period after the braking from the machine's top speed (refq.md) */
+    q.fault_periods = br_refq_fault_periods_min(&q);
     const br_svc_cfg_t sc = {BR_LINK_RX_BUDGET_MAX, BR_LINK_TX_BUF_BYTES, q, (uint32_t)o->status_periods, NULL, NULL,
                              BR_MACHINE_NAME};
     const br_tlm_cfg_t tc = {(uint32_t)o->tlm_every};

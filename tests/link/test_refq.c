@@ -57,6 +57,14 @@ static void test_init_guards(void **st)
     assert_int_equal(br_refq_init(&q, &c), BR_E_PARAM);
     c.fault_periods += 1u;
     assert_int_equal(br_refq_init(&q, &c), BR_OK);
+    /* the smallest accepted value is the one the helper gives; none for limits that give none */
+    assert_int_equal(br_refq_fault_periods_min(&c), c.fault_periods);
+    c.max_speed_mps = INFINITY;
+    assert_int_equal(br_refq_fault_periods_min(&c), 0u);
+    c = machine_cfg(8u);
+    c.hold_periods = 1000000001u;
+    assert_int_equal(br_refq_fault_periods_min(&c), 0u);
+    assert_int_equal(br_refq_init(&q, &c), BR_E_PARAM);
 }
 
 static void test_push_guards(void **st)

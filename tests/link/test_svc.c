@@ -147,7 +147,7 @@ static br_refq_cfg_t refq_cfg(void)
     const br_app_motion_cfg_t mo = br_app_motion_cfg(&m);
     br_refq_cfg_t c = {8u, DT, BR_MACHINE_RAD_PER_COUNT_F, mo.counts_per_m, mo.max_speed_mps, mo.max_accel_mps2,
                        HOLD, 0u};
-    c.fault_periods = HOLD + (uint32_t)ceilf(c.max_speed_mps / (c.max_accel_mps2 * DT)) + 1u;
+    c.fault_periods = br_refq_fault_periods_min(&c);
     return c;
 }
 

@@ -89,6 +89,13 @@ typedef struct {
     int ready;
 } br_refq_t;
 
+/* The smallest fault_periods br_refq_init accepts for cfg's other fields:
+ * hold_periods + ceil(max_speed / (max_accel dt)) + 1 (the fault one period
+ * after the braking from max_speed); 0 when they give none (a limit or the
+ * period not finite positive, the braking 1e9 periods or more, hold_periods
+ * above 1e9). */
+uint32_t br_refq_fault_periods_min(const br_refq_cfg_t *cfg);
+
 /* Validates cfg (BR_E_NULL, BR_E_PARAM); the queue empty, IDLE at count 0. */
 br_status_t br_refq_init(br_refq_t *q, const br_refq_cfg_t *cfg);
 

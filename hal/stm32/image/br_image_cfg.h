@@ -10,7 +10,6 @@
 #ifndef BR_IMAGE_CFG_H
 #define BR_IMAGE_CFG_H
 
-#include <math.h>
 #include <stdint.h>
 
 #include "br_board.h"
@@ -75,12 +74,12 @@ typedef char br_image_tlm_fits[(2ull * BR_IMAGE_TLM_FRAME_BYTES * 1000000000ull 
 #define BR_IMAGE_MAX_MISSED 2u
 
 /* The reference queue with the machine's limits; the underrun's fault comes
- * one period after the braking from the top speed (br_refq_init's rule). */
+ * one period after the braking from the top speed (br_refq_fault_periods_min). */
 static inline br_refq_cfg_t br_image_refq(const br_app_motion_cfg_t *m)
 {
     br_refq_cfg_t c = {BR_IMAGE_REFQ_LEN, BR_IMAGE_DT_S, BR_MACHINE_RAD_PER_COUNT_F, m->counts_per_m,
                        m->max_speed_mps, m->max_accel_mps2, BR_IMAGE_HOLD_PERIODS, 0u};
-    c.fault_periods = BR_IMAGE_HOLD_PERIODS + (uint32_t)ceilf(c.max_speed_mps / (c.max_accel_mps2 * c.dt_s)) + 1u;
+    c.fault_periods = br_refq_fault_periods_min(&c);
     return c;
 }
 
