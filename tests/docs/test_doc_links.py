@@ -78,48 +78,45 @@ def anchors(path):
     return out
 
 
-def broken(root):
-    """[(page, line, target)] of the links that lead nowhere."""
-    cache = {}
-    bad = []
+def links(root):
+    """(page, line, target) of every relative link of the pages."""
     for page in pages(root):
         with open(os.path.join(root, page), encoding="utf-8") as f:
             text = f.read()
         for n, line in prose_lines(text):
             for m in LINK.finditer(line):
-                target = m.group(1)
-                if re.match(r"^[a-z][a-z0-9+.-]*:", target):
-                    continue  # http:, https:, mailto:
-                path, _, anchor = target.partition("#")
-                if path:
-                    full = os.path.normpath(os.path.join(root, os.path.dirname(page), path))
-                    if not os.path.exists(full):
-                        bad.append((page, n, target))
-                        continue
-                else:
-                    full = os.path.join(root, page)
-                if anchor and full.endswith(".md") and os.path.isfile(full):
-                    if full not in cache:
-                        cache[full] = anchors(full)
-                    if anchor.lower() not in cache[full]:
-                        bad.append((page, n, target))
+                if not re.match(r"^[a-z][a-z0-9+.-]*:", m.group(1)):
+                    yield page, n, m.group(1)  # not http:, https:, mailto:
+
+
+def broken(root):
+    """[(page, line, target)] of the links that lead nowhere."""
+    cache = {}
+    bad = []
+    for page, n, target in links(root):
+        path, _, anchor = target.partition("#")
+        if path:
+            full = os.path.normpath(os.path.join(root, os.path.dirname(page), path))
+            if not os.path.exists(full):
+                bad.append((page, n, target))
+                continue
+        else:
+            full = os.path.join(root, page)
+        if anchor and full.endswith(".md") and os.path.isfile(full):
+            if full not in cache:
+                cache[full] = anchors(full)
+            if anchor.lower() not in cache[full]:
+                bad.append((page, n, target))
     return bad
 
 
 def first_link(root, with_anchor):
     """(page, target) of the first relative link to a .md page, with or
     without an anchor, for the self-test."""
-    for page in pages(root):
-        with open(os.path.join(root, page), encoding="utf-8") as f:
-            text = f.read()
-        for _, line in prose_lines(text):
-            for m in LINK.finditer(line):
-                t = m.group(1)
-                if re.match(r"^[a-z][a-z0-9+.-]*:", t):
-                    continue
-                p, _, a = t.partition("#")
-                if p.endswith(".md") and bool(a) == with_anchor:
-                    return page, t
+    for page, _, t in links(root):
+        p, _, a = t.partition("#")
+        if p.endswith(".md") and bool(a) == with_anchor:
+            return page, t
     return None
 
 
