@@ -23,6 +23,8 @@ What a cause module holds:
                        (firmware/design/machine.py's "causes"): PARAMS name ->
                        (lo, hi, meaning[, lo_open]); their order is PARAMS', which is
                        br_causes_t's (firmware/design/gen_causes.py writes the C table)
+  SWITCHES             (optional) the PARAMS whose value other than 0 switches the
+                       cause on in the firmware (default: all of them)
   search(prep, base, fit_with) -> dict | None
                        its nonlinear parameters for base + it; fit_with(nl)
                        solves the linear ones with those (model.Fit, train_sse);
