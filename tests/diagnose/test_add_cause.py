@@ -37,51 +37,9 @@ FIRMWARE_WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-
                      "-Wsign-conversion", "-Wshadow", "-Wstrict-prototypes", "-Wmissing-prototypes", "-Wundef",
                      "-Wvla", "-Wcast-qual"]
 
-TOY_MODULE = '''# SPDX-License-Identifier: Apache-2.0
-"""toy_load: a constant force against the motion (a test's cause, tests/diagnose/test_add_cause.py)."""
-import numpy as np
-
-from ..params import Param
-
-NAME = "toy_load"
-MEANING = "a constant force against the motion"
-ACTION = "Nothing: a test's cause."
-OPTION = "--toy"
-PARAMS = (Param("toy_N", "N", "force against the motion", -1e5, 1e5),)
-NL = ()
-HOOK = "force"
-MACHINE = {"toy_N": (-1.0e5, 1.0e5, "force against the motion")}
-DETECTION = ("force", "N", 0.001, lambda s, ref: ["--toy", f"{s:.6g}"])
-
-
-def load_columns(prep, nl):
-    return {"toy": prep.memo(("toy",), lambda: np.sign(prep.v))}
-
-
-def search(prep, base, fit_with):
-    return {}
-
-
-def params(coef, nl, p):
-    return {"toy_N": coef["toy"]}
-
-
-def from_params(p):
-    return {"toy": p["toy_N"]}, {}
-
-
-def report_params(p):
-    return {"force_N": p["toy_N"]}
-
-
-def evidence(r, p):
-    return f"A toy force of {p['force_N']:+.3g} N."
-
-
-def closed_loop(p, plant):
-    f = p["toy_N"]
-    plant.loads.append(lambda x: f)
-'''
+# the toy's module: offset.py's, renamed (a constant force, a cause of the same kind)
+TOY_FROM = "python/bristle/diagnose/causes/offset.py"
+TOY_RENAME = (('"--offset"', '"--toy"'), ("offset_N", FIELD), ('"offset"', '"%s"' % CAUSE))
 
 
 def fail(msg):
@@ -148,8 +106,12 @@ def edit(root, rel, old, new):
 def add_cause(root):
     """Steps 1-3 of the worked example; returns the files written by hand."""
     rel = "python/bristle/diagnose/causes/%s.py" % CAUSE
+    with open(os.path.join(root, TOY_FROM), encoding="utf-8") as f:
+        text = f.read()
+    for a, b in TOY_RENAME:
+        text = text.replace(a, b)
     with open(os.path.join(root, rel), "w", encoding="utf-8") as f:
-        f.write(TOY_MODULE)
+        f.write(text)
     init = "python/bristle/diagnose/causes/__init__.py"
     edit(root, init, "presliding_hysteresis)\n", "presliding_hysteresis, %s)\n" % CAUSE)
     edit(root, init, "    friction_drift,\n", "    friction_drift,\n    %s,\n" % CAUSE)
@@ -172,13 +134,14 @@ def run(cmd, **kw):
 CHECK = r'''
 import sys
 sys.path.insert(0, "firmware/design"); sys.path.insert(0, "sim/studies"); sys.path.insert(0, "python")
-import machine, detection_limits
+import machine, detection_limits, robustness
 from bristle.diagnose import causes
 assert causes.NAMES.index("toy_load") == causes.NAMES.index("friction_drift") + 1, causes.NAMES
 assert "toy_load" in machine.SCHEMA["causes"], "schema"
 assert "toy_N" in machine.SCHEMA["causes"]["toy_load"].section, "schema field"
 assert "toy_load" in machine.FORCE_CAUSES, "force causes"
 assert detection_limits.GENERATORS["toy_load"][3](0.5) == ["--toy", "0.5"], "detection limits"
+assert "toy_load" in robustness.CAUSES, "robustness"
 print("registry ok")
 '''
 
