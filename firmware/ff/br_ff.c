@@ -5,10 +5,9 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "br_cause_terms.h"
 #include "br_check.h"
 #include "br_mslip_kernel.h"
-
-#define BR_FF_2PI 6.28318530717958647692f
 
 static int causes_ok(const br_ff_cfg_t *c)
 {
@@ -45,8 +44,8 @@ br_status_t br_ff_init(br_ff_t *ff, const br_ff_cfg_t *cfg)
         return BR_E_PARAM;
     }
     ff->cfg = *cfg;
-    ff->c_neg = (cfg->Fc_N + cfg->causes.dFc_neg_N) / cfg->Fc_N;
-    ff->ripple_k_radpm = (cfg->causes.ripple_amp_N != 0.0f) ? BR_FF_2PI / cfg->causes.ripple_period_m : 0.0f;
+    ff->c_neg = br_ct_asym_c_neg(cfg->Fc_N, cfg->causes.dFc_neg_N);
+    ff->ripple_k_radpm = br_ct_ripple_k_radpm(cfg->causes.ripple_amp_N, cfg->causes.ripple_period_m);
     ff->in.v_mps = 0.0f;
     ff->in.a_mps2 = 0.0f;
     ff->in.p_m = 0.0f;
@@ -60,15 +59,12 @@ br_status_t br_ff_init(br_ff_t *ff, const br_ff_cfg_t *cfg)
     return BR_OK;
 }
 
-/* eq. 5, the Stribeck level at v (scaled by c in -x) */
+/* eq. 5, the Stribeck level at v (scaled by c in -x: asymmetric_friction) */
 static float level_N(const br_ff_t *ff, float v)
 {
     const br_ff_cfg_t *c = &ff->cfg;
-    float g = c->Fc_N + (c->Fs_N - c->Fc_N) * expf(-fabsf(v) / c->vs_mps);
-    if (v < 0.0f) {
-        g *= ff->c_neg;
-    }
-    return g;
+    const float g = c->Fc_N + (c->Fs_N - c->Fc_N) * expf(-fabsf(v) / c->vs_mps);
+    return br_ct_asym_level_N(g, ff->c_neg, v < 0.0f);
 }
 
 /* the elements of the stored reference moved to in's position at the level g:
@@ -103,17 +99,15 @@ br_status_t br_ff_step(const br_ff_t *ff, const br_ff_in_t *in, float *comp_N)
     const float g = level_N(ff, v);
     /* the steady-state LuGre force with a smoothed sign (or the elements along the
      * reference's path), plus viscous friction */
-    const float s2 = neg ? c->sigma2_Nspm + k->dsigma2_neg_Nspm : c->sigma2_Nspm;
+    const float s2 = br_ct_asym_sigma2_Nspm(c->sigma2_Nspm, c->sigma2_Nspm + k->dsigma2_neg_Nspm, neg);
     float z1[BR_MSLIP_MAX];
     float f = ((c->mslip.n > 0) ? elements_N(ff, in, g, z1) : tanhf(v / c->v_eps_mps) * g) + s2 * v;
-    /* position gradient k(p) */
-    if (k->grad_per_m != 0.0f) {
-        f *= fmaxf(0.0f, 1.0f + k->grad_per_m * in->p_m);
-    }
-    /* offset and position ripple (a cogging / lead-error map) */
-    f += k->offset_N;
+    /* the causes' terms (br_cause_terms.h): position gradient k(p) (1 without) and offset */
+    f = br_ct_scaled_load_N(br_ct_lin_scale(k->grad_per_m, in->p_m), f, k->offset_N);
+    /* position ripple (a cogging / lead-error map) */
     if (k->ripple_amp_N != 0.0f) {
-        f += k->ripple_amp_N * sinf(ff->ripple_k_radpm * fmodf(in->p_m, k->ripple_period_m) + k->ripple_phase_rad);
+        f += br_ct_ripple_N(k->ripple_amp_N,
+                            br_ct_ripple_phase_rad(ff->ripple_k_radpm, k->ripple_period_m, k->ripple_phase_rad, in->p_m));
     }
     /* inertia */
     f += c->mass_kg * in->a_mps2;
