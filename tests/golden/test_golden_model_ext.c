@@ -184,7 +184,7 @@ static void test_model_ext_one_step(void **state)
                        C_FNL * U32 * (F_scale + s2 * L * w0) + 2.0 * rip_x);
     }
     for (int seg = 1; seg <= n_seg; seg++) {
-        char key[16];
+        char key[32]; /* "seg" + any int + "_name" */
         snprintf(key, sizeof key, "seg%d_name", seg);
         print_message("golden model_ext seg %d (%s): %ld RK4, %ld bounded rows\n", seg, br_trace_meta(&t, key),
                       n_rows[seg][0], n_rows[seg][1]);
