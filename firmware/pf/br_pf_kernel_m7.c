@@ -16,6 +16,7 @@
 #include "br_inline.h"
 #include "br_math.h"
 #include "br_pf_kernel.h"
+#include "br_pf_ms4.h"
 
 uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                               br_pf_lsum_t *ls)
@@ -138,125 +139,11 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
     return sf;
 }
 
-/* fminf(fmaxf(v, -d), d): one vmaxnm, one vminnm (d > 0) */
-static inline float clamp_nm(float v, float d) { return fminf(fmaxf(v, -d), d); }
-
-/* four elements, in registers */
-typedef struct {
-    float v0, v1, v2, v3;
-} ms4_t;
-
-/* the bounds c_i g of the level g */
-static inline ms4_t ms4_bounds(ms4_t c, float g)
-{
-    const ms4_t d = {c.v0 * g, c.v1 * g, c.v2 * g, c.v3 * g};
-    return d;
-}
-
-/* e_i moved by dx, clamped at +-d_i (eq. MS1) */
-static inline ms4_t ms4_move(ms4_t e, float dx, ms4_t d)
-{
-    const ms4_t z = {clamp_nm(e.v0 + dx, d.v0), clamp_nm(e.v1 + dx, d.v1), clamp_nm(e.v2 + dx, d.v2),
-                     clamp_nm(e.v3 + dx, d.v3)};
-    return z;
-}
-
-/* sum k_i z_i in the reference's order, from 0 (eq. MS2) */
-static inline float ms4_force(ms4_t k, ms4_t z)
-{
-    return (((0.0f + k.v0 * z.v0) + k.v1 * z.v1) + k.v2 * z.v2) + k.v3 * z.v3;
-}
-
-/* Steps 1 and 2 with four elements (the common set), the reference's
- * operations written out: every element in a register, each clamp by vmaxnm
- * / vminnm (fminf(fmaxf(v, -d), d) is the reference's select clamp for
- * every v when d = c_i g_p > 0: a NaN gives -d in both), the bounds c_i g_p
- * made once per particle for both passes (the same products), the sums in
- * the reference's order (from 0: 0 + x is x but for x = -0), the
- * BR_MODEL_MS_PASSES = 2 passes written out (predict_ms runs the reference
- * for any other count). With the element loops over N on the stack this
- * path ran 315 instructions per particle-step against 182 written out
- * (docs/modules/pf.md). */
-static uint32_t predict_ms4(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
-                            br_pf_lsum_t *ls)
-{
-    const float uh = c->uh, h = c->km.h, L = c->km.L, visc = c->km.visc, Lh_half = c->km.Lh_half;
-    const float inv_Jeff = c->km.inv_Jeff;
-    const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
-    const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
-    const float shift = c->shift, y_rel = c->y_rel;
-    const ms4_t k = {c->km.k[0], c->km.k[1], c->km.k[2], c->km.k[3]};
-    const ms4_t cg = {c->km.c[0], c->km.c[1], c->km.c[2], c->km.c[3]};
-    const uint32_t m = pf->cfg.n_particles;
-    float *BR_RESTRICT e0p = pf->ms, *BR_RESTRICT e1p = pf->ms + m, *BR_RESTRICT e2p = pf->ms + 2u * m;
-    float *BR_RESTRICT e3p = pf->ms + 3u * m;
-    float *BR_RESTRICT th = pf->x[BR_X_THETA];
-    float *BR_RESTRICT om = pf->x[BR_X_OMEGA];
-    float *BR_RESTRICT gg = pf->x[BR_X_GP];
-    float *BR_RESTRICT ka = pf->kgp;
-    float lm = -INFINITY;
-    uint32_t n_ok = j1 - j0;
-    float s1 = ls->s1, s2 = ls->s2;
-    const float *np = nz;
-    float *fp = pf->fnl + j0, *lp = pf->l + j0;
-    for (uint32_t j = j0; j < j1; j++) {
-        const float w0 = om[j], g0 = gg[j], f0 = ka[j];
-        const ms4_t e = {e0p[j], e1p[j], e2p[j], e3p[j]};
-        const ms4_t d = ms4_bounds(cg, g0);
-        /* 1. predict: the trapezoidal step (eqs. MS1, MS2, 6); pass 1 from omega_m = omega0 */
-        const float dth1 = w0 * h;
-        const float f11 = ms4_force(k, ms4_move(e, L * dth1, d));
-        const float w11 = w0 + (uh - visc * dth1 - Lh_half * (f0 + f11)) * inv_Jeff;
-        /* pass 2 from omega_m = (omega0 + omega1) / 2 */
-        const float dth = (0.5f * (w0 + w11)) * h;
-        ms4_t z = ms4_move(e, L * dth, d);
-        const float f1 = ms4_force(k, z);
-        const float w1 = w0 + (uh - visc * dth - Lh_half * (f0 + f1)) * inv_Jeff;
-        /* process noise; g_p's clamp by vmaxnm / vminnm */
-        float nj[BR_NX];
-        br_load4_f(&np, nj);
-        const float t = ((th[j] + dth) + q0 * nj[0]) - shift;
-        const float w = w1 + q1 * nj[1];
-        const float g = fminf(fmaxf(g0 + q3 * nj[3], gp_min), gp_max);
-        /* z's sample on every element, clamped at the new g_p; f_nl = sum k_i e_i (eqs. MS1, MS2) */
-        z = ms4_move(z, q2 * nj[2], ms4_bounds(cg, g));
-        const float f = ms4_force(k, z);
-        /* 2. Gaussian log-likelihood */
-        const float ey = t - y_rel;
-        const float l = br_pf_loglik(ey, inv_2r);
-        s1 += ey;
-        s2 += ey * ey;
-        /* validity: theta, omega and f_nl finite */
-        if (!((t - t) + (w - w) + (f - f) == 0.0f)) {
-            br_store_f_inc(&fp, 0.0f);
-            br_store_f_inc(&lp, NAN);
-            n_ok--;
-            continue;
-        }
-        th[j] = t;
-        om[j] = w;
-        gg[j] = g;
-        ka[j] = f;
-        e0p[j] = z.v0;
-        e1p[j] = z.v1;
-        e2p[j] = z.v2;
-        e3p[j] = z.v3;
-        br_store_f_inc(&fp, f);
-        br_store_f_inc(&lp, l);
-        lm = fmaxf(lm, l);
-    }
-    ls->s1 = s1;
-    ls->s2 = s2;
-    if (n_ok > 0u) {
-        ls->lmax = (lm > ls->lmax) ? lm : ls->lmax;
-        ls->n_valid += n_ok;
-    }
-    return (j1 - j0) - n_ok;
-}
-
 uint32_t br_pf_kernel_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                                  br_pf_lsum_t *ls)
 {
-    /* any other number of elements or passes: the reference's loops */
-    return (c->km.n == 4 && BR_MODEL_MS_PASSES == 2) ? predict_ms4(pf, c, j0, j1, nz, ls) : br_pf_kref_predict_ms(pf, c, j0, j1, nz, ls);
+    /* four elements written out, the clamps and the largest l by vmaxnm /
+     * vminnm; any other number of elements or passes: the reference's loops */
+    return br_pf_ms4_applies(c) ? br_pf_ms4_predict(pf, c, j0, j1, nz, ls, 1)
+                                : br_pf_kref_predict_ms(pf, c, j0, j1, nz, ls);
 }
