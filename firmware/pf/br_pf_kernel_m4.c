@@ -67,8 +67,7 @@ uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uin
         /* validity as the reference's; a particle that fails branches out,
          * keeping its state (f_nl = 0, l = NaN) */
         if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
-            br_store_f_inc(&fp, 0.0f);
-            br_store_f_inc(&lp, NAN);
+            br_pf_store_left(&fp, &lp);
             n_ok--;
             continue;
         }

@@ -84,8 +84,7 @@ uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uin
         uint32_t c_bits;
         memcpy(&c_bits, &c_ah, sizeof c_bits);
         if (!(c_bits <= ah_lim_bits)) {
-            br_store_f_inc(&fp, 0.0f);
-            br_store_f_inc(&lp, NAN);
+            br_pf_store_left(&fp, &lp);
             n_ok--;
             continue;
         }

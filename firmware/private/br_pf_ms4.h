@@ -115,8 +115,7 @@ static inline uint32_t br_pf_ms4_predict(br_pf_t *pf, const br_pf_kc_t *c, uint3
         s2 += ey * ey;
         /* validity: theta, omega and f_nl finite */
         if (!((t - t) + (w - w) + (f - f) == 0.0f)) {
-            br_store_f_inc(&fp, 0.0f);
-            br_store_f_inc(&lp, NAN);
+            br_pf_store_left(&fp, &lp);
             n_ok--;
             continue;
         }
