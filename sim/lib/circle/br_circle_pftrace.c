@@ -27,11 +27,10 @@ static double theta_rel(const br_circle_sample_t *s, int a, double L, int32_t or
     return s->pos_m[a] / L - (double)origin * rpc;
 }
 
-static void trace_row(const br_pftrace_t *tr, const br_circle_sample_t *s, int a)
+void br_pftrace_cloud(const br_pf_t *pf, double mean[BR_NX], double sd[BR_NX], double *miss_counts)
 {
-    const br_pf_t *pf = s->pf[a];
     const uint32_t m = pf->cfg.n_particles;
-    const double rpc = (double)pf->cfg.est.rad_per_count, L = (double)pf->cfg.est.model.lead_mprad;
+    const double rpc = (double)pf->cfg.est.rad_per_count;
     double sum[BR_NX] = {0}, sum2[BR_NX] = {0};
     for (uint32_t j = 0; j < m; j++)
         for (int i = 0; i < BR_NX; i++) {
@@ -39,21 +38,27 @@ static void trace_row(const br_pftrace_t *tr, const br_circle_sample_t *s, int a
             sum[i] += v;
             sum2[i] += v * v;
         }
-    double mean[BR_NX], sd[BR_NX];
     for (int i = 0; i < BR_NX; i++) {
         mean[i] = sum[i] / m;
         sd[i] = sqrt(fmax(sum2[i] / m - mean[i] * mean[i], 0.0));
     }
-    /* the best predicted particle's signed miss: a resampled copy of it against the measurement */
     uint32_t jb = 0;
     for (uint32_t j = 1; j < m; j++)
         if (pf->l[j] > pf->l[jb]) jb = j;
-    double miss = NAN;
+    *miss_counts = NAN;
     for (uint32_t i = 0; i < m; i++)
         if (pf->idx[i] == jb) {
-            miss = ((double)pf->x[BR_X_THETA][i] - (double)pf->prev_frac * rpc) / rpc;
+            *miss_counts = ((double)pf->x[BR_X_THETA][i] - (double)pf->prev_frac * rpc) / rpc;
             break;
         }
+}
+
+static void trace_row(const br_pftrace_t *tr, const br_circle_sample_t *s, int a)
+{
+    const br_pf_t *pf = s->pf[a];
+    const double rpc = (double)pf->cfg.est.rad_per_count, L = (double)pf->cfg.est.model.lead_mprad;
+    double mean[BR_NX], sd[BR_NX], miss;
+    br_pftrace_cloud(pf, mean, sd, &miss);
     br_pf_stats_t st;
     const double ess = br_pf_stats(pf, &st) == BR_OK ? (double)st.ess : NAN;
     const double inv2r = (double)pf->inv_2r;

@@ -25,6 +25,11 @@ typedef struct {
     int next_at;
 } br_pftrace_t;
 
+/* The cloud of pf after its step: the particles' mean and standard deviation of each
+ * state (theta relative to the filter's origin), and the best predicted particle's
+ * signed miss in counts (a resampled copy of it against the measurement; NaN when none). */
+void br_pftrace_cloud(const br_pf_t *pf, double mean[BR_NX], double sd[BR_NX], double *miss_counts);
+
 /* The header lines of the files set in tr (those not NULL). */
 void br_pftrace_headers(const br_pftrace_t *tr);
 
