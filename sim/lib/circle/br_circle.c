@@ -536,6 +536,7 @@ int br_circle_run_remote(const br_circle_cfg_t *c, const br_circle_remote_t *rem
             if (k > 0) axis_perturb(&ax[i]);
             ax[i].hal.tick_wait(ax[i].hal.ctx, &tick);
             s.pos_m[i] = br_plant_pos_m(&ax[i].plant);
+            s.vel_mps[i] = br_plant_vel_mps(&ax[i].plant);
             s.counts[i] = br_plant_encoder(&ax[i].plant);
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);

@@ -189,6 +189,7 @@ typedef struct {
     double t_s;
     double ref_m[2];     /* x, y reference */
     double pos_m[2];     /* x, y plant position */
+    double vel_mps[2];   /* x, y plant velocity */
     int32_t counts[2];   /* x, y encoder readings */
     double radial_err_m; /* hypot(x, y) - A: + is outward */
     double duty[2];
