@@ -42,9 +42,10 @@ int br_ident_add_reversals(br_ident_cfg_t *c, int n_pairs)
         return -1;
     const br_move_t out = {BR_IDENT_REV_AMP_M, BR_IDENT_REV_SPEED_MPS, 0.0};
     br_move_t back = {0.0, BR_IDENT_REV_SPEED_MPS, 0.0};
+    const double rest_s = c->moves[c->n_moves - 1].dwell_s;
     for (int i = 0; i < n_pairs; i++) {
-        /* the last move back rests like the cycle's others before the next cycle */
-        back.dwell_s = i == n_pairs - 1 ? c->moves[c->n_moves - 1].dwell_s : 0.0;
+        /* the last move back rests like the cycle's last move before the next cycle */
+        back.dwell_s = i == n_pairs - 1 ? rest_s : 0.0;
         c->moves[c->n_moves++] = out;
         c->moves[c->n_moves++] = back;
     }
