@@ -165,11 +165,16 @@ def code_digest():
 DIGEST = {}
 
 
+def run_digest(simlog):
+    """The digest a log's cache key ends with: the diagnosis's code and br_simlog's binary."""
+    with open(simlog, "rb") as fh:
+        return code_digest() + hashlib.sha256(fh.read()).hexdigest()[:16]
+
+
 def run(simlog, work, key, flags, sigma, seed):
     """One log: br_simlog, then the diagnosis. Returns (verdict, findings)."""
     if simlog not in DIGEST:
-        with open(simlog, "rb") as fh:
-            DIGEST[simlog] = code_digest() + hashlib.sha256(fh.read()).hexdigest()[:16]
+        DIGEST[simlog] = run_digest(simlog)
     ck = f"{key}|{' '.join(flags)}|{sigma:.6g}|{seed}|{DIGEST[simlog]}"
     USED.add(ck)
     if ck in CACHE:
@@ -624,7 +629,9 @@ def main():
     if a.fresh and os.path.exists(_cache_path(a.work)):
         os.remove(_cache_path(a.work))
     CACHE.update(load_cache(a.work))
-    cached = len(CACHE)
+    # the cached logs this code can reuse (a result of other code is never reused: its digest differs)
+    digest = run_digest(a.simlog)
+    cached = sum(k.endswith("|" + digest) for k in CACHE)
     if CACHE:
         print(f"{len(CACHE)} logs from {_cache_path(a.work)} (an earlier run's; --fresh runs them again)")
     t0 = time.time()
