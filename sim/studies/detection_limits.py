@@ -375,9 +375,10 @@ BLOCK_TEXT = {"presliding_hysteresis": (
     "The size is d_max over LuGre's presliding displacement Fs/sigma0 ({scale_um:.3g} um on "
     "machines/reference.json): "
     "at a fixed shape it sets the travel over which the element set's piecewise-linear, multi-scale swing "
-    "differs from the single bristle the nominal fit can stiffen or soften at will; as d_max falls every "
-    "element breaks away within a few encoder steps of a reversal, both models become a Coulomb switch "
-    "and no log can tell them apart. Same bisection, proof and bounds as the table above; "
+    "differs from the single bristle, whose stiffness the nominal fit chooses (sigma0 is fitted, so a "
+    "length alone is no difference: the shape is). The element damping stays the demo's, so the "
+    "element set's stiffness also sets the plant's presliding resonance: what the smallest sizes are "
+    "named for is said in docs/diagnose.md (presliding_hysteresis). Same bisection, proof and bounds as the table above; "
     "the nominal logs are LuGre logs with the same reversal segment, where the cause is tested (the "
     "identification logs above are below its gate, MIN_PRESLIDING_SAMPLES).")}
 
