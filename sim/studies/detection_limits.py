@@ -291,7 +291,10 @@ def study(simlog, work, levels, n, n_nominal, jobs, causes, n_verify):
                 todo.append((nominal_task, (simlog, work, li, lname, sigma, kind, j0, min(j0 + step, n_nominal))))
     res = {"cause": {}, "nominal": {}}
 
-    def take(r):
+    def take(r_used):
+        r, used = r_used
+        USED.update(used)
+        SECONDS.update(used)
         kind, lname, key, val = r
         if kind == "cause":
             res["cause"][(lname, key)] = val
@@ -308,7 +311,7 @@ def study(simlog, work, levels, n, n_nominal, jobs, causes, n_verify):
 
     if jobs <= 1:
         for fn, a in todo:
-            take(fn(a))
+            take(_call((fn, a)))
     else:
         with mp.Pool(jobs) as pool:
             for r in pool.imap_unordered(_call, todo, chunksize=1):
@@ -317,8 +320,12 @@ def study(simlog, work, levels, n, n_nominal, jobs, causes, n_verify):
 
 
 def _call(t):
+    """A task's result and the wall seconds of the logs it used: a pool worker's USED and SECONDS are
+    its own, so they travel back with the result."""
     fn, a = t
-    return fn(a)
+    before = set(USED)
+    r = fn(a)
+    return r, {k: SECONDS.get(k, 0.0) for k in USED - before}
 
 
 def nominal_stats(nom):
@@ -388,8 +395,10 @@ def run_line(s, command, wall_s):
     return (f"Command: `{command}` ({n} logs per probed size, {s['n_nominal']} nominal logs per noise level; "
             f"seeds fixed). {s.get('logs_run', '?')} logs; wall time {wall_s / 60:.1f} min, CPU time "
             f"{s.get('cpu_s', float('nan')) / 60:.1f} min ({s.get('jobs', 1)} process(es))"
-            + (f"; {s['cached_logs']} logs came from an earlier run's cache (WORK/cache.jsonl); the logs' own wall "
-               f"times (cached and new) add up to {s['log_seconds'] / 60:.1f} min" if s.get("cached_logs") else "")
+            + (f"; {s['cached_logs']} logs came from an earlier run's cache (WORK/cache.jsonl)"
+               if s.get("cached_logs") else "")
+            + (f"; the logs' own wall times (cached and new) add up to {s['log_seconds'] / 60:.1f} min"
+               if s.get("cached_logs") and s.get("log_seconds") else "")
             + "." + (f" {s['note']}" if s.get("note") else ""))
 
 

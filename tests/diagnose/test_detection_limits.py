@@ -79,6 +79,23 @@ class Cache(unittest.TestCase):
             dl.CACHE.update(saved[1])
 
 
+class Workers(unittest.TestCase):
+    def test_a_task_returns_the_seconds_of_the_logs_it_ran(self):
+        # a pool worker's USED and SECONDS are its own: they travel back with the result
+        def fake(simlog, work, key, flags, sigma, seed):
+            dl.USED.add(key)
+            dl.SECONDS[key] = 1.5
+            return "none", []
+        saved = dl.run
+        dl.run = fake
+        try:
+            r, used = dl._call((dl.nominal_task, ("s", "w", 0, "quiet", 0.02, "ident", 0, 2)))
+        finally:
+            dl.run = saved
+        self.assertEqual(used, {"quiet-none-0": 1.5, "quiet-none-1": 1.5})
+        self.assertEqual(r[0], "nominal")
+
+
 class Statistics(unittest.TestCase):
     def test_clopper_pearson_bounds(self):
         self.assertAlmostEqual(dl.cp_lower(20, 20), 0.05 ** (1 / 20), places=9)
