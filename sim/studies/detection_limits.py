@@ -550,7 +550,9 @@ def plot(s, path, names):
     import matplotlib.ticker
     cols = min(3, len(names))
     rows = (len(names) + cols - 1) // cols
-    fig, axs = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.3 * rows), sharey=True, squeeze=False)
+    import textwrap
+    width = max(4.2 * cols, 8.0)   # one panel (a block's figure): room for the title and the label
+    fig, axs = plt.subplots(rows, cols, figsize=(width, 3.3 * rows + 0.4), sharey=True, squeeze=False)
     for ax, cause in zip(axs.flat, names):
         what, unit = GENERATORS[cause][:2]
         for k, v in s["levels"].items():
@@ -575,15 +577,15 @@ def plot(s, path, names):
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.axhline(100 * s["rate"], color="k", lw=0.6, ls=":")
         ax.set_title(cause, fontsize=9)
-        ax.set_xlabel(f"{what} [{unit}]" if unit else what, fontsize=8)
+        ax.set_xlabel(textwrap.fill(f"{what} [{unit}]" if unit else what, int(width * 12 / cols)), fontsize=8)
         ax.grid(alpha=0.3)
     for ax in axs.flat[len(names):]:
         ax.set_visible(False)
     for row in axs:
         row[0].set_ylabel("detected [% of logs]")
     axs.flat[0].legend(fontsize=7, loc="center right")
-    fig.suptitle("detection rate at the probed sizes (95 % Clopper-Pearson intervals; dashed: the limit; "
-                 "open squares: the proof's sizes; solid: the proven limit)",
+    fig.suptitle(textwrap.fill("detection rate at the probed sizes (95 % Clopper-Pearson intervals; dashed: the "
+                               "limit; open squares: the proof's sizes; solid: the proven limit)", int(width * 14)),
                  fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
