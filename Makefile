@@ -31,6 +31,8 @@ DL_N ?= 20
 DL_N_VERIFY ?= 59
 DL_N_NOMINAL ?= 150
 DL_JOBS ?= 1
+# the causes studied (comma-separated; all by default): a run of presliding_hysteresis alone rewrites its block
+DL_CAUSES ?= all
 FUZZ_SECONDS ?= 600
 MUTANTS_BUDGET ?= 3600
 override MACHINE  := $(value MACHINE)
@@ -333,9 +335,9 @@ detection-limits: deps
 	$(call configure,host-release)
 	$(call build,host-release)
 	$(Q)echo "== detection limits -> out/detection-limits, docs/detection-limits.md"
-	$(Q)OPENBLAS_NUM_THREADS=1 BR_DETECTION_COMMAND="make detection-limits DL_N=$(DL_N) DL_N_VERIFY=$(DL_N_VERIFY) DL_N_NOMINAL=$(DL_N_NOMINAL) DL_JOBS=$(DL_JOBS)" \
+	$(Q)OPENBLAS_NUM_THREADS=1 BR_DETECTION_COMMAND="make detection-limits DL_N=$(DL_N) DL_N_VERIFY=$(DL_N_VERIFY) DL_N_NOMINAL=$(DL_N_NOMINAL) DL_JOBS=$(DL_JOBS)$(if $(filter-out all,$(DL_CAUSES)), DL_CAUSES=$(DL_CAUSES))" \
 	  $(PYTHON) sim/studies/detection_limits.py --simlog build/host-release/sim/br_simlog --work out/detection-limits/logs \
-	  --n $(DL_N) --n-verify $(DL_N_VERIFY) --n-nominal $(DL_N_NOMINAL) --jobs $(DL_JOBS) --md docs/detection-limits.md --png docs/detection-limits.png \
+	  --n $(DL_N) --n-verify $(DL_N_VERIFY) --n-nominal $(DL_N_NOMINAL) --jobs $(DL_JOBS) $(if $(filter-out all,$(DL_CAUSES)),--causes $(DL_CAUSES)) --md docs/detection-limits.md --png docs/detection-limits.png \
 	  --json out/detection-limits/summary.json
 
 # MACHINE reaches the recipe only as "$$BR_MK_MACHINE"; its build folder comes

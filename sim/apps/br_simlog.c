@@ -3,8 +3,8 @@
  * ../shared/spec/measured-log.md) from the plant simulator, with any of the
  * causes a diagnosis names switched on. docs/simlog.md.
  *
- * Usage: br_simlog --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--duration S]
- *                  [--seed N] [--force-noise N] [--model MODEL.json]
+ * Usage: br_simlog --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--reversals N]
+ *                  [--duration S] [--seed N] [--force-noise N] [--model MODEL.json]
  *                  [--offset F] [--asym DFC,DFV] [--ripple A,P[,PHASE]]
  *                  [--gradient S] [--delay D] [--drift R] [--machine-out FILE]
  *                  [--truth]
@@ -88,8 +88,8 @@ static void circle_sink(void *user, const br_circle_sample_t *s)
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--duration S] [--seed N]\n"
-            "          [--force-noise N] [--model MODEL.json] [--offset F] [--asym DFC,DFV]\n"
+            "usage: %s --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--reversals N]\n"
+            "          [--duration S] [--seed N] [--force-noise N] [--model MODEL.json] [--offset F] [--asym DFC,DFV]\n"
             "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--drift R] [--gms D1,..,DN]\n"
             "          [--machine-out FILE] [--truth]\n"
             BR_ARGS_COMMON_USAGE
@@ -97,6 +97,8 @@ static int usage(const char *argv0, FILE *to)
             "  --traj T            ident: an identification run (default); circle: the circle's x axis;\n"
             "                      backforth: a slow back-and-forth; sweep: a frequency sweep\n"
             "  --cycles N          repetitions of the identification moves\n"
+            "  --reversals N       N slow back-and-forth pairs (0.1 mm at 0.1 mm/s) after each cycle's moves:\n"
+            "                      the reversal segment presliding_hysteresis needs (ident only)\n"
             "  --duration S        length of the circle, back-and-forth or sweep run (default 8 s)\n"
             "  --seed N            seed of the force noise\n"
             "  --force-noise N     standard deviation of the noise on the logged force\n"
@@ -105,8 +107,8 @@ static int usage(const char *argv0, FILE *to)
             "  cause options       switch causes on in the plant (docs/simlog.md)\n"
             "  --gms D1,..,DN      the plant's friction Maxwell-slip: N <= 8 equal elements breaking away at\n"
             "                      D1..DN m at Fs (the slip law and damping of the demo's hardware-like plant)\n"
-            "bounds: --cycles 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N (docs/tools.md)\n",
-            argv0, argv0, BR_TOOL_CYCLES_MAX, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
+            "bounds: --cycles 1 .. %d, --reversals 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N (docs/tools.md)\n",
+            argv0, argv0, BR_TOOL_CYCLES_MAX, BR_IDENT_REV_MAX_PAIRS, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
     return 2;
 }
 
@@ -123,7 +125,7 @@ static void write_machine(FILE *f, const br_ident_cfg_t *c)
 
 typedef struct {
     const char *out, *traj, *model, *machine_out;
-    long cycles, seed;
+    long cycles, seed, reversals;
     int truth;
     double duration, noise;
     br_plant_cfg_t causes;
@@ -179,6 +181,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"duration", required_argument, NULL, 'd'},
                                          {"force-noise", required_argument, NULL, 'n'},
                                          {"gms", required_argument, NULL, 'g'},
+                                         {"reversals", required_argument, NULL, 'r'},
                                          BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
     const int st = br_args_begin(&p, TOOL, argc, argv);
@@ -194,6 +197,7 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'm': o->model = val; break;
         case 'M': o->machine_out = val; break;
         case 'c': bad = br_arg_long(TOOL, p.opt, val, 1, BR_TOOL_CYCLES_MAX, &o->cycles); break;
+        case 'r': bad = br_arg_long(TOOL, p.opt, val, 1, BR_IDENT_REV_MAX_PAIRS, &o->reversals); break;
         case 's': bad = br_arg_long(TOOL, p.opt, val, 0, LONG_MAX, &o->seed); break;
         case 'd':
             bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &o->duration);
@@ -222,6 +226,10 @@ static int parse(int argc, char **argv, opts_t *o)
         fprintf(stderr, "%s: --cycles applies to --traj ident only (the others take --duration)\n", TOOL);
         return 2;
     }
+    if (o->reversals > 0 && strcmp(o->traj, "ident") != 0) {
+        fprintf(stderr, "%s: --reversals applies to --traj ident only\n", TOOL);
+        return 2;
+    }
     if (o->machine_out && strcmp(o->machine_out, o->out) == 0) {
         fprintf(stderr, "%s: --machine-out and --out name the same file\n", TOOL);
         return 2;
@@ -231,7 +239,7 @@ static int parse(int argc, char **argv, opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 8.0, 0.0, br_plant_cfg_reference(), 0, {0.0}};
+    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 0, 8.0, 0.0, br_plant_cfg_reference(), 0, {0.0}};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -270,7 +278,10 @@ int main(int argc, char **argv)
                            : strcmp(opt.traj, "sweep") == 0   ? br_ident_cfg_sweep(&plant, opt.duration)
                                                               : br_ident_cfg_default(&plant);
         if (opt.cycles > 0) c.cycles = (int)opt.cycles;
-        rc = br_ident_run(&c, &plant, ident_sink, &o);
+        /* --reversals N: N slow back-and-forth pairs after each cycle's moves (parse checked N) */
+        if (opt.reversals > 0 && br_ident_add_reversals(&c, (int)opt.reversals) != 0) rc = -1;
+        else
+            rc = br_ident_run(&c, &plant, ident_sink, &o);
         if (rc == 0 && opt.machine_out) write_machine(machine_file.f, &c);
     } else {
         br_circle_cfg_t c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);

@@ -75,7 +75,14 @@ def ladder(lo):
 
 # cause: (size name, unit, ladder, flags(size)); sizes of the effect, from each
 # registry cause's DETECTION (python/bristle/diagnose/causes/)
-REF_LEVELS = {"Fc_N": FC_N, "sigma2_Nspm": SIGMA2}
+def lugre_presliding_scale_m():
+    """LuGre's presliding displacement Fs / sigma0 on the reference machine (machines/reference.json)."""
+    with open(os.path.join(REPO, "machines", "reference.json")) as f:
+        fr = json.load(f)["friction"]
+    return fr["Fs_N"] / fr["sigma0_Npm"]
+
+
+REF_LEVELS = {"Fc_N": FC_N, "sigma2_Nspm": SIGMA2, "presliding_scale_m": lugre_presliding_scale_m()}
 
 
 def _generator(det):
@@ -84,6 +91,24 @@ def _generator(det):
 
 
 GENERATORS = {m.NAME: _generator(m.DETECTION) for m in causes.REGISTRY if hasattr(m, "DETECTION")}
+
+# the logs a cause's sizes and its nominal logs are made of: br_simlog's identification run, or with
+# its reversal segment (--reversals 1, docs/simlog.md), the log docs/diagnose.md asks for presliding
+LOGS = {"ident": [], "ident with the reversal segment": ["--reversals", "1"]}
+CAUSE_LOGS = {m.NAME: m.DETECTION_LOG for m in causes.REGISTRY if hasattr(m, "DETECTION_LOG")}
+# causes with their own block of the page (their own logs): a run of them alone rewrites only their block
+BLOCKS = ("presliding_hysteresis",)
+# the Maxwell-slip plant's element set relative to its largest breakaway (the cause's own)
+GMS_SHAPE = causes.get("presliding_hysteresis").DETECTION_SHAPE
+
+
+def logs_of(cause):
+    return CAUSE_LOGS.get(cause, "ident")
+
+
+def gms_elements(ratio):
+    """br_simlog's --gms for an element set whose largest breakaway is ratio times LuGre's Fs/sigma0."""
+    return GENERATORS["presliding_hysteresis"][3](ratio)[1]
 
 
 def emps_noise():
@@ -135,11 +160,16 @@ def code_digest():
 DIGEST = {}
 
 
+def run_digest(simlog):
+    """The digest a log's cache key ends with: the diagnosis's code and br_simlog's binary."""
+    with open(simlog, "rb") as fh:
+        return code_digest() + hashlib.sha256(fh.read()).hexdigest()[:16]
+
+
 def run(simlog, work, key, flags, sigma, seed):
     """One log: br_simlog, then the diagnosis. Returns (verdict, findings)."""
     if simlog not in DIGEST:
-        with open(simlog, "rb") as fh:
-            DIGEST[simlog] = code_digest() + hashlib.sha256(fh.read()).hexdigest()[:16]
+        DIGEST[simlog] = run_digest(simlog)
     ck = f"{key}|{' '.join(flags)}|{sigma:.6g}|{seed}|{DIGEST[simlog]}"
     USED.add(ck)
     if ck in CACHE:
@@ -186,7 +216,8 @@ def probe(simlog, work, li, lname, sigma, ci, cause, si, size, flags, n, allowed
     k = m = 0
     others = 0
     for j in range(n):
-        _, found = run(simlog, work, f"{lname}-{cause}-{si}-{j}", flags(size), sigma, hash_seed(li, ci + 1, si, j))
+        _, found = run(simlog, work, f"{lname}-{cause}-{si}-{j}", LOGS[logs_of(cause)] + flags(size), sigma,
+                       hash_seed(li, ci + 1, si, j))
         if cause in found:
             k += 1
         else:
@@ -231,11 +262,14 @@ def bisect_task(args):
 
 
 def nominal_task(args):
-    simlog, work, li, lname, sigma, j0, j1 = args
+    simlog, work, li, lname, sigma, kind, j0, j1 = args
+    # the identification logs keep their first keys and seeds; another kind of log has its own
+    ki = list(LOGS).index(kind)
+    tag = "" if ki == 0 else f"{ki}-"
     out = []
     for j in range(j0, j1):
-        out.append(run(simlog, work, f"{lname}-none-{j}", [], sigma, hash_seed(li, 0, 0, j)))
-    return ("nominal", lname, (j0, j1), out)
+        out.append(run(simlog, work, f"{lname}-none-{tag}{j}", LOGS[kind], sigma, hash_seed(li, 0, ki, j)))
+    return ("nominal", lname, (kind, j0, j1), out)
 
 
 def study(simlog, work, levels, n, n_nominal, jobs, causes, n_verify):
@@ -245,12 +279,17 @@ def study(simlog, work, levels, n, n_nominal, jobs, causes, n_verify):
             if cause in causes:
                 todo.append((bisect_task, (simlog, work, li, lname, sigma, ci, cause, n, n_verify)))
     step = 10
+    kinds = [k for k in LOGS if any(logs_of(c) == k for c in causes)]
     for j0 in range(0, n_nominal, step):
         for li, (lname, sigma) in enumerate(levels):
-            todo.append((nominal_task, (simlog, work, li, lname, sigma, j0, min(j0 + step, n_nominal))))
+            for kind in kinds:
+                todo.append((nominal_task, (simlog, work, li, lname, sigma, kind, j0, min(j0 + step, n_nominal))))
     res = {"cause": {}, "nominal": {}}
 
-    def take(r):
+    def take(r_used):
+        r, used = r_used
+        USED.update(used)
+        SECONDS.update(used)
         kind, lname, key, val = r
         if kind == "cause":
             res["cause"][(lname, key)] = val
@@ -262,12 +301,12 @@ def study(simlog, work, levels, n, n_nominal, jobs, causes, n_verify):
                   flush=True)
         else:
             res["nominal"].setdefault(lname, {})[key] = val
-            print(f"  {lname} nominal logs {key[0]}..{key[1] - 1}: "
+            print(f"  {lname} nominal logs ({key[0]}) {key[1]}..{key[2] - 1}: "
                   f"{sum(bool(f) for _, f in val)} with a finding", flush=True)
 
     if jobs <= 1:
         for fn, a in todo:
-            take(fn(a))
+            take(_call((fn, a)))
     else:
         with mp.Pool(jobs) as pool:
             for r in pool.imap_unordered(_call, todo, chunksize=1):
@@ -276,24 +315,35 @@ def study(simlog, work, levels, n, n_nominal, jobs, causes, n_verify):
 
 
 def _call(t):
+    """A task's result and the wall seconds of the logs it used: a pool worker's USED and SECONDS are
+    its own, so they travel back with the result."""
     fn, a = t
-    return fn(a)
+    before = set(USED)
+    r = fn(a)
+    return r, {k: SECONDS.get(k, 0.0) for k in USED - before}
+
+
+def nominal_stats(nom):
+    """False positives (any finding, and per cause) and the verdict unexplained of nominal logs'
+    (verdict, findings), with their one-sided upper bounds."""
+    fp = sum(bool(f) for _, f in nom)
+    un = sum(v == "unexplained" for v, _ in nom)
+    found = {}
+    for _, f in nom:
+        for c in f:
+            found[c] = found.get(c, 0) + 1
+    return {"nominal_logs": len(nom), "false_positives": fp, "false_positive_upper": cp_upper(fp, len(nom)),
+            "false_positive_causes": found, "unexplained": un, "unexplained_upper": cp_upper(un, len(nom))}
 
 
 def summarize(res, levels, n, n_nominal, causes, n_verify):
     s = {"levels": {}, "n": n, "n_nominal": n_nominal, "n_verify": n_verify, "rate": RATE, "conf": CONF}
     for lname, sigma in levels:
-        nom = [v for _, vals in sorted(res["nominal"].get(lname, {}).items()) for v in vals]
-        fp = sum(bool(f) for _, f in nom)
-        un = sum(v == "unexplained" for v, _ in nom)
-        found = {}
-        for _, f in nom:
-            for c in f:
-                found[c] = found.get(c, 0) + 1
-        lv = {"force_noise_N": sigma, "nominal_logs": len(nom), "false_positives": fp,
-              "false_positive_upper": cp_upper(fp, len(nom)) if nom else None,
-              "false_positive_causes": found, "unexplained": un,
-              "unexplained_upper": cp_upper(un, len(nom)) if nom else None, "causes": {}}
+        lv = {"force_noise_N": sigma, "nominal": {}, "causes": {}}
+        for kind in LOGS:
+            nom = [v for k, vals in sorted(res["nominal"].get(lname, {}).items()) if k[0] == kind for v in vals]
+            if nom:
+                lv["nominal"][kind] = nominal_stats(nom)
         for cause in GENERATORS:
             if cause not in causes:
                 continue
@@ -314,46 +364,48 @@ def _fmt(x, unit):
     return f"{x:.3g} {unit}".rstrip()
 
 
-def markdown(s, command, wall_s):
+BANNER = "<!-- generated by sim/studies/detection_limits.py; do not edit -->"
+# a block's first and last lines in the page
+BLOCK_BEGIN = "<!-- block {}: generated by sim/studies/detection_limits.py --causes {}; do not edit -->"
+BLOCK_END = "<!-- end block {} -->"
+# what a block's logs and size are, and why that size (docs/detection-limits.md)
+BLOCK_TEXT = {"presliding_hysteresis": (
+    "br_simlog identification logs of the reference machine (3 cycles) with the reversal segment "
+    "(`--reversals 1`, docs/simlog.md), the log docs/diagnose.md asks a user to record for this cause, "
+    "whose plant's friction is a Maxwell-slip element set instead of LuGre (`--gms`: four equal elements "
+    "breaking away at 0.1, 0.25, 0.5 and 1 times d_max, the demo's hardware-like shape and slip law). "
+    "The size is d_max over LuGre's presliding displacement Fs/sigma0 ({scale_um:.3g} um on "
+    "machines/reference.json): "
+    "at a fixed shape it sets the travel over which the element set's piecewise-linear, multi-scale swing "
+    "differs from the single bristle, whose stiffness the nominal fit chooses (sigma0 is fitted, so a "
+    "length alone is no difference: the shape is). The element damping stays the demo's, so the "
+    "element set's stiffness also sets the plant's presliding resonance: what the smallest sizes are "
+    "named for is said in docs/diagnose.md (presliding_hysteresis). Same bisection, proof and bounds as the table above; "
+    "the nominal logs are LuGre logs with the same reversal segment, where the cause is tested (the "
+    "identification logs above are below its gate, MIN_PRESLIDING_SAMPLES).")}
+
+
+def run_line(s, command, wall_s):
     n = s["n"]
-    L = ["<!-- generated by sim/studies/detection_limits.py; do not edit -->", "", "# Detection limits", "",
-         f"Command: `{command}` ({n} logs per probed size, {s['n_nominal']} nominal logs per noise level; "
-         f"seeds fixed). {s.get('logs_run', '?')} logs; wall time {wall_s / 60:.1f} min, CPU time "
-         f"{s.get('cpu_s', float('nan')) / 60:.1f} min ({s.get('jobs', 1)} process(es))"
-         + (f"; {s['cached_logs']} logs came from an earlier run's cache (WORK/cache.jsonl); the logs' own wall "
-            f"times (cached and new) add up to {s['log_seconds'] / 60:.1f} min" if s.get("cached_logs") else "") + "."
-         + (f" {s['note']}" if s.get("note") else ""), "",
-         "br_simlog identification logs of the reference machine (3 cycles, 27.96 s) with one cause of a given "
-         "size and Gaussian force noise, each diagnosed from the log alone. A cause is detected when it is "
-         "among the findings. Noise levels: the EMPS log's force noise as the noise floor measures it, and a "
-         "quiet log's.", "",
-         "Each cause has a ladder of sizes (ratio √2, 15 sizes). The limit is found by bisection on it: a "
-         f"probed size passes when at most {misses_allowed(n)} of its {n} logs miss the cause (at least "
-         f"{100 * s['rate']:.0f} % detected), and its logs stop as soon as it cannot pass. The bisection assumes "
-         "the detection rate grows with the size: the sizes it did not probe are not checked. The limit is "
-         "the smallest passing size; the largest failing probe below it is beside it (the true 95 % size lies "
-         "between the two). The lower bound is the one-sided "
-         f"{100 * s['conf']:.0f} % Clopper-Pearson bound of the detection rate at the limit (with {n} of {n} "
-         f"detected: 0.05^(1/{n}) = {100 * 0.05 ** (1 / n):.1f} %): {n} logs show a rate of "
-         f"{100 * s['rate']:.0f} % or more at the limit; they do not prove the rate is that high."]
+    return (f"Command: `{command}` ({n} logs per probed size, {s['n_nominal']} nominal logs per noise level; "
+            f"seeds fixed). {s.get('logs_run', '?')} logs; wall time {wall_s / 60:.1f} min, CPU time "
+            f"{s.get('cpu_s', float('nan')) / 60:.1f} min ({s.get('jobs', 1)} process(es))"
+            + (f"; {s['cached_logs']} logs came from an earlier run's cache (WORK/cache.jsonl)"
+               if s.get("cached_logs") else "")
+            + (f"; the logs' own wall times (cached and new) add up to {s['log_seconds'] / 60:.1f} min"
+               if s.get("cached_logs") and s.get("log_seconds") else "")
+            + "." + (f" {s['note']}" if s.get("note") else ""))
+
+
+def limit_table(s, causes):
     nv = s.get("n_verify", 0)
-    if nv:
-        L += ["", f"The proof: {nv} logs at the limit (its first {n} are the bisection's), all of which must "
-              f"detect the cause, else the next size up the ladder is tried the same way. {nv} of {nv} "
-              f"detected gives a one-sided {100 * s['conf']:.0f} % Clopper-Pearson lower bound of "
-              f"0.05^(1/{nv}) = {100 * 0.05 ** (1 / nv):.2f} %"
-              + (f": at the proven size the detection rate is at least {100 * s['rate']:.0f} % at "
-                 f"{100 * s['conf']:.0f} % confidence (given that the rate grows with the size)."
-                 if 0.05 ** (1 / nv) >= s["rate"] else
-                 f", short of {100 * s['rate']:.0f} %: too few logs to prove the rate.")]
-    L += ["", "| cause | size | " + " | ".join(
+    L = ["| cause | size | " + " | ".join(
         f"limit at {k} noise ({v['force_noise_N']:.3g} N): detected, {100 * s['conf']:.0f} % lower bound | "
         "failed below" + (" | proven: detected, lower bound" if nv else "")
         for k, v in s["levels"].items()) + " |",
         "|---|---|" + ("---|---|---|" if nv else "---|---|") * len(s["levels"])]
-    for cause, (what, unit, lad, _) in GENERATORS.items():
-        if not all(cause in v["causes"] for v in s["levels"].values()):
-            continue
+    for cause in causes:
+        what, unit = GENERATORS[cause][:2]
         cells = []
         for v in s["levels"].values():
             c = v["causes"][cause]
@@ -377,24 +429,35 @@ def markdown(s, command, wall_s):
                                  f"≥ {100 * c['proven_lower']:.1f} %"
                                  + (f" ({up} size{'s' if up > 1 else ''} up from the limit)" if up else ""))
         L.append(f"| {cause} | {what} | " + " | ".join(cells) + " |")
-    L += ["", "Nominal logs (no cause), any finding counted as a false positive; the upper bound is the one-sided "
-          f"{100 * s['conf']:.0f} % Clopper-Pearson bound. Goal: false positives at most 2 %.", "",
-          "| noise level | nominal logs | false positives (any finding) | upper bound | verdict unexplained | "
-          "upper bound |", "|---|---|---|---|---|---|"]
+    return L
+
+
+def nominal_table(s, kind):
+    L = [f"Nominal logs (no cause; {kind}), any finding counted as a false positive; the upper bound is the "
+         f"one-sided {100 * s['conf']:.0f} % Clopper-Pearson bound. Goal: false positives at most 2 %.", "",
+         "| noise level | nominal logs | false positives (any finding) | upper bound | verdict unexplained | "
+         "upper bound |", "|---|---|---|---|---|---|"]
     for k, v in s["levels"].items():
-        nl = v["nominal_logs"]
-        fp = v["false_positives"]
-        fc = ", ".join(f"{c} {m}" for c, m in sorted(v["false_positive_causes"].items()))
+        st = v["nominal"].get(kind)
+        if not st:
+            continue
+        nl, fp = st["nominal_logs"], st["false_positives"]
+        fc = ", ".join(f"{c} {m}" for c, m in sorted(st["false_positive_causes"].items()))
         L.append(f"| {k} ({v['force_noise_N']:.3g} N) | {nl} | {fp} ({100 * fp / nl:.1f} %{'; ' + fc if fc else ''})"
-                 f" | {100 * v['false_positive_upper']:.1f} % | {v['unexplained']} ({100 * v['unexplained'] / nl:.1f} %)"
-                 f" | {100 * v['unexplained_upper']:.1f} % |")
-    L += ["", "## Probed sizes", "",
-          "Detected / logs run at each size the bisection probed (a failing size stops once "
-          f"{misses_allowed(n) + 1} logs have missed the cause); in brackets, the logs where another cause was "
-          "found too.", ""]
+                 f" | {100 * st['false_positive_upper']:.1f} % | {st['unexplained']} "
+                 f"({100 * st['unexplained'] / nl:.1f} %) | {100 * st['unexplained_upper']:.1f} % |")
+    return L
+
+
+def probe_tables(s, causes, depth="##"):
+    L = ["Detected / logs run at each size the bisection probed (a failing size stops once "
+         f"{misses_allowed(s['n']) + 1} logs have missed the cause); in brackets, the logs where another cause was "
+         "found too.", ""]
     for k, v in s["levels"].items():
-        L += [f"### {k} noise ({v['force_noise_N']:.3g} N)", "", "| cause | size: detected/logs (other) |", "|---|---|"]
-        for cause, c in v["causes"].items():
+        L += [f"{depth}# {k} noise ({v['force_noise_N']:.3g} N)", "", "| cause | size: detected/logs (other) |",
+              "|---|---|"]
+        for cause in causes:
+            c = v["causes"][cause]
             unit = GENERATORS[cause][1]
             L.append(f"| {cause} | " + ", ".join(
                 f"{_fmt(p['size'], unit)}: {p['detected']}/{p['logs']}" + (f" ({p['other_findings']})"
@@ -404,20 +467,87 @@ def markdown(s, command, wall_s):
                                                                                if p["other_findings"] else "")
                     for p in c.get("verify", [])) if c.get("verify") else "") + " |")
         L.append("")
+    return L
+
+
+def ran(s):
+    """The causes of the summary, in GENERATORS' order."""
+    return [c for c in GENERATORS if all(c in v["causes"] for v in s["levels"].values())]
+
+
+def markdown(s, command, wall_s):
+    """(the page's main part, or None when the run had none of its causes; {block cause: its block})."""
+    n = s["n"]
+    main_causes = [c for c in ran(s) if c not in BLOCKS]
+    blocks = {}
+    for cause in (c for c in ran(s) if c in BLOCKS):
+        kind = logs_of(cause)
+        blocks[cause] = "\n".join(
+            [BLOCK_BEGIN.format(cause, cause), "", f"## {cause}", "", run_line(s, command, wall_s), "",
+             BLOCK_TEXT[cause].format(scale_um=1e6 * lugre_presliding_scale_m()), ""] + limit_table(s, [cause]) + [""] + nominal_table(s, kind) + [""]
+            + probe_tables(s, [cause], "##")
+            + [f"![detection rate of {cause} against its size at the probed sizes, with 95 % Clopper-Pearson "
+               f"intervals](detection-limits-{cause}.png)", "", BLOCK_END.format(cause)])
+    if not main_causes:
+        return None, blocks
+    L = [BANNER, "", "# Detection limits", "", run_line(s, command, wall_s), "",
+         "br_simlog identification logs of the reference machine (3 cycles, 27.96 s) with one cause of a given "
+         "size and Gaussian force noise, each diagnosed from the log alone. A cause is detected when it is "
+         "among the findings. Noise levels: the EMPS log's force noise as the noise floor measures it, and a "
+         "quiet log's.", "",
+         "Each cause has a ladder of sizes (ratio √2, 15 sizes). The limit is found by bisection on it: a "
+         f"probed size passes when at most {misses_allowed(n)} of its {n} logs miss the cause (at least "
+         f"{100 * s['rate']:.0f} % detected), and its logs stop as soon as it cannot pass. The bisection assumes "
+         "the detection rate grows with the size: the sizes it did not probe are not checked. The limit is "
+         "the smallest passing size; the largest failing probe below it is beside it (the true 95 % size lies "
+         "between the two). The lower bound is the one-sided "
+         f"{100 * s['conf']:.0f} % Clopper-Pearson bound of the detection rate at the limit (with {n} of {n} "
+         f"detected: 0.05^(1/{n}) = {100 * 0.05 ** (1 / n):.1f} %): {n} logs show a rate of "
+         f"{100 * s['rate']:.0f} % or more at the limit; they do not prove the rate is that high."]
+    nv = s.get("n_verify", 0)
+    if nv:
+        L += ["", f"The proof: {nv} logs at the limit (its first {n} are the bisection's), all of which must "
+              f"detect the cause, else the next size up the ladder is tried the same way. {nv} of {nv} "
+              f"detected gives a one-sided {100 * s['conf']:.0f} % Clopper-Pearson lower bound of "
+              f"0.05^(1/{nv}) = {100 * 0.05 ** (1 / nv):.2f} %"
+              + (f": at the proven size the detection rate is at least {100 * s['rate']:.0f} % at "
+                 f"{100 * s['conf']:.0f} % confidence (given that the rate grows with the size)."
+                 if 0.05 ** (1 / nv) >= s["rate"] else
+                 f", short of {100 * s['rate']:.0f} %: too few logs to prove the rate.")]
+    L += [""] + limit_table(s, main_causes) + [""] + nominal_table(s, "ident") + ["", "## Probed sizes", ""]
+    L += probe_tables(s, main_causes, "")
     L += ["![detection rate against effect size at the probed sizes, with 95 % Clopper-Pearson intervals]"
           "(detection-limits.png)", ""]
-    return "\n".join(L)
+    return "\n".join(L), blocks
 
 
-def plot(s, path):
+def compose(old, main, blocks):
+    """The page from a run's main part (None: the old page's) and blocks (the old page's others kept)."""
+    old_main, old_blocks = old or "", {}
+    for cause in BLOCKS:
+        b, e = BLOCK_BEGIN.format(cause, cause), BLOCK_END.format(cause)
+        if b in old_main and e in old_main:
+            i, j = old_main.index(b), old_main.index(e) + len(e)
+            old_blocks[cause] = old_main[i:j]
+            old_main = old_main[:i].rstrip("\n") + "\n" + old_main[j:].lstrip("\n")
+    page = (main if main is not None else old_main).rstrip("\n") + "\n"
+    for cause in BLOCKS:
+        blk = blocks.get(cause, old_blocks.get(cause))
+        if blk:
+            page += "\n" + blk + "\n"
+    return page
+
+
+def plot(s, path, names):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import matplotlib.ticker
-    names = [c for c in GENERATORS if all(c in v["causes"] for v in s["levels"].values())]
-    cols = 3
+    cols = min(3, len(names))
     rows = (len(names) + cols - 1) // cols
-    fig, axs = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.3 * rows), sharey=True, squeeze=False)
+    import textwrap
+    width = max(4.2 * cols, 8.0)   # one panel (a block's figure): room for the title and the label
+    fig, axs = plt.subplots(rows, cols, figsize=(width, 3.3 * rows + 0.4), sharey=True, squeeze=False)
     for ax, cause in zip(axs.flat, names):
         what, unit = GENERATORS[cause][:2]
         for k, v in s["levels"].items():
@@ -442,26 +572,36 @@ def plot(s, path):
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.axhline(100 * s["rate"], color="k", lw=0.6, ls=":")
         ax.set_title(cause, fontsize=9)
-        ax.set_xlabel(f"{what} [{unit}]" if unit else what, fontsize=8)
+        ax.set_xlabel(textwrap.fill(f"{what} [{unit}]" if unit else what, int(width * 12 / cols)), fontsize=8)
         ax.grid(alpha=0.3)
     for ax in axs.flat[len(names):]:
         ax.set_visible(False)
     for row in axs:
         row[0].set_ylabel("detected [% of logs]")
     axs.flat[0].legend(fontsize=7, loc="center right")
-    fig.suptitle("detection rate at the probed sizes (95 % Clopper-Pearson intervals; dashed: the limit; "
-                 "open squares: the proof's sizes; solid: the proven limit)",
+    fig.suptitle(textwrap.fill("detection rate at the probed sizes (95 % Clopper-Pearson intervals; dashed: the "
+                               "limit; open squares: the proof's sizes; solid: the proven limit)", int(width * 14)),
                  fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
 
 
 def write(s, a, cmd):
+    main, blocks = markdown(s, cmd, s.get("wall_s", float("nan")))
     if a.md:
+        old = None
+        if os.path.isfile(a.md):
+            with open(a.md) as f:
+                old = f.read()
         with open(a.md, "w") as f:
-            f.write(markdown(s, cmd, s.get("wall_s", float("nan"))))
+            f.write(compose(old, main, blocks))
     if a.png:
-        plot(s, a.png)
+        names = [c for c in ran(s) if c not in BLOCKS]
+        if names:
+            plot(s, a.png, names)
+        for cause in blocks:
+            # the block's figure beside the page's: detection-limits-<cause>.png
+            plot(s, os.path.join(os.path.dirname(a.png), f"detection-limits-{cause}.png"), [cause])
 
 
 def main():
@@ -496,7 +636,9 @@ def main():
     if a.fresh and os.path.exists(_cache_path(a.work)):
         os.remove(_cache_path(a.work))
     CACHE.update(load_cache(a.work))
-    cached = len(CACHE)
+    # the cached logs this code can reuse (a result of other code is never reused: its digest differs)
+    digest = run_digest(a.simlog)
+    cached = sum(k.endswith("|" + digest) for k in CACHE)
     if CACHE:
         print(f"{len(CACHE)} logs from {_cache_path(a.work)} (an earlier run's; --fresh runs them again)")
     t0 = time.time()
@@ -514,7 +656,7 @@ def main():
     s["command"] = cmd
     s["jobs"] = a.jobs
     s["note"] = os.environ.get("BR_DETECTION_NOTE", "")
-    s["logs_run"] = sum(v["nominal_logs"] for v in s["levels"].values())
+    s["logs_run"] = sum(st["nominal_logs"] for v in s["levels"].values() for st in v["nominal"].values())
     for v in s["levels"].values():
         for c in v["causes"].values():
             seen = {p["size"]: p["logs"] for p in c["probes"]}
@@ -528,12 +670,13 @@ def main():
     print(f"{s['logs_run']} logs ({cached} from the cache) in {s['wall_s'] / 60:.1f} min, "
           f"CPU {s['cpu_s'] / 60:.1f} min")
     for k, v in s["levels"].items():
-        nl = max(v["nominal_logs"], 1)
-        print(f"{k} noise {v['force_noise_N']:.3g} N: false positives {v['false_positives']}/{nl} "
-              f"(upper {100 * (v['false_positive_upper'] or 0):.1f} %), unexplained {v['unexplained']}/{nl}; limits "
-              + ", ".join(f"{c} {d['limit']} (proven {d.get('proven')})" for c, d in v["causes"].items()))
-    fp = max((v["false_positives"] / v["nominal_logs"] for v in s["levels"].values() if v["nominal_logs"]),
-             default=0.0)
+        print(f"{k} noise {v['force_noise_N']:.3g} N: " + "; ".join(
+            f"{kind}: false positives {st['false_positives']}/{st['nominal_logs']} (upper "
+            f"{100 * st['false_positive_upper']:.1f} %), unexplained {st['unexplained']}"
+            for kind, st in v["nominal"].items()) + "; limits "
+            + ", ".join(f"{c} {d['limit']} (proven {d.get('proven')})" for c, d in v["causes"].items()))
+    fp = max((st["false_positives"] / st["nominal_logs"] for v in s["levels"].values()
+              for st in v["nominal"].values() if st["nominal_logs"]), default=0.0)
     return 0 if fp <= 0.02 else 1
 
 

@@ -79,6 +79,23 @@ class Cache(unittest.TestCase):
             dl.CACHE.update(saved[1])
 
 
+class Workers(unittest.TestCase):
+    def test_a_task_returns_the_seconds_of_the_logs_it_ran(self):
+        # a pool worker's USED and SECONDS are its own: they travel back with the result
+        def fake(simlog, work, key, flags, sigma, seed):
+            dl.USED.add(key)
+            dl.SECONDS[key] = 1.5
+            return "none", []
+        saved = dl.run
+        dl.run = fake
+        try:
+            r, used = dl._call((dl.nominal_task, ("s", "w", 0, "quiet", 0.02, "ident", 0, 2)))
+        finally:
+            dl.run = saved
+        self.assertEqual(used, {"quiet-none-0": 1.5, "quiet-none-1": 1.5})
+        self.assertEqual(r[0], "nominal")
+
+
 class Statistics(unittest.TestCase):
     def test_clopper_pearson_bounds(self):
         self.assertAlmostEqual(dl.cp_lower(20, 20), 0.05 ** (1 / 20), places=9)
@@ -167,14 +184,91 @@ class Proof(unittest.TestCase):
         k = 4
         out = bisect(Stand(LAD[k] * 0.9, misses={(k, 25)}))
         res = {"cause": {(lv, CAUSE): dict(out) for lv in ("EMPS", "quiet")},
-               "nominal": {lv: {(0, 1): [("none", [])]} for lv in ("EMPS", "quiet")}}
+               "nominal": {lv: {("ident", 0, 1): [("none", [])]} for lv in ("EMPS", "quiet")}}
         s = dl.summarize(res, (("EMPS", 0.2), ("quiet", 0.02)), 20, 1, [CAUSE], 59)
         c = s["levels"]["quiet"]["causes"][CAUSE]
         self.assertAlmostEqual(c["proven_lower"], dl.cp_lower(59, 59))
-        md = dl.markdown(s, "cmd", 1.0)
+        md, blocks = dl.markdown(s, "cmd", 1.0)
+        self.assertEqual(blocks, {})
         row = next(line for line in md.splitlines() if line.startswith(f"| {CAUSE} | offset"))
         self.assertIn(f"**{dl._fmt(LAD[k + 1], 'N')}**: 59/59, ≥ {100 * dl.cp_lower(59, 59):.1f} % (1 size up from the limit)", row)
         self.assertTrue(re.search(r"at least 95 % at 95 % confidence", md))
+
+
+PS = "presliding_hysteresis"
+
+
+def summary(causes, kinds, misses=0):
+    """A summary of a stand-in run of `causes` with one nominal chunk of each log kind (the first
+    `misses` of its logs with a finding of presliding_hysteresis)."""
+    out = bisect(Stand(LAD[5] * 0.9), n_verify=0)
+    nom = [("presliding_hysteresis", [PS])] * misses + [("none", [])] * (10 - misses)
+    res = {"cause": {(lv, c): dict(out) for lv in ("EMPS", "quiet") for c in causes},
+           "nominal": {lv: {(k, 0, 10): nom for k in kinds} for lv in ("EMPS", "quiet")}}
+    return dl.summarize(res, (("EMPS", 0.2), ("quiet", 0.02)), 20, 10, causes, 0)
+
+
+class Presliding(unittest.TestCase):
+    def test_its_logs_have_the_reversal_segment_and_a_scaled_element_set(self):
+        _, _, lad, flags = dl.GENERATORS[PS]
+        scale = dl.lugre_presliding_scale_m()
+        import json
+        with open(os.path.join(REPO, "machines", "reference.json")) as f:
+            fr = json.load(f)["friction"]
+        self.assertAlmostEqual(scale, fr["Fs_N"] / fr["sigma0_Npm"])
+        f = dl.LOGS[dl.logs_of(PS)] + flags(2.0)
+        self.assertEqual(f[:2], ["--reversals", "1"])
+        d = [float(x) for x in f[f.index("--gms") + 1].split(",")]
+        self.assertAlmostEqual(max(d), 2.0 * scale, delta=1e-6 * scale)
+        self.assertEqual(len(d), len(dl.GMS_SHAPE))
+        # the other causes keep the plain identification run
+        self.assertEqual(dl.LOGS[dl.logs_of("offset")], [])
+
+    def test_nominal_logs_of_each_kind_the_causes_use(self):
+        calls = []
+
+        def fake_run(simlog, work, key, flags, sigma, seed):
+            calls.append((key, tuple(flags), seed))
+            return "none", []
+        saved = dl.run
+        dl.run = fake_run
+        try:
+            for kind in dl.LOGS:
+                dl.nominal_task(("s", "w", 0, "quiet", 0.02, kind, 0, 2))
+        finally:
+            dl.run = saved
+        # the identification logs keep their keys and seeds; the reversal logs have others
+        self.assertEqual(calls[0], ("quiet-none-0", (), dl.hash_seed(0, 0, 0, 0)))
+        self.assertEqual(calls[2][1], ("--reversals", "1"))
+        self.assertNotIn(calls[2][0], {c[0] for c in calls[:2]})
+        self.assertNotIn(calls[2][2], {c[2] for c in calls[:2]})
+
+    def test_false_detections_counted_per_log_kind(self):
+        s = summary([CAUSE, PS], list(dl.LOGS), misses=1)
+        st = s["levels"]["quiet"]["nominal"]["ident with the reversal segment"]
+        self.assertEqual((st["false_positives"], st["false_positive_causes"]), (1, {PS: 1}))
+        self.assertAlmostEqual(st["false_positive_upper"], dl.cp_upper(1, 10))
+
+    def test_a_run_of_the_block_alone_rewrites_only_its_block(self):
+        main, blocks = dl.markdown(summary([CAUSE], ["ident"]), "make all", 1.0)
+        page = dl.compose(None, main, blocks)
+        self.assertNotIn(PS, page)
+        m2, b2 = dl.markdown(summary([PS], ["ident with the reversal segment"], misses=2), "make ps", 1.0)
+        self.assertIsNone(m2)
+        page2 = dl.compose(page, m2, b2)
+        self.assertTrue(page2.startswith(page.rstrip("\n")))       # the main part kept as it was
+        blk = page2[page2.index(dl.BLOCK_BEGIN.format(PS, PS)):]
+        self.assertIn("`make ps`", blk)
+        self.assertIn("presliding_hysteresis 2", blk)                # its LuGre logs' false detections
+        row = next(line for line in blk.splitlines() if line.startswith(f"| {PS} |"))
+        self.assertIn("/", row)
+        # again: the block replaced, not repeated; a full run replaces the main part and keeps the block
+        page3 = dl.compose(page2, m2, b2)
+        self.assertEqual(page3, page2)
+        page4 = dl.compose(page3, main.replace("make all", "make again"), {})
+        self.assertEqual(page4.count(dl.BLOCK_BEGIN.format(PS, PS)), 1)
+        self.assertIn("make again", page4)
+        self.assertIn("`make ps`", page4)
 
 
 if __name__ == "__main__":

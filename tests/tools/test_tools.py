@@ -103,6 +103,14 @@ class ToolsTest(unittest.TestCase):
         r = run("br_simlog", "--out", out, "--machine-out", os.path.join(self.w, "m.json"), "--traj", "circle")
         self.assert_refused(r, 2, "does not apply to --traj circle")
         self.assert_untouched(out)
+        # --reversals: 1..BR_IDENT_REV_MAX_PAIRS pairs, the identification run only
+        for bad in ("0", "5", "1.5", "x"):
+            r = run("br_simlog", "--out", out, "--reversals", bad)
+            self.assert_refused(r, 2, "--reversals")
+            self.assert_untouched(out)
+        r = run("br_simlog", "--out", out, "--traj", "backforth", "--reversals", "1")
+        self.assert_refused(r, 2, "--reversals applies to --traj ident only")
+        self.assert_untouched(out)
         # --gms: 1..8 breakaway displacements, each in (0, 0.01] m
         for bad in ("0", "-1e-6", "0.02", "nan", "1e-6,", "1e-6,2e-6,3e-6,4e-6,5e-6,6e-6,7e-6,8e-6,9e-6"):
             r = run("br_simlog", "--out", out, "--traj", "circle", "--gms", bad)

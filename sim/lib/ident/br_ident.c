@@ -35,6 +35,23 @@ br_ident_cfg_t br_ident_cfg_default(const br_plant_cfg_t *plant)
     return c;
 }
 
+int br_ident_add_reversals(br_ident_cfg_t *c, int n_pairs)
+{
+    if (n_pairs < 1 || n_pairs > BR_IDENT_REV_MAX_PAIRS || c->n_moves + 2 * n_pairs > BR_IDENT_MAX_MOVES ||
+        c->n_moves < 1 || c->moves[c->n_moves - 1].x_to_m != 0.0)
+        return -1;
+    const br_move_t out = {BR_IDENT_REV_AMP_M, BR_IDENT_REV_SPEED_MPS, 0.0};
+    br_move_t back = {0.0, BR_IDENT_REV_SPEED_MPS, 0.0};
+    const double rest_s = c->moves[c->n_moves - 1].dwell_s;
+    for (int i = 0; i < n_pairs; i++) {
+        /* the last move back rests like the cycle's last move before the next cycle */
+        back.dwell_s = i == n_pairs - 1 ? rest_s : 0.0;
+        c->moves[c->n_moves++] = out;
+        c->moves[c->n_moves++] = back;
+    }
+    return 0;
+}
+
 br_ident_cfg_t br_ident_cfg_backforth(const br_plant_cfg_t *plant, double duration_s)
 {
     br_ident_cfg_t c = br_ident_cfg_default(plant);

@@ -61,6 +61,18 @@ typedef void (*br_log_sink_t)(void *user, const br_log_row_t *row);
  * kp and velocity-loop rate kv gain / m as EMPS: 160.18 1/s, 90 1/s). */
 br_ident_cfg_t br_ident_cfg_default(const br_plant_cfg_t *plant);
 
+/* The reversal segment (docs/simlog.md, "The reversal segment"): n_pairs
+ * back-and-forth moves 0 -> BR_IDENT_REV_AMP_M -> 0 at BR_IDENT_REV_SPEED_MPS,
+ * no dwell at the turn, appended to each cycle of c's moves (which must end at
+ * x = 0, as the default run's do): slow reversals whose presliding an element
+ * set and a bristle tell apart (docs/diagnose.md, presliding_hysteresis).
+ * 0, or -1 when n_pairs is outside 1 .. BR_IDENT_REV_MAX_PAIRS or the moves
+ * would not fit. */
+#define BR_IDENT_REV_AMP_M 1e-4
+#define BR_IDENT_REV_SPEED_MPS 1e-4
+#define BR_IDENT_REV_MAX_PAIRS 4
+int br_ident_add_reversals(br_ident_cfg_t *c, int n_pairs);
+
 /* The slow back-and-forth (docs/simlog.md): 0 -> 0.02 m -> 0 at 5 mm/s,
  * 0.5 m/s^2, no dwell at the reversals, repeated over duration_s. */
 br_ident_cfg_t br_ident_cfg_backforth(const br_plant_cfg_t *plant, double duration_s);

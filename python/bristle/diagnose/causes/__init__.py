@@ -57,7 +57,9 @@ The studies (sim/studies/) take a cause that has their setting:
 
   DETECTION            detection_limits.py: (size name, unit, smallest size of the ladder,
                        flags(s, ref)), br_simlog's options for an effect of size s
-                       (ref: the reference machine's Fc_N and sigma2_Nspm)
+                       (ref: the reference machine's Fc_N, sigma2_Nspm and LuGre presliding
+                       scale Fs / sigma0, presliding_scale_m); DETECTION_LOG: the log kind
+                       if not the identification run (detection_limits.LOGS)
   robustness_draw(c, sgn) -> dict
                        robustness.py: the plant's parameters of the cause from
                        three uniforms c and a sign

@@ -74,6 +74,14 @@ ELEMENT_COLS = tuple(f"ps_el{i}" for i in range(GRID_N))
 OWN_SHAPE = True           # the base's Stribeck shape was fitted with a bristle: searched again (model.add_with_shape)
 SHAPE_UNUSED = (0,)        # rho, in model.fit_shape's (log rho, beta, log vs)
 UNUSED_PARAMS = ("sigma0_Npm",)   # the element set's initial stiffness, not a fitted one: identify.py skips it
+# detection_limits.py: the size is the largest breakaway d_max over LuGre's Fs / sigma0 (ref's
+# presliding_scale_m), the elements at the demo's hardware-like shape (2, 5, 10, 20 um: docs/demo.md),
+# equal shares; on identification logs with the reversal segment (DETECTION_LOG: docs/diagnose.md asks
+# for it, too few samples near reversals otherwise)
+DETECTION_SHAPE = (0.1, 0.25, 0.5, 1.0)
+DETECTION = ("largest breakaway d_max / LuGre's Fs/sigma0 (elements at 0.1, 0.25, 0.5, 1 d_max)", "", 0.01,
+             lambda s, ref: ["--gms", ",".join(f"{s * ref['presliding_scale_m'] * f:.6g}" for f in DETECTION_SHAPE)])
+DETECTION_LOG = "ident with the reversal segment"
 
 
 def clamp_scan(lo, hi, y0):
