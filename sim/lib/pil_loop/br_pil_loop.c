@@ -280,14 +280,7 @@ static int pil_step(void *user, int axis, long k, int32_t counts, br_circle_remo
     /* the user's figure: the image's own counts against the commanded circle, both axes' once
      * the period's y is in (a period that faulted has no sample: br_circle's rule) */
     L->meas_counts[axis] = o.s.counts;
-    if (axis == 1 && o.s.status >= 0 && out->fault == 0) {
-        const double x = ((double)L->meas_counts[0] + 0.5) * L->m_per_count;
-        const double y = ((double)L->meas_counts[1] + 0.5) * L->m_per_count;
-        const double e = hypot(x, y) - L->c->radius_m;
-        L->sum2 += e * e;
-        L->emax = fmax(L->emax, fabs(e));
-        L->n_meas++;
-    }
+    if (axis == 1 && o.s.status >= 0 && out->fault == 0) br_pil_meas_add(&L->meas, L->meas_counts[0], L->meas_counts[1]);
     return 0;
 }
 
@@ -304,16 +297,36 @@ static int after_run(br_pil_loop_t *L, int axis)
     return 0;
 }
 
-/* every write answered, with status 0 and the value written, in order */
+/* every write answered, with status 0 and the value written, in order (R comes back from rad^2:
+ * v * rpc^2 / rpc^2 in float, within a relative 1e-6) */
 static int params_reached(const br_pil_loop_t *L, const br_pil_axis_t *a)
 {
     if (a->n_replies != L->n_params) return 0;
     for (int j = 0; j < L->n_params; j++) {
-        if (a->reply_id[j] != L->params[j].id || a->reply_status[j] != 0 ||
-            memcmp(&a->reply_value[j], &L->params[j].value, sizeof(float)) != 0)
+        const double w = (double)L->params[j].value, r = (double)a->reply_value[j];
+        if (a->reply_id[j] != L->params[j].id || a->reply_status[j] != 0 || !(fabs(r - w) <= 1e-6 * fabs(w)))
             return 0;
     }
     return 1;
+}
+
+void br_pil_meas_init(br_pil_meas_t *m, const br_circle_cfg_t *c)
+{
+    *m = (br_pil_meas_t){c->plant.lead_mprad * 2.0 * M_PI / c->plant.counts_per_rev, c->radius_m, 0.0, 0.0, 0};
+}
+
+void br_pil_meas_add(br_pil_meas_t *m, int32_t x_counts, int32_t y_counts)
+{
+    const double x = ((double)x_counts + 0.5) * m->m_per_count, y = ((double)y_counts + 0.5) * m->m_per_count;
+    const double e = hypot(x, y) - m->radius_m;
+    m->sum2 += e * e;
+    m->emax = fmax(m->emax, fabs(e));
+    m->n++;
+}
+
+double br_pil_meas_rms(const br_pil_meas_t *m)
+{
+    return m->n > 0 ? sqrt(m->sum2 / (double)m->n) : 0.0;
 }
 
 static double now_s(void)
@@ -359,17 +372,15 @@ int br_pil_loop_run(br_pil_loop_t *L, const br_circle_cfg_t *c, const br_pil_par
     L->n_params = n_params;
     L->duty[0] = duty != NULL ? duty[0] : NULL;
     L->duty[1] = duty != NULL ? duty[1] : NULL;
-    L->m_per_count = c->plant.lead_mprad * 2.0 * M_PI / c->plant.counts_per_rev;
-    L->sum2 = L->emax = 0.0;
-    L->n_meas = 0;
+    br_pil_meas_init(&L->meas, c);
     const br_circle_remote_t remote = {pil_step, L};
     const double t0 = now_s();
     if (br_circle_run_remote(c, &remote, NULL, NULL, &out->res) < 0) return -1;
     for (int i = 0; i < 2; i++)
         if (after_run(L, i) != 0) return -1;
     out->wall_s = now_s() - t0;
-    out->meas_rms_m = L->n_meas > 0 ? sqrt(L->sum2 / (double)L->n_meas) : 0.0;
-    out->meas_max_m = L->emax;
+    out->meas_rms_m = br_pil_meas_rms(&L->meas);
+    out->meas_max_m = L->meas.emax;
     out->params_ok = params_reached(L, &L->ax[0]) && params_reached(L, &L->ax[1]);
     return 0;
 }

@@ -46,6 +46,19 @@ typedef struct {
     float value;  /* in the parameter's unit */
 } br_pil_param_t;
 
+/* The contour error a user measures on a real axis: the encoder's position
+ * (the count's centre, (counts + 0.5) counts, both axes) against the
+ * commanded circle, hypot(x, y) - A; its sums over the periods added. */
+typedef struct {
+    double m_per_count, radius_m, sum2, emax;
+    long n;
+} br_pil_meas_t;
+
+void br_pil_meas_init(br_pil_meas_t *m, const br_circle_cfg_t *c);
+void br_pil_meas_add(br_pil_meas_t *m, int32_t x_counts, int32_t y_counts);
+/* its RMS (0 with no period) */
+double br_pil_meas_rms(const br_pil_meas_t *m);
+
 typedef struct {
     br_pil_axis_t ax[2];
     int started;      /* axes whose QEMU runs */
@@ -57,18 +70,16 @@ typedef struct {
     const br_pil_param_t *params;
     int n_params;
     float *duty[2];                       /* the controller's duty per period (NULL: not kept) */
-    double m_per_count, sum2, emax;       /* the measured contour error's sums */
-    long n_meas;
+    br_pil_meas_t meas;                   /* the measured contour error */
     int32_t meas_counts[2];               /* the period's counts from the image's samples */
 } br_pil_loop_t;
 
 /* A run's outcome. res: br_circle_run_remote's (the plant's truth: what the
- * simulator's tables report). meas_*: what a user has on a real axis, from
- * the image's own samples (the telemetry's fields): the contour error of the
- * encoder's position (the count's centre, (counts + 0.5) counts) against the
- * commanded circle, hypot(x, y) - A, over the periods run. params_ok: every
- * parameter write was answered with status 0 and the value written, on both
- * axes (1; 0: refused or unanswered, the run's figures are no result). */
+ * simulator's tables report). meas_*: what a user has on a real axis,
+ * br_pil_meas_t over the image's own samples (the telemetry's counts), the
+ * periods run. params_ok: every parameter write was answered with status 0
+ * and the value written (R, which the image keeps in rad^2, to a relative
+ * 1e-6), on both axes (1; 0: refused or unanswered: no result). */
 typedef struct {
     br_circle_result_t res;
     double meas_rms_m, meas_max_m;
