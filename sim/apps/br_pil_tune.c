@@ -44,8 +44,8 @@
 
 #define TOOL "br_pil_tune"
 #define TIMEOUT_MAX_S 3600.0
-/* the default segment: the circle's first 0.25 s (docs/link.md, "Tuning on the target", says why) */
-#define SEGMENT_S 0.25
+/* the default segment: the circle's first 0.5 s (docs/link.md, "Tuning on the target", says why) */
+#define SEGMENT_S 0.5
 #define MAX_SET 2
 
 typedef struct {
@@ -74,7 +74,8 @@ typedef struct {
     long n_alloc;
     FILE *csv;
     int nfev, n_fault, dead;
-    double best_f, best_x[BR_TUNE_MAX_P];
+    int best_eval;
+    double best_f, best_meas_m, best_x[BR_TUNE_MAX_P];
 } tune_t;
 
 static int usage(const char *argv0, FILE *to)
@@ -350,6 +351,8 @@ static double objective(void *user, const double *x, int n)
         t->n_fault++;
     } else if (e.f < t->best_f) {
         t->best_f = e.f;
+        t->best_eval = t->nfev;
+        t->best_meas_m = e.run.meas_rms_m;
         memcpy(t->best_x, x, sizeof(double) * (size_t)br_tune_n_params(t->pf));
     }
     return e.f;
@@ -457,11 +460,11 @@ int main(int argc, char **argv)
         printf("no setting ran to the end: no best\n");
         goto out;
     }
-    printf("best: measured contour RMS %.4e m at", t.best_f);
+    printf("best: objective %.4e m (eval %d: measured contour RMS %.4e m) at", t.best_f, t.best_eval, t.best_meas_m);
     for (int i = 0; i < n; i++) printf(" %s=%.4g", br_tune_param_name(t.pf, i), exp(t.best_x[i]));
     printf("\n");
     if (shipped.refused || shipped.run.res.fault_status != 0) printf("shipped: FAULT, no result\n");
-    else printf("shipped: measured contour RMS %.4e m (best / shipped %.3f)\n", shipped.f, t.best_f / shipped.f);
+    else printf("shipped: objective %.4e m (best / shipped %.3f)\n", shipped.f, t.best_f / shipped.f);
     if (compare(&t, &shipped, md) != 0) goto out;
     rc = 0;
 out:

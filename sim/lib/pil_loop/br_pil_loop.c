@@ -24,6 +24,8 @@
 /* after a run: the disarm and the fault reset, then periods at rest until the link's
  * backlog is taken (at most the D setpoints sent ahead of a period that faulted) */
 #define AFTER_PERIODS (SETUP_PERIODS + 6u)
+/* and at most this many until the outputs are off */
+#define AFTER_MAX_PERIODS 100000u
 
 static const char *const FILES[5] = {"link.in", "link.out", "plant.in", "plant.out", "qemu.log"};
 
@@ -284,14 +286,19 @@ static int pil_step(void *user, int axis, long k, int32_t counts, br_circle_remo
     return 0;
 }
 
-/* after a run: disarm and fault reset, then periods at rest at the last count */
+/* after a run: disarm and fault reset, then periods at rest at the last count until the link's
+ * backlog is taken and the outputs are off (a fault's braking ramp ends with them off) */
 static int after_run(br_pil_loop_t *L, int axis)
 {
     br_pil_axis_t *a = &L->ax[axis];
     if (send_request(a, BR_LINK_MSG_DISARM, NULL, 0) != 0 || send_request(a, BR_LINK_MSG_FAULT_RESET, NULL, 0) != 0)
         return -1;
-    for (uint32_t j = 0; j < AFTER_PERIODS; j++) {
-        br_link_pil_out_t o;
+    br_link_pil_out_t o = {0};
+    for (uint32_t j = 0; j < AFTER_PERIODS || o.on != 0u; j++) {
+        if (j == AFTER_MAX_PERIODS) {
+            fprintf(stderr, "%s: axis %d: the outputs still on %u periods after the disarm\n", TOOL, axis, j);
+            return -1;
+        }
         if (exchange(L, axis, a->last_counts, &o) != 0) return -1;
     }
     return 0;
