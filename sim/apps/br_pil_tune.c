@@ -384,7 +384,8 @@ static int compare(tune_t *t, const eval_t *shipped, FILE *md)
     fprintf(md, "\n");
     for (int row = 0; row < 2; row++) {
         br_circle_cfg_t c = t->seg;
-        fprintf(md, "| %s |", row == 0 ? "shipped (br_tune_est, the simulator)" : "best on the target");
+        const char *best = t->o.sim ? "best of this search (--sim)" : "best on the target";
+        fprintf(md, "| %s |", row == 0 ? "shipped (br_tune_est, the simulator)" : best);
         br_pil_param_t ws[BR_TUNE_MAX_P + MAX_SET];
         double xs[BR_TUNE_MAX_P];
         for (int i = 0; i < n; i++) xs[i] = log((double)*br_tune_param_ptr(&c, t->pf, i));
