@@ -370,9 +370,11 @@ static int compare(tune_t *t, const eval_t *shipped, FILE *md)
     if (t->o.circle) {
         br_circle_cfg_t full = br_circle_cfg_thesis(t->pf ? BR_CTRL_HINF_PF : BR_CTRL_HINF_UKF);
         printf("the whole circle (%.1f s), each setting once:\n", full.duration_s);
+        fflush(stdout);
         if (run(t, &full, t->o.set, t->o.n_set, &cs) != 0 || run(t, &full, w, nw, &cb) != 0) return -1;
         print_eval(stdout, "shipped", &cs);
         print_eval(stdout, "best", &cb);
+        fflush(stdout);
     }
     if (md == NULL) return 0;
     fprintf(md, "| H-inf + %s setting |", E);
