@@ -358,24 +358,27 @@ static double objective(void *user, const double *x, int n)
     return e.f;
 }
 
+/* --circle: the whole circle with the writes w (n; none: the image's own setting) */
+static int circle(tune_t *t, const char *label, const br_pil_param_t *w, int n, eval_t *e)
+{
+    const br_circle_cfg_t full = br_circle_cfg_thesis(t->pf ? BR_CTRL_HINF_PF : BR_CTRL_HINF_UKF);
+    if (run(t, &full, w, n, e) != 0) return -1;
+    printf("the whole circle (%.1f s), ", full.duration_s);
+    print_eval(stdout, label, e);
+    fflush(stdout);
+    return 0;
+}
+
 /* the shipped setting against the best: on the segment (evaluation 0 and the best's), with --circle
- * on the whole circle too */
-static int compare(tune_t *t, const eval_t *shipped, FILE *md)
+ * on the whole circle too (cs: the shipped one's, run before any write) */
+static int compare(tune_t *t, const eval_t *shipped, const eval_t *cs, FILE *md)
 {
     const int n = br_tune_n_params(t->pf);
     br_pil_param_t w[BR_TUNE_MAX_P + MAX_SET];
     const int nw = writes_of(t, t->best_x, w);
-    eval_t cs, cb;
+    eval_t cb;
     const char *E = t->pf ? "PF" : "UKF";
-    if (t->o.circle) {
-        br_circle_cfg_t full = br_circle_cfg_thesis(t->pf ? BR_CTRL_HINF_PF : BR_CTRL_HINF_UKF);
-        printf("the whole circle (%.1f s), each setting once:\n", full.duration_s);
-        fflush(stdout);
-        if (run(t, &full, t->o.set, t->o.n_set, &cs) != 0 || run(t, &full, w, nw, &cb) != 0) return -1;
-        print_eval(stdout, "shipped", &cs);
-        print_eval(stdout, "best", &cb);
-        fflush(stdout);
-    }
+    if (t->o.circle && circle(t, "best", w, nw, &cb) != 0) return -1;
     if (md == NULL) return 0;
     fprintf(md, "| H-inf + %s setting |", E);
     for (int i = 0; i < n; i++) fprintf(md, " %s%s |", br_tune_param_name(t->pf, i), i == n - 1 ? " [count^2]" : "");
@@ -395,7 +398,7 @@ static int compare(tune_t *t, const eval_t *shipped, FILE *md)
         for (int i = 0; i < n; i++) fprintf(md, " %.3e |", (double)ws[i].value);
         fprintf(md, " %.4e m |", row == 0 ? shipped->f : t->best_f);
         if (t->o.circle) {
-            const eval_t *e = row == 0 ? &cs : &cb;
+            const eval_t *e = row == 0 ? cs : &cb;
             if (e->refused || e->run.res.fault_status != 0) fprintf(md, " FAULT | FAULT |");
             else fprintf(md, " %.4e m | %.4e m |", e->run.meas_rms_m, e->run.res.contour_rms_m);
         }
@@ -455,6 +458,10 @@ int main(int argc, char **argv)
     printf("eval 0   shipped: the image's own br_%s_tuned.h, no variance written\n", t.o.est);
     print_eval(stdout, "", &shipped);
     csv_row(&t, 0, NULL, 0, &shipped);
+    /* the shipped setting on the whole circle now: the image keeps the values last written (its
+     * service's copy, applied at each arm), so after the search a run without writes would not be it */
+    eval_t cs;
+    if (t.o.circle && circle(&t, "shipped", t.o.set, t.o.n_set, &cs) != 0) goto out;
     br_nm_cfg_t cfg = br_tune_nm_cfg(n, lo, hi, (int)t.o.max_fev);
     br_nm_result_t r;
     if (br_nm_minimize(&cfg, objective, &t, x0, &r) != 0 || t.dead) goto out;
@@ -468,7 +475,7 @@ int main(int argc, char **argv)
     printf("\n");
     if (shipped.refused || shipped.run.res.fault_status != 0) printf("shipped: FAULT, no result\n");
     else printf("shipped: objective %.4e m (best / shipped %.3f)\n", shipped.f, t.best_f / shipped.f);
-    if (compare(&t, &shipped, md) != 0) goto out;
+    if (compare(&t, &shipped, &cs, md) != 0) goto out;
     rc = 0;
 out:
     if (!t.o.sim) br_pil_loop_close(&t.L);
