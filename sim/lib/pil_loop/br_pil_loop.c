@@ -15,6 +15,9 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 
 #include "bristle/br_link_pil.h"
 #include "bristle_gen/link/br_link_msgs.h"
@@ -59,6 +62,10 @@ static int axis_start(br_pil_axis_t *a, const char *qemu, const char *image, con
     a->pid = fork();
     if (a->pid < 0) return -1;
     if (a->pid == 0) {
+#ifdef __linux__
+        /* a host killed mid-run takes its QEMU with it (it would wait for ticks for 2^32 polls) */
+        (void)prctl(PR_SET_PDEATHSIG, SIGTERM);
+#endif
         const int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0600);
         if (fd >= 0) {
             dup2(fd, 1);
