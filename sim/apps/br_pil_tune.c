@@ -396,7 +396,8 @@ static int compare(tune_t *t, const eval_t *shipped, const eval_t *cs, FILE *md)
         for (int i = 0; i < n; i++) xs[i] = log((double)*br_tune_param_ptr(&c, t->pf, i));
         (void)writes_of(t, row == 0 ? xs : t->best_x, ws); /* in the link's units: R in counts^2 */
         for (int i = 0; i < n; i++) fprintf(md, " %.3e |", (double)ws[i].value);
-        fprintf(md, " %.4e m |", row == 0 ? shipped->f : t->best_f);
+        if (row == 0 && (shipped->refused || shipped->run.res.fault_status != 0)) fprintf(md, " FAULT |");
+        else fprintf(md, " %.4e m |", row == 0 ? shipped->f : t->best_f);
         if (t->o.circle) {
             const eval_t *e = row == 0 ? cs : &cb;
             if (e->refused || e->run.res.fault_status != 0) fprintf(md, " FAULT | FAULT |");
