@@ -22,7 +22,10 @@
  * figures bit for bit when the image in the loop is the simulator's: the
  * check of the harness). --set writes a further parameter (by its link name,
  * bristle_gen/link/br_link_params.h) before every evaluation. Writes into
- * DIR: evals.csv (one row per evaluation) and summary.md. */
+ * DIR (made if missing; its parent must exist): evals.csv (one row per
+ * evaluation) and summary.md, renamed into place only when the tuning
+ * succeeded (br_outfile.h; a search without a complete evaluation writes
+ * nothing). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -38,6 +41,7 @@
 #include "nm/br_nm.h"
 #include "pil_loop/br_pil_loop.h"
 #include "tool/br_args.h"
+#include "tool/br_outfile.h"
 #include "tool/br_run_report.h"
 #include "tool/br_tool_limits.h"
 #include "tune_space/br_tune_space.h"
@@ -429,30 +433,30 @@ int main(int argc, char **argv)
     const int n = br_tune_n_params(t.pf);
     double x0[BR_TUNE_MAX_P], lo[BR_TUNE_MAX_P], hi[BR_TUNE_MAX_P];
     br_tune_space(&start, t.pf, !t.pf, x0, lo, hi);
+    /* the outputs: temporary files beside their names, renamed when the tuning succeeded (br_outfile.h) */
+    br_outfile_t csv_file = {0}, md_file = {0};
     FILE *md = NULL;
     if (t.o.out != NULL) {
         char p[1024];
-        (void)mkdir(t.o.out, 0755);
+        (void)mkdir(t.o.out, 0755); /* the folder itself; its parent must exist */
         snprintf(p, sizeof p, "%s/evals.csv", t.o.out);
-        t.csv = fopen(p, "w");
+        const int bad = br_outfile_open(&csv_file, TOOL, p);
         snprintf(p, sizeof p, "%s/summary.md", t.o.out);
-        md = fopen(p, "w");
-        if (t.csv == NULL || md == NULL) {
-            fprintf(stderr, "%s: cannot write into %s\n", TOOL, t.o.out);
+        if (bad || br_outfile_open(&md_file, TOOL, p) != 0) {
+            br_outfile_discard(&csv_file);
             return 1;
         }
+        t.csv = csv_file.f;
+        md = md_file.f;
         fprintf(t.csv, "eval,fault");
         for (int i = 0; i < n; i++) fprintf(t.csv, ",%s%s", br_tune_param_name(t.pf, i), i == n - 1 ? "_counts2" : "");
         fprintf(t.csv, ",meas_contour_rms_m,meas_max_m,outlier_steps,plant_contour_rms_m,objective,duty_fnv,wall_s\n");
     }
-    if (!t.o.sim && br_pil_loop_open(&t.L, t.o.qemu, t.o.image, t.o.est, t.o.work, t.o.timeout_s) != 0) {
-        br_pil_loop_close(&t.L);
-        return 1;
-    }
+    int rc = 1;
+    if (!t.o.sim && br_pil_loop_open(&t.L, t.o.qemu, t.o.image, t.o.est, t.o.work, t.o.timeout_s) != 0) goto out;
     printf("tuning %s on the %s: H-inf + %s, the circle's first %.3g s per evaluation\n", t.o.est,
            t.o.sim ? "host simulator (--sim)" : "image in the loop (QEMU mps2-an500, Cortex-M7)", t.pf ? "PF" : "UKF",
            t.seg.duration_s);
-    int rc = 1;
     eval_t shipped;
     t.best_f = INFINITY;
     if (run(&t, &t.seg, t.o.set, t.o.n_set, &shipped) != 0) goto out;
@@ -480,8 +484,12 @@ int main(int argc, char **argv)
     rc = 0;
 out:
     if (!t.o.sim) br_pil_loop_close(&t.L);
-    if (t.csv != NULL) fclose(t.csv);
-    if (md != NULL) fclose(md);
+    /* evals.csv, then summary.md, only from a tuning that succeeded */
+    if (rc == 0 && t.o.out != NULL &&
+        (br_outfile_commit(&csv_file, TOOL) != 0 || br_outfile_commit(&md_file, TOOL) != 0))
+        rc = 1;
+    br_outfile_discard(&csv_file);
+    br_outfile_discard(&md_file);
     free(t.duty[0]);
     free(t.duty[1]);
     return rc;

@@ -108,6 +108,12 @@ class ToolsTest(unittest.TestCase):
         r = run("br_pil_tune", "--image", os.path.join(self.w, "none.elf"), "--out", out)
         self.assert_refused(r, 1, "no image at")
         self.assertEqual(os.listdir(self.w), [])
+        # a search where every evaluation faulted has no best: exit 1, nothing written (the folder stays empty)
+        r = run("br_pil_tune", "--sim", "--max-fev", "6", "--duration", "0.1", "--set", "outlier_sigma=0.01",
+                "--out", out)
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn("no setting ran to the end", r.stdout)
+        self.assertEqual(os.listdir(out), [])
         # --sim does not model a parameter it cannot set: refused, not ignored
         r = run("br_pil_tune", "--sim", "--max-fev", "6", "--set", "reanchor_after=2")
         self.assert_refused(r, 1, "--sim sets no parameter 0x0008")
