@@ -54,6 +54,8 @@ export BR_MK_FEED     := $(FEED)
 export BR_MK_DIR      := $(DIR)
 export BR_MK_PLANT    := $(or $(PLANT),offset=2.5)
 export BR_MK_MAX_FEV  := $(value MAX_FEV)
+export BR_MK_EST      := $(or $(value EST),ukf)
+export BR_MK_MAXFEV   := $(or $(value MAXFEV),60)
 # the counts: digits only (they are written into recipes)
 _nodigits = $(subst 0,,$(subst 1,,$(subst 2,,$(subst 3,,$(subst 4,,$(subst 5,,$(subst 6,,$(subst 7,,$(subst 8,,$(subst 9,,$(1)))))))))))
 _check_count = $(if $(value $(1)),$(if $(or $(call _nodigits,$(value $(1))),$(filter-out 1,$(words $(value $(1))))),$(error $(1) must be a whole number)))
@@ -114,7 +116,7 @@ define print_size
 	done
 endef
 
-.PHONY: fuzz help deps build test demo bench target-bench pil target-chain diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet mslip-plants
+.PHONY: fuzz help deps build test demo bench target-bench pil pil-tune target-chain diagnose validate diagnose-hidden diagnose-control diagnose-bench detection-limits firmware emps regen clean distclean robustness fleet mslip-plants
 
 help:
 	@echo "bristle targets:"
@@ -137,6 +139,7 @@ help:
 	@echo "  make faults                 the fault campaign on the simulator (production guards) -> docs/reliability-faults.md"
 	@echo "  make target-bench  instructions per PF particle-step / control period on QEMU's Cortex-M7 (and Cortex-M4: mps2-an386), flash / RAM; fails over target/mps2/budget.txt"
 	@echo "  make pil       the circle with each estimator on QEMU's Cortex-M7 in lockstep with the host plant, compared bit for bit with the simulator (docs/link.md)"
+	@echo "  make pil-tune [EST=ukf|pf] [MAXFEV=60]  Nelder-Mead over the noise variances, each evaluation a run of the image in the loop, against the shipped tuning -> $(PT_OUT)/<est> (docs/link.md)"
 	@echo "  make target-chain [PLANT='offset=2.5']  identification run over the link -> its log -> diagnose -> machine.json -> the images -> the circle in the loop before / after -> $(TC_OUT) (docs/link.md)"
 	@echo "  make regen     regenerate everything generated from machines/reference.json (headers, tuning, golden traces)"
 	@echo "  make tune [MACHINE=<json>] [MAX_FEV=n]  Nelder-Mead tuning of the PF and UKF noise (the reference: regenerates firmware/gen/bristle_gen/est/; another machine: its build folder's tune/, with tune/machine.json; docs/tuning.md)"
@@ -287,6 +290,20 @@ target-chain: deps
 	PYTHONPATH=python $(PYTHON) sim/studies/target_chain.py circles --pil build/host-release/sim/br_pil \
 	  --before build/cm7-release/target/mps2/br_pil_mps2.elf --after "$$dir/target/mps2/br_pil_mps2.elf" \
 	  --work $(TC_OUT)/circle --plant "$$BR_MK_PLANT" --est ukf --diagnosis $(TC_OUT)/diagnose/machine.json
+
+# Tuning on the target (docs/link.md, "Tuning on the target"): Nelder-Mead over
+# the estimator's noise variances, each evaluation 0.5 s of the circle on the
+# image in the loop with the variances written over the link; the shipped
+# (simulator-tuned) and the best setting then on the whole circle.
+PT_OUT := out/pil-tune
+pil-tune: deps
+	$(call configure,host-release)
+	$(Q)cmake --build --preset host-release --target br_pil_tune $(NINJA_QUIET)
+	$(call configure,cm7-release)
+	$(Q)cmake --build --preset cm7-release --target br_pil_mps2 $(NINJA_QUIET)
+	$(Q)mkdir -p $(PT_OUT)
+	$(Q)build/host-release/sim/br_pil_tune --image build/cm7-release/target/mps2/br_pil_mps2.elf --est "$$BR_MK_EST" \
+	  --max-fev "$$BR_MK_MAXFEV" --circle --out $(PT_OUT)/"$$BR_MK_EST"
 
 # Measured logs (docs/diagnose.md): diagnose one, validate a saved model on
 # another, and the hidden-cause suite that writes docs/diagnose-hidden.md.

@@ -36,6 +36,7 @@
 #include "circle/br_circle_est.h"
 #include "plant/br_plant_json.h"
 #include "nm/br_nm.h"
+#include "tune_space/br_tune_space.h"
 #include "tune_delay/br_tune_delay.h"
 #include "tune_mslip/br_tune_mslip.h"
 #include "bristle_gen/machine/br_machine.h"
@@ -44,7 +45,7 @@
 #include "tool/br_tool_limits.h"
 
 #define TOOL "br_tune_est"
-#define MAX_P 5
+#define MAX_P BR_TUNE_MAX_P
 #define MAX_PLANTS 32
 
 typedef struct {
@@ -81,15 +82,6 @@ typedef struct {
  * (make tune and make regen run that). */
 #define BR_TUNE_CHECKPOINT_FEV 30
 
-/* R's lower bound, counts^2: the variance of the encoder's quantisation, a
- * uniform error of one count (docs/machine-file.md: R = 1/12 count^2 +
- * position_noise_m2, the latter >= 0). A tuned R below it is no setting a
- * machine file can state (firmware/design/machine.py, est_physical), and the
- * UKF tuned without this bound (R 0.012 count^2) lost lock on a delayed plant
- * (docs/tuning.md). The bound sits a relative 1e-6 above it, so that the
- * float32 R written into the header is not below it either. */
-#define BR_TUNE_QUANT_COUNTS2 (1.0 / 12.0)
-#define BR_TUNE_R_FLOOR_MARGIN (1.0 + 1.0e-6)
 /* The delayed guard plants and R's floor for the PF: 0 for now. Its committed
  * variances pass both (test_tune_delay; R 0.72 count^2), but both move its
  * search's path, and its one retune with them (and --mslip-target 0.068)
@@ -104,25 +96,6 @@ typedef struct {
  * and Nelder-Mead local, so the tuner searches from the hand-tuned start and
  * from this one and keeps the better result. */
 static const double pf_start2[4] = {2.2e-6, 9.71e-17, 2.46, 0.23};
-
-/* The tuned parameters: PF (q_omega, q_z, q_gp, R); UKF (q_theta, q_omega, q_z, q_gp, R). */
-static int n_params(int pf) { return pf ? 4 : 5; }
-
-static float *param_ptr(br_circle_cfg_t *c, int pf, int i)
-{
-    if (pf) {
-        return i < 3 ? &c->pf.est.q_var[i + 1] : &c->pf.est.r_var_rad2;
-    }
-    return i < 4 ? &c->ukf.est.q_var[i] : &c->ukf.est.r_var_rad2;
-}
-
-static const char *param_name(int pf, int i)
-{
-    static const char *const pfn[] = {"q_omega", "q_z", "q_gp", "r"};
-    static const char *const ukn[] = {"q_theta", "q_omega", "q_z", "q_gp", "r"};
-    if (i < 0 || i >= (pf ? 4 : 5)) return "?";
-    return pf ? pfn[i] : ukn[i];
-}
 
 /* objective: contour RMS (m) of the circle with the variances e^x, times
  * (1 + outlier steps): a filter that loses lock and has to re-anchor is not an
@@ -155,10 +128,7 @@ static int cmp_double(const void *a, const void *b)
 #define BR_TUNE_GUARD_NOISE_MAX_N 10.0
 /* the bristle stiffness and damping factor of its third (the study's largest) */
 #define BR_TUNE_GUARD_BRISTLE_FACTOR 2.0
-/* the objective of a tuning that stops safe on a guard plant: above any
- * contour RMS a tuning that passes could have (H-inf only's is 2.3e-6 m), and
- * falling the later the stops come, so that the search can leave such a region */
-#define BR_TUNE_GUARD_PENALTY_M 1.0e-5
+/* a tuning that stops safe on a guard plant: BR_TUNE_GUARD_PENALTY_M (br_tune_space.h) */
 /* --guard-outliers' upper bound: one outlier step then counts as 1000 times
  * the contour RMS */
 #define BR_TUNE_GUARD_OUTLIERS_MAX 1000.0
@@ -216,7 +186,7 @@ static double objective(void *user, const double *x, int n)
 {
     tune_t *t = user;
     br_circle_cfg_t c = t->base;
-    for (int i = 0; i < n; i++) *param_ptr(&c, t->pf, i) = (float)exp(x[i]);
+    for (int i = 0; i < n; i++) *br_tune_param_ptr(&c, t->pf, i) = (float)exp(x[i]);
     if (t->n_plants == 0) {
         double stopped = 0.0, outliers = 0.0, worst = 0.0;
         const double f = one_plant(&c, &stopped);
@@ -262,7 +232,7 @@ static void progress(void *user, int iter, int nfev, const double *xb, double fb
         xb = t->x_prev;
     }
     printf("iter %3d  evals %4d  contour RMS %.4e m ", t->iter0 + iter, t->nfev0 + nfev, fb);
-    for (int i = 0; i < n; i++) printf(" %s=%.3g", param_name(t->pf, i), exp(xb[i]));
+    for (int i = 0; i < n; i++) printf(" %s=%.3g", br_tune_param_name(t->pf, i), exp(xb[i]));
     printf("\n");
     fflush(stdout);
     if (t->log) {
@@ -277,7 +247,7 @@ static void write_checkpoint(FILE *f, const tune_t *t)
 {
     fprintf(f, "/* checkpoint (--checkpoint): first search, iteration %d, %d evaluations: %.6e m at", t->ck_iter,
             t->ck_nfev, t->ck_f);
-    for (int i = 0; i < n_params(t->pf); i++) fprintf(f, " %s=%.6e", param_name(t->pf, i), exp(t->ck_x[i]));
+    for (int i = 0; i < br_tune_n_params(t->pf); i++) fprintf(f, " %s=%.6e", br_tune_param_name(t->pf, i), exp(t->ck_x[i]));
     fprintf(f, " */\n");
 }
 
@@ -379,9 +349,9 @@ int main(int argc, char **argv)
         return 2;
     }
     /* Nelder-Mead's first simplex takes n + 1 evaluations (br_nm.c refuses less) */
-    if (max_fev > 0 && max_fev < n_params(strcmp(est, "pf") == 0) + 1) {
+    if (max_fev > 0 && max_fev < br_tune_n_params(strcmp(est, "pf") == 0) + 1) {
         fprintf(stderr, "%s: --max-fev %ld: the search needs at least %d evaluations for --est %s\n", TOOL,
-                max_fev, n_params(strcmp(est, "pf") == 0) + 1, est);
+                max_fev, br_tune_n_params(strcmp(est, "pf") == 0) + 1, est);
         return 2;
     }
     if (checkpoint && max_fev > 0) {
@@ -445,21 +415,13 @@ int main(int argc, char **argv)
      * have no delay, would be tuned around (the PF's settings switch there) */
     br_circle_use_delay_id(&t.base, 0);
     t.log = log_file.f;
-    const int n = n_params(t.pf);
+    const int n = br_tune_n_params(t.pf);
     double x0[MAX_P], lo[MAX_P], hi[MAX_P];
-    for (int i = 0; i < n; i++) {
-        x0[i] = log((double)*param_ptr(&t.base, t.pf, i));
-        lo[i] = x0[i] - 3.0 * log(10.0);
-        hi[i] = x0[i] + 3.0 * log(10.0);
-    }
-    /* R (the last parameter) not below the quantisation; the bound never above the start
-     * (a machine file's R at the quantisation itself, position_noise_m2 0, is its start) */
-    const double rpc = (double)(t.pf ? t.base.pf.est.rad_per_count : t.base.ukf.est.rad_per_count);
-    const double r_floor = log(BR_TUNE_QUANT_COUNTS2 * BR_TUNE_R_FLOOR_MARGIN * rpc * rpc);
-    if (t.delay_guard) lo[n - 1] = fmax(lo[n - 1], fmin(r_floor, x0[n - 1]));
+    /* R (the last parameter) not below the quantisation with the delayed guards */
+    br_tune_space(&t.base, t.pf, t.delay_guard, x0, lo, hi);
     if (t.log) {
         fprintf(t.log, "iter,nfev,contour_rms_m");
-        for (int i = 0; i < n; i++) fprintf(t.log, ",%s", param_name(t.pf, i));
+        for (int i = 0; i < n; i++) fprintf(t.log, ",%s", br_tune_param_name(t.pf, i));
         fprintf(t.log, "\n");
     }
     const double f0 = objective(&t, x0, n);
@@ -469,15 +431,8 @@ int main(int argc, char **argv)
         for (int i = 0; i < n; i++) fprintf(t.log, ",%.6e", exp(x0[i]));
         fprintf(t.log, "\n");
     }
-    br_nm_cfg_t cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.n = n;
-    cfg.init_step = 0.25; /* about 0.7 decade of each variance from the start */
-    cfg.xatol = 0.01;     /* about 3 % of each variance */
-    cfg.fatol = 1e-12;    /* 1 pm of contour RMS */
-    cfg.max_fev = checkpoint ? BR_TUNE_CHECKPOINT_FEV : max_fev > 0 ? (int)max_fev : (t.pf ? 120 : 400);
-    cfg.lo = lo;
-    cfg.hi = hi;
+    br_nm_cfg_t cfg = br_tune_nm_cfg(n, lo, hi, checkpoint ? BR_TUNE_CHECKPOINT_FEV : max_fev > 0 ? (int)max_fev
+                                                                                  : (t.pf ? 120 : 400));
     cfg.progress = progress;
     /* one search from each start (the PF on the nominal plant: the hand-tuned one, then pf_start2);
      * the better result wins, the first on a tie */
@@ -533,7 +488,7 @@ int main(int argc, char **argv)
     if (t.n_plants > 0) {
         /* the tuned variances on each plant */
         br_circle_cfg_t c = t.base;
-        for (int i = 0; i < n; i++) *param_ptr(&c, t.pf, i) = (float)exp(r.x[i]);
+        for (int i = 0; i < n; i++) *br_tune_param_ptr(&c, t.pf, i) = (float)exp(r.x[i]);
         printf("per plant:");
         for (int j = 0; j < t.n_plants; j++) {
             c.plant = t.plants[j];
@@ -545,7 +500,7 @@ int main(int argc, char **argv)
     double res_nominal_m = NAN, res_worst = NAN;
     if (t.mslip_target > 0.0) {
         br_circle_cfg_t c = t.base;
-        for (int i = 0; i < n; i++) *param_ptr(&c, t.pf, i) = (float)exp(r.x[i]);
+        for (int i = 0; i < n; i++) *br_tune_param_ptr(&c, t.pf, i) = (float)exp(r.x[i]);
         double stopped = 0.0, ms = 0.0;
         res_nominal_m = one_plant(&c, &stopped);
         res_worst = br_tune_mslip_worst(&t.mslip, &c, &ms);
@@ -587,7 +542,7 @@ int main(int argc, char **argv)
     write_checkpoint(h, &t);
     fprintf(h, "#ifndef BR_%s_TUNED_H\n#define BR_%s_TUNED_H\n\n", E, E);
     for (int i = 0; i < n; i++) {
-        fprintf(h, "#define BR_%s_TUNED_%s (%.9ef)\n", E, param_name(t.pf, i), (double)(float)exp(r.x[i]));
+        fprintf(h, "#define BR_%s_TUNED_%s (%.9ef)\n", E, br_tune_param_name(t.pf, i), (double)(float)exp(r.x[i]));
     }
     fprintf(h, "\n#endif\n");
     return commit_outputs(&header_file, &log_file, log_path);

@@ -15,10 +15,11 @@ import unittest
 
 ARGS = None
 TOOLS = ("br_simlog", "br_demo_circle", "br_circle_ext", "br_pf_study", "br_dt_study", "br_tune_est", "br_track",
-         "br_robust_run", "br_bench", "br_link_sim", "br_mslip_plants")
+         "br_robust_run", "br_bench", "br_link_sim", "br_mslip_plants", "br_pil_tune")
 VALUED = {"br_simlog": "--out", "br_demo_circle": "--out", "br_circle_ext": "--json", "br_pf_study": "--table",
           "br_dt_study": "--seeds", "br_tune_est": "--out", "br_track": "--json", "br_robust_run": "--json",
-          "br_bench": "--json", "br_link_sim": "--pty-path", "br_mslip_plants": "--json"}  # an option that takes a value
+          "br_bench": "--json", "br_link_sim": "--pty-path", "br_mslip_plants": "--json",
+          "br_pil_tune": "--out"}  # an option that takes a value
 VERSION_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "VERSION")
 OLD = b"an existing file\r\nwith two lines\n"
 
@@ -89,6 +90,33 @@ class ToolsTest(unittest.TestCase):
         r = run("br_simlog", "--out", "x.csv", "--truth=1", cwd=self.w)
         self.assert_refused(r, 2, "--truth=1: the option takes no value")
         self.assertEqual(os.listdir(self.w), [])
+
+    def test_pil_tune_refusals(self):
+        # br_pil_tune (docs/link.md, "Tuning on the target"): each bad option refused before anything runs or is written
+        out = os.path.join(self.w, "out")
+        for bad, word in ((["--est", "kf"], "--est kf: ukf or pf"), (["--max-fev", "5"], "at least 6 evaluations"),
+                          (["--est", "pf", "--max-fev", "4"], "at least 5 evaluations"),
+                          (["--set", "q_bogus=1"], "no such parameter"), (["--set", "outlier_sigma=nan"], "finite"),
+                          (["--set", "outlier_sigma"], "NAME=VALUE"),
+                          (["--set", "outlier_sigma=1", "--set", "reanchor_after=2", "--set", "outlier_sigma=2"],
+                           "at most 2"),
+                          (["--duration", "0.05"], "--duration 0.05"), (["--timeout", "0"], "--timeout 0")):
+            r = run("br_pil_tune", "--sim", "--out", out, *bad)
+            self.assert_refused(r, 2, word)
+        r = run("br_pil_tune", "--out", out)
+        self.assert_refused(r, 2, "--image is required")
+        r = run("br_pil_tune", "--image", os.path.join(self.w, "none.elf"), "--out", out)
+        self.assert_refused(r, 1, "no image at")
+        self.assertEqual(os.listdir(self.w), [])
+        # a search where every evaluation faulted has no best: exit 1, nothing written (the folder stays empty)
+        r = run("br_pil_tune", "--sim", "--max-fev", "6", "--duration", "0.1", "--set", "outlier_sigma=0.01",
+                "--out", out)
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn("no setting ran to the end", r.stdout)
+        self.assertEqual(os.listdir(out), [])
+        # --sim does not model a parameter it cannot set: refused, not ignored
+        r = run("br_pil_tune", "--sim", "--max-fev", "6", "--set", "reanchor_after=2")
+        self.assert_refused(r, 1, "--sim sets no parameter 0x0008")
 
     def test_simlog_bad_options_touch_nothing(self):
         out = self.existing("log.csv")
