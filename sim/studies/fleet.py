@@ -7,6 +7,7 @@ run on Dask's local cluster, or on an existing one (--scheduler).
 Usage:
   fleet.py --out DIR [--n N] [--seed S] [--workers W | --scheduler ADDRESS]
            [--kinds thesis_circle,circle,p2p,emps] [--md DOC] [--command CMD] [--keep-builds]
+           [--hinf-weights reference|rule]
 
 Writes DIR/summary.json (the same for the same N, seed and kinds, whatever the
 workers: no time in it), DIR/timing.json (wall times), DIR/cdf.png, DIR/axes/NNNN/.
@@ -150,6 +151,16 @@ def lost_causes(summ):
     return out
 
 
+def hinf_line(summ):
+    """which axes' given files took the H-inf weights from the machine (fleet_axis.use_hinf_rule)"""
+    ruled = [r["i"] for r in summ["axes"] if r.get("machine", {}).get("hinf_weights", "the reference's")
+             != "the reference's"]
+    if summ.get("hinf_weights") == "rule":
+        return "H-inf weights: from the machine on every axis (`--hinf-weights rule`, firmware/design/hinf_weights.py)."
+    return ("H-inf weights: the reference's, and from the machine (firmware/design/hinf_weights.py) where the "
+            "reference's admit no acceptable design: %s." % (", ".join("axis %d" % i for i in ruled) or "no axis"))
+
+
 def write_md(path, summ, command, out_dir=None, out_name=None):
     """the page's measured part; out_dir's absolute path in the messages is written as out_name
     (default out_dir as given: a page does not name one machine's folders)"""
@@ -163,6 +174,7 @@ def write_md(path, summ, command, out_dir=None, out_name=None):
     L += ["Axes through the chain: %d of %d%s" % (summ["n_axes"] - len(fails), summ["n_axes"],
                                                   "; the chain failed on:" if fails else ".")]
     L += [""] + ["- axis %d, %s: %s" % (f["axis"], f["stage"], f["message"]) for f in fails] if fails else []
+    L += ["", hinf_line(summ)]
     L += ["", "### All trajectories (the contour RMS of the circles and the tracking RMS of the tracks together)",
           ""] + table(summ["controllers"])
     for kind, ctl in summ["kinds"].items():
@@ -240,6 +252,10 @@ def main():
     ap.add_argument("--md", help="docs page: its part after <!-- fleet:begin --> is rewritten")
     ap.add_argument("--command", default="make fleet")
     ap.add_argument("--keep-builds", action="store_true", help="keep each axis's two host builds")
+    ap.add_argument("--hinf-weights", choices=("reference", "rule"), default="reference",
+                    help="the given files' control.hinf: the reference's, replaced by the weights from the "
+                         "machine (firmware/design/hinf_weights.py) where they admit no acceptable design "
+                         "(default); or the weights from the machine on every axis")
     ap.add_argument("--expect-faults", action="store_true",
                     help="with --md: the page may tabulate faulted runs (listed with time and cause); "
                          "without it a faulted run makes the study exit 1 after writing the page")
@@ -270,13 +286,15 @@ def main():
     if not (1 <= a.n <= 100000) or a.workers < 1 or not kinds or set(kinds) - set(KINDS):
         ap.error("--n in 1..100000, --workers >= 1, --kinds from %s" % ",".join(KINDS))
     os.makedirs(a.out, exist_ok=True)
-    args = {"src": REPO, "out": os.path.abspath(a.out), "seed": a.seed, "kinds": kinds, "keep": a.keep_builds}
+    args = {"src": REPO, "out": os.path.abspath(a.out), "seed": a.seed, "kinds": kinds, "keep": a.keep_builds,
+            "hinf_rule": a.hinf_weights == "rule"}
     t0 = time.time()
     recs = distribute(a, args)
     wall = time.time() - t0
     errors = [r for r in recs if "error" in r]
     good = [r for r in recs if "error" not in r]
     summ = {"generator": "sim/studies/fleet.py", "n_axes": a.n, "seed": a.seed, "kinds_run": kinds,
+            "hinf_weights": a.hinf_weights,
             **({"axes_run": a.axes} if a.axes is not None else {}),
             "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],
             "controllers": summarise(good),

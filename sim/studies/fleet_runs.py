@@ -123,6 +123,7 @@ def chain(a, ax, d, log, sw):
     """the user's chain: the paths of the truth model and the two tools built for machine.json"""
     given, truth = os.path.join(d, "given.json"), os.path.join(d, "truth.json")
     g = fleet_axis.given_file(ax, "fleet-%04d" % ax["i"])
+    why = fleet_axis.use_hinf_rule(g, a.hinf_rule)
     for path, m in ((given, g), (truth, fleet_axis.truth_file(ax, g))):
         with open(path, "w", encoding="utf-8") as f:
             json.dump(m, f, indent=1)
@@ -151,7 +152,8 @@ def chain(a, ax, d, log, sw):
     sw.lap("builds")
     with open(machine_json, encoding="utf-8") as f:
         mj = json.load(f)
-    return truth_model, robust, track, {sec: mj[sec] for sec in ("mechanics", "friction", "causes")}
+    return truth_model, robust, track, {"hinf_weights": why or "the reference's",
+                                        **{sec: mj[sec] for sec in ("mechanics", "friction", "causes", "control")}}
 
 
 def trajectory_set(a, ax):
