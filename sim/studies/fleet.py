@@ -30,6 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import fleet_axis  # noqa: E402
 import fleet_runs  # noqa: E402
+from runs import refused  # noqa: E402
 
 REPO = fleet_axis.REPO
 KINDS = ("thesis_circle", "circle", "p2p", "emps")
@@ -60,10 +61,11 @@ def stats(vals):
 
 
 def summarise(recs, kinds=None):
-    """per controller: the RMS statistics of the completed runs, the ratio to H-inf only, the lost runs"""
+    """per controller: the RMS statistics of the completed runs, the ratio to H-inf only, the lost runs,
+    and the runs the firmware refused at init (never run: neither a figure nor lost)"""
     out = {}
     for ctrl in CONTROLLERS:
-        vals, ratios, lost, n = [], [], [], 0
+        vals, ratios, lost, refusals, n = [], [], [], [], 0
         for r in recs:
             for name, runs in r["runs"].items():
                 kind = r["traj"][name]["kind"]
@@ -71,6 +73,10 @@ def summarise(recs, kinds=None):
                     continue
                 n += 1
                 run_, h = runs[ctrl], runs.get("hinf_only")
+                if refused(run_):
+                    refusals.append({"axis": r["i"], "trajectory": name, "kind": kind,
+                                     "status": run_.get("init_status")})
+                    continue
                 hinf = None if ctrl == "hinf_only" or h is None or h["faulted"] else h["rms_m"]
                 if not run_["faulted"]:
                     vals.append(run_["rms_m"])
@@ -83,7 +89,8 @@ def summarise(recs, kinds=None):
         if n:
             out[ctrl] = {"n": n, "n_completed": len(vals), **stats(vals),
                          "median_ratio_to_hinf_only": float(np.median(ratios)) if ratios else None,
-                         "n_lost": len(lost), "lost": lost}
+                         "n_lost": len(lost), "lost": lost,
+                         "n_refused_at_init": len(refusals), "refused_at_init": refusals}
     return out
 
 
@@ -121,12 +128,14 @@ def fmt(v):
 
 
 def table(ctl):
-    L = ["| controller | runs | went to the end | median RMS | p90 | max | median / H-inf only | lost |",
-         "|---|---|---|---|---|---|---|---|"]
+    L = ["| controller | runs | went to the end | median RMS | p90 | max | median / H-inf only | lost "
+         "| refused at init |",
+         "|---|---|---|---|---|---|---|---|---|"]
     for k, v in ctl.items():
         ratio = "—" if v["median_ratio_to_hinf_only"] is None else "%.3f" % v["median_ratio_to_hinf_only"]
-        L.append("| %s | %d | %d | %s m | %s m | %s m | %s | %d |" % (k, v["n"], v["n_completed"], fmt(v["median_m"]),
-                                                                    fmt(v["p90_m"]), fmt(v["max_m"]), ratio, v["n_lost"]))
+        L.append("| %s | %d | %d | %s m | %s m | %s m | %s | %d | %d |" % (
+            k, v["n"], v["n_completed"], fmt(v["median_m"]), fmt(v["p90_m"]), fmt(v["max_m"]), ratio, v["n_lost"],
+            v["n_refused_at_init"]))
     return L
 
 
@@ -136,6 +145,17 @@ def lost_lines(summ):
         for x in v["lost"]:
             when = " at %.4f s" % x["t_s"] if x["t_s"] is not None else ""
             out.append("%s: axis %d, %s, %s%s" % (k, x["axis"], x["trajectory"], x["cause"], when))
+    return out
+
+
+def refused_lines(summ):
+    """the runs refused at init, by controller and axis"""
+    out = []
+    for k, v in summ["controllers"].items():
+        by_axis = {}
+        for x in v["refused_at_init"]:
+            by_axis.setdefault((x["axis"], x["status"]), []).append(x["trajectory"])
+        out += ["%s: axis %d, status %s: %s" % (k, ax, st, ", ".join(tr)) for (ax, st), tr in sorted(by_axis.items())]
     return out
 
 
@@ -190,6 +210,12 @@ def write_md(path, summ, command, out_dir=None, out_name=None):
         L += ["- " + x for x in lines] + ["", "</details>"]
     else:
         L += ["none"]
+    ref = refused_lines(summ)
+    L += ["", "### Refused at init (%d)" % len(ref), "",
+          "Runs whose application the firmware refused at init (`br_app_init`'s BR_E_* status, e.g. the "
+          "estimation model's sub-step bound): never run, so neither a figure nor lost; the \"runs\" column "
+          "counts them.", ""]
+    L += ["- " + x for x in ref] if ref else ["none"]
     L += ["", "CDF per trajectory kind: `out/fleet/cdf.png`.", ""]
     if out_dir:
         L = [x.replace(os.path.abspath(out_dir), (out_name or out_dir).rstrip("/")) for x in L]
@@ -320,6 +346,8 @@ def main():
         print("chain failed: axis %d, %s: %s" % (f["axis"], f["stage"], f["message"]))
     for line in lost_lines(summ):
         print("lost: " + line)
+    for line in refused_lines(summ):
+        print("refused at init: " + line)
     print("wrote %s/summary.json, timing.json, cdf.png%s" % (a.out, ", " + a.md if a.md else ""))
     for r in errors:
         print("fleet: internal error on axis %d:\n%s" % (r["i"], r["error"]), file=sys.stderr)

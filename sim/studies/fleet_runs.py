@@ -27,7 +27,7 @@ sys.path.insert(0, HERE)
 import fleet_axis  # noqa: E402
 import machine_chain  # noqa: E402
 from robustness import LOST_OUTLIER_FRAC  # noqa: E402
-from runs import faulted  # noqa: E402
+from runs import REFUSED_AT_INIT, faulted  # noqa: E402
 
 CIRCLE_CTRLS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")  # br_robust_run, the machine file's model
 TRACK_CTRLS = ("hinf_only", "hinf_ukf", "hinf_pf")              # br_track (its feedforward is the plant's: an oracle)
@@ -64,7 +64,9 @@ def run_seed(study_seed, i, k):
 def result(raw, rms_key, max_key):
     """one run's record: its figures, or its fault (then no figures)"""
     if faulted(raw):
-        return {"faulted": True, "fault_t_s": raw["fault_t_s"], "fault_cause": raw.get("fault_cause", "unknown")}
+        # a run refused at init keeps its status (the firmware's BR_E_*): fleet.py counts it apart
+        return {"faulted": True, "fault_t_s": raw["fault_t_s"], "fault_cause": raw.get("fault_cause", "unknown"),
+                **({"init_status": raw["fault_status"]} if raw.get("fault_cause") == REFUSED_AT_INIT else {})}
     r = {"faulted": False, "rms_m": raw[rms_key], "max_m": raw[max_key]}
     if "outlier_steps" in raw:
         r["outlier_steps"] = raw["outlier_steps"]
