@@ -445,19 +445,21 @@ static int axis_step(axis_sim_t *a, const br_circle_remote_t *remote, int i, lon
     return 0;
 }
 
-/* the firmware refused the application at init: the run never started (br_run_report.h) */
+/* the firmware refused the application at init: the run never started (br_run_report.h);
+ * -1 as for any configuration the run cannot take, res saying why */
 static int refused_at_init(br_circle_result_t *res, br_status_t st)
 {
     memset(res, 0, sizeof *res);
     res->fault_status = (int)st;
     res->fault_cause = BR_RUN_CAUSE_REFUSED_AT_INIT;
     res->last_outlier_t_s = -1.0;
-    return 1;
+    return -1;
 }
 
 int br_circle_run_remote(const br_circle_cfg_t *c, const br_circle_remote_t *remote, br_circle_sink_t sink,
                          void *user, br_circle_result_t *res)
 {
+    res->fault_cause = 0; /* BR_RUN_CAUSE_REFUSED_AT_INIT only when the firmware refused */
     if (!(c->radius_m > 0.0 && c->period_s > 0.0 && c->duration_s > 0.0 && c->dt_s > 0.0)) {
         fprintf(stderr, "br_circle: radius, period, duration and dt must be > 0\n");
         return -1;
