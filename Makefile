@@ -379,10 +379,11 @@ emps: deps
 # Everything generated from machines/reference.json (docs/machine-file.md):
 # after editing it, `make regen` then `make test` needs no hand edits.
 regen: deps
-	$(Q)echo "== regen: machine parameters, estimator settings, gains, noise table"
+	$(Q)echo "== regen: machine parameters, estimator settings, gains, noise table, causes' table"
 	$(Q)$(PYTHON) firmware/design/gen_machine.py
 	$(Q)$(PYTHON) firmware/design/synth_hinf.py
 	$(Q)$(PYTHON) firmware/design/gen_noise.py
+	$(Q)$(PYTHON) firmware/design/gen_causes.py
 	$(Q)echo "== regen: the link's message header and golden frames (docs/link.md)"
 	$(Q)$(PYTHON) firmware/design/gen_link.py
 	$(Q)$(PYTHON) tests/link/gen_golden.py

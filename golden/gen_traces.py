@@ -33,6 +33,7 @@ from ref import model as rmodel  # noqa: E402
 from ref import plant as rplant  # noqa: E402
 import gen_est_traces  # noqa: E402
 import gen_ext_traces  # noqa: E402
+import gen_ffpred_traces  # noqa: E402
 import gen_gms_traces  # noqa: E402
 import gen_mslip_traces  # noqa: E402
 import gen_mslip_model_traces  # noqa: E402
@@ -57,7 +58,9 @@ SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                # the firmware's Maxwell-slip kernel (gen_mslip_traces.py)
                "mslip": 10, "model_ms": 11,
                # the reversal compensation's pulse (gen_qec_traces.py)
-               "qec": 12}
+               "qec": 12,
+               # the compensation that predicts (gen_ffpred_traces.py)
+               "ff_pred": 13}
 
 DT = 1.0e-3
 INT32_MAX = 2**31 - 1
@@ -468,6 +471,7 @@ def main(argv=None):
     paths.append(gen_mslip_traces.generate(args.out, m, sys.modules[__name__]))
     paths.append(gen_mslip_model_traces.generate(args.out, m, sys.modules[__name__]))
     paths.append(gen_qec_traces.generate(args.out, m, sys.modules[__name__]))
+    paths.append(gen_ffpred_traces.generate(args.out, m, sys.modules[__name__]))
     for pth in paths:
         print("wrote", os.path.relpath(pth))
     return 0

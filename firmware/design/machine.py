@@ -29,6 +29,18 @@ REFERENCE_MACHINE = os.path.join(MACHINES_DIR, "reference.json")
 # generated headers: one root on the include path, one folder per kind below bristle_gen/
 GEN_DIR = os.path.join(REPO_ROOT, "firmware", "gen")
 
+# the causes' registry (python/bristle/diagnose/causes/; installed, the package beside this one):
+# the schema's "causes" follow it
+_PY = os.path.join(REPO_ROOT, "python")
+if os.path.isdir(_PY) and _PY not in sys.path:
+    sys.path.insert(0, _PY)
+from bristle.diagnose import causes as _causes  # noqa: E402
+
+# the causes that are a force term of the estimators' extended model (a Maxwell-slip
+# friction takes none of them yet), and those it combines with (the measurement side)
+FORCE_CAUSES = tuple(m.NAME for m in _causes.of_hook("force"))
+MSLIP_COMBINES = tuple(m.NAME for m in _causes.of_hook("measurement"))
+
 FORMAT_VERSION = 2
 # format 1 held the estimators' settings per step and in encoder counts; upgrade_machine.py converts it
 FORMAT_UPGRADE = "python firmware/design/upgrade_machine.py OLD.json NEW.json"
@@ -236,30 +248,10 @@ SCHEMA = {
     },
     # what a diagnosis of a measured log found beyond the nominal model (docs/diagnose.md);
     # grouped by cause, each parameter under its model.json name (the names of
-    # br_causes_t and of br_plant_cfg_t too), each cause absent = off
-    "causes": {
-        "offset": Optional({
-            "offset_N": Num(-1.0e5, 1.0e5, "constant load force, + opposes motion in +x"),
-        }),
-        "asymmetric_friction": Optional({
-            "dFc_neg_N": Num(-1.0e5, 1.0e5, "Coulomb level in -x is Fc_N + dFc_neg_N (Fs scaled alike)"),
-            "dsigma2_neg_Nspm": Num(-1.0e6, 1.0e6, "viscous friction in -x is sigma2_Nspm + this"),
-        }),
-        "position_ripple": Optional({
-            "ripple_amp_N": Num(0.0, 1.0e5, "ripple force amplitude"),
-            "ripple_period_m": Num(0.0, 10.0, "ripple period in load position", lo_open=True),
-            "ripple_phase_rad": Num(-2.0 * math.pi, 2.0 * math.pi, "phase at x = 0"),
-        }),
-        "position_gradient": Optional({
-            "grad_per_m": Num(-1.0e3, 1.0e3, "friction scaled by max(0, 1 + grad_per_m x) along the travel"),
-        }),
-        "actuator_delay": Optional({
-            "delay_s": Num(0.0, 0.1, "actuator dead time"),
-        }),
-        "friction_drift": Optional({
-            "drift_per_s": Num(-1.0, 1.0, "friction level scaled by max(0, 1 + drift_per_s t), t since the start"),
-        }),
-    },
+    # br_causes_t and of br_plant_cfg_t too), each cause absent = off; from the
+    # registry, each cause module's MACHINE (python/bristle/diagnose/causes/)
+    "causes": {m.NAME: Optional({q.name: Num(*m.MACHINE[q.name]) for q in m.PARAMS})
+               for m in _causes.REGISTRY if hasattr(m, "MACHINE")},
     # the estimators' friction model (docs/modules/mslip.md); absent = "lugre", the thesis model
     "friction_model": Optional({
         "model": Str(r"lugre|maxwell_slip", "the friction the estimators and the feedforward predict with: "
@@ -581,10 +573,10 @@ def _friction_model_checks(get, errors):
             errors.append(("friction_model." + f, "missing (model maxwell_slip needs its element set)"))
     if d is None or a is None:
         return
-    extra = sorted(c for c in (get("causes") or {}) if c != "actuator_delay")
+    extra = sorted(c for c in (get("causes") or {}) if c in FORCE_CAUSES)
     if extra:
         errors.append(("friction_model.model", "maxwell_slip is not combined with the causes %s yet "
-                       "(only actuator_delay; docs/modules/model.md)" % ", ".join(extra)))
+                       "(only %s; docs/modules/model.md)" % (", ".join(extra), ", ".join(MSLIP_COMBINES))))
     if len(d) != len(a):
         errors.append(("friction_model.share", "has %d entries, breakaway_m %d" % (len(a), len(d))))
     elif abs(math.fsum(a) - 1.0) > MSLIP_SHARE_TOL:
@@ -960,7 +952,7 @@ def _per_step_checks(m, errors):
             errors.append(("estimator.pf.load.q_N2_per_s", "gives q_N2 = %.6g per step on this machine, "
                            "outside the firmware's (0 excluded) [%g, %g]" % (pld["q_N2"], FLOAT32_MIN_NORMAL, 1.0e12)))
         # br_pf_init: the thesis model only (the cloud is moved and weighed again with eq. 6)
-        extended = sorted(c for c, v in m.get("causes", {}).items() if c != "actuator_delay" and any(v.values()))
+        extended = sorted(c for c, v in m.get("causes", {}).items() if c in FORCE_CAUSES and any(v.values()))
         if extended:
             errors.append(("estimator.pf.load", "needs the thesis model; the causes %s make the estimators' "
                            "model the extended one" % ", ".join(extended)))

@@ -5,10 +5,9 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "br_cause_terms.h"
 #include "br_check.h"
 #include "br_mslip_kernel.h"
-
-#define BR_FF_2PI 6.28318530717958647692f
 
 static int causes_ok(const br_ff_cfg_t *c)
 {
@@ -44,9 +43,14 @@ br_status_t br_ff_init(br_ff_t *ff, const br_ff_cfg_t *cfg)
     if (br_mslip_cfg_check(&cfg->mslip) != BR_OK || cfg->mslip.sigma2_Nspm != 0.0f) {
         return BR_E_PARAM;
     }
+    /* the prediction: off, or a horizon over the elements */
+    if (!(cfg->pred_ahead_s == 0.0f ||
+          (cfg->pred_ahead_s > 0.0f && cfg->pred_ahead_s <= BR_FF_PRED_MAX_S && cfg->mslip.n > 0))) {
+        return BR_E_PARAM;
+    }
     ff->cfg = *cfg;
-    ff->c_neg = (cfg->Fc_N + cfg->causes.dFc_neg_N) / cfg->Fc_N;
-    ff->ripple_k_radpm = (cfg->causes.ripple_amp_N != 0.0f) ? BR_FF_2PI / cfg->causes.ripple_period_m : 0.0f;
+    ff->c_neg = br_ct_asym_c_neg(cfg->Fc_N, cfg->causes.dFc_neg_N);
+    ff->ripple_k_radpm = br_ct_ripple_k_radpm(cfg->causes.ripple_amp_N, cfg->causes.ripple_period_m);
     ff->in.v_mps = 0.0f;
     ff->in.a_mps2 = 0.0f;
     ff->in.p_m = 0.0f;
@@ -60,15 +64,12 @@ br_status_t br_ff_init(br_ff_t *ff, const br_ff_cfg_t *cfg)
     return BR_OK;
 }
 
-/* eq. 5, the Stribeck level at v (scaled by c in -x) */
+/* eq. 5, the Stribeck level at v (scaled by c in -x: asymmetric_friction) */
 static float level_N(const br_ff_t *ff, float v)
 {
     const br_ff_cfg_t *c = &ff->cfg;
-    float g = c->Fc_N + (c->Fs_N - c->Fc_N) * expf(-fabsf(v) / c->vs_mps);
-    if (v < 0.0f) {
-        g *= ff->c_neg;
-    }
-    return g;
+    const float g = c->Fc_N + (c->Fs_N - c->Fc_N) * expf(-fabsf(v) / c->vs_mps);
+    return br_ct_asym_level_N(g, ff->c_neg, v < 0.0f);
 }
 
 /* the elements of the stored reference moved to in's position at the level g:
@@ -103,17 +104,15 @@ br_status_t br_ff_step(const br_ff_t *ff, const br_ff_in_t *in, float *comp_N)
     const float g = level_N(ff, v);
     /* the steady-state LuGre force with a smoothed sign (or the elements along the
      * reference's path), plus viscous friction */
-    const float s2 = neg ? c->sigma2_Nspm + k->dsigma2_neg_Nspm : c->sigma2_Nspm;
+    const float s2 = br_ct_asym_sigma2_Nspm(c->sigma2_Nspm, c->sigma2_Nspm + k->dsigma2_neg_Nspm, neg);
     float z1[BR_MSLIP_MAX];
     float f = ((c->mslip.n > 0) ? elements_N(ff, in, g, z1) : tanhf(v / c->v_eps_mps) * g) + s2 * v;
-    /* position gradient k(p) */
-    if (k->grad_per_m != 0.0f) {
-        f *= fmaxf(0.0f, 1.0f + k->grad_per_m * in->p_m);
-    }
-    /* offset and position ripple (a cogging / lead-error map) */
-    f += k->offset_N;
+    /* the causes' terms (br_cause_terms.h): position gradient k(p) (1 without) and offset */
+    f = br_ct_scaled_load_N(br_ct_lin_scale(k->grad_per_m, in->p_m), f, k->offset_N);
+    /* position ripple (a cogging / lead-error map) */
     if (k->ripple_amp_N != 0.0f) {
-        f += k->ripple_amp_N * sinf(ff->ripple_k_radpm * fmodf(in->p_m, k->ripple_period_m) + k->ripple_phase_rad);
+        f += br_ct_ripple_N(k->ripple_amp_N,
+                            br_ct_ripple_phase_rad(ff->ripple_k_radpm, k->ripple_period_m, k->ripple_phase_rad, in->p_m));
     }
     /* inertia */
     f += c->mass_kg * in->a_mps2;
@@ -145,9 +144,56 @@ br_status_t br_ff_set_ref(br_ff_t *ff, const br_ff_in_t *in)
     return BR_OK;
 }
 
+br_status_t br_ff_pred_N(const br_ff_t *ff, const float *z_anchor_m, const float *g_anchor_N, float *dF_N)
+{
+    if (ff == NULL || dF_N == NULL) {
+        return BR_E_NULL;
+    }
+    *dF_N = 0.0f;
+    if (!ff->ready) {
+        return BR_E_STATE;
+    }
+    const float tau = ff->cfg.pred_ahead_s;
+    if (tau == 0.0f) {
+        return BR_OK;
+    }
+    const br_mslip_cfg_t *m = &ff->cfg.mslip;
+    const float *z = (z_anchor_m != NULL) ? z_anchor_m : ff->ms_z_m;
+    int i;
+    for (i = 0; i < m->n; i++) {
+        if (!isfinite(z[i])) {
+            return BR_E_INPUT;
+        }
+    }
+    /* the reference's travel over the horizon (its Taylor polynomial): dp = v tau + a tau^2 / 2 */
+    const float v = ff->in.v_mps, a = ff->in.a_mps2;
+    const float dp = v * tau + 0.5f * a * tau * tau;
+    /* the level at the horizon's end: g1 = g(v + a tau) (eq. 5), or the anchor's */
+    const float g1 = (g_anchor_N != NULL) ? *g_anchor_N : level_N(ff, v + a * tau);
+    if (!br_finite_pos(g1) || !isfinite(dp)) {
+        return BR_E_INPUT;
+    }
+    /* dF = sum_i k_i clamp(z_i + dp, -c_i g1, c_i g1) - sum_i k_i z_i */
+    float z1[BR_MSLIP_MAX];
+    const float d = br_msk_move(m->n, m->k_Npm, ff->ms_c_mpN, z, z1, dp, g1) - br_msk_force(m->n, m->k_Npm, z);
+    if (!isfinite(d)) {
+        return BR_E_NUMERIC;
+    }
+    *dF_N = d;
+    return BR_OK;
+}
+
 br_status_t br_ff_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
 {
     (void)y;
     (void)u_prev_Nm;
-    return br_ff_step((const br_ff_t *)ctx, ctx ? &((const br_ff_t *)ctx)->in : NULL, F_hat_N);
+    const br_ff_t *ff = (const br_ff_t *)ctx;
+    br_status_t st = br_ff_step(ff, ff ? &ff->in : NULL, F_hat_N);
+    if (st == BR_OK && ff->cfg.pred_ahead_s > 0.0f) {
+        /* with a horizon: the map plus the elements' change over it */
+        float dF = 0.0f;
+        st = br_ff_pred_N(ff, NULL, NULL, &dF);
+        *F_hat_N = (st == BR_OK) ? br_clampf(*F_hat_N + dF, -ff->cfg.comp_max_N, ff->cfg.comp_max_N) : 0.0f;
+    }
+    return st;
 }

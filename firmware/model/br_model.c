@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "br_check.h"
+#include "bristle_gen/model/br_causes.h"
 #include "br_lugre_kernel.h"
 #include "br_model_kernel.h"
 
@@ -54,6 +55,15 @@ static br_status_t sub_steps(const br_model_cfg_t *cfg, float *rho_h, int *n)
     return BR_OK;
 }
 
+/* 1 when a force term of the extended model is on: a field of a force cause
+ * that switches it on (the registry's table, bristle_gen/model/br_causes.h) is not 0 */
+static int force_terms_on(const br_causes_t *c)
+{
+#define BR_CAUSE_ON(field, cause, hook, on) || ((hook) == BR_CAUSE_FORCE && (on) && c->field != 0.0f)
+    return 0 BR_CAUSE_FIELDS(BR_CAUSE_ON);
+#undef BR_CAUSE_ON
+}
+
 br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
 {
     if (m == NULL || cfg == NULL) {
@@ -88,9 +98,8 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
     if (st != BR_OK) {
         return st;
     }
-    if (cfg->mslip.n > 0 && (cfg->mslip.sigma2_Nspm != 0.0f || c->offset_N != 0.0f || c->dFc_neg_N != 0.0f ||
-                             c->dsigma2_neg_Nspm != 0.0f || c->ripple_amp_N != 0.0f || c->grad_per_m != 0.0f ||
-                             c->drift_per_s != 0.0f)) {
+    const int force_on = force_terms_on(c);
+    if (cfg->mslip.n > 0 && (cfg->mslip.sigma2_Nspm != 0.0f || force_on)) {
         return BR_E_PARAM;
     }
     st = sub_steps(cfg, &m->rho_h, &m->n_sub);
@@ -108,11 +117,10 @@ br_status_t br_model_init(br_model_t *m, const br_model_cfg_t *cfg)
     /* eq. 1: effective inertia on the motor side, J + L^2 M */
     m->inv_Jeff = 1.0f / (cfg->J_kgm2 + L * L * cfg->M_kg);
     m->visc_Nmsprad = L * L * cfg->sigma2_Nspm;
-    m->extended = c->offset_N != 0.0f || c->dFc_neg_N != 0.0f || c->dsigma2_neg_Nspm != 0.0f ||
-                  c->ripple_amp_N != 0.0f || c->grad_per_m != 0.0f || c->drift_per_s != 0.0f;
-    m->c_neg = (cfg->lugre.Fc_N + c->dFc_neg_N) / cfg->lugre.Fc_N;
+    m->extended = force_on;
+    m->c_neg = br_ct_asym_c_neg(cfg->lugre.Fc_N, c->dFc_neg_N);
     m->sigma2_neg_Nspm = cfg->sigma2_Nspm + c->dsigma2_neg_Nspm;
-    m->ripple_k_radpm = (c->ripple_amp_N != 0.0f) ? 6.28318531f / c->ripple_period_m : 0.0f;
+    m->ripple_k_radpm = br_ct_ripple_k_radpm(c->ripple_amp_N, c->ripple_period_m);
     br_model_set_clock(m, 0u);
     m->ready = 1;
     return BR_OK;
@@ -124,7 +132,7 @@ void br_model_set_clock(br_model_t *m, uint32_t n_steps)
     /* friction_drift: s(t) = max(0, 1 + drift t), t = n dt (the count is exact in
      * float up to 2^24 steps, to 6e-8 of t beyond) */
     const float t = (float)n_steps * m->cfg.dt_s;
-    m->drift_k = (m->cfg.causes.drift_per_s != 0.0f) ? fmaxf(0.0f, 1.0f + m->cfg.causes.drift_per_s * t) : 1.0f;
+    m->drift_k = (m->cfg.causes.drift_per_s != 0.0f) ? br_ct_lin_scale(m->cfg.causes.drift_per_s, t) : 1.0f;
 }
 
 void br_model_tick(br_model_t *m)
@@ -136,7 +144,7 @@ float br_model_fnl_N(const br_model_t *m, const float x[BR_NX])
 {
     const br_model_k_t k = br_model_k(m);
     /* eq. 3 with dz/dt from eq. 4, g = g_p (c g_p moving towards -x) */
-    const float gp = (x[BR_X_OMEGA] < 0.0f) ? m->c_neg * x[BR_X_GP] : x[BR_X_GP];
+    const float gp = br_ct_asym_level_N(x[BR_X_GP], m->c_neg, x[BR_X_OMEGA] < 0.0f);
     return br_model_k_fnl(&k, x[BR_X_Z], br_model_k_zdot(&k, x[BR_X_OMEGA], x[BR_X_Z], gp));
 }
 
@@ -208,13 +216,13 @@ void br_model_bounded_step_x(const br_model_kx_t *k, const float x[BR_NX], float
         const float dx = L * dth;
         const int neg = dx < 0.0f;
         /* eq. 4 over the displacement with the direction's level, exact and bounded */
-        const br_lk_step_t ls = br_lk_move_over(s0, z0, dx, neg ? k->c_neg * gp : gp, h);
+        const br_lk_step_t ls = br_lk_move_over(s0, z0, dx, br_ct_asym_level_N(gp, k->c_neg, neg), h);
         const float zint = ls.zint_ms;
         z1 = ls.z1_m;
         const float tm = t0 + 0.5f * dth;
-        const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + L * tm)) * k->ks;
+        const float kp = br_ct_lin_scale(k->grad, k->p0 + L * tm) * k->ks;
         /* the load impulse: k (sigma2_d dx + sigma0 int z + sigma1 dz) + (offset + ripple) h */
-        const float imp = kp * ((neg ? k->s2_neg : k->s2) * dx + s0 * zint + k->n.s1 * (z1 - z0)) +
+        const float imp = kp * (br_ct_asym_sigma2_Nspm(k->s2, k->s2_neg, neg) * dx + s0 * zint + k->n.s1 * (z1 - z0)) +
                           (k->off + br_model_kx_ripple_N(k, tm)) * h;
         w1 = w0 + (u * h - L * imp) * k->n.inv_Jeff;
         wm = 0.5f * (w0 + w1);

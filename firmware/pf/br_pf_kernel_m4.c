@@ -15,6 +15,7 @@
 #include "br_inline.h"
 #include "br_math.h"
 #include "br_pf_kernel.h"
+#include "br_pf_ms4.h"
 
 uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                               br_pf_lsum_t *ls)
@@ -66,8 +67,7 @@ uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uin
         /* validity as the reference's; a particle that fails branches out,
          * keeping its state (f_nl = 0, l = NaN) */
         if (!ok_rk || !((t - t) + (f - f) == 0.0f)) {
-            br_store_f_inc(&fp, 0.0f);
-            br_store_f_inc(&lp, NAN);
+            br_pf_store_left(&fp, &lp);
             n_ok--;
             continue;
         }
@@ -128,11 +128,12 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
     return sf;
 }
 
-/* Steps 1 and 2 with elements: the reference's element path (FPv4 has no
- * vmaxnm; the reference's select clamps are what the M4 runs). Not tuned for
- * the M4: its cost with elements is not measured (docs/modules/pf.md). */
+/* Steps 1 and 2 with elements: four written out (br_pf_ms4.h, the clamps and
+ * the largest l by selects: FPv4 has no vmaxnm); any other number of
+ * elements or passes: the reference's loops. */
 uint32_t br_pf_kernel_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                                  br_pf_lsum_t *ls)
 {
-    return br_pf_kref_predict_ms(pf, c, j0, j1, nz, ls);
+    return br_pf_ms4_applies(c) ? br_pf_ms4_predict(pf, c, j0, j1, nz, ls, 0)
+                                : br_pf_kref_predict_ms(pf, c, j0, j1, nz, ls);
 }

@@ -16,6 +16,7 @@
 #include "br_inline.h"
 #include "br_math.h"
 #include "br_pf_kernel.h"
+#include "br_pf_ms4.h"
 
 uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                               br_pf_lsum_t *ls)
@@ -83,8 +84,7 @@ uint32_t br_pf_kernel_predict(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uin
         uint32_t c_bits;
         memcpy(&c_bits, &c_ah, sizeof c_bits);
         if (!(c_bits <= ah_lim_bits)) {
-            br_store_f_inc(&fp, 0.0f);
-            br_store_f_inc(&lp, NAN);
+            br_pf_store_left(&fp, &lp);
             n_ok--;
             continue;
         }
@@ -138,107 +138,11 @@ float br_pf_kernel_resample(br_pf_t *pf, float lmax, int outlier)
     return sf;
 }
 
-/* fminf(fmaxf(v, -d), d): one vmaxnm, one vminnm (d > 0) */
-static inline float clamp_nm(float v, float d) { return fminf(fmaxf(v, -d), d); }
-
-/* Steps 1 and 2 with four elements (the common set), the reference's
- * operations written out: every element in a register, each clamp by vmaxnm
- * / vminnm (fminf(fmaxf(v, -d), d) is the reference's select clamp for
- * every v when d = c_i g_p > 0: a NaN gives -d in both), the bounds c_i g_p
- * made once per particle for both passes (the same products), the sums in
- * the reference's order (from 0: 0 + x is x but for x = -0). With the
- * element loops over N on the stack this path ran 315 instructions per
- * particle-step against 182 written out (docs/modules/pf.md). */
-static uint32_t predict_ms4(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
-                            br_pf_lsum_t *ls)
-{
-    const float uh = c->uh, h = c->km.h, L = c->km.L, visc = c->km.visc, Lh_half = c->km.Lh_half;
-    const float inv_Jeff = c->km.inv_Jeff;
-    const float q0 = c->q[0], q1 = c->q[1], q2 = c->q[2], q3 = c->q[3];
-    const float gp_min = c->gp_min, gp_max = c->gp_max, inv_2r = c->inv_2r;
-    const float shift = c->shift, y_rel = c->y_rel;
-    const float k0 = c->km.k[0], k1 = c->km.k[1], k2 = c->km.k[2], k3 = c->km.k[3];
-    const float c0 = c->km.c[0], c1 = c->km.c[1], c2 = c->km.c[2], c3 = c->km.c[3];
-    const uint32_t m = pf->cfg.n_particles;
-    float *BR_RESTRICT e0p = pf->ms, *BR_RESTRICT e1p = pf->ms + m, *BR_RESTRICT e2p = pf->ms + 2u * m;
-    float *BR_RESTRICT e3p = pf->ms + 3u * m;
-    float *BR_RESTRICT th = pf->x[BR_X_THETA];
-    float *BR_RESTRICT om = pf->x[BR_X_OMEGA];
-    float *BR_RESTRICT gg = pf->x[BR_X_GP];
-    float *BR_RESTRICT ka = pf->kgp;
-    float lm = -INFINITY;
-    uint32_t n_ok = j1 - j0;
-    float s1 = ls->s1, s2 = ls->s2;
-    const float *np = nz;
-    float *fp = pf->fnl + j0, *lp = pf->l + j0;
-    for (uint32_t j = j0; j < j1; j++) {
-        const float w0 = om[j], g0 = gg[j], f0 = ka[j];
-        const float e0 = e0p[j], e1 = e1p[j], e2 = e2p[j], e3 = e3p[j];
-        const float d0 = c0 * g0, d1 = c1 * g0, d2 = c2 * g0, d3 = c3 * g0;
-        /* 1. predict: the trapezoidal step (eqs. MS1, MS2, 6) */
-        float wm = w0, w1 = w0, dth = 0.0f, z0 = e0, z1 = e1, z2 = e2, z3 = e3;
-        for (int pass = 0; pass < BR_MODEL_MS_PASSES; pass++) {
-            dth = wm * h;
-            const float dx = L * dth;
-            /* e1_i = clamp(e_i + L dtheta, +-c_i g_p) (eq. MS1); f1 = sum k_i e1_i (eq. MS2) */
-            z0 = clamp_nm(e0 + dx, d0);
-            z1 = clamp_nm(e1 + dx, d1);
-            z2 = clamp_nm(e2 + dx, d2);
-            z3 = clamp_nm(e3 + dx, d3);
-            const float f1 = (((0.0f + k0 * z0) + k1 * z1) + k2 * z2) + k3 * z3;
-            /* eq. 6, trapezoidal */
-            w1 = w0 + (uh - visc * dth - Lh_half * (f0 + f1)) * inv_Jeff;
-            wm = 0.5f * (w0 + w1);
-        }
-        /* process noise; g_p's clamp by vmaxnm / vminnm */
-        float nj[BR_NX];
-        br_load4_f(&np, nj);
-        const float t = ((th[j] + dth) + q0 * nj[0]) - shift;
-        const float w = w1 + q1 * nj[1];
-        const float g = fminf(fmaxf(g0 + q3 * nj[3], gp_min), gp_max);
-        /* z's sample on every element, clamped at the new g_p; f_nl = sum k_i e_i (eqs. MS1, MS2) */
-        const float dz = q2 * nj[2];
-        z0 = clamp_nm(z0 + dz, c0 * g);
-        z1 = clamp_nm(z1 + dz, c1 * g);
-        z2 = clamp_nm(z2 + dz, c2 * g);
-        z3 = clamp_nm(z3 + dz, c3 * g);
-        const float f = (((0.0f + k0 * z0) + k1 * z1) + k2 * z2) + k3 * z3;
-        /* 2. Gaussian log-likelihood */
-        const float ey = t - y_rel;
-        const float l = br_pf_loglik(ey, inv_2r);
-        s1 += ey;
-        s2 += ey * ey;
-        /* validity: theta, omega and f_nl finite */
-        if (!((t - t) + (w - w) + (f - f) == 0.0f)) {
-            br_store_f_inc(&fp, 0.0f);
-            br_store_f_inc(&lp, NAN);
-            n_ok--;
-            continue;
-        }
-        th[j] = t;
-        om[j] = w;
-        gg[j] = g;
-        ka[j] = f;
-        e0p[j] = z0;
-        e1p[j] = z1;
-        e2p[j] = z2;
-        e3p[j] = z3;
-        br_store_f_inc(&fp, f);
-        br_store_f_inc(&lp, l);
-        lm = fmaxf(lm, l);
-    }
-    ls->s1 = s1;
-    ls->s2 = s2;
-    if (n_ok > 0u) {
-        ls->lmax = (lm > ls->lmax) ? lm : ls->lmax;
-        ls->n_valid += n_ok;
-    }
-    return (j1 - j0) - n_ok;
-}
-
 uint32_t br_pf_kernel_predict_ms(br_pf_t *pf, const br_pf_kc_t *c, uint32_t j0, uint32_t j1, const float *nz,
                                  br_pf_lsum_t *ls)
 {
-    /* any other number of elements: the reference's loops */
-    return (c->km.n == 4) ? predict_ms4(pf, c, j0, j1, nz, ls) : br_pf_kref_predict_ms(pf, c, j0, j1, nz, ls);
+    /* four elements written out, the clamps and the largest l by vmaxnm /
+     * vminnm; any other number of elements or passes: the reference's loops */
+    return br_pf_ms4_applies(c) ? br_pf_ms4_predict(pf, c, j0, j1, nz, ls, 1)
+                                : br_pf_kref_predict_ms(pf, c, j0, j1, nz, ls);
 }

@@ -15,6 +15,7 @@
 #include <math.h>
 
 #include "bristle/br_model.h"
+#include "br_cause_terms.h"
 #include "br_inline.h"
 #include "br_lugre_kernel.h"
 #include "br_mslip_kernel.h"
@@ -246,9 +247,9 @@ static inline br_model_kx_t br_model_kx(const br_model_t *m, float p0_m)
     k.rs = 0.0f;
     k.rc = 0.0f;
     if (c->ripple_amp_N != 0.0f) {
-        /* the phase at p0, reduced to one period first (fmodf is exact) */
-        const float phi0 = m->ripple_k_radpm * fmodf(p0_m, c->ripple_period_m) + c->ripple_phase_rad;
-        k.rs = c->ripple_amp_N * sinf(phi0);
+        /* the phase at p0 */
+        const float phi0 = br_ct_ripple_phase_rad(m->ripple_k_radpm, c->ripple_period_m, c->ripple_phase_rad, p0_m);
+        k.rs = br_ct_ripple_N(c->ripple_amp_N, phi0);
         k.rc = c->ripple_amp_N * cosf(phi0);
     }
     return k;
@@ -274,10 +275,11 @@ static inline float br_model_kx_load_N(const br_model_kx_t *k, float th, float w
     /* the level by the direction of motion, as the Stribeck curve g(v) of
      * eq. 5 and the plant: continuous through a reversal, where v crosses 0
      * and the level's term sigma0 |v| z / g vanishes */
-    *zd = br_lk_zdot_mps(k->n.s0, v, z, neg ? k->c_neg * gp : gp);
+    *zd = br_lk_zdot_mps(k->n.s0, v, z, br_ct_asym_level_N(gp, k->c_neg, neg));
     const float f = br_lk_force_N(k->n.s0, k->n.s1, z, *zd);
-    const float kp = fmaxf(0.0f, 1.0f + k->grad * (k->p0 + k->n.L * th)) * k->ks;
-    return kp * ((neg ? k->s2_neg : k->s2) * v + f) + k->off + br_model_kx_ripple_N(k, th);
+    const float kp = br_ct_lin_scale(k->grad, k->p0 + k->n.L * th) * k->ks;
+    return br_ct_scaled_load_N(kp, br_ct_asym_sigma2_Nspm(k->s2, k->s2_neg, neg) * v + f, k->off) +
+           br_model_kx_ripple_N(k, th);
 }
 
 /* The force to compensate: the load force without the nominal viscous term */

@@ -20,9 +20,11 @@
 #ifndef BR_PF_KERNEL_H
 #define BR_PF_KERNEL_H
 
+#include <math.h>
 #include <stdint.h>
 
 #include "bristle/br_pf.h"
+#include "br_inline.h"
 #include "br_model_kernel.h"
 
 /* W of a particle of weight 1 (the best one after the max-shift) */
@@ -117,6 +119,14 @@ static inline float br_pf_ms_noise(const br_model_km_t *k, float e[], float dz, 
         f += k->k[i] * e[i];
     }
     return f;
+}
+
+/* The target kernels' particle left for the fix-up: f_nl = 0 and l = NaN
+ * stored with the pointers moved on (br_inline.h's br_store_f_inc) */
+static inline void br_pf_store_left(float **fp, float **lp)
+{
+    br_store_f_inc(fp, 0.0f);
+    br_store_f_inc(lp, NAN);
 }
 
 /* 1 for a valid particle (its log-weight l is not NaN), 0 for one kept at its state */

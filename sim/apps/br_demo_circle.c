@@ -159,6 +159,10 @@ typedef struct {
     br_circle_path_t path; /* the circle (default the thesis's) */
     int hw_clamp;          /* the hardware-like plant's clamp limit instead of the slip law */
     double hw_c_mps;       /* its slip law's C (<= 0: BR_CIRCLE_HW_C_MPS) */
+    int ff_el;             /* the feedforward's elements: BR_CIRCLE_FF_EL_NONE, _OWN or _FIT */
+    double pred_s;         /* the prediction's horizon, s (0: off) */
+    int pred_anchor;       /* 1: the feedforward's elements, 2: the UKF's */
+    int oracle_late;       /* the true friction one period late */
 } opts_t;
 
 static int usage(const char *argv0, FILE *to)
@@ -167,7 +171,8 @@ static int usage(const char *argv0, FILE *to)
             "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
             "       [--ahead P] [--ukf-load Q_N2_PER_S] [--ukf-mslip] [--ukf-q-scale FZ,FG] [--pf-load Q_N2_PER_S]\n"
             "       [--pf-mslip] [--pf-q-scale FZ,FG] [--pf-gp-curve TAU_S] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
-            "       [--hw-law slip|clamp] [--hw-c-mps C]\n" BR_ARGS_COMMON_USAGE
+            "       [--hw-law slip|clamp] [--hw-c-mps C] [--ff-el own|fit] [--pred S] [--pred-anchor ff|ukf]\n"
+            "       [--oracle-late]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
             "  --only NAME         run one controller (hinf_only, hinf_ukf, hinf_pf, ...)\n"
             "  --gains K0,K1,K2    the H-inf gains instead of the generated ones\n"
@@ -189,9 +194,17 @@ static int usage(const char *argv0, FILE *to)
             BR_CIRCLE_USAGE("--dir cw|ccw|both  ") "                      (both: each controller both ways, the ISO 230-4 pair; --direction the same)\n"
             "  --hw-law slip|clamp the hardware-like plant's Maxwell-slip law (default slip, docs/demo.md)\n"
             "  --hw-c-mps C        its slip law's attraction rate C, m/s (default %g, %g .. %g)\n"
+            "  --ff-el own|fit     the feedforward with Maxwell-slip elements: the plant's own (a LuGre plant:\n"
+            "                      the fit) or four fitted to its initial stiffness and Fs (docs/modules/ff-pred.md)\n"
+            "  --pred S            the compensation that predicts over S s (0 .. %g; needs --ff-el): the UKF's,\n"
+            "                      the PF's, the oracle's and the feedforward's plus the elements' change\n"
+            "  --pred-anchor ff|ukf the prediction's elements: the feedforward's (default) or the UKF's own\n"
+            "                      (with --ukf-mslip; then on the hardware-like plant only)\n"
+            "  --oracle-late       the true friction one period late instead of at t_k\n"
             "bounds: --dt %g .. %g s, --nsub 1 .. %d, |gain| <= %g, --radius-m %g .. %g m,\n"
             "        --feed-mm-min %g .. %g, a revolution %g .. %g s (docs/tools.md)\n",
             argv0, argv0, (double)BR_EST_AHEAD_MAX_PERIODS, BR_CIRCLE_HW_C_MPS, HW_C_MIN_MPS, HW_C_MAX_MPS,
+            (double)BR_FF_PRED_MAX_S,
             BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX,
             BR_TOOL_GAIN_MAX, BR_TOOL_RADIUS_MIN_M, BR_TOOL_RADIUS_MAX_M, BR_TOOL_FEED_MIN_MM_MIN,
             BR_TOOL_FEED_MAX_MM_MIN, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S);
@@ -236,6 +249,10 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"pf-gp-curve", required_argument, NULL, 'G'},
                                          {"hw-law", required_argument, NULL, 'w'},
                                          {"hw-c-mps", required_argument, NULL, 'c'},
+                                         {"ff-el", required_argument, NULL, 'E'},
+                                         {"pred", required_argument, NULL, 'P'},
+                                         {"pred-anchor", required_argument, NULL, 'A'},
+                                         {"oracle-late", no_argument, NULL, 'O'},
                                          BR_CIRCLE_LONGOPTS BR_CIRCLE_LONGOPT_DIR{NULL, 0, NULL, 0}};
     br_args_t p;
     const int st = br_args_begin(&p, TOOL, argc, argv);
@@ -270,12 +287,32 @@ static int parse(int argc, char **argv, opts_t *o)
             if (bad) fprintf(stderr, "%s: --hw-law %s: slip or clamp\n", TOOL, val);
             break;
         case 'c': bad = br_arg_double(TOOL, p.opt, val, HW_C_MIN_MPS, HW_C_MAX_MPS, &o->hw_c_mps); break;
+        case 'E':
+            o->ff_el = strcmp(val, "own") == 0 ? BR_CIRCLE_FF_EL_OWN : strcmp(val, "fit") == 0 ? BR_CIRCLE_FF_EL_FIT : -1;
+            bad = o->ff_el < 0;
+            if (bad) fprintf(stderr, "%s: --ff-el %s: own or fit\n", TOOL, val);
+            break;
+        case 'P': bad = br_arg_double(TOOL, p.opt, val, 0.0, (double)BR_FF_PRED_MAX_S, &o->pred_s); break;
+        case 'A':
+            o->pred_anchor = strcmp(val, "ukf") == 0 ? 2 : strcmp(val, "ff") == 0 ? 1 : -1;
+            bad = o->pred_anchor < 0;
+            if (bad) fprintf(stderr, "%s: --pred-anchor %s: ff or ukf\n", TOOL, val);
+            break;
+        case 'O': o->oracle_late = 1; break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
     }
     if (!o->out) {
         fprintf(stderr, "%s: --out is required\n", TOOL);
+        return 2;
+    }
+    if (o->pred_s > 0.0 && o->ff_el == BR_CIRCLE_FF_EL_NONE) {
+        fprintf(stderr, "%s: --pred needs the feedforward's elements (--ff-el own|fit)\n", TOOL);
+        return 2;
+    }
+    if (o->pred_anchor == 2 && !o->ukf_mslip) {
+        fprintf(stderr, "%s: --pred-anchor ukf needs --ukf-mslip\n", TOOL);
         return 2;
     }
     const br_circle_cfg_t thesis = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
@@ -327,11 +364,17 @@ static br_circle_cfg_t plant_cfg(int pl, br_circle_ctrl_t ctrl, const opts_t *o)
                         : (pl == 1) ? br_circle_cfg_realistic(ctrl) : br_circle_cfg_hardware_like(ctrl);
     /* the PF's particles with the hardware-like element set (every plant) */
     br_circle_use_pf_mslip(&c, o->pf_mslip);
-    if (pl != PLANT_HW) return c;
-    if (o->hw_clamp) c.plant.gms.clamp = 1;
-    if (o->hw_c_mps > 0.0) c.plant.gms.C_mps = o->hw_c_mps;
-    /* the UKF's model with the plant's own element set (this plant only) */
-    br_circle_use_ukf_mslip(&c, o->ukf_mslip);
+    if (pl == PLANT_HW) {
+        if (o->hw_clamp) c.plant.gms.clamp = 1;
+        if (o->hw_c_mps > 0.0) c.plant.gms.C_mps = o->hw_c_mps;
+        /* the UKF's model with the plant's own element set (this plant only) */
+        br_circle_use_ukf_mslip(&c, o->ukf_mslip);
+    }
+    /* the feedforward's elements (from the plant's presliding) and the prediction; the
+     * UKF anchor only where the UKF has the elements */
+    br_circle_use_ff_el(&c, o->ff_el);
+    if (o->pred_anchor != 2 || pl == PLANT_HW) br_circle_use_pred(&c, o->pred_s, o->pred_anchor);
+    c.oracle_late = o->oracle_late;
     return c;
 }
 
@@ -366,7 +409,7 @@ static void hw_describe(FILE *js, const opts_t *o)
 int main(int argc, char **argv)
 {
     opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, 0, {0.0f, 0.0f}, {0.0f, 0.0f}, 0.0, 0.0,
-                  BR_CIRCLE_PATH_DEFAULT, 0, 0.0};
+                  BR_CIRCLE_PATH_DEFAULT, 0, 0.0, BR_CIRCLE_FF_EL_NONE, 0.0, 1, 0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) {
         usage(argv[0], stdout);
@@ -510,9 +553,10 @@ int main(int argc, char **argv)
                 }
                 char fname[256];
                 snprintf(fname, sizeof fname, "trace_%s%s%s.csv", plant_prefix[pl], dir_prefix[d], name);
-                if (pl == PLANT_HW || opt.pf_mslip) {
+                if (pl == PLANT_HW || opt.pf_mslip || opt.ff_el != BR_CIRCLE_FF_EL_NONE || opt.oracle_late) {
                     /* a plant outside the estimators' model class (or, with --pf-mslip, a model
-                     * outside the plant's): a run may stop, and is then a fault with its time and
+                     * outside the plant's; with --ff-el, --pred or --oracle-late a compensation
+                     * never checked to go round): a run may stop, and is then a fault with its time and
                      * cause, never a figure (br_run_report.h) */
                     const br_run_report_t rep = {res.contour_rms_m, res.max_err_m, res.fault_status,
                                                  res.fault_cause, res.fault_t_s};

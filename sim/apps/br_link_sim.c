@@ -50,6 +50,7 @@
 #include "hal_sim/br_hal_sim.h"
 #include "tool/br_args.h"
 #include "tool/br_outfile.h"
+#include "tool/br_run_report.h"
 #include "tool/br_tool_limits.h"
 #include "bristle_gen/machine/br_machine.h"
 #include "cause_args/br_cause_args.h"
@@ -365,11 +366,13 @@ int main(int argc, char **argv)
     const br_link_counters_t *lc = &a->svc.link.dec.cnt;
     fprintf(stderr,
             "%s: %ld periods (%.3f s simulated), %ld late; link rx %lu frames, %lu replayed, %lu bad crc, "
-            "tx %lu frames, %lu busy; telemetry %lu sent, %lu dropped; arm refused %lu; fault %d at tick %lu\n",
+            "tx %lu frames, %lu busy; telemetry %lu sent, %lu dropped; arm refused %lu; ended %s; "
+            "last fault latched: %s (tick %lu)\n",
             TOOL, k, (double)k * dt, n_late, (unsigned long)lc->rx_frames, (unsigned long)lc->rx_replayed,
             (unsigned long)lc->rx_bad_crc, (unsigned long)lc->tx_frames, (unsigned long)lc->tx_busy,
             (unsigned long)a->tlm.n_sent, (unsigned long)a->tlm.n_dropped, (unsigned long)a->svc.cnt.arm_refused,
-            (int)a->svc.fault_cause, (unsigned long)a->svc.fault_tick);
+            a->svc.armed ? "armed" : br_run_fault_name((int)a->svc.fault), br_run_fault_name((int)a->svc.fault_cause),
+            (unsigned long)a->svc.fault_tick);
     rc = 0;
 out:
     if (a != NULL) axis_free(a);

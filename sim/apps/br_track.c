@@ -41,6 +41,7 @@
 #include "bristle/br_app.h"
 #include "bristle/br_machine_cfg.h"
 #include "circle/br_circle.h"
+#include "circle/br_circle_pftrace.h"
 #include "hal_sim/br_hal_sim.h"
 #include "plant/br_model_params.h"
 #include "plant/br_plant_json.h"
@@ -185,31 +186,9 @@ static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, f
  * filter's origin, speeds in m/s, forces in N. */
 static void pf_trace_row(FILE *f, double t, const br_plant_t *p, const br_pf_t *pf)
 {
-    const uint32_t m = pf->cfg.n_particles;
     const double rpc = (double)pf->cfg.est.rad_per_count, L = (double)pf->cfg.est.model.lead_mprad;
-    double s[BR_NX] = {0}, s2[BR_NX] = {0};
-    for (uint32_t j = 0; j < m; j++) {
-        for (int i = 0; i < BR_NX; i++) {
-            const double v = (double)pf->x[i][j];
-            s[i] += v;
-            s2[i] += v * v;
-        }
-    }
-    double mean[BR_NX], sd[BR_NX];
-    for (int i = 0; i < BR_NX; i++) {
-        mean[i] = s[i] / m;
-        sd[i] = sqrt(fmax(s2[i] / m - mean[i] * mean[i], 0.0));
-    }
-    /* the best predicted particle (largest log-weight) and a resampled copy of it: its signed miss */
-    uint32_t jb = 0;
-    for (uint32_t j = 1; j < m; j++)
-        if (pf->l[j] > pf->l[jb]) jb = j;
-    double miss = NAN;
-    for (uint32_t i = 0; i < m; i++)
-        if (pf->idx[i] == jb) {
-            miss = ((double)pf->x[BR_X_THETA][i] - (double)pf->prev_frac * rpc) / rpc;
-            break;
-        }
+    double mean[BR_NX], sd[BR_NX], miss;
+    br_pftrace_cloud(pf, mean, sd, &miss);
     const double inv2r = (double)pf->inv_2r;
     const double th_true = p->x.theta_rad - (double)pf->origin_counts * rpc;
     /* the plant's Stribeck level g(v) (eq. 5) */

@@ -2,8 +2,8 @@
 """Detection limits of the diagnosis (docs/detection-limits.md, `make
 detection-limits`).
 
-For each cause with a generator here (GENERATORS: br_simlog's option for an
-effect of size s), at two force-noise levels (the EMPS log's, as the noise
+For each cause with a generator (GENERATORS, from each registry cause's
+DETECTION: br_simlog's option for an effect of size s), at two force-noise levels (the EMPS log's, as the noise
 floor measures it from ../shared/data/emps/emps_estimation.csv, and a quiet
 log's, QUIET_N): the smallest size of the cause's ladder (geometric, ratio
 sqrt 2) detected in at least 95 % of N logs. Each log is made by br_simlog
@@ -57,7 +57,7 @@ from scipy import stats
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "python"))
-from bristle.diagnose import logreader, noise, report, selection, signals  # noqa: E402
+from bristle.diagnose import causes, logreader, noise, report, selection, signals  # noqa: E402
 
 EMPS_LOG = os.path.join(REPO, "..", "shared", "data", "emps", "emps_estimation.csv")
 QUIET_N = 0.02
@@ -73,18 +73,17 @@ def ladder(lo):
     return lo * np.sqrt(2.0) ** np.arange(LADDER_LEN)
 
 
-# cause: (size name, unit, ladder, flags(size)); sizes of the effect
-GENERATORS = {
-    "offset": ("offset", "N", ladder(0.001), lambda s: ["--offset", f"{s:.6g}"]),
-    "asymmetric_friction": ("relative asymmetry of Fc and Fv in -x", "", ladder(0.0002),
-                            lambda s: ["--asym", f"{FC_N * s:.6g},{SIGMA2 * s:.6g}"]),
-    "position_ripple": ("ripple amplitude, period 6 mm", "N", ladder(0.002),
-                        lambda s: ["--ripple", f"{s:.6g},0.006,1.0"]),
-    "position_gradient": ("relative slope", "1/m", ladder(0.008), lambda s: ["--gradient", f"{s:.6g}"]),
-    "actuator_delay": ("dead time", "s", ladder(5e-6), lambda s: ["--delay", f"{s:.6g}"]),
-    "friction_drift": ("relative rate of the friction level", "1/s", ladder(1e-5),
-                       lambda s: ["--drift", f"{s:.6g}"]),
-}
+# cause: (size name, unit, ladder, flags(size)); sizes of the effect, from each
+# registry cause's DETECTION (python/bristle/diagnose/causes/)
+REF_LEVELS = {"Fc_N": FC_N, "sigma2_Nspm": SIGMA2}
+
+
+def _generator(det):
+    what, unit, lo, flags = det
+    return what, unit, ladder(lo), lambda s: flags(s, REF_LEVELS)
+
+
+GENERATORS = {m.NAME: _generator(m.DETECTION) for m in causes.REGISTRY if hasattr(m, "DETECTION")}
 
 
 def emps_noise():

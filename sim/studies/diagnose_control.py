@@ -39,15 +39,12 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from runs import fault_text, faulted  # noqa: E402
 
-# the hidden causes (br_simlog / br_circle_ext options) and what they stand for
-CASES = (
-    ("offset", ["--offset", "2.5"], "2.5 N constant force (tilted axis)"),
-    ("asymmetric_friction", ["--asym", "2.1,15"], "Coulomb 7 -> 9.1 N and viscous 50 -> 65 N s/m in -x"),
-    ("position_ripple", ["--ripple", "1.0,0.004,0.5"], "1 N ripple, 4 mm period"),
-    ("position_gradient", ["--gradient", "4"], "friction +4 %/cm along the travel"),
-    ("actuator_delay", ["--delay", "0.003"], "3 ms actuator dead time"),
-    ("friction_drift", ["--drift", "0.01"], "friction level +1 % of its start a second (warm-up)"),
-)
+sys.path.insert(0, os.path.join(REPO, "python"))
+from bristle.diagnose import causes  # noqa: E402
+
+# the hidden causes (br_simlog / br_circle_ext options) and what they stand for:
+# each registry cause's CONTROL_CASE
+CASES = tuple((m.NAME, *m.CONTROL_CASE) for m in causes.REGISTRY if hasattr(m, "CONTROL_CASE"))
 
 
 # --check: the extended model may not be worse than the nominal one by more

@@ -34,10 +34,14 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from runs import faulted  # noqa: E402
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "python"))
+from bristle.diagnose import causes  # noqa: E402
+
 DURATION_S = 8.0           # the circle's length (br_circle_cfg_thesis)
 LOST_OUTLIER_FRAC = 0.01   # outlier steps above 1 % of the axis-periods: lock lost (re-anchoring over and over)
 P_CAUSE = 0.3              # probability that a plant has one named cause
-CAUSES = ("offset", "asymmetric_friction", "position_ripple", "position_gradient", "actuator_delay")
+# the causes a plant may have: the registry's with a robustness_draw, in its order
+CAUSES = tuple(m.NAME for m in causes.REGISTRY if hasattr(m, "robustness_draw"))
 CONTROLLERS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf", "hinf_true", "hinf_ff_id", "hinf_ukf_id", "hinf_pf_id")
 ESTIMATORS = ("hinf_ukf", "hinf_pf", "hinf_ukf_id", "hinf_pf_id")
 
@@ -75,19 +79,7 @@ def draw(seed, ref):
     if u < P_CAUSE:
         cause = CAUSES[int(rng.integers(len(CAUSES)))]
         sgn = 1.0 if c[2] < 0.5 else -1.0
-        if cause == "offset":
-            params["offset_N"] = sgn * (0.5 + 2.5 * c[0])
-        elif cause == "asymmetric_friction":
-            params["dFc_neg_N"] = sgn * (0.5 + 2.0 * c[0])
-            params["dsigma2_neg_Nspm"] = sgn * (5.0 + 15.0 * c[1])
-        elif cause == "position_ripple":
-            params["ripple_amp_N"] = 0.3 + 1.2 * c[0]
-            params["ripple_period_m"] = 0.002 + 0.006 * c[1]
-            params["ripple_phase_rad"] = 2.0 * math.pi * c[2]
-        elif cause == "position_gradient":
-            params["grad_per_m"] = sgn * (1.0 + 4.0 * c[0])
-        else:
-            params["delay_s"] = 0.0005 + 0.0025 * c[0]
+        params.update(causes.get(cause).robustness_draw(c, sgn))
     return {"factors": f, "params": params, "real": real, "cause": cause}
 
 

@@ -27,6 +27,8 @@ CHECKS = [
      rf"FREE_LOAD_FROM = {NUM}"),
     ("test_golden_ukf.c", "ukf_ms free-run factor", rf"#define C_FREE_RUN_MS \({NUM} \* C_FREE_RUN\)", "### ukf",
      rf"C_FREE_RUN_MS = {NUM} × C_FREE_RUN"),
+    # ff_pred
+    ("test_golden_ff_pred.c", "prediction", rf"#define C_PRED {NUM}", "### ff_pred", rf"\| dF \| {NUM}u·S"),
     # pf_ms
     ("test_golden_pf_ms.c", "one particle-step factor C_MS", rf"#define C_MS {NUM}", "### pf_ms",
      rf"C_MS = {NUM} u"),

@@ -16,8 +16,10 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "bristle/br_model.h"
+#include "bristle_gen/model/br_causes.h"
 #include "trace_reader.h"
 
 #define U32 5.9604644775390625e-08 /* float32 unit roundoff 2^-24 */
@@ -26,18 +28,62 @@
 #define C_OMEGA 32.0
 #define C_Z 64.0
 #define C_FNL 32.0
-#define N_SEG 6
-#define N_CAUSE 8 /* the trace's causes_order */
+#define SEG_MAX 16 /* segments the test holds; the trace says how many it has */
 #define PI 3.14159265358979323846
 
-static br_causes_t seg_causes(const br_trace_t *t, int seg)
+/* br_causes_t's fields by name: the registry's table (bristle_gen/model/br_causes.h) */
+#define FIELD_ROW(field, cause, hook, on) {#field, offsetof(br_causes_t, field)},
+static const struct {
+    const char *name;
+    size_t off;
+} FIELDS[BR_CAUSE_N_FIELDS] = {BR_CAUSE_FIELDS(FIELD_ROW)};
+#undef FIELD_ROW
+
+/* the trace's segments: its seg<n>_name header lines, n = 1.. */
+static int n_segments(const br_trace_t *t)
+{
+    int n = 0;
+    for (int i = 0; i < t->nmeta; i++) {
+        int seg, len = 0;
+        if (sscanf(t->meta_key[i], "seg%d_name%n", &seg, &len) == 1 && t->meta_key[i][len] == '\0') {
+            n++;
+        }
+    }
+    return n;
+}
+
+/* the trace's causes_order: each value's offset in br_causes_t; returns their count */
+static int causes_order(const br_trace_t *t, size_t off[BR_CAUSE_N_FIELDS])
+{
+    const char *p = br_trace_meta(t, "causes_order");
+    int n = 0;
+    char word[64];
+    int len;
+    while (sscanf(p, "%63s%n", word, &len) == 1) {
+        int f = 0;
+        while (f < BR_CAUSE_N_FIELDS && strcmp(FIELDS[f].name, word) != 0) {
+            f++;
+        }
+        if (f == BR_CAUSE_N_FIELDS || n == BR_CAUSE_N_FIELDS) {
+            fail_msg("%s: causes_order: '%s' is not a field of br_causes_t (or one too many)", t->path, word);
+        }
+        off[n++] = FIELDS[f].off;
+        p += len;
+    }
+    return n;
+}
+
+static br_causes_t seg_causes(const br_trace_t *t, int seg, const size_t off[], int n_cause)
 {
     char key[16];
-    double v[N_CAUSE];
+    double v[BR_CAUSE_N_FIELDS];
     snprintf(key, sizeof key, "seg%d", seg);
-    br_trace_meta_nums(t, key, v, N_CAUSE);
-    const br_causes_t c = {(float)v[0], (float)v[1], (float)v[2], (float)v[3], (float)v[4], (float)v[5],
-                           (float)v[6], 0.0f, (float)v[7]};
+    br_trace_meta_nums(t, key, v, n_cause);
+    br_causes_t c;
+    memset(&c, 0, sizeof c);
+    for (int i = 0; i < n_cause; i++) {
+        *(float *)(void *)((char *)&c + off[i]) = (float)v[i];
+    }
     return c;
 }
 
@@ -60,10 +106,14 @@ static void test_model_ext_one_step(void **state)
     const double L = cfg.lead_mprad, s0 = cfg.lugre.sigma0_Npm, s1 = cfg.lugre.sigma1_Nspm;
     const double s2 = cfg.sigma2_Nspm, h = cfg.dt_s, Fc = cfg.lugre.Fc_N;
     const double Jeff = cfg.J_kgm2 + L * L * cfg.M_kg;
-    br_model_t m[N_SEG + 1];
-    br_causes_t causes[N_SEG + 1];
-    for (int seg = 1; seg <= N_SEG; seg++) {
-        causes[seg] = seg_causes(&t, seg);
+    const int n_seg = n_segments(&t);
+    assert_true(n_seg >= 1 && n_seg <= SEG_MAX);
+    size_t off[BR_CAUSE_N_FIELDS];
+    const int n_cause = causes_order(&t, off);
+    br_model_t m[SEG_MAX + 1];
+    br_causes_t causes[SEG_MAX + 1];
+    for (int seg = 1; seg <= n_seg; seg++) {
+        causes[seg] = seg_causes(&t, seg, off, n_cause);
         cfg.causes = causes[seg];
         assert_int_equal(br_model_init(&m[seg], &cfg), BR_OK);
         assert_true(m[seg].extended);
@@ -81,11 +131,11 @@ static void test_model_ext_one_step(void **state)
     br_errstat_init(&e[2], "z", "m");
     br_errstat_init(&e[3], "gp", "N");
     br_errstat_init(&efc, "fcomp", "N");
-    long n_rows[N_SEG + 1][2] = {{0}}, bad_status = 0;
+    long n_rows[SEG_MAX + 1][2] = {{0}}, bad_status = 0;
 
     for (int r = 0; r < t.nrows; r++) {
         const int seg = (int)br_trace_get(&t, r, cseg);
-        assert_true(seg >= 1 && seg <= N_SEG);
+        assert_true(seg >= 1 && seg <= n_seg);
         const br_causes_t *c = &causes[seg];
         float x[BR_NX], xn[BR_NX];
         double xd[BR_NX], x1d[BR_NX];
@@ -133,8 +183,8 @@ static void test_model_ext_one_step(void **state)
         br_errstat_add(&efc, &t, r, (double)br_model_fcomp_N(&m[seg], x, (float)p0), br_trace_get(&t, r, cfc),
                        C_FNL * U32 * (F_scale + s2 * L * w0) + 2.0 * rip_x);
     }
-    for (int seg = 1; seg <= N_SEG; seg++) {
-        char key[16];
+    for (int seg = 1; seg <= n_seg; seg++) {
+        char key[32]; /* "seg" + any int + "_name" */
         snprintf(key, sizeof key, "seg%d_name", seg);
         print_message("golden model_ext seg %d (%s): %ld RK4, %ld bounded rows\n", seg, br_trace_meta(&t, key),
                       n_rows[seg][0], n_rows[seg][1]);

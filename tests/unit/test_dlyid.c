@@ -167,10 +167,26 @@ static void test_dlyid_bounds(void **st)
     assert_int_equal(br_est_cfg_check(&c), BR_OK);
     c.delay_id.step_s = 1.01f * (float)(BR_EST_DELAY_HIST - 2u) * dt / (float)(BR_DLYID_MAX_CAND - 1u);
     assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
-    /* a period so long that the bank's constants overflow (T^2 / J_eff) */
+    /* a period so long that the bank's constant L T^2 / (2 J_eff) overflows (a02; b1 and a12
+     * stay finite), with bristles soft enough that the model's sub-step bound holds and the
+     * presliding length (dly7) stays finite: a02's check is the only one that refuses */
     c = ok;
-    c.model.dt_s = 1.0e20f;
-    refused_only_with_the_bank(c);
+    {
+        const double L = (double)c.model.lead_mprad;
+        const double J = (double)c.model.J_kgm2 + (double)c.model.M_kg * L * L;
+        c.gp_min_N = 0.5f;
+        c.gp0_N = 0.75f;
+        c.gp_max_N = 1.0f;
+        /* settle_rad = 3 g_p,max / (sigma0 L) = FLT_MAX / 2 */
+        c.model.lugre.sigma0_Npm = (float)(2.0 * (double)BR_DLYID_SETTLE_LENGTHS / ((double)FLT_MAX * L));
+        c.model.lugre.sigma1_Nspm = 0.0f;
+        c.model.sigma2_Nspm = 0.0f;
+        /* L T^2 / (2 J_eff) = 2 FLT_MAX; (omega_n T)^2 = (sigma0 L)(L T^2 / J_eff) = 24 */
+        c.model.dt_s = (float)sqrt(4.0 * (double)FLT_MAX * J / L);
+    }
+    assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c.delay_id.n_cand = 0u;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
     /* a lead and an inertia at which L T / J_eff overflows, L T^2 / (2 J_eff) not */
     c = ok;
     c.model.lead_mprad = 1.8e19f;

@@ -8,6 +8,7 @@
 
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_ff.h"
+#include "bristle/br_ff_pred.h"
 
 static br_ff_cfg_t ref_cfg(void)
 {
@@ -235,6 +236,208 @@ static void test_mslip_elements(void **st)
     }
 }
 
+
+/* the hardware-like plant's element set (breakaways 2, 5, 10, 20 um at Fs, equal shares) */
+static br_ff_cfg_t pred_cfg(float tau)
+{
+    br_ff_cfg_t c = ref_cfg();
+    const double d[4] = {2e-6, 5e-6, 10e-6, 20e-6};
+    c.mslip.n = 4;
+    for (int i = 0; i < 4; i++) {
+        c.mslip.k_Npm[i] = (float)(0.25 * c.Fs_N / d[i]);
+        c.mslip.share[i] = 0.25f;
+    }
+    c.pred_ahead_s = tau;
+    return c;
+}
+
+/* the horizon's guards at init and br_ff_pred_N's */
+static void test_pred_guards(void **st)
+{
+    (void)st;
+    br_ff_t ff;
+    br_ff_cfg_t c = pred_cfg(1e-3f);
+    assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    c = pred_cfg(0.0f);                 assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    c = pred_cfg(BR_FF_PRED_MAX_S);     assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    c = pred_cfg(-1e-3f);               assert_int_equal(br_ff_init(&ff, &c), BR_E_PARAM);
+    c = pred_cfg(NAN);                  assert_int_equal(br_ff_init(&ff, &c), BR_E_PARAM);
+    c = pred_cfg(INFINITY);             assert_int_equal(br_ff_init(&ff, &c), BR_E_PARAM);
+    c = pred_cfg(BR_FF_PRED_MAX_S * 1.01f); assert_int_equal(br_ff_init(&ff, &c), BR_E_PARAM);
+    c = ref_cfg(); c.pred_ahead_s = 1e-3f; /* a horizon without elements */
+    assert_int_equal(br_ff_init(&ff, &c), BR_E_PARAM);
+    float dF = 1.0f;
+    assert_int_equal(br_ff_pred_N(&ff, NULL, NULL, &dF), BR_E_STATE); /* the refused init */
+    assert_true(dF == 0.0f);
+    c = pred_cfg(1e-3f);
+    assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    assert_int_equal(br_ff_pred_N(NULL, NULL, NULL, &dF), BR_E_NULL);
+    assert_int_equal(br_ff_pred_N(&ff, NULL, NULL, NULL), BR_E_NULL);
+    const float z_nan[4] = {0.0f, NAN, 0.0f, 0.0f}, z_big[4] = {3e38f, 3e38f, 0.0f, 0.0f}, z0[4] = {0};
+    dF = 1.0f;
+    assert_int_equal(br_ff_pred_N(&ff, z_nan, NULL, &dF), BR_E_INPUT);
+    assert_true(dF == 0.0f);
+    const float g0 = 0.0f, ginf = INFINITY, g1 = 10.0f;
+    assert_int_equal(br_ff_pred_N(&ff, z0, &g0, &dF), BR_E_INPUT);
+    assert_int_equal(br_ff_pred_N(&ff, z0, &ginf, &dF), BR_E_INPUT);
+    assert_int_equal(br_ff_pred_N(&ff, z0, &g1, &dF), BR_OK);
+    dF = 1.0f;
+    assert_int_equal(br_ff_pred_N(&ff, z_big, NULL, &dF), BR_E_NUMERIC); /* sum k z overflows */
+    assert_true(dF == 0.0f);
+    /* no horizon: no change, and the feedforward's output as without it */
+    c = pred_cfg(0.0f);
+    assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    const br_ff_in_t in = {5e-5f, 1e-3f, 3e-6f};
+    assert_int_equal(br_ff_set_ref(&ff, &in), BR_OK);
+    dF = 1.0f;
+    assert_int_equal(br_ff_pred_N(&ff, NULL, NULL, &dF), BR_OK);
+    assert_true(dF == 0.0f);
+}
+
+/* The prediction at a reversal: the reference at rest, accelerating into +x,
+ * every element at its -x bound at the sliding level g(-2e-5 m/s). Over tau
+ * the travel a tau^2 / 2 moves each element off its bound, clamped at the
+ * level at the horizon's end g(a tau): the clamp written here in double.
+ * br_ff_est_step with the horizon is the map plus that change; without the
+ * term it would be the map alone. */
+static void test_pred_at_reversal(void **st)
+{
+    (void)st;
+    const float tau = 2e-3f;
+    br_ff_cfg_t c = pred_cfg(tau);
+    br_ff_t ff, ff0;
+    assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    br_ff_cfg_t c0 = c;
+    c0.pred_ahead_s = 0.0f;
+    assert_int_equal(br_ff_init(&ff0, &c0), BR_OK);
+    /* slide 60 um in -x (every element to its -x bound), then stop with a = +0.5 m/s^2 */
+    const double vs = -2e-5;
+    for (int j = 1; j <= 60; j++) {
+        const br_ff_in_t in = {(float)vs, 0.0f, -1e-6f * (float)j};
+        assert_int_equal(br_ff_set_ref(&ff, &in), BR_OK);
+        assert_int_equal(br_ff_set_ref(&ff0, &in), BR_OK);
+    }
+    const float a = 0.5f;
+    const br_ff_in_t rev = {0.0f, a, -60e-6f};
+    assert_int_equal(br_ff_set_ref(&ff, &rev), BR_OK);
+    assert_int_equal(br_ff_set_ref(&ff0, &rev), BR_OK);
+    const double dp = 0.5 * (double)a * (double)tau * (double)tau; /* 1 um */
+    const double g0 = c.Fc_N + ((double)c.Fs_N - c.Fc_N) * exp(vs / c.vs_mps);
+    const double g1 = c.Fc_N + ((double)c.Fs_N - c.Fc_N) * exp(-(double)a * tau / c.vs_mps);
+    double want = 0.0;
+    for (int i = 0; i < 4; i++) {
+        const double ci = 0.25 / c.mslip.k_Npm[i], z = -ci * g0;
+        want += c.mslip.k_Npm[i] * (fmin(fmax(z + dp, -ci * g1), ci * g1) - z);
+    }
+    float dF = 0.0f, F = 0.0f, F0 = 0.0f;
+    assert_int_equal(br_ff_pred_N(&ff, NULL, NULL, &dF), BR_OK);
+    BR_ASSERT_NEAR(dF, want, 1e-4 * c.Fs_N);
+    assert_true(dF > 1.0f);
+    assert_int_equal(br_ff_est_step(&ff, NULL, 0.0f, &F), BR_OK);
+    assert_int_equal(br_ff_est_step(&ff0, NULL, 0.0f, &F0), BR_OK);
+    BR_ASSERT_NEAR(F - F0, want, 1e-4 * c.Fs_N);
+    /* sliding on in +x at the bound: only the level changes (g(v + a tau) against g(v)) */
+    const br_ff_in_t slide = {1e-4f, 0.0f, 0.0f};
+    for (int j = 0; j < 3; j++) assert_int_equal(br_ff_set_ref(&ff, &slide), BR_OK); /* 60 um: at +bounds */
+    const br_ff_in_t slide2 = {1e-4f, 0.0f, 100e-6f};
+    assert_int_equal(br_ff_set_ref(&ff, &slide2), BR_OK);
+    assert_int_equal(br_ff_pred_N(&ff, NULL, NULL, &dF), BR_OK);
+    assert_true(fabsf(dF) < 1e-5f * c.Fs_N); /* the same level: the bounds do not move */
+}
+
+/* a stand-in estimator: F_hat = 2 N with the status it is told */
+typedef struct {
+    br_status_t st;
+    int resets, predicts;
+} fake_est_t;
+static br_status_t fake_step(void *ctx, const br_meas_t *y, float u, float *F)
+{
+    (void)y;
+    (void)u;
+    *F = 2.0f;
+    return ((fake_est_t *)ctx)->st;
+}
+static br_status_t fake_predict(void *ctx, float u, float *F)
+{
+    (void)u;
+    ((fake_est_t *)ctx)->predicts++;
+    *F = 2.0f;
+    return ((fake_est_t *)ctx)->st;
+}
+static br_status_t fake_reset(void *ctx)
+{
+    ((fake_est_t *)ctx)->resets++;
+    return BR_OK;
+}
+
+/* br_ff_pred: the estimate plus dF when the estimator gave one, its status kept */
+static void test_pred_adapter(void **st)
+{
+    (void)st;
+    br_ff_cfg_t c = pred_cfg(1e-3f);
+    br_ff_t ff;
+    assert_int_equal(br_ff_init(&ff, &c), BR_OK);
+    const br_ff_in_t in = {0.0f, 1.0f, 0.0f}; /* a start into +x: dF = k0 a tau^2 / 2 > 0 */
+    assert_int_equal(br_ff_set_ref(&ff, &in), BR_OK);
+    float dF = 0.0f;
+    assert_int_equal(br_ff_pred_N(&ff, NULL, NULL, &dF), BR_OK);
+    assert_true(dF > 0.5f);
+    fake_est_t fe = {BR_OK, 0, 0};
+    const br_est_t inner = {&fe, fake_step, fake_predict, fake_reset};
+    br_ff_pred_t p;
+    assert_int_equal(br_ff_pred_init(NULL, inner, &ff, NULL, NULL), BR_E_NULL);
+    assert_int_equal(br_ff_pred_init(&p, inner, NULL, NULL, NULL), BR_E_NULL);
+    const br_est_t no_step = {&fe, NULL, NULL, NULL};
+    assert_int_equal(br_ff_pred_init(&p, no_step, &ff, NULL, NULL), BR_E_NULL);
+    br_ff_t ff0;
+    br_ff_cfg_t c0 = c;
+    c0.pred_ahead_s = 0.0f;
+    assert_int_equal(br_ff_init(&ff0, &c0), BR_OK);
+    assert_int_equal(br_ff_pred_init(&p, inner, &ff0, NULL, NULL), BR_E_PARAM); /* no horizon */
+    const br_est_t e0 = br_ff_pred_est(&p);
+    float F = 0.0f;
+    assert_int_equal(e0.step(e0.ctx, NULL, 0.0f, &F), BR_E_STATE); /* the refused init */
+    assert_int_equal(br_ff_pred_init(&p, inner, &ff, NULL, NULL), BR_OK);
+    const br_est_t e = br_ff_pred_est(&p);
+    const br_meas_t y = {0, 0.0f};
+    assert_int_equal(br_est_period(&e, &y, 0.0f, &F), BR_OK);
+    assert_true(F == 2.0f + dF);
+    fe.st = BR_W_OUTLIER; /* an outlier step still gives an estimate */
+    assert_int_equal(br_est_period(&e, &y, 0.0f, &F), BR_W_OUTLIER);
+    assert_true(F == 2.0f + dF);
+    fe.st = BR_E_NUMERIC; /* an error passes through without the term */
+    assert_int_equal(br_est_period(&e, &y, 0.0f, &F), BR_E_NUMERIC);
+    assert_true(F == 2.0f);
+    fe.st = BR_OK;
+    assert_int_equal(br_est_period(&e, NULL, 0.0f, &F), BR_OK); /* predict-only */
+    assert_int_equal(fe.predicts, 1);
+    assert_true(F == 2.0f + dF);
+    assert_int_equal(br_est_restart(&e), BR_OK);
+    assert_int_equal(fe.resets, 1);
+    /* without the inner's predict: F held */
+    const br_est_t inner2 = {&fe, fake_step, NULL, NULL};
+    assert_int_equal(br_ff_pred_init(&p, inner2, &ff, NULL, NULL), BR_OK);
+    F = 7.0f;
+    assert_int_equal(br_est_period(&e, NULL, 0.0f, &F), BR_OK);
+    assert_true(F == 7.0f);
+    assert_int_equal(br_est_restart(&e), BR_OK);
+    assert_int_equal(fe.resets, 1);
+    /* an anchor: the elements and level it names, not the feedforward's */
+    const float z[4] = {2e-6f, 0.0f, 0.0f, 0.0f}, g = 18.0f; /* the first element at its bound */
+    assert_int_equal(br_ff_pred_init(&p, inner, &ff, z, &g), BR_OK);
+    float dFa = 0.0f;
+    assert_int_equal(br_ff_pred_N(&ff, z, &g, &dFa), BR_OK);
+    assert_int_equal(br_est_period(&e, &y, 0.0f, &F), BR_OK);
+    assert_true(F == 2.0f + dFa);
+    assert_true(dFa < dF); /* the first element clamped: less than the feedforward's (undeflected) */
+    const float z_nan[4] = {NAN, 0.0f, 0.0f, 0.0f};
+    assert_int_equal(br_ff_pred_init(&p, inner, &ff, z_nan, NULL), BR_OK);
+    assert_int_equal(br_est_period(&e, &y, 0.0f, &F), BR_E_INPUT); /* the axis stops */
+    assert_int_equal(e.step(NULL, &y, 0.0f, &F), BR_E_NULL);
+    assert_int_equal(e.predict(NULL, 0.0f, &F), BR_E_NULL);
+    assert_int_equal(e.reset(NULL), BR_E_NULL);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -244,6 +447,9 @@ int main(void)
         cmocka_unit_test(test_clamp_and_inputs),
         cmocka_unit_test(test_est_adapter),
         cmocka_unit_test(test_mslip_elements),
+        cmocka_unit_test(test_pred_guards),
+        cmocka_unit_test(test_pred_at_reversal),
+        cmocka_unit_test(test_pred_adapter),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

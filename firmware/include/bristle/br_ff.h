@@ -18,7 +18,14 @@
  * term s(v) g(v) is replaced by the elements driven along the reference's
  * position path: br_ff_set_ref moves them by the travel p - p_prev at the level
  * g(v) (z_i <- clamp(z_i + dp, -share_i g / k_i, +share_i g / k_i)), and the
- * term is sum_i k_i z_i: the presliding memory a static map has not. */
+ * term is sum_i k_i z_i: the presliding memory a static map has not.
+ *
+ * With a horizon tau = cfg.pred_ahead_s > 0 (elements only; docs/modules/ff-pred.md)
+ * the elements' change over the coming tau along the stored reference,
+ *   dp = v tau + a tau^2 / 2,  g1 = g(v + a tau),
+ *   dF = sum_i k_i clamp(z_i + dp, -share_i g1 / k_i, +share_i g1 / k_i) - sum_i k_i z_i,
+ * is added to what br_ff_est_step returns (br_ff_pred_N; br_ff_pred.h adds it
+ * to an estimator's F_hat). tau = 0: off, every output as without it. */
 #ifndef BR_FF_H
 #define BR_FF_H
 
@@ -26,6 +33,10 @@
 #include "bristle/br_model.h"
 #include "bristle/br_mslip.h"
 #include "bristle/br_status.h"
+
+/* Longest prediction horizon accepted, s (a hundred periods at 1 ms: farther
+ * than the reference's Taylor travel means anything on a ball screw's circle) */
+#define BR_FF_PRED_MAX_S 0.1f
 
 typedef struct {
     float Fc_N;         /* Coulomb level, > 0 */
@@ -38,6 +49,8 @@ typedef struct {
     br_causes_t causes; /* diagnosed causes as feedforward maps; delay_s ignored */
     br_mslip_cfg_t mslip; /* n = 0: the static map; n >= 1: the Maxwell-slip elements along the
                              reference (their sigma2 must be 0: the viscous term is sigma2_Nspm) */
+    float pred_ahead_s;   /* the prediction's horizon tau, s: 0 off; in (0, BR_FF_PRED_MAX_S] needs
+                             the elements (mslip.n >= 1) */
 } br_ff_cfg_t;
 
 /* The reference at t_k, load side. */
@@ -58,7 +71,8 @@ typedef struct {
 } br_ff_t;
 
 /* Validates cfg (every field finite and in its range; Fc + dFc_neg > 0,
- * sigma2 + dsigma2_neg >= 0, ripple period > 0 with a ripple); the stored
+ * sigma2 + dsigma2_neg >= 0, ripple period > 0 with a ripple; a prediction
+ * horizon 0, or in (0, BR_FF_PRED_MAX_S] with elements); the stored
  * reference starts at rest at 0. BR_OK, BR_E_NULL or BR_E_PARAM. */
 br_status_t br_ff_init(br_ff_t *ff, const br_ff_cfg_t *cfg);
 
@@ -71,8 +85,18 @@ br_status_t br_ff_step(const br_ff_t *ff, const br_ff_in_t *in, float *comp_N);
  * each br_app_step (with elements: they move by the travel from the stored one). BR_E_INPUT (non-finite; the stored one is kept). */
 br_status_t br_ff_set_ref(br_ff_t *ff, const br_ff_in_t *in);
 
+/* The prediction dF over the horizon tau from the stored reference (the
+ * equations above). z_anchor_m: the element deflections it starts from
+ * (cfg.mslip.n of them; NULL: the feedforward's own, driven by the reference);
+ * g_anchor_N: the level g1 (NULL: g(v + a tau), eq. 5). Without a horizon
+ * (tau = 0) *dF_N = 0. BR_E_NULL, BR_E_STATE (not initialised), BR_E_INPUT (a
+ * non-finite anchor, a level <= 0 or not finite), BR_E_NUMERIC (a change that
+ * overflows); each with *dF_N = 0. */
+br_status_t br_ff_pred_N(const br_ff_t *ff, const float *z_anchor_m, const float *g_anchor_N, float *dF_N);
+
 /* br_est_step_fn over a br_ff_t (ctx): the feedforward as the compensation
- * source of br_app (BR_APP_EST_EXTERN); the measurement is not used. */
+ * source of br_app (BR_APP_EST_EXTERN); the measurement is not used. With a
+ * horizon, the map at the stored reference plus br_ff_pred_N (own elements). */
 br_status_t br_ff_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N);
 
 #endif

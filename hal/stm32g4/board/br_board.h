@@ -40,11 +40,10 @@
 #define BR_BOARD_IWDG_RLR   79u
 
 /* What the shared image needs at compile time (hal/stm32/image): */
-/* the PF does not run in its period on this core: 570 352 instructions per
- * 1.5 ms period at 1500 particles on the Cortex-M4 (QEMU mps2-an386, `make
- * target-bench`, docs/target.md), more than twice the 255 000 cycles of
- * 1.5 ms at 170 MHz; H-inf + UKF is 10 777 instructions per 1 ms period
- * there, 6.3 % of 170 000 cycles */
+/* the PF does not run in its period on this core: at 1500 particles its
+ * period takes more instructions than 1.5 ms has cycles at 170 MHz, while
+ * H-inf + UKF takes a few percent of 1 ms (the Cortex-M4 figures of `make
+ * target-bench`: docs/target.md, "Current figures") */
 #define BR_BOARD_RUNS_PF 0
 /* the recorder's ring and the USART's DMA buffers in SRAM1 + SRAM2: the DMA
  * does not reach the CCM SRAM that holds the stack; NOLOAD, zeroed by the

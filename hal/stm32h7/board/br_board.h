@@ -36,8 +36,9 @@
 #define BR_BOARD_IWDG_RLR   79u
 
 /* What the shared image needs at compile time (hal/stm32/image): */
-/* the PF runs in its period on this core (docs/target.md: 372 424
- * instructions per 1.5 ms period at 1500 particles, 720 000 cycles) */
+/* the PF runs in its period on this core: at 1500 particles under half of
+ * the 720 000 cycles of 1.5 ms (`make target-bench`: docs/target.md,
+ * "Current figures") */
 #define BR_BOARD_RUNS_PF 1
 /* the big statics (the PF's state, the recorder's ring, the USART's DMA
  * buffers) in AXI SRAM: DMA1 does not reach the DTCM that holds the stack;

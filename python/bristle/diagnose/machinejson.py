@@ -56,8 +56,8 @@ PRESLIDING_MIN_QUANTA = 2.0
 # constant (docs/modules/pf.md, "Fast moves": measured 10 periods of 1.5 ms)
 GP_CURVE_TAU_S = 0.015
 # the causes the firmware's estimation model takes beside a Maxwell-slip friction
-# (firmware/design/machine.py's friction_model check)
-MSLIP_COMBINES = ("actuator_delay",)
+# (firmware/design/machine.py's friction_model check): the measurement-side ones
+MSLIP_COMBINES = tuple(m.NAME for m in causes_.of_hook("measurement"))
 
 
 def _loader():

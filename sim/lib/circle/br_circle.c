@@ -13,6 +13,7 @@
 #include "bristle_gen/machine/br_machine.h"
 #include "bristle/br_machine_cfg.h"
 #include "bristle/br_app.h"
+#include "bristle/br_ff_pred.h"
 #include "plant/br_model_params.h"
 #include "tool/br_rng.h"
 #include "tool/br_run_report.h"
@@ -65,6 +66,8 @@ br_circle_cfg_t br_circle_cfg_thesis(br_circle_ctrl_t controller)
     c.ff = br_circle_ff_cfg_machine();
     c.qec = br_circle_qec_cfg_machine((float)c.dt_s);
     c.real = (br_circle_real_t){0.0, 0.0, 0.0, 0u};
+    c.pred = 0;
+    c.oracle_late = 0;
     return c;
 }
 
@@ -221,15 +224,6 @@ void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *m)
     c->ff.causes = br_causes_from_model(m);
 }
 
-/* The limit: an "estimator" that reads the plant's true friction at t_k. */
-static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
-{
-    (void)y;
-    (void)u_prev_Nm;
-    *F_hat_N = (float)br_plant_comp_force_N((const br_plant_t *)ctx);
-    return BR_OK;
-}
-
 typedef struct {
     br_plant_t plant;
     br_hal_sim_t port;
@@ -238,6 +232,11 @@ typedef struct {
     br_app_mem_t mem; /* the filter's state, owned: PF or UKF only */
     br_ff_t ff;       /* the feedforward (BR_CTRL_HINF_FF) */
     br_qec_t qec;     /* the reversal compensation (BR_CTRL_HINF_QEC) */
+    int ff_on;        /* ff initialised: set to the reference each period */
+    br_ff_pred_t pred; /* the estimate plus the feedforward's prediction (cfg.pred) */
+    int oracle_late;  /* the oracle: one period late */
+    int oracle_primed; /* oracle_prev_N holds a period's force */
+    double oracle_prev_N;
     double phase;
     /* the run's drift and noise (br_circle_real_t) */
     br_circle_real_t real;
@@ -245,6 +244,20 @@ typedef struct {
     br_plant_cfg_t base;  /* the plant's configuration before drift and noise */
     br_hal_t inner;       /* the simulator's HAL behind the noisy encoder */
 } axis_sim_t;
+
+/* The limit: an "estimator" that reads the plant's true friction at t_k (or,
+ * oracle_late, the one it read a period before). */
+static br_status_t oracle_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float *F_hat_N)
+{
+    (void)y;
+    (void)u_prev_Nm;
+    axis_sim_t *a = ctx;
+    const double f = br_plant_comp_force_N(&a->plant);
+    *F_hat_N = (float)((a->oracle_late && a->oracle_primed) ? a->oracle_prev_N : f);
+    a->oracle_prev_N = f;
+    a->oracle_primed = 1;
+    return BR_OK;
+}
 
 /* encoder noise: the simulator's reading, one count off with probability p */
 static br_status_t noisy_encoder_read(void *ctx, int32_t *counts)
@@ -326,11 +339,46 @@ br_ctrl_cfg_t br_circle_ctrl_cfg(const br_circle_cfg_t *c)
     return cc;
 }
 
+/* cfg.pred: the compensation ac names (the UKF, the PF or the oracle) made
+ * first, then handed to the application through br_ff_pred's interface: its
+ * estimate plus the feedforward's prediction (a->ff, set to the reference each
+ * period) */
+static int pred_wrap(axis_sim_t *a, const br_circle_cfg_t *c, br_app_cfg_t *ac, br_est_t *ext)
+{
+    if (ac->est == BR_APP_EST_NONE || c->controller == BR_CTRL_HINF_FF || c->controller == BR_CTRL_HINF_QEC)
+        return 0; /* H-inf alone has nothing to add to; the feedforward adds its own (pred_ahead_s) */
+    br_est_t inner;
+    const float *z = NULL, *g = NULL;
+    if (br_ff_init(&a->ff, &c->ff) != BR_OK || br_app_est_init(ac, &a->mem, &inner) != BR_OK) {
+        fprintf(stderr, "br_circle: invalid feedforward or estimator configuration for the prediction\n");
+        return -1;
+    }
+    a->ff_on = 1;
+    if (c->pred == 2) {
+        /* anchored on the UKF's own elements and level */
+        if (a->mem.ukf == NULL || c->ukf.est.model.mslip.n != c->ff.mslip.n) {
+            fprintf(stderr, "br_circle: the prediction's UKF anchor needs a Maxwell-slip UKF with the "
+                            "feedforward's element set\n");
+            return -1;
+        }
+        z = a->mem.ukf->est.elem_m;
+        g = &a->mem.ukf->est.mean[BR_X_GP];
+    }
+    if (br_ff_pred_init(&a->pred, inner, &a->ff, z, g) != BR_OK) {
+        fprintf(stderr, "br_circle: the prediction needs the feedforward's elements and a horizon\n");
+        return -1;
+    }
+    *ext = br_ff_pred_est(&a->pred);
+    ac->est = BR_APP_EST_EXTERN;
+    return 0;
+}
+
 /* 0, or -1 with a message; *refused the firmware's BR_E_* when it refused the
  * application (an estimator, the feedforward) at init, else left as it is */
 static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int index, br_status_t *refused)
 {
     a->phase = phase;
+    a->ff_on = 0;
     a->mem = (br_app_mem_t){NULL, NULL};
     a->real = c->real;
     a->base = c->plant;
@@ -355,7 +403,10 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
     case BR_CTRL_HINF_ONLY:
         break;
     case BR_CTRL_HINF_TRUE:
-        ext = (br_est_t){&a->plant, oracle_step, NULL, NULL};
+        a->oracle_late = c->oracle_late;
+        a->oracle_primed = 0;
+        a->oracle_prev_N = 0.0;
+        ext = (br_est_t){a, oracle_step, NULL, NULL};
         ac.est = BR_APP_EST_EXTERN;
         break;
     case BR_CTRL_HINF_FF:
@@ -363,6 +414,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
             fprintf(stderr, "br_circle: invalid feedforward configuration\n");
             return -1;
         }
+        a->ff_on = 1;
         ext = (br_est_t){&a->ff, br_ff_est_step, NULL, NULL};
         ac.est = BR_APP_EST_EXTERN;
         break;
@@ -383,6 +435,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
         ac.est = BR_APP_EST_PF;
         break;
     }
+    if (c->pred != 0 && pred_wrap(a, c, &ac, &ext) != 0) return -1;
     br_status_t st;
     /* BR_E_PARAM also when an estimator's period is not the control period */
     st = br_app_init(&a->app, &ac, &a->hal, &a->mem);
@@ -502,15 +555,16 @@ int br_circle_run_remote(const br_circle_cfg_t *c, const br_circle_remote_t *rem
             if (k > 0) axis_perturb(&ax[i]);
             ax[i].hal.tick_wait(ax[i].hal.ctx, &tick);
             s.pos_m[i] = br_plant_pos_m(&ax[i].plant);
+            s.vel_mps[i] = br_plant_vel_mps(&ax[i].plant);
             s.counts[i] = br_plant_encoder(&ax[i].plant);
             s.fnl_N[i] = ax[i].plant.fnl_N;
             br_ref_t r = axis_ref(c, ax[i].phase, t, &s.ref_m[i]);
-            if (c->controller == BR_CTRL_HINF_FF || c->controller == BR_CTRL_HINF_QEC) {
+            if (ax[i].ff_on || c->controller == BR_CTRL_HINF_QEC) {
                 /* the feedforward's (the reversal compensation's) reference at t_k, load side */
                 const double w = circle_omega(c), ph = w * t + ax[i].phase;
                 const br_ff_in_t in = {(float)(c->radius_m * w * cos(ph)), (float)(-c->radius_m * w * w * sin(ph)),
                                        (float)s.ref_m[i]};
-                if (c->controller == BR_CTRL_HINF_FF) br_ff_set_ref(&ax[i].ff, &in);
+                if (ax[i].ff_on) br_ff_set_ref(&ax[i].ff, &in);
                 else br_qec_set_ref(&ax[i].qec, &in);
             }
             br_circle_remote_out_t o;

@@ -59,6 +59,11 @@ typedef struct {
     br_ff_cfg_t ff;      /* BR_CTRL_HINF_FF: the feedforward's identified model */
     br_qec_cfg_t qec;    /* BR_CTRL_HINF_QEC: the reversal compensation (its dt_s must equal dt_s) */
     br_circle_real_t real; /* drift and noise of the run (all 0 for the thesis experiment) */
+    int pred;            /* BR_CTRL_HINF_UKF, _PF, _TRUE: 0 their compensation as it is; 1 plus the
+                            feedforward's prediction (br_ff_pred.h: ff.pred_ahead_s over ff.mslip, the
+                            elements driven by the reference); 2 the same anchored on the UKF's own
+                            elements and g_p (a Maxwell-slip UKF only) */
+    int oracle_late;     /* BR_CTRL_HINF_TRUE: 0 the plant's force at t_k, 1 that of t_k-1 (one period late) */
 } br_circle_cfg_t;
 
 typedef struct {
@@ -115,6 +120,22 @@ void br_circle_use_pf_mslip(br_circle_cfg_t *c, int on);
  * (k_i = share_i Fs / d_i at the model's Fs), its look-ahead off. */
 void br_circle_est_mslip(br_est_cfg_t *est);
 
+/* The feedforward's Maxwell-slip elements (br_ff_cfg_t.mslip; docs/modules/ff-pred.md):
+ * BR_CIRCLE_FF_EL_OWN the plant's own element set (the oracle case; a LuGre
+ * plant has none and gets the fit), BR_CIRCLE_FF_EL_FIT four equal-share
+ * elements whose breakaways span a decade (d, 2.15 d, 4.64 d, 10 d at Fs), d
+ * chosen so that their initial stiffness is the plant's (sum k_i, or sigma0 on a
+ * LuGre plant): what a diagnosis that measured the initial stiffness and Fs
+ * gives. NONE: the static map. Call after the plant's presliding is set. */
+enum { BR_CIRCLE_FF_EL_NONE = 0, BR_CIRCLE_FF_EL_OWN = 1, BR_CIRCLE_FF_EL_FIT = 2 };
+void br_circle_use_ff_el(br_circle_cfg_t *c, int mode);
+
+/* The tools' --pred: the prediction over the horizon ahead_s (> 0; <= 0 leaves
+ * it off) added to the UKF's, the PF's, the oracle's and the feedforward's
+ * compensation, from the feedforward's elements (anchor 1) or the UKF's own
+ * (anchor 2); the feedforward needs its elements (br_circle_use_ff_el). */
+void br_circle_use_pred(br_circle_cfg_t *c, double ahead_s, int anchor);
+
 /* The estimators' and the feedforward's model from an identified one (a
  * diagnosis's model.json loaded as a plant configuration): its mass, LuGre
  * and viscous parameters and its causes (br_causes_from_model). */
@@ -168,6 +189,7 @@ typedef struct {
     double t_s;
     double ref_m[2];     /* x, y reference */
     double pos_m[2];     /* x, y plant position */
+    double vel_mps[2];   /* x, y plant velocity */
     int32_t counts[2];   /* x, y encoder readings */
     double radial_err_m; /* hypot(x, y) - A: + is outward */
     double duty[2];

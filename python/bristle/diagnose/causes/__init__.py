@@ -14,6 +14,17 @@ What a cause module holds:
   PARAMS               its model.json parameters (params.Param), in the
                        option's order; the same names as br_plant_cfg_t's fields
   NL                   the names of its nonlinear parameters in a fit's `nl`
+  HOOK                 its kind of hook in the models (docs/architecture.md, "Adding a
+                       cause"): "force" (a term of the load force: the firmware's
+                       br_causes_t and its kernel term), "measurement" (what reaches the
+                       axis or the log: the actuator delay) or "state" (states of its own:
+                       the presliding element set, br_mslip_cfg_t)
+  MACHINE              (force and measurement causes) the machine file's fields
+                       (firmware/design/machine.py's "causes"): PARAMS name ->
+                       (lo, hi, meaning[, lo_open]); their order is PARAMS', which is
+                       br_causes_t's (firmware/design/gen_causes.py writes the C table)
+  SWITCHES             (optional) the PARAMS whose value other than 0 switches the
+                       cause on in the firmware (default: all of them)
   search(prep, base, fit_with) -> dict | None
                        its nonlinear parameters for base + it; fit_with(nl)
                        solves the linear ones with those (model.Fit, train_sse);
@@ -41,6 +52,16 @@ and, for the force model (model.py), the hooks it needs of:
   report_nl(nl) -> dict               report parameters from its nonlinear ones (an element set: a list)
 
 and FIGURES, ((file, what, function(path, prep, diag)), ...), if it draws any.
+
+The studies (sim/studies/) take a cause that has their setting:
+
+  DETECTION            detection_limits.py: (size name, unit, smallest size of the ladder,
+                       flags(s, ref)), br_simlog's options for an effect of size s
+                       (ref: the reference machine's Fc_N and sigma2_Nspm)
+  robustness_draw(c, sgn) -> dict
+                       robustness.py: the plant's parameters of the cause from
+                       three uniforms c and a sign
+  CONTROL_CASE         diagnose_control.py: (br_simlog / br_circle_ext flags, what they stand for)
 """
 from .. import params
 from . import (actuator_delay, asymmetric_friction, friction_drift, offset, position_gradient, position_ripple,
@@ -74,6 +95,17 @@ def of(names):
 def present(p):
     """The modules with parameters, every one of which p (model.json "params") holds."""
     return tuple(m for m in REGISTRY if m.PARAMS and all(q.name in p for q in m.PARAMS))
+
+
+def of_hook(kind):
+    """The modules whose HOOK is kind ("force", "measurement", "state"), in order."""
+    return tuple(m for m in REGISTRY if m.HOOK == kind)
+
+
+def firmware_params():
+    """The causes' parameters the firmware's br_causes_t holds, in its order:
+    (module, Param) of every force and measurement cause."""
+    return tuple((m, q) for m in REGISTRY if m.HOOK in ("force", "measurement") for q in m.PARAMS)
 
 
 def hooks(mods, name):

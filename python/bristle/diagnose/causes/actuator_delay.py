@@ -21,7 +21,16 @@ ACTION = ("Look for the dead time in the drive chain: fieldbus cycles, the drive
 OPTION = "--delay"
 PARAMS = (Param("delay_s", "s", "actuator dead time d", 0.0, 0.1),)  # upper: BR_PLANT_DELAY_MAX_S
 NL = ("delay_s",)
+HOOK = "measurement"
+MACHINE = {"delay_s": (0.0, 0.1, "actuator dead time")}
+DETECTION = ("dead time", "s", 5e-6, lambda s, ref: ["--delay", f"{s:.6g}"])
+CONTROL_CASE = (["--delay", "0.003"], "3 ms actuator dead time")
 DELAY_MAX_S = 0.02
+
+
+def robustness_draw(c, sgn):
+    """The robustness study's plant parameters of this cause from uniforms c[0..2] and a sign."""
+    return {"delay_s": 0.0005 + 0.0025 * c[0]}
 
 
 def delayed_force(prep, delay_s):

@@ -31,7 +31,19 @@ PARAMS = (Param("dFc_neg_N", "N", "Coulomb level in −x minus that in +x (the s
                 -1e5, 1e5),
           Param("dsigma2_neg_Nspm", "N s/m", "viscous friction in −x minus that in +x", -1e6, 1e6))
 NL = ("fc_ratio", "fc_split")      # c = Fc in -x / Fc in +x; the split first estimate
+HOOK = "force"
+MACHINE = {"dFc_neg_N": (-1.0e5, 1.0e5, "Coulomb level in -x is Fc_N + dFc_neg_N (Fs scaled alike)"),
+           "dsigma2_neg_Nspm": (-1.0e6, 1.0e6, "viscous friction in -x is sigma2_Nspm + this")}
+DETECTION = ("relative asymmetry of Fc and Fv in -x", "", 0.0002,
+             lambda s, ref: ["--asym", f"{ref['Fc_N'] * s:.6g},{ref['sigma2_Nspm'] * s:.6g}"])
+CONTROL_CASE = (["--asym", "2.1,15"], "Coulomb 7 -> 9.1 N and viscous 50 -> 65 N s/m in -x")
 FC_RATIO_BOUNDS = (0.2, 5.0)
+
+
+def robustness_draw(c, sgn):
+    """The robustness study's plant parameters of this cause from uniforms c[0..2] and a sign."""
+    return {"dFc_neg_N": sgn * (0.5 + 2.0 * c[0]),
+            "dsigma2_neg_Nspm": sgn * (5.0 + 15.0 * c[1])}
 
 
 def stribeck_neg_ratio(nl):

@@ -26,6 +26,10 @@ OPTION = "--drift"
 PARAMS = (Param("drift_per_s", "1/s", "relative rate r of the friction level in time: friction × max(0, 1 + r t)",
                 -1.0, 1.0),)
 NL = ("drift_per_s",)
+HOOK = "force"
+MACHINE = {"drift_per_s": (-1.0, 1.0, "friction level scaled by max(0, 1 + drift_per_s t), t since the start")}
+DETECTION = ("relative rate of the friction level", "1/s", 1e-5, lambda s, ref: ["--drift", f"{s:.6g}"])
+CONTROL_CASE = (["--drift", "0.01"], "friction level +1 % of its start a second (warm-up)")
 GRID = 21
 
 

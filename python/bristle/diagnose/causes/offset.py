@@ -18,6 +18,15 @@ ACTION = ("Check whether the axis is tilted (gravity), a cable chain or hose pul
 OPTION = "--offset"
 PARAMS = (Param("offset_N", "N", "constant load force, + opposes motion in +x", -1e5, 1e5),)
 NL = ()
+HOOK = "force"
+MACHINE = {"offset_N": (-1.0e5, 1.0e5, "constant load force, + opposes motion in +x")}
+DETECTION = ("offset", "N", 0.001, lambda s, ref: ["--offset", f"{s:.6g}"])
+CONTROL_CASE = (["--offset", "2.5"], "2.5 N constant force (tilted axis)")
+
+
+def robustness_draw(c, sgn):
+    """The robustness study's plant parameters of this cause from uniforms c[0..2] and a sign."""
+    return {"offset_N": sgn * (0.5 + 2.5 * c[0])}
 
 
 def load_columns(prep, nl):

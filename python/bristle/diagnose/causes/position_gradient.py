@@ -20,7 +20,16 @@ OPTION = "--gradient"
 PARAMS = (Param("grad_per_m", "1/m", "relative slope s of the friction along the travel: friction × max(0, 1 + s x)",
                  -1e3, 1e3),)
 NL = ("grad_per_m",)
+HOOK = "force"
+MACHINE = {"grad_per_m": (-1.0e3, 1.0e3, "friction scaled by max(0, 1 + grad_per_m x) along the travel")}
+DETECTION = ("relative slope", "1/m", 0.008, lambda s, ref: ["--gradient", f"{s:.6g}"])
+CONTROL_CASE = (["--gradient", "4"], "friction +4 %/cm along the travel")
 GRID = 21
+
+
+def robustness_draw(c, sgn):
+    """The robustness study's plant parameters of this cause from uniforms c[0..2] and a sign."""
+    return {"grad_per_m": sgn * (1.0 + 4.0 * c[0])}
 
 
 def scale(s, x):

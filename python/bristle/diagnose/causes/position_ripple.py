@@ -26,11 +26,24 @@ PARAMS = (Param("ripple_amp_N", "N", "amplitude A of A sin(2πx/P + φ)", -1e5, 
           Param("ripple_period_m", "m", "its period P in load position", GT0, 10.0),
           Param("ripple_phase_rad", "rad", "its phase φ at x = 0", -1e3, 1e3))
 NL = ("ripple_period_m",)
+SWITCHES = ("ripple_amp_N",)   # the period and the phase alone are no ripple
+HOOK = "force"
+MACHINE = {"ripple_amp_N": (0.0, 1.0e5, "ripple force amplitude"),
+           "ripple_period_m": (0.0, 10.0, "ripple period in load position", True),
+           "ripple_phase_rad": (-2.0 * math.pi, 2.0 * math.pi, "phase at x = 0")}
+DETECTION = ("ripple amplitude, period 6 mm", "N", 0.002, lambda s, ref: ["--ripple", f"{s:.6g},0.006,1.0"])
+CONTROL_CASE = (["--ripple", "1.0,0.004,0.5"], "1 N ripple, 4 mm period")
 PERIODS = 400
 PEAKS = 3
 PERIODOGRAM_DECIMATE = 4     # the residual is low-passed far below the sampling rate
 PERIOD_BLOCK = 64            # periods of the periodogram computed together
 BLOCK_ELEMS = 1 << 21        # at most this many (16 MB of float64) in one of its arrays
+
+
+def robustness_draw(c, sgn):
+    """The robustness study's plant parameters of this cause from uniforms c[0..2] and a sign."""
+    return {"ripple_amp_N": 0.3 + 1.2 * c[0], "ripple_period_m": 0.002 + 0.006 * c[1],
+            "ripple_phase_rad": 2.0 * math.pi * c[2]}
 
 
 def load_columns(prep, nl):

@@ -59,6 +59,7 @@ ACTION = ("Expect it on rolling contacts (ball screw, recirculating guides): it 
 OPTION = "--gms"   # br_simlog's Maxwell-slip plant (the elements' breakaway displacements)
 PARAMS = ()        # the element set is a list: model.json's "presliding" object (modelfile.py)
 NL = ("ps_grid", "ps_breakaway", "ps_share")
+HOOK = "state"
 GRID_N = 8                 # firmware/include/bristle/br_mslip.h's BR_MSLIP_MAX
 GRID_MIN_M = 0.3e-6        # presliding.md's range of breakaway displacements: 0.3 .. 30 um
 GRID_MAX_M = 30e-6
