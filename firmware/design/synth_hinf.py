@@ -25,8 +25,12 @@ unstable) ends the script with "FILE: field control.hinf: problem", exit status 
 With --report it also prints the design report: the gains, gamma, the
 closed-loop norm and poles, and the loop's gain and phase margins and
 closed-loop bandwidth, continuous and sampled (loop_analysis.py).
+With --suggest it writes no header: it prints the weights the machine's
+periods, inertia, torque limit and encoder give (hinf_weights.py), as the
+file's control.hinf block, and the design they give (exit 1 if it fails).
 
-Usage: synth_hinf.py [--machine FILE] [--out FILE] [--report]"""
+Usage: synth_hinf.py [--machine FILE] [--out FILE] [--report] [--suggest]"""
+import json
 import argparse
 import os
 import sys
@@ -110,11 +114,18 @@ def sampled_loop(p, K, dt):
     return Phi, Gw, Ku
 
 
-def design(p, wts):
+def problem(p, wts):
+    """A, B1, B2, Cz, R = Dz'Dz of the design (the module's docstring)"""
     A, B2 = plant(p)
     B1 = B2 * (p["L_mprad"] * p["Fs_N"])
     C = np.diag(wts["Cz_diag"])
     R = np.array([[1.0 / wts["u_norm_Nm"] ** 2]])
+    return A, B1, B2, C, R
+
+
+def gain(p, wts):
+    """The gamma-iteration and the state feedback, unchecked: (K, gamma_min, gamma), or DesignError."""
+    A, B1, B2, C, R = problem(p, wts)
     lo, hi = 1e-9, 1e9
     if riccati(A, B1, B2, C, R, hi) is None:
         raise DesignError("the weights admit no stabilising design (no gamma up to %g)" % hi)
@@ -132,6 +143,13 @@ def design(p, wts):
     if X is None:
         raise DesignError("no stabilising solution at gamma = %g * gamma_min" % wts["gamma_margin"])
     K = (-np.linalg.solve(R, B2.T @ X)).ravel()
+    return K, gamma_min, gamma
+
+
+def design(p, wts):
+    """The design and its checks (the closed-loop norm, the sampled loop at each period), or DesignError."""
+    K, gamma_min, gamma = gain(p, wts)
+    A, B1, B2, C, R = problem(p, wts)
     Acl = A + B2 @ K[None, :]
     Ccl = np.vstack([C, (np.sqrt(R) @ K[None, :])])
     norm = hinf_norm(Acl, B1, Ccl, np.zeros((4, 1)))
@@ -145,7 +163,7 @@ def design(p, wts):
         rho = np.max(np.abs(np.linalg.eigvals(Phi)))
         if not rho < 1.0:
             raise DesignError("the sampled loop is unstable at %g s (spectral radius %.6f): "
-                              "lower the weights or the period" % (dt, rho))
+                              "lower the weights or the period (synth_hinf.py --suggest)" % (dt, rho))
         Cd = np.vstack([np.hstack([C, np.zeros((3, 1))]), np.sqrt(R) @ Ku])
         th = np.linspace(1e-4, np.pi, 4000)
         dnorm = max(np.linalg.norm(Cd @ np.linalg.solve(np.exp(1j * t) * np.eye(4) - Phi, Gw), 2) for t in th)
@@ -183,8 +201,18 @@ def main():
     ap.add_argument("--report", action="store_true",
                     help="also print the design report: gains, gamma, poles, gain and phase margins and the "
                          "closed-loop bandwidth, continuous and sampled at the checked periods")
+    ap.add_argument("--suggest", action="store_true",
+                    help="write no header: print the weights from the machine's periods, inertia, torque limit "
+                         "and encoder (docs/modules/hinf.md, \"Weights from the machine\") and their design")
     a = ap.parse_args()
     m = machine.load_or_exit(a.machine)
+    if a.suggest:
+        import hinf_weights
+        hinf, info = hinf_weights.suggest(m)
+        m = hinf_weights.with_hinf(m, hinf)
+        sys.stdout.write(json.dumps({"control": {"hinf": hinf}}, indent=1) + "\n")
+        sys.stdout.write("w0 = %.4g Hz (bound by the %s); one encoder count of velocity asks %.3g of the torque "
+                         "limit\n" % (info["omega0_rad_s"] / (2.0 * np.pi), info["bound"], info["count_torque_share"]))
     wts = weights(m)
     try:
         d = design(machine.params(m), wts)
@@ -192,8 +220,8 @@ def main():
         sys.stderr.write("%s: field control.hinf: %s\n" % (m["file"], e))
         sys.exit(1)
     d["machine_file"] = m["file"]
-    text = render(d, wts)
-    machine.write_atomic(a.out, text)  # a failed run leaves the old header
+    if not a.suggest:
+        machine.write_atomic(a.out, render(d, wts))  # a failed run leaves the old header
     sys.stdout.write("K = %s\ngamma_min = %.6g, gamma = %.6g, closed-loop norm = %.6g\n" % (
         d["K"], d["gamma_min"], d["gamma"], d["norm"]))
     if a.report:

@@ -258,7 +258,9 @@ int main(int argc, char **argv)
         br_circle_result_t res;
         /* 1: the firmware stopped the axis safe (a fault), part of the result */
         const int st = br_circle_run(&c, dir ? sink : NULL, &k, &res);
-        if (st < 0 || !isfinite(res.contour_rms_m) || !isfinite(res.max_err_m)) {
+        /* refused at init: a record of its own (br_run_report.h), not a failed tool */
+        const int refused = st < 0 && res.fault_cause == BR_RUN_CAUSE_REFUSED_AT_INIT;
+        if ((st < 0 && !refused) || !isfinite(res.contour_rms_m) || !isfinite(res.max_err_m)) {
             fprintf(stderr, "%s: run %s %s; nothing written\n", TOOL, runs[r].name,
                     st < 0 ? "failed" : "gave a non-finite result");
             br_outfile_discard(&tr);

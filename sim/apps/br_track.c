@@ -257,6 +257,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     const run_in_t ri = {tr->ref[0], v0, (double)n_run * c.dt_s};
     const br_plant_state_t x0 = {run_in_ref(&ri, -ri.t_s) / pc->lead_mprad, 0.0, 0.0};
     int rc = -1;
+    br_status_t refused = BR_OK; /* the firmware refused the application at init (br_run_report.h) */
     if (ctrl == BR_CTRL_HINF_PF && (mem.pf = calloc(1, sizeof *mem.pf)) == NULL) return -1;
     if (ctrl == BR_CTRL_HINF_UKF && (mem.ukf = calloc(1, sizeof *mem.ukf)) == NULL) return -1;
     br_est_t ffe = {&w.ff, br_ff_est_step, NULL, NULL};
@@ -266,7 +267,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     } else if (ff == 2) {
         /* the PF as configured (or the oracle), behind the wrapper that adds the inertia term */
         if (ctrl == BR_CTRL_HINF_TRUE) w.inner = ext;
-        else if (br_app_est_init(&ac, &mem, &w.inner) != BR_OK) {
+        else if ((refused = br_app_est_init(&ac, &mem, &w.inner)) != BR_OK) {
             fprintf(stderr, "br_track: PF init failed\n");
             goto done;
         }
@@ -279,6 +280,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     if (st == BR_OK) st = br_app_arm(&app); /* the simulator arms right after init */
     if (st != BR_OK) {
         fprintf(stderr, "br_track: application init failed (status %d)\n", (int)st);
+        refused = st;
         goto done;
     }
     const double L = pc->lead_mprad, rpc = 2.0 * BR_PI / pc->counts_per_rev;
@@ -312,6 +314,13 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     }
     rc = 0;
 done:
+    if (refused != BR_OK) {
+        /* the run never started: a fault at 0 s, counted, never a figure */
+        rep->fault_status = (int)refused;
+        rep->fault_cause = BR_RUN_CAUSE_REFUSED_AT_INIT;
+        rep->fault_t_s = 0.0;
+        rc = 0;
+    }
     free(mem.pf);
     free(mem.ukf);
     return rc;

@@ -7,6 +7,7 @@ run on Dask's local cluster, or on an existing one (--scheduler).
 Usage:
   fleet.py --out DIR [--n N] [--seed S] [--workers W | --scheduler ADDRESS]
            [--kinds thesis_circle,circle,p2p,emps] [--md DOC] [--command CMD] [--keep-builds]
+           [--hinf-weights reference|rule]
 
 Writes DIR/summary.json (the same for the same N, seed and kinds, whatever the
 workers: no time in it), DIR/timing.json (wall times), DIR/cdf.png, DIR/axes/NNNN/.
@@ -29,6 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import fleet_axis  # noqa: E402
 import fleet_runs  # noqa: E402
+from runs import refused  # noqa: E402
 
 REPO = fleet_axis.REPO
 KINDS = ("thesis_circle", "circle", "p2p", "emps")
@@ -59,10 +61,11 @@ def stats(vals):
 
 
 def summarise(recs, kinds=None):
-    """per controller: the RMS statistics of the completed runs, the ratio to H-inf only, the lost runs"""
+    """per controller: the RMS statistics of the completed runs, the ratio to H-inf only, the lost runs,
+    and the runs the firmware refused at init (never run: neither a figure nor lost)"""
     out = {}
     for ctrl in CONTROLLERS:
-        vals, ratios, lost, n = [], [], [], 0
+        vals, ratios, lost, refusals, n = [], [], [], [], 0
         for r in recs:
             for name, runs in r["runs"].items():
                 kind = r["traj"][name]["kind"]
@@ -70,6 +73,10 @@ def summarise(recs, kinds=None):
                     continue
                 n += 1
                 run_, h = runs[ctrl], runs.get("hinf_only")
+                if refused(run_):
+                    refusals.append({"axis": r["i"], "trajectory": name, "kind": kind,
+                                     "status": run_.get("init_status")})
+                    continue
                 hinf = None if ctrl == "hinf_only" or h is None or h["faulted"] else h["rms_m"]
                 if not run_["faulted"]:
                     vals.append(run_["rms_m"])
@@ -82,7 +89,8 @@ def summarise(recs, kinds=None):
         if n:
             out[ctrl] = {"n": n, "n_completed": len(vals), **stats(vals),
                          "median_ratio_to_hinf_only": float(np.median(ratios)) if ratios else None,
-                         "n_lost": len(lost), "lost": lost}
+                         "n_lost": len(lost), "lost": lost,
+                         "n_refused_at_init": len(refusals), "refused_at_init": refusals}
     return out
 
 
@@ -120,12 +128,14 @@ def fmt(v):
 
 
 def table(ctl):
-    L = ["| controller | runs | went to the end | median RMS | p90 | max | median / H-inf only | lost |",
-         "|---|---|---|---|---|---|---|---|"]
+    L = ["| controller | runs | went to the end | median RMS | p90 | max | median / H-inf only | lost "
+         "| refused at init |",
+         "|---|---|---|---|---|---|---|---|---|"]
     for k, v in ctl.items():
         ratio = "—" if v["median_ratio_to_hinf_only"] is None else "%.3f" % v["median_ratio_to_hinf_only"]
-        L.append("| %s | %d | %d | %s m | %s m | %s m | %s | %d |" % (k, v["n"], v["n_completed"], fmt(v["median_m"]),
-                                                                    fmt(v["p90_m"]), fmt(v["max_m"]), ratio, v["n_lost"]))
+        L.append("| %s | %d | %d | %s m | %s m | %s m | %s | %d | %d |" % (
+            k, v["n"], v["n_completed"], fmt(v["median_m"]), fmt(v["p90_m"]), fmt(v["max_m"]), ratio, v["n_lost"],
+            v["n_refused_at_init"]))
     return L
 
 
@@ -135,6 +145,17 @@ def lost_lines(summ):
         for x in v["lost"]:
             when = " at %.4f s" % x["t_s"] if x["t_s"] is not None else ""
             out.append("%s: axis %d, %s, %s%s" % (k, x["axis"], x["trajectory"], x["cause"], when))
+    return out
+
+
+def refused_lines(summ):
+    """the runs refused at init, by controller and axis"""
+    out = []
+    for k, v in summ["controllers"].items():
+        by_axis = {}
+        for x in v["refused_at_init"]:
+            by_axis.setdefault((x["axis"], x["status"]), []).append(x["trajectory"])
+        out += ["%s: axis %d, status %s: %s" % (k, ax, st, ", ".join(tr)) for (ax, st), tr in sorted(by_axis.items())]
     return out
 
 
@@ -150,6 +171,16 @@ def lost_causes(summ):
     return out
 
 
+def hinf_line(summ):
+    """which axes' given files took the H-inf weights from the machine (fleet_axis.use_hinf_rule)"""
+    ruled = [r["i"] for r in summ["axes"] if r.get("machine", {}).get("hinf_weights", "the reference's")
+             != "the reference's"]
+    if summ.get("hinf_weights") == "rule":
+        return "H-inf weights: from the machine on every axis (`--hinf-weights rule`, firmware/design/hinf_weights.py)."
+    return ("H-inf weights: the reference's, and from the machine (firmware/design/hinf_weights.py) where the "
+            "reference's admit no acceptable design: %s." % (", ".join("axis %d" % i for i in ruled) or "no axis"))
+
+
 def write_md(path, summ, command, out_dir=None, out_name=None):
     """the page's measured part; out_dir's absolute path in the messages is written as out_name
     (default out_dir as given: a page does not name one machine's folders)"""
@@ -163,6 +194,7 @@ def write_md(path, summ, command, out_dir=None, out_name=None):
     L += ["Axes through the chain: %d of %d%s" % (summ["n_axes"] - len(fails), summ["n_axes"],
                                                   "; the chain failed on:" if fails else ".")]
     L += [""] + ["- axis %d, %s: %s" % (f["axis"], f["stage"], f["message"]) for f in fails] if fails else []
+    L += ["", hinf_line(summ)]
     L += ["", "### All trajectories (the contour RMS of the circles and the tracking RMS of the tracks together)",
           ""] + table(summ["controllers"])
     for kind, ctl in summ["kinds"].items():
@@ -178,6 +210,12 @@ def write_md(path, summ, command, out_dir=None, out_name=None):
         L += ["- " + x for x in lines] + ["", "</details>"]
     else:
         L += ["none"]
+    ref = refused_lines(summ)
+    L += ["", "### Refused at init (%d)" % len(ref), "",
+          "Runs whose application the firmware refused at init (`br_app_init`'s BR_E_* status, e.g. the "
+          "estimation model's sub-step bound): never run, so neither a figure nor lost; the \"runs\" column "
+          "counts them.", ""]
+    L += ["- " + x for x in ref] if ref else ["none"]
     L += ["", "CDF per trajectory kind: `out/fleet/cdf.png`.", ""]
     if out_dir:
         L = [x.replace(os.path.abspath(out_dir), (out_name or out_dir).rstrip("/")) for x in L]
@@ -240,6 +278,10 @@ def main():
     ap.add_argument("--md", help="docs page: its part after <!-- fleet:begin --> is rewritten")
     ap.add_argument("--command", default="make fleet")
     ap.add_argument("--keep-builds", action="store_true", help="keep each axis's two host builds")
+    ap.add_argument("--hinf-weights", choices=("reference", "rule"), default="reference",
+                    help="the given files' control.hinf: the reference's, replaced by the weights from the "
+                         "machine (firmware/design/hinf_weights.py) where they admit no acceptable design "
+                         "(default); or the weights from the machine on every axis")
     ap.add_argument("--expect-faults", action="store_true",
                     help="with --md: the page may tabulate faulted runs (listed with time and cause); "
                          "without it a faulted run makes the study exit 1 after writing the page")
@@ -270,13 +312,15 @@ def main():
     if not (1 <= a.n <= 100000) or a.workers < 1 or not kinds or set(kinds) - set(KINDS):
         ap.error("--n in 1..100000, --workers >= 1, --kinds from %s" % ",".join(KINDS))
     os.makedirs(a.out, exist_ok=True)
-    args = {"src": REPO, "out": os.path.abspath(a.out), "seed": a.seed, "kinds": kinds, "keep": a.keep_builds}
+    args = {"src": REPO, "out": os.path.abspath(a.out), "seed": a.seed, "kinds": kinds, "keep": a.keep_builds,
+            "hinf_rule": a.hinf_weights == "rule"}
     t0 = time.time()
     recs = distribute(a, args)
     wall = time.time() - t0
     errors = [r for r in recs if "error" in r]
     good = [r for r in recs if "error" not in r]
     summ = {"generator": "sim/studies/fleet.py", "n_axes": a.n, "seed": a.seed, "kinds_run": kinds,
+            "hinf_weights": a.hinf_weights,
             **({"axes_run": a.axes} if a.axes is not None else {}),
             "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],
             "controllers": summarise(good),
@@ -302,6 +346,8 @@ def main():
         print("chain failed: axis %d, %s: %s" % (f["axis"], f["stage"], f["message"]))
     for line in lost_lines(summ):
         print("lost: " + line)
+    for line in refused_lines(summ):
+        print("refused at init: " + line)
     print("wrote %s/summary.json, timing.json, cdf.png%s" % (a.out, ", " + a.md if a.md else ""))
     for r in errors:
         print("fleet: internal error on axis %d:\n%s" % (r["i"], r["error"]), file=sys.stderr)

@@ -19,6 +19,7 @@ import numpy as np
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "firmware", "design"))
+import hinf_weights  # noqa: E402  (the H-inf weights from the machine)
 import machine  # noqa: E402  (the stop bound of the drive protections)
 
 # the ranges of issue 28 (a machine file a user may bring)
@@ -140,6 +141,16 @@ def given_file(ax, name):
     set_stroke(m)
     m["provenance"] = {"friction." + k: "assumed" for k in m["friction"]}
     return m
+
+
+def use_hinf_rule(m, always=False):
+    """control.hinf of the given file m from the machine (hinf_weights.py, docs/modules/hinf.md) when
+    the reference's weights admit no acceptable design on it, or always: why, or None (kept)"""
+    hinf, why = hinf_weights.weights_or_rule(m, always)
+    if why is not None:
+        m["control"]["hinf"] = hinf
+        m["provenance"].update({"control.hinf." + k: "derived" for k in hinf})
+    return why
 
 
 def set_stroke(m):

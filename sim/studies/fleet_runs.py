@@ -27,7 +27,7 @@ sys.path.insert(0, HERE)
 import fleet_axis  # noqa: E402
 import machine_chain  # noqa: E402
 from robustness import LOST_OUTLIER_FRAC  # noqa: E402
-from runs import faulted  # noqa: E402
+from runs import REFUSED_AT_INIT, faulted  # noqa: E402
 
 CIRCLE_CTRLS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")  # br_robust_run, the machine file's model
 TRACK_CTRLS = ("hinf_only", "hinf_ukf", "hinf_pf")              # br_track (its feedforward is the plant's: an oracle)
@@ -64,7 +64,9 @@ def run_seed(study_seed, i, k):
 def result(raw, rms_key, max_key):
     """one run's record: its figures, or its fault (then no figures)"""
     if faulted(raw):
-        return {"faulted": True, "fault_t_s": raw["fault_t_s"], "fault_cause": raw.get("fault_cause", "unknown")}
+        # a run refused at init keeps its status (the firmware's BR_E_*): fleet.py counts it apart
+        return {"faulted": True, "fault_t_s": raw["fault_t_s"], "fault_cause": raw.get("fault_cause", "unknown"),
+                **({"init_status": raw["fault_status"]} if raw.get("fault_cause") == REFUSED_AT_INIT else {})}
     r = {"faulted": False, "rms_m": raw[rms_key], "max_m": raw[max_key]}
     if "outlier_steps" in raw:
         r["outlier_steps"] = raw["outlier_steps"]
@@ -123,6 +125,7 @@ def chain(a, ax, d, log, sw):
     """the user's chain: the paths of the truth model and the two tools built for machine.json"""
     given, truth = os.path.join(d, "given.json"), os.path.join(d, "truth.json")
     g = fleet_axis.given_file(ax, "fleet-%04d" % ax["i"])
+    why = fleet_axis.use_hinf_rule(g, a.hinf_rule)
     for path, m in ((given, g), (truth, fleet_axis.truth_file(ax, g))):
         with open(path, "w", encoding="utf-8") as f:
             json.dump(m, f, indent=1)
@@ -151,7 +154,8 @@ def chain(a, ax, d, log, sw):
     sw.lap("builds")
     with open(machine_json, encoding="utf-8") as f:
         mj = json.load(f)
-    return truth_model, robust, track, {sec: mj[sec] for sec in ("mechanics", "friction", "causes")}
+    return truth_model, robust, track, {"hinf_weights": why or "the reference's",
+                                        **{sec: mj[sec] for sec in ("mechanics", "friction", "causes", "control")}}
 
 
 def trajectory_set(a, ax):

@@ -19,6 +19,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from runs import refused  # noqa: E402
+
 CTRLS = ("hinf_ukf", "hinf_pf")
 
 
@@ -55,8 +58,8 @@ def runs(root):
             for f in sorted(glob.glob(os.path.join(ax, "*_%s.json" % ctrl))):
                 raw = load(f)
                 r = raw.get("controllers", raw).get(ctrl)  # br_robust_run nests, br_track does not
-                if r is None:
-                    continue
+                if r is None or refused(r):
+                    continue  # not run: refused at init (fleet.py counts it apart)
                 h = p["T_pf_s"] if ctrl == "hinf_pf" else p["T_s"]
                 out.append(dict(p, ctrl=ctrl, faulted=bool(r.get("faulted")),
                                 d_m=p["Fc_N"] * h * h / (2.0 * p["Meff_kg"])))

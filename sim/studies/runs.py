@@ -9,6 +9,16 @@ def faulted(run_):
     return run_.get("fault_status", 0) != 0
 
 
+# the cause of a run whose application the firmware refused at init (sim/lib/tool/br_run_report.h)
+REFUSED_AT_INIT = "refused_at_init"
+
+
+def refused(run_):
+    """the firmware refused the application at init (an estimator's setting, the model's sub-step
+    bound): the run never started; a fault with this cause in the tools' records (and fleet.py's)"""
+    return run_.get("fault_cause") == REFUSED_AT_INIT
+
+
 def fault_text(run_):
     """the fault where a figure would stand: its time and cause"""
     return "fault at %.3f s (%s)" % (run_["fault_t_s"], run_.get("fault_cause", "unknown"))

@@ -167,6 +167,15 @@ static void test_pf_beats_thesis_ratio(void **st)
 #endif
 }
 
+static void assert_refused_at_init(const br_circle_cfg_t *c)
+{
+    br_circle_result_t r;
+    assert_int_equal(br_circle_run(c, NULL, NULL, &r), -1);
+    assert_int_equal(r.fault_status, BR_E_PARAM);
+    assert_int_equal(r.fault_cause, BR_RUN_CAUSE_REFUSED_AT_INIT);
+    assert_true(r.fault_t_s == 0.0 && r.n_samples == 0);
+}
+
 static void test_rejects_bad_experiment(void **st)
 {
     (void)st;
@@ -177,16 +186,19 @@ static void test_rejects_bad_experiment(void **st)
     c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     c.plant.sigma0_Npm = -1.0;
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+    assert_int_equal(r.fault_cause, 0); /* the harness's plant, not the firmware, refused it */
+    /* what the firmware refuses at init (br_app_init: the controller's gains, an estimator
+     * whose period is not the loop's, an estimator's setting): -1, the result saying so
+     * (br_run_report.h) */
     c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     c.K[0] = NAN;
-    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
-    /* an estimator whose period is not the loop's */
+    assert_refused_at_init(&c);
     c = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
     c.dt_s = 2.0 * c.dt_s;
-    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+    assert_refused_at_init(&c);
     c = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
     c.ukf.est.r_var_rad2 = -1.0f;
-    assert_int_equal(br_circle_run(&c, NULL, NULL, &r), -1);
+    assert_refused_at_init(&c);
     /* a direction other than +1 (clockwise) or -1 */
     c = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
     c.dir = 0.5;

@@ -81,7 +81,13 @@ class Fleet(unittest.TestCase):
             for name, runs in r["runs"].items():
                 for ctrl, run_ in runs.items():
                     lost = [x for x in s["controllers"][ctrl]["lost"] if x["axis"] == r["i"] and x["trajectory"] == name]
-                    if run_["faulted"]:
+                    if fleet.refused(run_):
+                        # refused at init: counted apart, never lost, never a figure
+                        self.assertNotIn("rms_m", run_)
+                        self.assertEqual(lost, [])
+                        self.assertIn({"axis": r["i"], "trajectory": name, "kind": r["traj"][name]["kind"],
+                                       "status": run_["init_status"]}, s["controllers"][ctrl]["refused_at_init"])
+                    elif run_["faulted"]:
                         self.assertNotIn("rms_m", run_)
                         self.assertEqual(len(lost), 1, (r["i"], name, ctrl))
                         self.assertEqual(lost[0]["cause"], run_["fault_cause"])
@@ -119,12 +125,22 @@ class Fleet(unittest.TestCase):
                     "runs": {"c": {"hinf_only": {"faulted": False, "rms_m": 1e-6, "max_m": 2e-6}, "hinf_pf": pf}}}
         recs = [rec(0, {"faulted": True, "fault_t_s": 0.05, "fault_cause": "lost_lock"}),
                 rec(1, {"faulted": False, "rms_m": 2e-6, "max_m": 3e-6}),
-                rec(2, {"faulted": False, "rms_m": 1e-8, "max_m": 3e-8})]
+                rec(2, {"faulted": False, "rms_m": 1e-8, "max_m": 3e-8}),
+                rec(3, {"faulted": True, "fault_t_s": 0.0, "fault_cause": "refused_at_init", "init_status": -2})]
         pf = fleet.summarise(recs)["hinf_pf"]
-        self.assertEqual((pf["n"], pf["n_completed"], pf["n_lost"]), (3, 2, 2))
+        self.assertEqual((pf["n"], pf["n_completed"], pf["n_lost"]), (4, 2, 2))
         self.assertEqual(pf["max_m"], 2e-6)
         self.assertEqual([(x["axis"], x["cause"], x["t_s"]) for x in pf["lost"]],
                          [(0, "lost_lock", 0.05), (1, "worse_than_hinf_only", None)])
+        # the run the firmware refused at init: counted per controller, neither lost nor a figure
+        self.assertEqual((pf["n_refused_at_init"], pf["refused_at_init"]),
+                         (1, [{"axis": 3, "trajectory": "c", "kind": "circle", "status": -2}]))
+        row = [x for x in fleet.table({"hinf_pf": pf}) if x.startswith("| hinf_pf")][0]
+        self.assertTrue(row.endswith("| 2 | 1 |"), row)
+        summ = {"controllers": {"hinf_pf": pf}}
+        self.assertEqual(fleet.refused_lines(summ), ["hinf_pf: axis 3, status -2: c"])
+        self.assertEqual(fleet.unexpected_faults(summ, __import__("types").SimpleNamespace(
+            md="page.md", expect_faults=False)), 1)  # the lost_lock, not the refusal
 
     def test_axis_draw_in_range(self):
         for i in range(50):

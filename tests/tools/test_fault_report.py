@@ -4,7 +4,8 @@ is not a result"): br_circle_ext and br_track print it as a fault with its time
 and cause and write null figures; machine_chain.py and robustness.py show it as
 a fault, keep it out of every RMS statistic, and exit 1 on one they did not
 expect. The faults are real: a plant whose actuator delay (6 ms, 20 ms) is
-beyond every candidate of the delay identification.
+beyond every candidate of the delay identification. An estimator the firmware
+refuses at init is such a record too (refused_at_init), never a failed tool.
 
 Usage: test_fault_report.py --bin BUILD/sim --work DIR"""
 import argparse
@@ -30,11 +31,12 @@ def run(tool, *a):
     return subprocess.run([os.path.join(ARGS.bin, tool), *a], capture_output=True, text=True, timeout=600)
 
 
-def reference_model(path, delay_s):
-    """the reference machine's plant (machines/reference.json) with an actuator delay, as a model.json"""
+def reference_model(path, delay_s, **friction):
+    """the reference machine's plant (machines/reference.json) with an actuator delay (and the friction
+    terms given), as a model.json"""
     m = machine.load(os.path.join(REPO, "machines", "reference.json"))
     p = machine.params(m)
-    params = {"Meff_kg": p["Jeff_kgm2"] / p["L_mprad"] ** 2, **m["friction"], "delay_s": delay_s}
+    params = {"Meff_kg": p["Jeff_kgm2"] / p["L_mprad"] ** 2, **m["friction"], **friction, "delay_s": delay_s}
     with open(path, "w", encoding="utf-8") as f:
         json.dump({"format": "bristle-model/2", "params": params}, f)
 
@@ -84,6 +86,38 @@ class FaultReport(unittest.TestCase):
         self.assertIsNone(t["hinf_pf"]["rms_m"])
         self.assertNotEqual(t["hinf_pf"]["fault_cause"], "none")
         self.assert_fault_line(r.stdout, "hinf_pf")
+
+    def assert_refused(self, out, rec, name, rms_key):
+        """a run the firmware refused at init: a fault at 0 s with its BR_E_* and the cause
+        refused_at_init, null figures, one REFUSED line (br_run_report.h)"""
+        self.assertTrue(rec["faulted"])
+        self.assertEqual((rec["fault_cause"], rec["fault_status"], rec["fault_t_s"]), ("refused_at_init", -2, 0))
+        self.assertIsNone(rec[rms_key])
+        line = [ln for ln in out.splitlines() if ln.split() and ln.split()[0] == name]
+        self.assertEqual(line, ["%-14s REFUSED at init (status -2): no result" % name])
+
+    def test_refused_at_init(self):
+        """an estimator the firmware refuses at init is a record, not a failed tool (exit 0): br_robust_run's
+        identified model with a bristle damping beyond the model's sub-step bound (docs/modules/model.md),
+        br_track's extended model with a delay beyond the estimators' bound"""
+        model = os.path.join(self.w, "model.json")
+        reference_model(model, 0.0, sigma1_Nspm=1e7)
+        js = os.path.join(self.w, "r.json")
+        r = run("br_robust_run", "--model", model, "--only", "hinf_only,hinf_pf_id,hinf_ukf_id", "--json", js)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(js) as f:
+            c = json.load(f)["controllers"]
+        self.assertFalse(c["hinf_only"]["faulted"])
+        for name in ("hinf_pf_id", "hinf_ukf_id"):
+            self.assert_refused(r.stdout, c[name], name, "contour_rms_m")
+        ref = os.path.join(self.w, "ref.csv")
+        with open(ref, "w") as f:
+            f.write("t,ref\n" + "".join("%.6f,%.9e\n" % (k * 1e-3, 1e-3 * min(k / 500.0, 1.0)) for k in range(1000)))
+        reference_model(model, 0.1)
+        r = run("br_track", "--ref", ref, "--model", model, "--ctrl", "hinf_pf_ext", "--json", js)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(js) as f:
+            self.assert_refused(r.stdout, json.load(f)["hinf_pf_ext"], "hinf_pf_ext", "rms_m")
 
     def test_machine_chain_page(self):
         s = {"track": {"hinf_only": {"rms_m": 4e-5, "max_m": 1e-4, "fault_status": 0},

@@ -113,7 +113,7 @@ def cmd_diagnose(args):
             rep["impossible_samples"] = output.rounded(impossible)
         output.write_json(os.path.join(out, "report.json"), rep)
         output.write_json(os.path.join(out, "model.json"), modelfile.build(prep, diag, log_path=args.log))
-        machinejson.write(out, prep, diag, given, args.log, say)
+        machinejson.write(out, prep, diag, given, args.log, say, hinf_rule=args.hinf_weights == "rule")
         figs = []
         if not args.no_plots:
             for name, what, draw in FIGURES:
@@ -210,6 +210,10 @@ def parser(prog="bristle-diagnose"):
     d.add_argument("--fc", type=float, default=signals.FC_HZ, metavar="HZ",
                    help=f"low-pass cutoff of the velocity and acceleration filter, Hz (default {signals.FC_HZ:g})")
     d.add_argument("--no-plots", action="store_true", help="write no figures (no matplotlib needed)")
+    d.add_argument("--hinf-weights", choices=("given", "rule"), default="given",
+                   help="machine.json's control.hinf: the given (or reference) file's weights, replaced by the "
+                        "weights from the machine where they admit no acceptable design (given, the default); "
+                        "or the weights from the machine (rule; docs/modules/hinf.md, \"Weights from the machine\")")
     v = sub.add_parser("validate", parents=[common], epilog=EPILOG,
                        help="relerr of a saved model on another log",
                        description="The relative error of a saved model (model.json of a diagnosis) on another "

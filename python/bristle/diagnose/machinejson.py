@@ -25,6 +25,9 @@ marked "assumed"; what follows from the log and the rest is "derived". The
   causes           model.json's causes and their parameters, same names ("identified")
   friction_model   presliding_hysteresis's element set as maxwell_slip ("identified"),
                    when the other causes are ones the estimators combine with it
+  control.hinf     the base's weights, unless they admit no acceptable H-inf design on
+                   the identified machine, or hinf_rule asks: then the weights from the
+                   machine (firmware/design/hinf_weights.py, "derived")
   estimator        the base's, as they are: format 2 states them in the
                    machine's own units (per second, in metres, in Fs, Fc and
                    Fs/sigma0), so they follow the identified friction and
@@ -38,6 +41,7 @@ import importlib.util
 import math
 import os
 import re
+import sys
 
 import numpy as np
 
@@ -101,6 +105,36 @@ def base(given=None):
         raise closedloop.ControllerError("\n".join(e.lines)) from None
 
 
+def _hinf_weights():
+    """firmware/design/hinf_weights.py (with synth_hinf.py), or None where the source tree is not
+    there (the installed package: `make firmware` checks the weights then)"""
+    design = os.path.join(REPO, "firmware", "design")
+    if not os.path.isfile(os.path.join(design, "hinf_weights.py")):
+        return None
+    if design not in sys.path:
+        sys.path.insert(0, design)
+    return importlib.import_module("hinf_weights")
+
+
+def _hinf(m, prov, notes, always):
+    """control.hinf: the base's weights when they give an acceptable design on m, else (or always)
+    the weights from the machine (docs/modules/hinf.md, "Weights from the machine")"""
+    hw = _hinf_weights()
+    if hw is None:
+        notes.append("control.hinf is not checked: firmware/design/hinf_weights.py is not here "
+                     "(`make firmware` checks it)")
+        return
+    try:
+        hinf, why = hw.weights_or_rule(m, always)
+    except hw.synth_hinf.DesignError as e:
+        raise closedloop.ControllerError("control.hinf: %s" % e) from None
+    if why is not None:
+        m["control"]["hinf"] = hinf
+        for k in hinf:
+            prov["control.hinf." + k] = "derived"
+        notes.append("control.hinf: %s" % why)
+
+
 def _leaves(d, prefix=""):
     for k, v in d.items():
         path = prefix + k
@@ -138,8 +172,9 @@ def _set(m, dotted, value, prov, kind):
     prov[dotted] = kind
 
 
-def build(prep, diag, given=None, log_path=None):
-    """The machine file as a dict (not yet rounded) and a list of notes."""
+def build(prep, diag, given=None, log_path=None, hinf_rule=False):
+    """The machine file as a dict (not yet rounded) and a list of notes; hinf_rule: the H-inf
+    weights from the machine whatever the base's are."""
     mach = _loader()
     notes = []
     if given is not None:
@@ -242,6 +277,7 @@ def build(prep, diag, given=None, log_path=None):
                  "assumed" if q.name in held else "identified")
 
     _friction_model(m, diag, prov, notes)
+    _hinf(m, prov, notes, hinf_rule)
 
     log_name = os.path.basename(log_path or prep.path)
     if given is None:
@@ -282,9 +318,9 @@ def _friction_model(m, diag, prov, notes):
                      "estimation model does not combine with it yet" % ", ".join(others))
 
 
-def write(out_dir, prep, diag, given=None, log_path=None, say=print):
+def write(out_dir, prep, diag, given=None, log_path=None, say=print, hinf_rule=False):
     """Writes out_dir/machine.json and checks that it loads; returns its path."""
-    m, notes = build(prep, diag, given=given, log_path=log_path)
+    m, notes = build(prep, diag, given=given, log_path=log_path, hinf_rule=hinf_rule)
     m = output.rounded(m)
     for f in ("counts_per_rev", "counter_bits"):
         m["encoder"][f] = int(m["encoder"][f])

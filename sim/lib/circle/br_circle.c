@@ -373,7 +373,9 @@ static int pred_wrap(axis_sim_t *a, const br_circle_cfg_t *c, br_app_cfg_t *ac, 
     return 0;
 }
 
-static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int index)
+/* 0, or -1 with a message; *refused the firmware's BR_E_* when it refused the
+ * application (an estimator, the feedforward) at init, else left as it is */
+static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int index, br_status_t *refused)
 {
     a->phase = phase;
     a->ff_on = 0;
@@ -408,7 +410,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
         ac.est = BR_APP_EST_EXTERN;
         break;
     case BR_CTRL_HINF_FF:
-        if (br_ff_init(&a->ff, &c->ff) != BR_OK) {
+        if ((*refused = br_ff_init(&a->ff, &c->ff)) != BR_OK) {
             fprintf(stderr, "br_circle: invalid feedforward configuration\n");
             return -1;
         }
@@ -417,7 +419,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
         ac.est = BR_APP_EST_EXTERN;
         break;
     case BR_CTRL_HINF_QEC:
-        if ((float)c->dt_s != c->qec.dt_s || br_qec_init(&a->qec, &c->qec) != BR_OK) {
+        if ((float)c->dt_s != c->qec.dt_s || (*refused = br_qec_init(&a->qec, &c->qec)) != BR_OK) {
             fprintf(stderr, "br_circle: invalid reversal compensation configuration\n");
             return -1;
         }
@@ -442,6 +444,7 @@ static int axis_init(axis_sim_t *a, const br_circle_cfg_t *c, double phase, int 
     }
     if (st != BR_OK) {
         fprintf(stderr, "br_circle: application init failed (status %d)\n", (int)st);
+        *refused = st;
         return -1;
     }
     return 0;
@@ -495,9 +498,21 @@ static int axis_step(axis_sim_t *a, const br_circle_remote_t *remote, int i, lon
     return 0;
 }
 
+/* the firmware refused the application at init: the run never started (br_run_report.h);
+ * -1 as for any configuration the run cannot take, res saying why */
+static int refused_at_init(br_circle_result_t *res, br_status_t st)
+{
+    memset(res, 0, sizeof *res);
+    res->fault_status = (int)st;
+    res->fault_cause = BR_RUN_CAUSE_REFUSED_AT_INIT;
+    res->last_outlier_t_s = -1.0;
+    return -1;
+}
+
 int br_circle_run_remote(const br_circle_cfg_t *c, const br_circle_remote_t *remote, br_circle_sink_t sink,
                          void *user, br_circle_result_t *res)
 {
+    res->fault_cause = 0; /* BR_RUN_CAUSE_REFUSED_AT_INIT only when the firmware refused */
     if (!(c->radius_m > 0.0 && c->period_s > 0.0 && c->duration_s > 0.0 && c->dt_s > 0.0)) {
         fprintf(stderr, "br_circle: radius, period, duration and dt must be > 0\n");
         return -1;
@@ -515,7 +530,11 @@ int br_circle_run_remote(const br_circle_cfg_t *c, const br_circle_remote_t *rem
     axis_sim_t ax[2];
     ax[0].mem = ax[1].mem = (br_app_mem_t){NULL, NULL};
     int rc = -1;
-    if (axis_init(&ax[0], c, axis_phase(0), 0) != 0 || axis_init(&ax[1], c, axis_phase(1), 1) != 0) goto done;
+    br_status_t refused = BR_OK;
+    if (axis_init(&ax[0], c, axis_phase(0), 0, &refused) != 0 || axis_init(&ax[1], c, axis_phase(1), 1, &refused) != 0) {
+        if (refused != BR_OK) rc = refused_at_init(res, refused);
+        goto done;
+    }
     const long n = lround(c->duration_s / c->dt_s);
     double sum2 = 0.0, emax = 0.0, fe2 = 0.0, track_max = 0.0, lost_t = 0.0;
     int nsat = 0, nout = 0;

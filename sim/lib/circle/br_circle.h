@@ -204,7 +204,9 @@ typedef void (*br_circle_sink_t)(void *user, const br_circle_sample_t *s);
 /* Runs the experiment, calling sink (if not NULL) once per period. Returns 0;
  * 1 when the firmware stopped an axis (a fault: zero duty, the status and time
  * in res->fault_status, fault_t_s; the results cover the periods before it);
- * -1 with a message on stderr on an invalid configuration. */
+ * -1 with a message on stderr on an invalid configuration, res->fault_cause
+ * BR_RUN_CAUSE_REFUSED_AT_INIT (and res->fault_status the BR_E_*) when it was
+ * the firmware that refused the application at init (br_run_report.h). */
 int br_circle_run(const br_circle_cfg_t *cfg, br_circle_sink_t sink, void *user, br_circle_result_t *res);
 
 /* The application elsewhere: the image in the loop (sim/apps/br_pil.c, docs/link.md,

@@ -23,13 +23,16 @@ const char *br_run_fault_name(int cause)
     case BR_APP_FAULT_TRAVEL: return "travel";
     case BR_APP_FAULT_REF_UNDERRUN: return "ref_underrun";
     case BR_RUN_CAUSE_NOT_FOLLOWED: return "not_followed";
+    case BR_RUN_CAUSE_REFUSED_AT_INIT: return "refused_at_init";
     default: return "unknown";
     }
 }
 
 void br_run_print(FILE *f, const char *name, const char *what, const br_run_report_t *r)
 {
-    if (r->fault_status != 0) {
+    if (r->fault_status != 0 && r->fault_cause == BR_RUN_CAUSE_REFUSED_AT_INIT) {
+        fprintf(f, "%-14s REFUSED at init (status %d): no result\n", name, r->fault_status);
+    } else if (r->fault_status != 0) {
         fprintf(f, "%-14s FAULT at %.4f s (%s, status %d): no result\n", name, r->fault_t_s,
                 br_run_fault_name(r->fault_cause), r->fault_status);
     } else {

@@ -19,6 +19,13 @@
 #define BR_RUN_NOT_FOLLOWED (-1000)
 #define BR_RUN_CAUSE_NOT_FOLLOWED (-1)
 
+/* A run whose application the firmware refused at init (br_app_init or an
+ * estimator's init returned a BR_E_* status: a setting out of range, the
+ * estimation model's sub-step bound) never started: it is reported as a
+ * fault at 0 s with that status and the cause BR_RUN_CAUSE_REFUSED_AT_INIT
+ * ("refused_at_init"), so that it is counted, never a figure and never absent. */
+#define BR_RUN_CAUSE_REFUSED_AT_INIT (-2)
+
 typedef struct {
     double rms_m;   /* contour or tracking RMS over the run */
     double max_m;   /* largest error */
@@ -32,7 +39,8 @@ typedef struct {
 const char *br_run_fault_name(int cause);
 
 /* One line: "<name> <what> RMS %.4e m, max %.4e m" for a run that went to the end,
- * "<name> FAULT at %.4f s (<cause>, status %d): no result" for a faulted one. */
+ * "<name> FAULT at %.4f s (<cause>, status %d): no result" for a faulted one,
+ * "<name> REFUSED at init (status %d): no result" for one refused at init. */
 void br_run_print(FILE *f, const char *name, const char *what, const br_run_report_t *r);
 
 /* The run's JSON members, without braces: "<rms_key>": x, "<max_key>": y, "faulted": false,
