@@ -10,9 +10,9 @@ search around the best point. Plant (br_sim_plant.c), closed loop and
 estimator (the firmware's extended model: model.causes.delay_s, a command
 history in br_est): the torque reaching the axis is the command of d earlier."""
 import numpy as np
-from scipy import optimize
 
 from ..params import Param
+from ..search1d import grid_then_bounded
 
 NAME = "actuator_delay"
 MEANING = "a dead time between the commanded and the applied force"
@@ -59,13 +59,7 @@ def search(prep, base, fit_with):
         return fit_with({"delay_s": max(d, 0.0)}).train_sse
 
     grid = np.arange(0.0, DELAY_MAX_S + 1e-12, 0.5 * dt)
-    vals = [sse(d) for d in grid]
-    i = int(np.argmin(vals))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    if b <= a:
-        return {"delay_s": float(grid[i])}
-    r = optimize.minimize_scalar(sse, bounds=(a, b), method="bounded", options={"xatol": 1e-3 * dt})
-    return {"delay_s": float(max(r.x, 0.0))}
+    return {"delay_s": max(grid_then_bounded(sse, grid, 1e-3 * dt), 0.0)}
 
 
 def params(coef, nl, p):

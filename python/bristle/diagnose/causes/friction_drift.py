@@ -12,9 +12,9 @@ starting value each second. r is searched on a GRID-point grid over
 |r| < 0.95 / T (T the log's duration: s stays positive on the log), then by a
 bounded search around the best point."""
 import numpy as np
-from scipy import optimize
 
 from ..params import Param
+from ..search1d import grid_then_bounded
 
 NAME = "friction_drift"
 MEANING = ("friction level (Coulomb, stiction, viscous together) changing with time: warm-up of screw, "
@@ -52,12 +52,7 @@ def search(prep, base, fit_with):
     def sse(r):
         return fit_with({"drift_per_s": r}).train_sse
 
-    grid = np.linspace(-rmax, rmax, GRID)
-    vals = [sse(r) for r in grid]
-    i = int(np.argmin(vals))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    r = optimize.minimize_scalar(sse, bounds=(a, b), method="bounded", options={"xatol": 1e-4 * rmax})
-    return {"drift_per_s": float(r.x)}
+    return {"drift_per_s": grid_then_bounded(sse, np.linspace(-rmax, rmax, GRID), 1e-4 * rmax)}
 
 
 def params(coef, nl, p):

@@ -8,9 +8,9 @@ s = grad_per_m. s is searched on a GRID-point grid over |s| < 0.95 / max|x|
 (k stays positive on the log), then by a bounded search around the best
 point."""
 import numpy as np
-from scipy import optimize
 
 from ..params import Param
+from ..search1d import grid_then_bounded
 
 NAME = "position_gradient"
 MEANING = "friction that grows or shrinks along the travel: misalignment, preload variation"
@@ -47,12 +47,7 @@ def search(prep, base, fit_with):
     def sse(s):
         return fit_with({"grad_per_m": s}).train_sse
 
-    grid = np.linspace(-smax, smax, GRID)
-    vals = [sse(s) for s in grid]
-    i = int(np.argmin(vals))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    r = optimize.minimize_scalar(sse, bounds=(a, b), method="bounded", options={"xatol": 1e-4 * smax})
-    return {"grad_per_m": float(r.x)}
+    return {"grad_per_m": grid_then_bounded(sse, np.linspace(-smax, smax, GRID), 1e-4 * smax)}
 
 
 def params(coef, nl, p):
