@@ -80,24 +80,29 @@
         .dt_s = (dt), .causes = BR_MACHINE_CAUSES, .mslip = BR_MACHINE_MSLIP                       \
     }
 
+/* What both filters take from the estimator section (br_est_cfg_t; E: PF or
+ * UKF): the model at period dt, the process noise q_* (rad^2, (rad/s)^2, m^2,
+ * N^2) and the measurement noise r (rad^2), the g_p range, the gates, the
+ * lead and the delay identification. */
+#define BR_MACHINE_EST_CFG(E, dt, q_theta, q_omega, q_z, q_gp, r)                                  \
+    {                                                                                              \
+        .model = BR_MACHINE_MODEL_CFG(dt), .q_var = {(q_theta), (q_omega), (q_z), (q_gp)},         \
+        .r_var_rad2 = (r), .gp0_N = BR_EST_##E##_GP0_N_F, .gp_min_N = BR_EST_##E##_GP_MIN_N_F,     \
+        .gp_max_N = BR_EST_##E##_GP_MAX_N_F, .outlier_sigma = BR_EST_##E##_OUTLIER_SIGMA_F,        \
+        .reanchor_after = BR_EST_##E##_REANCHOR_AFTER, .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F, \
+        .comp_ahead_periods = BR_EST_##E##_COMP_AHEAD_PERIODS_F,                                   \
+        .delay_id = BR_MACHINE_DELAY_ID_CFG(E)                                                     \
+    }
+
 /* The PF at period dt with the process noise q_omega, q_z, q_gp and the
  * measurement noise r (rad^2); the rest from the machine file's estimator
  * section (particles, theta noise and spreads in counts, g_p range, gates). */
 #define BR_MACHINE_PF_CFG_Q(dt, q_omega, q_z, q_gp, r)                                             \
     {                                                                                              \
-        .est = {.model = BR_MACHINE_MODEL_CFG(dt),                                                 \
-                .q_var = {BR_EST_PF_Q_THETA_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F *               \
-                              BR_MACHINE_RAD_PER_COUNT_F,                                          \
-                          (q_omega), (q_z), (q_gp)},                                               \
-                .r_var_rad2 = (r),                                                                 \
-                .gp0_N = BR_EST_PF_GP0_N_F,                                                        \
-                .gp_min_N = BR_EST_PF_GP_MIN_N_F,                                                  \
-                .gp_max_N = BR_EST_PF_GP_MAX_N_F,                                                  \
-                .outlier_sigma = BR_EST_PF_OUTLIER_SIGMA_F,                                        \
-                .reanchor_after = BR_EST_PF_REANCHOR_AFTER,                                        \
-                .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,                                   \
-                .comp_ahead_periods = BR_EST_PF_COMP_AHEAD_PERIODS_F,                          \
-                .delay_id = BR_MACHINE_DELAY_ID_CFG(PF)},                                          \
+        .est = BR_MACHINE_EST_CFG(PF, dt,                                                          \
+                                  BR_EST_PF_Q_THETA_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F *       \
+                                      BR_MACHINE_RAD_PER_COUNT_F,                                  \
+                                  q_omega, q_z, q_gp, r),                                          \
         .n_particles = BR_EST_PF_N_PARTICLES,                                                      \
         .x0_std = {BR_EST_PF_X0_STD_THETA_COUNTS_F * BR_MACHINE_RAD_PER_COUNT_F,                   \
                    BR_EST_PF_X0_STD_OMEGA_RADPS_F, BR_EST_PF_X0_STD_Z_M_F, BR_EST_PF_X0_STD_GP_N_F}, \
@@ -120,17 +125,7 @@
  * and measurement noise r (rad^2); the rest from the estimator section. */
 #define BR_MACHINE_UKF_CFG_Q(dt, q_theta, q_omega, q_z, q_gp, r)                                   \
     {                                                                                              \
-        .est = {.model = BR_MACHINE_MODEL_CFG(dt),                                                 \
-                .q_var = {(q_theta), (q_omega), (q_z), (q_gp)},                                    \
-                .r_var_rad2 = (r),                                                                 \
-                .gp0_N = BR_EST_UKF_GP0_N_F,                                                       \
-                .gp_min_N = BR_EST_UKF_GP_MIN_N_F,                                                 \
-                .gp_max_N = BR_EST_UKF_GP_MAX_N_F,                                                 \
-                .outlier_sigma = BR_EST_UKF_OUTLIER_SIGMA_F,                                       \
-                .reanchor_after = BR_EST_UKF_REANCHOR_AFTER,                                       \
-                .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F,                                   \
-                .comp_ahead_periods = BR_EST_UKF_COMP_AHEAD_PERIODS_F,                         \
-                .delay_id = BR_MACHINE_DELAY_ID_CFG(UKF)},                                          \
+        .est = BR_MACHINE_EST_CFG(UKF, dt, q_theta, q_omega, q_z, q_gp, r),                        \
         .p0_var = {BR_EST_UKF_P0_THETA_COUNTS2_F * BR_MACHINE_RAD_PER_COUNT_F *                    \
                        BR_MACHINE_RAD_PER_COUNT_F,                                                 \
                    BR_EST_UKF_P0_OMEGA_RAD2PS2_F, BR_EST_UKF_P0_Z_M2_F, BR_EST_UKF_P0_GP_N2_F},    \
