@@ -9,18 +9,16 @@
 
 #include <stddef.h>
 
-/* Compile-time layout checks against the RM0433 / RM0440 register maps (the
- * same offsets on both; C99 has no static_assert: a negative array size
- * fails the build). */
-#define BR_LAYOUT_CHECK(name, cond) typedef char br_layout_##name[(cond) ? 1 : -1]
-BR_LAYOUT_CHECK(tim_cnt, offsetof(br_stm32_tim_t, CNT) == 0x24u);
-BR_LAYOUT_CHECK(tim_rcr, offsetof(br_stm32_tim_t, RCR) == 0x30u);
-BR_LAYOUT_CHECK(tim_ccr1, offsetof(br_stm32_tim_t, CCR1) == 0x34u);
-BR_LAYOUT_CHECK(tim_bdtr, offsetof(br_stm32_tim_t, BDTR) == 0x44u);
-BR_LAYOUT_CHECK(gpio_afr, offsetof(br_stm32_gpio_t, AFR) == 0x20u);
-BR_LAYOUT_CHECK(systick_val, offsetof(br_stm32_systick_t, VAL) == 0x08u);
-BR_LAYOUT_CHECK(iwdg_sr, offsetof(br_stm32_iwdg_t, SR) == 0x0Cu);
-BR_LAYOUT_CHECK(iwdg_winr, offsetof(br_stm32_iwdg_t, WINR) == 0x10u);
+/* Layout checks against the RM0433 / RM0440 register maps (the same offsets
+ * on both). */
+BR_STM32_LAYOUT_CHECK(tim_cnt, offsetof(br_stm32_tim_t, CNT) == 0x24u);
+BR_STM32_LAYOUT_CHECK(tim_rcr, offsetof(br_stm32_tim_t, RCR) == 0x30u);
+BR_STM32_LAYOUT_CHECK(tim_ccr1, offsetof(br_stm32_tim_t, CCR1) == 0x34u);
+BR_STM32_LAYOUT_CHECK(tim_bdtr, offsetof(br_stm32_tim_t, BDTR) == 0x44u);
+BR_STM32_LAYOUT_CHECK(gpio_afr, offsetof(br_stm32_gpio_t, AFR) == 0x20u);
+BR_STM32_LAYOUT_CHECK(systick_val, offsetof(br_stm32_systick_t, VAL) == 0x08u);
+BR_STM32_LAYOUT_CHECK(iwdg_sr, offsetof(br_stm32_iwdg_t, SR) == 0x0Cu);
+BR_STM32_LAYOUT_CHECK(iwdg_winr, offsetof(br_stm32_iwdg_t, WINR) == 0x10u);
 
 /* ---- configuration ------------------------------------------------------ */
 

@@ -9,15 +9,14 @@
 
 #include "bristle/br_stm32.h"
 
-/* Compile-time layout checks against the RM0433 / RM0440 register maps (the
+/* Layout checks against the RM0433 / RM0440 register maps (the
  * USART alike on both; the DMA's first four registers alike, see
  * br_stm32_regs.h). */
-#define BR_LAYOUT_CHECK(name, cond) typedef char br_layout_##name[(cond) ? 1 : -1]
-BR_LAYOUT_CHECK(usart_brr, offsetof(br_stm32_usart_t, BRR) == 0x0Cu);
-BR_LAYOUT_CHECK(usart_isr, offsetof(br_stm32_usart_t, ISR) == 0x1Cu);
-BR_LAYOUT_CHECK(usart_rdr, offsetof(br_stm32_usart_t, RDR) == 0x24u);
-BR_LAYOUT_CHECK(usart_presc, offsetof(br_stm32_usart_t, PRESC) == 0x2Cu);
-BR_LAYOUT_CHECK(dma_mar, offsetof(br_stm32_dma_ch_t, MAR) == 0x0Cu);
+BR_STM32_LAYOUT_CHECK(usart_brr, offsetof(br_stm32_usart_t, BRR) == 0x0Cu);
+BR_STM32_LAYOUT_CHECK(usart_isr, offsetof(br_stm32_usart_t, ISR) == 0x1Cu);
+BR_STM32_LAYOUT_CHECK(usart_rdr, offsetof(br_stm32_usart_t, RDR) == 0x24u);
+BR_STM32_LAYOUT_CHECK(usart_presc, offsetof(br_stm32_usart_t, PRESC) == 0x2Cu);
+BR_STM32_LAYOUT_CHECK(dma_mar, offsetof(br_stm32_dma_ch_t, MAR) == 0x0Cu);
 
 /* A bus address as the DMA's 32-bit register holds it (on the host, a fake
  * register keeps the low 32 bits: a test compares them the same way). */

@@ -7,19 +7,17 @@
 
 #include <stddef.h>
 
-/* Compile-time layout checks against the RM0440 register maps (C99 has no
- * static_assert: a negative array size fails the build). */
-#define BR_G4_LAYOUT_CHECK(name, cond) typedef char br_g4_layout_##name[(cond) ? 1 : -1]
-BR_G4_LAYOUT_CHECK(rcc_cfgr, offsetof(br_stm32g4_rcc_t, CFGR) == 0x08u);
-BR_G4_LAYOUT_CHECK(rcc_pllcfgr, offsetof(br_stm32g4_rcc_t, PLLCFGR) == 0x0Cu);
-BR_G4_LAYOUT_CHECK(rcc_ahb2enr, offsetof(br_stm32g4_rcc_t, AHB2ENR) == 0x4Cu);
-BR_G4_LAYOUT_CHECK(rcc_apb1enr1, offsetof(br_stm32g4_rcc_t, APB1ENR1) == 0x58u);
-BR_G4_LAYOUT_CHECK(rcc_apb2enr, offsetof(br_stm32g4_rcc_t, APB2ENR) == 0x60u);
-BR_G4_LAYOUT_CHECK(rcc_csr, offsetof(br_stm32g4_rcc_t, CSR) == 0x94u);
-BR_G4_LAYOUT_CHECK(rcc_ahb1enr, offsetof(br_stm32g4_rcc_t, AHB1ENR) == 0x48u);
-BR_G4_LAYOUT_CHECK(dma_ccr1, offsetof(br_stm32g4_dma_t, C) == 0x08u);
-BR_G4_LAYOUT_CHECK(dma_ccr8, offsetof(br_stm32g4_dma_t, C[7]) == 0x94u);
-BR_G4_LAYOUT_CHECK(pwr_cr5, offsetof(br_stm32g4_pwr_t, CR5) == 0x80u);
+/* Layout checks against the RM0440 register maps. */
+BR_STM32_LAYOUT_CHECK(rcc_cfgr, offsetof(br_stm32g4_rcc_t, CFGR) == 0x08u);
+BR_STM32_LAYOUT_CHECK(rcc_pllcfgr, offsetof(br_stm32g4_rcc_t, PLLCFGR) == 0x0Cu);
+BR_STM32_LAYOUT_CHECK(rcc_ahb2enr, offsetof(br_stm32g4_rcc_t, AHB2ENR) == 0x4Cu);
+BR_STM32_LAYOUT_CHECK(rcc_apb1enr1, offsetof(br_stm32g4_rcc_t, APB1ENR1) == 0x58u);
+BR_STM32_LAYOUT_CHECK(rcc_apb2enr, offsetof(br_stm32g4_rcc_t, APB2ENR) == 0x60u);
+BR_STM32_LAYOUT_CHECK(rcc_csr, offsetof(br_stm32g4_rcc_t, CSR) == 0x94u);
+BR_STM32_LAYOUT_CHECK(rcc_ahb1enr, offsetof(br_stm32g4_rcc_t, AHB1ENR) == 0x48u);
+BR_STM32_LAYOUT_CHECK(dma_ccr1, offsetof(br_stm32g4_dma_t, C) == 0x08u);
+BR_STM32_LAYOUT_CHECK(dma_ccr8, offsetof(br_stm32g4_dma_t, C[7]) == 0x94u);
+BR_STM32_LAYOUT_CHECK(pwr_cr5, offsetof(br_stm32g4_pwr_t, CR5) == 0x80u);
 
 /* ---- board helpers -------------------------------------------------------- */
 

@@ -7,26 +7,24 @@
 
 #include <stddef.h>
 
-/* Compile-time layout checks against the RM0433 register maps (C99 has no
- * static_assert: a negative array size fails the build). */
-#define BR_LAYOUT_CHECK(name, cond) typedef char br_layout_##name[(cond) ? 1 : -1]
-BR_LAYOUT_CHECK(rcc_ahb4enr, offsetof(br_stm32h7_rcc_t, AHB4ENR) == 0x0E0u);
-BR_LAYOUT_CHECK(rcc_apb1lenr, offsetof(br_stm32h7_rcc_t, APB1LENR) == 0x0E8u);
-BR_LAYOUT_CHECK(rcc_apb2enr, offsetof(br_stm32h7_rcc_t, APB2ENR) == 0x0F0u);
-BR_LAYOUT_CHECK(rcc_cfgr, offsetof(br_stm32h7_rcc_t, CFGR) == 0x010u);
-BR_LAYOUT_CHECK(rcc_d1cfgr, offsetof(br_stm32h7_rcc_t, D1CFGR) == 0x018u);
-BR_LAYOUT_CHECK(rcc_d3cfgr, offsetof(br_stm32h7_rcc_t, D3CFGR) == 0x020u);
-BR_LAYOUT_CHECK(rcc_pllckselr, offsetof(br_stm32h7_rcc_t, PLLCKSELR) == 0x028u);
-BR_LAYOUT_CHECK(rcc_pll1divr, offsetof(br_stm32h7_rcc_t, PLL1DIVR) == 0x030u);
-BR_LAYOUT_CHECK(rcc_rsr, offsetof(br_stm32h7_rcc_t, RSR) == 0x0D0u);
-BR_LAYOUT_CHECK(rcc_apb4enr, offsetof(br_stm32h7_rcc_t, APB4ENR) == 0x0F4u);
-BR_LAYOUT_CHECK(pwr_cr3, offsetof(br_stm32h7_pwr_t, CR3) == 0x0Cu);
-BR_LAYOUT_CHECK(pwr_d3cr, offsetof(br_stm32h7_pwr_t, D3CR) == 0x18u);
-BR_LAYOUT_CHECK(rcc_ahb1enr, offsetof(br_stm32h7_rcc_t, AHB1ENR) == 0x0D8u);
-BR_LAYOUT_CHECK(dma_s0cr, offsetof(br_stm32h7_dma_t, S) == 0x10u);
-BR_LAYOUT_CHECK(dma_stream, sizeof(br_stm32h7_dma_stream_t) == 0x18u);
-BR_LAYOUT_CHECK(dma_s7fcr, offsetof(br_stm32h7_dma_t, S[7].FCR) == 0xCCu);
-BR_LAYOUT_CHECK(syscfg_pwrcr, offsetof(br_stm32h7_syscfg_t, PWRCR) == 0x2Cu);
+/* Layout checks against the RM0433 register maps. */
+BR_STM32_LAYOUT_CHECK(rcc_ahb4enr, offsetof(br_stm32h7_rcc_t, AHB4ENR) == 0x0E0u);
+BR_STM32_LAYOUT_CHECK(rcc_apb1lenr, offsetof(br_stm32h7_rcc_t, APB1LENR) == 0x0E8u);
+BR_STM32_LAYOUT_CHECK(rcc_apb2enr, offsetof(br_stm32h7_rcc_t, APB2ENR) == 0x0F0u);
+BR_STM32_LAYOUT_CHECK(rcc_cfgr, offsetof(br_stm32h7_rcc_t, CFGR) == 0x010u);
+BR_STM32_LAYOUT_CHECK(rcc_d1cfgr, offsetof(br_stm32h7_rcc_t, D1CFGR) == 0x018u);
+BR_STM32_LAYOUT_CHECK(rcc_d3cfgr, offsetof(br_stm32h7_rcc_t, D3CFGR) == 0x020u);
+BR_STM32_LAYOUT_CHECK(rcc_pllckselr, offsetof(br_stm32h7_rcc_t, PLLCKSELR) == 0x028u);
+BR_STM32_LAYOUT_CHECK(rcc_pll1divr, offsetof(br_stm32h7_rcc_t, PLL1DIVR) == 0x030u);
+BR_STM32_LAYOUT_CHECK(rcc_rsr, offsetof(br_stm32h7_rcc_t, RSR) == 0x0D0u);
+BR_STM32_LAYOUT_CHECK(rcc_apb4enr, offsetof(br_stm32h7_rcc_t, APB4ENR) == 0x0F4u);
+BR_STM32_LAYOUT_CHECK(pwr_cr3, offsetof(br_stm32h7_pwr_t, CR3) == 0x0Cu);
+BR_STM32_LAYOUT_CHECK(pwr_d3cr, offsetof(br_stm32h7_pwr_t, D3CR) == 0x18u);
+BR_STM32_LAYOUT_CHECK(rcc_ahb1enr, offsetof(br_stm32h7_rcc_t, AHB1ENR) == 0x0D8u);
+BR_STM32_LAYOUT_CHECK(dma_s0cr, offsetof(br_stm32h7_dma_t, S) == 0x10u);
+BR_STM32_LAYOUT_CHECK(dma_stream, sizeof(br_stm32h7_dma_stream_t) == 0x18u);
+BR_STM32_LAYOUT_CHECK(dma_s7fcr, offsetof(br_stm32h7_dma_t, S[7].FCR) == 0xCCu);
+BR_STM32_LAYOUT_CHECK(syscfg_pwrcr, offsetof(br_stm32h7_syscfg_t, PWRCR) == 0x2Cu);
 
 /* ---- board helpers -------------------------------------------------------- */
 

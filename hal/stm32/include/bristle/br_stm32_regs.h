@@ -17,6 +17,11 @@
 
 #define BR_STM32_SYSTICK_BASE 0xE000E010u /* Cortex-M system timer */
 
+/* A register block's layout checked at compile time against its reference
+ * manual, in the driver file that uses the block (C99 has no static_assert:
+ * a negative array size fails the build). */
+#define BR_STM32_LAYOUT_CHECK(name, cond) typedef char br_stm32_layout_##name[(cond) ? 1 : -1]
+
 /* ---- TIMx, CR1 .. BDTR ----------------------------------------------------- */
 typedef struct {
     volatile uint32_t CR1;    /* 0x00 control 1 */
