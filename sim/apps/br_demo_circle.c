@@ -230,7 +230,7 @@ static int parse_gains(const char *val, float K[3])
     return 0;
 }
 
-/* every option checked: 0, 1 (--help), 3 (--version) or 2 (usage error, message printed) */
+/* every option checked: 0, 1 (--help or --version answered) or 2 (usage error, message printed) */
 static int parse(int argc, char **argv, opts_t *o)
 {
     static const struct option opts[] = {{"out", required_argument, NULL, 'o'},
@@ -255,8 +255,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"oracle-late", no_argument, NULL, 'O'},
                                          BR_CIRCLE_LONGOPTS BR_CIRCLE_LONGOPT_DIR{NULL, 0, NULL, 0}};
     br_args_t p;
-    const int st = br_args_begin(&p, TOOL, argc, argv);
-    if (st != BR_ARGS_RUN) return st == BR_ARGS_HELP ? 1 : 3;
+    if (br_args_start(&p, TOOL, argc, argv, usage)) return 1;
     const char *val;
     for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
         int bad = 0;
@@ -411,14 +410,7 @@ int main(int argc, char **argv)
     opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, 0, {0.0f, 0.0f}, {0.0f, 0.0f}, 0.0, 0.0,
                   BR_CIRCLE_PATH_DEFAULT, 0, 0.0, BR_CIRCLE_FF_EL_NONE, 0.0, 1, 0};
     const int p = parse(argc, argv, &opt);
-    if (p == 1) {
-        usage(argv[0], stdout);
-        return 0;
-    }
-    if (p == 3) {
-        br_args_print_version(TOOL, stdout);
-        return 0;
-    }
+    if (p == 1) return 0; /* --help or --version answered */
     if (p != 0) return usage(argv[0], stderr);
     const char *out = opt.out;
     if (mkdir(out, 0775) != 0 && errno != EEXIST) {

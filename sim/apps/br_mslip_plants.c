@@ -148,12 +148,7 @@ int main(int argc, char **argv)
                                          {"pf-gate", required_argument, NULL, 'g'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
-    const int st = br_args_begin(&p, TOOL, argc, argv);
-    if (st == BR_ARGS_HELP) return usage(argv[0], stdout);
-    if (st == BR_ARGS_VERSION) {
-        br_args_print_version(TOOL, stdout);
-        return 0;
-    }
+    if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
     const char *val;
     for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
         int bad = 1;

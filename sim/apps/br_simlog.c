@@ -168,7 +168,7 @@ static void apply_gms(br_plant_cfg_t *plant, const opts_t *o)
     plant->gms.delta = 1.0;
 }
 
-/* every option checked: 0, 1 (--help), 3 (--version) or 2 (usage error, message printed) */
+/* every option checked: 0, 1 (--help or --version answered) or 2 (usage error, message printed) */
 static int parse(int argc, char **argv, opts_t *o)
 {
     static const struct option opts[] = {{"truth", no_argument, NULL, 't'},
@@ -184,8 +184,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"reversals", required_argument, NULL, 'r'},
                                          BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
-    const int st = br_args_begin(&p, TOOL, argc, argv);
-    if (st != BR_ARGS_RUN) return st == BR_ARGS_HELP ? 1 : 3;
+    if (br_args_start(&p, TOOL, argc, argv, usage)) return 1;
     const char *val;
     for (int c; (c = br_args_next(&p, opts, &val)) != BR_ARGS_END;) {
         int bad = 0;
@@ -241,14 +240,7 @@ int main(int argc, char **argv)
 {
     opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 0, 8.0, 0.0, br_plant_cfg_reference(), 0, {0.0}};
     const int p = parse(argc, argv, &opt);
-    if (p == 1) {
-        usage(argv[0], stdout);
-        return 0;
-    }
-    if (p == 3) {
-        br_args_print_version(TOOL, stdout);
-        return 0;
-    }
+    if (p == 1) return 0; /* --help or --version answered */
     if (p != 0) return usage(argv[0], stderr);
 
     br_plant_cfg_t plant = br_plant_cfg_reference();
