@@ -28,18 +28,19 @@
 
 #include "circle/br_circle.h"
 #include "cause_args/br_cause_args.h"
+#include "pil_args/br_pil_args.h"
 #include "pil_loop/br_pil_loop.h"
 #include "tool/br_args.h"
 #include "tool/br_run_report.h"
 #include "tool/br_tool_limits.h"
 
 #define TOOL "br_pil"
-#define TIMEOUT_MAX_S 3600.0
 
 typedef struct {
-    const char *image, *est, *qemu, *work;
-    double duration_s, timeout_s;
+    const char *image, *est;
+    double duration_s;
     int compare;
+    br_pil_qemu_t q;
     br_plant_cfg_t causes; /* the cause options (br_cause_args.h) on the reference machine */
 } opts_t;
 
@@ -51,13 +52,10 @@ static int usage(const char *argv0, FILE *to)
             "  --image     the image in the loop (build/cm7-release/target/mps2/br_pil_mps2.elf)\n"
             "  --est       the estimator: none (H-inf only), ukf, pf, or all three (default all)\n"
             "  --duration  simulated seconds of the circle, %g .. %g (default: the thesis's, one turn)\n"
-            "  --compare   also run the simulator's circle and compare the duty sequences bit for bit\n"
-            "  --qemu      qemu-system-arm to run (default $BR_QEMU, else qemu-system-arm on PATH)\n"
-            "  --timeout   seconds to wait for one answer of the image, 1 .. %g (default 60)\n"
-            "  --work      folder for the FIFOs and QEMU's logs (default a new one under /tmp, removed)\n"
+            "  --compare   also run the simulator's circle and compare the duty sequences bit for bit\n" BR_PIL_USAGE
             "  cause options  a cause in the host's plant: --offset F, --asym DFC,DFV, --ripple A,P[,PH],\n"
             "              --gradient S, --delay D, --drift R (docs/simlog.md; the image keeps its machine's model)\n",
-            argv0, argv0, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, TIMEOUT_MAX_S);
+            argv0, argv0, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S);
     return 2;
 }
 
@@ -67,13 +65,8 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
                                          {"est", required_argument, NULL, 'e'},
                                          {"duration", required_argument, NULL, 'd'},
                                          {"compare", no_argument, NULL, 'c'},
-                                         {"qemu", required_argument, NULL, 'q'},
-                                         {"timeout", required_argument, NULL, 't'},
-                                         {"work", required_argument, NULL, 'w'},
-                                         BR_CAUSE_LONGOPTS{0, 0, 0, 0}};
-    const char *qe = getenv("BR_QEMU");
-    *o = (opts_t){NULL, "all", (qe != NULL && qe[0] != '\0') ? qe : "qemu-system-arm", NULL, 0.0, 60.0, 0,
-                  br_plant_cfg_reference()};
+                                         BR_PIL_LONGOPTS BR_CAUSE_LONGOPTS{0, 0, 0, 0}};
+    *o = (opts_t){NULL, "all", 0.0, 0, br_pil_qemu_default(), br_plant_cfg_reference()};
     br_args_t p;
     *done = br_args_start(&p, TOOL, argc, argv, usage);
     if (*done) return 0;
@@ -93,9 +86,7 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
             bad = br_arg_double(TOOL, p.opt, v, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &o->duration_s);
             break;
         case 'c': o->compare = 1; break;
-        case 'q': o->qemu = v; break;
-        case 't': bad = br_arg_double(TOOL, p.opt, v, 1.0, TIMEOUT_MAX_S, &o->timeout_s); break;
-        case 'w': o->work = v; break;
+        case BR_PIL_OPT: bad = br_pil_arg(TOOL, p.opt, v, &o->q) < 0; break;
         case BR_CAUSE_OPT: bad = br_cause_arg(p.opt, v, &o->causes) < 0; break;
         default: return usage(argv[0], stderr);
         }
@@ -174,7 +165,7 @@ static int run_one(const opts_t *o, br_circle_ctrl_t ctrl, const char *est, run_
     memset(&L, 0, sizeof L);
     br_pil_run_t run;
     int rc = -1;
-    if (duty[0] != NULL && duty[1] != NULL && br_pil_loop_open(&L, o->qemu, o->image, est, o->work, o->timeout_s) == 0 &&
+    if (duty[0] != NULL && duty[1] != NULL && br_pil_loop_open(&L, o->q.qemu, o->image, est, o->q.work, o->q.timeout_s) == 0 &&
         br_pil_loop_run(&L, &c, NULL, 0, duty, &run) == 0) {
         out->res = run.res;
         out->wall_s = run.wall_s;

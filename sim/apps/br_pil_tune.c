@@ -39,6 +39,7 @@
 #include "circle/br_circle.h"
 #include "circle/br_circle_est.h"
 #include "nm/br_nm.h"
+#include "pil_args/br_pil_args.h"
 #include "pil_loop/br_pil_loop.h"
 #include "tool/br_args.h"
 #include "tool/br_outfile.h"
@@ -47,14 +48,14 @@
 #include "tune_space/br_tune_space.h"
 
 #define TOOL "br_pil_tune"
-#define TIMEOUT_MAX_S 3600.0
 /* the default segment: the circle's first 0.5 s (docs/link.md, "Tuning on the target", says why) */
 #define SEGMENT_S 0.5
 #define MAX_SET 2
 
 typedef struct {
-    const char *image, *est, *qemu, *work, *out;
-    double duration_s, timeout_s;
+    const char *image, *est, *out;
+    double duration_s;
+    br_pil_qemu_t q;
     long max_fev;
     int circle, sim;
     br_pil_param_t set[MAX_SET];
@@ -94,11 +95,8 @@ static int usage(const char *argv0, FILE *to)
             "  --circle    at the end, the shipped and the best setting on the whole circle\n"
             "  --out       folder for evals.csv and summary.md (default: none written)\n"
             "  --set       a further parameter written before every evaluation (name=value; at most %d)\n"
-            "  --sim       each evaluation on the host simulator (the harness's check), not the image\n"
-            "  --qemu      qemu-system-arm to run (default $BR_QEMU, else qemu-system-arm on PATH)\n"
-            "  --timeout   seconds to wait for one answer of the image, 1 .. %g (default 60)\n"
-            "  --work      folder for the FIFOs and QEMU's logs (default new ones under /tmp, removed)\n",
-            argv0, argv0, BR_TOOL_MAX_FEV, SEGMENT_S, MAX_SET, TIMEOUT_MAX_S);
+            "  --sim       each evaluation on the host simulator (the harness's check), not the image\n" BR_PIL_USAGE,
+            argv0, argv0, BR_TOOL_MAX_FEV, SEGMENT_S, MAX_SET);
     return 2;
 }
 
@@ -140,16 +138,11 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
                                          {"out", required_argument, NULL, 'o'},
                                          {"set", required_argument, NULL, 's'},
                                          {"sim", no_argument, NULL, 'S'},
-                                         {"qemu", required_argument, NULL, 'q'},
-                                         {"timeout", required_argument, NULL, 't'},
-                                         {"work", required_argument, NULL, 'w'},
-                                         {0, 0, 0, 0}};
-    const char *qe = getenv("BR_QEMU");
+                                         BR_PIL_LONGOPTS{0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->est = "ukf";
-    o->qemu = (qe != NULL && qe[0] != '\0') ? qe : "qemu-system-arm";
+    o->q = br_pil_qemu_default();
     o->duration_s = SEGMENT_S;
-    o->timeout_s = 60.0;
     o->max_fev = 60;
     br_args_t p;
     *done = br_args_start(&p, TOOL, argc, argv, usage);
@@ -172,9 +165,7 @@ static int parse(int argc, char **argv, opts_t *o, int *done)
         case 'o': o->out = v; break;
         case 's': bad = parse_set(v, o); break;
         case 'S': o->sim = 1; break;
-        case 'q': o->qemu = v; break;
-        case 't': bad = br_arg_double(TOOL, p.opt, v, 1.0, TIMEOUT_MAX_S, &o->timeout_s); break;
-        case 'w': o->work = v; break;
+        case BR_PIL_OPT: bad = br_pil_arg(TOOL, p.opt, v, &o->q) < 0; break;
         default: return usage(argv[0], stderr);
         }
         if (bad) return usage(argv[0], stderr);
@@ -453,7 +444,7 @@ int main(int argc, char **argv)
         fprintf(t.csv, ",meas_contour_rms_m,meas_max_m,outlier_steps,plant_contour_rms_m,objective,duty_fnv,wall_s\n");
     }
     int rc = 1;
-    if (!t.o.sim && br_pil_loop_open(&t.L, t.o.qemu, t.o.image, t.o.est, t.o.work, t.o.timeout_s) != 0) goto out;
+    if (!t.o.sim && br_pil_loop_open(&t.L, t.o.q.qemu, t.o.image, t.o.est, t.o.q.work, t.o.q.timeout_s) != 0) goto out;
     printf("tuning %s on the %s: H-inf + %s, the circle's first %.3g s per evaluation\n", t.o.est,
            t.o.sim ? "host simulator (--sim)" : "image in the loop (QEMU mps2-an500, Cortex-M7)", t.pf ? "PF" : "UKF",
            t.seg.duration_s);
