@@ -69,3 +69,12 @@ void br_sh_exit(uint32_t status)
         __asm__ volatile("nop");
     }
 }
+
+void br_sh_fail(const char *image, const char *msg)
+{
+    br_sh_puts(image);
+    br_sh_puts(": ");
+    br_sh_puts(msg);
+    br_sh_puts("\n");
+    br_sh_exit(1u);
+}

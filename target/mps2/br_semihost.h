@@ -19,5 +19,8 @@ void br_sh_puts(const char *s);
 int br_sh_cmdline(char *buf, uint32_t len);
 /* Ends the emulation with this exit status (SYS_EXIT_EXTENDED). */
 void br_sh_exit(uint32_t status) __attribute__((noreturn));
+/* "image: msg" and a newline on the console, then exit status 1: how an
+ * image reports a failure it cannot go on from. */
+void br_sh_fail(const char *image, const char *msg) __attribute__((noreturn));
 
 #endif

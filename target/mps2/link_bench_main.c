@@ -116,10 +116,7 @@ static size_t chan_write(void *ctx, const uint8_t *buf, size_t n)
 
 static void fail(const char *msg)
 {
-    br_sh_puts("br_link_bench_mps2: ");
-    br_sh_puts(msg);
-    br_sh_puts("\n");
-    br_sh_exit(1u);
+    br_sh_fail("br_link_bench_mps2", msg);
 }
 
 /* appends one frame (the next seq); returns where it starts in the wire */

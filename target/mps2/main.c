@@ -96,10 +96,7 @@ static uint32_t parse_u32(const char *s)
 
 static void fail(const char *msg)
 {
-    br_sh_puts("br_replay_mps2: ");
-    br_sh_puts(msg);
-    br_sh_puts("\n");
-    br_sh_exit(1u);
+    br_sh_fail("br_replay_mps2", msg);
 }
 
 int main(void)

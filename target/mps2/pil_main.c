@@ -51,10 +51,7 @@ typedef enum { EST_NONE, EST_UKF, EST_PF } est_t;
 
 static void fail(const char *msg)
 {
-    br_sh_puts("br_pil_mps2: ");
-    br_sh_puts(msg);
-    br_sh_puts("\n");
-    br_sh_exit(1u);
+    br_sh_fail("br_pil_mps2", msg);
 }
 
 /* the estimator named on the command line ("pil EST") */
