@@ -156,6 +156,7 @@ typedef struct {
     float pf_qs[2];  /* factors on the PF's z and g_p process noise (0: 1) */
     double pf_load;  /* the PF's shared external force's random walk, N^2/s (0: the machine's) */
     double pf_gp_tau; /* the PF's g_p along the Stribeck curve, time constant s (0: the machine's) */
+    double pf_gate;   /* the PF's outlier gate, sigmas (0: the machine's) */
     br_circle_path_t path; /* the circle (default the thesis's) */
     int hw_clamp;          /* the hardware-like plant's clamp limit instead of the slip law */
     double hw_c_mps;       /* its slip law's C (<= 0: BR_CIRCLE_HW_C_MPS) */
@@ -170,7 +171,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s --out DIR [--only NAME] [--gains K0,K1,K2] [--dt S] [--nsub N] [--pf-proposal K]\n"
             "       [--ahead P] [--ukf-load Q_N2_PER_S] [--ukf-mslip] [--ukf-q-scale FZ,FG] [--pf-load Q_N2_PER_S]\n"
-            "       [--pf-mslip] [--pf-q-scale FZ,FG] [--pf-gp-curve TAU_S] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
+            "       [--pf-mslip] [--pf-q-scale FZ,FG] [--pf-gp-curve TAU_S] [--pf-gate SIGMA] [--radius-m R] [--feed-mm-min F] [--dir cw|ccw|both]\n"
             "       [--hw-law slip|clamp] [--hw-c-mps C] [--ff-el own|fit] [--pred S] [--pred-anchor ff|ukf]\n"
             "       [--oracle-late]\n" BR_ARGS_COMMON_USAGE
             "  --out DIR           where summary.json and the traces go\n"
@@ -191,6 +192,7 @@ static int usage(const char *argv0, FILE *to)
             "                      Maxwell-slip elements (clamp form, docs/modules/pf.md)\n"
             "  --pf-q-scale FZ,FG  the PF's z and g_p process noise times FZ and FG (1e-6 .. 1e6)\n"
             "  --pf-gp-curve TAU   the PF's g_p along the Stribeck curve, time constant TAU s (0 .. 100; docs/modules/pf.md)\n"
+            "  --pf-gate SIGMA     the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
             BR_CIRCLE_USAGE("--dir cw|ccw|both  ") "                      (both: each controller both ways, the ISO 230-4 pair; --direction the same)\n"
             "  --hw-law slip|clamp the hardware-like plant's Maxwell-slip law (default slip, docs/demo.md)\n"
             "  --hw-c-mps C        its slip law's attraction rate C, m/s (default %g, %g .. %g)\n"
@@ -203,7 +205,8 @@ static int usage(const char *argv0, FILE *to)
             "  --oracle-late       the true friction one period late instead of at t_k\n"
             "bounds: --dt %g .. %g s, --nsub 1 .. %d, |gain| <= %g, --radius-m %g .. %g m,\n"
             "        --feed-mm-min %g .. %g, a revolution %g .. %g s (docs/tools.md)\n",
-            argv0, argv0, (double)BR_EST_AHEAD_MAX_PERIODS, BR_CIRCLE_HW_C_MPS, HW_C_MIN_MPS, HW_C_MAX_MPS,
+            argv0, argv0, (double)BR_EST_AHEAD_MAX_PERIODS, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA,
+            BR_CIRCLE_HW_C_MPS, HW_C_MIN_MPS, HW_C_MAX_MPS,
             (double)BR_FF_PRED_MAX_S,
             BR_TOOL_DT_MIN_S, BR_TOOL_DT_MAX_S, BR_TOOL_NSUB_MAX,
             BR_TOOL_GAIN_MAX, BR_TOOL_RADIUS_MIN_M, BR_TOOL_RADIUS_MAX_M, BR_TOOL_FEED_MIN_MM_MIN,
@@ -247,6 +250,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"pf-mslip", no_argument, NULL, 'M'},
                                          {"pf-q-scale", required_argument, NULL, 'Q'},
                                          {"pf-gp-curve", required_argument, NULL, 'G'},
+                                         {"pf-gate", required_argument, NULL, 'T'},
                                          {"hw-law", required_argument, NULL, 'w'},
                                          {"hw-c-mps", required_argument, NULL, 'c'},
                                          {"ff-el", required_argument, NULL, 'E'},
@@ -279,6 +283,9 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'Q': bad = parse_q_scale(p.opt, val, o->pf_qs); break;
         case 'L': bad = br_arg_double(TOOL, p.opt, val, 0.0, 1.0e9, &o->pf_load); break;
         case 'G': bad = br_arg_double(TOOL, p.opt, val, 0.0, 100.0, &o->pf_gp_tau); break;
+        case 'T':
+            bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &o->pf_gate);
+            break;
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, p.opt, val, 1, &o->path); break;
         case 'w':
             o->hw_clamp = strcmp(val, "clamp") == 0;
@@ -407,7 +414,7 @@ static void hw_describe(FILE *js, const opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, 0, {0.0f, 0.0f}, {0.0f, 0.0f}, 0.0, 0.0,
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, 0, {0.0f, 0.0f}, {0.0f, 0.0f}, 0.0, 0.0, 0.0,
                   BR_CIRCLE_PATH_DEFAULT, 0, 0.0, BR_CIRCLE_FF_EL_NONE, 0.0, 1, 0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) return 0; /* --help or --version answered */
@@ -522,6 +529,7 @@ int main(int argc, char **argv)
                 }
                 br_circle_use_pf_load(&cfg, opt.pf_load);
                 br_circle_use_pf_gp_curve(&cfg, opt.pf_gp_tau);
+                br_circle_use_pf_gate(&cfg, opt.pf_gate);
                 sinks_t k = {o.trace[pl][d][r].f, rows[r].ctrl == BR_CTRL_HINF_PF ? o.hist[pl][d].f : NULL};
                 br_circle_csv_header(k.trace);
                 if (k.hist)

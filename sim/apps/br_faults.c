@@ -29,6 +29,7 @@
 #include "tool/br_args.h"
 #include "tool/br_outfile.h"
 #include "tool/br_run_report.h"
+#include "tool/br_tool_limits.h"
 
 #define TOOL "br_faults"
 #define BR_PI 3.14159265358979323846
@@ -157,7 +158,7 @@ static void move_at(double t, double p0, double v, double acc, double *p, double
 }
 
 static int run_one(const scenario_t *s, br_circle_ctrl_t ctrl, const char *plant_name, double gp_tau_s,
-                   double load_q_N2ps, double pf_load_q_N2ps, outcome_t *o)
+                   double load_q_N2ps, double pf_load_q_N2ps, double pf_gate, outcome_t *o)
 {
     memset(o, 0, sizeof *o);
     br_circle_cfg_t c = (strcmp(plant_name, "thesis") == 0) ? br_circle_cfg_thesis(ctrl)
@@ -166,6 +167,7 @@ static int run_one(const scenario_t *s, br_circle_ctrl_t ctrl, const char *plant
     br_circle_use_pf_gp_curve(&c, gp_tau_s); /* --pf-gp-curve */
     br_circle_use_ukf_load(&c, load_q_N2ps); /* --ukf-load */
     br_circle_use_pf_load(&c, pf_load_q_N2ps); /* --pf-load */
+    br_circle_use_pf_gate(&c, pf_gate);        /* --pf-gate */
     const br_app_machine_t mm = BR_MACHINE_APP_MACHINE;
     const br_app_motion_cfg_t mc = br_app_motion_cfg(&mm);
     const double L = c.plant.lead_mprad, rpc = 2.0 * BR_PI / c.plant.counts_per_rev, dt = c.dt_s;
@@ -303,16 +305,18 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s [--plant thesis|realistic|hardware_like] [--only LIST] [--ctrl LIST]\n"
-            "          [--pf-gp-curve TAU_S] [--pf-load Q_N2_PER_S] [--ukf-load Q_N2_PER_S] [--md OUT.md] [--expect LIST]\n" BR_ARGS_COMMON_USAGE
+            "          [--pf-gp-curve TAU_S] [--pf-load Q_N2_PER_S] [--ukf-load Q_N2_PER_S] [--pf-gate SIGMA]\n"
+            "          [--md OUT.md] [--expect LIST]\n" BR_ARGS_COMMON_USAGE
             "  --plant P     the reference machine's plant (default realistic)\n"
             "  --only LIST   the scenarios to run, comma-separated (default all)\n"
             "  --ctrl LIST   hinf_only,hinf_ukf,hinf_pf (default all)\n"
             "  --pf-gp-curve TAU_S  the PF's g_p along the Stribeck curve, time constant (0: off, the machine's)\n"
             "  --pf-load Q_N2_PER_S  the PF's shared external force with this random walk, N^2/s (0: off, the machine's)\n"
             "  --ukf-load Q_N2_PER_S  the UKF's external-force state with this random walk, N^2/s (0: off, the machine's)\n"
+            "  --pf-gate SIGMA  the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
             "  --md OUT.md   the table as markdown\n"
             "  --expect LIST scenario/controller pairs (enc_stuck_90/hinf_pf) whose bound is known broken\n",
-            argv0, argv0);
+            argv0, argv0, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA);
     return 2;
 }
 
@@ -334,13 +338,14 @@ static void print_row(FILE *f, const scenario_t *s, br_circle_ctrl_t ctrl, const
 int main(int argc, char **argv)
 {
     const char *plant = "realistic", *only = NULL, *ctrls = NULL, *md = NULL, *expect = NULL;
-    double gp_tau_s = 0.0, load_q = 0.0, pf_load_q = 0.0;
+    double gp_tau_s = 0.0, load_q = 0.0, pf_load_q = 0.0, pf_gate = 0.0;
     static const struct option opts[] = {{"plant", required_argument, NULL, 'p'}, {"only", required_argument, NULL, 'o'},
                                          {"ctrl", required_argument, NULL, 'c'},  {"md", required_argument, NULL, 'm'},
                                          {"expect", required_argument, NULL, 'e'},
                                          {"pf-gp-curve", required_argument, NULL, 'g'},
                                          {"ukf-load", required_argument, NULL, 'l'},
-                                         {"pf-load", required_argument, NULL, 'L'}, {NULL, 0, NULL, 0}};
+                                         {"pf-load", required_argument, NULL, 'L'},
+                                         {"pf-gate", required_argument, NULL, 'G'}, {NULL, 0, NULL, 0}};
     br_args_t ap;
     if (br_args_start(&ap, TOOL, argc, argv, usage)) return 0;
     const char *val;
@@ -359,6 +364,10 @@ int main(int argc, char **argv)
             break;
         case 'L':
             if (br_arg_double(TOOL, ap.opt, val, 0.0, 1.0e9, &pf_load_q)) return usage(argv[0], stderr);
+            break;
+        case 'G':
+            if (br_arg_double(TOOL, ap.opt, val, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &pf_gate))
+                return usage(argv[0], stderr);
             break;
         default: return usage(argv[0], stderr);
         }
@@ -395,8 +404,10 @@ int main(int argc, char **argv)
     if (load_q > 0.0) snprintf(ld, sizeof ld, "on (%g N^2/s)", load_q);
     char pld[64] = "off (the machine's)";
     if (pf_load_q > 0.0) snprintf(pld, sizeof pld, "on (%g N^2/s)", pf_load_q);
-    fprintf(f, "Plant: %s; PF g_p curve %s; PF external force %s; UKF external force %s. Stop bound %.1f mm (coast %.1f mm), speed fault %.4f m/s, stroke [%.4f, %.4f] m, soft limits [%.4f, %.4f] m.\n\n",
-            plant, gp_tau_s > 0.0 ? "on" : "off (the machine's)", pld, ld, 1e3 * (double)mc.stop_bound_m, 1e3 * (double)BR_MACHINE_COAST_M_F, (double)mc.speed_fault_mps, (double)BR_MACHINE_TRAVEL_MIN_M,
+    char gt[64] = "";
+    if (pf_gate > 0.0) snprintf(gt, sizeof gt, "; PF gate %g sigma (a study)", pf_gate);
+    fprintf(f, "Plant: %s; PF g_p curve %s; PF external force %s; UKF external force %s%s. Stop bound %.1f mm (coast %.1f mm), speed fault %.4f m/s, stroke [%.4f, %.4f] m, soft limits [%.4f, %.4f] m.\n\n",
+            plant, gp_tau_s > 0.0 ? "on" : "off (the machine's)", pld, ld, gt, 1e3 * (double)mc.stop_bound_m, 1e3 * (double)BR_MACHINE_COAST_M_F, (double)mc.speed_fault_mps, (double)BR_MACHINE_TRAVEL_MIN_M,
             (double)BR_MACHINE_TRAVEL_MIN_M + (double)BR_MACHINE_TRAVEL_M, (double)mc.soft_min_m, (double)mc.soft_max_m);
     fprintf(f, "| scenario | what | controller | latched | detection | peak speed | stopping distance | bounds |\n");
     fprintf(f, "|---|---|---|---|---|---|---|---|\n");
@@ -406,7 +417,7 @@ int main(int argc, char **argv)
         for (size_t k = 0; k < N_CTRL; k++) {
             if (ctrls && !br_arg_list_has(ctrls, br_circle_ctrl_name(k_ctrls[k]))) continue;
             outcome_t o;
-            if (run_one(&k_scen[i], k_ctrls[k], plant, gp_tau_s, load_q, pf_load_q, &o) != 0) {
+            if (run_one(&k_scen[i], k_ctrls[k], plant, gp_tau_s, load_q, pf_load_q, pf_gate, &o) != 0) {
                 br_outfile_discard(&out);
                 return 1;
             }

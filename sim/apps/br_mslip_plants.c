@@ -42,6 +42,7 @@
 #include "tool/br_outfile.h"
 #include "tool/br_rng.h"
 #include "tool/br_run_report.h"
+#include "tool/br_tool_limits.h"
 
 #define TOOL "br_mslip_plants"
 #define MAX_N 200
@@ -169,7 +170,7 @@ int main(int argc, char **argv)
         else if (c == 't') trace = val, bad = 0;
         else if (c == 'p') post = val, bad = 0;
         else if (c == 'a') bad = br_pftrace_parse_at(TOOL, val, &tr), have_at = 1;
-        else if (c == 'g') bad = br_arg_double(TOOL, p.opt, val, 1.0, 1000.0, &gate);
+        else if (c == 'g') bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &gate);
         else if (c == 'q') {
             int used = 0;
             bad = sscanf(val, "%f,%f%n", &qs[0], &qs[1], &used) != 2 || val[used] != '\0' ||
@@ -231,7 +232,7 @@ int main(int argc, char **argv)
             c.oracle_late = late;
             c.pf.est.q_var[BR_X_Z] *= qs[0];
             c.pf.est.q_var[BR_X_GP] *= qs[1];
-            if (gate > 0.0) c.pf.est.outlier_sigma = (float)gate;
+            br_circle_use_pf_gate(&c, gate);
             tr.label = first + j;
             tr.plant = &c.plant;
             tr.next_at = 0;

@@ -193,7 +193,8 @@ class ToolsTest(unittest.TestCase):
         for bad in (["--dt", "5"], ["--dt", "0"], ["--dt", "inf"], ["--nsub", "0"], ["--nsub", "1001"],
                     ["--gains", "1,2"], ["--gains", "1,2,inf"], ["--gains", "1,2,3x"], ["--only", "nope"],
                     ["--pf-proposal", "3"], ["--pf-proposal", "-1"], ["--ahead", "2.5"], ["--ahead", "-0.1"],
-                    ["--ahead", "nan"], ["--bogus", "1"]):
+                    ["--ahead", "nan"], ["--pf-gate", "0.5"], ["--pf-gate", "1001"], ["--pf-gate", "nan"],
+                    ["--bogus", "1"]):
             r = run("br_demo_circle", "--out", d, *bad)
             self.assert_refused(r, 2)
             with open(summary, "rb") as f:
@@ -213,7 +214,7 @@ class ToolsTest(unittest.TestCase):
     def test_robust_run_bad_options_touch_nothing(self):
         keep = self.existing("robust.json")
         for bad in (["--drift", "0.6"], ["--drift", "nan"], ["--force-noise", "-1"], ["--enc-noise", "1.5"],
-                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--delay-id", "2"], ["--delay-id", "-1"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
+                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--delay-id", "2"], ["--delay-id", "-1"], ["--pf-gate", "0"], ["--pf-gate", "1e4"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
                     ["--bogus", "1"], ["--drift"]):
             r = run("br_robust_run", "--json", keep, *bad)
             self.assert_refused(r, 2)

@@ -215,8 +215,11 @@ static void test_outlier_100_sigma(void **st)
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     for (int k = 0; k < 5; k++) assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    /* 100 sigma (R = 1 count^2): every particle is an outlier */
-    y.counts = 100;
+    /* ten gates (the machine's gate, outlier_sigma sqrt(R + rpc^2 / 12), at least
+     * 100 counts): every particle is an outlier */
+    const double gate_counts = (double)pf->cfg.est.outlier_sigma * sqrt((double)pf->r_gate) / (double)RPC;
+    const int32_t jump = (int32_t)ceil((10.0 * gate_counts > 100.0) ? 10.0 * gate_counts : 100.0);
+    y.counts = jump;
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
     assert_true(all_finite(pf));
     assert_true(isfinite(br_pf_estimate(pf)->F_hat_N));
@@ -227,7 +230,7 @@ static void test_outlier_100_sigma(void **st)
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     BR_ASSERT_NEAR(stats(pf).mean[0] / RPC, 0.5, 1.0);
     /* a lasting jump (the filter lost lock): re-anchored after 3 outliers */
-    y.counts = 100;
+    y.counts = jump;
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);

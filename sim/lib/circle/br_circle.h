@@ -164,6 +164,11 @@ void br_circle_use_pf_load(br_circle_cfg_t *c, double q_N2ps);
  * period; tau_s <= 0 leaves the machine file's. */
 void br_circle_use_pf_gp_curve(br_circle_cfg_t *c, double tau_s);
 
+/* The tools' --pf-gate: the PF's outlier gate (est.outlier_sigma, docs/modules/pf.md,
+ * "The gate"), sigma standard deviations; sigma <= 0 leaves the machine file's. A study
+ * setting (docs/presliding-plants.md, "The PF's gate"). */
+void br_circle_use_pf_gate(br_circle_cfg_t *c, double sigma);
+
 /* The tools' --delay-id: 0 turns both estimators' delay identification off
  * (est.delay_id, docs/modules/dlyid.md); any other value leaves the machine's. */
 void br_circle_use_delay_id(br_circle_cfg_t *c, long on);

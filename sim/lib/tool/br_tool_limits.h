@@ -44,6 +44,12 @@
 #define BR_TOOL_FEED_MIN_MM_MIN 0.01
 #define BR_TOOL_FEED_MAX_MM_MIN 3000.0
 
+/* --pf-gate (a study of the PF's outlier gate, docs/presliding-plants.md): standard
+ * deviations; the firmware refuses a gate <= 0 or above BR_EST_GATE_MAX_SIGMA, a study
+ * needs neither end */
+#define BR_TOOL_GATE_MIN_SIGMA 1.0
+#define BR_TOOL_GATE_MAX_SIGMA 1000.0
+
 /* br_simlog --force-noise: standard deviation, N */
 #define BR_TOOL_NOISE_MAX_N 1e4
 
