@@ -18,7 +18,6 @@ period: 50 periods on the reference machine).
    fails ("faulted").
 
 Usage: test_refq_gap.py --sim BR_LINK_SIM --machine M.json --work DIR"""
-import argparse
 import json
 import math
 import os
@@ -27,6 +26,9 @@ import signal
 import subprocess
 import sys
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import work_args  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -90,12 +92,7 @@ def one(args, move, gap_ms):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--sim", required=True)
-    ap.add_argument("--machine", required=True)
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
+    args = work_args.parse("sim", "machine")
     move = os.path.join(args.work, "move.csv")
     write_move(move)
     with open(args.machine) as f:
