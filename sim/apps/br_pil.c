@@ -166,13 +166,14 @@ static int run_one(const opts_t *o, br_circle_ctrl_t ctrl, const char *est, run_
     br_pil_run_t run;
     int rc = -1;
     if (duty[0] != NULL && duty[1] != NULL && br_pil_loop_open(&L, o->q.qemu, o->image, est, o->q.work, o->q.timeout_s) == 0 &&
-        br_pil_loop_run(&L, &c, NULL, 0, duty, &run) == 0) {
+        br_pil_loop_run(&L, &c, NULL, 0, duty, &run) == 0)
+        rc = 0;
+    br_pil_loop_close(&L); /* before --compare's simulator run: a signal then acts at once */
+    if (rc == 0) {
         out->res = run.res;
         out->wall_s = run.wall_s;
         out->same = o->compare ? compare(&c, est, &run.res, duty) : -1;
-        rc = 0;
     }
-    br_pil_loop_close(&L);
     free(duty[0]);
     free(duty[1]);
     return rc;
@@ -204,7 +205,7 @@ int main(int argc, char **argv)
         run_t run;
         if (run_one(&o, rows[r].ctrl, rows[r].est, &run) != 0) {
             fprintf(stderr, "%s: the run %s failed\n", TOOL, rows[r].est);
-            return 1;
+            return br_pil_loop_end(1);
         }
         const char *same = run.same < 0 ? "-" : run.same ? "yes" : "NO";
         if (run.same == 0) rc = 1;

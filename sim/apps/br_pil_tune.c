@@ -329,7 +329,8 @@ static double objective(void *user, const double *x, int n)
     const int nw = writes_of(t, x, w);
     eval_t e;
     if (run(t, &t->seg, w, nw, &e) != 0) {
-        fprintf(stderr, "%s: evaluation %d: the image did not answer; the search stops\n", TOOL, t->nfev + 1);
+        fprintf(stderr, "%s: evaluation %d: %s; the search stops\n", TOOL, t->nfev + 1,
+                br_pil_loop_stopped() ? "stopped by a signal" : "the image did not answer");
         t->dead = 1;
         return INFINITY;
     }
@@ -483,5 +484,5 @@ out:
     br_outfile_discard(&md_file);
     free(t.duty[0]);
     free(t.duty[1]);
-    return rc;
+    return br_pil_loop_end(rc); /* killed by a signal: only now, the folders and outputs gone */
 }

@@ -17,7 +17,6 @@ pace), each step a separate invocation of the tool as a user would run it:
 5. reset and arm again are accepted.
 
 Usage: test_link_sim_e2e.py --sim BR_LINK_SIM --machine machines/reference.json --work DIR"""
-import argparse
 import csv
 import json
 import math
@@ -33,6 +32,9 @@ ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "python"))
 
 from bristle.diagnose.logreader import read_log  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import work_args  # noqa: E402
 
 MOVE_M = 0.004   # the move: 4 mm in MOVE_S (a raised cosine), then held
 MOVE_S = 0.6
@@ -67,12 +69,7 @@ def check(cond, what):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--sim", required=True)
-    ap.add_argument("--machine", required=True)
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
+    args = work_args.parse("sim", "machine", fresh=False)
     with open(args.machine) as f:
         machine = json.load(f)
     pty_file = os.path.join(args.work, "pty.txt")

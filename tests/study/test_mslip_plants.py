@@ -6,12 +6,13 @@ run is listed with its time and cause and has no figure, and that the page
 writer exits 1 on a fault it was not told to expect (docs/tools.md).
 
 Usage: test_mslip_plants.py --bin BUILD/sim --work DIR"""
-import argparse
 import json
 import os
-import shutil
 import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import work_args  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 STUDY = os.path.join(ROOT, "sim", "studies", "mslip_plants.py")
@@ -24,12 +25,7 @@ def study(a, out, jobs, *extra):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--bin", required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    shutil.rmtree(a.work, ignore_errors=True)
-    os.makedirs(a.work)
+    a = work_args.parse("bin")
     fails = []
 
     def check(cond, what):

@@ -8,12 +8,13 @@ sigma; the plot script draws the figure from it; bad --at lists and a
 --posterior without --at are refused with exit 2 and no file.
 
 Usage: test_posterior.py --bin BUILD/sim --work DIR"""
-import argparse
 import csv
 import os
-import shutil
 import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import work_args  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PLOT = os.path.join(ROOT, "sim", "plots", "plot_posterior.py")
@@ -21,12 +22,7 @@ AT = (1.9, 2.0, 2.3)
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--bin", required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    shutil.rmtree(a.work, ignore_errors=True)
-    os.makedirs(a.work)
+    a = work_args.parse("bin")
     tool = os.path.join(a.bin, "br_mslip_plants")
     fails = []
 

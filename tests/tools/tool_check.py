@@ -3,20 +3,16 @@
 (test_tune_refusal.py, test_tune_guard_outliers.py, test_bench_numpy.py):
 the command line (the tool's path and --work), a fresh work folder, and the
 report of the checks that failed."""
-import argparse
 import os
-import shutil
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import work_args  # noqa: E402
 
 
 def start(tool_flag):
     """(the tool's path, the work folder, now empty) from --<tool_flag> BIN --work DIR"""
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--" + tool_flag, required=True)
-    ap.add_argument("--work", required=True)
-    a = ap.parse_args()
-    shutil.rmtree(a.work, ignore_errors=True)
-    os.makedirs(a.work)
+    a = work_args.parse(tool_flag)
     return getattr(a, tool_flag), a.work
 
 

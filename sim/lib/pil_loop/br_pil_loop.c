@@ -32,6 +32,57 @@
 
 static const char *const FILES[5] = {"link.in", "link.out", "plant.in", "plant.out", "qemu.log"};
 
+/* The signals that stop a tool (Ctrl-C, kill, a closed terminal): while a loop is
+ * open, their handler only records the signal; the loop's waits see it (a wait
+ * returns EINTR, or at its next slice) and the run ends with -1, so that the tool
+ * removes the work folders (br_pil_loop_close) and its temporary outputs before
+ * br_pil_loop_end re-raises it. A process-wide flag: a signal handler reaches
+ * nothing else (the one mutable global of the loop, async-signal-safe). */
+static const int STOP_SIGNALS[3] = {SIGINT, SIGTERM, SIGHUP};
+static volatile sig_atomic_t stop_signal;
+static struct sigaction stop_saved[3];
+static int stop_installed;
+/* the longest single wait: a signal that lands between the flag's test and the wait is seen within it */
+#define WAIT_SLICE_MS 100
+
+static void on_stop_signal(int sig)
+{
+    stop_signal = sig;
+}
+
+static void stop_install(void)
+{
+    if (stop_installed) return;
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal; /* no SA_RESTART: a blocked read, write or poll returns EINTR */
+    sigemptyset(&sa.sa_mask);
+    for (int i = 0; i < 3; i++) sigaction(STOP_SIGNALS[i], &sa, &stop_saved[i]);
+    stop_installed = 1;
+}
+
+static void stop_restore(void)
+{
+    if (!stop_installed) return;
+    for (int i = 0; i < 3; i++) sigaction(STOP_SIGNALS[i], &stop_saved[i], NULL);
+    stop_installed = 0;
+}
+
+/* 1 (with a message) when a signal asked the tool to stop */
+static int stopped(int axis)
+{
+    if (stop_signal == 0) return 0;
+    fprintf(stderr, "%s: axis %d: stopped by signal %d; the work folders are removed\n", TOOL, axis, (int)stop_signal);
+    return 1;
+}
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 /* the FIFO DIR/NAME, opened read-write (no open waits for the other end) */
 static int fifo(const char *dir, const char *name)
 {
@@ -99,7 +150,7 @@ static void axis_stop(br_pil_axis_t *a, int keep)
 {
     if (a->pid > 0) {
         kill(a->pid, SIGTERM);
-        waitpid(a->pid, NULL, 0);
+        while (waitpid(a->pid, NULL, 0) < 0 && errno == EINTR) continue;
         a->pid = 0;
     }
     const int fds[4] = {a->link_in, a->link_out, a->plant_in, a->plant_out};
@@ -119,7 +170,7 @@ static int write_all(int fd, const uint8_t *b, size_t n)
 {
     while (n > 0) {
         const ssize_t w = write(fd, b, n);
-        if (w < 0 && errno == EINTR) continue;
+        if (w < 0 && errno == EINTR && stop_signal == 0) continue;
         if (w <= 0) return -1;
         b += w;
         n -= (size_t)w;
@@ -220,9 +271,16 @@ static int exchange(br_pil_loop_t *L, int axis, int32_t counts, br_link_pil_out_
                 return 0;
             }
         }
+        if (stopped(axis)) return -1;
         if (r > 0 || (r < 0 && errno == EINTR)) continue;
         struct pollfd pf = {a->plant_out, POLLIN, 0};
-        if (poll(&pf, 1, (int)(L->timeout_s * 1000.0)) <= 0) {
+        int ready = 0;
+        for (const double end_s = now_s() + L->timeout_s; ready == 0 && now_s() < end_s;) {
+            ready = poll(&pf, 1, WAIT_SLICE_MS);
+            if (ready < 0 && errno == EINTR) ready = 0;
+            if (stopped(axis)) return -1;
+        }
+        if (ready <= 0) {
             int ws;
             if (waitpid(a->pid, &ws, WNOHANG) == a->pid) {
                 a->pid = 0;
@@ -343,13 +401,6 @@ double br_pil_meas_rms(const br_pil_meas_t *m)
     return m->n > 0 ? sqrt(m->sum2 / (double)m->n) : 0.0;
 }
 
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 int br_pil_loop_open(br_pil_loop_t *L, const char *qemu, const char *image, const char *est, const char *work,
                      double timeout_s)
 {
@@ -358,8 +409,10 @@ int br_pil_loop_open(br_pil_loop_t *L, const char *qemu, const char *image, cons
     L->keep = work != NULL;
     for (int i = 0; i < 2; i++) L->ax[i].link_in = L->ax[i].link_out = L->ax[i].plant_in = L->ax[i].plant_out = -1;
     signal(SIGPIPE, SIG_IGN);
+    stop_install();
     for (int i = 0; i < 2; i++) {
         char dir[512];
+        if (stopped(i)) return -1;
         if (work != NULL) {
             snprintf(dir, sizeof dir, "%s/%s_axis%d", work, est, i);
             if (mkdir(dir, 0700) != 0 && errno != EEXIST) {
@@ -392,6 +445,7 @@ int br_pil_loop_run(br_pil_loop_t *L, const br_circle_cfg_t *c, const br_pil_par
     if (br_circle_run_remote(c, &remote, NULL, NULL, &out->res) < 0) return -1;
     for (int i = 0; i < 2; i++)
         if (after_run(L, i) != 0) return -1;
+    if (stopped(0)) return -1; /* a run the signal reached only in its last wait is no result either */
     out->wall_s = now_s() - t0;
     out->meas_rms_m = br_pil_meas_rms(&L->meas);
     out->meas_max_m = L->meas.emax;
@@ -403,4 +457,19 @@ void br_pil_loop_close(br_pil_loop_t *L)
 {
     for (int i = 0; i < L->started; i++) axis_stop(&L->ax[i], L->keep);
     L->started = 0;
+    stop_restore();
+}
+
+int br_pil_loop_stopped(void)
+{
+    return (int)stop_signal;
+}
+
+int br_pil_loop_end(int rc)
+{
+    if (stop_signal == 0) return rc;
+    /* the signal's own action now (the handlers were restored at close): the exit status a killed tool has */
+    signal((int)stop_signal, SIG_DFL);
+    raise((int)stop_signal);
+    return 128 + (int)stop_signal; /* a signal whose default action did not end the process */
 }

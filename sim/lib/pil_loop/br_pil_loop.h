@@ -104,4 +104,18 @@ int br_pil_loop_run(br_pil_loop_t *L, const br_circle_cfg_t *c, const br_pil_par
 /* Stops the QEMUs; the work folders are removed unless they were given. */
 void br_pil_loop_close(br_pil_loop_t *L);
 
+/* A stop by signal (docs/link.md, "The image in the loop"). From
+ * br_pil_loop_open to br_pil_loop_close, SIGINT, SIGTERM and SIGHUP only
+ * record themselves: the run in progress (or the next open or run) ends with
+ * -1 and a message, the tool goes its ordinary failure path (close removes the
+ * work folders, its temporary outputs are discarded) and ends with
+ * br_pil_loop_end. SIGKILL cannot be caught: the QEMUs then end with the tool
+ * (PR_SET_PDEATHSIG) and the folders stay. */
+/* the signal that asked the stop, 0 when none */
+int br_pil_loop_stopped(void);
+/* rc when no signal asked the stop; else the signal is raised again with its
+ * default action (the exit status of a killed tool) after the caller's
+ * clean-up. The last call of a tool's main: return br_pil_loop_end(rc). */
+int br_pil_loop_end(int rc);
+
 #endif
