@@ -138,14 +138,21 @@ static br_status_t rx_decode(br_link_t *l, br_link_cmd_t *cmd)
     return BR_OK;
 }
 
-br_status_t br_link_step(br_link_t *l, br_link_cmd_t *cmd)
+/* the guards of br_link_step and br_link_next; *cmd NONE */
+static br_status_t rx_begin(br_link_t *l, br_link_cmd_t *cmd)
 {
     if (l == NULL || cmd == NULL) {
         return BR_E_NULL;
     }
     cmd->kind = BR_LINK_CMD_NONE;
-    if (!l->ready) {
-        return BR_E_STATE;
+    return l->ready ? BR_OK : BR_E_STATE;
+}
+
+br_status_t br_link_step(br_link_t *l, br_link_cmd_t *cmd)
+{
+    const br_status_t st = rx_begin(l, cmd);
+    if (st != BR_OK) {
+        return st;
     }
     tx_flush(l);
     /* a new period: its K bytes and its one read */
@@ -156,12 +163,6 @@ br_status_t br_link_step(br_link_t *l, br_link_cmd_t *cmd)
 
 br_status_t br_link_next(br_link_t *l, br_link_cmd_t *cmd)
 {
-    if (l == NULL || cmd == NULL) {
-        return BR_E_NULL;
-    }
-    cmd->kind = BR_LINK_CMD_NONE;
-    if (!l->ready) {
-        return BR_E_STATE;
-    }
-    return rx_decode(l, cmd);
+    const br_status_t st = rx_begin(l, cmd);
+    return st != BR_OK ? st : rx_decode(l, cmd);
 }

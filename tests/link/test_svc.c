@@ -205,6 +205,14 @@ static void steps(rig_t *g, unsigned n)
     for (unsigned i = 0u; i < n; ++i) (void)br_svc_step(&g->svc);
 }
 
+/* an arm request and its period; the tick after it */
+static uint32_t rig_arm(rig_t *g)
+{
+    host_send(&g->wire, BR_LINK_MSG_ARM, NULL, 0u);
+    steps(g, 1u);
+    return g->svc.tick;
+}
+
 /* the reports a period queues leave at the next period's br_link_step */
 #define SENT(g) steps((g), 1u)
 
@@ -374,9 +382,7 @@ static void test_underrun_faults(void **st)
     (void)st;
     rig_t *g = test_malloc(sizeof *g);
     rig_init(g, 0, 0);
-    host_send(&g->wire, BR_LINK_MSG_ARM, NULL, 0u);
-    steps(g, 1u);
-    const uint32_t t0 = g->svc.tick;
+    const uint32_t t0 = rig_arm(g);
     for (uint32_t k = 0u; k < 4u; ++k) host_setpoint(&g->wire, t0 + 1u + k, 0, 0.0f, 0u);
     steps(g, 6u);
     assert_int_equal(g->svc.ref.state, BR_REFQ_HOLD);
@@ -464,9 +470,7 @@ static void test_two_refs_a_period(void **st)
     assert_int_equal(g->svc.ref.n, 3u);
     /* with K = 256 (eight setpoint frames would fit) still two a period */
     rig_budget(g, 256u);
-    host_send(&g->wire, BR_LINK_MSG_ARM, NULL, 0u);
-    steps(g, 1u);
-    const uint32_t t1 = g->svc.tick;
+    const uint32_t t1 = rig_arm(g);
     for (uint32_t k = 0u; k < 6u; ++k) host_setpoint(&g->wire, t1 + 100u + k, 0, 0.0f, 0u);
     steps(g, 1u);
     assert_int_equal(g->svc.ref.n, 2u);
@@ -484,9 +488,7 @@ static void test_overflow_refused(void **st)
     (void)st;
     rig_t *g = test_malloc(sizeof *g);
     rig_init(g, 0, 0);
-    host_send(&g->wire, BR_LINK_MSG_ARM, NULL, 0u);
-    steps(g, 1u);
-    const uint32_t t0 = g->svc.tick;
+    const uint32_t t0 = rig_arm(g);
     const uint32_t len = g->scfg.ref.queue_len, extra = 4u;
     for (uint32_t k = 0u; k < len + extra; ++k) host_setpoint(&g->wire, t0 + 100u + k, (int32_t)k, 0.0f, 0u);
     steps(g, (len + extra) / 2u);
