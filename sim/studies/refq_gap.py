@@ -81,6 +81,9 @@ def one_run(a, machine, gap_ms, at_s):
                     gaps.pop(0)
                     out["gap_ticks"].append(sess.tick)
                     time.sleep(gap_ms / 1000.0)  # the host stopped: nothing read, nothing sent
+                    sess.poll(0.0)  # the reports sent during the gap: the level at its end, before any refill
+                    rs = sess.ref_status
+                    out["levels"].append((sess.tick, rs["queued"], rs["underruns"], rs["state"]))
                     last = time.monotonic()
         except cli.ToolError as e:
             out["refused"] = str(e)
