@@ -22,7 +22,7 @@ Setpoints (one period each):
 4. three gaps of SP_GAP_PERIODS each, 0.5 s apart, each within the
    queue's reach, the host's loop itself asleep (bristle-link's own
    streaming loop run here, sim/studies/refq_gap.py): no underrun, nothing
-   refused, a gap that took at least a third of its periods from the queue,
+   refused, at least one gap taking a third of its periods from the queue,
    and after each gap the queue refills by at least half of what it took
    (the service takes two setpoints a period; with one, the level stayed at
    its lowest, the rest of the items waiting in the byte channel);
