@@ -198,6 +198,12 @@ static void svc_command(br_svc_t *s, const br_link_cmd_t *cmd)
     }
 }
 
+/* 1 for a request that feeds the reference queue */
+static int svc_is_ref(br_link_cmd_kind_t kind)
+{
+    return kind == BR_LINK_CMD_SETPOINT || kind == BR_LINK_CMD_SEGMENT;
+}
+
 /* the enable input: its rising edge arms, low disarms */
 static void svc_enable(br_svc_t *s)
 {
@@ -243,8 +249,22 @@ br_status_t br_svc_step(br_svc_t *s)
     if (!s->ready) {
         return BR_E_STATE;
     }
-    const br_status_t lst = br_link_step(&s->link, &s->cmd);
+    br_status_t lst = br_link_step(&s->link, &s->cmd);
     svc_command(s, &s->cmd);
+    /* after a setpoint or segment, the period's next request within its K
+     * bytes (up to BR_SVC_REQUESTS_MAX): a stream refills the queue after a
+     * host's gap; at most one other request a period */
+    for (unsigned n = 1u; n < BR_SVC_REQUESTS_MAX && svc_is_ref(s->cmd.kind); ++n) {
+        br_link_cmd_t next;
+        if (br_link_next(&s->link, &next) == BR_E_INPUT) {
+            lst = BR_E_INPUT;
+        }
+        if (next.kind == BR_LINK_CMD_NONE) {
+            break;
+        }
+        s->cmd = next;
+        svc_command(s, &s->cmd);
+    }
     svc_enable(s);
     br_app_t *app = s->app;
     br_ref_t r = {s->ref.pos_counts, s->ref.pos_frac, 0.0f};

@@ -24,6 +24,8 @@ br_status_t br_link_init(br_link_t *l, const br_link_cfg_t *cfg, const br_byte_c
     br_link_dec_init(&l->dec);
     l->rx_pos = 0u;
     l->rx_end = 0u;
+    l->rx_done = 0u;
+    l->rx_have_read = 0u;
     l->tx_len = 0u;
     l->tx_seq = 0u;
     l->ready = 1;
@@ -102,27 +104,20 @@ static int frame_to_cmd(br_link_t *l, const br_link_frame_t *f, br_link_cmd_t *c
     return 1;
 }
 
-br_status_t br_link_step(br_link_t *l, br_link_cmd_t *cmd)
+/* Decodes received bytes until a request, within what is left of the
+ * period's K bytes and its one read (rx_done, rx_have_read). */
+static br_status_t rx_decode(br_link_t *l, br_link_cmd_t *cmd)
 {
-    if (l == NULL || cmd == NULL) {
-        return BR_E_NULL;
-    }
-    cmd->kind = BR_LINK_CMD_NONE;
-    if (!l->ready) {
-        return BR_E_STATE;
-    }
-    tx_flush(l);
     const size_t k = l->cfg.rx_budget_bytes;
-    int have_read = 0;
     br_link_frame_t f;
     /* at most k bytes, at most one read, at most one command */
-    for (size_t done = 0u; done < k; ++done) {
+    while (l->rx_done < k) {
         if (l->rx_pos == l->rx_end) {
-            if (have_read) {
+            if (l->rx_have_read) {
                 break;
             }
-            have_read = 1;
-            const size_t want = k - done;
+            l->rx_have_read = 1u;
+            const size_t want = k - l->rx_done;
             const size_t got = l->chan.read(l->chan.ctx, l->rx, want);
             l->rx_pos = 0u;
             l->rx_end = 0u;
@@ -135,9 +130,39 @@ br_status_t br_link_step(br_link_t *l, br_link_cmd_t *cmd)
             l->rx_end = got;
             l->dec.cnt.rx_bytes += (uint32_t)got;
         }
+        ++l->rx_done;
         if (br_link_dec_push(&l->dec, l->rx[l->rx_pos++], &f) && frame_to_cmd(l, &f, cmd)) {
             break;
         }
     }
     return BR_OK;
+}
+
+/* the guards of br_link_step and br_link_next; *cmd NONE */
+static br_status_t rx_begin(br_link_t *l, br_link_cmd_t *cmd)
+{
+    if (l == NULL || cmd == NULL) {
+        return BR_E_NULL;
+    }
+    cmd->kind = BR_LINK_CMD_NONE;
+    return l->ready ? BR_OK : BR_E_STATE;
+}
+
+br_status_t br_link_step(br_link_t *l, br_link_cmd_t *cmd)
+{
+    const br_status_t st = rx_begin(l, cmd);
+    if (st != BR_OK) {
+        return st;
+    }
+    tx_flush(l);
+    /* a new period: its K bytes and its one read */
+    l->rx_done = 0u;
+    l->rx_have_read = 0u;
+    return rx_decode(l, cmd);
+}
+
+br_status_t br_link_next(br_link_t *l, br_link_cmd_t *cmd)
+{
+    const br_status_t st = rx_begin(l, cmd);
+    return st != BR_OK ? st : rx_decode(l, cmd);
 }

@@ -6,7 +6,9 @@ queue, on a pseudo-terminal, at real time) armed and fed a setpoint stream by
 bristle-link's own streaming loop (bristle.link.cli.stream_steps), whose
 host stops for GAP ms (nothing sent, as a descheduled process) at each of
 --at S seconds after the stream's start. Per run it prints the target's
-queue level (ref_status.queued) before and after each gap, the underruns
+queue level (ref_status.queued) before and after the gaps, per gap the
+level before it, the lowest after it and the highest after that (the
+refill: the service takes two setpoints a period), the underruns
 and the fault the target reported, and the largest wall-clock gap between
 two turns of the host's loop (its scheduling gaps on this machine).
 
@@ -47,7 +49,7 @@ def one_run(a, machine, gap_ms, at_s):
     sim = subprocess.Popen([os.path.join(a.bin, "br_link_sim"), "--est", a.est, "--status-periods", "5",
                             "--tlm-every", "10", "--pty-path", pty], stdout=subprocess.DEVNULL,
                            stderr=subprocess.PIPE, text=True)
-    out = {"gap_ms": gap_ms, "levels": [], "refused": None}
+    out = {"gap_ms": gap_ms, "levels": [], "refused": None, "gap_ticks": []}
     try:
         t0 = time.monotonic()
         while not os.path.exists(pty):
@@ -77,7 +79,11 @@ def one_run(a, machine, gap_ms, at_s):
                 out["levels"].append((sess.tick, rs["queued"], rs["underruns"], rs["state"]))
                 if gaps and sess.tick >= gaps[0]:
                     gaps.pop(0)
+                    out["gap_ticks"].append(sess.tick)
                     time.sleep(gap_ms / 1000.0)  # the host stopped: nothing read, nothing sent
+                    sess.poll(0.0)  # the reports sent during the gap: the level at its end, before any refill
+                    rs = sess.ref_status
+                    out["levels"].append((sess.tick, rs["queued"], rs["underruns"], rs["state"]))
                     last = time.monotonic()
         except cli.ToolError as e:
             out["refused"] = str(e)
@@ -92,6 +98,23 @@ def one_run(a, machine, gap_ms, at_s):
         sim.terminate()
         _, err = sim.communicate(timeout=30)
         out["sim_end"] = err.strip().splitlines()[-1] if err.strip() else ""
+    return out
+
+
+def refill(r):
+    """per gap (the host's tick at its start): the queue's level last reported before it, the lowest
+    after it, and the highest after that lowest, until the next gap (or 100 periods before the
+    stream's end, where the queue empties)"""
+    out = []
+    ends = r["gap_ticks"][1:] + [r["end_tick"] - 100]
+    for g, e in zip(r["gap_ticks"], ends):
+        before = [q for tk, q, _, _ in r["levels"] if tk < g]
+        after = [(tk, q) for tk, q, _, _ in r["levels"] if g <= tk < e]
+        if not before or not after:
+            out.append((-1, -1, -1))
+            continue
+        low_tick, low = min(after, key=lambda x: x[1])
+        out.append((before[-1], low, max(q for tk, q in after if tk >= low_tick)))
     return out
 
 
@@ -121,6 +144,8 @@ def main():
         fault = "cause %d tick %d" % (r["fault"]["cause"], r["fault"]["tick"]) if r["fault"] else "none"
         print("%6.0f  %4d  %17d  %16d  %9d  %s  %15.1f  %s" % (g, len(at_s), before, after, r["underruns"], fault,
                                                                1e3 * r["host_gap_max_s"], r["refused"] or "-"))
+        print("        queued before -> lowest -> refilled, per gap: "
+              + ", ".join("%d -> %d -> %d" % x for x in refill(r)))
         print("        br_link_sim: " + r["sim_end"], flush=True)
     return 0
 

@@ -17,6 +17,7 @@
  *     force): any seq;
  *   - every non-empty segment between delimiters is counted exactly once;
  *   - a step takes at most K bytes and returns at most one valid command;
+ *     a period of a step and br_link_next calls (every other one) at most K;
  *   - after any input, a valid frame with the next sequence number is decoded
  *     (resynchronisation).
  * A violated property aborts (a finding). */
@@ -168,6 +169,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const uint32_t before = l.dec.cnt.rx_bytes;
         br_link_cmd_t cmd;
         if (br_link_step(&l, &cmd) != BR_OK) abort();
+        /* every other period, the period's further requests (br_svc's second): the same K bytes */
+        for (unsigned m = 0u; m < 2u && steps % 2u == 1u && cmd.kind != BR_LINK_CMD_NONE; ++m) {
+            if (cmd.kind == BR_LINK_CMD_PARAM_WRITE && cmd.value != cmd.value) abort();
+            if (br_link_next(&l, &cmd) != BR_OK) abort();
+        }
         if (l.dec.cnt.rx_bytes - before > k) abort();
         if (cmd.kind == BR_LINK_CMD_PARAM_WRITE && cmd.value != cmd.value) abort(); /* NaN reached the caller */
         if (src.pos == n && l.rx_pos == l.rx_end) break;

@@ -359,6 +359,55 @@ static void test_step_bounded(void **s)
     assert_int_equal(b.kind, BR_LINK_CMD_DISARM); /* from the bytes kept from the first read */
 }
 
+/* br_link_next: the period's next request within what is left of its K bytes
+ * and its one read; the budget and the read are the period's, not the call's */
+static void test_next_shares_the_budget(void **s)
+{
+    (void)s;
+    br_link_t l;
+    chan_t c;
+    const size_t k = 25; /* two 10-byte arms and half of a third */
+    link_up(&l, &c, k);
+    for (uint16_t q = 1; q <= 4; ++q) host_frame(&c, q % 2u ? BR_LINK_MSG_ARM : BR_LINK_MSG_DISARM, q, NULL, 0);
+    br_link_cmd_t a, b, d;
+    assert_int_equal(br_link_step(&l, &a), BR_OK);
+    assert_int_equal(a.kind, BR_LINK_CMD_ARM);
+    assert_int_equal(br_link_next(&l, &b), BR_OK);
+    assert_int_equal(b.kind, BR_LINK_CMD_DISARM);
+    assert_int_equal(br_link_next(&l, &d), BR_OK);
+    assert_int_equal(d.kind, BR_LINK_CMD_NONE); /* the third frame's rest is beyond the period's k bytes */
+    assert_int_equal(l.dec.cnt.rx_bytes, k);    /* one read of k bytes in the period */
+    assert_int_equal(l.rx_done, k);
+    assert_int_equal(br_link_next(&l, &d), BR_OK);
+    assert_int_equal(d.kind, BR_LINK_CMD_NONE);
+    assert_int_equal(l.dec.cnt.rx_bytes, k);
+    /* the next period: the third frame, then the fourth, from a new read */
+    assert_int_equal(br_link_step(&l, &a), BR_OK);
+    assert_int_equal(a.kind, BR_LINK_CMD_ARM);
+    assert_int_equal(a.seq, 3);
+    assert_int_equal(br_link_next(&l, &b), BR_OK);
+    assert_int_equal(b.kind, BR_LINK_CMD_DISARM);
+    assert_int_equal(b.seq, 4);
+    /* the period made its one read in the step: br_link_next does not read again */
+    link_up(&l, &c, 64);
+    c.read_max = 10; /* the channel hands one arm a read */
+    host_frame(&c, BR_LINK_MSG_ARM, 1, NULL, 0);
+    host_frame(&c, BR_LINK_MSG_DISARM, 2, NULL, 0);
+    assert_int_equal(br_link_step(&l, &a), BR_OK);
+    assert_int_equal(a.kind, BR_LINK_CMD_ARM);
+    assert_int_equal(br_link_next(&l, &b), BR_OK);
+    assert_int_equal(b.kind, BR_LINK_CMD_NONE);
+    assert_int_equal(l.dec.cnt.rx_bytes, 10);
+    assert_int_equal(br_link_step(&l, &b), BR_OK);
+    assert_int_equal(b.kind, BR_LINK_CMD_DISARM);
+    /* the guards */
+    assert_int_equal(br_link_next(NULL, &b), BR_E_NULL);
+    assert_int_equal(br_link_next(&l, NULL), BR_E_NULL);
+    br_link_t cold;
+    memset(&cold, 0, sizeof cold);
+    assert_int_equal(br_link_next(&cold, &b), BR_E_STATE);
+}
+
 static void test_channel_claiming_more_refused(void **s)
 {
     (void)s;
@@ -509,6 +558,7 @@ int main(void)
         cmocka_unit_test(test_hello_opens_a_session),
         cmocka_unit_test(test_resync_after_garbage),
         cmocka_unit_test(test_step_bounded),
+        cmocka_unit_test(test_next_shares_the_budget),
         cmocka_unit_test(test_channel_claiming_more_refused),
         cmocka_unit_test(test_param_write_checked),
         cmocka_unit_test(test_send_partial_and_busy),

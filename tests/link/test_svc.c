@@ -127,6 +127,16 @@ static void host_setpoint(wire_t *w, uint32_t tick, int32_t counts, float omega,
     host_send(w, BR_LINK_MSG_SETPOINT, p, sizeof p);
 }
 
+static void host_segment(wire_t *w, uint32_t tick, uint32_t periods, int32_t counts)
+{
+    uint8_t p[BR_LINK_MSG_SEGMENT_LEN];
+    memset(p, 0, sizeof p); /* frac, v, a, j 0: a segment holding counts */
+    put32(&p[BR_LINK_MSG_SEGMENT_OFF_TICK], tick);
+    put32(&p[BR_LINK_MSG_SEGMENT_OFF_PERIODS], periods);
+    put32(&p[BR_LINK_MSG_SEGMENT_OFF_COUNTS], (uint32_t)counts);
+    host_send(w, BR_LINK_MSG_SEGMENT, p, sizeof p);
+}
+
 typedef struct {
     hw_t hw;
     wire_t wire;
@@ -193,6 +203,14 @@ static size_t host_frames(rig_t *g, uint8_t id, br_link_frame_t *out, size_t max
 static void steps(rig_t *g, unsigned n)
 {
     for (unsigned i = 0u; i < n; ++i) (void)br_svc_step(&g->svc);
+}
+
+/* an arm request and its period; the tick after it */
+static uint32_t rig_arm(rig_t *g)
+{
+    host_send(&g->wire, BR_LINK_MSG_ARM, NULL, 0u);
+    steps(g, 1u);
+    return g->svc.tick;
 }
 
 /* the reports a period queues leave at the next period's br_link_step */
@@ -364,9 +382,7 @@ static void test_underrun_faults(void **st)
     (void)st;
     rig_t *g = test_malloc(sizeof *g);
     rig_init(g, 0, 0);
-    host_send(&g->wire, BR_LINK_MSG_ARM, NULL, 0u);
-    steps(g, 1u);
-    const uint32_t t0 = g->svc.tick;
+    const uint32_t t0 = rig_arm(g);
     for (uint32_t k = 0u; k < 4u; ++k) host_setpoint(&g->wire, t0 + 1u + k, 0, 0.0f, 0u);
     steps(g, 6u);
     assert_int_equal(g->svc.ref.state, BR_REFQ_HOLD);
@@ -388,6 +404,109 @@ static void test_underrun_faults(void **st)
     steps(g, 10u);
     assert_true(host_frames(g, BR_LINK_MSG_REF_STATUS, f, 2u) >= 1u);
     assert_int_equal(get32(&f[0].payload[BR_LINK_MSG_REF_STATUS_OFF_UNDERRUNS]), 1u);
+    test_free(g);
+}
+
+/* the application and the service again, with another link budget K */
+static void rig_budget(rig_t *g, size_t k)
+{
+    assert_int_equal(br_app_init(&g->app, &g->cfg, &g->hal, &g->mem), BR_OK);
+    g->scfg.rx_budget_bytes = k;
+    const br_byte_chan_t ch = {&g->wire, wire_read, wire_write};
+    assert_int_equal(br_svc_init(&g->svc, &g->scfg, &g->app, &g->cfg, &g->mem, &ch), BR_OK);
+}
+
+/* one step; the bytes the link took in it */
+static uint32_t step_bytes(rig_t *g)
+{
+    const uint32_t before = g->svc.link.dec.cnt.rx_bytes;
+    steps(g, 1u);
+    return g->svc.link.dec.cnt.rx_bytes - before;
+}
+
+/* up to BR_SVC_REQUESTS_MAX (2) requests a period, the second only after a
+ * setpoint or segment and only within the period's K bytes: two 27-byte
+ * setpoint frames fit K = 64, two 39-byte segment frames do not */
+static void test_two_refs_a_period(void **st)
+{
+    (void)st;
+    rig_t *g = test_malloc(sizeof *g);
+    rig_init(g, 0, 0);
+    /* an arm and two setpoints: the arm alone in its period */
+    host_send(&g->wire, BR_LINK_MSG_ARM, NULL, 0u);
+    const uint32_t t0 = g->svc.tick;
+    host_setpoint(&g->wire, t0 + 100u, 0, 0.0f, 0u);
+    host_setpoint(&g->wire, t0 + 101u, 0, 0.0f, 0u);
+    steps(g, 1u);
+    assert_int_equal(g->app.fault, BR_APP_FAULT_NONE);
+    assert_int_equal(g->svc.ref.n, 0u);
+    steps(g, 1u);
+    assert_int_equal(g->svc.ref.n, 2u);
+    assert_int_equal(g->svc.cmd.kind, BR_LINK_CMD_SETPOINT);
+    /* six setpoints: two a period */
+    for (uint32_t k = 2u; k < 8u; ++k) host_setpoint(&g->wire, t0 + 100u + k, 0, 0.0f, 0u);
+    for (uint32_t k = 1u; k <= 3u; ++k) {
+        assert_true(step_bytes(g) <= g->scfg.rx_budget_bytes);
+        assert_int_equal(g->svc.ref.n, 2u + 2u * k);
+    }
+    /* a setpoint, then a request of another kind: both in the period, the latter the caller's */
+    (void)br_refq_clear(&g->svc.ref);
+    const uint8_t d[BR_LINK_MSG_REC_DUMP_LEN] = {37u, 0u};
+    host_setpoint(&g->wire, t0 + 200u, 0, 0.0f, 0u);
+    host_send(&g->wire, BR_LINK_MSG_REC_DUMP, d, sizeof d);
+    host_setpoint(&g->wire, t0 + 201u, 0, 0.0f, 0u);
+    steps(g, 1u);
+    assert_int_equal(g->svc.ref.n, 1u);
+    assert_int_equal(g->svc.cmd.kind, BR_LINK_CMD_REC_DUMP);
+    assert_int_equal(g->svc.cmd.first, 37);
+    steps(g, 1u);
+    assert_int_equal(g->svc.ref.n, 2u);
+    /* segments: the second frame does not fit the period's K bytes; 3 in two periods */
+    (void)br_refq_clear(&g->svc.ref);
+    for (uint32_t k = 0u; k < 3u; ++k) host_segment(&g->wire, t0 + 300u + 4u * k, 4u, 0);
+    assert_true(step_bytes(g) <= g->scfg.rx_budget_bytes);
+    assert_int_equal(g->svc.ref.n, 1u);
+    assert_true(step_bytes(g) <= g->scfg.rx_budget_bytes);
+    assert_int_equal(g->svc.ref.n, 3u);
+    /* with K = 256 (eight setpoint frames would fit) still two a period */
+    rig_budget(g, 256u);
+    const uint32_t t1 = rig_arm(g);
+    for (uint32_t k = 0u; k < 6u; ++k) host_setpoint(&g->wire, t1 + 100u + k, 0, 0.0f, 0u);
+    steps(g, 1u);
+    assert_int_equal(g->svc.ref.n, 2u);
+    steps(g, 1u);
+    assert_int_equal(g->svc.ref.n, 4u);
+    assert_int_equal(g->svc.ref.cnt.dropped + g->svc.ref.cnt.late + g->svc.ref.cnt.rejected, 0u);
+    test_free(g);
+}
+
+/* a host that sends more than the queue holds: two a period fill it, each
+ * item beyond refused and counted (dropped), reported by ref_status; the
+ * queued ones kept in order */
+static void test_overflow_refused(void **st)
+{
+    (void)st;
+    rig_t *g = test_malloc(sizeof *g);
+    rig_init(g, 0, 0);
+    const uint32_t t0 = rig_arm(g);
+    const uint32_t len = g->scfg.ref.queue_len, extra = 4u;
+    for (uint32_t k = 0u; k < len + extra; ++k) host_setpoint(&g->wire, t0 + 100u + k, (int32_t)k, 0.0f, 0u);
+    steps(g, (len + extra) / 2u);
+    assert_int_equal(g->svc.ref.n, len);
+    assert_int_equal(g->svc.ref.cnt.dropped, extra);
+    for (uint32_t k = 0u; k < len; ++k) {
+        const br_refq_item_t *it = &g->svc.ref.q[(g->svc.ref.head + k) % len];
+        assert_int_equal(it->tick, t0 + 100u + k);
+        assert_int_equal(it->counts, (int32_t)k);
+    }
+    g->wire.tx_len = 0u;
+    steps(g, g->scfg.status_periods + 1u);
+    br_link_frame_t f[4];
+    assert_true(host_frames(g, BR_LINK_MSG_REF_STATUS, f, 4u) >= 1u);
+    assert_int_equal(f[0].payload[BR_LINK_MSG_REF_STATUS_OFF_QUEUED], len);
+    assert_int_equal(f[0].payload[BR_LINK_MSG_REF_STATUS_OFF_FREE], 0u);
+    assert_int_equal(get32(&f[0].payload[BR_LINK_MSG_REF_STATUS_OFF_DROPPED]), extra);
+    assert_int_equal(g->app.fault, BR_APP_FAULT_NONE);
     test_free(g);
 }
 
@@ -578,6 +697,8 @@ int main(void)
         cmocka_unit_test(test_enable_input),
         cmocka_unit_test(test_enable_high_at_start),
         cmocka_unit_test(test_underrun_faults),
+        cmocka_unit_test(test_two_refs_a_period),
+        cmocka_unit_test(test_overflow_refused),
         cmocka_unit_test(test_params),
         cmocka_unit_test(test_arm_restores_params),
         cmocka_unit_test(test_rec_request_to_caller),

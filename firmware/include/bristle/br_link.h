@@ -161,6 +161,8 @@ typedef struct {
     br_link_dec_t dec;
     uint8_t rx[BR_LINK_RX_BUDGET_MAX]; /* read from the channel, not yet decoded */
     size_t rx_pos, rx_end;
+    size_t rx_done;                    /* bytes decoded in this period (since br_link_step) */
+    uint8_t rx_have_read;              /* this period's one read was made */
     uint8_t tx[BR_LINK_TX_BUF_BYTES];  /* queued frames, not yet taken by the channel */
     size_t tx_len;
     uint16_t tx_seq;                   /* the next frame's sequence number */
@@ -197,6 +199,15 @@ br_status_t br_link_init(br_link_t *l, const br_link_cfg_t *cfg, const br_byte_c
  * BR_E_NULL, BR_E_STATE (not initialised), BR_E_INPUT (the channel claimed
  * more bytes than asked: they are discarded). */
 br_status_t br_link_step(br_link_t *l, br_link_cmd_t *cmd);
+
+/* The period's next request, after br_link_step returned one: decoding goes
+ * on within what is left of the same period's rx_budget_bytes and its one
+ * read (none when the step made it), nothing is written; *cmd as
+ * br_link_step's (kind NONE when the budget ends first: the bytes of a frame
+ * begun stay decoded, the rest waits for the next period). So a period
+ * handles at most rx_budget_bytes and one read however many calls it makes.
+ * BR_E_NULL, BR_E_STATE, BR_E_INPUT (br_link_step's). */
+br_status_t br_link_next(br_link_t *l, br_link_cmd_t *cmd);
 
 /* Queues one frame of message id with the next sequence number.
  * BR_E_NULL, BR_E_STATE, BR_E_PARAM (len above BR_LINK_PAYLOAD_MAX),

@@ -1,9 +1,12 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The command service: the link bound to one application (docs/link.md,
  * "The command service"; docs/modules/svc.md). One br_svc_step per control
- * period, after the tick, in place of br_app_step: it takes at most one
- * request from the link (arm, disarm, fault reset, a parameter, a setpoint or
- * a segment), reads the enable input, makes the period's reference
+ * period, after the tick, in place of br_app_step: it takes a request from
+ * the link (arm, disarm, fault reset, a parameter, a setpoint or a segment),
+ * and after a setpoint or segment the next one, up to BR_SVC_REQUESTS_MAX a
+ * period within the link's K bytes (so a setpoint stream, one item a period,
+ * refills the queue after a host's gap; at most one request of another kind
+ * a period), reads the enable input, makes the period's reference
  * (br_refq), runs br_app_step with it and queues the reports (hello_reply
  * to a hello: the protocol and firmware versions, the machine's name) (status
  * periodically and on a change, fault once when one latches, ref_status with
@@ -30,6 +33,9 @@
 #include "bristle/br_app.h"
 #include "bristle/br_link.h"
 #include "bristle/br_refq.h"
+
+/* the most requests a period: the first, then more only after a setpoint or segment */
+#define BR_SVC_REQUESTS_MAX 2u
 
 /* The enable input, br_hal_t's style (optional): 1 high, 0 low; never waits. */
 typedef int (*br_svc_enable_fn)(void *ctx);
@@ -71,7 +77,7 @@ typedef struct {
     uint8_t send_hello;       /* a hello_reply waiting for room */
     uint32_t hello_session;   /* the session number it answers */
     int enable_last;          /* the enable input last period */
-    br_link_cmd_t cmd;        /* the period's request (kind NONE: none): after br_svc_step, the
+    br_link_cmd_t cmd;        /* the period's last request (kind NONE: none): after br_svc_step, the
                                  caller's to read; the recorder's (REC_ARM, REC_TRIGGER,
                                  REC_DUMP) are not acted on here but by br_rec_command */
     br_svc_counters_t cnt;
