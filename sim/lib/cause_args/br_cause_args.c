@@ -110,16 +110,21 @@ void br_cause_usage(FILE *to, const char *note)
             "  cause options       switch a cause on in the plant (docs/simlog.md), the values its\n"
             "                      model.json parameters in order (docs/diagnose.md, \"Parameters\")\n");
     if (note[0] != '\0') fprintf(to, "                      %s\n", note);
-    int i = 0;
-    while (i < N_CAUSE_PARAMS) {
-        /* one line per option: its rows' names, the optional ones in brackets */
-        int col = fprintf(to, "    %s ", rows[i].option), open = 0, j = i;
-        for (; j < N_CAUSE_PARAMS && strcmp(rows[j].option, rows[i].option) == 0; j++) {
-            col += fprintf(to, "%s%s", j == i ? "" : (rows[j].req ? "," : "[,"), rows[j].name);
-            open += !rows[j].req;
+    /* one line per option: its rows' names, the optional ones in brackets, then its cause */
+    int col = 0, open = 0;
+    for (int i = 0; i < N_CAUSE_PARAMS; i++) {
+        const int first = i == 0 || strcmp(rows[i].option, rows[i - 1].option) != 0;
+        const int last = i == N_CAUSE_PARAMS - 1 || strcmp(rows[i].option, rows[i + 1].option) != 0;
+        if (first) {
+            col = fprintf(to, "    %s %s", rows[i].option, rows[i].name);
+            open = 0;
+        } else {
+            col += fprintf(to, "%s%s", rows[i].req ? "," : "[,", rows[i].name);
+            open += !rows[i].req;
         }
-        for (; open > 0; open--) col += fprintf(to, "]");
-        fprintf(to, "%*s%s\n", col < USAGE_CAUSE_COL ? USAGE_CAUSE_COL - col : 1, "", rows[i].cause);
-        i = j;
+        if (last) {
+            for (; open > 0; open--) col += fprintf(to, "]");
+            fprintf(to, "%*s%s\n", col < USAGE_CAUSE_COL ? USAGE_CAUSE_COL - col : 1, "", rows[i].cause);
+        }
     }
 }
