@@ -86,37 +86,33 @@ static void usage_text(const char *note, char *buf, size_t n)
     fclose(f);
 }
 
-static const struct {
-    const char *name, *cause, *option;
-    int req;
-} PARAMS[] = {
-#define PARAM_ROW(json, fld, unit, lo, hi, cause, option, req) {json, cause, option, req},
-    BR_CAUSE_PARAMS(PARAM_ROW)
-#undef PARAM_ROW
-};
-#define N_PARAMS ((int)(sizeof PARAMS / sizeof PARAMS[0]))
+/* one row of BR_CAUSE_PARAMS in the text: the option's line "    --option first,...",
+ * ending with its cause, holds its name, after "[," when optional */
+static void check_row(const char *text, const char *name, const char *cause, const char *option, int req)
+{
+    char want[128];
+    snprintf(want, sizeof want, "\n    %s ", option);
+    const char *line = strstr(text, want);
+    assert_non_null(line);
+    const char *end = strchr(line + 1, '\n');
+    assert_non_null(end);
+    snprintf(want, sizeof want, "%s%s", req ? "" : "[,", name);
+    const char *at_name = strstr(line, want);
+    assert_true(at_name != NULL && at_name < end);
+    assert_true(req || strstr(line, "]") < end);
+    const size_t lc = strlen(cause);
+    assert_true((size_t)(end - line) > lc && memcmp(end - lc, cause, lc) == 0);
+    assert_true(end[-(long)lc - 1] == ' ');
+}
 
 static void test_usage_lists_every_row(void **st)
 {
     (void)st;
-    char text[4096], want[128];
+    char text[4096];
     usage_text("", text, sizeof text);
-    for (int i = 0; i < N_PARAMS; i++) {
-        /* the option's line: "    --option first,..." ending with its cause */
-        snprintf(want, sizeof want, "\n    %s ", PARAMS[i].option);
-        const char *line = strstr(text, want);
-        assert_non_null(line);
-        const char *end = strchr(line + 1, '\n');
-        assert_non_null(end);
-        /* its name, after "[," when optional, "," or the option when required */
-        snprintf(want, sizeof want, "%s%s", PARAMS[i].req ? "" : "[,", PARAMS[i].name);
-        const char *name = strstr(line, want);
-        assert_true(name != NULL && name < end);
-        assert_true(PARAMS[i].req || strstr(line, "]") < end);
-        const size_t lc = strlen(PARAMS[i].cause);
-        assert_true((size_t)(end - line) > lc && memcmp(end - lc, PARAMS[i].cause, lc) == 0);
-        assert_true(end[-(long)lc - 1] == ' ');
-    }
+#define CHECK_ROW(json, fld, unit, lo, hi, cause, option, req) check_row(text, json, cause, option, req);
+    BR_CAUSE_PARAMS(CHECK_ROW)
+#undef CHECK_ROW
     /* no note: the heading's two lines, then the options */
     assert_non_null(strstr(text, "\"Parameters\")\n    --"));
     usage_text("(a note)", text, sizeof text);
