@@ -30,17 +30,16 @@
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s [--model MODEL.json] [--est ukf|pf] [--ahead P] [--json OUT] [--offset F] [--asym DFC,DFV]\n"
-            "       [--ripple A,P[,PH]] [--gradient S] [--delay D] [--drift R] [--radius-m R] [--feed-mm-min F]\n"
-            "       [--dir cw|ccw]\n" BR_ARGS_COMMON_USAGE
+            "usage: %s [--model MODEL.json] [--est ukf|pf] [--ahead P] [--json OUT] [cause options]\n"
+            "       [--radius-m R] [--feed-mm-min F] [--dir cw|ccw]\n" BR_ARGS_COMMON_USAGE
             "  --model MODEL.json  a diagnosis's saved model: adds the extended-model run\n"
             "  --est ukf|pf        the estimator beside H-inf (default ukf)\n"
             "  --ahead P           the estimator's compensation lead, periods beyond the delay\n"
             "                      (est.comp_ahead_periods; default the machine file's)\n"
             "  --json OUT          write the runs' figures to OUT as well\n"
-            "  cause options       switch causes on in the plant (docs/simlog.md)\n"
             BR_CIRCLE_USAGE("--dir cw|ccw       "),
             argv0, argv0);
+    br_cause_usage(to, "");
     return 2;
 }
 

@@ -24,7 +24,7 @@
  * Usage: br_link_sim [--est none|ukf|pf] [--plant thesis|hardware_like]
  *                    [--speed S] [--duration S] [--pty-path FILE]
  *                    [--tlm-every N] [--status-periods N] [--queue N]
- *                    [--hold-periods N] [--rec-capacity N] [--rec-pre N]
+ *                    [--hold-periods N] [--rec-capacity N] [--rec-pre N] [cause options]
  * Prints the slave's path on stdout at the start ("pty /dev/pts/N"), and at
  * the end one summary line of what ran and what the link counted. Runs until
  * --duration of simulated time or SIGINT / SIGTERM. */
@@ -92,12 +92,11 @@ static int usage(const char *argv0, FILE *to)
             "  --queue           the reference queue's places, 1 .. %u (default %u)\n"
             "  --hold-periods    underrun: periods the last reference goes on before braking, 0 .. %ld (default 20)\n"
             "  --rec-capacity    the recorder's samples, 1 .. %u (default 2000)\n"
-            "  --rec-pre         of them before the trigger, 0 .. capacity - 1 (default capacity / 2)\n"
-            "  cause options     a cause in the plant: --offset F, --asym DFC,DFV, --ripple A,P[,PH], --gradient S,\n"
-            "                    --delay D, --drift R (docs/simlog.md; the application keeps the machine's model)\n",
+            "  --rec-pre         of them before the trigger, 0 .. capacity - 1 (default capacity / 2)\n",
             argv0, argv0, SPEED_MAX, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_DURATION_MAX_S,
             PERIODS_MAX, PERIODS_MAX, (unsigned)BR_REFQ_MAX, (unsigned)BR_REFQ_MAX, PERIODS_MAX,
             (unsigned)BR_REC_CAPACITY_MAX);
+    br_cause_usage(to, "(the application keeps the machine's model)");
     return 2;
 }
 

@@ -15,7 +15,7 @@
  * simulator's does right after init (br_app_arm).
  *
  * Usage: br_pil --image ELF [--est none|ukf|pf|all] [--duration S] [--compare]
- *                [--qemu PATH] [--timeout S] [--work DIR]
+ *                [--qemu PATH] [--timeout S] [--work DIR] [cause options]
  * --compare runs the simulator's circle (br_circle_run, the same
  * configuration) too and compares the duty sequences bit for bit; exit 1 on a
  * difference (the first one printed). Prints the demo's table; a run the
@@ -52,10 +52,9 @@ static int usage(const char *argv0, FILE *to)
             "  --image     the image in the loop (build/cm7-release/target/mps2/br_pil_mps2.elf)\n"
             "  --est       the estimator: none (H-inf only), ukf, pf, or all three (default all)\n"
             "  --duration  simulated seconds of the circle, %g .. %g (default: the thesis's, one turn)\n"
-            "  --compare   also run the simulator's circle and compare the duty sequences bit for bit\n" BR_PIL_USAGE
-            "  cause options  a cause in the host's plant: --offset F, --asym DFC,DFV, --ripple A,P[,PH],\n"
-            "              --gradient S, --delay D, --drift R (docs/simlog.md; the image keeps its machine's model)\n",
+            "  --compare   also run the simulator's circle and compare the duty sequences bit for bit\n" BR_PIL_USAGE,
             argv0, argv0, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S);
+    br_cause_usage(to, "(the host's plant; the image keeps its machine's model)");
     return 2;
 }
 

@@ -5,9 +5,8 @@
  *
  * Usage: br_simlog --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--reversals N]
  *                  [--duration S] [--seed N] [--force-noise N] [--model MODEL.json]
- *                  [--offset F] [--asym DFC,DFV] [--ripple A,P[,PHASE]]
- *                  [--gradient S] [--delay D] [--drift R] [--machine-out FILE]
- *                  [--truth]
+ *                  [cause options] [--gms D1,..,DN] [--machine-out FILE] [--truth]
+ * (the cause options: br_cause_args.h, printed by --help)
  *
  * --machine-out (identification run) writes the position loop as a machine
  * file for the diagnosis (its closed-loop re-simulation); named
@@ -89,9 +88,8 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--reversals N]\n"
-            "          [--duration S] [--seed N] [--force-noise N] [--model MODEL.json] [--offset F] [--asym DFC,DFV]\n"
-            "          [--ripple A,P[,PHASE]] [--gradient S] [--delay D] [--drift R] [--gms D1,..,DN]\n"
-            "          [--machine-out FILE] [--truth]\n"
+            "          [--duration S] [--seed N] [--force-noise N] [--model MODEL.json] [cause options]\n"
+            "          [--gms D1,..,DN] [--machine-out FILE] [--truth]\n"
             BR_ARGS_COMMON_USAGE
             "  --out FILE          the log (CSV t,ref,pos,force; with --truth the plant's truth too)\n"
             "  --traj T            ident: an identification run (default); circle: the circle's x axis;\n"
@@ -104,11 +102,13 @@ static int usage(const char *argv0, FILE *to)
             "  --force-noise N     standard deviation of the noise on the logged force\n"
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
             "  --machine-out FILE  the run's machine file (not with circle)\n"
-            "  cause options       switch causes on in the plant (docs/simlog.md)\n"
             "  --gms D1,..,DN      the plant's friction Maxwell-slip: N <= 8 equal elements breaking away at\n"
-            "                      D1..DN m at Fs (the slip law and damping of the demo's hardware-like plant)\n"
+            "                      D1..DN m at Fs (the slip law and damping of the demo's hardware-like plant)\n",
+            argv0, argv0);
+    br_cause_usage(to, "");
+    fprintf(to,
             "bounds: --cycles 1 .. %d, --reversals 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N (docs/tools.md)\n",
-            argv0, argv0, BR_TOOL_CYCLES_MAX, BR_IDENT_REV_MAX_PAIRS, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
+            BR_TOOL_CYCLES_MAX, BR_IDENT_REV_MAX_PAIRS, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
     return 2;
 }
 

@@ -1,16 +1,20 @@
 # SPDX-License-Identifier: Apache-2.0
 """docs/architecture.md's worked example, "Adding a cause", checked: in a
 scratch copy of the tracked files that the steps touch, add a toy force-term
-cause by the documented steps 1-3 (a cause module, its registry line, its
-row of BR_CAUSE_PARAMS and its field of br_causes_t), regenerate the causes'
-table and the machine header, and check
+cause by the documented steps 1-3 (a cause module and its registry line, then
+regenerate the causes' C tables and the machine header), and check
 
   - that the registry carried it everywhere it should without another edit:
-    the machine file's schema, the detection-limits study, the C table
-    (BR_CAUSE_FIELDS, as a force term that switches the extended model on),
+    the machine file's schema, the detection-limits study, the C tables
+    (BR_CAUSE_FIELDS, as a force term that switches the extended model on,
+    br_causes_t's field; BR_CAUSE_PARAMS, its parameter row and option),
     BR_MACHINE_CAUSES;
   - that the firmware's model and feedforward and a machine configuration
     compile against it (-fsyntax-only with the firmware's warnings);
+  - that the simulator's cause options take it: a probe built with the
+    plant and br_cause_args (the host's warnings) sets the toy's field by
+    its option, lays it over a plant (br_causes_apply), sees it switch the
+    plant's causes on, and prints it in the usage text (br_cause_usage);
   - that every file it touched is one the docs' table names, and that it
     touched no more files by hand, nor regenerated more, than the docs state.
 
@@ -30,12 +34,13 @@ import tempfile
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ARCH = os.path.join(REPO, "docs", "architecture.md")
 # what the scratch copy holds: the tracked files below these
-COPY = ("python", "firmware", "machines", "sim/lib/plant", "sim/studies")
+COPY = ("python", "firmware", "machines", "sim/lib/plant", "sim/lib/cause_args", "sim/studies")
 CAUSE = "toy_load"
 FIELD = "toy_N"
 FIRMWARE_WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-Wdouble-promotion", "-Wconversion",
                      "-Wsign-conversion", "-Wshadow", "-Wstrict-prototypes", "-Wmissing-prototypes", "-Wundef",
                      "-Wvla", "-Wcast-qual"]
+HOST_WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-Wshadow", "-Wvla"]
 
 # the toy's module: offset.py's, renamed (a constant force, a cause of the same kind)
 TOY_FROM = "python/bristle/diagnose/causes/offset.py"
@@ -104,7 +109,7 @@ def edit(root, rel, old, new):
 
 
 def add_cause(root):
-    """Steps 1-3 of the worked example; returns the files written by hand."""
+    """Steps 1 and 2 of the worked example (step 3 regenerates); returns the files written by hand."""
     rel = "python/bristle/diagnose/causes/%s.py" % CAUSE
     with open(os.path.join(root, TOY_FROM), encoding="utf-8") as f:
         text = f.read()
@@ -115,13 +120,7 @@ def add_cause(root):
     init = "python/bristle/diagnose/causes/__init__.py"
     edit(root, init, "presliding_hysteresis)\n", "presliding_hysteresis, %s)\n" % CAUSE)
     edit(root, init, "    friction_drift,\n", "    friction_drift,\n    %s,\n" % CAUSE)
-    params = "sim/lib/plant/br_model_params.h"
-    edit(root, params, '"friction_drift", "--drift", 1)\n',
-         '"friction_drift", "--drift", 1)                                    \\\n'
-         '    X("%s", %s, "N", -1e5, 1e5, "%s", "--toy", 1)\n' % (FIELD, FIELD, CAUSE))
-    model_h = "firmware/include/bristle/br_model.h"
-    edit(root, model_h, "} br_causes_t;", "    float %s; /* a test's cause */\n} br_causes_t;" % FIELD)
-    return {rel, init, params, model_h}
+    return {rel, init}
 
 
 def run(cmd, **kw):
@@ -155,6 +154,25 @@ float br_toy_probe(void)
 }
 '''
 
+# the simulator's side: the toy's option, its application over a plant, its usage line
+OPTIONS_C = '''#include <stdio.h>
+
+#include "cause_args/br_cause_args.h"
+
+int main(void)
+{
+    br_plant_cfg_t opt = br_plant_cfg_reference(), plant = br_plant_cfg_reference();
+    if (opt.toy_N != 0.0 || br_plant_causes_on(&opt)) return 1;      /* the reference has it off */
+    if (br_cause_arg("--toy", "0.5", &opt) != 1 || opt.toy_N != 0.5) return 2;
+    if (br_cause_arg("--toy", "2e5", &opt) != -1 || opt.toy_N != 0.5) return 3; /* its bounds */
+    br_causes_apply(&plant, &opt);
+    if (plant.toy_N != 0.5 || !br_plant_causes_on(&plant)) return 4;
+    br_cause_usage(stdout, "");
+    return 0;
+}
+'''
+SIM_SOURCES = ("sim/lib/cause_args/br_cause_args.c", "sim/lib/plant/br_sim_plant.c", "sim/lib/plant/br_gms.c")
+
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -177,6 +195,8 @@ def main():
         table = open(os.path.join(root, "firmware/gen/bristle_gen/model/br_causes.h")).read()
         if "X(%s, %s, BR_CAUSE_FORCE, 1)" % (FIELD, CAUSE) not in table:
             fail("br_causes.h has no force row for %s" % FIELD)
+        if 'X("%s", %s, "N", -1e5, 1e5, "%s", "--toy", 1)' % (FIELD, FIELD, CAUSE) not in table:
+            fail("br_causes.h has no BR_CAUSE_PARAMS row for %s" % FIELD)
         # the firmware compiles against it: the model, the feedforward, a machine's causes
         with open(os.path.join(root, "probe.c"), "w") as f:
             f.write(MACHINE_C)
@@ -185,6 +205,17 @@ def main():
             run([a.cc, *FIRMWARE_WARNINGS, *inc, "-fsyntax-only", src], cwd=root)
         os.remove(os.path.join(root, "probe.c"))
         print("compiled: br_model.c, br_ff.c, BR_MACHINE_CAUSES")
+        with open(os.path.join(root, "options.c"), "w") as f:
+            f.write(OPTIONS_C)
+        exe = os.path.join(root, "options_probe")
+        run([a.cc, *HOST_WARNINGS, "-Isim/lib", "-Isim/lib/plant", "-Ifirmware/include", "-Ifirmware/gen",
+             "-o", exe, "options.c", *SIM_SOURCES, "-lm"], cwd=root)
+        usage = run([exe], cwd=root)
+        if not re.search(r"^ +--toy %s +%s$" % (FIELD, CAUSE), usage, re.M):
+            fail("the cause options' usage text has no line for --toy:\n" + usage)
+        os.remove(os.path.join(root, "options.c"))
+        os.remove(exe)
+        print("cause options: --toy sets %s, br_causes_apply lays it over a plant, the usage lists it" % FIELD)
         after = digest(root)
         touched = {p for p in after if before.get(p) != after[p]} | {p for p in before if p not in after}
         regenerated = touched - hand

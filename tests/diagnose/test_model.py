@@ -277,9 +277,11 @@ class RegistryTest(unittest.TestCase):
 
 class OneTableTest(unittest.TestCase):
     """model.json's parameters have one name each: the Python table
-    (params.py, causes/) is the C table (sim/lib/plant/br_model_params.h: the
-    model loader, the simulators' options, the plant configuration's fields)
-    and the table of docs/diagnose.md, row by row."""
+    (params.py, causes/) is the C table (sim/lib/plant/br_model_params.h's
+    nominal rows and the causes' rows it takes from the generated
+    bristle_gen/model/br_causes.h: the model loader, the simulators' options,
+    the plant configuration's and br_causes_t's fields) and the table of
+    docs/diagnose.md, row by row."""
 
     # X("json name", field, "unit", lower, upper[, "cause", "--option", required])
     C_ROW = re.compile(r'X\("(\w+)",\s*(\w+),\s*"([^"]*)",\s*([^,]+?),\s*([^,)]+?)'
@@ -292,17 +294,23 @@ class OneTableTest(unittest.TestCase):
         named = {"BR_GT0": sys.float_info.min, "HUGE_VAL": math.inf, "-HUGE_VAL": -math.inf}
         if token in named:
             return named[token]
-        if token == "BR_PLANT_DELAY_MAX_S":
-            with open(os.path.join(REPO, "sim", "lib", "plant", "br_sim_plant.h")) as f:
-                return float(re.search(r"#define BR_PLANT_DELAY_MAX_S ([0-9.eE+-]+)", f.read()).group(1))
         return float(token)
+
+    @staticmethod
+    def c_tables():
+        """The text of the C table: the hand-written nominal rows, then the generated causes' rows."""
+        text = ""
+        for rel in (("sim", "lib", "plant", "br_model_params.h"),
+                    ("firmware", "gen", "bristle_gen", "model", "br_causes.h")):
+            with open(os.path.join(REPO, *rel)) as f:
+                text += f.read()
+        return text
 
     def owner(self, name):
         return next((m for m in causes.REGISTRY if any(q.name == name for q in m.PARAMS)), None)
 
     def test_the_c_table_is_the_python_table(self):
-        with open(os.path.join(REPO, "sim", "lib", "plant", "br_model_params.h")) as f:
-            rows = self.C_ROW.findall(f.read())
+        rows = self.C_ROW.findall(self.c_tables())
         self.assertEqual([r[0] for r in rows], [q.name for q in causes.MODEL_PARAMS])
         self.assertEqual(len(rows), len(causes.MODEL_PARAMS))
         for (name, field, unit, lo, _hi, cause, option, _req), q in zip(rows, causes.MODEL_PARAMS):
@@ -313,6 +321,29 @@ class OneTableTest(unittest.TestCase):
             m = self.owner(name)
             self.assertEqual(cause or None, m and m.NAME, name)
             self.assertEqual(option or None, m and m.OPTION, name)
+
+    def test_every_firmware_cause_has_its_c_rows(self):
+        """Each parameter of a force or measurement cause is a field of
+        br_causes_t and br_plant_cfg_t (BR_CAUSE_FIELDS, with its switch) and
+        a row of the cause options' usage (BR_CAUSE_PARAMS), in registry order;
+        the delay's bound is the plant's command history (BR_PLANT_DELAY_MAX_S)."""
+        text = self.c_tables()
+        fields = re.findall(r"X\((\w+), (\w+), (BR_CAUSE_\w+), ([01])\)", text)
+        want = [(q.name, m.NAME, "BR_CAUSE_" + m.HOOK.upper(),
+                 "1" if q.name in getattr(m, "SWITCHES", [p.name for p in m.PARAMS]) else "0")
+                for m, q in causes.firmware_params()]
+        self.assertEqual(fields, want)
+        self.assertEqual(re.findall(r"X\((\w+), BR_CAUSE_\w+\)", text),
+                         list(dict.fromkeys(m.NAME for m, _ in causes.firmware_params())))
+        self.assertEqual({m.NAME for m in causes.REGISTRY if m.HOOK != "state"},
+                         {m.NAME for m, _ in causes.firmware_params()}, "a force or measurement cause without rows")
+        opt = [r for r in self.C_ROW.findall(text) if r[6]]
+        self.assertEqual([(r[0], r[6], r[7]) for r in opt],
+                         [(q.name, m.OPTION, "0" if q.name in getattr(m, "OPTION_OPTIONAL", ()) else "1")
+                          for m, q in causes.firmware_params()])
+        with open(os.path.join(REPO, "sim", "lib", "plant", "br_sim_plant.h")) as f:
+            ring = float(re.search(r"#define BR_PLANT_DELAY_MAX_S ([0-9.eE+-]+)", f.read()).group(1))
+        self.assertEqual(causes.get("actuator_delay").PARAMS[0].hi, ring)
 
     def test_the_docs_table_is_the_python_table(self):
         with open(os.path.join(REPO, "docs", "diagnose.md")) as f:

@@ -17,6 +17,7 @@
 #include "bristle/br_lugre.h"
 #include "bristle/br_mslip.h"
 #include "bristle/br_status.h"
+#include "bristle_gen/model/br_causes.h"
 
 enum { BR_X_THETA = 0, BR_X_OMEGA = 1, BR_X_Z = 2, BR_X_GP = 3, BR_NX = 4 };
 
@@ -41,20 +42,17 @@ enum { BR_X_THETA = 0, BR_X_OMEGA = 1, BR_X_Z = 2, BR_X_GP = 3, BR_NX = 4 };
  *   J_eff omega' = u(t - delay) - L [ k(p) s(t) (sigma2_d v + f_nl) + offset + A sin(2 pi p / P + phi) ]
  *   k(p) = max(0, 1 + grad p);  in -x (v < 0): sigma2_d = sigma2 + dsigma2_neg and the
  *   Stribeck level is c g_p, c = (Fc + dFc_neg) / Fc (eq. 4 with that level);
- *   s(t) = max(0, 1 + drift t), t the model's clock (br_model_tick), held over a step. */
+ *   s(t) = max(0, 1 + drift t), t the model's clock (br_model_tick), held over a step.
+ * The fields: one float per parameter of a force or measurement cause, in the cause
+ * registry's order (bristle_gen/model/br_causes.h, BR_CAUSE_FIELDS, generated from
+ * python/bristle/diagnose/causes/; docs/architecture.md, "Adding a cause"). delay_s is read by the
+ * estimators' command history (br_est.h), which delays the torque they predict with, not by the
+ * model step. */
+#define BR_CAUSE_FLOAT_FIELD_(field, cause, hook, on) float field;
 typedef struct {
-    float offset_N;          /* constant load force, + opposes motion in +x (gravity, cable drag) */
-    float dFc_neg_N;         /* Coulomb level in -x minus that in +x (Stribeck curve scaled alike) */
-    float dsigma2_neg_Nspm;  /* viscous friction in -x minus that in +x */
-    float ripple_amp_N;      /* position ripple amplitude A (lead error, recirculation, cogging) */
-    float ripple_period_m;   /* its period P in load position, > 0 when A != 0 */
-    float ripple_phase_rad;  /* its phase phi at p = 0 */
-    float grad_per_m;        /* friction scaled by max(0, 1 + grad p) along the travel */
-    float delay_s;           /* actuator dead time; the estimators delay the torque they predict
-                                with through a command history (br_est.h), the model step not */
-    float drift_per_s;       /* friction level (Coulomb, stiction, viscous together) scaled by
-                                max(0, 1 + drift t) with the time t since the estimator started */
+    BR_CAUSE_FIELDS(BR_CAUSE_FLOAT_FIELD_)
 } br_causes_t;
+#undef BR_CAUSE_FLOAT_FIELD_
 
 typedef struct {
     float J_kgm2;       /* motor + screw inertia, > 0 */

@@ -75,17 +75,56 @@ int br_cause_arg(const char *opt, const char *val, br_plant_cfg_t *c)
 void br_causes_apply(br_plant_cfg_t *plant, const br_plant_cfg_t *causes)
 {
     const br_plant_cfg_t ref = br_plant_cfg_reference();
-    if (causes->offset_N != 0.0) plant->offset_N = causes->offset_N;
-    if (causes->dFc_neg_N != ref.dFc_neg_N || causes->dsigma2_neg_Nspm != ref.dsigma2_neg_Nspm) {
-        plant->dFc_neg_N = causes->dFc_neg_N;
-        plant->dsigma2_neg_Nspm = causes->dsigma2_neg_Nspm;
+    /* a cause is set when a field that switches it on differs from the reference machine's
+     * (the registry's rows, bristle_gen/model/br_causes.h) */
+#define CAUSE_FLAG(cause, hook) int cause;
+    struct {
+        BR_CAUSE_NAMES(CAUSE_FLAG)
+    } set = {0};
+#undef CAUSE_FLAG
+#define CAUSE_SET(field, cause, hook, on) \
+    if ((on) && causes->field != ref.field) set.cause = 1;
+    BR_CAUSE_FIELDS(CAUSE_SET)
+#undef CAUSE_SET
+    /* then every field of a set cause replaces plant's */
+#define CAUSE_COPY(field, cause, hook, on) \
+    if (set.cause) plant->field = causes->field;
+    BR_CAUSE_FIELDS(CAUSE_COPY)
+#undef CAUSE_COPY
+}
+
+/* the column where a usage line's cause name starts */
+#define USAGE_CAUSE_COL 62
+
+void br_cause_usage(FILE *to, const char *note)
+{
+    static const struct {
+        const char *name, *cause, *option;
+        int req;
+    } rows[] = {
+#define USAGE_ROW(json, fld, unit, lo, hi, cause, option, req) {json, cause, option, req},
+        BR_CAUSE_PARAMS(USAGE_ROW)
+#undef USAGE_ROW
+    };
+    fprintf(to,
+            "  cause options       switch a cause on in the plant (docs/simlog.md), the values its\n"
+            "                      model.json parameters in order (docs/diagnose.md, \"Parameters\")\n");
+    if (note[0] != '\0') fprintf(to, "                      %s\n", note);
+    /* one line per option: its rows' names, the optional ones in brackets, then its cause */
+    int col = 0, open = 0;
+    for (int i = 0; i < N_CAUSE_PARAMS; i++) {
+        const int first = i == 0 || strcmp(rows[i].option, rows[i - 1].option) != 0;
+        const int last = i == N_CAUSE_PARAMS - 1 || strcmp(rows[i].option, rows[i + 1].option) != 0;
+        if (first) {
+            col = fprintf(to, "    %s %s", rows[i].option, rows[i].name);
+            open = 0;
+        } else {
+            col += fprintf(to, "%s%s", rows[i].req ? "," : "[,", rows[i].name);
+            open += !rows[i].req;
+        }
+        if (last) {
+            for (; open > 0; open--) col += fprintf(to, "]");
+            fprintf(to, "%*s%s\n", col < USAGE_CAUSE_COL ? USAGE_CAUSE_COL - col : 1, "", rows[i].cause);
+        }
     }
-    if (causes->ripple_amp_N != 0.0) {
-        plant->ripple_amp_N = causes->ripple_amp_N;
-        plant->ripple_period_m = causes->ripple_period_m;
-        plant->ripple_phase_rad = causes->ripple_phase_rad;
-    }
-    if (causes->grad_per_m != 0.0) plant->grad_per_m = causes->grad_per_m;
-    if (causes->delay_s != 0.0) plant->delay_s = causes->delay_s;
-    if (causes->drift_per_s != 0.0) plant->drift_per_s = causes->drift_per_s;
 }

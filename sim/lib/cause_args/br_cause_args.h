@@ -1,17 +1,13 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The cause options of the simulator's command lines (br_simlog,
- * br_circle_ext): docs/simlog.md. Each sets the br_plant_cfg_t fields of its
- * rows in sim/lib/plant/br_model_params.h, its values in their order:
- *
- *   --offset F           offset_N: constant load force, N
- *   --asym DFC,DFV       dFc_neg_N, dsigma2_neg_Nspm: friction in -x, Coulomb (and stiction) + DFC N,
- *                        viscous + DFV N s/m
- *   --ripple A,P[,PH]    ripple_amp_N, ripple_period_m, ripple_phase_rad: A sin(2 pi x / P + PH), N, m, rad
- *   --gradient S         grad_per_m: friction times max(0, 1 + S x), 1/m
- *   --delay D            delay_s: actuator dead time, s
- *   --drift R            drift_per_s: friction level times max(0, 1 + R t), t since the start, 1/s */
+ * br_circle_ext, br_pil, br_link_sim): docs/simlog.md. Each sets the
+ * br_plant_cfg_t fields of its rows of BR_CAUSE_PARAMS (the cause registry's,
+ * bristle_gen/model/br_causes.h, through sim/lib/plant/br_model_params.h),
+ * its values in their order; br_cause_usage prints them. */
 #ifndef BR_CAUSE_ARGS_H
 #define BR_CAUSE_ARGS_H
+
+#include <stdio.h>
 
 #include "plant/br_model_params.h"
 #include "plant/br_sim_plant.h"
@@ -37,5 +33,10 @@ int br_cause_arg(const char *opt, const char *val, br_plant_cfg_t *c);
  * from the reference machine's replaces plant's; the others are left as
  * plant has them. */
 void br_causes_apply(br_plant_cfg_t *plant, const br_plant_cfg_t *causes);
+
+/* The cause options' part of a usage text on to: a heading, note on a line of
+ * its own (none when ""), then one line per option with its values (the rows'
+ * json names, the optional ones in brackets) and its cause. */
+void br_cause_usage(FILE *to, const char *note);
 
 #endif

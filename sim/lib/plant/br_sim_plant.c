@@ -31,16 +31,10 @@ br_plant_cfg_t br_plant_cfg_reference(void)
     c.counts_per_rev = BR_MACHINE_COUNTS_PER_REV;
     c.tau_per_duty_Nm = BR_MACHINE_TAU_PER_DUTY_NM;
     c.n_sub = 20;
-    /* causes off */
-    c.offset_N = 0.0;
-    c.dFc_neg_N = 0.0;
-    c.dsigma2_neg_Nspm = 0.0;
-    c.ripple_amp_N = 0.0;
-    c.ripple_period_m = 0.0;
-    c.ripple_phase_rad = 0.0;
-    c.grad_per_m = 0.0;
-    c.delay_s = 0.0;
-    c.drift_per_s = 0.0;
+    /* causes off: every field of the registry's (bristle_gen/model/br_causes.h) */
+#define CAUSE_OFF(field, cause, hook, on) c.field = 0.0;
+    BR_CAUSE_FIELDS(CAUSE_OFF)
+#undef CAUSE_OFF
     /* LuGre: no Maxwell-slip elements */
     memset(&c.gms, 0, sizeof c.gms);
     return c;
@@ -52,8 +46,10 @@ static double dist_force(const br_plant_cfg_t *c, double x);
 
 int br_plant_causes_on(const br_plant_cfg_t *c)
 {
-    return c->offset_N != 0.0 || c->dFc_neg_N != 0.0 || c->dsigma2_neg_Nspm != 0.0 || c->ripple_amp_N != 0.0 ||
-           c->grad_per_m != 0.0 || c->delay_s != 0.0 || c->drift_per_s != 0.0;
+    /* a field that switches its cause on (the registry's, bristle_gen/model/br_causes.h) is not 0 */
+#define CAUSE_ON(field, cause, hook, on) || ((on) && c->field != 0.0)
+    return 0 BR_CAUSE_FIELDS(CAUSE_ON);
+#undef CAUSE_ON
 }
 
 static int bad(const char *what)

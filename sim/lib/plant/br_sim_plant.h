@@ -30,6 +30,7 @@
 #include <stdint.h>
 
 #include "br_gms.h"
+#include "bristle_gen/model/br_causes.h"
 
 typedef struct {
     double J_kgm2, M_kg, lead_mprad, sigma2_Nspm;
@@ -37,17 +38,13 @@ typedef struct {
     double counts_per_rev;    /* encoder on the motor */
     double tau_per_duty_Nm;   /* amplifier gain */
     int n_sub;                /* substeps per step, >= 1 */
-    /* Causes (all 0 = off; the reference machine has them off). */
-    double offset_N;          /* constant load force, + opposes motion in +x (gravity on a tilted axis, cable drag) */
-    double dFc_neg_N;         /* asymmetric friction: Coulomb level in -x is Fc_N + dFc_neg_N (Fs scaled alike) */
-    double dsigma2_neg_Nspm;  /* asymmetric friction: viscous friction in -x is sigma2_Nspm + dsigma2_neg_Nspm */
-    double ripple_amp_N;      /* position ripple amplitude (screw lead error, recirculation, cogging) */
-    double ripple_period_m;   /* its period in load position, > 0 when ripple_amp_N != 0 */
-    double ripple_phase_rad;  /* its phase at x = 0 */
-    double grad_per_m;        /* friction (viscous + LuGre) scaled by max(0, 1 + grad_per_m x) along the travel */
-    double delay_s;           /* actuator dead time, 0 .. BR_PLANT_DELAY_MAX_S */
-    double drift_per_s;       /* friction level (Coulomb, stiction, viscous together) scaled by
-                                 max(0, 1 + drift_per_s t) with the time since init (warm-up) */
+    /* Causes (all 0 = off; the reference machine has them off): one double per
+     * parameter of a force or measurement cause, the cause registry's fields in its
+     * order (bristle_gen/model/br_causes.h, BR_CAUSE_FIELDS; the equation above);
+     * ripple_period_m > 0 when ripple_amp_N != 0, delay_s 0 .. BR_PLANT_DELAY_MAX_S. */
+#define BR_PLANT_CAUSE_FIELD_(field, cause, hook, on) double field;
+    BR_CAUSE_FIELDS(BR_PLANT_CAUSE_FIELD_)
+#undef BR_PLANT_CAUSE_FIELD_
     /* The friction's presliding: gms.n == 0 (the default, all zero) is the
      * LuGre above, bit for bit; gms.n > 0 replaces it by the generalized
      * Maxwell-slip friction of br_gms.h with the same Stribeck level (Fc_N,

@@ -27,6 +27,7 @@ PARAMS = (Param("ripple_amp_N", "N", "amplitude A of A sin(2πx/P + φ)", -1e5, 
           Param("ripple_phase_rad", "rad", "its phase φ at x = 0", -1e3, 1e3))
 NL = ("ripple_period_m",)
 SWITCHES = ("ripple_amp_N",)   # the period and the phase alone are no ripple
+OPTION_OPTIONAL = ("ripple_phase_rad",)   # --ripple A,P: phase 0
 HOOK = "force"
 MACHINE = {"ripple_amp_N": (0.0, 1.0e5, "ripple force amplitude"),
            "ripple_period_m": (0.0, 10.0, "ripple period in load position", True),
