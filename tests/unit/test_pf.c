@@ -246,12 +246,13 @@ static void test_outlier_100_sigma(void **st)
  * cloud at rest): a one-count innovation is accepted (without the rpc^2 / 12
  * term the 8-sigma gate is 0.25 count from the nearest particle and rejects
  * it); a jump of 10 gate sigmas is rejected. */
-static void test_gate_quantisation(void **st)
+/* A PF of 300 particles sure of itself: R = 1e-3 count^2, no theta or z
+ * noise, a tight cloud; the gate's formula, not a machine's value: 8 sigma as
+ * the reference machine ships (a machine with a wider gate, e.g. the heavy
+ * one, would not meet test_gate_quantisation's premise). */
+static br_pf_cfg_t sure_cfg(void)
 {
-    (void)st;
     br_pf_cfg_t c = cfg(300);
-    /* the gate's formula, not a machine's value: 8 sigma as the reference machine ships
-     * (a machine with a wider gate, e.g. the heavy one, would not meet the premise) */
     c.est.outlier_sigma = 8.0f;
     c.est.r_var_rad2 = 1.0e-3f * RPC * RPC;
     c.est.q_var[BR_X_THETA] = 0.0f;
@@ -260,6 +261,13 @@ static void test_gate_quantisation(void **st)
     c.x0_std[BR_X_OMEGA] = 0.0f;
     c.x0_std[BR_X_Z] = 0.0f;
     c.est.q_var[BR_X_Z] = 0.0f;
+    return c;
+}
+
+static void test_gate_quantisation(void **st)
+{
+    (void)st;
+    br_pf_cfg_t c = sure_cfg();
     const double sig_counts = sqrt((double)c.est.r_var_rad2 + (double)RPC * (double)RPC / 12.0) / (double)RPC;
     const double k = (c.est.outlier_sigma < 10.0f) ? 10.0 : (double)c.est.outlier_sigma + 1.0;
     /* the premise: R alone would put a count beyond the gate */
@@ -280,7 +288,7 @@ static void test_gate_quantisation(void **st)
 }
 
 /* The gate's transient term d (eq. G1, docs/modules/pf.md, "The gate"): the
- * sure PF of test_gate_quantisation at rest, 8 sigma (about 2.3 counts) wide;
+ * sure PF (sure_cfg) at rest, 8 sigma (about 2.3 counts) wide;
  * a jump of 10 counts is an outlier without d and accepted with d = 20 counts,
  * a jump beyond 8 sigma + d is an outlier with it. With d = 0 the threshold and
  * cfg.adapt's NIS cap are the thesis gate's, bit for bit; with d the cap is the
@@ -289,15 +297,7 @@ static void test_gate_quantisation(void **st)
 static void test_gate_transient(void **st)
 {
     (void)st;
-    br_pf_cfg_t c = cfg(300);
-    c.est.outlier_sigma = 8.0f;
-    c.est.r_var_rad2 = 1.0e-3f * RPC * RPC;
-    c.est.q_var[BR_X_THETA] = 0.0f;
-    c.est.q_var[BR_X_OMEGA] = 1.0e-12f;
-    c.est.q_var[BR_X_Z] = 0.0f;
-    c.x0_std[BR_X_THETA] = 0.0f;
-    c.x0_std[BR_X_OMEGA] = 0.0f;
-    c.x0_std[BR_X_Z] = 0.0f;
+    br_pf_cfg_t c = sure_cfg();
     const double sig_counts = sqrt((double)c.est.r_var_rad2 + (double)RPC * (double)RPC / 12.0) / (double)RPC;
     const double d_counts = 20.0;
     assert_true(8.0 * sig_counts < 5.0); /* the premise: 10 counts are beyond 8 sigma */
