@@ -161,7 +161,7 @@ def est_fields(m):
     for k, c in (("x0_theta_counts", "X0_STD_THETA_COUNTS"), ("x0_omega_radps", "X0_STD_OMEGA_RADPS"),
                  ("x0_z_m", "X0_STD_Z_M"), ("x0_gp_N", "X0_STD_GP_N")):
         out.append(("BR_EST_PF_" + c, P[k], "initial spread"))
-    out += gate_fields("PF", pf, P)
+    out += gate_fields("PF", pf, P, machine.gate_transient_rad(m, "pf"))
     out.append(("BR_EST_PF_NOISE_SKIP", pf["noise_skip"], "extra noise-table advance per step"))
     out += [("BR_EST_PF_ADAPT_NIS_REF", pf["adapt"]["nis_ref"], "innovation-driven noise of omega, z and g_p (0: off)"),
             ("BR_EST_PF_ADAPT_ALPHA", P["adapt_alpha"], "its NIS smoothing per step (period / tau_s)"),
@@ -176,7 +176,7 @@ def est_fields(m):
     for k, c in (("p0_theta_counts2", "P0_THETA_COUNTS2"), ("p0_omega_rad2ps2", "P0_OMEGA_RAD2PS2"),
                  ("p0_z_m2", "P0_Z_M2"), ("p0_gp_N2", "P0_GP_N2")):
         out.append(("BR_EST_UKF_" + c, U[k], "initial (and recovery) variance"))
-    out += gate_fields("UKF", ukf, U)
+    out += gate_fields("UKF", ukf, U, machine.gate_transient_rad(m, "ukf"))
     out += [("BR_EST_UKF_ALPHA", ukf["alpha"], "sigma-point spread"),
             ("BR_EST_UKF_BETA", ukf["beta"], "prior-distribution weight"),
             ("BR_EST_UKF_KAPPA", ukf["kappa"], "secondary scaling"),
@@ -198,11 +198,13 @@ def delay_id_fields(E, e, per_step):
             (P + "SWITCH_RATIO", d.get("switch_ratio", 0.0), "switch below this ratio")]
 
 
-def gate_fields(E, e, per_step):
+def gate_fields(E, e, per_step, transient_rad):
     return [("BR_EST_%s_GP0_N" % E, per_step["gp0_N"], "initial g_p"),
             ("BR_EST_%s_GP_MIN_N" % E, per_step["gp_min_N"], "g_p range"),
             ("BR_EST_%s_GP_MAX_N" % E, per_step["gp_max_N"], ""),
             ("BR_EST_%s_OUTLIER_SIGMA" % E, e["outlier_gate_sigma"], "outlier gate, standard deviations"),
+            ("BR_EST_%s_OUTLIER_TRANSIENT_RAD" % E, transient_rad,
+             "the gate's transient term, rad (outlier_transient_k (Fs - Fc) T^2 / (2 Meff) / L; 0: off)"),
             ("BR_EST_%s_REANCHOR_AFTER" % E, e["reanchor_after"], "consecutive outliers before re-anchoring"),
             ("BR_EST_%s_COMP_AHEAD_PERIODS" % E, e["comp_ahead_periods"],
              "compensation lead beyond the actuator delay, periods (0: the filtered estimate)")] + \

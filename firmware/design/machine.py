@@ -58,6 +58,8 @@ MSLIP_SHARE_TOL = 1.0e-6
 # BR_EST_DELAY_HIST - 2 of firmware/include/bristle/br_est.h: the longest delay, in periods, an
 # estimator's command history holds
 EST_DELAY_MAX_PERIODS = 62
+# the gate's transient factor k at most 10: ten of the largest single drops within one period
+GATE_TRANSIENT_K_MAX = 10.0
 
 
 class MachineError(Exception):
@@ -202,6 +204,12 @@ def _gates():
                                  "R = 1/12 count^2 + this"),
         "outlier_gate_sigma": Num(0.0, 1.0e4, "a measurement further than this many standard deviations "
                                   "is an outlier", lo_open=True),
+        "outlier_transient_k": Optional(Num(0.0, GATE_TRANSIENT_K_MAX,
+                                            "the gate's transient term: a measurement is an outlier further "
+                                            "than outlier_gate_sigma deviations plus k (Fs - Fc) T^2 / (2 Meff), "
+                                            "the displacement a friction drop of Fs - Fc makes over the period "
+                                            "(1: a drop at the period's start, the largest one drop makes; "
+                                            "1/3: its mean); 0 or absent: the thesis gate")),
         "reanchor_after": Int(1, 1000, "consecutive outliers before the filter is re-anchored on the measurement "
                               "(a count: how unlikely that many in a row are by chance)"),
         "comp_ahead_periods": Num(0.0, EST_AHEAD_MAX_PERIODS, "0: compensate the filtered estimate (the thesis); "
@@ -685,6 +693,7 @@ def params(m):
 #   period (docs/fleet.md, "Holding on the fleet's axes"); the floor is 0 where d <= zs (the reference)
 #   and at most R_COUNTS2_MAX
 #   g_p      = gp0_Fs Fs in [gp_min_Fc Fc, gp_max_Fs Fs]
+#   d_gate   = outlier_transient_k (Fs - Fc) T^2 / (2 Meff) / L  (rad: the outlier gate's transient term)
 QUANT_COUNTS2 = 1.0 / 12.0  # variance of a uniform quantisation of one count
 TRANSIENT_STD_SHARE = 1.0 / 8.0  # R's floor: the std of the position's prediction error, this share of
                                  # the friction transient beyond the bristles' zone (docs/fleet.md)
@@ -701,6 +710,23 @@ def transient_m(m, est):
 
 
 MODEL_H = os.path.join(HERE, "..", "include", "bristle", "br_model.h")
+
+
+def gate_transient_m(m, est):
+    """The outlier gate's transient term of estimator est (eq. G1, docs/modules/pf.md,
+    "The gate"): d = k (Fs - Fc) T^2 / (2 Meff), Meff = Jeff / L^2, k the file's
+    outlier_transient_k (0 when absent): how far a friction drop of Fs - Fc at the
+    start of the period moves the axis from the prediction by the period's end (m)."""
+    p, T, _, _ = _scales(m, est)
+    k = m["estimator"][est].get("outlier_transient_k", 0.0)
+    meff = p["Jeff_kgm2"] / (p["L_mprad"] * p["L_mprad"])
+    return k * (p["Fs_N"] - p["Fc_N"]) * T * T / (2.0 * meff)
+
+
+def gate_transient_rad(m, est):
+    """The gate's transient term as the firmware takes it (br_est_cfg_t.outlier_transient_rad):
+    gate_transient_m / L, motor rad."""
+    return gate_transient_m(m, est) / params(m)["L_mprad"]
 
 
 def model_substep_bounds():
@@ -929,7 +955,8 @@ _PER_STEP_BOUNDS = {
     "both": [("q_omega_rad2ps2", "process_noise.force_Fs2_s", 0.0, 1.0e3, True),
              ("q_z_m2", "process_noise.z_zs2_per_s", 0.0, 1.0e-6, True),
              ("q_gp_N2", "process_noise.gp_Fs2_per_s", 0.0, 1.0e6, True),
-             ("r_counts2", "position_noise_m2", 0.0, 1.0e6, False)],
+             ("r_counts2", "position_noise_m2", 0.0, 1.0e6, False),
+             ("outlier_transient_counts", "outlier_transient_k", 0.0, 1.0e6, True)],
 }
 FLOAT32_MIN_NORMAL = 1.1754943508222875e-38
 
@@ -958,6 +985,8 @@ def _per_step_checks(m, errors):
                            "model the extended one" % ", ".join(extended)))
     for est in ("pf", "ukf"):
         v = est_per_step(m, est)
+        # br_est_cfg_check bounds the gate's transient term in counts (BR_EST_GATE_MAX_TRANSIENT_COUNTS)
+        v["outlier_transient_counts"] = gate_transient_rad(m, est) / params(m)["rad_per_count"]
         for key, field, lo, hi, zero_ok in _PER_STEP_BOUNDS[est] + _PER_STEP_BOUNDS["both"]:
             x = v[key]
             bad = (x == 0.0 and not zero_ok) or (x != 0.0 and not FLOAT32_MIN_NORMAL <= x <= hi) or x < lo

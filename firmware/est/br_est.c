@@ -23,6 +23,13 @@ int br_est_var_ok(float v, int zero_ok)
     return isfinite(v) && v >= FLT_MIN && v <= BR_EST_VAR_MAX;
 }
 
+float br_est_gate_f2(const br_est_cfg_t *cfg, float v)
+{
+    /* eq. G1: f = 1 + d / (g sqrt(v)) */
+    const float f = 1.0f + cfg->outlier_transient_rad / (cfg->outlier_sigma * sqrtf(v));
+    return f * f;
+}
+
 br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
 {
     if (cfg == NULL) {
@@ -35,6 +42,11 @@ br_status_t br_est_cfg_check(const br_est_cfg_t *cfg)
     }
     if (!br_finite_pos(cfg->rad_per_count) || !br_finite_pos(cfg->outlier_sigma) ||
         cfg->outlier_sigma > BR_EST_GATE_MAX_SIGMA || cfg->reanchor_after < 1u) {
+        return BR_E_PARAM;
+    }
+    /* the gate's transient term: a displacement, 0 (off) up to BR_EST_GATE_MAX_TRANSIENT_COUNTS */
+    if (!(cfg->outlier_transient_rad >= 0.0f &&
+          cfg->outlier_transient_rad <= BR_EST_GATE_MAX_TRANSIENT_COUNTS * cfg->rad_per_count)) {
         return BR_E_PARAM;
     }
     if (!br_est_delay_fits(cfg->model.causes.delay_s, cfg->model.dt_s)) {

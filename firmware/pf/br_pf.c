@@ -50,9 +50,11 @@ static br_status_t proposal_init(br_pf_t *pf)
     pf->prop_l11 = (s_tt > 0.0f) ? sqrtf(qw * (qt / s_tt)) : pf->q_std[BR_X_OMEGA];
     pf->prop_inv_2s = 0.5f / s;
     pf->prop_hold = c * pf->q_std[BR_X_OMEGA];
-    /* outlier when min_j e_j^2 > g^2 (S + rpc^2 / 12): max_j l_j < -g^2 (S + rpc^2 / 12) / (2 S) */
-    pf->outlier_l = -0.5f * pf->cfg.est.outlier_sigma * pf->cfg.est.outlier_sigma *
-                    (1.0f + pf->cfg.est.rad_per_count * pf->cfg.est.rad_per_count * (1.0f / 12.0f) / s);
+    /* gate (eq. G1 with S for R): outlier when min_j e_j^2 > (g sqrt(S + rpc^2 / 12) + d)^2:
+     * max_j l_j < -g^2 (S + rpc^2 / 12) f^2 / (2 S), f = 1 + d / (g sqrt(S + rpc^2 / 12)) */
+    const float rpc2_12 = pf->cfg.est.rad_per_count * pf->cfg.est.rad_per_count * (1.0f / 12.0f);
+    pf->outlier_l = -0.5f * pf->cfg.est.outlier_sigma * pf->cfg.est.outlier_sigma * (1.0f + rpc2_12 / s) *
+                    br_est_gate_f2(&pf->cfg.est, s + rpc2_12);
     const float k[] = {pf->prop_k_th, pf->prop_k_om, pf->prop_l00, pf->prop_l10,
                        pf->prop_l11,  pf->prop_inv_2s, pf->prop_hold, pf->outlier_l};
     for (size_t i = 0; i < sizeof k / sizeof k[0]; i++) {
@@ -126,11 +128,20 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg)
     pf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
     br_est_delay_init(&pf->delay, &cfg->est);
     br_est_dlyid_init(&pf->dlyid, &cfg->est);
-    /* gate (docs/modules/pf.md): outlier when min_j e_j^2 > g^2 (R + rpc^2 / 12), R with
-     * the encoder's quantisation; in log-weights l = -e^2 / (2 R): max_j l_j < -g^2 (R + rpc^2 / 12) / (2 R) */
-    pf->outlier_l = -0.5f * cfg->est.outlier_sigma * cfg->est.outlier_sigma *
-                    (1.0f + cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f) / cfg->est.r_var_rad2);
+    /* gate (eq. G1, docs/modules/pf.md): outlier when min_j e_j^2 > (g sqrt(R + rpc^2 / 12) + d)^2,
+     * R with the encoder's quantisation, d the transient term; in log-weights l = -e^2 / (2 R):
+     * max_j l_j < -g^2 (R + rpc^2 / 12) f^2 / (2 R), f = 1 + d / (g sqrt(R + rpc^2 / 12)) */
     pf->r_gate = cfg->est.r_var_rad2 + cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f);
+    const float f2 = br_est_gate_f2(&cfg->est, pf->r_gate);
+    pf->outlier_l = -0.5f * cfg->est.outlier_sigma * cfg->est.outlier_sigma *
+                    (1.0f + cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f) / cfg->est.r_var_rad2) * f2;
+    /* eq. G2: cfg.adapt's NIS cap, the NIS of a step at the gate, (g + d / sqrt(R + rpc^2 / 12))^2 */
+    pf->gate_nis = cfg->est.outlier_sigma * cfg->est.outlier_sigma * f2;
+    /* a gate beyond the float range (a tiny outlier_sigma with a transient term: f^2 = inf);
+     * gate_nis, at most twice |outlier_l|, is finite with it */
+    if (!isfinite(pf->outlier_l)) {
+        return BR_E_PARAM;
+    }
     pf->nis_avg = 0.0f;
     pf->q_scale_std = 1.0f;
     if (cfg->proposal != BR_PF_PROPOSAL_PRIOR && proposal_init(pf) != BR_OK) {
@@ -630,7 +641,7 @@ static float sum_state(const br_pf_t *pf, int i)
 /* cfg.adapt: the normalised innovation squared of the predicted cloud,
  * (y - mean theta_j)^2 / (var theta_j + R + rpc^2 / 12) over the n valid
  * particles (theta relative to the new origin; d_j = theta_j - y, whose
- * sums s1, s2 predict_and_weigh makes), limited to outlier_sigma^2 (also
+ * sums s1, s2 predict_and_weigh makes), limited to the gate's, gate_nis (eq. G2; also
  * for a NaN or an overflow); then E and the factor on omega's, z's and g_p's
  * noise std for the next predictions. */
 static void adapt_update(br_pf_t *pf, float s1, float s2, uint32_t n_valid)
@@ -640,8 +651,7 @@ static void adapt_update(br_pf_t *pf, float s1, float s2, uint32_t n_valid)
     const float mean = s1 / n;
     const float var = s2 / n - mean * mean;
     float nis = (mean * mean) / (((var > 0.0f) ? var : 0.0f) + pf->r_gate);
-    const float nis_max = pf->cfg.est.outlier_sigma * pf->cfg.est.outlier_sigma; /* <= 1e8 */
-    nis = (nis <= nis_max) ? nis : nis_max; /* a NaN too */
+    nis = (nis <= pf->gate_nis) ? nis : pf->gate_nis; /* a NaN too */
     const br_pf_adapt_t *ad = &pf->cfg.adapt;
     pf->nis_avg += ad->alpha * (nis - pf->nis_avg);
     const float s = pf->nis_avg / ad->nis_ref;

@@ -102,6 +102,11 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->out_s2 = cfg->est.outlier_sigma * cfg->est.outlier_sigma;
     /* the encoder's quantisation variance rpc^2 / 12 (a uniform error over one count) */
     ukf->quant_var_rad2 = cfg->est.rad_per_count * cfg->est.rad_per_count * (1.0f / 12.0f);
+    /* the widest gate (eq. G1) is at the smallest innovation variance, R + rpc^2 / 12: a finite float */
+    const float v_min = cfg->est.r_var_rad2 + ukf->quant_var_rad2;
+    if (!isfinite(ukf->out_s2 * v_min * br_est_gate_f2(&cfg->est, v_min))) {
+        return BR_E_PARAM;
+    }
     ukf->m_per_count = cfg->est.model.lead_mprad * cfg->est.rad_per_count;
     br_est_delay_init(&ukf->delay, &cfg->est);
     br_est_dlyid_init(&ukf->dlyid, &cfg->est);
@@ -473,7 +478,7 @@ static void clamp_mean(const br_ukf_t *ukf, float x[NM])
 /* Step 3: theta- re-expressed relative to the new origin y.counts (wrap-safe
  * integer delta) into *theta_new; the innovation nu = frac rpc - theta- and
  * S = P-_00 + R (h(x) = theta). Returns 1 when nu passes the gate,
- * nu^2 <= g^2 (S + rpc^2 / 12) (docs/modules/ukf.md). */
+ * |nu| <= g sqrt(S + rpc^2 / 12) + d (eq. G1, docs/modules/ukf.md). */
 static int innovate(const br_ukf_t *ukf, const br_meas_t *y, const float xm[NM], const float Pm[NM][NM],
                     float *theta_new, float *nu, float *S)
 {
@@ -482,7 +487,9 @@ static int innovate(const br_ukf_t *ukf, const br_meas_t *y, const float xm[NM],
     *theta_new = xm[BR_X_THETA] - shift;
     *nu = y->frac * rpc - *theta_new;
     *S = Pm[0][0] + ukf->cfg.est.r_var_rad2;
-    return !(*nu * *nu > ukf->out_s2 * (*S + ukf->quant_var_rad2));
+    /* eq. G1: |nu| > g sqrt(v) + d, v = S + rpc^2 / 12, as nu^2 > g^2 v f^2 */
+    const float v = *S + ukf->quant_var_rad2;
+    return !(*nu * *nu > ukf->out_s2 * v * br_est_gate_f2(&ukf->cfg.est, v));
 }
 
 /* Load re-acquisition (cfg.load; docs/modules/ukf.md, "External force"): a

@@ -20,9 +20,10 @@ One step with y_k = (counts, frac) and the torque u_{k-1} of the last period:
                 A particle whose model step fails or that is non-finite (or whose
                 f_nl is) is invalid: it keeps its previous state and weight 0.
     2. weigh    l_j = -(theta_j - y)^2 / (2 R),  w_j = exp(l_j - max l)   (valid j)
-                max l < -outlier_sigma^2 (R + rpc^2/12) / (2 R) (y further than
-                outlier_sigma sqrt(R + rpc^2/12), R with the encoder's quantisation,
-                from every particle): outlier, every valid particle gets w = 1.
+                max l < -(outlier_sigma sqrt(R + rpc^2/12) + d)^2 / (2 R) (y further
+                than outlier_sigma sqrt(R + rpc^2/12) + d, R with the encoder's
+                quantisation, d the gate's transient term, from every particle;
+                eq. G1): outlier, every valid particle gets w = 1.
     3. quantise W_j = floor(w_j 2^16)          (integers, the best particle 2^16)
     4. resample particle i copies j with C_{j-1} <= xi_i C_m < C_j,
                 xi_i = (i + 1/2) / m, C_j = W_0 + ... + W_j (exact integers)
@@ -107,6 +108,7 @@ class PfCfg:
     load: object = None   # LoadCfg: the shared external force F_d; None: off
     mslip: object = None  # mslip.MslipParams (sigma2 0): the particles' elements; None: LuGre
     ms_passes: int = 2    # the trapezoidal step's fixed-point passes
+    outlier_transient: float = 0.0  # the gate's transient term d, rad (eq. G1); 0: the thesis gate
 
 
 @dataclass(frozen=True)
@@ -264,7 +266,8 @@ class Pf:
         if lmax == -math.inf:
             self.W = self.idx = None
             return BR_E_NUMERIC
-        l_gate = -0.5 * c.outlier_sigma ** 2 * (c.r_var + rpc * rpc / 12.0) / c.r_var
+        # eq. G1: the gate g sqrt(R + rpc^2/12) + d in log-weight units
+        l_gate = -((c.outlier_sigma * math.sqrt(c.r_var + rpc * rpc / 12.0) + c.outlier_transient) ** 2) / (2.0 * c.r_var)
         if c.load is not None:
             lmax = self._load_update(xp, fn, l, y, lmax < l_gate)
         outlier = lmax < l_gate

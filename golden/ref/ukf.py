@@ -18,7 +18,8 @@ One step with y_k = (counts, frac) and u_{k-1}:
  2. Y_j = f_d(X_j, u); x- = sum Wm_j Y_j; P- = sum Wc_j (Y_j - x-)(Y_j - x-)^T + Q
     (the standard form here; the C evaluates the same sum expanded about Y_0)
  3. theta- -= wrapdiff(counts, origin) rpc; nu = frac rpc - theta-; S = P-_00 + R
- 4. nu^2 > outlier_sigma^2 (S + rpc^2/12) (with the encoder's quantisation):
+ 4. |nu| > outlier_sigma sqrt(S + rpc^2/12) + d (with the encoder's quantisation,
+    d the gate's transient term; eq. G1):
     outlier. (x, P) = the prediction in the old origin's frame, no update; from
     the reanchor_after-th consecutive outlier on: re-anchored: origin = counts, x = [frac rpc, (wrapdiff(counts,
     prev_counts) + frac - frac_prev) rpc / dt, z, g_p], P = diag(p0_var).
@@ -96,6 +97,7 @@ class UkfCfg:
     load: object = None   # LoadCfg: the external-force state F_d; None: off (n = 4)
     mslip: object = None  # mslip.MslipParams (sigma2 0): the Maxwell-slip elements; None: LuGre
     ms_passes: int = 2    # the Maxwell-slip step's fixed-point passes (BR_MODEL_MS_PASSES)
+    outlier_transient: float = 0.0  # the gate's transient term d, rad (eq. G1); 0: the thesis gate
 
 
 @dataclass(frozen=True)
@@ -234,7 +236,9 @@ class Ukf:
         nu = frac * rpc - th_new
         S = Pm[0][0] + c.r_var
         # the gate: the innovation's variance with the encoder's quantisation rpc^2/12
-        return th_new, nu, S, not (nu * nu > c.outlier_sigma ** 2 * (S + rpc * rpc / 12.0))
+        # eq. G1: beyond g sqrt(S + rpc^2/12) + d
+        gate = c.outlier_sigma * math.sqrt(S + rpc * rpc / 12.0) + c.outlier_transient
+        return th_new, nu, S, not (abs(nu) > gate)
 
     def _reacquire(self, nu, u, counts, frac):
         """Load re-acquisition of a gated nu: the prediction from the posterior

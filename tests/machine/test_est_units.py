@@ -125,6 +125,42 @@ def main():
     check(machine.est_per_step(rough, "pf")["r_counts2"] == machine.R_COUNTS2_MAX,
           "a floor beyond the firmware's bound on R: R at the bound")
 
+    # the outlier gate's transient term (docs/modules/pf.md, "The gate", eq. G1):
+    # d = k (Fs - Fc) T^2 / (2 Meff) in m, / L in the firmware's rad; absent = 0
+    g0 = copy.deepcopy(good)
+    for est in ("pf", "ukf"):
+        g0["estimator"][est].pop("outlier_transient_k", None)
+    m0 = loaded(g0, work, "gate_0.json")
+    check(all(machine.gate_transient_rad(m0, est) == 0.0 for est in ("pf", "ukf")),
+          "no outlier_transient_k: no transient term (the thesis gate)")
+    gk = copy.deepcopy(good)
+    gk["estimator"]["pf"]["outlier_transient_k"] = 1.0
+    gk["estimator"]["ukf"]["outlier_transient_k"] = 1.0 / 3.0
+    mk = loaded(gk, work, "gate_k.json")
+    check(close(machine.gate_transient_rad(mk, "pf"), (Fs - Fc) * Tp ** 2 / (2.0 * Meff) / L),
+          "k = 1: the PF's transient term (Fs - Fc) T^2 / (2 Meff) / L rad")
+    check(close(machine.gate_transient_rad(mk, "ukf"), (Fs - Fc) * Tu ** 2 / (6.0 * Meff) / L),
+          "k = 1/3 at the UKF's period: (Fs - Fc) T^2 / (6 Meff) / L rad")
+    gk8 = copy.deepcopy(gk)
+    gk8["encoder"]["counts_per_rev"] = 8 * cpr
+    check(close(machine.gate_transient_rad(loaded(gk8, work, "gate_k8.json"), "pf"),
+                machine.gate_transient_rad(mk, "pf")),
+          "8x the counts: the transient term in rad unchanged (8x in counts)")
+    gk2 = copy.deepcopy(gk)
+    gk2["estimator"]["pf"]["period_s"] = 2.0 * Tp
+    check(close(machine.gate_transient_rad(loaded(gk2, work, "gate_t2.json"), "pf"),
+                4.0 * machine.gate_transient_rad(mk, "pf")),
+          "twice the period: four times the transient term")
+    for bad in (-0.1, machine.GATE_TRANSIENT_K_MAX * 1.01):
+        gb = copy.deepcopy(good)
+        gb["estimator"]["pf"]["outlier_transient_k"] = bad
+        try:
+            loaded(gb, work, "gate_bad.json")
+            refused = False
+        except machine.MachineError as e:
+            refused = "estimator.pf.outlier_transient_k" in str(e)
+        check(refused, "outlier_transient_k %g refused, named" % bad)
+
     # est_physical inverts est_per_step
     for est, vals in (("pf", P), ("ukf", U)):
         phys = machine.est_physical(ref, est, vals)

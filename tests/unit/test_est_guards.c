@@ -46,6 +46,14 @@ static void test_variance_bounds(void **st)
      * a gate of 1e30 sigma made the PF's threshold -inf and the ESS 0/0) */
     c = ok; c.outlier_sigma = 2.0f * BR_EST_GATE_MAX_SIGMA; assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
     c = ok; c.outlier_sigma = BR_EST_GATE_MAX_SIGMA;        assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    /* the gate's transient term (rad): 0 (off) up to BR_EST_GATE_MAX_TRANSIENT_COUNTS counts, finite */
+    const float d_max = BR_EST_GATE_MAX_TRANSIENT_COUNTS * ok.rad_per_count;
+    c = ok; c.outlier_transient_rad = 0.0f;          assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    c = ok; c.outlier_transient_rad = d_max;         assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    c = ok; c.outlier_transient_rad = 2.0f * d_max;  assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c = ok; c.outlier_transient_rad = -ok.rad_per_count; assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c = ok; c.outlier_transient_rad = NAN;           assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
+    c = ok; c.outlier_transient_rad = INFINITY;      assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);
     assert_true(br_est_var_ok(BR_EST_VAR_MAX, 0));
     assert_false(br_est_var_ok(0.0f, 0));
     assert_true(br_est_var_ok(0.0f, 1));

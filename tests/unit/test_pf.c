@@ -215,9 +215,10 @@ static void test_outlier_100_sigma(void **st)
     br_meas_t y = {0, 0.5f};
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
     for (int k = 0; k < 5; k++) assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    /* ten gates (the machine's gate, outlier_sigma sqrt(R + rpc^2 / 12), at least
+    /* ten gates (the machine's gate, outlier_sigma sqrt(R + rpc^2 / 12) + d, at least
      * 100 counts): every particle is an outlier */
-    const double gate_counts = (double)pf->cfg.est.outlier_sigma * sqrt((double)pf->r_gate) / (double)RPC;
+    const double gate_counts = ((double)pf->cfg.est.outlier_sigma * sqrt((double)pf->r_gate) +
+                                (double)pf->cfg.est.outlier_transient_rad) / (double)RPC;
     const int32_t jump = (int32_t)ceil((10.0 * gate_counts > 100.0) ? 10.0 * gate_counts : 100.0);
     y.counts = jump;
     assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_W_OUTLIER);
@@ -245,12 +246,13 @@ static void test_outlier_100_sigma(void **st)
  * cloud at rest): a one-count innovation is accepted (without the rpc^2 / 12
  * term the 8-sigma gate is 0.25 count from the nearest particle and rejects
  * it); a jump of 10 gate sigmas is rejected. */
-static void test_gate_quantisation(void **st)
+/* A PF of 300 particles sure of itself: R = 1e-3 count^2, no theta or z
+ * noise, a tight cloud; the gate's formula, not a machine's value: 8 sigma as
+ * the reference machine ships (a machine with a wider gate, e.g. the heavy
+ * one, would not meet test_gate_quantisation's premise). */
+static br_pf_cfg_t sure_cfg(void)
 {
-    (void)st;
     br_pf_cfg_t c = cfg(300);
-    /* the gate's formula, not a machine's value: 8 sigma as the reference machine ships
-     * (a machine with a wider gate, e.g. the heavy one, would not meet the premise) */
     c.est.outlier_sigma = 8.0f;
     c.est.r_var_rad2 = 1.0e-3f * RPC * RPC;
     c.est.q_var[BR_X_THETA] = 0.0f;
@@ -259,6 +261,13 @@ static void test_gate_quantisation(void **st)
     c.x0_std[BR_X_OMEGA] = 0.0f;
     c.x0_std[BR_X_Z] = 0.0f;
     c.est.q_var[BR_X_Z] = 0.0f;
+    return c;
+}
+
+static void test_gate_quantisation(void **st)
+{
+    (void)st;
+    br_pf_cfg_t c = sure_cfg();
     const double sig_counts = sqrt((double)c.est.r_var_rad2 + (double)RPC * (double)RPC / 12.0) / (double)RPC;
     const double k = (c.est.outlier_sigma < 10.0f) ? 10.0 : (double)c.est.outlier_sigma + 1.0;
     /* the premise: R alone would put a count beyond the gate */
@@ -275,6 +284,54 @@ static void test_gate_quantisation(void **st)
     /* 10 gate sigmas: rejected */
     const br_meas_t y10 = {(int32_t)ceil(k * sig_counts), 0.5f};
     assert_int_equal(br_pf_step(&pf[0], &y10, 0.0f), BR_W_OUTLIER);
+    free(pf);
+}
+
+/* The gate's transient term d (eq. G1, docs/modules/pf.md, "The gate"): the
+ * sure PF (sure_cfg) at rest, 8 sigma (about 2.3 counts) wide;
+ * a jump of 10 counts is an outlier without d and accepted with d = 20 counts,
+ * a jump beyond 8 sigma + d is an outlier with it. With d = 0 the threshold and
+ * cfg.adapt's NIS cap are the thesis gate's, bit for bit; with d the cap is the
+ * NIS of a step at the gate, (g + d / sigma)^2 (eq. G2). A gate beyond the
+ * float range is refused at init. */
+static void test_gate_transient(void **st)
+{
+    (void)st;
+    br_pf_cfg_t c = sure_cfg();
+    const double sig_counts = sqrt((double)c.est.r_var_rad2 + (double)RPC * (double)RPC / 12.0) / (double)RPC;
+    const double d_counts = 20.0;
+    assert_true(8.0 * sig_counts < 5.0); /* the premise: 10 counts are beyond 8 sigma */
+    br_pf_t *pf = calloc(3, sizeof *pf);
+    assert_non_null(pf);
+    br_pf_cfg_t cd = c;
+    cd.est.outlier_transient_rad = (float)d_counts * RPC;
+    assert_int_equal(br_pf_init(&pf[0], &c), BR_OK);
+    /* d = 0: the thesis gate's constants */
+    const float thesis_l = -0.5f * c.est.outlier_sigma * c.est.outlier_sigma *
+                           (1.0f + c.est.rad_per_count * c.est.rad_per_count * (1.0f / 12.0f) / c.est.r_var_rad2);
+    assert_true(pf[0].outlier_l == thesis_l);
+    assert_true(pf[0].gate_nis == c.est.outlier_sigma * c.est.outlier_sigma);
+    assert_int_equal(br_pf_init(&pf[1], &cd), BR_OK);
+    const double g_nis = 8.0 + d_counts / sig_counts;
+    BR_ASSERT_NEAR((double)pf[1].gate_nis, g_nis * g_nis, 1e-4 * g_nis * g_nis);
+    /* the gate in counts from the threshold: sqrt(-2 R l) = g sigma + d */
+    BR_ASSERT_NEAR(sqrt(-2.0 * (double)cd.est.r_var_rad2 * (double)pf[1].outlier_l) / (double)RPC,
+                   8.0 * sig_counts + d_counts, 1e-3);
+    br_meas_t y = {0, 0.5f};
+    for (int k = 0; k < 20; k++) {
+        assert_int_equal(br_pf_step(&pf[0], &y, 0.0f), BR_OK);
+        assert_int_equal(br_pf_step(&pf[1], &y, 0.0f), BR_OK);
+    }
+    pf[2] = pf[1];
+    const br_meas_t y10 = {10, 0.5f};
+    assert_int_equal(br_pf_step(&pf[0], &y10, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(br_pf_step(&pf[1], &y10, 0.0f), BR_OK);
+    const br_meas_t yfar = {(int32_t)ceil(8.0 * sig_counts + d_counts) + 2, 0.5f};
+    assert_int_equal(br_pf_step(&pf[2], &yfar, 0.0f), BR_W_OUTLIER);
+    /* f^2 = inf: a tiny gate in sigma with a transient term */
+    cd.est.outlier_sigma = 1.0e-30f;
+    cd.est.outlier_transient_rad = BR_EST_GATE_MAX_TRANSIENT_COUNTS * RPC;
+    assert_int_equal(br_pf_init(&pf[0], &cd), BR_E_PARAM);
     free(pf);
 }
 
@@ -1066,6 +1123,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_init_guards),          cmocka_unit_test(test_resample_idx),
         cmocka_unit_test(test_bad_input_keeps_state), cmocka_unit_test(test_outlier_100_sigma),
+        cmocka_unit_test(test_gate_transient),
         cmocka_unit_test(test_gate_quantisation),
         cmocka_unit_test(test_all_invalid_keeps_previous), cmocka_unit_test(test_weights_survive_underflow),
         cmocka_unit_test(test_ess_reported),         cmocka_unit_test(test_tracks_plant_friction),

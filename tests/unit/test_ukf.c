@@ -296,6 +296,39 @@ static void test_outlier(void **st)
     assert_int_equal(u.origin_counts, y3.counts);
 }
 
+/* The gate's transient term d (eq. G1, docs/modules/ukf.md): at rest, a jump
+ * of twice the gate g sqrt(S + rpc^2 / 12) is an outlier without d and accepted
+ * with d of three gates; a jump beyond g sqrt(S + rpc^2 / 12) + d is an outlier
+ * with it. A gate beyond the float range is refused at init. */
+static void test_gate_transient(void **st)
+{
+    (void)st;
+    br_ukf_cfg_t c = ref_cfg();
+    br_ukf_t *u = malloc(3 * sizeof *u);
+    assert_non_null(u);
+    assert_int_equal(br_ukf_init(&u[0], &c), BR_OK);
+    run_at_rest(&u[0], 1000, 50);
+    const br_meas_t rest = {1000, 0.5f};
+    const double gate = (double)c.est.outlier_sigma * gate_sigma_counts(&u[0], &rest);
+    assert_true(gate > 1.0); /* the premise: a jump of twice the gate is more than a count */
+    br_ukf_cfg_t cd = c;
+    cd.est.outlier_transient_rad = (float)(3.0 * gate) * RPC_F;
+    assert_int_equal(br_ukf_init(&u[1], &cd), BR_OK);
+    run_at_rest(&u[1], 1000, 50); /* no outlier at rest: the same state as u[0] */
+    assert_memory_equal(u[1].x, u[0].x, sizeof u[0].x);
+    u[2] = u[1];
+    const br_meas_t y2 = {1000 + (int32_t)ceil(2.0 * gate), 0.5f};
+    assert_int_equal(br_ukf_step(&u[0], &y2, 0.0f), BR_W_OUTLIER);
+    assert_int_equal(br_ukf_step(&u[1], &y2, 0.0f), BR_OK);
+    const br_meas_t y5 = {1000 + (int32_t)ceil(4.0 * gate) + 2, 0.5f};
+    assert_int_equal(br_ukf_step(&u[2], &y5, 0.0f), BR_W_OUTLIER);
+    free(u);
+    /* f^2 = inf: a tiny gate in sigma with a transient term */
+    c.est.outlier_sigma = 1.0e-30f;
+    c.est.outlier_transient_rad = BR_EST_GATE_MAX_TRANSIENT_COUNTS * RPC_F;
+    assert_int_equal(init_with(c), BR_E_PARAM);
+}
+
 /* A filter sure of itself (R = 1e-3 count^2, small process noise, converged
  * at rest): S alone is far below a count. A one-count innovation is the encoder's quantisation,
  * never an outlier (without the rpc^2 / 12 term the 8-sigma gate is about
@@ -841,6 +874,7 @@ int main(void)
         cmocka_unit_test(test_prime),
         cmocka_unit_test(test_bad_input_leaves_state),
         cmocka_unit_test(test_outlier),
+        cmocka_unit_test(test_gate_transient),
         cmocka_unit_test(test_gate_quantisation),
         cmocka_unit_test(test_reanchor_after_lost_lock),
         cmocka_unit_test(test_chol4),

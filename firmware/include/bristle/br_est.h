@@ -19,6 +19,11 @@
 /* Widest outlier gate, in standard deviations: a gate of a million is no gate,
  * and its square must stay a float (the PF's log-weight threshold). */
 #define BR_EST_GATE_MAX_SIGMA 1.0e6f
+/* Largest transient term of the outlier gate (outlier_transient_rad), in
+ * encoder counts: a million counts of friction transient within one period is
+ * no axis's; the bound keeps the gate's square and the NIS cap finite floats
+ * (each filter checks its own constants too). */
+#define BR_EST_GATE_MAX_TRANSIENT_COUNTS 1.0e6f
 /* Smallest measurement variance, in encoder counts^2: a millionth of a count^2
  * is far below any quantised encoder's noise (1/12 count^2), and it keeps
  * 1 / (2 R) and the log-weights finite. */
@@ -38,6 +43,10 @@ typedef struct {
     float gp_max_N;
     float outlier_sigma;     /* a measurement further than outlier_sigma standard deviations from the
                                 whole estimate is an outlier, > 0 (each filter says which deviation) */
+    float outlier_transient_rad; /* the gate's transient term d: an outlier is further than
+                                    outlier_sigma deviations + d (rad; the friction transient's
+                                    displacement over a period, docs/modules/pf.md, "The gate");
+                                    0: the thesis gate, in [0, BR_EST_GATE_MAX_TRANSIENT_COUNTS rpc] */
     uint32_t reanchor_after; /* consecutive outliers before the filter is re-anchored on y, >= 1 */
     float rad_per_count;     /* encoder resolution, > 0 */
     float comp_ahead_periods; /* 0: the compensation is the filtered estimate (the thesis);
@@ -51,12 +60,20 @@ typedef struct {
  * encoder resolution > 0, process-noise variances 0 or normal floats up to
  * BR_EST_VAR_MAX (no subnormals), R from BR_EST_R_MIN_COUNTS2 counts^2 up to
  * BR_EST_VAR_MAX, 0 < gp_min < gp_max with gp0 inside, an outlier gate in
- * (0, BR_EST_GATE_MAX_SIGMA], at
+ * (0, BR_EST_GATE_MAX_SIGMA] with a transient term finite in
+ * [0, BR_EST_GATE_MAX_TRANSIENT_COUNTS rad_per_count], at
  * least one outlier before re-anchoring, a compensation lead in
  * [0, BR_EST_AHEAD_MAX_PERIODS], and the delay identification off or within
  * br_dlyid_cfg_t's ranges (its largest candidate within the command history).
  * BR_OK, BR_E_NULL or BR_E_PARAM. */
 br_status_t br_est_cfg_check(const br_est_cfg_t *cfg);
+
+/* The outlier gate's factor f^2 = (1 + d / (g sqrt(v)))^2 (eq. G1,
+ * docs/modules/pf.md, "The gate"; g = cfg->outlier_sigma, d =
+ * cfg->outlier_transient_rad): the gate g sqrt(v) + d of a residual of variance
+ * v is f times g sqrt(v); exactly 1 when d = 0 (the thesis gate, bit for bit).
+ * v > 0; infinite for a gate beyond the float range (each filter's init refuses it). */
+float br_est_gate_f2(const br_est_cfg_t *cfg, float v);
 
 /* 1 when v is a usable variance: a normal float in [FLT_MIN, BR_EST_VAR_MAX],
  * or exactly 0 where zero_ok. */

@@ -89,6 +89,7 @@
         .model = BR_MACHINE_MODEL_CFG(dt), .q_var = {(q_theta), (q_omega), (q_z), (q_gp)},         \
         .r_var_rad2 = (r), .gp0_N = BR_EST_##E##_GP0_N_F, .gp_min_N = BR_EST_##E##_GP_MIN_N_F,     \
         .gp_max_N = BR_EST_##E##_GP_MAX_N_F, .outlier_sigma = BR_EST_##E##_OUTLIER_SIGMA_F,        \
+        .outlier_transient_rad = BR_EST_##E##_OUTLIER_TRANSIENT_RAD_F,                             \
         .reanchor_after = BR_EST_##E##_REANCHOR_AFTER, .rad_per_count = BR_MACHINE_RAD_PER_COUNT_F, \
         .comp_ahead_periods = BR_EST_##E##_COMP_AHEAD_PERIODS_F,                                   \
         .delay_id = BR_MACHINE_DELAY_ID_CFG(E)                                                     \

@@ -46,15 +46,17 @@
 #endif
 
 /* cfg.adapt: nis_ref below this is refused (E / nis_ref stays finite:
- * a step's NIS is limited to outlier_sigma^2 <= 1e8) */
+ * a step's NIS is limited to the gate's, (g + d / sigma)^2, at most
+ * (1e6 + 1e6 sqrt(12))^2 < 3e13 by the gate's bounds, sigma >= rpc / sqrt(12)) */
 #define BR_PF_ADAPT_REF_MIN 1.0e-6f
 
 /* Innovation-driven process noise (docs/modules/pf.md, "Keeping lock"): a
  * variant of the thesis filter, off when nis_ref = 0. Each measured step
  * takes the normalised innovation squared of the predicted cloud,
  *   NIS = (y - mean theta_j)^2 / (var theta_j + R + rpc^2 / 12),
- * limited to est.outlier_sigma^2 (a glitch counts as much as a step at the
- * gate), smooths it, E <- E + alpha (NIS - E), and the next predictions draw the
+ * limited to the NIS of a step at the gate, (outlier_sigma + d / sqrt(R +
+ * rpc^2 / 12))^2 with the gate's transient term d (a glitch counts as much as
+ * a step at the gate), smooths it, E <- E + alpha (NIS - E), and the next predictions draw the
  * process noise of omega, z and g_p with the variances times
  *   s = min(max(E / nis_ref, 1), max_scale)
  * (standard deviations times sqrt(s)). While E <= nis_ref, s = 1 and the
@@ -115,7 +117,8 @@ typedef struct {
 typedef struct {
     br_est_cfg_t est;        /* what the PF shares with the UKF: model (est.model.dt_s is the PF's
                                 period), noise, g_p range, gates; outlier: |y - theta_j| >
-                                est.outlier_sigma sqrt(R + rpc^2 / 12) for every particle j */
+                                est.outlier_sigma sqrt(R + rpc^2 / 12) + est.outlier_transient_rad
+                                for every particle j (eq. G1) */
     uint32_t n_particles;    /* m, 1..BR_PF_MAX_PARTICLES */
     float x0_std[BR_NX];     /* initial spread around [y_0, 0, 0, gp0]; >= 0 */
     const float *noise;      /* standard-normal ROM table (e.g. br_noise_table) */
@@ -160,7 +163,9 @@ typedef struct {
     float m_per_count;            /* L rpc: load position per encoder count */
     br_est_delay_t delay;         /* commands for the actuator delay (model.causes.delay_s) */
     br_dlyid_t dlyid;             /* the delay's identification (cfg.est.delay_id) */
-    float outlier_l;              /* -outlier_sigma^2 (R + rpc^2 / 12) / (2 R): log-weight threshold */
+    float outlier_l;              /* -outlier_sigma^2 (R + rpc^2 / 12) f^2 / (2 R): log-weight threshold,
+                                     f = 1 + d / (outlier_sigma sqrt(R + rpc^2 / 12)), d the transient term */
+    float gate_nis;               /* cfg.adapt's NIS cap, (outlier_sigma f)^2: a step's NIS at the gate */
     uint32_t noise_pos;           /* table position, advances every step */
     int32_t origin_counts;
     float prev_frac;              /* the last measurement's fraction */
@@ -203,7 +208,8 @@ br_status_t br_pf_init(br_pf_t *pf, const br_pf_cfg_t *cfg);
 
 /* One filter step (see above). Statuses: BR_E_INPUT for a non-finite u or
  * frac outside [0, 1] (state untouched); BR_W_OUTLIER when y is further than
- * outlier_sigma sqrt(R + rpc^2 / 12) from every particle (no weighting: the valid predicted
+ * outlier_sigma sqrt(R + rpc^2 / 12) + outlier_transient_rad from every particle (eq. G1;
+ * no weighting: the valid predicted
  * particles are kept with equal weights; after reanchor_after consecutive
  * outliers the cloud is re-anchored, its mean theta moved to y and its mean
  * omega to the measured velocity, so the filter regains lock);

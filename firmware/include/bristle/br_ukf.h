@@ -16,7 +16,7 @@
  *   4. estimate      F_hat = sum_j Wm_j f_nl(X+_j) over the posterior sigma points
  * A failed Cholesky (pivot <= 0 or non-finite) resets P to diag(p0_var),
  * keeping the mean, and reports BR_E_NUMERIC. An outlier (|y - theta-| >
- * outlier_sigma sqrt(S + rpc^2 / 12), the innovation's spread with the
+ * outlier_sigma sqrt(S + rpc^2 / 12) + outlier_transient_rad (eq. G1), the innovation's spread with the
  * encoder's quantisation) skips the update; reanchor_after of them in a row
  * re-anchor the filter on the measurement (as the PF does).
  * With cfg.load the state has a fifth entry, the external force F_d (the
@@ -57,7 +57,8 @@ typedef struct {
 typedef struct {
     br_est_cfg_t est;        /* what the UKF shares with the PF: model (est.model.dt_s is the UKF's
                                 period), noise, g_p range (every sigma point and the mean are kept
-                                in it), gates; outlier: |y - theta-| > est.outlier_sigma sqrt(S + rpc^2 / 12) */
+                                in it), gates; outlier: |y - theta-| > est.outlier_sigma sqrt(S + rpc^2 / 12)
+                                + est.outlier_transient_rad (eq. G1) */
     float p0_var[BR_NX];     /* initial (and recovery) variances P0 = diag(p0_var), > 0 */
     float alpha;             /* sigma-point spread, in (0, 1]; use >= 0.1 in float32 (1 recommended) */
     float beta;              /* prior-distribution weight, >= 0 (2 for a Gaussian) */
@@ -122,7 +123,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg);
  * Statuses:
  *   BR_E_NULL / BR_E_STATE  NULL argument / not initialised;
  *   BR_E_INPUT    non-finite u, or frac non-finite or outside [0, 1]: state untouched;
- *   BR_W_OUTLIER  |y - theta-| > outlier_sigma sqrt(S + rpc^2 / 12): the prediction is kept
+ *   BR_W_OUTLIER  |y - theta-| > outlier_sigma sqrt(S + rpc^2 / 12) + d: the prediction is kept
  *                 (origin unchanged), no update; on the reanchor_after-th
  *                 consecutive outlier the filter has lost lock and is
  *                 re-anchored: origin = y.counts, x = [frac rpc, measured
