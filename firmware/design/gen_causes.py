@@ -35,6 +35,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "python"))
 
 from bristle.diagnose import causes, params  # noqa: E402
+import machine  # noqa: E402  (this folder: write_atomic)
 
 REL = os.path.join("bristle_gen", "model", "br_causes.h")
 HOOKS = {"force": "BR_CAUSE_FORCE", "measurement": "BR_CAUSE_MEASUREMENT"}
@@ -110,9 +111,8 @@ def render():
 
 
 def write(path, text):
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    with open(path, "w", newline="\n") as f:
-        f.write(text)
+    """through a temporary file and a rename (machine.write_atomic): a failed run leaves the old header"""
+    machine.write_atomic(path, text)
 
 
 def main(argv=None):

@@ -122,11 +122,8 @@ def render_params():
 
 
 def write(path, text):
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    tmp = path + ".tmp"
-    with open(tmp, "w", encoding="utf-8", newline="\n") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    """through a temporary file and a rename (machine.write_atomic): a failed run leaves the old header"""
+    machine.write_atomic(path, text)
 
 
 def main(argv=None):
