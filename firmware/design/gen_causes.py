@@ -110,11 +110,6 @@ def render():
     return "\n".join(out)
 
 
-def write(path, text):
-    """through a temporary file and a rename (machine.write_atomic): a failed run leaves the old header"""
-    machine.write_atomic(path, text)
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     g = ap.add_mutually_exclusive_group()
@@ -122,7 +117,7 @@ def main(argv=None):
     g.add_argument("--gen-root", help="a generated-header root; writes %s below it" % REL)
     a = ap.parse_args(argv)
     root = a.gen_root or os.path.join(HERE, "..", "gen")
-    write(a.out or os.path.join(root, REL), render())
+    machine.write_atomic(a.out or os.path.join(root, REL), render())
 
 
 if __name__ == "__main__":

@@ -121,11 +121,6 @@ def render_params():
     return "\n".join(out)
 
 
-def write(path, text):
-    """through a temporary file and a rename (machine.write_atomic): a failed run leaves the old header"""
-    machine.write_atomic(path, text)
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     g = ap.add_mutually_exclusive_group()
@@ -133,11 +128,11 @@ def main(argv=None):
     g.add_argument("--gen-root", help="a generated-header root; writes %s and %s below it" % (REL, REL_PARAMS))
     a = ap.parse_args(argv)
     if a.out:
-        write(a.out, render())
+        machine.write_atomic(a.out, render())
         return
     root = a.gen_root or os.path.join(HERE, "..", "gen")
-    write(os.path.join(root, REL), render())
-    write(os.path.join(root, REL_PARAMS), render_params())
+    machine.write_atomic(os.path.join(root, REL), render())
+    machine.write_atomic(os.path.join(root, REL_PARAMS), render_params())
 
 
 if __name__ == "__main__":
