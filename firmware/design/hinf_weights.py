@@ -31,8 +31,8 @@ keeps RAISE_PM_MIN_DEG and RAISE_GM_MIN at each period and w_count.
 
 `synth_hinf.py --machine FILE --suggest` prints the weights it gives; the
 diagnosis's machine.json and the fleet's machine files take them when the
-file's own weights admit no acceptable design (weights_or_rule), which
-refuses a machine whose stiction step passes e_max even at the raised w0."""
+file's own weights admit no acceptable design (weights_or_rule), with a
+warning where the stiction step passes e_max even at the raised w0."""
 import math
 
 import numpy as np
@@ -193,14 +193,15 @@ def refusal(m):
     return None
 
 
-def friction_refusal(info):
-    """None when the rule's stiction step stays within the following-error limit, else why not"""
+def friction_shortfall(info):
+    """None when the rule's stiction step stays within the following-error limit, else a warning:
+    H-inf alone cannot keep a breakaway within it at this period"""
     if info["friction_step_m"] <= info["following_m"]:
         return None
     hz = 1.0 / (2.0 * math.pi)
     return ("a stiction step moves the axis %.3g mm, beyond the following-error limit %.3g mm: (4) needs "
             "w0 = %.4g Hz (%.3g of the Nyquist frequency %.4g Hz), the sampled loop's margins and the encoder "
-            "allow %.4g Hz: shorten the period" % (
+            "allow %.4g Hz: H-inf alone may brake the axis at a breakaway; a shorter period holds it" % (
                 info["friction_step_m"] * 1e3, info["following_m"] * 1e3, info["omega_friction_rad_s"] * hz,
                 info["omega_friction_rad_s"] / info["nyquist_rad_s"], info["nyquist_rad_s"] * hz,
                 info["omega0_rad_s"] * hz))
@@ -208,15 +209,16 @@ def friction_refusal(info):
 
 def weights_or_rule(m, always=False, reason="asked for"):
     """(control.hinf, why): m's own weights with why None when they give an acceptable design and
-    always is False; else the rule's (suggest) and why the rule was used (reason when always);
-    DesignError when the rule's weights fail synth_hinf's checks or hold the stiction step
-    beyond the following-error limit"""
+    always is False; else the rule's (suggest) and why the rule was used (reason when always), with
+    friction_shortfall's warning where there is one; DesignError when the rule's weights fail
+    synth_hinf's checks too"""
     why = reason if always else refusal(m)
     if why is None:
         return m["control"]["hinf"], None
     hinf, info = suggest(m)
-    fail = refusal(with_hinf(m, hinf)) or friction_refusal(info)
+    fail = refusal(with_hinf(m, hinf))
     if fail is not None:
         raise synth_hinf.DesignError("the weights from the machine fail too: " + fail)
-    return hinf, "%s; the weights from the machine (w0 = %.4g Hz, bound by the %s)" % (
-        why, info["omega0_rad_s"] / (2.0 * math.pi), info["bound"])
+    short = friction_shortfall(info)
+    return hinf, "%s; the weights from the machine (w0 = %.4g Hz, bound by the %s)%s" % (
+        why, info["omega0_rad_s"] / (2.0 * math.pi), info["bound"], "; " + short if short else "")

@@ -28,7 +28,8 @@ closed-loop bandwidth, continuous and sampled (loop_analysis.py).
 With --suggest it writes no header: it prints the weights the machine's
 periods, inertia, torque limit, encoder, stiction and following-error limit
 give (hinf_weights.py), as the file's control.hinf block, and the design they
-give (exit 1 if it fails or its stiction step passes the following-error limit).
+give (exit 1 if it fails; a warning where a stiction step passes the
+following-error limit even so).
 
 Usage: synth_hinf.py [--machine FILE] [--out FILE] [--report] [--suggest]"""
 import json
@@ -217,10 +218,9 @@ def main():
                          "limit; a stiction step moves the axis %.4g mm (following-error limit %.4g mm)\n" % (
                              info["omega0_rad_s"] / (2.0 * np.pi), info["bound"], info["count_torque_share"],
                              info["friction_step_m"] * 1e3, info["following_m"] * 1e3))
-        why = hinf_weights.friction_refusal(info)
-        if why is not None:
-            sys.stderr.write("%s: field control.hinf: %s\n" % (m["file"], why))
-            sys.exit(1)
+        short = hinf_weights.friction_shortfall(info)
+        if short is not None:
+            sys.stdout.write("warning: %s\n" % short)
     wts = weights(m)
     try:
         d = design(machine.params(m), wts)

@@ -35,8 +35,8 @@ def row(name, m):
     s = [res[k] for k in w["check_dt_s"]]
     hz = 1.0 / (2.0 * math.pi)
     step = "%.3g / %.3g mm" % (info["friction_step_m"] * 1e3, info["following_m"] * 1e3)
-    if hinf_weights.friction_refusal(info):
-        step += " (refused: needs %.1f Hz, %.3g of Nyquist)" % (
+    if hinf_weights.friction_shortfall(info):
+        step += " (beyond: needs %.1f Hz, %.3g of Nyquist)" % (
             info["omega_friction_rad_s"] * hz, info["omega_friction_rad_s"] / info["nyquist_rad_s"])
     return "| %s | %s | %.3g / %.3g ms | %.2f Hz (%s) | %s | %s | %s | %s |" % (
         name, "refused: %s" % why if why else "holds", w["check_dt_s"][0] * 1e3, w["check_dt_s"][-1] * 1e3,
@@ -66,17 +66,17 @@ def main():
             print(row("machines/" + f, machine.load(os.path.join(folder, f))))
     for i in (int(x) for x in a.axes.split(",") if x):
         print(row("fleet axis %d" % i, fleet_file(a.seed, i, a.friction)))
-    bounds, refused = {}, []
+    bounds, short = {}, []
     for i in range(a.n):
         info = hinf_weights.suggest(fleet_file(a.seed, i, a.friction))[1]
         bounds.setdefault(info["bound"], []).append(i)
-        if hinf_weights.friction_refusal(info):
-            refused.append(i)
+        if hinf_weights.friction_shortfall(info):
+            short.append(i)
     for b, axes in sorted(bounds.items()):
         print("\nthe %s bounds w0 on %d of %d axes%s" % (b, len(axes), a.n, "" if b == "period" else
                                                         ": " + ", ".join(map(str, axes))))
-    print("\nrefused (the stiction step beyond the following limit at the raised w0): %d of %d axes: %s"
-          % (len(refused), a.n, ", ".join(map(str, refused)) or "none"))
+    print("\nthe stiction step beyond the following limit at the raised w0: %d of %d axes: %s"
+          % (len(short), a.n, ", ".join(map(str, short)) or "none"))
 
 
 if __name__ == "__main__":
