@@ -57,7 +57,8 @@ FOLLOWING_SHARE = 0.5
 RAISE_PM_MIN_DEG = 50.0
 RAISE_GM_MIN = 10.0 ** (8.0 / 20.0)
 RAISE_SPAN = 100.0      # the raise looks up to this times the w0 of (3)
-REL_TOL = 1e-3          # the bisections' relative resolution in w0
+REL_TOL = 1e-3          # the raise's bisections' relative resolution in w0
+ENCODER_HALVINGS = 60   # the encoder bound's bisection over 1e-4 ... 1 of (3)'s w0: to the float
 STEP_DECAY = 1e-3       # the stiction step's response is followed until its slowest mode falls to this
 STEP_MAX_PERIODS = 100000
 MARGIN_GRID = 2000      # the raise's margin search brackets its crossings on this many frequencies
@@ -135,19 +136,22 @@ def raise_holds(m, w0):
     return count_torque_share(m, hinf) <= COUNT_TORQUE_SHARE
 
 
-def _edge(ok, lo, hi):
-    """(a, b), b / a <= 1 + REL_TOL, with ok(a) and not ok(b), by bisection on log w0 between lo
-    (ok) and hi (not ok); ok is monotone"""
-    a, b = math.log(lo), math.log(hi)
-    for _ in range(200):  # bounded: 200 halvings pass any span of w0 a float holds
-        if b - a <= math.log1p(REL_TOL):
-            break
+def _edge(ok, a, b, halvings):
+    """(exp(a), exp(b)) after this many halvings of [a, b] in log w0, ok(exp(a)) and not ok(exp(b))
+    kept; ok is monotone"""
+    for _ in range(halvings):
         mid = 0.5 * (a + b)
         if ok(math.exp(mid)):
             a = mid
         else:
             b = mid
     return math.exp(a), math.exp(b)
+
+
+def _raise_edge(ok, lo, hi):
+    """_edge between the frequencies lo and hi to REL_TOL"""
+    a, b = math.log(lo), math.log(hi)
+    return _edge(ok, a, b, max(0, int(math.ceil(math.log2((b - a) / math.log1p(REL_TOL))))))
 
 
 def suggest(m):
@@ -162,17 +166,17 @@ def suggest(m):
     w0, bound = w_hi, "period"
     if count_torque_share(m, from_omega(m, w_hi)) > COUNT_TORQUE_SHARE:
         w0, bound = _edge(lambda w: count_torque_share(m, from_omega(m, w)) <= COUNT_TORQUE_SHARE,
-                          w_hi / 1e4, w_hi)[0], "encoder"
+                          math.log(w_hi) - math.log(1e4), math.log(w_hi), ENCODER_HALVINGS)[0], "encoder"
     step = friction_step_m(m, from_omega(m, w0))
     w_fric = w0
     if step > target:
         w_cap = w0
         if raise_holds(m, w0):
             w_top = RAISE_SPAN * w0
-            w_cap = w_top if raise_holds(m, w_top) else _edge(lambda w: raise_holds(m, w), w0, w_top)[0]
+            w_cap = w_top if raise_holds(m, w_top) else _raise_edge(lambda w: raise_holds(m, w), w0, w_top)[0]
         step_cap = friction_step_m(m, from_omega(m, w_cap))
         if step_cap <= target:
-            w0, bound = _edge(lambda w: friction_step_m(m, from_omega(m, w)) > target, w0, w_cap)[1], "friction"
+            w0, bound = _raise_edge(lambda w: friction_step_m(m, from_omega(m, w)) > target, w0, w_cap)[1], "friction"
             w_fric = w0
         else:
             # e_step falls as 1 / w0^2 (the normalised design, eq. 2): the w0 it would need
