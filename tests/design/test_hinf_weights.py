@@ -201,8 +201,8 @@ class Rule(unittest.TestCase):
         self.assertTrue(hinf_weights.raise_holds(t, w0))
         self.assertFalse(hinf_weights.raise_holds(t, w0 * (1.0 + 2.0 * hinf_weights.REL_TOL)))
         self.assert_holds(hinf_weights.with_hinf(t, hinf), "axis %d's truth" % FLEET_MARGINS_BOUND)
-        # within the following-error limit: the rule's weights are taken
-        self.assertIsNone(hinf_weights.friction_refusal(info))
+        # within the following-error limit: no warning
+        self.assertIsNone(hinf_weights.friction_shortfall(info))
 
     def test_warns_on_a_period_too_long_for_the_friction(self):
         m = too_slow_for_its_friction()
