@@ -22,14 +22,20 @@ from scipy.optimize import brentq
 DB_DROP = -3.0
 
 
+def _solve_each(s, A, B, K):
+    """-K (s_i I - A)^-1 B for each s_i of the array s (one batched solve)."""
+    n = A.shape[0]
+    M = s[:, None, None] * np.eye(n)[None] - A[None]
+    x = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (len(s),) + B.shape))
+    return -(np.asarray(K, dtype=float).reshape(1, -1) @ x)[:, 0, 0]
+
+
 def continuous_loop(A, B2, K):
     """L(jw) for an array of w (rad/s)."""
-    K = np.asarray(K, dtype=float).reshape(1, -1)
-    n = A.shape[0]
 
     def resp(w):
         w = np.atleast_1d(np.asarray(w, dtype=float))
-        return np.array([-(K @ np.linalg.solve(1j * wi * np.eye(n) - A, B2))[0, 0] for wi in w])
+        return _solve_each(1j * w, A, B2, K)
     return resp
 
 
@@ -56,7 +62,7 @@ def sampled_loop(A, B2, K, dt):
 
     def resp(w):
         w = np.atleast_1d(np.asarray(w, dtype=float))
-        return np.array([-(Ku @ np.linalg.solve(np.exp(1j * wi * dt) * np.eye(4) - Phi0, Gu))[0, 0] for wi in w])
+        return _solve_each(np.exp(1j * w * dt), Phi0, Gu, Ku)
     return resp
 
 

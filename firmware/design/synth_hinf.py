@@ -26,8 +26,10 @@ With --report it also prints the design report: the gains, gamma, the
 closed-loop norm and poles, and the loop's gain and phase margins and
 closed-loop bandwidth, continuous and sampled (loop_analysis.py).
 With --suggest it writes no header: it prints the weights the machine's
-periods, inertia, torque limit and encoder give (hinf_weights.py), as the
-file's control.hinf block, and the design they give (exit 1 if it fails).
+periods, inertia, torque limit, encoder, stiction and following-error limit
+give (hinf_weights.py), as the file's control.hinf block, and the design they
+give (exit 1 if it fails; a warning where a stiction step passes the
+following-error limit even so).
 
 Usage: synth_hinf.py [--machine FILE] [--out FILE] [--report] [--suggest]"""
 import json
@@ -202,8 +204,9 @@ def main():
                     help="also print the design report: gains, gamma, poles, gain and phase margins and the "
                          "closed-loop bandwidth, continuous and sampled at the checked periods")
     ap.add_argument("--suggest", action="store_true",
-                    help="write no header: print the weights from the machine's periods, inertia, torque limit "
-                         "and encoder (docs/modules/hinf.md, \"Weights from the machine\") and their design")
+                    help="write no header: print the weights from the machine's periods, inertia, torque limit, "
+                         "encoder, stiction and following-error limit (docs/modules/hinf.md, \"Weights from the "
+                         "machine\") and their design")
     a = ap.parse_args()
     m = machine.load_or_exit(a.machine)
     if a.suggest:
@@ -212,7 +215,12 @@ def main():
         m = hinf_weights.with_hinf(m, hinf)
         sys.stdout.write(json.dumps({"control": {"hinf": hinf}}, indent=1) + "\n")
         sys.stdout.write("w0 = %.4g Hz (bound by the %s); one encoder count of velocity asks %.3g of the torque "
-                         "limit\n" % (info["omega0_rad_s"] / (2.0 * np.pi), info["bound"], info["count_torque_share"]))
+                         "limit; a stiction step moves the axis %.4g mm (following-error limit %.4g mm)\n" % (
+                             info["omega0_rad_s"] / (2.0 * np.pi), info["bound"], info["count_torque_share"],
+                             info["friction_step_m"] * 1e3, info["following_m"] * 1e3))
+        short = hinf_weights.friction_shortfall(info)
+        if short is not None:
+            sys.stdout.write("warning: %s\n" % short)
     wts = weights(m)
     try:
         d = design(machine.params(m), wts)

@@ -13,9 +13,24 @@ docs/modules/hinf.md, "Weights from the machine"), label `design`:
 - where one encoder count of velocity would ask more than COUNT_TORQUE_SHARE
   of the torque limit at the period's frequency (axis 176), the frequency is
   lowered to that share;
+- the friction term (4): on a light axis with strong stiction (the truth of
+  fleet axis 137) the frequency rises until a stiction step moves the axis
+  FOLLOWING_SHARE of the following-error limit, on the same axis with the
+  reference's stiction (its given file) it stays at the period's; where the
+  margins stop the raise short of it (axis 55's truth) w0 is the largest
+  frequency that keeps them;
+- a machine whose period is too long for its mass's stiction (the reference
+  with a 1.5 kg table, 300 N of stiction, a 2 ms period) gets the weights at
+  the margins' bound with a warning naming the needed w0 and the Nyquist
+  frequency (weights_or_rule's why, `synth_hinf.py --suggest`'s output);
+- the guard: where the rule's own weights fail synth_hinf's checks (the
+  reference with a 10-tonne table, a 4-count encoder, a 10 us control period
+  and a 0.1 s PF period: the encoder bound takes w0 so low that the loop at
+  10 us has a mode at 1 in float64) weights_or_rule raises DesignError;
 - `synth_hinf.py --suggest` prints the block and writes no header;
 - the diagnosis's machine.json takes the rule's weights, marked derived,
-  where the given weights fail, and keeps the given ones where they hold.
+  where the given weights fail, keeps the given ones where they hold, and
+  derives again the given file's derived weights for the identified friction.
 
 Usage: test_hinf_weights.py WORKDIR"""
 import json
@@ -42,6 +57,8 @@ WORK = None
 FLEET_SEED = 20261201
 FLEET_REFUSED = (25, 55, 124, 128, 136, 137, 184)
 FLEET_ENCODER_BOUND = 176
+FLEET_FRICTION_BOUND = 137   # light (1.4 kg), 436 N of stiction: the friction term raises w0
+FLEET_MARGINS_BOUND = 55     # 4.7 kg, 445 N at a 1.68 ms PF period: the margins stop the raise
 PM_MIN_DEG, GM_MIN = 45.0, 10.0 ** (6.0 / 20.0)
 
 
@@ -55,6 +72,35 @@ def figures(m):
 
 def fleet_given(i):
     return fleet_axis.given_file(fleet_axis.draw(FLEET_SEED, i), "fleet-%04d" % i)
+
+
+def fleet_truth(i):
+    """the axis's true plant as a machine file: its drawn stiction, where the diagnosis identifies it"""
+    ax = fleet_axis.draw(FLEET_SEED, i)
+    return fleet_axis.truth_file(ax, fleet_axis.given_file(ax, "fleet-%04d" % i))
+
+
+def too_slow_for_its_friction():
+    """machines/reference.json with a 1.5 kg table on a light screw, 300 N of stiction and a 2 ms
+    control period (3 ms for the PF): the friction needs a loop its period cannot carry"""
+    m = machine.load(machine.REFERENCE_MACHINE)
+    m["mechanics"].update({"table_mass_kg": 1.5, "inertia_kgm2": 1e-7})
+    m["friction"].update({"Fc_N": 200.0, "Fs_N": 300.0})
+    m["control"].update({"period_s": 0.002, "torque_limit_Nm": 3.0})
+    m["amplifier"]["torque_per_duty_Nm"] = 3.0
+    m["estimator"]["pf"]["period_s"] = 0.003
+    return m
+
+
+def too_coarse_for_its_periods():
+    """machines/reference.json with a 10-tonne table, 4 counts per revolution, a 10 us control period
+    and a 0.1 s PF period: one count of velocity at 10 us asks the torque limit at any w0 (3) allows"""
+    m = machine.load(machine.REFERENCE_MACHINE)
+    m["mechanics"]["table_mass_kg"] = 1e4
+    m["encoder"]["counts_per_rev"] = 4
+    m["control"]["period_s"] = 1e-5
+    m["estimator"]["pf"]["period_s"] = 0.1
+    return m
 
 
 class Rule(unittest.TestCase):
@@ -127,6 +173,69 @@ class Rule(unittest.TestCase):
         self.assertAlmostEqual(info["count_torque_share"], hinf_weights.COUNT_TORQUE_SHARE, delta=1e-3)
         self.assert_holds(hinf_weights.with_hinf(g, hinf), "axis %d" % FLEET_ENCODER_BOUND)
 
+    def test_friction_raises_w0(self):
+        t = fleet_truth(FLEET_FRICTION_BOUND)
+        w_period = hinf_weights.NYQUIST_SHARE * math.pi / hinf_weights.periods(t)[0]
+        target = hinf_weights.FOLLOWING_SHARE * machine.following_m(t)
+        self.assertGreater(hinf_weights.friction_step_m(t, hinf_weights.from_omega(t, w_period)), target)
+        hinf, info = hinf_weights.suggest(t)
+        self.assertEqual(info["bound"], "friction")
+        self.assertGreater(info["omega0_rad_s"], 1.2 * w_period)
+        # the smallest w0 meeting (4), to the bisection's resolution
+        self.assertLessEqual(info["friction_step_m"], target)
+        below = info["omega0_rad_s"] / (1.0 + 2.0 * hinf_weights.REL_TOL)
+        self.assertGreater(hinf_weights.friction_step_m(t, hinf_weights.from_omega(t, below)), target)
+        self.assert_holds(hinf_weights.with_hinf(t, hinf), "axis %d's truth" % FLEET_FRICTION_BOUND)
+        self.assertIn("friction", hinf_weights.weights_or_rule(t, always=True)[1])
+        # the same axis with the reference's stiction (its given file): the period's w0
+        g = fleet_given(FLEET_FRICTION_BOUND)
+        self.assertEqual(hinf_weights.suggest(g)[1]["bound"], "period")
+
+    def test_margins_stop_the_raise(self):
+        t = fleet_truth(FLEET_MARGINS_BOUND)
+        hinf, info = hinf_weights.suggest(t)
+        self.assertEqual(info["bound"], "margins")
+        self.assertGreater(info["friction_step_m"], hinf_weights.FOLLOWING_SHARE * info["following_m"])
+        self.assertGreater(info["omega_friction_rad_s"], info["omega0_rad_s"])
+        w0 = info["omega0_rad_s"]
+        self.assertTrue(hinf_weights.raise_holds(t, w0))
+        self.assertFalse(hinf_weights.raise_holds(t, w0 * (1.0 + 2.0 * hinf_weights.REL_TOL)))
+        self.assert_holds(hinf_weights.with_hinf(t, hinf), "axis %d's truth" % FLEET_MARGINS_BOUND)
+        # within the following-error limit: no warning
+        self.assertIsNone(hinf_weights.friction_shortfall(info))
+
+    def test_warns_on_a_period_too_long_for_the_friction(self):
+        m = too_slow_for_its_friction()
+        self.assertIsNotNone(hinf_weights.refusal(m))  # the reference's weights: unstable on it
+        hinf, info = hinf_weights.suggest(m)
+        self.assertEqual(info["bound"], "margins")
+        self.assertGreater(info["friction_step_m"], machine.following_m(m))
+        self.assertGreater(info["omega_friction_rad_s"], info["omega0_rad_s"])
+        got, why = hinf_weights.weights_or_rule(m)
+        self.assertEqual(got, hinf)
+        self.assertIn("a stiction step moves the axis", why)
+        self.assertIn("%.4g Hz" % (info["omega_friction_rad_s"] / (2.0 * math.pi)), why)
+        self.assertIn("Nyquist frequency %.4g Hz" % (info["nyquist_rad_s"] / (2.0 * math.pi)), why)
+        self.assertNotIn("stiction step", hinf_weights.weights_or_rule(fleet_truth(FLEET_FRICTION_BOUND),
+                                                                        always=True)[1])
+        path = os.path.join(WORK, "too-slow.json")
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump({k: v for k, v in m.items() if k != "file"}, f)
+        r = subprocess.run([sys.executable, os.path.join(DESIGN, "synth_hinf.py"), "--machine", path, "--suggest",
+                            "--out", os.path.join(WORK, "never.h")], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("warning: a stiction step moves the axis", r.stdout)
+
+    def test_guard_refuses_when_the_rule_fails_too(self):
+        m = too_coarse_for_its_periods()
+        self.assertIsNotNone(hinf_weights.refusal(m))
+        hinf, info = hinf_weights.suggest(m)
+        self.assertEqual(info["bound"], "encoder")
+        self.assertIsNotNone(hinf_weights.refusal(hinf_weights.with_hinf(m, hinf)))
+        with self.assertRaises(synth_hinf.DesignError) as cm:
+            hinf_weights.weights_or_rule(m)
+        self.assertIn("the weights from the machine fail too: the sampled loop is unstable", str(cm.exception))
+
     def test_suggest_cli(self):
         out = os.path.join(WORK, "never.h")
         r = subprocess.run([sys.executable, os.path.join(DESIGN, "synth_hinf.py"), "--machine",
@@ -148,6 +257,22 @@ class Rule(unittest.TestCase):
             self.assertEqual(g["control"]["hinf"] != given, fails, i)
             self.assertEqual(prov.get("control.hinf.weight_theta_per_rad"), "derived" if fails else None)
             self.assertEqual(len(notes), 1 if fails else 0)
+
+    def test_diagnosis_derives_again(self):
+        """a given file whose weights are derived (the rule's, for its assumed stiction) gets the
+        rule's for the identified stiction; the same weights marked given are kept"""
+        g = fleet_given(FLEET_FRICTION_BOUND)
+        fleet_axis.use_hinf_rule(g, always=True)
+        ident = fleet_truth(FLEET_FRICTION_BOUND)["friction"]
+        for marked, derives in (("derived", True), ("given", False)):
+            m = dict(g, friction=dict(ident), control=dict(g["control"]))
+            prov, notes = {"control.hinf." + k: marked for k in g["control"]["hinf"]}, []
+            machinejson._hinf(m, prov, notes, False)
+            want = hinf_weights.suggest(m)[0] if derives else g["control"]["hinf"]
+            self.assertEqual(m["control"]["hinf"], want, marked)
+            if derives:
+                self.assertNotEqual(want, g["control"]["hinf"])
+            self.assertEqual(len(notes), 1 if derives else 0, marked)
 
 
 if __name__ == "__main__":

@@ -26,8 +26,9 @@ marked "assumed"; what follows from the log and the rest is "derived". The
   friction_model   presliding_hysteresis's element set as maxwell_slip ("identified"),
                    when the other causes are ones the estimators combine with it
   control.hinf     the base's weights, unless they admit no acceptable H-inf design on
-                   the identified machine, or hinf_rule asks: then the weights from the
-                   machine (firmware/design/hinf_weights.py, "derived")
+                   the identified machine, or hinf_rule asks, or they are derived (the
+                   rule's for the base's friction): then the weights from the machine
+                   for the identified one (firmware/design/hinf_weights.py, "derived")
   estimator        the base's, as they are: format 2 states them in the
                    machine's own units (per second, in metres, in Fs, Fc and
                    Fs/sigma0), so they follow the identified friction and
@@ -117,15 +118,18 @@ def _hinf_weights():
 
 
 def _hinf(m, prov, notes, always):
-    """control.hinf: the base's weights when they give an acceptable design on m, else (or always)
+    """control.hinf: the base's weights when they give an acceptable design on m, else (or always,
+    or when the base's weights are themselves derived: the rule's for the base's assumed friction)
     the weights from the machine (docs/modules/hinf.md, "Weights from the machine")"""
     hw = _hinf_weights()
     if hw is None:
         notes.append("control.hinf is not checked: firmware/design/hinf_weights.py is not here "
                      "(`make firmware` checks it)")
         return
+    derived = all(prov.get("control.hinf." + k) == "derived" for k in m["control"]["hinf"])
     try:
-        hinf, why = hw.weights_or_rule(m, always)
+        hinf, why = hw.weights_or_rule(m, always or derived, "asked for" if always else
+                                       "the base's weights are derived: derived again on the identified machine")
     except hw.synth_hinf.DesignError as e:
         raise closedloop.ControllerError("control.hinf: %s" % e) from None
     if why is not None:
