@@ -414,6 +414,11 @@ int main(int argc, char **argv)
      * dlyid.md) runs on top of them, and its switches on the nominal and guard plants, which
      * have no delay, would be tuned around (the PF's settings switch there) */
     br_circle_use_delay_id(&t.base, 0);
+    /* and with the thesis gate: the gate's transient term (eq. G1, docs/modules/pf.md) is an
+     * operating margin on top of the variances, not one of them; a search that sees it leans
+     * on it (the UKF retuned with it: 1.34-1.44 times worse on the realistic plant, docs/tuning.md) */
+    t.base.pf.est.outlier_transient_rad = 0.0f;
+    t.base.ukf.est.outlier_transient_rad = 0.0f;
     t.log = log_file.f;
     const int n = br_tune_n_params(t.pf);
     double x0[MAX_P], lo[MAX_P], hi[MAX_P];

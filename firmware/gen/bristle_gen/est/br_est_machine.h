@@ -54,8 +54,8 @@
 #define BR_EST_PF_OUTLIER_SIGMA (8.0)
 #define BR_EST_PF_OUTLIER_SIGMA_F (8.000000000e+00f)
 /* the gate's transient term, rad (outlier_transient_k (Fs - Fc) T^2 / (2 Meff) / L; 0: off) */
-#define BR_EST_PF_OUTLIER_TRANSIENT_RAD (0.0)
-#define BR_EST_PF_OUTLIER_TRANSIENT_RAD_F (0.000000000e+00f)
+#define BR_EST_PF_OUTLIER_TRANSIENT_RAD (0.0002803051043411171)
+#define BR_EST_PF_OUTLIER_TRANSIENT_RAD_F (2.803051029e-04f)
 /* consecutive outliers before re-anchoring */
 #define BR_EST_PF_REANCHOR_AFTER 3u
 /* compensation lead beyond the actuator delay, periods (0: the filtered estimate) */
@@ -133,8 +133,8 @@
 #define BR_EST_UKF_OUTLIER_SIGMA (8.0)
 #define BR_EST_UKF_OUTLIER_SIGMA_F (8.000000000e+00f)
 /* the gate's transient term, rad (outlier_transient_k (Fs - Fc) T^2 / (2 Meff) / L; 0: off) */
-#define BR_EST_UKF_OUTLIER_TRANSIENT_RAD (0.0)
-#define BR_EST_UKF_OUTLIER_TRANSIENT_RAD_F (0.000000000e+00f)
+#define BR_EST_UKF_OUTLIER_TRANSIENT_RAD (0.00012458004637382977)
+#define BR_EST_UKF_OUTLIER_TRANSIENT_RAD_F (1.245800522e-04f)
 /* consecutive outliers before re-anchoring */
 #define BR_EST_UKF_REANCHOR_AFTER 3u
 /* compensation lead beyond the actuator delay, periods (0: the filtered estimate) */
