@@ -12,7 +12,8 @@ logs made from the model's own force around the reference machine
    whose zone spans five position steps on a log whose zone is a fifth of
    one does not vouch for itself (fleet axis 87);
 3. a borderline cause that moves a parameter beyond its interval and by
-   more than half its value keeps that parameter out of machine.json;
+   more than half its value keeps that parameter out of machine.json (a
+   smaller move is reported, the value written);
 4. a bristle damping ratio above physical.ZETA_MAX is held at the machine
    file's value; a shape parameter on its search bound is flagged.
 """
@@ -124,6 +125,14 @@ class RulesTest(unittest.TestCase):
         # without the borderline cause nothing moves: nothing kept out for it
         out2 = identify.apply(prep, diagnosis(free), P0, say=lambda m: None)
         self.assertNotIn("Fc_N", out2["kept_out"])
+        # a small asymmetry moves Fc beyond its interval but by less than half: written as fitted
+        truth = dict(truth, dFc_neg_N=0.4 * P0["Fc_N"])
+        prep = prepared(truth, causes=("asymmetric_friction",))
+        free = model.fit_nominal(prep)
+        diag = diagnosis(free, rounds=[[border]])
+        out = identify.apply(prep, diag, P0, say=lambda m: None)
+        self.assertIn("Fc_N", out["borderline_moves"]["asymmetric_friction"])
+        self.assertNotIn("Fc_N", out["kept_out"])
 
     def test_4_non_physical_values_are_flagged(self):
         p = nominal_truth()

@@ -262,7 +262,7 @@ def _hold_distorted(h, diag):
     the REL_95 an identified parameter may be off, when it is added to the
     model distorts it: the value without the cause is no measurement
     either: it is kept out of machine.json (h.kept_out). h.moves: {cause:
-    {param: [without, with, interval]}}."""
+    {param: [without, with, interval]}} of every move beyond the interval."""
     border = [c["cause"] for c in selection.borderline(diag)]
     if not border:
         return
@@ -277,11 +277,11 @@ def _hold_distorted(h, diag):
             continue
         q = model.refine(prep, w, rounds=1, max_nfev=selection.REFINE_NFEV).params()
         mv = {k: [p[k], q[k], list(ivals[k])] for k in _assessed(h.best)
-              if k in NOMINAL and k in ivals and k not in h.fixed and not ivals[k][0] <= q[k] <= ivals[k][1]
-              and abs(q[k] - p[k]) > REL_95 * abs(p[k])}
+              if k in NOMINAL and k in ivals and k not in h.fixed and not ivals[k][0] <= q[k] <= ivals[k][1]}
         h.moves[cause] = mv
-        for k in mv:
-            moved.setdefault(k, cause)
+        for k, (a, b, _) in mv.items():
+            if abs(b - a) > REL_95 * abs(a):
+                moved.setdefault(k, cause)
     for k, cause in moved.items():
         h.kept_out.setdefault(k, f"the borderline {cause} moves it beyond its 95 % interval (the model without it "
                                   f"{p[k]:.4g}, with it {h.moves[cause][k][1]:.4g}): machine.json takes the machine "

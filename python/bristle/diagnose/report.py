@@ -206,7 +206,8 @@ def markdown(rep, figures):
             if moves:
                 L.append("  - added to the model it moves " + "; ".join(
                     f"`{k}` {a:.4g} → {b:.4g} (95 % interval {iv[0]:.4g} .. {iv[1]:.4g})"
-                    for k, (a, b, iv) in moves.items()) + ": these are not written to machine.json")
+                    for k, (a, b, iv) in moves.items()) + "; a move by more than half the value keeps the parameter out of "
+                    "machine.json")
         L.append("")
     for c in rep.get("dropped", []):
         L += [f"Dropped: {c['cause']} was found in round {c['round']} and left the joint model when later findings "
