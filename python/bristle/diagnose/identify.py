@@ -24,17 +24,23 @@ over the parameters still free. The worst parameter with Z rse_i > REL_95
 log's weakest; it is set aside and the rest assessed again, until every
 remaining one passes. The parameters set aside are not identified.
 
-Profile test: each parameter set aside, in that order, is held at the
-machine file's value (prep.fixed, model.solve / fit_shape) and the
-extended model refitted; it stays held when the log cannot tell the
-machine file's value from its own fit (with every parameter held so far): the
-held-out relerr rises by no more than HOLD_TOL relative and the free fit
-is not better consistently over the held-out blocks
-(selection.block_p_value, p < P_MAX), or when the free fit put it on its
-physical bound (the log pulls it to a non-physical value); else it keeps the fitted value, reported
-as poorly determined (the log does show a difference). Every fit is also
-bounded to the physical ranges (model.COEF_LOWER), so no parameter is ever
-fitted to a non-physical value.
+Held at the machine file's value (prep.fixed, model.solve / fit_shape), the
+extended model refitted with every parameter held so far:
+  - each parameter set aside, in that order: either the log cannot tell the
+    machine file's value from its own fit (the held-out relerr rises by no
+    more than HOLD_TOL relative and the free fit is not better consistently
+    over the held-out blocks, selection.block_p_value, p < P_MAX; or the
+    free fit put it on its physical bound), or it is poorly determined (the
+    log shows a difference but does not fix the value): held either way,
+    the report saying which;
+  - sigma1 when the bristle damping ratio is non-physical (physical.py);
+  - sigma0 and sigma1 when the log cannot tell the fit from a model whose
+    presliding zone is ZONE_STEPS position steps (the log does not show
+    presliding, whatever the fitted sigma0 says).
+Kept out of machine.json (the model keeps its fit): a nominal parameter a
+borderline cause moves beyond its jackknife interval and by more than REL_95
+of its value when added, and the values on a search bound (physical.py).
+Every fit is also bounded to the physical ranges (model.COEF_LOWER).
 """
 import math
 
@@ -201,7 +207,7 @@ def apply(prep, diag, p0, say=print):
     diag.extended = h.best
     out = {"method": "relative standard error at the machine file's values, sensitivities over the training part "
                      f"(docs/diagnose.md, Identifiability); identified when {Z:g} rse <= {REL_95:g}",
-           "identified": {k: _r(v) for k, v in rest.items() if k not in h.held},
+           "identified": {k: _r(v) for k, v in rest.items() if k not in h.held and k not in h.kept_out},
            "held": h.held, "kept_out": {k: v for k, v in h.kept_out.items() if k not in h.held},
            "poorly_determined": {}, "borderline_moves": h.moves}
     for k, v in h.held.items():
