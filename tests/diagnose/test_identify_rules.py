@@ -98,10 +98,19 @@ class RulesTest(unittest.TestCase):
         self.assertGreater(p["Fc_N"] / p["sigma0_Npm"], machinejson.PRESLIDING_MIN_QUANTA * q)
         h = identify._Holder(prep, five, P0)
         identify._hold_presliding(h)
-        self.assertIn("sigma0_Npm", h.held)
-        self.assertIn("sigma1_Nspm", h.held)
-        self.assertIn("does not show the presliding zone", h.held["sigma0_Npm"]["why"])
-        self.assertAlmostEqual(h.best.params()["sigma0_Npm"] / h.best.params()["Fc_N"], P0["sigma0_Npm"] / P0["Fc_N"])
+        self.assertIn("sigma0_Npm", h.kept_out)
+        self.assertIn("sigma1_Nspm", h.kept_out)
+        self.assertIn("does not show the presliding zone", h.kept_out["sigma0_Npm"])
+        # the model keeps a zone under a step (the file's zone would add a presliding the log has not)
+        p = h.best.params()
+        self.assertAlmostEqual(p["Fc_N"] / p["sigma0_Npm"] / q, identify.ZONE_STEPS)
+        # machine.json takes the file's sigma0 and sigma1
+        diag = diagnosis(h.best)
+        diag.identifiability = {"held": h.held, "kept_out": h.kept_out}
+        m, _ = machinejson.build(prep, diag)
+        self.assertEqual((m["friction"]["sigma0_Npm"], m["friction"]["sigma1_Nspm"]),
+                         (P0["sigma0_Npm"], P0["sigma1_Nspm"]))
+        self.assertEqual(m["provenance"]["friction.sigma0_Npm"], "assumed")
 
     def test_3_a_borderline_cause_that_moves_a_parameter_keeps_it_out(self):
         # -x friction three times +x's: the symmetric fit's Fc is the two sides' mean

@@ -34,9 +34,9 @@ extended model refitted with every parameter held so far:
     log shows a difference but does not fix the value): held either way,
     the report saying which;
   - sigma1 when the bristle damping ratio is non-physical (physical.py);
-  - sigma0 and sigma1 when the log cannot tell the fit from a model whose
-    presliding zone is ZONE_STEPS position steps (the log does not show
-    presliding, whatever the fitted sigma0 says).
+  - sigma0 at a zone of ZONE_STEPS position steps when the log cannot tell
+    the fit from that model (the log does not show presliding, whatever the
+    fitted sigma0 says); sigma0 and sigma1 are then kept out of machine.json.
 Kept out of machine.json (the model keeps its fit): a nominal parameter a
 borderline cause moves beyond its jackknife interval and by more than REL_95
 of its value when added, and the values on a search bound (physical.py).
@@ -203,7 +203,7 @@ def apply(prep, diag, p0, say=print):
     _hold_presliding(h)
     _hold_distorted(h, diag)
     _flag_bounds(h)
-    prep.fixed = h.fixed if h.held else None  # best was refitted with exactly these
+    prep.fixed = h.fixed if set(h.fixed) - {"Fc_ref_N"} else None  # best was refitted with exactly these
     diag.extended = h.best
     out = {"method": "relative standard error at the machine file's values, sensitivities over the training part "
                      f"(docs/diagnose.md, Identifiability); identified when {Z:g} rse <= {REL_95:g}",
@@ -242,24 +242,30 @@ def _flag_bounds(h):
 
 def _hold_presliding(h):
     """The presliding zone judged by the log, not by the fitted sigma0: the
-    model refitted with a zone Fc/sigma0 of half a position step (1 nm
+    model refitted with a zone Fc/sigma0 of ZONE_STEPS position steps (1 nm
     without an encoder step in the log), which no log resolves; when the log
-    cannot tell it from the fit (_tells), it does not show presliding and
-    sigma0, sigma1 are the machine file's."""
+    cannot tell it from the fit (_tells), it does not show presliding: the
+    model keeps that zone (the machine file's would put a presliding the log
+    has not in it) and sigma0, sigma1 are kept out of machine.json."""
     if "sigma0_Npm" in h.fixed or "sigma0_Npm" not in _assessed(h.best):
         return
     prep = h.prep
     q = machinejson.encoder_step(prep.pos)
     zone = max(ZONE_STEPS * q, 1.0 / model.RHO_BOUNDS[1])
-    flat = h.trial({"sigma0_Npm": h.fixed["Fc_ref_N"] / zone})
+    flat_s0 = h.fixed["Fc_ref_N"] / zone
+    flat = h.trial({"sigma0_Npm": flat_s0})
     rel = h.best.relerr(prep, prep.test)
     if _tells(prep, flat, h.best, rel):
         return
     why = (f"the log does not show the presliding zone: with a zone Fc/sigma0 of {zone:.3g} m ({ZONE_STEPS:g} "
            f"position step) the held-out relerr is {flat.relerr(prep, prep.test):.4g} % against the fit's "
-           f"{rel:.4g} %, not worse: taken from the machine file")
-    names = tuple(k for k in ("sigma0_Npm", "sigma1_Nspm") if k not in h.fixed)
-    h.take(names, h.trial({k: h.p0[k] for k in names}), why)
+           f"{rel:.4g} %, not worse (the fitted zone {h.best.params()['Fc_N'] / h.best.params()['sigma0_Npm']:.3g} m "
+           "is no measurement): the model keeps that zone, machine.json takes the machine file's value")
+    h.fixed["sigma0_Npm"] = flat_s0
+    h.best = flat
+    for k in ("sigma0_Npm", "sigma1_Nspm"):
+        if k not in h.held:
+            h.kept_out[k] = why
 
 
 def _hold_distorted(h, diag):
