@@ -211,13 +211,13 @@ def apply(prep, diag, p0, say=print):
            "held": h.held, "kept_out": {k: v for k, v in h.kept_out.items() if k not in h.held},
            "poorly_determined": {}, "borderline_moves": h.moves}
     for k, v in h.held.items():
-        say(f"identifiability: {k}: {v['why']}; the machine file's {v['value']:.4g} is used")
+        say(f"identifiability: {k} = {v['value']:.4g}, the machine file's: {v['why']}")
     for k, r in kept:
         out["poorly_determined"][k] = {"rse": _r(r),
                                        "why": f"weakly determined (95 % interval ±{_pct(r)} of the machine file's "
                                               f"value; it needs {NEEDS[k]}); a cause's parameter: kept as fitted"}
     for k, why in out["kept_out"].items():
-        say(f"identifiability: {k}: {why}")
+        say(f"identifiability: {k} not written to machine.json: {why}")
     if h.held:
         say(f"identifiability: extended model refitted with {', '.join(h.held)} held: held-out relerr "
             f"{free_rel:.4g} % -> {h.best.relerr(prep, te):.4g} %")
