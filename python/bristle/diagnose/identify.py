@@ -24,29 +24,36 @@ over the parameters still free. The worst parameter with Z rse_i > REL_95
 log's weakest; it is set aside and the rest assessed again, until every
 remaining one passes. The parameters set aside are not identified.
 
-Profile test: each parameter set aside, in that order, is held at the
-machine file's value (prep.fixed, model.solve / fit_shape) and the
-extended model refitted; it stays held when the log cannot tell the
-machine file's value from its own fit (with every parameter held so far): the
-held-out relerr rises by no more than HOLD_TOL relative and the free fit
-is not better consistently over the held-out blocks
-(selection.block_p_value, p < P_MAX), or when the free fit put it on its
-physical bound (the log pulls it to a non-physical value); else it keeps the fitted value, reported
-as poorly determined (the log does show a difference). Every fit is also
-bounded to the physical ranges (model.COEF_LOWER), so no parameter is ever
-fitted to a non-physical value.
+Held at the machine file's value (prep.fixed, model.solve / fit_shape), the
+extended model refitted with every parameter held so far:
+  - each parameter set aside, in that order: either the log cannot tell the
+    machine file's value from its own fit (the held-out relerr rises by no
+    more than HOLD_TOL relative and the free fit is not better consistently
+    over the held-out blocks, selection.block_p_value, p < P_MAX; or the
+    free fit put it on its physical bound), or it is poorly determined (the
+    log shows a difference but does not fix the value): held either way,
+    the report saying which;
+  - sigma1 when the bristle damping ratio is non-physical (physical.py);
+  - sigma0 at a zone of ZONE_STEPS position steps when the log cannot tell
+    the fit from that model (the log does not show presliding, whatever the
+    fitted sigma0 says); sigma0 and sigma1 are then kept out of machine.json.
+Kept out of machine.json (the model keeps its fit): a nominal parameter a
+borderline cause moves beyond its jackknife interval and by more than REL_95
+of its value when added, and the values on a search bound (physical.py).
+Every fit is also bounded to the physical ranges (model.COEF_LOWER).
 """
 import math
 
 import numpy as np
 
 from . import causes as causes_
-from . import model, selection
+from . import intervals, machinejson, model, params, physical, selection
 
 Z = 1.96
 REL_95 = 0.5     # a parameter is identified when its 95 % interval is within +-50 % of its scale
 H = 1e-3         # finite-difference step, in units of the scale
 HOLD_TOL = 0.05  # held-out relerr may rise 5 % (relative) when a parameter is held
+ZONE_STEPS = 0.5  # the presliding zone of the visibility test, in position steps
 # the parameters assessed and the machine-file parameter that gives each its scale
 SCALE = {"Meff_kg": "Meff_kg", "sigma2_Nspm": "sigma2_Nspm", "Fc_N": "Fc_N", "Fs_N": "Fs_N", "vs_mps": "vs_mps",
          "sigma0_Npm": "sigma0_Npm", "sigma1_Nspm": "sigma1_Nspm",
@@ -63,6 +70,8 @@ NEEDS = {"Meff_kg": "accelerations",
          "dsigma2_neg_Nspm": "sliding in -x at several speeds"}
 # parameters that can be held at the machine file's value (model.FIXED_COEF, FIXED_SHAPE)
 HOLDABLE = set(model.FIXED_COEF) | set(model.FIXED_SHAPE)
+# the nominal model's parameters: what machine.json can take from the machine file instead
+NOMINAL = {q.name for q in params.NOMINAL}
 
 
 def prior(machine):
@@ -137,49 +146,158 @@ def _refit(prep, fit, fixed):
     return model.refine(prep, f, rounds=1)
 
 
+class _Holder:
+    """The parameters held so far at the machine file's values, and the
+    extended model refitted with them (best)."""
+
+    def __init__(self, prep, fit, p0):
+        self.prep, self.free, self.p0 = prep, fit, p0
+        self.fixed = {"Fc_ref_N": p0["Fc_N"]}
+        self.best = fit
+        self.held = {}   # {param: {"value", "rse", "why"}} in the order held
+        self.kept_out = {}  # {param: why}: the model keeps the fit, machine.json the machine file's value
+        self.moves = {}
+
+    def trial(self, extra):
+        """The free fit refitted with the parameters held so far and `extra` ({param: value})."""
+        return _refit(self.prep, self.free, dict(self.fixed, **extra))
+
+    def take(self, names, trial, why, rse=math.inf):
+        """Holds `names` at the machine file's values; trial is the refit with them held."""
+        te = self.prep.test
+        rel = (self.best.relerr(self.prep, te), trial.relerr(self.prep, te))
+        for k in names:
+            fitted = self.best.params().get(k)
+            self.fixed[k] = self.p0.get(k, 0.0)
+            self.held[k] = {"value": self.p0.get(k, 0.0), "rse": _r(rse), "fitted": fitted,
+                            "relerr_percent": list(rel), "why": why}
+        self.best = trial
+
+
 def apply(prep, diag, p0, say=print):
-    """Assesses the extended model of diag, holds what the log cannot tell
-    from the machine file and refits; replaces diag.extended and returns
-    the report's "identifiability" block."""
+    """Assesses the extended model of diag, holds at the machine file's
+    values what the log cannot determine (set aside by the assessment,
+    non-physical, a presliding zone the log does not show, moved by a
+    borderline cause beyond its interval) and refits; replaces diag.extended
+    and returns the report's "identifiability" block."""
     fit = diag.extended
     aside, rest = assess(prep, fit, p0)
     te = prep.test
     free_rel = fit.relerr(prep, te)
-    fixed = {"Fc_ref_N": p0["Fc_N"]}
-    held, kept = [], []
-    best = fit
+    h = _Holder(prep, fit, p0)
+    kept = []
     for k, r in aside:
         if k not in HOLDABLE:
             kept.append((k, r))
             continue
-        trial = _refit(prep, fit, dict(fixed, **{k: p0.get(k, 0.0)}))
+        trial = h.trial({k: p0.get(k, 0.0)})
         if _at_bound(fit, k) or not _tells(prep, trial, fit, free_rel):
-            fixed[k] = p0.get(k, 0.0)
-            held.append((k, r))
-            best = trial
+            why = (f"the log cannot separate it (95 % interval ±{_pct(r)} of the machine file's value; it needs "
+                   f"{NEEDS[k]}): taken from the machine file")
         else:
-            kept.append((k, r))
-    prep.fixed = fixed if held else None  # best was refitted with exactly these
-    diag.extended = best
+            # poorly determined: the log shows a difference, but does not fix the value
+            why = (f"poorly determined (95 % interval ±{_pct(r)} of the machine file's value; it needs {NEEDS[k]}): "
+                   f"the log's fit {h.best.params()[k]:.4g} is no measurement, the machine file's value is taken")
+        h.take((k,), trial, why, r)
+    _hold_unphysical(h)
+    _hold_presliding(h)
+    _hold_distorted(h, diag)
+    _flag_bounds(h)
+    prep.fixed = h.fixed if set(h.fixed) - {"Fc_ref_N"} else None  # best was refitted with exactly these
+    diag.extended = h.best
     out = {"method": "relative standard error at the machine file's values, sensitivities over the training part "
                      f"(docs/diagnose.md, Identifiability); identified when {Z:g} rse <= {REL_95:g}",
-           "identified": {k: _r(v) for k, v in rest.items()},
-           "held": {}, "poorly_determined": {}}
-    for k, r in held:
-        out["held"][k] = {"value": p0.get(k, 0.0), "rse": _r(r),
-                          "why": f"the log cannot separate it (95 % interval ±{_pct(r)} of the machine file's value; "
-                                 f"it needs {NEEDS[k]}): taken from the machine file"}
-        say(f"identifiability: {k} not identified by this log (it needs {NEEDS[k]}): the machine file's "
-            f"{p0.get(k, 0.0):.4g} is used")
+           "identified": {k: _r(v) for k, v in rest.items() if k not in h.held and k not in h.kept_out},
+           "held": h.held, "kept_out": {k: v for k, v in h.kept_out.items() if k not in h.held},
+           "poorly_determined": {}, "borderline_moves": h.moves}
+    for k, v in h.held.items():
+        say(f"identifiability: {k} = {v['value']:.4g}, the machine file's: {v['why']}")
     for k, r in kept:
         out["poorly_determined"][k] = {"rse": _r(r),
                                        "why": f"weakly determined (95 % interval ±{_pct(r)} of the machine file's "
-                                              f"value; it needs {NEEDS[k]}), but the log's fit differs from the "
-                                              "machine file's value by more than its residual allows: kept as fitted"}
-    if held:
-        say(f"identifiability: extended model refitted with {', '.join(k for k, _ in held)} held: held-out relerr "
-            f"{free_rel:.4g} % -> {best.relerr(prep, te):.4g} %")
+                                              f"value; it needs {NEEDS[k]}); a cause's parameter: kept as fitted"}
+    for k, why in out["kept_out"].items():
+        say(f"identifiability: {k} not written to machine.json: {why}")
+    if h.held:
+        say(f"identifiability: extended model refitted with {', '.join(h.held)} held: held-out relerr "
+            f"{free_rel:.4g} % -> {h.best.relerr(prep, te):.4g} %")
     return out
+
+
+def _hold_unphysical(h):
+    """A non-physical bristle damping (physical.py, P1) held at the machine file's value."""
+    why = physical.unphysical(h.best).get("sigma1_Nspm", "")
+    if "sigma1_Nspm" not in h.fixed and why.startswith(physical.NON_PHYSICAL):
+        h.take(("sigma1_Nspm",), h.trial({"sigma1_Nspm": h.p0["sigma1_Nspm"]}), why + ": taken from the machine file")
+
+
+def _flag_bounds(h):
+    """The final model's values on a search bound (physical.py) kept out of
+    machine.json (h.kept_out): the model keeps them, the log fits them better
+    than the machine file's values."""
+    for k, why in physical.unphysical(h.best).items():
+        if k not in h.fixed:
+            h.kept_out.setdefault(k, why + ": machine.json takes the machine file's value")
+
+
+def _hold_presliding(h):
+    """The presliding zone judged by the log, not by the fitted sigma0: the
+    model refitted with a zone Fc/sigma0 of ZONE_STEPS position steps (1 nm
+    without an encoder step in the log), which no log resolves; when the log
+    cannot tell it from the fit (_tells), it does not show presliding: the
+    model keeps that zone (the machine file's would put a presliding the log
+    has not in it) and sigma0, sigma1 are kept out of machine.json."""
+    if "sigma0_Npm" in h.fixed or "sigma0_Npm" not in _assessed(h.best):
+        return
+    prep = h.prep
+    q = machinejson.encoder_step(prep.pos)
+    zone = max(ZONE_STEPS * q, 1.0 / model.RHO_BOUNDS[1])
+    flat_s0 = h.fixed["Fc_ref_N"] / zone
+    flat = h.trial({"sigma0_Npm": flat_s0})
+    rel = h.best.relerr(prep, prep.test)
+    if _tells(prep, flat, h.best, rel):
+        return
+    why = (f"the log does not show the presliding zone: with a zone Fc/sigma0 of {zone:.3g} m ({ZONE_STEPS:g} "
+           f"position step) the held-out relerr is {flat.relerr(prep, prep.test):.4g} % against the fit's "
+           f"{rel:.4g} %, not worse (the fitted zone {h.best.params()['Fc_N'] / h.best.params()['sigma0_Npm']:.3g} m "
+           "is no measurement): the model keeps that zone, machine.json takes the machine file's value")
+    h.fixed["sigma0_Npm"] = flat_s0
+    h.best = flat
+    for k in ("sigma0_Npm", "sigma1_Nspm"):
+        if k not in h.held:
+            h.kept_out[k] = why
+
+
+def _hold_distorted(h, diag):
+    """A borderline cause (selection.borderline: not a finding) that moves a
+    parameter beyond its 95 % interval (intervals.jackknife), and by more than
+    the REL_95 an identified parameter may be off, when it is added to the
+    model distorts it: the value without the cause is no measurement
+    either: it is kept out of machine.json (h.kept_out). h.moves: {cause:
+    {param: [without, with, interval]}} of every move beyond the interval."""
+    border = [c["cause"] for c in selection.borderline(diag)]
+    if not border:
+        return
+    prep = h.prep
+    prep.fixed = h.fixed
+    ivals = intervals.jackknife(prep, h.best)
+    p = h.best.params()
+    moved = {}
+    for cause in border:
+        w = model.add_cause(prep, h.best, cause)
+        if w is None:
+            continue
+        q = model.refine(prep, w, rounds=1, max_nfev=selection.REFINE_NFEV).params()
+        mv = {k: [p[k], q[k], list(ivals[k])] for k in _assessed(h.best)
+              if k in NOMINAL and k in ivals and k not in h.fixed and not ivals[k][0] <= q[k] <= ivals[k][1]}
+        h.moves[cause] = mv
+        for k, (a, b, _) in mv.items():
+            if abs(b - a) > REL_95 * abs(a):
+                moved.setdefault(k, cause)
+    for k, cause in moved.items():
+        h.kept_out.setdefault(k, f"the borderline {cause} moves it beyond its 95 % interval (the model without it "
+                                  f"{p[k]:.4g}, with it {h.moves[cause][k][1]:.4g}): machine.json takes the machine "
+                                  "file's value")
 
 
 def _at_bound(fit, name):

@@ -167,6 +167,14 @@ def encoder_step(pos):
     return q if np.mean(np.abs(r - np.round(r)) < 0.02) > 0.95 else 0.0
 
 
+def taken_from_file(diag):
+    """The parameters machine.json takes from the machine file (identify.py):
+    held in the model, or kept out of machine.json (non-physical, on a search
+    bound, moved by a borderline cause)."""
+    ident = getattr(diag, "identifiability", None) or {}
+    return set(ident.get("held", {})) | set(ident.get("kept_out", {}))
+
+
 def _set(m, dotted, value, prov, kind):
     *head, last = dotted.split(".")
     node = m
@@ -214,8 +222,9 @@ def build(prep, diag, given=None, log_path=None, hinf_rule=False):
     # the moving mass at the load
     Meff = p["Meff_kg"]
     J, M = m["mechanics"]["inertia_kgm2"], m["mechanics"]["table_mass_kg"]
-    if "Meff_kg" in getattr(diag, "identifiability", {}).get("held", {}):
-        notes.append("the log cannot identify the moving mass: the mechanics are the base's")
+    from_file = taken_from_file(diag)
+    if "Meff_kg" in from_file:
+        notes.append("the moving mass is not taken from the log (report.json identifiability): the mechanics are the base's")
     elif kind("mechanics.inertia_kgm2") == "given" and kind("mechanics.table_mass_kg") == "given" and given:
         share = M / (J / L ** 2 + M)
         _set(m, "mechanics.table_mass_kg", share * Meff, prov, "identified")
@@ -248,7 +257,7 @@ def build(prep, diag, given=None, log_path=None, hinf_rule=False):
         unresolved |= {"sigma0_Npm", "sigma1_Nspm"}
         notes.append("the presliding length Fc/sigma0 %.3g m is under %g position steps: sigma0_Npm and "
                      "sigma1_Nspm are not identified" % (p["Fc_N"] / p["sigma0_Npm"], PRESLIDING_MIN_QUANTA))
-    held = set(getattr(diag, "identifiability", {}).get("held", {}))
+    held = from_file
     unresolved |= held & set(fr)
     for q in params.NOMINAL:
         if q.name not in fr:

@@ -81,6 +81,7 @@ def build(prep, diag, machine=None, closed=None, log_path=None, floor=None):
     if ident:
         for k, h in list(ident["held"].items()) + list(ident["poorly_determined"].items()):
             unident[k] = h["why"]
+        unident.update(ident.get("kept_out", {}))
     for cand, refined in diag.findings:
         mod = causes_.get(cand.cause)
         findings.append({
@@ -201,6 +202,12 @@ def markdown(rep, figures):
             ps = ", ".join(_param(k, v) for k, v in c["params"].items())
             L.append(f"- {c['cause']} ({c['meaning']}; {ps}): held-out relerr {c['base_relerr_percent']:.4g} % → "
                      f"{c['relerr_percent']:.4g} % ({100 * c['relative_gain']:.3g} %, p = {c['p_value']:.2g})")
+            moves = ((rep.get("identifiability") or {}).get("borderline_moves") or {}).get(c["cause"])
+            if moves:
+                L.append("  - added to the model it moves " + "; ".join(
+                    f"`{k}` {a:.4g} → {b:.4g} (95 % interval {iv[0]:.4g} .. {iv[1]:.4g})"
+                    for k, (a, b, iv) in moves.items()) + "; a move by more than half the value keeps the parameter out of "
+                    "machine.json")
         L.append("")
     for c in rep.get("dropped", []):
         L += [f"Dropped: {c['cause']} was found in round {c['round']} and left the joint model when later findings "
