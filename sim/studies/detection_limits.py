@@ -82,7 +82,20 @@ def lugre_presliding_scale_m():
     return fr["Fs_N"] / fr["sigma0_Npm"]
 
 
-REF_LEVELS = {"Fc_N": FC_N, "sigma2_Nspm": SIGMA2, "presliding_scale_m": lugre_presliding_scale_m()}
+def lugre_presliding_zeta():
+    """The damping ratio of LuGre's presliding mode on the reference machine (machines/reference.json):
+    the bristle's stiffness sigma0 and damping sigma1 on the moving mass at the load, M + J / L^2
+    (L = lead / 2 pi): sigma1 / (2 sqrt(sigma0 M))."""
+    with open(os.path.join(REPO, "machines", "reference.json")) as f:
+        m = json.load(f)
+    mech, fr = m["mechanics"], m["friction"]
+    lead = mech["lead_m_per_rev"] / (2.0 * math.pi)
+    meff = mech["table_mass_kg"] + mech["inertia_kgm2"] / lead ** 2
+    return fr["sigma1_Nspm"] / (2.0 * math.sqrt(fr["sigma0_Npm"] * meff))
+
+
+REF_LEVELS = {"Fc_N": FC_N, "sigma2_Nspm": SIGMA2, "presliding_scale_m": lugre_presliding_scale_m(),
+              "presliding_zeta": lugre_presliding_zeta()}
 
 
 def _generator(det):
@@ -99,7 +112,8 @@ CAUSE_LOGS = {m.NAME: m.DETECTION_LOG for m in causes.REGISTRY if hasattr(m, "DE
 # causes with their own block of the page (their own logs): a run of them alone rewrites only their block
 BLOCKS = ("presliding_hysteresis",)
 # the Maxwell-slip plant's element set relative to its largest breakaway (the cause's own)
-GMS_SHAPE = causes.get("presliding_hysteresis").DETECTION_SHAPE
+PS_NAME = "presliding_hysteresis"
+GMS_SHAPE = causes.get(PS_NAME).DETECTION_SHAPE
 
 
 def logs_of(cause):
@@ -183,9 +197,12 @@ def run(simlog, work, key, flags, sigma, seed):
     verdict, _ = report.verdict(prep, diag, noise.measure(prep, diag.nominal))
     os.remove(path)
     found = [c.cause for c, _ in diag.findings]
+    line = {"key": ck, "verdict": verdict, "findings": found}
+    # what a finding of presliding_hysteresis measured (presliding_table: its presliding_m against the plant's)
+    line.update({"ps_m": c.fit.cause_params(c.cause)["presliding_m"] for c, _ in diag.findings if c.cause == PS_NAME})
     with open(_cache_path(work), "a") as f:
         SECONDS[ck] = round(time.time() - t0, 3)
-        f.write(json.dumps({"key": ck, "verdict": verdict, "findings": found, "s": SECONDS[ck]}) + "\n")
+        f.write(json.dumps({**line, "s": SECONDS[ck]}) + "\n")
     CACHE[ck] = (verdict, found)   # the verification reuses the bisection's logs in this process
     return verdict, found
 
