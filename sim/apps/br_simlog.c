@@ -85,10 +85,6 @@ static void circle_sink(void *user, const br_circle_sample_t *s)
     write_row(c->o, s->t_s, s->ref_m[0], pos, s->duty[0] * c->F_per_duty, s->pos_m[0], NAN, s->fnl_N[0]);
 }
 
-/* --gms-zeta's bounds: a mode practically undamped, critical damping of each element's mode */
-#define GMS_ZETA_MIN 1e-3
-#define GMS_ZETA_MAX 1.0
-
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
@@ -115,7 +111,8 @@ static int usage(const char *argv0, FILE *to)
             "                      moving mass (sigma1_i = 2 Z sqrt(k_i M)) instead of the demo's %g N s/m\n"
             "bounds: --cycles 1 .. %d, --reversals 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N,\n"
             "        --gms-zeta %g .. %g (docs/tools.md)\n",
-            argv0, argv0, BR_CIRCLE_HW_SIGMA1_NSPM, BR_TOOL_CYCLES_MAX, BR_IDENT_REV_MAX_PAIRS, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N, GMS_ZETA_MIN, GMS_ZETA_MAX);
+            argv0, argv0, BR_CIRCLE_HW_SIGMA1_NSPM, BR_TOOL_CYCLES_MAX, BR_IDENT_REV_MAX_PAIRS, BR_TOOL_DURATION_MIN_S,
+            BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N, BR_TOOL_GMS_ZETA_MIN, BR_TOOL_GMS_ZETA_MAX);
     return 2;
 }
 
@@ -216,7 +213,7 @@ static int parse(int argc, char **argv, opts_t *o)
         case 'n': bad = br_arg_double(TOOL, p.opt, val, 0.0, BR_TOOL_NOISE_MAX_N, &o->noise); break;
         case 'g': bad = parse_gms(val, o); break;
         case 'z':
-            bad = br_arg_double(TOOL, p.opt, val, GMS_ZETA_MIN, GMS_ZETA_MAX, &o->gms_zeta);
+            bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_GMS_ZETA_MIN, BR_TOOL_GMS_ZETA_MAX, &o->gms_zeta);
             break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
