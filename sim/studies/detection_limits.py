@@ -500,7 +500,9 @@ def presliding_table(s):
         c = v["causes"][PS_NAME]
         per = {}
         for p in c["probes"] + c.get("verify", []):
-            per.setdefault(p["size"], []).extend(p.get("ps_m", []))
+            # a proof's first logs are the bisection's at that size: the longer list holds the other
+            if len(p.get("ps_m", [])) >= len(per.get(p["size"], [])):
+                per[p["size"]] = p.get("ps_m", [])
         cells = []
         for size in sorted(per):
             r = np.array(per[size]) / plant_presliding_m(size)

@@ -255,15 +255,17 @@ class Presliding(unittest.TestCase):
         saved = dl.run
         dl.run = stand
         try:
-            _, _, _, out = dl.bisect_task(("simlog", "work", 0, "quiet", 0.02, 0, PS, 20, 0))
+            _, _, _, out = dl.bisect_task(("simlog", "work", 0, "quiet", 0.02, 0, PS, 20, 59))
         finally:
             dl.run = saved
         res = {"cause": {(lv, PS): dict(out) for lv in ("EMPS", "quiet")}, "nominal": {}}
-        s = dl.summarize(res, (("EMPS", 0.2), ("quiet", 0.02)), 20, 10, [PS], 0)
+        s = dl.summarize(res, (("EMPS", 0.2), ("quiet", 0.02)), 20, 10, [PS], 59)
         table = "\n".join(dl.presliding_table(s))
         at = out["limit"]
         self.assertGreaterEqual(at, 0.5)
-        self.assertIn(f"{at:.3g}: {1e6 * dl.plant_presliding_m(at):.3g} um, 0.50 (0.50 .. 0.50), 20", table)
+        # the proof's 59 logs at the limit, its first 20 the bisection's: counted once
+        self.assertEqual(out["proven"], at)
+        self.assertIn(f"{at:.3g}: {1e6 * dl.plant_presliding_m(at):.3g} um, 0.50 (0.50 .. 0.50), 59 |", table)
         below = max(p["size"] for p in out["probes"] if not p["passed"])
         self.assertIn(f"{below:.3g}: {1e6 * dl.plant_presliding_m(below):.3g} um, —", table)
 
