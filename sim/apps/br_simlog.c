@@ -89,7 +89,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s --out FILE [--traj ident|circle|backforth|sweep] [--cycles N] [--reversals N]\n"
             "          [--duration S] [--seed N] [--force-noise N] [--model MODEL.json] [cause options]\n"
-            "          [--gms D1,..,DN] [--machine-out FILE] [--truth]\n"
+            "          [--gms D1,..,DN] [--gms-zeta Z] [--machine-out FILE] [--truth]\n"
             BR_ARGS_COMMON_USAGE
             "  --out FILE          the log (CSV t,ref,pos,force; with --truth the plant's truth too)\n"
             "  --traj T            ident: an identification run (default); circle: the circle's x axis;\n"
@@ -103,12 +103,16 @@ static int usage(const char *argv0, FILE *to)
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
             "  --machine-out FILE  the run's machine file (not with circle)\n"
             "  --gms D1,..,DN      the plant's friction Maxwell-slip: N <= 8 equal elements breaking away at\n"
-            "                      D1..DN m at Fs (the slip law and damping of the demo's hardware-like plant)\n",
-            argv0, argv0);
+            "                      D1..DN m at Fs (the slip law and damping of the demo's hardware-like plant)\n"
+            "  --gms-zeta Z        with --gms: each element's damping for a damping ratio Z of its mode on the\n"
+            "                      moving mass (sigma1_i = 2 Z sqrt(k_i M)) instead of the demo's %g N s/m\n",
+            argv0, argv0, BR_CIRCLE_HW_SIGMA1_NSPM);
     br_cause_usage(to, "");
     fprintf(to,
-            "bounds: --cycles 1 .. %d, --reversals 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N (docs/tools.md)\n",
-            BR_TOOL_CYCLES_MAX, BR_IDENT_REV_MAX_PAIRS, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, BR_TOOL_NOISE_MAX_N);
+            "bounds: --cycles 1 .. %d, --reversals 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N,\n"
+            "        --gms-zeta %g .. %g (docs/tools.md)\n",
+            BR_TOOL_CYCLES_MAX, BR_IDENT_REV_MAX_PAIRS, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S,
+            BR_TOOL_NOISE_MAX_N, BR_TOOL_GMS_ZETA_MIN, BR_TOOL_GMS_ZETA_MAX);
     return 2;
 }
 
@@ -131,7 +135,9 @@ typedef struct {
     br_plant_cfg_t causes;
     int gms_n;                     /* --gms: elements, 0 = the LuGre plant */
     double gms_d_m[BR_GMS_MAX];    /* their breakaway displacements at Fs */
+    double gms_zeta;               /* --gms-zeta: the element modes' damping ratio, 0 = the demo's damping */
 } opts_t;
+
 
 /* --gms D1,..,DN: N in 1..BR_GMS_MAX breakaway displacements, each in (0, 1e-2] m */
 static int parse_gms(const char *val, opts_t *o)
@@ -156,7 +162,8 @@ static int parse_gms(const char *val, opts_t *o)
 }
 
 /* the Maxwell-slip elements of --gms on the plant: equal shares, k_i = Fs / (N d_i),
- * the hardware-like plant's slip law (C, element damping, docs/demo.md) */
+ * the hardware-like plant's slip law (C, element damping, docs/demo.md); with
+ * --gms-zeta the damping of a ratio per element instead (br_gms_damping_ratio) */
 static void apply_gms(br_plant_cfg_t *plant, const opts_t *o)
 {
     if (o->gms_n == 0) return;
@@ -166,6 +173,7 @@ static void apply_gms(br_plant_cfg_t *plant, const opts_t *o)
     plant->gms.clamp = 0;
     plant->gms.C_mps = BR_CIRCLE_HW_C_MPS;
     plant->gms.delta = 1.0;
+    if (o->gms_zeta > 0.0) br_gms_damping_ratio(&plant->gms, o->gms_zeta, br_plant_meff_kg(plant));
 }
 
 /* every option checked: 0, 1 (--help or --version answered) or 2 (usage error, message printed) */
@@ -182,6 +190,7 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"force-noise", required_argument, NULL, 'n'},
                                          {"gms", required_argument, NULL, 'g'},
                                          {"reversals", required_argument, NULL, 'r'},
+                                         {"gms-zeta", required_argument, NULL, 'z'},
                                          BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 1;
@@ -203,6 +212,9 @@ static int parse(int argc, char **argv, opts_t *o)
             break;
         case 'n': bad = br_arg_double(TOOL, p.opt, val, 0.0, BR_TOOL_NOISE_MAX_N, &o->noise); break;
         case 'g': bad = parse_gms(val, o); break;
+        case 'z':
+            bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_GMS_ZETA_MIN, BR_TOOL_GMS_ZETA_MAX, &o->gms_zeta);
+            break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
@@ -225,6 +237,10 @@ static int parse(int argc, char **argv, opts_t *o)
         fprintf(stderr, "%s: --cycles applies to --traj ident only (the others take --duration)\n", TOOL);
         return 2;
     }
+    if (o->gms_zeta > 0.0 && o->gms_n == 0) {
+        fprintf(stderr, "%s: --gms-zeta applies with --gms only (the damping of its elements)\n", TOOL);
+        return 2;
+    }
     if (o->reversals > 0 && strcmp(o->traj, "ident") != 0) {
         fprintf(stderr, "%s: --reversals applies to --traj ident only\n", TOOL);
         return 2;
@@ -238,7 +254,7 @@ static int parse(int argc, char **argv, opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 0, 8.0, 0.0, br_plant_cfg_reference(), 0, {0.0}};
+    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 0, 8.0, 0.0, br_plant_cfg_reference(), 0, {0.0}, 0.0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) return 0; /* --help or --version answered */
     if (p != 0) return usage(argv[0], stderr);

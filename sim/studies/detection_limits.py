@@ -82,7 +82,20 @@ def lugre_presliding_scale_m():
     return fr["Fs_N"] / fr["sigma0_Npm"]
 
 
-REF_LEVELS = {"Fc_N": FC_N, "sigma2_Nspm": SIGMA2, "presliding_scale_m": lugre_presliding_scale_m()}
+def lugre_presliding_zeta():
+    """The damping ratio of LuGre's presliding mode on the reference machine (machines/reference.json):
+    the bristle's stiffness sigma0 and damping sigma1 on the moving mass at the load, M + J / L^2
+    (L = lead / 2 pi): sigma1 / (2 sqrt(sigma0 M))."""
+    with open(os.path.join(REPO, "machines", "reference.json")) as f:
+        m = json.load(f)
+    mech, fr = m["mechanics"], m["friction"]
+    lead = mech["lead_m_per_rev"] / (2.0 * math.pi)
+    meff = mech["table_mass_kg"] + mech["inertia_kgm2"] / lead ** 2
+    return fr["sigma1_Nspm"] / (2.0 * math.sqrt(fr["sigma0_Npm"] * meff))
+
+
+REF_LEVELS = {"Fc_N": FC_N, "sigma2_Nspm": SIGMA2, "presliding_scale_m": lugre_presliding_scale_m(),
+              "presliding_zeta": lugre_presliding_zeta()}
 
 
 def _generator(det):
@@ -99,7 +112,8 @@ CAUSE_LOGS = {m.NAME: m.DETECTION_LOG for m in causes.REGISTRY if hasattr(m, "DE
 # causes with their own block of the page (their own logs): a run of them alone rewrites only their block
 BLOCKS = ("presliding_hysteresis",)
 # the Maxwell-slip plant's element set relative to its largest breakaway (the cause's own)
-GMS_SHAPE = causes.get("presliding_hysteresis").DETECTION_SHAPE
+PS_NAME = "presliding_hysteresis"
+GMS_SHAPE = causes.get(PS_NAME).DETECTION_SHAPE
 
 
 def logs_of(cause):
@@ -134,6 +148,8 @@ def load_cache(work):
                     continue   # a line cut by an interrupted run
                 out[d["key"]] = (d["verdict"], d["findings"])
                 SECONDS[d["key"]] = d.get("s", 0.0)
+                if "ps_m" in d:
+                    PS_M[d["key"]] = d["ps_m"]
     except FileNotFoundError:
         pass
     return out
@@ -142,6 +158,8 @@ def load_cache(work):
 CACHE = {}
 USED = set()
 SECONDS = {}   # key -> wall seconds of that log (br_simlog + diagnosis), this run's or the cached run's
+PS_M = {}      # key -> presliding_m of the log's finding of presliding_hysteresis
+LAST_PS_M = [None]   # run()'s last log's PS_M (None: no such finding), for probe()
 
 
 def code_digest():
@@ -173,6 +191,7 @@ def run(simlog, work, key, flags, sigma, seed):
     ck = f"{key}|{' '.join(flags)}|{sigma:.6g}|{seed}|{DIGEST[simlog]}"
     USED.add(ck)
     if ck in CACHE:
+        LAST_PS_M[0] = PS_M.get(ck)
         return CACHE[ck]
     t0 = time.time()
     path = os.path.join(work, f"{key}.csv")
@@ -183,9 +202,13 @@ def run(simlog, work, key, flags, sigma, seed):
     verdict, _ = report.verdict(prep, diag, noise.measure(prep, diag.nominal))
     os.remove(path)
     found = [c.cause for c, _ in diag.findings]
+    line = {"key": ck, "verdict": verdict, "findings": found}
+    # what a finding of presliding_hysteresis measured (presliding_table: its presliding_m against the plant's)
+    line.update({"ps_m": c.fit.cause_params(c.cause)["presliding_m"] for c, _ in diag.findings if c.cause == PS_NAME})
+    LAST_PS_M[0] = PS_M[ck] = line.get("ps_m")
     with open(_cache_path(work), "a") as f:
         SECONDS[ck] = round(time.time() - t0, 3)
-        f.write(json.dumps({"key": ck, "verdict": verdict, "findings": found, "s": SECONDS[ck]}) + "\n")
+        f.write(json.dumps({**line, "s": SECONDS[ck]}) + "\n")
     CACHE[ck] = (verdict, found)   # the verification reuses the bisection's logs in this process
     return verdict, found
 
@@ -215,18 +238,24 @@ def probe(simlog, work, li, lname, sigma, ci, cause, si, size, flags, n, allowed
         allowed = misses_allowed(n)
     k = m = 0
     others = 0
+    ps_m = []
     for j in range(n):
+        LAST_PS_M[0] = None
         _, found = run(simlog, work, f"{lname}-{cause}-{si}-{j}", LOGS[logs_of(cause)] + flags(size), sigma,
                        hash_seed(li, ci + 1, si, j))
         if cause in found:
             k += 1
+            if LAST_PS_M[0] is not None:
+                ps_m.append(LAST_PS_M[0])
         else:
             m += 1
         others += any(c != cause for c in found)
         if m > allowed:
             break
-    return {"size": float(size), "detected": k, "logs": k + m, "other_findings": others,
-            "passed": m <= allowed}
+    out = {"size": float(size), "detected": k, "logs": k + m, "other_findings": others, "passed": m <= allowed}
+    if ps_m:
+        out["ps_m"] = ps_m   # the detections' presliding_m (presliding_table)
+    return out
 
 
 def bisect_task(args):
@@ -378,9 +407,13 @@ BLOCK_TEXT = {"presliding_hysteresis": (
     "machines/reference.json): "
     "at a fixed shape it sets the travel over which the element set's piecewise-linear, multi-scale swing "
     "differs from the single bristle, whose stiffness the nominal fit chooses (sigma0 is fitted, so a "
-    "length alone is no difference: the shape is). The element damping stays the demo's, so the "
-    "element set's stiffness also sets the plant's presliding resonance: what the smallest sizes are "
-    "named for is said in docs/diagnose.md (presliding_hysteresis). Same bisection, proof and bounds as the table above; "
+    "length alone is no difference: the shape is). Each element's damping gives its mode on the moving "
+    "mass the damping ratio of LuGre's bristle mode on the reference machine (`--gms-zeta {zeta:.3g}`: "
+    "sigma1 / (2 sqrt(sigma0 M)), sigma1_i = 2 zeta sqrt(k_i M), docs/modules/plant.md), so the plant's "
+    "presliding dynamics change with the size in their length scale only, not in their damping: with the "
+    "demo's fixed 2000 N s/m per element the smallest sizes made a lightly damped mode (ratio 0.02 at "
+    "0.02) whose chatter the diagnosis named, with a presliding_m 25 times the plant's (docs/diagnose.md, "
+    "presliding_hysteresis). Same bisection, proof and bounds as the table above; "
     "the nominal logs are LuGre logs with the same reversal segment, where the cause is tested (the "
     "identification logs above are below its gate, MIN_PRESLIDING_SAMPLES).")}
 
@@ -449,6 +482,36 @@ def nominal_table(s, kind):
     return L
 
 
+def plant_presliding_m(size):
+    """presliding_m of the study's element set at a size (presliding.md's figure, the cause's own
+    function): d_max = size times LuGre's Fs/sigma0, the shape GMS_SHAPE, equal shares."""
+    d_max = size * lugre_presliding_scale_m()
+    return causes.get(PS_NAME).presliding_m([d_max * f for f in GMS_SHAPE], [1.0] * len(GMS_SHAPE))
+
+
+def presliding_table(s):
+    """What the detections of presliding_hysteresis measured: at each probed size (the bisection's
+    and the proof's logs), the presliding_m the findings reported over the plant's."""
+    L = ["What the detections measured: at each probed size, presliding_m of the finding over the plant's "
+         "(presliding.md's figure of the element set: 1.2 d_max for this shape), the median and range over the "
+         "logs that named the cause.", "",
+         "| noise level | size: plant's presliding_m, identified / plant's: median (range), logs |", "|---|---|"]
+    for k, v in s["levels"].items():
+        c = v["causes"][PS_NAME]
+        per = {}
+        for p in c["probes"] + c.get("verify", []):
+            # a proof's first logs are the bisection's at that size: the longer list holds the other
+            if len(p.get("ps_m", [])) >= len(per.get(p["size"], [])):
+                per[p["size"]] = p.get("ps_m", [])
+        cells = []
+        for size in sorted(per):
+            r = np.array(per[size]) / plant_presliding_m(size)
+            cells.append(f"{size:.3g}: {1e6 * plant_presliding_m(size):.3g} um, "
+                         + (f"{np.median(r):.2f} ({r.min():.2f} .. {r.max():.2f}), {len(r)}" if len(r) else "—"))
+        L.append(f"| {k} ({v['force_noise_N']:.3g} N) | " + "; ".join(cells) + " |")
+    return L
+
+
 def probe_tables(s, causes, depth="##"):
     L = ["Detected / logs run at each size the bisection probed (a failing size stops once "
          f"{misses_allowed(s['n']) + 1} logs have missed the cause); in brackets, the logs where another cause was "
@@ -484,7 +547,9 @@ def markdown(s, command, wall_s):
         kind = logs_of(cause)
         blocks[cause] = "\n".join(
             [BLOCK_BEGIN.format(cause, cause), "", f"## {cause}", "", run_line(s, command, wall_s), "",
-             BLOCK_TEXT[cause].format(scale_um=1e6 * lugre_presliding_scale_m()), ""] + limit_table(s, [cause]) + [""] + nominal_table(s, kind) + [""]
+             BLOCK_TEXT[cause].format(scale_um=1e6 * lugre_presliding_scale_m(), zeta=lugre_presliding_zeta()), ""]
+            + limit_table(s, [cause]) + [""] + nominal_table(s, kind) + [""]
+            + (presliding_table(s) + [""] if cause == PS_NAME else [])
             + probe_tables(s, [cause], "##")
             + [f"![detection rate of {cause} against its size at the probed sizes, with 95 % Clopper-Pearson "
                f"intervals](detection-limits-{cause}.png)", "", BLOCK_END.format(cause)])

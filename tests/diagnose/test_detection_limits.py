@@ -224,6 +224,51 @@ class Presliding(unittest.TestCase):
         # the other causes keep the plain identification run
         self.assertEqual(dl.LOGS[dl.logs_of("offset")], [])
 
+    def test_its_element_modes_have_lugres_damping_ratio_at_every_size(self):
+        # the element damping of a ratio per element (br_simlog --gms-zeta): LuGre's bristle mode's on the
+        # reference machine, sigma1 / (2 sqrt(sigma0 M)), M = m + J / (lead / 2 pi)^2, the same at every size
+        import json
+        import math
+        with open(os.path.join(REPO, "machines", "reference.json")) as f:
+            m = json.load(f)
+        mech, fr = m["mechanics"], m["friction"]
+        meff = mech["table_mass_kg"] + mech["inertia_kgm2"] * (2 * math.pi / mech["lead_m_per_rev"]) ** 2
+        zeta = fr["sigma1_Nspm"] / (2 * math.sqrt(fr["sigma0_Npm"] * meff))
+        _, _, lad, flags = dl.GENERATORS[PS]
+        for size in (lad[0], lad[-1]):
+            f = flags(size)
+            self.assertAlmostEqual(float(f[f.index("--gms-zeta") + 1]), zeta, delta=1e-6 * zeta)
+        # the ladder's top keeps d_max within the diagnosis's grid of breakaway displacements
+        ps = dl.causes.get(PS)
+        self.assertLessEqual(lad[-1] * dl.lugre_presliding_scale_m(), ps.GRID_MAX_M)
+
+    def test_the_detections_presliding_m_against_the_plants(self):
+        # a stand-in diagnosis that names the cause from size 0.5 on with half the plant's presliding_m
+        # (as run() leaves it in LAST_PS_M); the block's table reports that ratio per probed size
+        def stand(simlog, work, key, flags, sigma, seed):
+            size = max(float(x) for x in flags[flags.index("--gms") + 1].split(",")) / dl.lugre_presliding_scale_m()
+            if size < 0.5:
+                return "none", []
+            dl.LAST_PS_M[0] = 0.5 * dl.plant_presliding_m(size)
+            return PS, [PS]
+        self.assertAlmostEqual(dl.plant_presliding_m(1.0), 1.2 * dl.lugre_presliding_scale_m())
+        saved = dl.run
+        dl.run = stand
+        try:
+            _, _, _, out = dl.bisect_task(("simlog", "work", 0, "quiet", 0.02, 0, PS, 20, 59))
+        finally:
+            dl.run = saved
+        res = {"cause": {(lv, PS): dict(out) for lv in ("EMPS", "quiet")}, "nominal": {}}
+        s = dl.summarize(res, (("EMPS", 0.2), ("quiet", 0.02)), 20, 10, [PS], 59)
+        table = "\n".join(dl.presliding_table(s))
+        at = out["limit"]
+        self.assertGreaterEqual(at, 0.5)
+        # the proof's 59 logs at the limit, its first 20 the bisection's: counted once
+        self.assertEqual(out["proven"], at)
+        self.assertIn(f"{at:.3g}: {1e6 * dl.plant_presliding_m(at):.3g} um, 0.50 (0.50 .. 0.50), 59 |", table)
+        below = max(p["size"] for p in out["probes"] if not p["passed"])
+        self.assertIn(f"{below:.3g}: {1e6 * dl.plant_presliding_m(below):.3g} um, —", table)
+
     def test_nominal_logs_of_each_kind_the_causes_use(self):
         calls = []
 

@@ -144,6 +144,14 @@ class ToolsTest(unittest.TestCase):
             r = run("br_simlog", "--out", out, "--traj", "circle", "--gms", bad)
             self.assert_refused(r, 2, "bad value for --gms")
             self.assert_untouched(out)
+        # --gms-zeta: a damping ratio in 0.001 .. 1, with --gms only
+        for bad in ("0", "-0.1", "1.5", "nan", "x"):
+            r = run("br_simlog", "--out", out, "--traj", "circle", "--gms", "2e-6", "--gms-zeta", bad)
+            self.assert_refused(r, 2, "--gms-zeta")
+            self.assert_untouched(out)
+        r = run("br_simlog", "--out", out, "--traj", "circle", "--gms-zeta", "0.1")
+        self.assert_refused(r, 2, "--gms-zeta applies with --gms only")
+        self.assert_untouched(out)
 
     def test_simlog_failed_run_writes_nothing(self):
         out, machine = self.existing("log.csv"), self.existing("log.machine.json")
@@ -183,6 +191,20 @@ class ToolsTest(unittest.TestCase):
         self.assertEqual(lines[0], "t,ref,pos,force")
         self.assertGreater(len(lines), 9000)
         self.assertEqual(os.stat(out).st_mode & 0o077, 0o066 & ~_umask())
+
+    def test_simlog_gms_zeta_sets_the_element_damping(self):
+        # the damping of a ratio per element (br_gms_damping_ratio, whose physics test_plant_gms checks)
+        # reaches the plant: the logged force differs from the demo's damping's; a LuGre log is refused above
+        logs = []
+        for extra in ([], ["--gms-zeta", "0.5"]):
+            out = os.path.join(self.w, f"gms{len(logs)}.csv")
+            r = run("br_simlog", "--out", out, "--traj", "circle", "--duration", "0.5", "--truth",
+                    "--gms", "2e-7,1e-6", *extra)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(out) as f:
+                logs.append(f.read())
+        self.assertEqual(logs[0].splitlines()[0], logs[1].splitlines()[0])
+        self.assertNotEqual(logs[0], logs[1])
 
     def test_demo_bad_options_touch_nothing(self):
         d = os.path.join(self.w, "demo")

@@ -10,6 +10,8 @@
 #include "circle/br_circle.h"
 #include "plant/br_sim_plant.h"
 
+#define TWO_PI 6.283185307179586
+
 static const br_plant_state_t rest = {0.0, 0.0, 0.0};
 
 /* a valid Maxwell-slip plant: the reference machine with the demo's
@@ -142,6 +144,82 @@ static void test_hardware_like_plant(void **st)
     assert_int_equal(c.gms.clamp, 0);
 }
 
+/* The free decay of the load on sticking elements with the damping of
+ * br_gms_damping_ratio (zeta per element), from an initial speed with no
+ * torque and no viscous friction: the damping ratio from the logarithmic
+ * decrement of the velocity's peaks over `cycles` periods, delta = ln(p0 / pn) / n,
+ * zeta = delta / sqrt(4 pi^2 + delta^2); *wn_radps the undamped frequency from
+ * the peaks' spacing, wd / sqrt(1 - zeta^2). Breakaways of a millimetre: the
+ * sub-micrometre swing never reaches a slip. */
+static double decay_ratio(int n, const double d_m[], double zeta, double *wn_radps)
+{
+    br_plant_cfg_t c = br_plant_cfg_reference();
+    c.sigma2_Nspm = 0.0;
+    double share[BR_GMS_MAX];
+    for (int i = 0; i < n; i++) share[i] = 1.0 / n;
+    br_gms_from_breakaway(&c.gms, n, d_m, share, c.Fs_N, 0.0);
+    c.gms.clamp = 1;
+    c.gms.delta = 1.0;
+    br_gms_damping_ratio(&c.gms, zeta, br_plant_meff_kg(&c));
+    const br_plant_state_t moving = {0.0, 1e-5 / c.lead_mprad, 0.0}; /* 10 um/s at the load */
+    br_plant_t p;
+    assert_int_equal(br_plant_init(&p, &c, &moving), 0);
+    const double dt = 1e-4;
+    const int cycles = 3;
+    double v_prev2 = 0.0, v_prev = br_plant_vel_mps(&p), peak[4] = {0.0}, t_peak[4] = {0.0};
+    int found = 0;
+    for (int k = 1; k <= 200000 && found <= cycles; k++) {
+        br_plant_step(&p, 0.0, dt);
+        const double v = br_plant_vel_mps(&p);
+        for (int i = 0; i < n; i++) /* within half its slip deflection: sticking throughout */
+            assert_true(fabs(p.gms.z_m[i]) < 0.5 * c.gms.alpha[i] * c.Fc_N / c.gms.k_Npm[i]);
+        if (k >= 2 && v_prev > v_prev2 && v_prev >= v && v_prev > 0.0) { /* a positive peak at step k - 1 */
+            peak[found] = v_prev;
+            t_peak[found] = (k - 1) * dt;
+            found++;
+        }
+        v_prev2 = v_prev;
+        v_prev = v;
+    }
+    assert_int_equal(found, cycles + 1);
+    const double delta = log(peak[0] / peak[cycles]) / cycles;
+    const double z = delta / sqrt(TWO_PI * TWO_PI + delta * delta);
+    *wn_radps = TWO_PI / ((t_peak[cycles] - t_peak[0]) / cycles) / sqrt(1.0 - z * z);
+    return z;
+}
+
+/* br_gms_damping_ratio: one element on the moving mass is a mode sqrt(k / M)
+ * of damping ratio zeta; four elements sticking together a mode
+ * sqrt(sum k_i / M) of ratio zeta sum sqrt(k_i) / sqrt(sum k_i)
+ * (docs/modules/plant.md, "Element damping") */
+static void test_gms_damping_ratio(void **st)
+{
+    (void)st;
+    const br_plant_cfg_t ref = br_plant_cfg_reference();
+    const double meff = br_plant_meff_kg(&ref);
+    assert_float_equal(meff, ref.M_kg + ref.J_kgm2 / (ref.lead_mprad * ref.lead_mprad), 1e-12);
+    const double one[1] = {1e-3}, four[4] = {1e-4, 2.5e-4, 5e-4, 1e-3};
+    for (int z = 0; z < 2; z++) {
+        const double zeta = z == 0 ? 0.085 : 0.3;
+        double wn, wn4;
+        const double z1 = decay_ratio(1, one, zeta, &wn);
+        const double z4 = decay_ratio(4, four, zeta, &wn4);
+        double ksum = 0.0, sqsum = 0.0;
+        for (int i = 0; i < 4; i++) {
+            const double k = 0.25 * ref.Fs_N / four[i];
+            ksum += k;
+            sqsum += sqrt(k);
+        }
+        print_message("zeta %.3g: one element %.4g (wn %.4g, sqrt(k/M) %.4g rad/s); four elements %.4g "
+                      "(expected %.4g, wn %.4g, sqrt(sum k/M) %.4g rad/s)\n", zeta, z1, wn,
+                      sqrt(ref.Fs_N / one[0] / meff), z4, zeta * sqsum / sqrt(ksum), wn4, sqrt(ksum / meff));
+        assert_true(fabs(z1 / zeta - 1.0) < 0.01);
+        assert_true(fabs(wn / sqrt(ref.Fs_N / one[0] / meff) - 1.0) < 0.005);
+        assert_true(fabs(z4 / (zeta * sqsum / sqrt(ksum)) - 1.0) < 0.01);
+        assert_true(fabs(wn4 / sqrt(ksum / meff) - 1.0) < 0.005);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -150,6 +228,7 @@ int main(void)
         cmocka_unit_test(test_gms_slip_tends_to_clamp),
         cmocka_unit_test(test_gms_presliding_m),
         cmocka_unit_test(test_hardware_like_plant),
+        cmocka_unit_test(test_gms_damping_ratio),
     };
     return cmocka_run_group_tests_name("plant_gms", tests, NULL, NULL);
 }

@@ -39,6 +39,14 @@ void br_gms_from_breakaway(br_gms_cfg_t *g, int n, const double d_m[], const dou
     }
 }
 
+void br_gms_damping_ratio(br_gms_cfg_t *g, double zeta, double Meff_kg)
+{
+    for (int i = 0; i < g->n && i < BR_GMS_MAX; i++) {
+        /* sigma1_i = 2 zeta sqrt(k_i Meff): element i's mode on the moving mass at ratio zeta */
+        g->sigma1_Nspm[i] = 2.0 * zeta * sqrt(g->k_Npm[i] * Meff_kg);
+    }
+}
+
 /* Clamp limit: the integral over [0, h] of clamp(a + v t, -D, D), the path
  * of z <- clamp(z + dx) at the held velocity v: at the bound behind until the
  * line enters [-D, D], along it, then at the bound ahead. */

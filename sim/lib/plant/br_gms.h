@@ -51,6 +51,15 @@ const char *br_gms_check(const br_gms_cfg_t *g);
 void br_gms_from_breakaway(br_gms_cfg_t *g, int n, const double d_m[], const double alpha[], double Fs_N,
                            double sigma1_Nspm);
 
+/* Element damping by a damping ratio per element (docs/modules/plant.md,
+ * "Element damping"): element i alone on the moving mass Meff_kg (at the
+ * load, M + J / L^2) is a mode of stiffness k_i with damping ratio zeta,
+ *   sigma1_i = 2 zeta sqrt(k_i Meff),
+ * so scaling every breakaway displacement scales the element modes'
+ * frequencies and keeps their damping ratio; any set of elements sticking
+ * together has a ratio between zeta and zeta sqrt(n). Sets sigma1_Nspm only. */
+void br_gms_damping_ratio(br_gms_cfg_t *g, double zeta, double Meff_kg);
+
 /* Advances every element from x0 into x1 over h seconds at the held velocity
  * v with the Stribeck level s_N (> 0); returns the friction impulse
  * integral of sum_i (k_i z_i + sigma1_i dz_i/dt) dt over the substep. */

@@ -296,6 +296,8 @@ int32_t br_plant_encoder(const br_plant_t *p)
     return u <= (uint32_t)INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1;
 }
 
+double br_plant_meff_kg(const br_plant_cfg_t *c) { return c->M_kg + c->J_kgm2 / (c->lead_mprad * c->lead_mprad); }
+
 double br_plant_pos_m(const br_plant_t *p) { return p->cfg.lead_mprad * p->x.theta_rad; }
 
 double br_plant_vel_mps(const br_plant_t *p) { return p->cfg.lead_mprad * p->x.omega_radps; }

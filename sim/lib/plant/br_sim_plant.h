@@ -103,6 +103,8 @@ int32_t br_plant_encoder(const br_plant_t *p);
 
 /* Load-side position and velocity. */
 double br_plant_pos_m(const br_plant_t *p);
+/* The moving mass at the load, M + J / L^2 (L = lead_mprad), kg. */
+double br_plant_meff_kg(const br_plant_cfg_t *c);
 double br_plant_vel_mps(const br_plant_t *p);
 
 /* The force an ideal estimator would hand the controller at the end of the

@@ -20,6 +20,11 @@
 /* br_simlog --cycles: identification cycles of 9.32 s (400: 3728 s, about the duration bound) */
 #define BR_TOOL_CYCLES_MAX 400
 
+/* br_simlog --gms-zeta: the damping ratio of each Maxwell-slip element's mode, from a mode
+ * practically undamped to critical damping */
+#define BR_TOOL_GMS_ZETA_MIN 1e-3
+#define BR_TOOL_GMS_ZETA_MAX 1.0
+
 /* plant substeps per control period */
 #define BR_TOOL_NSUB_MAX 1000
 

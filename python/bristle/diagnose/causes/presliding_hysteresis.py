@@ -76,11 +76,15 @@ SHAPE_UNUSED = (0,)        # rho, in model.fit_shape's (log rho, beta, log vs)
 UNUSED_PARAMS = ("sigma0_Npm",)   # the element set's initial stiffness, not a fitted one: identify.py skips it
 # detection_limits.py: the size is the largest breakaway d_max over LuGre's Fs / sigma0 (ref's
 # presliding_scale_m), the elements at the demo's hardware-like shape (2, 5, 10, 20 um: docs/demo.md),
-# equal shares; on identification logs with the reversal segment (DETECTION_LOG: docs/diagnose.md asks
-# for it, too few samples near reversals otherwise)
+# equal shares, each element's mode on the moving mass at the damping ratio of LuGre's bristle mode
+# (ref's presliding_zeta, br_simlog --gms-zeta): the plant's presliding dynamics change with d_max only
+# in their length scale, not in their damping (docs/detection-limits.md); the ladder from 0.05 (its top,
+# 6.4, puts d_max at 28.8 um, within the grid's GRID_MAX_M); on identification logs with the reversal
+# segment (DETECTION_LOG: docs/diagnose.md asks for it, too few samples near reversals otherwise)
 DETECTION_SHAPE = (0.1, 0.25, 0.5, 1.0)
-DETECTION = ("largest breakaway d_max / LuGre's Fs/sigma0 (elements at 0.1, 0.25, 0.5, 1 d_max)", "", 0.01,
-             lambda s, ref: ["--gms", ",".join(f"{s * ref['presliding_scale_m'] * f:.6g}" for f in DETECTION_SHAPE)])
+DETECTION = ("largest breakaway d_max / LuGre's Fs/sigma0 (elements at 0.1, 0.25, 0.5, 1 d_max)", "", 0.05,
+             lambda s, ref: ["--gms", ",".join(f"{s * ref['presliding_scale_m'] * f:.6g}" for f in DETECTION_SHAPE),
+                             "--gms-zeta", f"{ref['presliding_zeta']:.6g}"])
 DETECTION_LOG = "ident with the reversal segment"
 
 
