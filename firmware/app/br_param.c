@@ -36,7 +36,7 @@ static int in_range(float v, float lo, float hi, int lo_open, int hi_open, int z
 
 br_status_t br_param_check(uint16_t id, unsigned est_mask, float v)
 {
-#define BR_PARAM_ROW(name, pid, mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field, rpc2) \
+#define BR_PARAM_ROW(name, pid, mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field, rpc_pow) \
     if (id == (pid) && ((mask) & est_mask) != 0u) { \
         return in_range(v, lo, hi, lo_open, hi_open, zero_ok, normal, BR_PARAM_INT_##type) ? BR_OK : BR_E_PARAM; \
     }
@@ -50,10 +50,12 @@ br_status_t br_param_get(const br_est_cfg_t *c, uint16_t id, unsigned est_mask, 
     if (c == NULL || v == NULL) {
         return BR_E_NULL;
     }
-    const float rpc2 = c->rad_per_count * c->rad_per_count;
-#define BR_PARAM_ROW(name, pid, mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field, to_rad2) \
+    const float rpc = c->rad_per_count;
+    const float rpc2 = rpc * rpc;
+#define BR_PARAM_ROW(name, pid, mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field, rpc_pow) \
     if (id == (pid) && ((mask) & est_mask) != 0u) { \
-        *v = (to_rad2) ? BR_PARAM_GET_##type(c->field) / rpc2 : BR_PARAM_GET_##type(c->field); \
+        *v = ((rpc_pow) == 2) ? BR_PARAM_GET_##type(c->field) / rpc2 \
+           : ((rpc_pow) == 1) ? BR_PARAM_GET_##type(c->field) / rpc : BR_PARAM_GET_##type(c->field); \
         return BR_OK; \
     }
     BR_LINK_PARAM_TABLE(BR_PARAM_ROW)
@@ -71,10 +73,11 @@ br_status_t br_param_set(br_est_cfg_t *c, uint16_t id, unsigned est_mask, float 
         return st;
     }
     br_est_cfg_t cand = *c;
-    const float rpc2 = c->rad_per_count * c->rad_per_count;
-#define BR_PARAM_ROW(name, pid, mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field, to_rad2) \
+    const float rpc = c->rad_per_count;
+    const float rpc2 = rpc * rpc;
+#define BR_PARAM_ROW(name, pid, mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field, rpc_pow) \
     if (id == (pid)) { \
-        BR_PARAM_SET_##type(cand.field, (to_rad2) ? v * rpc2 : v); \
+        BR_PARAM_SET_##type(cand.field, ((rpc_pow) == 2) ? v * rpc2 : ((rpc_pow) == 1) ? v * rpc : v); \
     }
     BR_LINK_PARAM_TABLE(BR_PARAM_ROW)
 #undef BR_PARAM_ROW
@@ -89,7 +92,7 @@ br_status_t br_param_set(br_est_cfg_t *c, uint16_t id, unsigned est_mask, float 
 
 int br_param_live(uint16_t id)
 {
-#define BR_PARAM_ROW(name, pid, mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field, rpc2) \
+#define BR_PARAM_ROW(name, pid, mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field, rpc_pow) \
     if (id == (pid)) { \
         return (live); \
     }

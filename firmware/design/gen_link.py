@@ -65,6 +65,10 @@ def render():
     return "\n".join(out)
 
 
+# the wire value's factor to the firmware's field: rad_per_count to this power (counts to rad)
+RPC_POW = {"": 0, "rpc": 1, "rpc2": 2}
+
+
 def param_range(p):
     """(lo, hi, lo_open, hi_open, zero_ok, normal, is_int) of parameter p, from
     the machine file's rules: a per-step value's bounds (machine._PER_STEP_BOUNDS:
@@ -101,7 +105,7 @@ def render_params():
     for p in params.PARAMS:
         if not 1 <= p.id <= 0xFFFF or p.id in ids or p.name in names or p.est not in EST_MASK:
             raise ValueError("parameter %s: id 0x%04x or name repeated, or estimator %r unknown" % (p.name, p.id, p.est))
-        if p.scale not in ("", "rpc2") or p.live not in (0, 1):
+        if p.scale not in RPC_POW or p.live not in (0, 1):
             raise ValueError("parameter %s: scale %r or live %r" % (p.name, p.scale, p.live))
         ids.add(p.id)
         names.add(p.name)
@@ -111,12 +115,12 @@ def render_params():
         rows.append("    X(%s, 0x%04Xu, %du, %s, %s, %d, %d, %d, %d, %s, %d, %s, %d)"
                     % (p.name.upper(), p.id, EST_MASK[p.est], machine.c_float(lo), machine.c_float(hi),
                        lo_open, hi_open, zero_ok, normal, "U" if is_int else "F", p.live, p.target,
-                       p.scale == "rpc2"))
+                       RPC_POW[p.scale]))
     out += ["", "/* X(NAME, id, est_mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field,",
-            " *   rpc2) for every parameter: the value v is accepted when it is in [lo, hi] (an open",
+            " *   rpc_pow) for every parameter: the value v is accepted when it is in [lo, hi] (an open",
             " *   end excluded), 0 only when zero_ok, otherwise at least FLT_MIN when normal (no",
             " *   subnormal), whole when type is U (a uint32_t field; F: a float); live: written while",
-            " *   armed; field: the br_est_cfg_t member it sets, v times rad_per_count^2 when rpc2 */",
+            " *   armed; field: the br_est_cfg_t member it sets, v times rad_per_count^rpc_pow */",
             "#define BR_LINK_PARAM_TABLE(X) \\", " \\\n".join(rows), "", "#endif", ""]
     return "\n".join(out)
 

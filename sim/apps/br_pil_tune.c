@@ -201,7 +201,8 @@ static int writes_of(const tune_t *t, const double *x, br_pil_param_t *w)
     return n + t->o.n_set;
 }
 
-/* --sim: the writes as the image takes them (br_param.c: a value, R times rpc^2 in float) into c;
+/* --sim: the writes as the image takes them (br_param.c: a value, R times rpc^2, the gate's term times
+ * rpc, in float) into c;
  * 0, or -1 for a parameter this harness does not set on the simulator */
 static int apply_writes(br_circle_cfg_t *c, int pf, const br_pil_param_t *w, int n)
 {
@@ -215,6 +216,7 @@ static int apply_writes(br_circle_cfg_t *c, int pf, const br_pil_param_t *w, int
         case BR_LINK_PARAM_Q_GP_N2: e->q_var[3] = w[i].value; break;
         case BR_LINK_PARAM_R_COUNTS2: e->r_var_rad2 = w[i].value * rpc2; break;
         case BR_LINK_PARAM_OUTLIER_SIGMA: e->outlier_sigma = w[i].value; break;
+        case BR_LINK_PARAM_OUTLIER_TRANSIENT_COUNTS: e->outlier_transient_rad = w[i].value * e->rad_per_count; break;
         default: fprintf(stderr, "%s: --sim sets no parameter 0x%04x\n", TOOL, (unsigned)w[i].id); return -1;
         }
     }

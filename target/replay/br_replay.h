@@ -12,7 +12,8 @@
  *           est.comp_ahead_periods; zero there: no lead; est.delay_id's
  *           n_cand, step_s, q_force_N2ps, memory_s, warmup_s, switch_ratio;
  *           zeros there: off; the model's Maxwell-slip elements: n,
- *           k_Npm[BR_MSLIP_MAX], share[BR_MSLIP_MAX], sigma2; zeros there: LuGre),
+ *           k_Npm[BR_MSLIP_MAX], share[BR_MSLIP_MAX], sigma2; zeros there: LuGre;
+ *           est.outlier_transient_rad; zero there: the thesis gate),
  *           floats as their bit patterns, so every value is exact;
  *   steps   n_steps records of 4 words per axis: encoder counts (int32),
  *           reference counts (int32), reference fraction (float), reference

@@ -544,10 +544,17 @@ static void test_params(void **st)
     assert_int_equal(status_of(&f), BR_OK);
     BR_ASSERT_NEAR(value_of(&f), 0.5f, 1e-6);
     assert_true(g->ukf.cfg.est.r_var_rad2 == g->ukfc.est.r_var_rad2);
+    /* the gate's transient term: counts on the wire, rad in the filter (rad_per_count^1) */
+    host_param_write(&g->wire, BR_LINK_PARAM_OUTLIER_TRANSIENT_COUNTS, 10.0f);
+    steps(g, 1u);
+    f = last_value(g);
+    assert_int_equal(status_of(&f), BR_OK);
+    BR_ASSERT_NEAR(value_of(&f), 10.0f, 1e-5);
     host_send(&g->wire, BR_LINK_MSG_ARM, NULL, 0u);
     steps(g, 1u);
     assert_int_equal(g->app.fault, BR_APP_FAULT_NONE);
     assert_true(g->ukf.cfg.est.r_var_rad2 == 0.5f * rpc * rpc);
+    assert_true(g->ukf.cfg.est.outlier_transient_rad == 10.0f * rpc);
     /* while armed: a parameter read at init only is refused, the live one taken at once */
     host_param_write(&g->wire, BR_LINK_PARAM_OUTLIER_SIGMA, 7.0f);
     steps(g, 1u);

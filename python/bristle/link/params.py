@@ -16,7 +16,8 @@ Fields of a Param:
   source   where the range comes from: ("per_step", key) for
            machine._PER_STEP_BOUNDS, ("schema", field under estimator.<est>.)
   target   the br_est_cfg_t field it sets (C syntax), and the factor from the
-           wire value ("rpc2": times rad_per_count^2, counts^2 to rad^2)
+           wire value ("rpc2": times rad_per_count^2, counts^2 to rad^2; "rpc":
+           times rad_per_count, counts to rad)
   live     1: written while armed (it is read every period); 0: refused
            while armed, applied at the next arm
 """
@@ -54,6 +55,9 @@ PARAMS = (
           "consecutive outliers before the filter is re-anchored (an integer)"),
     Param(0x0009, "comp_ahead_periods", "both", ("schema", "comp_ahead_periods"), "comp_ahead_periods", "", 1,
           "the compensation's lead beyond the actuator delay, periods (0: the filtered estimate)"),
+    Param(0x000A, "outlier_transient_counts", "both", ("per_step", "outlier_transient_counts"),
+          "outlier_transient_rad", "rpc", 0,
+          "the outlier gate's transient term d (eq. G1), counts (0: the thesis gate)"),
 )
 
 BY_ID = {p.id: p for p in PARAMS}

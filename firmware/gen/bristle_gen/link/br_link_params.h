@@ -27,21 +27,24 @@
 #define BR_LINK_PARAM_REANCHOR_AFTER 0x0008u
 /* the compensation's lead beyond the actuator delay, periods (0: the filtered estimate) (both; range from schema comp_ahead_periods) */
 #define BR_LINK_PARAM_COMP_AHEAD_PERIODS 0x0009u
+/* the outlier gate's transient term d (eq. G1), counts (0: the thesis gate) (both; range from per_step outlier_transient_counts) */
+#define BR_LINK_PARAM_OUTLIER_TRANSIENT_COUNTS 0x000Au
 
 /* X(NAME, id, est_mask, lo, hi, lo_open, hi_open, zero_ok, normal, type, live, field,
- *   rpc2) for every parameter: the value v is accepted when it is in [lo, hi] (an open
+ *   rpc_pow) for every parameter: the value v is accepted when it is in [lo, hi] (an open
  *   end excluded), 0 only when zero_ok, otherwise at least FLT_MIN when normal (no
  *   subnormal), whole when type is U (a uint32_t field; F: a float); live: written while
- *   armed; field: the br_est_cfg_t member it sets, v times rad_per_count^2 when rpc2 */
+ *   armed; field: the br_est_cfg_t member it sets, v times rad_per_count^rpc_pow */
 #define BR_LINK_PARAM_TABLE(X) \
-    X(Q_THETA_COUNTS2, 0x0001u, 1u, 0.000000000e+00f, 1.000000000e+06f, 0, 0, 1, 1, F, 0, q_var[0], 1) \
+    X(Q_THETA_COUNTS2, 0x0001u, 1u, 0.000000000e+00f, 1.000000000e+06f, 0, 0, 1, 1, F, 0, q_var[0], 2) \
     X(Q_THETA_RAD2, 0x0002u, 2u, 0.000000000e+00f, 1.000000000e+00f, 0, 0, 1, 1, F, 0, q_var[0], 0) \
     X(Q_OMEGA_RAD2PS2, 0x0003u, 3u, 0.000000000e+00f, 1.000000000e+03f, 0, 0, 1, 1, F, 0, q_var[1], 0) \
     X(Q_Z_M2, 0x0004u, 3u, 0.000000000e+00f, 9.999999975e-07f, 0, 0, 1, 1, F, 0, q_var[2], 0) \
     X(Q_GP_N2, 0x0005u, 3u, 0.000000000e+00f, 1.000000000e+06f, 0, 0, 1, 1, F, 0, q_var[3], 0) \
-    X(R_COUNTS2, 0x0006u, 3u, 0.000000000e+00f, 1.000000000e+06f, 0, 0, 0, 1, F, 0, r_var_rad2, 1) \
+    X(R_COUNTS2, 0x0006u, 3u, 0.000000000e+00f, 1.000000000e+06f, 0, 0, 0, 1, F, 0, r_var_rad2, 2) \
     X(OUTLIER_SIGMA, 0x0007u, 3u, 0.000000000e+00f, 1.000000000e+04f, 1, 0, 1, 0, F, 0, outlier_sigma, 0) \
     X(REANCHOR_AFTER, 0x0008u, 3u, 1.000000000e+00f, 1.000000000e+03f, 0, 0, 1, 0, U, 0, reanchor_after, 0) \
-    X(COMP_AHEAD_PERIODS, 0x0009u, 3u, 0.000000000e+00f, 2.000000000e+00f, 0, 0, 1, 0, F, 1, comp_ahead_periods, 0)
+    X(COMP_AHEAD_PERIODS, 0x0009u, 3u, 0.000000000e+00f, 2.000000000e+00f, 0, 0, 1, 0, F, 1, comp_ahead_periods, 0) \
+    X(OUTLIER_TRANSIENT_COUNTS, 0x000Au, 3u, 0.000000000e+00f, 1.000000000e+06f, 0, 0, 1, 1, F, 0, outlier_transient_rad, 1)
 
 #endif
