@@ -420,11 +420,11 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
     fprintf(f,
             ", \"gp_min_N\": %.9g, \"gp_max_N\": %.9g, \"outlier_sigma\": %.9g, \"reanchor_after\": %u, "
             "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"noise_fnv1a64\": \"%016llx\", "
-            "\"adapt\": {\"nis_ref\": %.9g, \"alpha\": %.9g, \"max_scale\": %.9g}}",
+            "\"adapt\": {\"nis_ref\": %.9g, \"alpha\": %.9g, \"max_scale\": %.9g}, \"outlier_transient_rad\": %.9g}",
             (double)c->est.gp_min_N, (double)c->est.gp_max_N, (double)c->est.outlier_sigma, (unsigned)c->est.reanchor_after,
             (double)c->est.rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip,
             (unsigned long long)fnv1a(c->noise, (size_t)c->noise_len * sizeof *c->noise), (double)c->adapt.nis_ref,
-            (double)c->adapt.alpha, (double)c->adapt.max_scale);
+            (double)c->adapt.alpha, (double)c->adapt.max_scale, (double)c->est.outlier_transient_rad);
 }
 
 /* the recording into f (a br_outfile's temporary file, docs/tools.md) */
@@ -505,13 +505,15 @@ static void json_timing_pf(FILE *f, const char *key, const br_circle_cfg_t *cpf,
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N] [--plant thesis|realistic]\n" BR_ARGS_COMMON_USAGE
+            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N] [--plant thesis|realistic] [--thesis-gate]\n" BR_ARGS_COMMON_USAGE
             "  --json FILE         the figures as JSON (make bench: out/bench/bench.json)\n"
             "  --record FILE       the replayed stream's per-step record (CSV)\n"
             "  --reps N            repetitions of each PF timing, 1 .. 256 (default 7)\n"
             "  --ukf-reps N        repetitions of each UKF timing, 1 .. 256 (default 21)\n"
             "  --plant P           the recorded closed loop's plant: thesis (the estimators' own model,\n"
-            "                      default) or realistic (the demo's realistic plant, docs/demo.md)\n",
+            "                      default) or realistic (the demo's realistic plant, docs/demo.md)\n"
+            "  --thesis-gate       the filters' outlier gate without the machine's transient term (eq. G1):\n"
+            "                      the realistic plant's outliers then re-anchor the PF (for pf_numpy.py --check)\n",
             argv0, argv0);
     return 2;
 }
@@ -519,12 +521,13 @@ static int usage(const char *argv0, FILE *to)
 int main(int argc, char **argv)
 {
     const char *json_path = NULL, *rec_path = NULL;
-    int reps = 7, ukf_reps = 21, realistic = 0;
+    int reps = 7, ukf_reps = 21, realistic = 0, thesis_gate = 0;
     static const struct option opts[] = {{"json", required_argument, NULL, 'j'},
                                          {"record", required_argument, NULL, 'r'},
                                          {"reps", required_argument, NULL, 'n'},
                                          {"ukf-reps", required_argument, NULL, 'u'},
                                          {"plant", required_argument, NULL, 'p'},
+                                         {"thesis-gate", no_argument, NULL, 'g'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -550,6 +553,7 @@ int main(int argc, char **argv)
                 bad = 1;
             }
             break;
+        case 'g': thesis_gate = 1; break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return usage(argv[0], stderr);
@@ -581,9 +585,12 @@ int main(int argc, char **argv)
 
     /* 1. recordings */
     const char *const plant = realistic ? "realistic" : "thesis";
-    const br_circle_cfg_t cpf = realistic ? br_circle_cfg_realistic(BR_CTRL_HINF_PF) : br_circle_cfg_thesis(BR_CTRL_HINF_PF);
-    const br_circle_cfg_t cukf =
-        realistic ? br_circle_cfg_realistic(BR_CTRL_HINF_UKF) : br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
+    br_circle_cfg_t cpf = realistic ? br_circle_cfg_realistic(BR_CTRL_HINF_PF) : br_circle_cfg_thesis(BR_CTRL_HINF_PF);
+    br_circle_cfg_t cukf = realistic ? br_circle_cfg_realistic(BR_CTRL_HINF_UKF) : br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
+    if (thesis_gate) {
+        cpf.pf.est.outlier_transient_rad = 0.0f;
+        cukf.ukf.est.outlier_transient_rad = 0.0f;
+    }
     if (br_pf_init(pf, &cpf.pf) != BR_OK || br_ukf_init(ukf, &cukf.ukf) != BR_OK) {
         fprintf(stderr, "br_bench: filter init failed\n");
         goto done;

@@ -122,14 +122,18 @@ class NumpyPf:
         self.nis_ref = F(ad.get("nis_ref", 0.0))
         self.alpha, self.max_scale = F(ad.get("alpha", 0.0)), F(ad.get("max_scale", 1.0))
         self.r_gate = F(cfg["r_var_rad2"]) + F(cfg["rad_per_count"]) * F(cfg["rad_per_count"]) * F(1.0 / 12.0)
-        self.nis_max = F(cfg["outlier_sigma"]) * F(cfg["outlier_sigma"])
         self.nis_avg = F(0.0)
         self.q_scale = F(1.0)
         self.inv_2r = F(0.5) / F(cfg["r_var_rad2"])
-        # the gate with the encoder's quantisation: -g^2 (R + rpc^2 / 12) / (2 R), as br_pf_init
+        # the gate with the encoder's quantisation and the transient term d (eq. G1, as br_pf_init
+        # and br_est_gate_f2): -g^2 (R + rpc^2 / 12) f^2 / (2 R), f = 1 + d / (g sqrt(R + rpc^2 / 12));
+        # cfg.adapt's NIS cap g^2 f^2 (eq. G2)
         rpc = F(cfg["rad_per_count"])
-        self.outlier_l = F(-0.5) * F(cfg["outlier_sigma"]) * F(cfg["outlier_sigma"]) * \
-            (F(1.0) + rpc * rpc * F(1.0 / 12.0) / F(cfg["r_var_rad2"]))
+        g = F(cfg["outlier_sigma"])
+        f = F(1.0) + F(cfg.get("outlier_transient_rad", 0.0)) / (g * np.sqrt(self.r_gate))
+        f2 = f * f
+        self.nis_max = g * g * f2
+        self.outlier_l = F(-0.5) * g * g * (F(1.0) + rpc * rpc * F(1.0 / 12.0) / F(cfg["r_var_rad2"])) * f2
         self.reanchor_after = int(cfg["reanchor_after"])
         self.rpc = F(cfg["rad_per_count"])
         self.gp0 = F(cfg["gp0_N"])

@@ -2,7 +2,9 @@
 """make bench's numpy PF (sim/bench/pf_numpy.py) is the C filter bit for bit,
 also where the thesis circle never takes it: on the demo's realistic plant
 cfg.adapt's noise factor rises above 1 and the cloud is re-anchored after
-consecutive outliers. br_bench records that closed loop (--plant realistic);
+consecutive outliers (with the thesis gate, --thesis-gate; with the machine's
+transient term no outlier comes). br_bench records that closed loop (--plant realistic)
+both ways;
 pf_numpy.py --check replays it and exits 1 unless every step's F_hat equals
 the C filter's. The test also requires that the recording reaches both paths
 (else it would prove nothing); --plant's refusals are in test_tools.py.
@@ -27,25 +29,30 @@ def run(cmd):
 def main():
     bench, work = tool_check.start("bench")
     fails = []
-    rec = os.path.join(work, "pf_input.csv")
-    rc, out = run([bench, "--plant", "realistic", "--reps", "1", "--ukf-reps", "1", "--record", rec])
-    if rc != 0:
-        sys.exit("br_bench --plant realistic failed (exit %d):\n%s" % (rc, out))
-    res = os.path.join(work, "numpy.json")
-    rc, out = run([sys.executable, os.path.join(ROOT, "sim", "bench", "pf_numpy.py"), rec, "--reps", "1", "--check",
-                   "--out", res])
-    print(out)
-    if rc != 0:
-        fails.append("pf_numpy.py --check: exit %d (not bit-identical to the C filter, or not tracking)" % rc)
-    else:
+    # the machine's gate (its transient term, eq. G1, in the threshold and the NIS cap), then the
+    # thesis gate, with which the realistic plant's encoder noise re-anchors the cloud
+    for tag, extra, need in (("term", [], ("adapt_active_steps",)),
+                             ("thesis_gate", ["--thesis-gate"], ("adapt_active_steps", "reanchor_steps"))):
+        rec = os.path.join(work, "pf_input_%s.csv" % tag)
+        rc, out = run([bench, "--plant", "realistic", "--reps", "1", "--ukf-reps", "1", "--record", rec] + extra)
+        if rc != 0:
+            sys.exit("br_bench --plant realistic %s failed (exit %d):\n%s" % (" ".join(extra), rc, out))
+        res = os.path.join(work, "numpy_%s.json" % tag)
+        rc, out = run([sys.executable, os.path.join(ROOT, "sim", "bench", "pf_numpy.py"), rec, "--reps", "1",
+                       "--check", "--out", res])
+        print(out)
+        if rc != 0:
+            fails.append("%s: pf_numpy.py --check: exit %d (not bit-identical to the C filter, or not tracking)"
+                         % (tag, rc))
+            continue
         with open(res) as f:
             r = json.load(f)
-        if r["adapt_active_steps"] == 0:
-            fails.append("the recording never raises cfg.adapt's noise factor: the adapt path is not compared")
-        if r["reanchor_steps"] == 0:
-            fails.append("the recording never re-anchors the cloud: that path is not compared")
+        if "adapt_active_steps" in need and r["adapt_active_steps"] == 0:
+            fails.append("%s: the recording never raises cfg.adapt's noise factor: the adapt path is not compared"
+                         % tag)
+        if "reanchor_steps" in need and r["reanchor_steps"] == 0:
+            fails.append("%s: the recording never re-anchors the cloud: that path is not compared" % tag)
     return tool_check.finish(fails)
-
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -254,6 +254,7 @@ static br_pf_cfg_t sure_cfg(void)
 {
     br_pf_cfg_t c = cfg(300);
     c.est.outlier_sigma = 8.0f;
+    c.est.outlier_transient_rad = 0.0f; /* the thesis gate (the term: test_gate_transient) */
     c.est.r_var_rad2 = 1.0e-3f * RPC * RPC;
     c.est.q_var[BR_X_THETA] = 0.0f;
     c.est.q_var[BR_X_OMEGA] = 1.0e-12f;
