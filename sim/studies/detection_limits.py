@@ -57,7 +57,7 @@ from scipy import stats
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "python"))
-from bristle.diagnose import causes, logreader, noise, report, selection, signals  # noqa: E402
+from bristle.diagnose import causes, logreader, noise, physical, report, selection, signals  # noqa: E402
 
 EMPS_LOG = os.path.join(REPO, "..", "shared", "data", "emps", "emps_estimation.csv")
 QUIET_N = 0.02
@@ -85,13 +85,14 @@ def lugre_presliding_scale_m():
 def lugre_presliding_zeta():
     """The damping ratio of LuGre's presliding mode on the reference machine (machines/reference.json):
     the bristle's stiffness sigma0 and damping sigma1 on the moving mass at the load, M + J / L^2
-    (L = lead / 2 pi): sigma1 / (2 sqrt(sigma0 M))."""
+    (L = lead / 2 pi): the diagnosis's damping ratio (physical.py, eq. P1)."""
     with open(os.path.join(REPO, "machines", "reference.json")) as f:
         m = json.load(f)
     mech, fr = m["mechanics"], m["friction"]
     lead = mech["lead_m_per_rev"] / (2.0 * math.pi)
     meff = mech["table_mass_kg"] + mech["inertia_kgm2"] / lead ** 2
-    return fr["sigma1_Nspm"] / (2.0 * math.sqrt(fr["sigma0_Npm"] * meff))
+    return physical.damping_ratio({"sigma0_Npm": fr["sigma0_Npm"], "sigma1_Nspm": fr["sigma1_Nspm"],
+                                   "Meff_kg": meff})
 
 
 REF_LEVELS = {"Fc_N": FC_N, "sigma2_Nspm": SIGMA2, "presliding_scale_m": lugre_presliding_scale_m(),
