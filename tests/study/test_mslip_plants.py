@@ -66,6 +66,11 @@ def main():
           % (FIRST, FIRST + N - 1))
     check(r2.returncode == (1 if n_faults else 0), "a fault not expected must fail the page writer: rc %d"
           % r2.returncode)
+    # --first outside its range: refused before any plant runs
+    r4 = subprocess.run([sys.executable, STUDY, "--bin", a.bin, "--out", os.path.join(a.work, "j4"), "--n", "1",
+                         "--first", "-1"], capture_output=True, text=True)
+    check(r4.returncode == 2 and "--first" in r4.stderr and not os.path.exists(os.path.join(a.work, "j4")),
+          "--first -1: refused (exit 2) with nothing written: rc %d %s" % (r4.returncode, r4.stderr))
     r3 = study(a, os.path.join(a.work, "j3"), 2, "--md", page, "--command", "test", "--expect-faults")
     check(r3.returncode == 0, "--expect-faults: %s" % r3.stderr)
     for f in fails:
