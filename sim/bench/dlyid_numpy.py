@@ -4,7 +4,8 @@ command history and the delay identification's bank, written from
 docs/modules/dlyid.md (equations dly1-dly7) and docs/modules/model.md ("the
 delay is the estimators'"), in float32 like the firmware. The slots' filters
 are a float32 array over the slots (each slot's operations are the same
-elementwise), the common covariance 3 x 3 scalars.
+elementwise), the common covariance a 3 x 3 float32 array whose products sum
+their three terms in order, from 0, one array operation per term.
 
   history  u_a = (1 - f) u[k-1-m] + f u[k-2-m] for the delay (m + f) periods,
            0 for a command before the first; without a delay and without the
@@ -34,25 +35,25 @@ def periods(delay_s, dt_s):
 
 
 class DelayHistory:
-    """The estimator's commands and the torque of the delay in use."""
+    """The estimator's commands (newest first, 0 before the first; the keep newest, keep >= the
+    longest delay's m + 2) and the torque of the delay in use."""
 
-    def __init__(self, delay_s, dt_s, on):
+    def __init__(self, delay_s, dt_s, on, keep):
         self.m, self.f = periods(delay_s, dt_s)
         self.on = on
-        self.u = []   # newest first
+        self.u = np.zeros(keep, dtype=F)
 
     def torque(self, m, f):
-        """u_a = (1 - f) u[k-1-m] + f u[k-2-m] (0 before the first command)"""
-        def ago(j):
-            return self.u[j] if j < len(self.u) else F(0.0)
-        return (F(1.0) - f) * ago(m) + f * ago(m + 1)
+        """u_a = (1 - f) u[k-1-m] + f u[k-2-m]; m and f arrays (one per slot) or scalars"""
+        return (F(1.0) - f) * self.u[m] + f * self.u[m + 1]
 
-    def apply(self, u, keep):
-        """the command u of the last period joins the history (the keep newest are kept);
-        returns the torque that reached the axis"""
+    def apply(self, u):
+        """the command u of the last period joins the history; returns the torque that reached
+        the axis"""
         if not self.on:
             return u
-        self.u = [u] + self.u[:keep - 1]
+        self.u[1:] = self.u[:-1]
+        self.u[0] = u
         return self.torque(self.m, self.f)
 
 
@@ -81,15 +82,17 @@ class DelayBank:
         self.warmup = int(F(d["warmup_s"]) / T + F(0.5))
         # the slots' delays: the candidates j step_s, then the configured delay
         mf = [periods(F(j) * F(d["step_s"]), T) for j in range(n)] + [periods(cfg.get("delay_s", 0.0), T)]
-        self.cm = [p[0] for p in mf]
-        self.cf = [p[1] for p in mf]
+        self.cm = np.array([p[0] for p in mf])
+        self.cf = np.array([p[1] for p in mf], dtype=F)
+        self.diag = np.diag_indices(3)
+        self.A = np.array([[1.0, T, self.a02], [0.0, 1.0, self.a12], [0.0, 0.0, 1.0]], dtype=F)
         self.cur = n
         self.n_switch = 0
         self.primed = False
 
     def keep(self):
         """commands the history must keep for the longest slot"""
-        return max(self.cm) + 2
+        return int(self.cm.max()) + 2
 
     def _prime(self, counts, frac):
         """dly2: every filter at theta = frac rpc, at rest, F = 0; P0 diagonal"""
@@ -98,7 +101,7 @@ class DelayBank:
         self.x[0] = frac * self.rpc
         self.J = np.zeros(s, dtype=F)
         w = self.rpc / self.T
-        self.P = [[self.r, F(0.0), F(0.0)], [F(0.0), w * w, F(0.0)], [F(0.0), F(0.0), self.gp_max * self.gp_max]]
+        self.P = np.diag(np.array([self.r, w * w, self.gp_max * self.gp_max], dtype=F))
         self.origin = counts
         self.k = 0
         self.dir = 0
@@ -125,28 +128,22 @@ class DelayBank:
 
     def _covariance(self):
         """dly3: P- = A P A^T + diag(0, 0, q_F T), K = P-[:, 0] / S, S = P-_00 + R', P+ = P- - K P-[0, :],
-        symmetrised; the products summed over l = 0, 1, 2 in order"""
-        one, zero = F(1.0), F(0.0)
-        A = [[one, self.T, self.a02], [zero, one, self.a12], [zero, zero, one]]
-        P = self.P
-
-        def dot(a, b):
-            s = F(0.0)
-            for l in range(3):
-                s = s + a[l] * b[l]
-            return s
-
-        AP = [[dot(A[i], [P[l][j] for l in range(3)]) for j in range(3)] for i in range(3)]
-        Pm = [[dot(AP[i], A[j]) for j in range(3)] for i in range(3)]
-        Pm[2][2] = Pm[2][2] + self.q_force
-        S = Pm[0][0] + self.r
-        K = [Pm[i][0] / S for i in range(3)]
-        P = [[Pm[i][j] - K[i] * Pm[0][j] for j in range(3)] for i in range(3)]
-        for i in range(3):
-            for j in range(i + 1, 3):
-                m = F(0.5) * (P[i][j] + P[j][i])
-                P[i][j] = P[j][i] = m
-        self.P = P
+        symmetrised; the products summed over l = 0, 1, 2 in order. Returns K."""
+        A, P = self.A, self.P
+        AP = np.zeros((3, 3), dtype=F)
+        for l in range(3):
+            AP = AP + A[:, l:l + 1] * P[l:l + 1, :]    # AP[i, j] += A[i, l] P[l, j]
+        Pm = np.zeros((3, 3), dtype=F)
+        for l in range(3):
+            Pm = Pm + AP[:, l:l + 1] * A[:, l]          # Pm[i, j] += AP[i, l] A[j, l]
+        Pm[2, 2] += self.q_force
+        S = Pm[0, 0] + self.r
+        K = Pm[:, 0] / S
+        P = Pm - K[:, None] * Pm[0, :]
+        # (P + P^T) / 2 off the diagonal (symmetric as computed), the diagonal kept
+        Ps = F(0.5) * (P + P.T)
+        Ps[self.diag] = P[self.diag]
+        self.P = Ps
         return K
 
     def step(self, counts, frac, hist):
@@ -165,7 +162,7 @@ class DelayBank:
         shift = F(d) * self.rpc
         y_rel = frac * self.rpc
         # dly4: each slot's prediction with the torque its delay brings
-        u = np.array([hist.torque(m, f) for m, f in zip(self.cm, self.cf)], dtype=F)
+        u = hist.torque(self.cm, self.cf)
         x0, x1, x2 = self.x
         th = (((x0 + T * x1) + self.a02 * x2) + self.b0 * u) - shift
         om = (x1 + self.a12 * x2) + self.b1 * u
@@ -176,7 +173,7 @@ class DelayBank:
             if scored:
                 self.J = self.forget * self.J + nu * nu
         self.origin = counts
-        if not (np.all(np.isfinite(self.x)) and np.all(np.isfinite(self.J))):
+        if not (np.isfinite(self.x).all() and np.isfinite(self.J).all()):
             self.primed = False
             return 0
         self.k += 1
@@ -188,7 +185,7 @@ class DelayBank:
         for j in range(self.n + 1):
             if self.J[j] < self.J[best]:
                 best = j
-        j_noise = NOISE_FACTOR * (self.r + self.P[0][0]) / (F(1.0) - self.forget)
+        j_noise = NOISE_FACTOR * (self.r + self.P[0, 0]) / (F(1.0) - self.forget)
         if best == self.cur or not (self.J[best] < self.ratio * self.J[self.cur]) or not (self.J[self.cur] > j_noise):
             return 0
         self.cur = best

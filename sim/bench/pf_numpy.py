@@ -145,8 +145,8 @@ class NumpyPf:
         self.x0_std = np.array(cfg["x0_std"], dtype=F).reshape(4, 1)
         # the actuator delay and its identification (dlyid_numpy.py, docs/modules/dlyid.md)
         self.bank = DelayBank(cfg)
-        self.hist = DelayHistory(cfg["delay_s"], cfg["dt_s"], F(cfg["delay_s"]) > F(0.0) or self.bank.n > 0)
-        self.keep = self.bank.keep()
+        self.hist = DelayHistory(cfg["delay_s"], cfg["dt_s"], F(cfg["delay_s"]) > F(0.0) or self.bank.n > 0,
+                                 self.bank.keep())
         self.noise = noise
         self.mask = len(noise) - 1
         self.skip = int(cfg["noise_skip"])
@@ -255,7 +255,7 @@ class NumpyPf:
         """br_pf_step; counts a Python int, frac and u np.float32. Returns the status."""
         # the torque that reached the axis over the last period: u with the delay in use; then the
         # delay identification takes the measurement, its switch acting from the next period on
-        u = self.hist.apply(u, self.keep)
+        u = self.hist.apply(u)
         if self.bank.step(counts, frac, self.hist):
             self.hist.m, self.hist.f = self.bank.cm[self.bank.cur], self.bank.cf[self.bank.cur]
         if not self.primed:
