@@ -429,7 +429,7 @@ class ToolsTest(unittest.TestCase):
             self.assert_refused(run("br_dt_study", *bad), 2)
 
     def test_bench_plant_named(self):
-        # br_bench --plant: thesis or realistic, anything else refused by name before any run
+        # br_bench --plant: thesis, realistic or hardware_like, anything else refused by name before any run
         for bad in ("nominal", "", "Realistic"):
             r = run("br_bench", "--plant", bad)
             self.assert_refused(r, 2, "--plant")
