@@ -24,6 +24,7 @@ br_status_t br_pf_load_init(br_pf_t *pf)
 {
     const br_pf_load_t *ld = &pf->cfg.load;
     pf->load_N = 0.0f;
+    pf->load_prev_N = 0.0f;
     pf->load_g_radpN = 0.0f;
     pf->n_load_acq = 0u;
     for (int i = 0; i < 6; i++) {
@@ -73,6 +74,8 @@ void br_pf_load_tick(br_pf_t *pf)
     P[3] = r11 - a * r12;
     P[4] = r12;
     P[5] = p22 + pf->cfg.load.q_N2;
+    /* F_d at the period's start: the compensation's second term (br_pf_load_comp_N) */
+    pf->load_prev_N = pf->load_N;
     for (int i = 0; i < 6; i++) {
         if (!isfinite(P[i])) {
             cov_reset(pf);
@@ -180,5 +183,9 @@ float br_pf_load_comp_N(const br_pf_t *pf, float F_N)
     if (!br_pf_load_on(pf)) {
         return F_N;
     }
-    return br_clampf(F_N + pf->load_N, -pf->cfg.load.max_N, pf->cfg.load.max_N);
+    /* (L1) F_comp = f_nl + (F_d,k-1 + F_d,k) / 2: the compensation of a period-2 swing of F_d
+     * cancels, the loop's mode near -1 with an actuator delay of a period or more (docs/modules/pf.md,
+     * "The period-2 mode"); the particles keep u - L F_d with the torque that reached the axis */
+    const float fd = 0.5f * (pf->load_prev_N + pf->load_N);
+    return br_clampf(F_N + fd, -pf->cfg.load.max_N, pf->cfg.load.max_N);
 }

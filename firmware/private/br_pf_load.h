@@ -20,7 +20,8 @@ br_status_t br_pf_load_init(br_pf_t *pf);
 /* The torque the particles are predicted with: u - L F_d (u itself when off) */
 float br_pf_load_torque(const br_pf_t *pf, float u_Nm);
 
-/* One period passes: F_d's variance grows by its random walk (nothing when off) */
+/* One period passes: F_d's variance grows by its random walk, F_d's value at
+ * the period's start kept for the compensation (nothing when off) */
 void br_pf_load_tick(br_pf_t *pf);
 
 /* After a measured step's prediction and weighing (at least one valid
@@ -31,7 +32,8 @@ void br_pf_load_tick(br_pf_t *pf);
  * log-weight (lmax itself when nothing moved). */
 float br_pf_load_update(br_pf_t *pf, float y_rel, float lmax, float sums[2], uint32_t n_valid);
 
-/* The compensation: F (the mean f_nl) + F_d, kept within +-max_N (F itself when off) */
+/* The compensation: F (the mean f_nl) + the mean of F_d at the period's start
+ * and end, kept within +-max_N (F itself when off) */
 float br_pf_load_comp_N(const br_pf_t *pf, float F_N);
 
 #endif
