@@ -69,7 +69,9 @@ g = L h^2 / (2 J_eff), Phi = [1 h -g; 0 1 -2g/h; 0 0 1].
        theta_j += K0 nu, omega_j += K1 nu (each valid particle; f_nl and l_j
        made again), F_d <- clamp(F_d + K2 nu, +-max_N), P <- P - K P[0, :]
        The outlier decision and steps 3-5 then take the moved cloud.
-    F_hat = clamp(mean f_nl + F_d, +-max_N).
+    F_hat = clamp(mean f_nl + (F_d' + F_d) / 2, +-max_N), F_d' the value at
+    the step's start (before the update): the compensation of a period-2
+    swing of F_d cancels (pf.md, "The period-2 mode").
 """
 import bisect
 import math
@@ -164,6 +166,7 @@ class Pf:
         self.l = None           # log-weights of the last step
         # cfg.load: F_d, the common error's covariance, re-acquisitions
         self.Fd = 0.0
+        self.Fd_start = 0.0     # F_d at the last step's start, before its update
         self.n_load_acq = 0
         self.load_acq = False   # the last step re-acquired
         self.d = 0.0            # the last step's mean innovation mean(theta_j) - y (before the move)
@@ -197,7 +200,7 @@ class Pf:
         self.mean = s / c.m
         self.F_hat = sf / c.m
         if c.load is not None:
-            self.F_hat = min(max(self.F_hat + self.Fd, -c.load.max_N), c.load.max_N)
+            self.F_hat = min(max(self.F_hat + 0.5 * (self.Fd_start + self.Fd), -c.load.max_N), c.load.max_N)
 
     def _prime(self, counts, frac):
         c = self.cfg
@@ -232,6 +235,7 @@ class Pf:
         if c.load is not None:
             # the common error's covariance over the period; the torque with the load
             self.P = self.Phi @ self.P @ self.Phi.T + np.diag([0.0, 0.0, c.load.q_N2])
+            self.Fd_start = self.Fd
             u = u - c.model.L * self.Fd
         xp, ep, fn, l = [], [], [], []
         for j in range(c.m):
