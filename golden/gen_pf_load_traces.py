@@ -9,6 +9,7 @@
                  gen_load_traces.load_inputs), one row per step: the input,
                  status, origin, noise position, outliers, re-anchoring,
                  re-acquisition, max log-weight, mean state, F_hat, ESS, F_d,
+                 F_d through the compensation's notch,
                  P after the update and before it (Pm), the cloud's mean
                  innovation d and spread v
   pf_load_x.csv  the particle set after step k, float32-rounded, at every
@@ -35,7 +36,7 @@ SYNC_EVERY = 10
 
 P_NAMES = ["00", "01", "02", "11", "12", "22"]
 PF_LOAD_COLUMNS = (["k", "counts", "frac", "u_prev_Nm", "status", "origin_counts", "noise_pos", "n_outliers",
-                    "reanchored", "load_acq", "lmax", "theta", "omega", "z", "gp", "F_hat", "ess", "Fd"]
+                    "reanchored", "load_acq", "lmax", "theta", "omega", "z", "gp", "F_hat", "ess", "Fd", "Fd_comp"]
                    + ["P" + n for n in P_NAMES] + ["Pm" + n for n in P_NAMES] + ["innov_d", "spread_v"])
 PF_LOAD_X_COLUMNS = ["k", "j", "theta", "omega", "z", "gp", "idx_next"]
 
@@ -67,7 +68,7 @@ def run(cfg, inputs):
         lmax = 0.0 if primed else max(pf.l)
         Pm = pf.P if primed else pf.Pm
         rows.append([k, counts, frac, u_prev, st, pf.origin, pf.noise_pos, pf.n_outliers, int(pf.reanchored),
-                     int(pf.load_acq), lmax, *pf.mean, pf.F_hat, pf.ess, pf.Fd, *upper(pf.P), *upper(Pm),
+                     int(pf.load_acq), lmax, *pf.mean, pf.F_hat, pf.ess, pf.Fd, pf.Fd_comp, *upper(pf.P), *upper(Pm),
                      pf.d, pf.v])
         sets.append([x.copy() for x in pf.x])
         idx.append(None if primed else list(pf.idx))
@@ -105,7 +106,8 @@ def generate(out_dir, m, gt, rows_in):
         "load_off_k) (a load the plant never got). One row per step (k = 0 primes): the",
         "input, status, origin, noise position, consecutive outliers, re-anchored (0/1),",
         "load re-acquired (0/1), max log-weight of the moved cloud (0 when priming),",
-        "mean state, F_hat (mean f_nl + F_d within +-load_max_N), ESS, F_d, the common",
+        "mean state, F_hat (mean f_nl + Fd_comp within +-load_max_N), ESS, F_d, Fd_comp",
+        "(F_d through the compensation's notch at the Nyquist frequency), the common",
         "error's P after the update and Pm before it (after the period's growth and any",
         "re-acquisition; P0 when priming), the predicted cloud's d = mean theta_j - y",
         "and v = var theta_j (0 when priming)."])]

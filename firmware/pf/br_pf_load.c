@@ -25,6 +25,7 @@ br_status_t br_pf_load_init(br_pf_t *pf)
     const br_pf_load_t *ld = &pf->cfg.load;
     pf->load_N = 0.0f;
     pf->load_prev_N = 0.0f;
+    pf->load_comp_N = 0.0f;
     pf->load_g_radpN = 0.0f;
     pf->n_load_acq = 0u;
     for (int i = 0; i < 6; i++) {
@@ -178,14 +179,17 @@ float br_pf_load_update(br_pf_t *pf, float y_rel, float lmax, float sums[2], uin
     return move_cloud(pf, y_rel, k0 * nu, k1 * nu, sums);
 }
 
-float br_pf_load_comp_N(const br_pf_t *pf, float F_N)
+float br_pf_load_comp_N(br_pf_t *pf, float F_N)
 {
     if (!br_pf_load_on(pf)) {
         return F_N;
     }
-    /* (L1) F_comp = f_nl + (F_d,k-1 + F_d,k) / 2: the compensation of a period-2 swing of F_d
-     * cancels, the loop's mode near -1 with an actuator delay of a period or more (docs/modules/pf.md,
-     * "The period-2 mode"); the particles keep u - L F_d with the torque that reached the axis */
-    const float fd = 0.5f * (pf->load_prev_N + pf->load_N);
-    return br_clampf(F_N + fd, -pf->cfg.load.max_N, pf->cfg.load.max_N);
+    /* (L1) F_d through a notch at the PF's Nyquist frequency, unit gain at rest:
+     * y_k = (1 + r)/2 (F_d,k + F_d,k-1) - r y_k-1; a period-2 swing of F_d does not reach the axis
+     * (the loop's mode near -1 with an actuator delay of a period or more) */
+    const float r = BR_PF_LOAD_NOTCH_R, c = 0.5f * (1.0f + r);
+    const float y = c * (pf->load_N + pf->load_prev_N) - r * pf->load_comp_N;
+    pf->load_comp_N = br_clampf(y, -pf->cfg.load.max_N, pf->cfg.load.max_N);
+    /* (L2) the compensation: the mean f_nl plus the filtered F_d */
+    return br_clampf(F_N + pf->load_comp_N, -pf->cfg.load.max_N, pf->cfg.load.max_N);
 }

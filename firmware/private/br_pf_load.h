@@ -9,6 +9,12 @@
 
 #include "bristle/br_pf.h"
 
+/* The compensation's notch at the PF's Nyquist frequency: its pole, -r
+ * (docs/modules/pf.md, "The period-2 mode": the loop's map stays inside the
+ * unit circle for actuator delays up to 3.5 ms and q up to 3e5 N^2/s with
+ * r <= 0.4) */
+#define BR_PF_LOAD_NOTCH_R 0.2f
+
 /* 1 when cfg.load is on */
 static inline int br_pf_load_on(const br_pf_t *pf) { return pf->cfg.load.max_N > 0.0f; }
 
@@ -32,8 +38,9 @@ void br_pf_load_tick(br_pf_t *pf);
  * log-weight (lmax itself when nothing moved). */
 float br_pf_load_update(br_pf_t *pf, float y_rel, float lmax, float sums[2], uint32_t n_valid);
 
-/* The compensation: F (the mean f_nl) + the mean of F_d at the period's start
- * and end, kept within +-max_N (F itself when off) */
-float br_pf_load_comp_N(const br_pf_t *pf, float F_N);
+/* The compensation, once a period: F (the mean f_nl) + F_d through the
+ * notch at the PF's Nyquist frequency (its state advanced), kept within
+ * +-max_N (F itself when off) */
+float br_pf_load_comp_N(br_pf_t *pf, float F_N);
 
 #endif

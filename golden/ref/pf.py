@@ -69,9 +69,10 @@ g = L h^2 / (2 J_eff), Phi = [1 h -g; 0 1 -2g/h; 0 0 1].
        theta_j += K0 nu, omega_j += K1 nu (each valid particle; f_nl and l_j
        made again), F_d <- clamp(F_d + K2 nu, +-max_N), P <- P - K P[0, :]
        The outlier decision and steps 3-5 then take the moved cloud.
-    F_hat = clamp(mean f_nl + (F_d' + F_d) / 2, +-max_N), F_d' the value at
-    the step's start (before the update): the compensation of a period-2
-    swing of F_d cancels (pf.md, "The period-2 mode").
+    F_hat = clamp(mean f_nl + y, +-max_N) with F_d through a notch at the
+    period's Nyquist frequency (pf.md, "The period-2 mode"):
+    y = clamp((1 + r)/2 (F_d + F_d') - r y', +-max_N), F_d' the value at the
+    step's start (before the update), y' the last step's, r = LOAD_NOTCH_R.
 """
 import bisect
 import math
@@ -88,6 +89,7 @@ BR_E_NUMERIC = -4
 BR_W_OUTLIER = 1  # a warning (positive): the step predicted only
 
 W_BITS = 16
+LOAD_NOTCH_R = 0.2  # the compensation's notch: its pole at -r (pf.md, "The period-2 mode")
 NX = 4
 
 
@@ -167,6 +169,7 @@ class Pf:
         # cfg.load: F_d, the common error's covariance, re-acquisitions
         self.Fd = 0.0
         self.Fd_start = 0.0     # F_d at the last step's start, before its update
+        self.Fd_comp = 0.0      # F_d through the compensation's notch
         self.n_load_acq = 0
         self.load_acq = False   # the last step re-acquired
         self.d = 0.0            # the last step's mean innovation mean(theta_j) - y (before the move)
@@ -200,7 +203,10 @@ class Pf:
         self.mean = s / c.m
         self.F_hat = sf / c.m
         if c.load is not None:
-            self.F_hat = min(max(self.F_hat + 0.5 * (self.Fd_start + self.Fd), -c.load.max_N), c.load.max_N)
+            r = LOAD_NOTCH_R
+            y = 0.5 * (1.0 + r) * (self.Fd + self.Fd_start) - r * self.Fd_comp
+            self.Fd_comp = min(max(y, -c.load.max_N), c.load.max_N)
+            self.F_hat = min(max(self.F_hat + self.Fd_comp, -c.load.max_N), c.load.max_N)
 
     def _prime(self, counts, frac):
         c = self.cfg

@@ -183,6 +183,7 @@ static void resync(br_pf_t *pf, const pfl_t *G, int k, int xrow)
     pf->prev_frac = (float)col(G, k, "frac");
     pf->n_predicted = 0u;
     pf->load_N = (float)col(G, k, "Fd");
+    pf->load_comp_N = (float)col(G, k, "Fd_comp");
     for (int e = 0; e < 6; e++) {
         pf->load_P[e] = (float)br_trace_get(&G->t, k, G->c_P[e]);
     }
@@ -290,9 +291,13 @@ static void test_pf_load_one_step(void **state)
             br_errstat_add(&e_mean[i], &G.t, k1, (double)ps.mean[i], xb[i],
                            D.d[i] + C_SUM * (double)m * U32 * xmax[i]);
         }
-        /* F_hat = clamp(mean f_nl + F_d): f_nl's bound, the sum's rounding, F_d's bound */
+        /* the notch y = (1 + r)/2 (F_d + F_d') - r y' (0 <= r < 1, so both weights <= 1): F_d's
+         * bound, F_d' and y' float32-rounded from the trace, the rounding of its three terms */
+        const double fd0 = fabs(col(&G, k, "Fd")), yc0 = fabs(col(&G, k, "Fd_comp"));
+        const double dy = T.Fd + U32 * (fd0 + yc0) + C_KF * U32 * (fabs(col(&G, k1, "Fd")) + fd0 + yc0);
+        /* F_hat = clamp(mean f_nl + y): f_nl's bound, the sum's rounding, y's bound */
         br_errstat_add(&e_F, &G.t, k1, (double)pf->est.F_hat_N, col(&G, k1, "F_hat"),
-                       dF + C_SUM * (double)m * U32 * fmax_ + T.Fd + 2.0 * U32 * G.max_N);
+                       dF + C_SUM * (double)m * U32 * fmax_ + dy + 2.0 * U32 * G.max_N);
     }
     print_message("golden pf_load    %ld one-step comparisons (%ld re-acquisitions, %ld outliers), %u particles; "
                   "own indices == trace on %ld\n",

@@ -99,8 +99,8 @@ typedef struct {
  * per newton) takes the predicted cloud's mean innovation, moves the cloud's
  * theta and omega by its gain and F_d by its third component, and the
  * moved cloud is then weighed and resampled; the compensation is f_nl plus
- * F_d averaged over the period's two ends (the loop's period-2 mode, which an
- * actuator delay of a period or more makes unstable, cancelled).
+ * F_d through a notch at the PF's Nyquist frequency (the loop's period-2
+ * mode, which an actuator delay of a period or more makes unstable).
  * A gated innovation that a change of at most 2 max_N over the k periods
  * since the last measurement explains (theta moved by -g k^2 dF) is
  * re-acquired as a load (the covariance inflated as if F_d's variance had
@@ -182,11 +182,12 @@ typedef struct {
      * S = Q_theta' + R, and the prior's coupling h/2 sqrt(Q_omega) of omega's
      * sample into theta (OPT_HELD; 0 otherwise) */
     float prop_k_th, prop_k_om, prop_l00, prop_l10, prop_l11, prop_inv_2s, prop_hold;
-    /* cfg.load: the shared external force's estimate F_d (N) and its value at the period's start
-     * (load_prev_N, before the update); the covariance of the cloud's common
+    /* cfg.load: the shared external force's estimate F_d (N), its value at the period's start
+     * (load_prev_N, before the update) and F_d through the compensation's notch (load_comp_N);
+     * the covariance of the cloud's common
      * error [theta, omega, F_d] (rad, rad/s, N), its upper triangle P00 P01 P02 P11 P12 P22;
      * g = L h^2 / (2 J_eff) (rad per N over one period); the re-acquisitions counted */
-    float load_N, load_prev_N, load_P[6], load_g_radpN;
+    float load_N, load_prev_N, load_comp_N, load_P[6], load_g_radpN;
     uint32_t n_load_acq;
     int primed;                   /* particles drawn around the first measurement */
     /* particles as a structure of arrays: x[i][j] is state i of particle j.
