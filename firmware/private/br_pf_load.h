@@ -12,7 +12,7 @@
 /* The compensation's notch at the PF's Nyquist frequency: its pole, -r
  * (docs/modules/pf.md, "The period-2 mode": the loop's map stays inside the
  * unit circle for actuator delays up to 3.5 ms and q up to 3e5 N^2/s with
- * r <= 0.4) */
+ * r <= 0.3) */
 #define BR_PF_LOAD_NOTCH_R 0.2f
 
 /* 1 when cfg.load is on */
