@@ -773,26 +773,30 @@ static void test_encoder_frozen_latches(void **st)
 }
 
 /* the rig with the machine's drive protections on an encoder so coarse for
- * its period that a speed change of one count per period is the force
- * COARSE_BANDS x the friction band (the fleet's axis 3: 0.096 um counts at
- * 0.27 ms, mass / (counts_per_m dt^2) = 140 N, 3.9 x its machine file's
- * band), the controller on the same counts */
-#define COARSE_BANDS 4.0f
+ * its period that the friction band plus the quantization allowance (2 k,
+ * k = mass / (counts_per_m dt^2) the force of one count per period^2) is
+ * COARSE_SHARE of the actuator's force, as on the fleet's axis 3 (0.096 um
+ * counts at 0.27 ms: k = 140 N, 36 + 280 N of 659 N); the controller on the
+ * same counts */
+#define COARSE_SHARE 0.5f
 static void rig_coarse(rig_t *g)
 {
     rig_init(g, 0);
     br_app_machine_t mm = BR_MACHINE_APP_MACHINE;
     const br_app_motion_cfg_t fine = br_app_motion_cfg(&mm);
-    const float dt = g->k.dt_s;
-    /* counts_per_m = mass / (COARSE_BANDS band dt^2) */
-    const float cpm = fine.mass_kg / (COARSE_BANDS * fine.stuck_band_N * dt * dt);
+    const float dt = g->k.dt_s, F_max = g->k.tau_max_Nm / g->k.lead_mprad;
+    const float k_N = (COARSE_SHARE * F_max - fine.stuck_band_N) / BR_APP_STUCK_QUANT_ACCEL;
+    /* counts_per_m = mass / (k dt^2) */
+    const float cpm = fine.mass_kg / (k_N * dt * dt);
     mm.rad_per_count = 1.0f / (mm.lead_mprad * cpm);
     g->k.rad_per_count = mm.rad_per_count;
     g->c.motion = br_app_motion_cfg(&mm);
     g->c.guard = br_app_guard_cfg(dt, mm.max_speed_mps * cpm);
     assert_int_equal(br_app_init(&g->app, &g->c, &g->hal, NULL), BR_OK);
     assert_int_equal(br_app_arm(&g->app), BR_OK);
-    assert_float_equal(g->app.mot_k_m, COARSE_BANDS * g->app.motion.stuck_band_N, 1e-3f * g->app.mot_k_m);
+    assert_float_equal(g->app.mot_k_m, k_N, 1e-3f * k_N);
+    /* one count per period^2 is more than the band: the edge below matters */
+    assert_true(k_N > g->app.motion.stuck_band_N);
 }
 
 /* The stuck-encoder model on a coarse count (rig_coarse): an axis held on a
