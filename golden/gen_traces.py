@@ -47,7 +47,7 @@ SEED = 20240611  # base seed; trace i uses SEED + i (recorded in each header)
 SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                # estimator traces (gen_est_traces.py): one recorded input, one seed
                "est_input": 6, "pf": 6, "pf_w": 6, "pf_x": 6, "ukf": 6,
-               "ukf_load": 6,  # gen_load_traces.py: the same input, no random draw of its own
+               "ukf_load": 6, "ukf_glitch": 6,  # gen_load_traces.py: the same input, no random draw of its own
                "ukf_ms": 6,    # gen_ukf_ms_traces.py: the same input, no random draw of its own
                "pf_load": 6, "pf_load_x": 6,  # gen_pf_load_traces.py: likewise
                "pf_ms": 6, "pf_ms_x": 6,  # gen_pf_ms_traces.py: likewise
@@ -462,7 +462,7 @@ def main(argv=None):
     paths += gen_plant(args.out, m)
     est_paths, est_input = gen_est_traces.generate(args.out, m, sys.modules[__name__])
     paths += est_paths
-    paths.append(gen_load_traces.generate(args.out, m, sys.modules[__name__], est_input))
+    paths += gen_load_traces.generate(args.out, m, sys.modules[__name__], est_input)
     paths.append(gen_ukf_ms_traces.generate(args.out, m, sys.modules[__name__], est_input))
     paths += gen_pf_load_traces.generate(args.out, m, sys.modules[__name__], est_input)
     paths += gen_pf_ms_traces.generate(args.out, m, sys.modules[__name__], est_input)
