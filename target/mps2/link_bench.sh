@@ -13,8 +13,9 @@
 # telemetry is above deadline-share (target/mps2/budget.txt) of the period's
 # cycles, when the calibration is not 40 instructions per tick, or when the
 # run did not exercise what it measures (telemetry dropped at the full rate,
-# no dump chunk, no bad frame). The period and the clock are the image's own
-# output, from their generated / port headers.
+# no dump chunk, no bad frame, or an axis that did not hold: a measurement the
+# estimator rejected while the reference holds the axis still). The period and
+# the clock are the image's own output, from their generated / port headers.
 set -euo pipefail
 cm7=$1 out=$2 periods=$3
 qemu=${BR_QEMU:-qemu-system-arm}
@@ -37,6 +38,7 @@ for mode in full shipped; do
     /^link_bench / { for (i = 2; i <= NF; i++) { split($i, kv, "="); h[kv[1]] = kv[2] } }
     /^part / { n[$2] = substr($3, 3); s[$2] = substr($4, 11); x[$2] = substr($5, 11) }
     /^counters / { for (i = 2; i <= NF; i++) { split($i, kv, "="); c[kv[1]] = kv[2] } }
+    /^hold / { for (i = 2; i <= NF; i++) { split($i, kv, "="); hd[kv[1]] = kv[2] } }
     END {
       if (ipt == "" || ipt != 40) { printf "link-bench: calibration %s instructions per tick, expected 40\n", ipt; exit 1 }
       cyc = h["period_ns"] * h["cpu_hz"] / 1e9; lim = cyc * share / 100
@@ -50,7 +52,9 @@ for mode in full shipped; do
       printf "  link + telemetry + recorder (svc + tlm + rec + dump), sum of the worst: %.0f instructions (%.2f%% of the period)\n", (x["svc"] + x["tlm"] + x["rec"] + x["dump"]) * ipt, 100 * (x["svc"] + x["tlm"] + x["rec"] + x["dump"]) * ipt / cyc
       printf "  counters: %d frames accepted, %d bad CRC, %d unknown id; %d frames sent, %d refused; telemetry dropped %d\n", c["rx_frames"], c["rx_bad_crc"], c["rx_unknown_id"], c["tx_frames"], c["tx_busy"], c["tlm_dropped"]
       if (mode == "full" && (c["tlm_dropped"] != 0 || h["tlm_every"] != 1)) { print "link-bench: FAIL: telemetry not at the control rate"; exit 1 }
+      printf "  the held axis: %s measurements rejected (BR_W_OUTLIER), largest |count| %s (the reference at 0.5)\n", hd["outliers"], hd["max_abs_counts"]
       if (n["dump"] == 0 || c["rx_bad_crc"] == 0) { print "link-bench: FAIL: no dump chunk or no bad frame in the run"; exit 1 }
+      if (hd["outliers"] == "" || hd["outliers"] != 0) { print "link-bench: FAIL: the held axis did not hold (a measurement rejected: the bench plant or the loop)"; exit 1 }
       w = x["total"] * ipt
       if (mode == "full") {
         printf "  deadline: worst period %.0f instructions, budget %.0f (%s%% of %.0f cycles, target/mps2/budget.txt): %s\n", w, lim, share, cyc, (w <= lim) ? "within" : "OVER"

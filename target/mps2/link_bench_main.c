@@ -32,8 +32,11 @@
  * Prints the calibration line, "link_bench periods=... tlm_every=...
  * period_ns=... cpu_hz=..." (the period and the STM32H743's clock, from
  * their headers), one "part NAME n=... sum_ticks=... max_ticks=..." per part
- * (periods k >= 1; dump: the periods a dump chunk was queued in) and the
- * counters; exit 0, or 1 on a fault, a failed init or a bad command line. */
+ * (periods k >= 1; dump: the periods a dump chunk was queued in), the
+ * counters and "hold outliers=... max_abs_counts=..." (periods k >= 1: the
+ * steps whose measurement the estimator rejected, BR_W_OUTLIER, and the
+ * axis's largest |count|; every request holds it at its start, 0.5 counts);
+ * exit 0, or 1 on a fault, a failed init or a bad command line. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -212,7 +215,9 @@ int main(void)
     const br_app_cfg_t ac = {&cc, BR_IMAGE_EST, &pfc, &ukc, &no_ext,
                              br_app_guard_cfg(BR_IMAGE_DT_S, BR_MACHINE_MAX_SPEED_COUNTS_PER_S_F), mc};
     const br_app_mem_t mem = {BR_IMAGE_USES_PF ? &pf : 0, BR_IMAGE_USES_UKF ? &ukf : 0};
-    bench_io_t io = {{0, 0.0f, 0.0f, 0.0f, BR_IMAGE_DT_S}, &clk, 0u, 0u};
+    bench_io_t io;
+    io.clk = &clk;
+    io.t_enc = io.t_pwm = 0u;
     const br_hal_t hal = {&io, io_enc, io_pwm, br_bench_plant_tick_wait, 0, 0};
     host_t host;
     host.rd = host.wr = host.tx_bytes = 0u;
@@ -227,7 +232,8 @@ int main(void)
     br_svc_t svc;
     br_tlm_t tlm;
     br_rec_t rec;
-    if (br_app_init(&app, &ac, &hal, &mem) != BR_OK || br_svc_init(&svc, &sc, &app, &ac, &mem, &chan) != BR_OK ||
+    if (br_bench_plant_init(&io.plant, BR_IMAGE_DT_S) != BR_OK || br_app_init(&app, &ac, &hal, &mem) != BR_OK ||
+        br_svc_init(&svc, &sc, &app, &ac, &mem, &chan) != BR_OK ||
         br_tlm_init(&tlm, &tc) != BR_OK || br_rec_init(&rec, &rc) != BR_OK) {
         fail("firmware init failed");
     }
@@ -236,8 +242,11 @@ int main(void)
 
     stat_t st[PART_N];
     memset(st, 0, sizeof st);
+    uint32_t n_outlier = 0u, max_abs_counts = 0u; /* the held axis: the filter's rejections, its excursion */
     for (uint32_t k = 0u; k < periods; ++k) {
-        br_bench_plant_period(&io.plant);
+        if (br_bench_plant_period(&io.plant) != BR_OK) {
+            fail("the bench plant's step failed");
+        }
         host_refill(&host, &svc);
         const uint32_t t0 = br_bench_clock_stamp(&clk);
         const br_status_t s = br_svc_step(&svc);
@@ -262,6 +271,9 @@ int main(void)
         if (k == 0u) {
             continue; /* the arm, the filter's first step */
         }
+        n_outlier += (s == BR_W_OUTLIER) ? 1u : 0u;
+        const uint32_t ax = (io.plant.counts < 0) ? 0u - (uint32_t)io.plant.counts : (uint32_t)io.plant.counts;
+        max_abs_counts = (ax > max_abs_counts) ? ax : max_abs_counts;
         const uint32_t app_t = io.t_pwm - io.t_enc;
         stat_add(&st[PART_APP], app_t);
         stat_add(&st[PART_SVC], (t1 - t0) - app_t);
@@ -293,6 +305,9 @@ int main(void)
     br_bench_say_u32(" tlm_dropped=", tlm.n_dropped);
     br_bench_say_u32(" ref_dropped=", svc.ref.cnt.dropped);
     br_bench_say_u32(" rec_state=", (uint32_t)rec.state);
+    br_sh_puts("\n");
+    br_bench_say_u32("hold outliers=", n_outlier);
+    br_bench_say_u32(" max_abs_counts=", max_abs_counts);
     br_sh_puts("\n");
     br_sh_exit(0u);
 }

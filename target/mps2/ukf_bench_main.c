@@ -44,7 +44,7 @@ static const br_refgen_cfg_t bench_ref = {
 
 int main(void)
 {
-    br_bench_plant_t io = {0, 0.0f, 0.0f, 0.0f, BR_UKF_BENCH_DT_S};
+    br_bench_plant_t io;
     const br_hal_t hal = {&io, br_bench_plant_enc_read, br_bench_plant_pwm_write, br_bench_plant_tick_wait, 0, 0};
     br_ukf_t ukf;
     br_app_t app;
@@ -64,15 +64,16 @@ int main(void)
 
     br_bench_clock_start(&clk);
 
-    if (br_refgen_init(&refgen, &bench_ref) != BR_OK || br_app_init(&app, &cfg, &hal, &mem) != BR_OK ||
+    if (br_bench_plant_init(&io, BR_UKF_BENCH_DT_S) != BR_OK || br_refgen_init(&refgen, &bench_ref) != BR_OK ||
+        br_app_init(&app, &cfg, &hal, &mem) != BR_OK ||
         br_app_arm(&app) != BR_OK) {
         br_sh_puts("ukf bench: init failed\n");
         br_sh_exit(1u);
     }
     for (uint32_t k = 0u; k < BR_UKF_BENCH_STEPS; ++k) {
-        br_bench_plant_period(&io); /* the axis under the last period's duty */
-        if (br_refgen_step(&refgen, &ref) != BR_OK) {
-            br_sh_puts("ukf bench: reference failed\n");
+        /* the axis under the last period's duty, then the period's reference */
+        if (br_bench_plant_period(&io) != BR_OK || br_refgen_step(&refgen, &ref) != BR_OK) {
+            br_sh_puts("ukf bench: plant or reference failed\n");
             br_sh_exit(1u);
         }
         const uint32_t t0 = br_bench_clock_stamp(&clk);
