@@ -172,17 +172,19 @@ def gen_model(out_dir, m):
     rows = []
     skipped = [0]
 
-    def near_threshold(x, x1):
-        a0 = rmodel.ah(p, x[1], x[3], DT)
-        a1 = rmodel.ah(p, x1[1], x[3], DT)
-        return any(abs(a / rmodel.RK4_AH_MAX - 1.0) < BRANCH_MARGIN for a in (a0, a1))
+    def near_threshold(x, u):
+        """a h within the margin of the switch at an end or a stage of the step"""
+        ws = []
+        x1 = rmodel.rk4(p, x, u, DT, ws)
+        return any(abs(rmodel.ah(p, w, x[3], DT) / rmodel.RK4_AH_MAX - 1.0) < BRANCH_MARGIN
+                   for w in [x[1]] + ws + [x1[1]])
 
     def emit(seg, t, x, u):
         """One-step row for float32-exact (x, u); returns x_{k+1} (float64)."""
         x = np.array([f32(v) for v in x], dtype=np.float64)
         u = f32(u)
         status, x1, branch = rmodel.step(p, x, u, DT)
-        if status == rmodel.BR_OK and near_threshold(x, rmodel.rk4(p, x, u, DT)):
+        if status == rmodel.BR_OK and near_threshold(x, u):
             skipped[0] += 1
             return x1
         fn = rmodel.fnl(p, x) if status == rmodel.BR_OK else float("nan")
