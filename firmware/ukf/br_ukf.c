@@ -600,27 +600,31 @@ static void alt_swap(br_ukf_t *ukf)
  * again from the alternative (the last step's first prediction, its clock
  * put back first), and its innovation gated as it is (a spike: the last
  * measurement alone was off) and with theta- moved by the last step's gated
- * innovation nu_1 (a slip: the counter stays off by it). The first that
- * passes is taken: the alternative becomes the committed posterior and its
- * prediction (moved for a slip) is written into xm, Pm; returns 1. Neither:
- * returns 0 with the committed posterior and the first prediction's elements
- * back (xm, Pm untouched). */
+ * innovation nu_1 (a slip: the counter stays off by it). One that passes is
+ * taken, the smaller |nu| when both do: the alternative becomes the
+ * committed posterior and its prediction (moved for a slip) is written into
+ * xm, Pm; returns 1. Neither: returns 0 with the committed posterior and the
+ * first prediction's elements back (xm, Pm untouched). */
 static int glitch_undo(br_ukf_t *ukf, const br_meas_t *y, float u_a, float xm[NM], float Pm[NM][NM],
                        int *chol_reset)
 {
-    float xa[NM], Pa[NM][NM], th, nu, S, el_m[BR_MSLIP_MAX];
+    float xa[NM], Pa[NM][NM], th, S, el_m[BR_MSLIP_MAX];
     int reset = 0;
     elements_copy(ukf->model.cfg.mslip.n, ukf->el_m, el_m);
     alt_swap(ukf);
     br_model_set_clock(&ukf->model, ukf->model.n_steps - 1u);
     if (predict(ukf, u_a, xa, Pa, &reset)) {
-        /* a spike, then a slip: theta- + nu_1 */
-        int pass = innovate(ukf, y, xa, (const float(*)[NM])Pa, &th, &nu, &S);
-        if (!pass) {
-            xa[BR_X_THETA] += ukf->alt_nu_rad;
-            pass = innovate(ukf, y, xa, (const float(*)[NM])Pa, &th, &nu, &S);
-        }
-        if (pass && isfinite(nu)) {
+        /* a spike (theta- as it is) and a slip (theta- + nu_1); one S for
+         * both, so the likelier is the smaller |nu| (a slip can be within
+         * the spike's gate, the alternative being two periods old) */
+        const float th_s = xa[BR_X_THETA];
+        float nu_s, nu_l;
+        const int pass_s = innovate(ukf, y, xa, (const float(*)[NM])Pa, &th, &nu_s, &S);
+        xa[BR_X_THETA] = th_s + ukf->alt_nu_rad;
+        const int pass_l = innovate(ukf, y, xa, (const float(*)[NM])Pa, &th, &nu_l, &S);
+        const int slip = pass_l && !(pass_s && fabsf(nu_s) <= fabsf(nu_l));
+        xa[BR_X_THETA] = slip ? xa[BR_X_THETA] : th_s;
+        if ((slip || pass_s) && isfinite(slip ? nu_l : nu_s)) {
             copy_mean_cov(ukf->n, xa, (const float(*)[NM])Pa, xm, Pm);
             *chol_reset = *chol_reset || reset;
             if (ukf->n_load_undo < UINT32_MAX) {

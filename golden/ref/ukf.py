@@ -54,9 +54,10 @@ covariance, its elements clipped as an outlier's, the step's origin, the
 gated innovation nu_1). At the next step only (a predict-only period or any
 error drops it), if the innovation of the ordinary prediction is gated, step
 2 is repeated from A (as if the last step had been an outlier) and gated:
-first as it is (a spike), then with theta- + nu_1 (a slip: the counter stays
-off by nu_1). The first passing one is the step's prediction (an ordinary
-update, BR_OK, counted in n_load_undo; origin = counts as always). Neither:
+as it is (a spike) and with theta- + nu_1 (a slip: the counter stays off by
+nu_1). The passing one, the smaller |nu| when both pass (one S for both), is
+the step's prediction (an ordinary update, BR_OK, counted in n_load_undo;
+origin = counts as always). Neither:
 the ordinary prediction stands and the re-acquisition rule follows.
 
 Maxwell-slip elements (cfg.mslip, docs/modules/ukf.md "Maxwell-slip
@@ -283,17 +284,23 @@ class Ukf:
     def _undo(self, alt, u, counts, frac):
         """The last step's re-acquisition undone: the prediction from its
         alternative alt and the innovation of a spike (as it is) or of a slip
-        (theta- + nu_1), the first that passes; None when neither does."""
+        (theta- + nu_1), the one that passes, the smaller |nu| when both do;
+        None when neither does."""
         pred = self._predict(alt["x"], alt["P"], u, alt["el"])
         if pred is None:
             return None
         xa, Pa, ok, em = pred
+        cands = []
         for shift in (0.0, alt["nu"]):
             xs = [xa[0] + shift] + xa[1:]
             inn = self._innovate(xs, Pa, counts, frac, alt["origin"])
             if inn[3]:
-                return (xs, Pa, ok, em), inn
-        return None
+                cands.append((abs(inn[1]), (xs, Pa, ok, em), inn))
+        if not cands:
+            return None
+        # the spike on a tie (min keeps the first of equal keys)
+        _, pred, inn = min(cands, key=lambda cand: cand[0])
+        return pred, inn
 
     def step(self, counts, frac, u):
         c, n = self.cfg, self.n

@@ -27,8 +27,9 @@
  * re-acquisition keeps its alternative (the period's first prediction, as an
  * outlier would have committed it); when the next innovation is gated and
  * that alternative, or it moved by the re-acquired innovation (a counter
- * slip), passes the gate, the re-acquisition is undone: the step updates the
- * alternative's prediction (docs/modules/ukf.md, "A glitch is not a load").
+ * slip), passes the gate (the smaller innovation of the two when both do),
+ * the re-acquisition is undone: the step updates the alternative's
+ * prediction (docs/modules/ukf.md, "A glitch is not a load").
  * theta is stored relative to an integer origin (the latest accepted count),
  * as in the PF, so float32 keeps sub-count resolution at any travel.
  * See docs/modules/ukf.md. */
