@@ -420,11 +420,18 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
     fprintf(f,
             ", \"gp_min_N\": %.9g, \"gp_max_N\": %.9g, \"outlier_sigma\": %.9g, \"reanchor_after\": %u, "
             "\"rad_per_count\": %.9g, \"noise_len\": %u, \"noise_skip\": %u, \"noise_fnv1a64\": \"%016llx\", "
-            "\"adapt\": {\"nis_ref\": %.9g, \"alpha\": %.9g, \"max_scale\": %.9g}, \"outlier_transient_rad\": %.9g}",
+            "\"adapt\": {\"nis_ref\": %.9g, \"alpha\": %.9g, \"max_scale\": %.9g}, \"outlier_transient_rad\": %.9g",
             (double)c->est.gp_min_N, (double)c->est.gp_max_N, (double)c->est.outlier_sigma, (unsigned)c->est.reanchor_after,
             (double)c->est.rad_per_count, (unsigned)c->noise_len, (unsigned)c->noise_skip,
             (unsigned long long)fnv1a(c->noise, (size_t)c->noise_len * sizeof *c->noise), (double)c->adapt.nis_ref,
             (double)c->adapt.alpha, (double)c->adapt.max_scale, (double)c->est.outlier_transient_rad);
+    /* the actuator delay and its identification (docs/modules/dlyid.md) */
+    const br_dlyid_cfg_t *d = &c->est.delay_id;
+    fprintf(f,
+            ", \"delay_s\": %.9g, \"delay_id\": {\"n_cand\": %u, \"step_s\": %.9g, \"q_force_N2ps\": %.9g, "
+            "\"memory_s\": %.9g, \"warmup_s\": %.9g, \"switch_ratio\": %.9g}}",
+            (double)m->causes.delay_s, (unsigned)d->n_cand, (double)d->step_s, (double)d->q_force_N2ps,
+            (double)d->memory_s, (double)d->warmup_s, (double)d->switch_ratio);
 }
 
 /* the recording into f (a br_outfile's temporary file, docs/tools.md) */
@@ -502,16 +509,33 @@ static void json_timing_pf(FILE *f, const char *key, const br_circle_cfg_t *cpf,
             t->fhat_rms_err_N, t->outliers, t->errors);
 }
 
+/* --plant's circle configuration for the controller into c (NULL: the name's check only);
+ * -1 for a name that is none of the three */
+static int plant_cfg(const char *name, br_circle_ctrl_t ctrl, br_circle_cfg_t *c)
+{
+    br_circle_cfg_t (*const make[])(br_circle_ctrl_t) = {br_circle_cfg_thesis, br_circle_cfg_realistic,
+                                                          br_circle_cfg_hardware_like};
+    static const char *const names[] = {"thesis", "realistic", "hardware_like"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        if (strcmp(name, names[i]) == 0) {
+            if (c) *c = make[i](ctrl);
+            return 0;
+        }
+    }
+    return -1;
+}
+
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N] [--plant thesis|realistic] [--thesis-gate]\n" BR_ARGS_COMMON_USAGE
+            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N] [--plant thesis|realistic|hardware_like] [--thesis-gate]\n" BR_ARGS_COMMON_USAGE
             "  --json FILE         the figures as JSON (make bench: out/bench/bench.json)\n"
             "  --record FILE       the replayed stream's per-step record (CSV)\n"
             "  --reps N            repetitions of each PF timing, 1 .. 256 (default 7)\n"
             "  --ukf-reps N        repetitions of each UKF timing, 1 .. 256 (default 21)\n"
             "  --plant P           the recorded closed loop's plant: thesis (the estimators' own model,\n"
-            "                      default) or realistic (the demo's realistic plant, docs/demo.md)\n"
+            "                      default), realistic (the demo's realistic plant, docs/demo.md) or\n"
+            "                      hardware_like (the demo's Maxwell-slip plant, docs/demo.md)\n"
             "  --thesis-gate       the filters' outlier gate without the machine's transient term (eq. G1):\n"
             "                      the realistic plant's outliers then re-anchor the PF (for pf_numpy.py --check)\n",
             argv0, argv0);
@@ -521,7 +545,8 @@ static int usage(const char *argv0, FILE *to)
 int main(int argc, char **argv)
 {
     const char *json_path = NULL, *rec_path = NULL;
-    int reps = 7, ukf_reps = 21, realistic = 0, thesis_gate = 0;
+    int reps = 7, ukf_reps = 21, thesis_gate = 0;
+    const char *plant = "thesis";
     static const struct option opts[] = {{"json", required_argument, NULL, 'j'},
                                          {"record", required_argument, NULL, 'r'},
                                          {"reps", required_argument, NULL, 'n'},
@@ -547,9 +572,9 @@ int main(int argc, char **argv)
             if (!bad) ukf_reps = (int)n;
             break;
         case 'p':
-            realistic = strcmp(v, "realistic") == 0;
-            if (!realistic && strcmp(v, "thesis") != 0) {
-                fprintf(stderr, "%s: --plant: '%s' is neither thesis nor realistic\n", TOOL, v);
+            plant = v;
+            if (plant_cfg(v, BR_CTRL_HINF_PF, NULL) != 0) {
+                fprintf(stderr, "%s: --plant: '%s' is none of thesis, realistic, hardware_like\n", TOOL, v);
                 bad = 1;
             }
             break;
@@ -584,9 +609,9 @@ int main(int argc, char **argv)
     if (!pf || !ukf) goto done;
 
     /* 1. recordings */
-    const char *const plant = realistic ? "realistic" : "thesis";
-    br_circle_cfg_t cpf = realistic ? br_circle_cfg_realistic(BR_CTRL_HINF_PF) : br_circle_cfg_thesis(BR_CTRL_HINF_PF);
-    br_circle_cfg_t cukf = realistic ? br_circle_cfg_realistic(BR_CTRL_HINF_UKF) : br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
+    br_circle_cfg_t cpf, cukf;
+    (void)plant_cfg(plant, BR_CTRL_HINF_PF, &cpf);
+    (void)plant_cfg(plant, BR_CTRL_HINF_UKF, &cukf);
     if (thesis_gate) {
         cpf.pf.est.outlier_transient_rad = 0.0f;
         cukf.ukf.est.outlier_transient_rad = 0.0f;

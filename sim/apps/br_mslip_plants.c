@@ -21,15 +21,16 @@
  *
  * Usage: br_mslip_plants [--n N] [--first J] [--seed S] [--json OUT] [--ff-el own|fit] [--pred S] [--oracle-late]
  *                        [--hw] [--pf-trace FILE] [--posterior FILE --at T1,T2,..]
- *                        [--pf-q-scale FZ,FG] [--pf-gate SIGMA]
+ *                        [--pf-q-scale FZ,FG] [--pf-gate SIGMA] [--pf-load Q]
  * Prints one line per plant (contour RMS in m, or FAULT) and the medians; --json writes
  * each plant's elements and runs (br_outfile.h: nothing is written unless every run was
  * made). --hw runs the demo's hardware-like plant itself (plant -1) instead of draws.
  * --pf-trace writes one row per PF step and axis of every PF run (br_circle_pftrace.h:
  * the cloud beside the truth, the best particle's miss and the gate); --posterior the
- * x axis's PF particles and UKF mean and sigma at the times --at. --pf-q-scale and
- * --pf-gate change the PF's z and g_p process noise (factors) and its outlier gate
- * (sigmas) on every plant, for studies; a figure with them is not the shipped PF's.
+ * x axis's PF particles and UKF mean and sigma at the times --at. --pf-q-scale,
+ * --pf-gate and --pf-load change the PF's z and g_p process noise (factors), its outlier
+ * gate (sigmas) and its shared external force (random walk, N^2/s; docs/modules/pf.md)
+ * on every plant, for studies; a figure with them is not the shipped PF's.
  * Exit 0, 1 (a run could not be made, or the output), 2 (usage). */
 #include <math.h>
 #include <stdio.h>
@@ -92,6 +93,7 @@ static int usage(const char *argv0, FILE *f)
     fprintf(f,
             "usage: %s [--n N] [--first J] [--seed S] [--json OUT] [--ff-el own|fit] [--pred S] [--oracle-late]\n"
             "       [--hw] [--pf-trace FILE] [--posterior FILE --at T1,T2,..] [--pf-q-scale FZ,FG] [--pf-gate SIGMA]\n"
+            "       [--pf-load Q]\n"
             "  --n N       how many plants (1 .. %d; default 10)\n"
             "  --first J   the first plant's index in the seed's stream (0 .. %d; default 0)\n"
             "  --seed S    the draw's seed (0 .. 1000000000; default 1)\n"
@@ -104,7 +106,9 @@ static int usage(const char *argv0, FILE *f)
             "  --posterior FILE  the x axis's PF particles and UKF mean and sigma at the times --at (CSV)\n"
             "  --at T1,T2,..     ascending times, s (at most %d)\n"
             "  --pf-q-scale FZ,FG  the PF's z and g_p process noise times FZ and FG (1e-6 .. 1e6; a study)\n"
-            "  --pf-gate SIGMA   the PF's outlier gate, sigmas (1 .. 1000; a study)\n" BR_ARGS_COMMON_USAGE,
+            "  --pf-gate SIGMA   the PF's outlier gate, sigmas (1 .. 1000; a study)\n"
+            "  --pf-load Q       the PF's shared external force, random walk Q N^2/s (0 .. 1e9; 0: the machine's;\n"
+            "                    a study, docs/modules/pf.md)\n" BR_ARGS_COMMON_USAGE,
             argv0, MAX_N, MAX_FIRST, (double)BR_FF_PRED_MAX_S, BR_PFTRACE_MAX_AT, argv0);
     return f == stdout ? 0 : 2;
 }
@@ -133,6 +137,7 @@ int main(int argc, char **argv)
     double pred_s = 0.0;
     float qs[2] = {1.0f, 1.0f};
     double gate = 0.0; /* 0: the machine file's */
+    double pf_load = 0.0; /* 0: the machine file's */
     static br_pftrace_t tr;
     static const struct option opts[] = {{"ff-el", required_argument, NULL, 'E'},
                                          {"pred", required_argument, NULL, 'P'},
@@ -147,6 +152,7 @@ int main(int argc, char **argv)
                                          {"at", required_argument, NULL, 'a'},
                                          {"pf-q-scale", required_argument, NULL, 'q'},
                                          {"pf-gate", required_argument, NULL, 'g'},
+                                         {"pf-load", required_argument, NULL, 'L'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -171,6 +177,7 @@ int main(int argc, char **argv)
         else if (c == 'p') post = val, bad = 0;
         else if (c == 'a') bad = br_pftrace_parse_at(TOOL, val, &tr), have_at = 1;
         else if (c == 'g') bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &gate);
+        else if (c == 'L') bad = br_arg_double(TOOL, p.opt, val, 0.0, 1.0e9, &pf_load);
         else if (c == 'q') {
             int used = 0;
             bad = sscanf(val, "%f,%f%n", &qs[0], &qs[1], &used) != 2 || val[used] != '\0' ||
@@ -233,6 +240,7 @@ int main(int argc, char **argv)
             c.pf.est.q_var[BR_X_Z] *= qs[0];
             c.pf.est.q_var[BR_X_GP] *= qs[1];
             br_circle_use_pf_gate(&c, gate);
+            br_circle_use_pf_load(&c, pf_load);
             tr.label = first + j;
             tr.plant = &c.plant;
             tr.next_at = 0;

@@ -42,6 +42,7 @@
 
 #include "circle/br_circle.h"
 #include "circle_args/br_circle_args.h"
+#include "gms_args/br_gms_args.h"
 #include "plant/br_plant_json.h"
 #include "tool/br_args.h"
 #include "tool/br_outfile.h"
@@ -72,7 +73,7 @@ static int usage(const char *argv0, FILE *to)
             "usage: %s [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N] [--enc-noise P]\n"
             "       [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT] [--pf-dt S] [--pf-n M]\n"
             "       [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--ahead P] [--delay-id 0|1] [--radius-m R] [--feed-mm-min F]\n"
-            "       [--direction cw|ccw]\n"
+            "       [--direction cw|ccw] [--gms D1,..,DN] [--gms-zeta Z]\n"
             BR_ARGS_COMMON_USAGE
             "  --plant PLANT.json  the simulated plant (a model.json; default the reference machine)\n"
             "  --model MODEL.json  the identified model the *_id runs' estimators and feedforward use\n"
@@ -92,8 +93,10 @@ static int usage(const char *argv0, FILE *to)
             "  --pf-gate SIGMA     the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
             "  --ahead P           the estimators' compensation lead, periods past the delay (docs/modules/est.md)\n"
             "  --delay-id 0|1      the estimators' delay identification off / as the machine has it (docs/modules/dlyid.md)\n"
-            BR_CIRCLE_USAGE("--direction cw|ccw ")
-            "runs:", argv0, argv0, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA);
+            BR_CIRCLE_USAGE("--direction cw|ccw "),
+            argv0, argv0, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA);
+    br_gms_usage(to);
+    fprintf(to, "runs:");
     for (unsigned r = 0; r < N_RUNS; r++) fprintf(to, " %s", runs[r].name);
     fprintf(to, " (the *_id ones need --model)\n");
     return 2;
@@ -138,6 +141,7 @@ int main(int argc, char **argv)
     double veps = -1.0, pf_dt = -1.0, ahead = -1.0, pf_load = 0.0, pf_gate = 0.0;
     long pf_n = 0, pf_prop = -1, delay_id = -1;
     br_circle_path_t path = BR_CIRCLE_PATH_DEFAULT;
+    br_gms_args_t gms = BR_GMS_ARGS_DEFAULT;
     static const struct option opts[] = {
         {"plant", required_argument, NULL, 'P'},  {"model", required_argument, NULL, 'm'},
         {"json", required_argument, NULL, 'j'},   {"only", required_argument, NULL, 'o'},
@@ -147,7 +151,7 @@ int main(int argc, char **argv)
         {"pf-n", required_argument, NULL, 'n'},   {"seed", required_argument, NULL, 's'},
         {"pf-proposal", required_argument, NULL, 'p'}, {"ahead", required_argument, NULL, 'a'},
         {"delay-id", required_argument, NULL, 'i'}, {"pf-load", required_argument, NULL, 'L'},
-        {"pf-gate", required_argument, NULL, 'G'}, BR_CIRCLE_LONGOPTS{NULL, 0, NULL, 0}};
+        {"pf-gate", required_argument, NULL, 'G'}, BR_CIRCLE_LONGOPTS BR_GMS_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t ap;
     if (br_args_start(&ap, TOOL, argc, argv, usage)) return 0;
     const char *val;
@@ -174,6 +178,7 @@ int main(int argc, char **argv)
             bad = br_arg_double(TOOL, ap.opt, val, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &pf_gate);
             break;
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, ap.opt, val, 0, &path); break;
+        case BR_GMS_OPT: bad = br_gms_arg(TOOL, ap.opt, val, &gms); break;
         case 's':
             bad = br_arg_long(TOOL, ap.opt, val, 0, 2147483647L, &seed);
             real.seed = (unsigned long long)seed;
@@ -200,7 +205,8 @@ int main(int argc, char **argv)
         }
     }
     const br_circle_cfg_t thesis = br_circle_cfg_thesis(BR_CTRL_HINF_ONLY);
-    if (br_circle_path_check(TOOL, &path, &thesis) != 0) return usage(argv[0], stderr);
+    if (br_circle_path_check(TOOL, &path, &thesis) != 0 || br_gms_args_check(TOOL, &gms) != 0)
+        return usage(argv[0], stderr);
     br_plant_cfg_t plant = thesis.plant, model = thesis.plant;
     char msg[512];
     if (plant_path && br_plant_cfg_from_model_json(plant_path, &thesis.plant, &plant, msg, sizeof msg) != 0) {
@@ -211,6 +217,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: %s\n", TOOL, msg);
         return 1;
     }
+    /* --gms: the plant's friction Maxwell-slip (the truth only; the identified model stays as read) */
+    br_gms_args_apply(&gms, &plant);
     if (dir && mkdir(dir, 0775) != 0 && errno != EEXIST) {
         fprintf(stderr, "%s: cannot create %s: %s\n", TOOL, dir, strerror(errno));
         return 1;

@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "cause_args/br_cause_args.h"
+#include "gms_args/br_gms_args.h"
 #include "circle/br_circle.h"
 #include "ident/br_ident.h"
 #include "tool/br_args.h"
@@ -101,18 +102,15 @@ static int usage(const char *argv0, FILE *to)
             "  --seed N            seed of the force noise\n"
             "  --force-noise N     standard deviation of the noise on the logged force\n"
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
-            "  --machine-out FILE  the run's machine file (not with circle)\n"
-            "  --gms D1,..,DN      the plant's friction Maxwell-slip: N <= 8 equal elements breaking away at\n"
-            "                      D1..DN m at Fs (the slip law and damping of the demo's hardware-like plant)\n"
-            "  --gms-zeta Z        with --gms: each element's damping for a damping ratio Z of its mode on the\n"
-            "                      moving mass (sigma1_i = 2 Z sqrt(k_i M)) instead of the demo's %g N s/m\n",
-            argv0, argv0, BR_CIRCLE_HW_SIGMA1_NSPM);
+            "  --machine-out FILE  the run's machine file (not with circle)\n",
+            argv0, argv0);
+    br_gms_usage(to);
     br_cause_usage(to, "");
     fprintf(to,
-            "bounds: --cycles 1 .. %d, --reversals 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N,\n"
-            "        --gms-zeta %g .. %g (docs/tools.md)\n",
+            "bounds: --cycles 1 .. %d, --reversals 1 .. %d, --duration %g .. %g s, --force-noise 0 .. %g N\n"
+            "        (docs/tools.md)\n",
             BR_TOOL_CYCLES_MAX, BR_IDENT_REV_MAX_PAIRS, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S,
-            BR_TOOL_NOISE_MAX_N, BR_TOOL_GMS_ZETA_MIN, BR_TOOL_GMS_ZETA_MAX);
+            BR_TOOL_NOISE_MAX_N);
     return 2;
 }
 
@@ -133,48 +131,9 @@ typedef struct {
     int truth;
     double duration, noise;
     br_plant_cfg_t causes;
-    int gms_n;                     /* --gms: elements, 0 = the LuGre plant */
-    double gms_d_m[BR_GMS_MAX];    /* their breakaway displacements at Fs */
-    double gms_zeta;               /* --gms-zeta: the element modes' damping ratio, 0 = the demo's damping */
+    br_gms_args_t gms;             /* --gms, --gms-zeta: the plant's Maxwell-slip friction */
 } opts_t;
 
-
-/* --gms D1,..,DN: N in 1..BR_GMS_MAX breakaway displacements, each in (0, 1e-2] m */
-static int parse_gms(const char *val, opts_t *o)
-{
-    double d[BR_GMS_MAX + 1];
-    const int n = br_parse_numbers(val, d, BR_GMS_MAX + 1);
-    if (n < 1 || n > BR_GMS_MAX) {
-        fprintf(stderr, "%s: bad value for --gms: %s (1 to %d breakaway displacements in m, comma-separated)\n",
-                TOOL, val, BR_GMS_MAX);
-        return 1;
-    }
-    for (int i = 0; i < n; i++) {
-        if (!(d[i] > 0.0 && d[i] <= 1e-2)) {
-            fprintf(stderr, "%s: bad value for --gms: %s (each breakaway displacement must be in (0, 0.01] m)\n",
-                    TOOL, val);
-            return 1;
-        }
-        o->gms_d_m[i] = d[i];
-    }
-    o->gms_n = n;
-    return 0;
-}
-
-/* the Maxwell-slip elements of --gms on the plant: equal shares, k_i = Fs / (N d_i),
- * the hardware-like plant's slip law (C, element damping, docs/demo.md); with
- * --gms-zeta the damping of a ratio per element instead (br_gms_damping_ratio) */
-static void apply_gms(br_plant_cfg_t *plant, const opts_t *o)
-{
-    if (o->gms_n == 0) return;
-    double share[BR_GMS_MAX];
-    for (int i = 0; i < o->gms_n; i++) share[i] = 1.0 / o->gms_n;
-    br_gms_from_breakaway(&plant->gms, o->gms_n, o->gms_d_m, share, plant->Fs_N, BR_CIRCLE_HW_SIGMA1_NSPM);
-    plant->gms.clamp = 0;
-    plant->gms.C_mps = BR_CIRCLE_HW_C_MPS;
-    plant->gms.delta = 1.0;
-    if (o->gms_zeta > 0.0) br_gms_damping_ratio(&plant->gms, o->gms_zeta, br_plant_meff_kg(plant));
-}
 
 /* every option checked: 0, 1 (--help or --version answered) or 2 (usage error, message printed) */
 static int parse(int argc, char **argv, opts_t *o)
@@ -188,10 +147,8 @@ static int parse(int argc, char **argv, opts_t *o)
                                          {"seed", required_argument, NULL, 's'},
                                          {"duration", required_argument, NULL, 'd'},
                                          {"force-noise", required_argument, NULL, 'n'},
-                                         {"gms", required_argument, NULL, 'g'},
                                          {"reversals", required_argument, NULL, 'r'},
-                                         {"gms-zeta", required_argument, NULL, 'z'},
-                                         BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
+                                         BR_GMS_LONGOPTS BR_CAUSE_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 1;
     const char *val;
@@ -211,10 +168,7 @@ static int parse(int argc, char **argv, opts_t *o)
             bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_DURATION_MIN_S, BR_TOOL_DURATION_MAX_S, &o->duration);
             break;
         case 'n': bad = br_arg_double(TOOL, p.opt, val, 0.0, BR_TOOL_NOISE_MAX_N, &o->noise); break;
-        case 'g': bad = parse_gms(val, o); break;
-        case 'z':
-            bad = br_arg_double(TOOL, p.opt, val, BR_TOOL_GMS_ZETA_MIN, BR_TOOL_GMS_ZETA_MAX, &o->gms_zeta);
-            break;
+        case BR_GMS_OPT: bad = br_gms_arg(TOOL, p.opt, val, &o->gms) != 0; break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return 2;
@@ -237,10 +191,7 @@ static int parse(int argc, char **argv, opts_t *o)
         fprintf(stderr, "%s: --cycles applies to --traj ident only (the others take --duration)\n", TOOL);
         return 2;
     }
-    if (o->gms_zeta > 0.0 && o->gms_n == 0) {
-        fprintf(stderr, "%s: --gms-zeta applies with --gms only (the damping of its elements)\n", TOOL);
-        return 2;
-    }
+    if (br_gms_args_check(TOOL, &o->gms) != 0) return 2;
     if (o->reversals > 0 && strcmp(o->traj, "ident") != 0) {
         fprintf(stderr, "%s: --reversals applies to --traj ident only\n", TOOL);
         return 2;
@@ -254,7 +205,7 @@ static int parse(int argc, char **argv, opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 0, 8.0, 0.0, br_plant_cfg_reference(), 0, {0.0}, 0.0};
+    opts_t opt = {NULL, "ident", NULL, NULL, 0, 1, 0, 0, 8.0, 0.0, br_plant_cfg_reference(), BR_GMS_ARGS_DEFAULT};
     const int p = parse(argc, argv, &opt);
     if (p == 1) return 0; /* --help or --version answered */
     if (p != 0) return usage(argv[0], stderr);
@@ -267,7 +218,7 @@ int main(int argc, char **argv)
     }
     /* the plant: the reference machine or a saved model, then the cause options on top */
     br_causes_apply(&plant, &opt.causes);
-    apply_gms(&plant, &opt);
+    br_gms_args_apply(&opt.gms, &plant);
 
     /* the outputs: temporary files beside their names until the run succeeded */
     br_outfile_t log_file, machine_file = {0};

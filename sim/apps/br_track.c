@@ -44,6 +44,7 @@
 #include "circle/br_circle_pftrace.h"
 #include "hal_sim/br_hal_sim.h"
 #include "plant/br_model_params.h"
+#include "gms_args/br_gms_args.h"
 #include "plant/br_plant_json.h"
 #include "cause_args/br_cause_args.h"
 #include "tool/br_args.h"
@@ -346,6 +347,7 @@ static int usage(const char *argv0, FILE *to)
             "usage: %s --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]\n"
             "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,\n"
             "                  hinf_pf_ext_ff,hinf_true_ff,hinf_ukf] [--json OUT] [--trace DIR]\n"
+            "          [--gms D1,..,DN] [--gms-zeta Z]\n"
             BR_ARGS_COMMON_USAGE
             "  --ref LOG.csv       the measured log whose reference trajectory is tracked\n"
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
@@ -355,6 +357,7 @@ static int usage(const char *argv0, FILE *to)
             "  --trace DIR         each run's trace as CSV into DIR (track_NAME.csv), and for\n"
             "                      the PF runs its steps (pf_NAME.csv: truth, cloud, miss, gate)\n",
             argv0, argv0);
+    br_gms_usage(to);
     return 2;
 }
 
@@ -363,13 +366,14 @@ int main(int argc, char **argv)
     const char *ref = NULL, *model = NULL, *json = NULL, *trace = NULL, *ctrls = NULL;
     double pd[4];
     int have_pd = 0;
+    br_gms_args_t gms = BR_GMS_ARGS_DEFAULT;
     static const struct option opts[] = {{"ref", required_argument, NULL, 'r'},
                                          {"model", required_argument, NULL, 'm'},
                                          {"json", required_argument, NULL, 'j'},
                                          {"trace", required_argument, NULL, 't'},
                                          {"ctrl", required_argument, NULL, 'c'},
                                          {"pd", required_argument, NULL, 'p'},
-                                         {NULL, 0, NULL, 0}};
+                                         BR_GMS_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
     const char *val;
@@ -387,9 +391,13 @@ int main(int argc, char **argv)
                 return 2;
             }
             break;
+        case BR_GMS_OPT:
+            if (br_gms_arg(TOOL, p.opt, val, &gms) != 0) return usage(argv[0], stderr);
+            break;
         default: return usage(argv[0], stderr); /* BR_ARGS_BAD: reported */
         }
     }
+    if (br_gms_args_check(TOOL, &gms) != 0) return usage(argv[0], stderr);
     if (!ref) {
         fprintf(stderr, "%s: --ref is required\n", TOOL);
         return usage(argv[0], stderr);
@@ -401,6 +409,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "br_track: %s\n", msg);
         return 1;
     }
+    /* --gms: the plant's friction Maxwell-slip (after the model: its Fs and moving mass) */
+    br_gms_args_apply(&gms, &plant);
     traj_t tr;
     if (read_traj(ref, &tr) != 0) return 1;
     /* written to a temporary file, renamed onto --json only when every run succeeded */

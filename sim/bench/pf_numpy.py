@@ -5,6 +5,9 @@ in numpy, vectorised over the particles, timed on the recording br_bench made
 (br_bench --record FILE), and compared with the C filter.
 
 Same model and algorithm as br_pf.c, in float32 throughout (as the firmware):
+  delay     the torque u_a the command history gives for the delay in use, and
+            the delay identification's bank (dly1-dly7, dlyid_numpy.py), whose
+            switch changes the delay from the next period on
   predict   eq. 6 by the PF's RK4 (br_model_kp_rk4) on every particle,
             then, per particle (a mask on the a h <= 2 test at both ends of
             the step), the bounded
@@ -52,6 +55,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "firmware", "design"))
 import gen_noise  # noqa: E402
+from dlyid_numpy import DelayBank, DelayHistory  # noqa: E402
 
 F = np.float32
 # constants of the C code
@@ -139,6 +143,10 @@ class NumpyPf:
         self.gp0 = F(cfg["gp0_N"])
         self.gp_min, self.gp_max = F(cfg["gp_min_N"]), F(cfg["gp_max_N"])
         self.x0_std = np.array(cfg["x0_std"], dtype=F).reshape(4, 1)
+        # the actuator delay and its identification (dlyid_numpy.py, docs/modules/dlyid.md)
+        self.bank = DelayBank(cfg)
+        self.hist = DelayHistory(cfg["delay_s"], cfg["dt_s"], F(cfg["delay_s"]) > F(0.0) or self.bank.n > 0,
+                                 self.bank.keep())
         self.noise = noise
         self.mask = len(noise) - 1
         self.skip = int(cfg["noise_skip"])
@@ -245,6 +253,11 @@ class NumpyPf:
 
     def step(self, counts, frac, u):
         """br_pf_step; counts a Python int, frac and u np.float32. Returns the status."""
+        # the torque that reached the axis over the last period: u with the delay in use; then the
+        # delay identification takes the measurement, its switch acting from the next period on
+        u = self.hist.apply(u)
+        if self.bank.step(counts, frac, self.hist):
+            self.hist.m, self.hist.f = self.bank.cm[self.bank.cur], self.bank.cf[self.bank.cur]
         if not self.primed:
             return self._prime(counts, frac)
         m, rpc = self.m, self.rpc
@@ -329,7 +342,7 @@ def replay(cfg, noise, rec, n_steps=None):
     """A fresh filter over the recording; returns (F_hat per step, wall ns of each
     step k >= 1, thread CPU ns of steps 1.. together, statuses, {"adapt_active_steps":
     steps after which cfg.adapt's noise factor is above 1, "reanchor_steps": steps
-    that re-anchored the cloud})."""
+    that re-anchored the cloud, "delay_switches": the delay identification's switches})."""
     pf = NumpyPf(cfg, noise)
     counts = [int(c) for c in rec["counts"]]
     frac = rec["frac"].astype(F)
@@ -357,7 +370,8 @@ def replay(cfg, noise, rec, n_steps=None):
             fhat[k] = fhat[k - 1]
     cpu = time.thread_time_ns() - c0
     return fhat, ns, cpu, st, {"adapt_active_steps": int(np.count_nonzero(adapt)),
-                               "reanchor_steps": int(np.count_nonzero(anchor))}
+                               "reanchor_steps": int(np.count_nonzero(anchor)),
+                               "delay_switches": pf.bank.n_switch}
 
 
 def rms(a):
@@ -487,6 +501,7 @@ def main():
         "outlier_steps": int(np.count_nonzero(st == BR_W_OUTLIER)),
         "adapt_active_steps": paths["adapt_active_steps"],
         "reanchor_steps": paths["reanchor_steps"],
+        "delay_switches": paths["delay_switches"],
         "error_steps": int(np.count_nonzero((st != BR_OK) & (st != BR_W_OUTLIER))),
     }
     print("PF  numpy (float32, vectorised over particles, numpy %s): %.1f ns per particle-step "
@@ -500,8 +515,8 @@ def main():
           % (res["fhat_rms_err_N"], res["fhat_c_rms_err_N"], res["outlier_steps"], res["error_steps"]))
     print("    F_hat identical to the C filter's (bit for bit) at %d of %d steps; numpy - C: RMS %.2e N, max %.2e N"
           % (same, n, res["fhat_vs_c_rms_N"], res["fhat_vs_c_max_N"]))
-    print("    cfg.adapt's noise factor above 1 after %d of %d steps; %d re-anchoring steps"
-          % (paths["adapt_active_steps"], n, paths["reanchor_steps"]))
+    print("    cfg.adapt's noise factor above 1 after %d of %d steps; %d re-anchoring steps; %d switches of the "
+          "identified delay" % (paths["adapt_active_steps"], n, paths["reanchor_steps"], paths["delay_switches"]))
     if same != n:
         print("pf_numpy: %s: the numpy PF is not bit-identical to the C one%s"
               % (("error", "") if a.check else ("warning", " (timing still valid if it tracks)")), file=sys.stderr)

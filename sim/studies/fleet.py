@@ -94,6 +94,37 @@ def summarise(recs, kinds=None):
     return out
 
 
+FRICTIONS = (("lugre", "LuGre"), ("maxwell_slip", "Maxwell-slip presliding"))
+
+
+def friction_of(r):
+    return "maxwell_slip" if r["axis"].get("presliding") else "lugre"
+
+
+def friction_split(recs):
+    """per plant friction (fleet_axis.P_PRESLIDING): the axes, how many the diagnosis named
+    presliding_hysteresis on, and the controllers' statistics over their runs"""
+    out = {}
+    for key, _ in FRICTIONS:
+        sub = [r for r in recs if friction_of(r) == key]
+        through = [r for r in sub if "chain_failed" not in r]
+        named = [r["i"] for r in through if "presliding_hysteresis" in (r.get("machine", {}).get("causes") or {})]
+        out[key] = {"n_axes": len(sub), "n_through_chain": len(through), "presliding_named": named,
+                    "controllers": summarise(sub)}
+    return out
+
+
+def friction_lines(summ):
+    L = []
+    for key, title in FRICTIONS:
+        f = summ.get("friction", {}).get(key)
+        if not f or not f["n_axes"]:
+            continue
+        L += ["", "### %s plants (%d axes, %d through the chain; the diagnosis named presliding_hysteresis on %d)"
+              % (title, f["n_axes"], f["n_through_chain"], len(f["presliding_named"])), ""] + table(f["controllers"])
+    return L
+
+
 def cdf_plot(recs, path, n_axes):
     import matplotlib
     matplotlib.use("Agg")
@@ -199,6 +230,7 @@ def write_md(path, summ, command, out_dir=None, out_name=None):
           ""] + table(summ["controllers"])
     for kind, ctl in summ["kinds"].items():
         L += ["", "### %s" % kind, ""] + table(ctl)
+    L += friction_lines(summ)
     lines = lost_lines(summ)
     L += ["", "### Lost runs (%d)" % len(lines), "",
           "A run is lost when the firmware stopped it (its fault's cause and time), its filter re-anchored "
@@ -325,6 +357,7 @@ def main():
             "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],
             "controllers": summarise(good),
             "kinds": {k: summarise(good, (k,)) for k in kinds},
+            "friction": friction_split(good),
             "axes": [{k: v for k, v in r.items() if k != "timing"} for r in good]}
     with open(os.path.join(a.out, "summary.json"), "w", encoding="utf-8") as f:
         json.dump(summ, f, indent=1, sort_keys=True)

@@ -32,7 +32,11 @@ SIGMA0_NPM = (1e5, 1e8)
 PERIOD_S = (0.25e-3, 2e-3)
 DELAY_MAX_S = 3e-3
 P_DELAY = 0.5              # probability that the axis has an actuator delay the machine file does not know
-P_PRESLIDING = 0.0         # hook: the presliding plant of the presliding issue, once it exists
+P_PRESLIDING = 0.25        # probability that the plant's presliding is Maxwell-slip (issue 30), not LuGre
+GMS_N = (2, 6)             # its elements (equal shares), issue 30's drawn plants' range
+GMS_D_M = (0.3e-6, 30e-6)  # their breakaway displacements at Fs, log-uniform (issue 30's range)
+GMS_ZETA = (0.01, 0.8)     # each element's mode damping ratio on the moving mass, log-uniform: the span
+                           # issue 30's 300-4000 N s/m gives for those elements on the reference axis
 MOTOR_REV_PER_S = 50.0     # 3000 rpm: the axis's speed limit is lead x this
 TRAVEL_M = 0.3             # every axis's working range from position 0 (the reference's stroke); the
                            # circles (centred on 0) reach RADIUS_M[1] below it. The stroke adds each axis's
@@ -89,6 +93,12 @@ def draw(study_seed, i):
     force_noise = fc * float(rng.uniform(0.0, 0.03))
     delay = float(rng.uniform(0.0, DELAY_MAX_S)) if rng.uniform() < P_DELAY else 0.0
     presliding = bool(rng.uniform() < P_PRESLIDING)
+    # drawn last, and only for such a plant: every other axis draws what it drew before
+    gms = None
+    if presliding:
+        n = int(rng.integers(GMS_N[0], GMS_N[1] + 1))
+        gms = {"breakaway_m": sorted(loguniform(rng, *GMS_D_M) for _ in range(n)),
+               "zeta": loguniform(rng, *GMS_ZETA)}
     vmax = lead * MOTOR_REV_PER_S
     f_max = FORCE_MARGIN * (fs + sigma2 * vmax + meff * SIZING_ACC_MPS2)
     return {"i": i, "seed": axis_seed(study_seed, i), "lead_m_per_rev": lead, "table_mass_kg": mass,
@@ -96,7 +106,16 @@ def draw(study_seed, i):
             "friction": {"sigma2_Nspm": sigma2, "sigma0_Npm": sigma0, "sigma1_Nspm": sigma1, "Fc_N": fc, "Fs_N": fs,
                          "vs_mps": vs},
             "period_s": period, "force_noise_N": force_noise, "delay_s": delay, "presliding": presliding,
+            "gms": gms,
             "max_speed_mps": vmax, "force_max_N": f_max, "traj": trajectories(np.random.default_rng(axis_seed(study_seed, i) + [1]), vmax)}
+
+
+def gms_options(ax):
+    """the plant's Maxwell-slip friction as the simulating tools' options (sim/lib/gms_args): [] for LuGre"""
+    g = ax.get("gms")
+    if not g:
+        return []
+    return ["--gms", ",".join("%.6g" % d for d in g["breakaway_m"]), "--gms-zeta", "%.6g" % g["zeta"]]
 
 
 def trajectories(rng, vmax):

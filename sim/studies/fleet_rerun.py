@@ -86,7 +86,7 @@ def main():
         with open(os.path.join(od, "runs.log"), "w", encoding="utf-8") as log:
             for k, tr in circles:
                 if tr["name"] in names:
-                    fleet_runs.circle_runs(od, exe, os.path.join(d, "truth-model.json"), tr,
+                    fleet_runs.circle_runs(od, exe, os.path.join(d, "truth-model.json"), fleet_axis.gms_options(ax), tr,
                                            fleet_runs.run_seed(a.seed, i, k + 1), ax["force_noise_N"], log)
         for key, r in records(d, names).items():
             before[(i,) + key] = r

@@ -32,6 +32,7 @@ from runs import REFUSED_AT_INIT, faulted  # noqa: E402
 CIRCLE_CTRLS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")  # br_robust_run, the machine file's model
 TRACK_CTRLS = ("hinf_only", "hinf_ukf", "hinf_pf")              # br_track (its feedforward is the plant's: an oracle)
 ESTIMATORS = ("hinf_ff", "hinf_ukf", "hinf_pf")
+IDENT_REVERSALS = 1  # the identification log's reversal segment: the log docs/diagnose.md asks for presliding
 
 
 class ChainError(Exception):
@@ -74,11 +75,11 @@ def result(raw, rms_key, max_key):
     return r
 
 
-def circle_runs(d, exe, truth, tr, seed, noise, log):
+def circle_runs(d, exe, truth, gms, tr, seed, noise, log):
     out = {}
     for k, ctrl in enumerate(CIRCLE_CTRLS):
         js = os.path.join(d, "%s_%s.json" % (tr["name"], ctrl))
-        cmd = [exe, "--plant", truth, "--only", ctrl, "--force-noise", "%.6g" % noise, "--seed", str(seed),
+        cmd = [exe, "--plant", truth, *gms, "--only", ctrl, "--force-noise", "%.6g" % noise, "--seed", str(seed),
                "--json", js]
         if tr["kind"] == "circle":
             cmd += ["--radius-m", "%.6g" % tr["radius_m"], "--feed-mm-min", "%.6g" % tr["feed_mm_min"],
@@ -93,12 +94,12 @@ def circle_runs(d, exe, truth, tr, seed, noise, log):
     return out
 
 
-def track_runs(d, exe, truth, ref, name, log):
+def track_runs(d, exe, truth, gms, ref, name, log):
     out = {}
     for ctrl in TRACK_CTRLS:
         js = os.path.join(d, "%s_%s.json" % (name, ctrl))
         try:
-            tool("br_track", [exe, "--ref", ref, "--model", truth, "--ctrl", ctrl, "--json", js], log)
+            tool("br_track", [exe, "--ref", ref, "--model", truth, *gms, "--ctrl", ctrl, "--json", js], log)
         except ChainError as e:
             out[ctrl] = {"faulted": True, "fault_t_s": None, "fault_cause": "tool failed: " + e.msg}
             continue
@@ -137,6 +138,7 @@ def chain(a, ax, d, log, sw):
     ident = os.path.join(d, "ident.csv")
     tool("identification log", [simlog, "--out", ident, "--traj", "ident", "--model", truth_model,
                                 "--force-noise", "%.6g" % ax["force_noise_N"], "--seed", str(run_seed(a.seed, ax["i"], 0)),
+                                "--reversals", str(IDENT_REVERSALS), *fleet_axis.gms_options(ax),
                                 "--machine-out", os.path.join(d, "ident.machine.json")], log)
     sw.lap("identification_log")
     diag = os.path.join(d, "diagnose")
@@ -155,7 +157,8 @@ def chain(a, ax, d, log, sw):
     with open(machine_json, encoding="utf-8") as f:
         mj = json.load(f)
     return truth_model, robust, track, {"hinf_weights": why or "the reference's",
-                                        **{sec: mj[sec] for sec in ("mechanics", "friction", "causes", "control")}}
+                                        **{sec: mj[sec] for sec in ("mechanics", "friction", "causes", "control",
+                                                                    "friction_model") if sec in mj}}
 
 
 def trajectory_set(a, ax):
@@ -177,10 +180,11 @@ def one_axis(a, i):
         try:
             truth, robust, track, rec["machine"] = chain(a, ax, d, log, sw)
             acc = fleet_axis.move_acc(ax)
+            gms = fleet_axis.gms_options(ax)  # the truth's Maxwell-slip friction, where it has one
             for k, tr in enumerate(trajectory_set(a, ax)):
                 rec["traj"][tr["name"]] = tr
                 if tr["kind"] in ("thesis_circle", "circle"):
-                    rec["runs"][tr["name"]] = circle_runs(d, robust, truth, tr, run_seed(a.seed, i, k + 1),
+                    rec["runs"][tr["name"]] = circle_runs(d, robust, truth, gms, tr, run_seed(a.seed, i, k + 1),
                                                           ax["force_noise_N"], log)
                     continue
                 t, ref = (fleet_axis.p2p_reference(tr["moves"], ax["max_speed_mps"], acc) if tr["kind"] == "p2p"
@@ -188,7 +192,7 @@ def one_axis(a, i):
                 tr["duration_s"] = float(t[-1])
                 path = os.path.join(d, tr["name"] + ".ref.csv")
                 fleet_axis.write_reference(path, t, ref)
-                rec["runs"][tr["name"]] = track_runs(d, track, truth, path, tr["name"], log)
+                rec["runs"][tr["name"]] = track_runs(d, track, truth, gms, path, tr["name"], log)
         except ChainError as e:
             rec["chain_failed"] = {"stage": e.stage, "message": e.msg}
         except Exception:  # noqa: BLE001 - the study's own error, reported and made its exit status

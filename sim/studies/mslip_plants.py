@@ -11,7 +11,10 @@ with its time and cause (sim/studies/runs.py), never given a figure.
 
 Usage:
   mslip_plants.py --bin BUILD/sim --out DIR [--n N] [--first J] [--seed S] [--jobs J]
-                  [--md PAGE --command CMD [--expect-faults]]"""
+                  [--pf-load Q] [--md PAGE --command CMD [--expect-faults]]
+
+--pf-load Q runs the PF with its shared external force at Q N^2/s
+(br_mslip_plants --pf-load; docs/modules/pf.md), a study."""
 import argparse
 import json
 import math
@@ -36,9 +39,10 @@ BEGIN, END = "<!-- mslip-plants:begin -->", "<!-- mslip-plants:end -->"
 
 
 def one_plant(job):
-    j, seed, binary, out = job
+    j, seed, binary, out, pf_load = job
     path = os.path.join(out, "plants", "plant_%04d.json" % j)
-    r = subprocess.run([binary, "--first", str(j), "--n", "1", "--seed", str(seed), "--json", path],
+    extra = ["--pf-load", repr(pf_load)] if pf_load is not None else []
+    r = subprocess.run([binary, "--first", str(j), "--n", "1", "--seed", str(seed), "--json", path] + extra,
                        capture_output=True, text=True)
     if r.returncode != 0:
         return {"plant": j, "error": "br_mslip_plants rc %d: %s" % (r.returncode, r.stderr.strip())}
@@ -137,17 +141,21 @@ def main():
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--md", help="docs page: its part after %s is rewritten" % BEGIN)
     ap.add_argument("--command", default="make mslip-plants")
+    ap.add_argument("--pf-load", type=float,
+                    help="the PF's shared external force, random walk N^2/s (br_mslip_plants --pf-load; a study)")
     ap.add_argument("--expect-faults", action="store_true",
                     help="with --md: the page may list faulted runs; without it a fault makes the study exit 1 "
                          "after writing the page")
     a = ap.parse_args()
     if not 1 <= a.n <= 100000 or not 0 <= a.first <= 100000 or a.jobs < 1 or not 0 <= a.seed <= 1000000000:
         ap.error("--n in 1..100000, --first in 0..100000, --jobs >= 1, --seed in 0..1e9")
+    if a.pf_load is not None and not 0 <= a.pf_load <= 1e9:  # br_mslip_plants's bound, before any plant
+        ap.error("--pf-load in 0..1e9")
     binary = os.path.join(a.bin, "br_mslip_plants")
     if not os.access(binary, os.X_OK):
         ap.error("no br_mslip_plants in %s" % a.bin)
     os.makedirs(os.path.join(a.out, "plants"), exist_ok=True)
-    jobs = [(j, a.seed, binary, a.out) for j in range(a.first, a.first + a.n)]
+    jobs = [(j, a.seed, binary, a.out, a.pf_load) for j in range(a.first, a.first + a.n)]
     plants = []
     with Pool(a.jobs) as pool:
         for k, rec in enumerate(pool.imap_unordered(one_plant, jobs), 1):

@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: Apache-2.0
 """The fleet study (docs/fleet.md), label `study`.
 
-- A fleet of 2 axes on the thesis circle and the point-to-point moves on Dask's local cluster of 2
-  workers: summary.json's structure; H-inf only's contour RMS finite and
+- A fleet of 2 axes (one with a LuGre plant, one with a Maxwell-slip plant) on the thesis circle and
+  the point-to-point moves on Dask's local cluster of 2 workers: summary.json's structure; H-inf only's contour RMS finite and
   positive on every run that went to the end; every faulted run listed in
   "lost" with its cause and time and never carrying an RMS; a chain failure
   listed with its stage.
-- The study with N=1 on 1 worker: axis 0's record is the same (the axes do
+- Axis 0 alone on 1 worker: its record is the same (the axes do
   not depend on the scheduling, the worker count or N).
 - The statistics on records made here: a faulted run stays out of the RMS
   figures and is lost with its cause; a run worse than H-inf only is lost.
@@ -32,9 +32,14 @@ ARGS = None
 SEED = 7
 
 
-def study(out, n, workers):
+# the two-axis fleet: axis 0 (LuGre) and the seed's first axis with a Maxwell-slip plant
+TWO_AXES = (0, 7)
+
+
+def study(out, axes, workers):
     shutil.rmtree(out, ignore_errors=True)
-    r = subprocess.run([sys.executable, os.path.join(REPO, "sim", "studies", "fleet.py"), "--out", out, "--n", str(n),
+    r = subprocess.run([sys.executable, os.path.join(REPO, "sim", "studies", "fleet.py"), "--out", out,
+                        "--axes", ",".join(str(i) for i in axes),
                         "--seed", str(SEED), "--workers", str(workers), "--kinds", "thesis_circle,p2p"],
                        capture_output=True, text=True, timeout=500)
     if r.returncode != 0:
@@ -46,13 +51,17 @@ def study(out, n, workers):
 class Fleet(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.two, cls.out2 = study(os.path.join(ARGS.work, "two"), 2, 2)
-        cls.one, _ = study(os.path.join(ARGS.work, "one"), 1, 1)
+        cls.two, cls.out2 = study(os.path.join(ARGS.work, "two"), TWO_AXES, 2)
+        cls.one, _ = study(os.path.join(ARGS.work, "one"), TWO_AXES[:1], 1)
 
     def test_structure(self):
         s = self.two
         self.assertEqual(s["n_axes"], 2)
-        self.assertEqual([r["i"] for r in s["axes"]], [0, 1])
+        self.assertEqual([r["i"] for r in s["axes"]], list(TWO_AXES))
+        # the plants by friction: one LuGre, one Maxwell-slip, each with its controllers' statistics
+        self.assertEqual([s["friction"][k]["n_axes"] for k in ("lugre", "maxwell_slip")], [1, 1])
+        self.assertEqual(s["friction"]["maxwell_slip"]["controllers"]["hinf_only"]["n"],
+                         len(s["axes"][1]["runs"]))
         self.assertEqual(sorted(s["kinds"]), ["p2p", "thesis_circle"])
         # br_track runs the UKF too
         self.assertEqual(sorted(s["kinds"]["p2p"]), ["hinf_only", "hinf_pf", "hinf_ukf"])
@@ -152,6 +161,15 @@ class Fleet(unittest.TestCase):
             self.assertLess((fleet_axis.TRAVEL_M + 0.01 * ax["max_speed_mps"]) / ax["lead_m_per_rev"]
                             * ax["counts_per_rev"], 2 ** 31)
             self.assertTrue(0.25e-3 <= ax["period_s"] <= 2e-3 and 0.0 <= ax["delay_s"] <= 3e-3)
+            # a Maxwell-slip plant's elements within issue 30's ranges, and none on a LuGre plant
+            g = ax["gms"]
+            self.assertEqual(g is not None, ax["presliding"])
+            self.assertEqual(fleet_axis.gms_options(ax) != [], ax["presliding"])
+            if g:
+                self.assertTrue(fleet_axis.GMS_N[0] <= len(g["breakaway_m"]) <= fleet_axis.GMS_N[1])
+                self.assertEqual(g["breakaway_m"], sorted(g["breakaway_m"]))
+                self.assertTrue(all(fleet_axis.GMS_D_M[0] <= d <= fleet_axis.GMS_D_M[1] for d in g["breakaway_m"]))
+                self.assertTrue(fleet_axis.GMS_ZETA[0] <= g["zeta"] <= fleet_axis.GMS_ZETA[1])
             # the machine file a user writes for it loads, and its soft travel limits (the drive's
             # protections) hold the working range every trajectory stays in
             path = os.path.join(ARGS.work, "given-%d.json" % i)

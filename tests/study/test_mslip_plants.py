@@ -71,6 +71,22 @@ def main():
                          "--first", "-1"], capture_output=True, text=True)
     check(r4.returncode == 2 and "--first" in r4.stderr and not os.path.exists(os.path.join(a.work, "j4")),
           "--first -1: refused (exit 2) with nothing written: rc %d %s" % (r4.returncode, r4.stderr))
+    # --pf-load outside br_mslip_plants's bound (0 .. 1e9, nan included): refused before any plant runs
+    for bad in ("-1", "2e9", "nan"):
+        r5 = subprocess.run([sys.executable, STUDY, "--bin", a.bin, "--out", os.path.join(a.work, "j5"), "--n", "1",
+                             "--pf-load", bad], capture_output=True, text=True)
+        check(r5.returncode == 2 and "--pf-load" in r5.stderr and not os.path.exists(os.path.join(a.work, "j5")),
+              "--pf-load %s: refused (exit 2) with nothing written: rc %d %s" % (bad, r5.returncode, r5.stderr))
+    # --pf-load reaches the PF and only the PF: plant 103 with the PF's shared external force
+    r6 = subprocess.run([sys.executable, STUDY, "--bin", a.bin, "--out", os.path.join(a.work, "j6"), "--n", "1",
+                         "--first", "103", "--jobs", "1", "--pf-load", "1e4"], capture_output=True, text=True)
+    check(r6.returncode == 0, "--pf-load 1e4: %s" % r6.stderr)
+    if r6.returncode == 0:
+        p6 = json.load(open(os.path.join(a.work, "j6", "plants", "plant_0103.json")))["plants"][0]
+        p0 = plants[103 - FIRST]
+        check(all(p6["runs"][c] == p0["runs"][c] for c in p0["runs"] if c != "hinf_pf"),
+              "--pf-load changed a run other than the PF's")
+        check(p6["runs"]["hinf_pf"] != p0["runs"]["hinf_pf"], "--pf-load did not reach the PF's run")
     r3 = study(a, os.path.join(a.work, "j3"), 2, "--md", page, "--command", "test", "--expect-faults")
     check(r3.returncode == 0, "--expect-faults: %s" % r3.stderr)
     for f in fails:

@@ -4,8 +4,10 @@ also where the thesis circle never takes it: on the demo's realistic plant
 cfg.adapt's noise factor rises above 1 and the cloud is re-anchored after
 consecutive outliers (with the thesis gate, --thesis-gate; with the machine's
 transient term no outlier comes). br_bench records that closed loop (--plant realistic)
-both ways;
-pf_numpy.py --check replays it and exits 1 unless every step's F_hat equals
+both ways, and the hardware-like plant's (--plant hardware_like), where the
+PF's delay identification switches (docs/modules/dlyid.md: its setting does on
+plants without a delay) and the filter predicts with the delayed torque;
+pf_numpy.py --check replays each and exits 1 unless every step's F_hat equals
 the C filter's. The test also requires that the recording reaches both paths
 (else it would prove nothing); --plant's refusals are in test_tools.py.
 Run with a release br_bench (a sanitised one is slow).
@@ -31,12 +33,15 @@ def main():
     fails = []
     # the machine's gate (its transient term, eq. G1, in the threshold and the NIS cap), then the
     # thesis gate, with which the realistic plant's encoder noise re-anchors the cloud
-    for tag, extra, need in (("term", [], ("adapt_active_steps",)),
-                             ("thesis_gate", ["--thesis-gate"], ("adapt_active_steps", "reanchor_steps"))):
+    # the hardware-like plant (Maxwell-slip friction): the delay identification switches there
+    for tag, plant, extra, need in (
+            ("term", "realistic", [], ("adapt_active_steps",)),
+            ("thesis_gate", "realistic", ["--thesis-gate"], ("adapt_active_steps", "reanchor_steps")),
+            ("hardware_like", "hardware_like", [], ("adapt_active_steps", "delay_switches"))):
         rec = os.path.join(work, "pf_input_%s.csv" % tag)
-        rc, out = run([bench, "--plant", "realistic", "--reps", "1", "--ukf-reps", "1", "--record", rec] + extra)
+        rc, out = run([bench, "--plant", plant, "--reps", "1", "--ukf-reps", "1", "--record", rec] + extra)
         if rc != 0:
-            sys.exit("br_bench --plant realistic %s failed (exit %d):\n%s" % (" ".join(extra), rc, out))
+            sys.exit("br_bench --plant %s %s failed (exit %d):\n%s" % (plant, " ".join(extra), rc, out))
         res = os.path.join(work, "numpy_%s.json" % tag)
         rc, out = run([sys.executable, os.path.join(ROOT, "sim", "bench", "pf_numpy.py"), rec, "--reps", "1",
                        "--check", "--out", res])
@@ -52,6 +57,8 @@ def main():
                          % tag)
         if "reanchor_steps" in need and r["reanchor_steps"] == 0:
             fails.append("%s: the recording never re-anchors the cloud: that path is not compared" % tag)
+        if "delay_switches" in need and r["delay_switches"] == 0:
+            fails.append("%s: the delay identification never switches: the delayed torque is not compared" % tag)
     return tool_check.finish(fails)
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ byte for byte and no temporary file behind.
 
 Usage: test_tools.py --bin DIR --work DIR"""
 import argparse
+import json
 import os
 import shutil
 import subprocess
@@ -139,19 +140,55 @@ class ToolsTest(unittest.TestCase):
         r = run("br_simlog", "--out", out, "--traj", "backforth", "--reversals", "1")
         self.assert_refused(r, 2, "--reversals applies to --traj ident only")
         self.assert_untouched(out)
-        # --gms: 1..8 breakaway displacements, each in (0, 0.01] m
-        for bad in ("0", "-1e-6", "0.02", "nan", "1e-6,", "1e-6,2e-6,3e-6,4e-6,5e-6,6e-6,7e-6,8e-6,9e-6"):
-            r = run("br_simlog", "--out", out, "--traj", "circle", "--gms", bad)
-            self.assert_refused(r, 2, "bad value for --gms")
-            self.assert_untouched(out)
-        # --gms-zeta: a damping ratio in 0.001 .. 1, with --gms only
-        for bad in ("0", "-0.1", "1.5", "nan", "x"):
-            r = run("br_simlog", "--out", out, "--traj", "circle", "--gms", "2e-6", "--gms-zeta", bad)
-            self.assert_refused(r, 2, "--gms-zeta")
-            self.assert_untouched(out)
-        r = run("br_simlog", "--out", out, "--traj", "circle", "--gms-zeta", "0.1")
-        self.assert_refused(r, 2, "--gms-zeta applies with --gms only")
-        self.assert_untouched(out)
+
+    def test_gms_options_checked_in_every_tool(self):
+        # --gms: 1..8 breakaway displacements, each in (0, 0.01] m; --gms-zeta: a damping ratio in
+        # 0.001 .. 1, with --gms only (sim/lib/gms_args, the three tools that simulate an axis)
+        for tool, head in (("br_simlog", ["--out", "{}", "--traj", "circle"]), ("br_robust_run", ["--json", "{}"]),
+                           ("br_track", ["--json", "{}", "--ref", "{}"])):
+            out = self.existing(tool + ".out")
+            args = [out if a == "{}" else a for a in head]
+            for bad in ("0", "-1e-6", "0.02", "nan", "1e-6,", "1e-6,2e-6,3e-6,4e-6,5e-6,6e-6,7e-6,8e-6,9e-6"):
+                r = run(tool, *args, "--gms", bad)
+                self.assert_refused(r, 2, "bad value for --gms")
+            for bad in ("0", "-0.1", "1.5", "nan", "x"):
+                r = run(tool, *args, "--gms", "2e-6", "--gms-zeta", bad)
+                self.assert_refused(r, 2, "--gms-zeta")
+            r = run(tool, *args, "--gms-zeta", "0.1")
+            self.assert_refused(r, 2, "--gms-zeta applies with --gms only")
+            with open(out, "rb") as f:
+                self.assertEqual(f.read(), OLD, tool)
+
+    def test_robust_run_gms_is_the_demos_hardware_like_plant(self):
+        # br_robust_run --gms with the demo's elements (read from its summary.json) runs the demo's
+        # hardware-like plant: the same H-inf only contour RMS to the digit; without --gms the LuGre one
+        demo = os.path.join(self.w, "demo")
+        r = run("br_demo_circle", "--out", demo, "--only", "hinf_only")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(demo, "summary.json")) as f:
+            hw = json.load(f)["hardware_like"]
+        d = ",".join(repr(e["breakaway_m"]) for e in hw["plant"]["elements"])
+        rms = []
+        for extra in (["--gms", d], []):
+            js = os.path.join(self.w, "r%d.json" % len(rms))
+            r = run("br_robust_run", "--only", "hinf_only", "--json", js, *extra)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(js) as f:
+                rms.append(json.load(f)["controllers"]["hinf_only"]["contour_rms_m"])
+        self.assertAlmostEqual(rms[0] / hw["hinf_only"]["contour_rms_m"], 1.0, places=6)
+        self.assertGreater(abs(rms[1] / rms[0] - 1.0), 0.1)  # without --gms: the LuGre plant's figure
+        # br_track: the same elements reach its plant (a short back-and-forth's reference)
+        ref = os.path.join(self.w, "ref.csv")
+        r = run("br_simlog", "--out", ref, "--traj", "backforth", "--duration", "1")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        track = []
+        for extra in (["--gms", d], []):
+            js = os.path.join(self.w, "t%d.json" % len(track))
+            r = run("br_track", "--ref", ref, "--ctrl", "hinf_only", "--json", js, *extra)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(js) as f:
+                track.append(json.load(f)["hinf_only"]["rms_m"])
+        self.assertGreater(abs(track[1] / track[0] - 1.0), 0.01)
 
     def test_simlog_failed_run_writes_nothing(self):
         out, machine = self.existing("log.csv"), self.existing("log.machine.json")
@@ -307,7 +344,6 @@ class ToolsTest(unittest.TestCase):
         d = os.path.join(self.w, "demo")
         r = run("br_demo_circle", "--out", d, "--only", "hinf_only", "--feed-mm-min", "300", "--dir", "both")
         self.assertEqual(r.returncode, 0, r.stderr)
-        import json
         with open(os.path.join(d, "summary.json")) as f:
             s = json.load(f)
         e = s["experiment"]
@@ -393,7 +429,7 @@ class ToolsTest(unittest.TestCase):
             self.assert_refused(run("br_dt_study", *bad), 2)
 
     def test_bench_plant_named(self):
-        # br_bench --plant: thesis or realistic, anything else refused by name before any run
+        # br_bench --plant: thesis, realistic or hardware_like, anything else refused by name before any run
         for bad in ("nominal", "", "Realistic"):
             r = run("br_bench", "--plant", bad)
             self.assert_refused(r, 2, "--plant")

@@ -20,7 +20,10 @@
 /* br_simlog --cycles: identification cycles of 9.32 s (400: 3728 s, about the duration bound) */
 #define BR_TOOL_CYCLES_MAX 400
 
-/* br_simlog --gms-zeta: the damping ratio of each Maxwell-slip element's mode, from a mode
+/* --gms: a Maxwell-slip element's breakaway displacement at most 10 mm (presliding is micrometres) */
+#define BR_TOOL_GMS_D_MAX_M 1e-2
+
+/* --gms-zeta: the damping ratio of each Maxwell-slip element's mode, from a mode
  * practically undamped to critical damping */
 #define BR_TOOL_GMS_ZETA_MIN 1e-3
 #define BR_TOOL_GMS_ZETA_MAX 1.0
