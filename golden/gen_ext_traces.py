@@ -72,9 +72,10 @@ def generate(out_dir, m, gt):
             t = n * DT
             x = np.array([th, w, z, gp], dtype=np.float64)
             status, x1, branch = rmodel.step_ext(p, c, p0, x, u, DT, t)
-            x_rk = rmodel.rk4_ext(p, c, p0, x, u, DT, t)
+            ws = []
+            x_rk = rmodel.rk4_ext(p, c, p0, x, u, DT, t, ws)
             if any(abs(rmodel.ah_ext(p, c, wv, gp, DT) / rmodel.RK4_AH_MAX - 1.0) < gt.BRANCH_MARGIN
-                   for wv in (x[1], x_rk[1])):
+                   for wv in [x[1]] + ws + [x_rk[1]]):
                 skipped += 1
                 continue
             fc = rmodel.fcomp_ext(p, c, p0, x, t)

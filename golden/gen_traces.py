@@ -47,7 +47,7 @@ SEED = 20240611  # base seed; trace i uses SEED + i (recorded in each header)
 SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                # estimator traces (gen_est_traces.py): one recorded input, one seed
                "est_input": 6, "pf": 6, "pf_w": 6, "pf_x": 6, "ukf": 6,
-               "ukf_load": 6,  # gen_load_traces.py: the same input, no random draw of its own
+               "ukf_load": 6, "ukf_glitch": 6,  # gen_load_traces.py: the same input, no random draw of its own
                "ukf_ms": 6,    # gen_ukf_ms_traces.py: the same input, no random draw of its own
                "pf_load": 6, "pf_load_x": 6,  # gen_pf_load_traces.py: likewise
                "pf_ms": 6, "pf_ms_x": 6,  # gen_pf_ms_traces.py: likewise
@@ -172,17 +172,19 @@ def gen_model(out_dir, m):
     rows = []
     skipped = [0]
 
-    def near_threshold(x, x1):
-        a0 = rmodel.ah(p, x[1], x[3], DT)
-        a1 = rmodel.ah(p, x1[1], x[3], DT)
-        return any(abs(a / rmodel.RK4_AH_MAX - 1.0) < BRANCH_MARGIN for a in (a0, a1))
+    def near_threshold(x, u):
+        """a h within the margin of the switch at an end or a stage of the step"""
+        ws = []
+        x1 = rmodel.rk4(p, x, u, DT, ws)
+        return any(abs(rmodel.ah(p, w, x[3], DT) / rmodel.RK4_AH_MAX - 1.0) < BRANCH_MARGIN
+                   for w in [x[1]] + ws + [x1[1]])
 
     def emit(seg, t, x, u):
         """One-step row for float32-exact (x, u); returns x_{k+1} (float64)."""
         x = np.array([f32(v) for v in x], dtype=np.float64)
         u = f32(u)
         status, x1, branch = rmodel.step(p, x, u, DT)
-        if status == rmodel.BR_OK and near_threshold(x, rmodel.rk4(p, x, u, DT)):
+        if status == rmodel.BR_OK and near_threshold(x, u):
             skipped[0] += 1
             return x1
         fn = rmodel.fnl(p, x) if status == rmodel.BR_OK else float("nan")
@@ -462,7 +464,7 @@ def main(argv=None):
     paths += gen_plant(args.out, m)
     est_paths, est_input = gen_est_traces.generate(args.out, m, sys.modules[__name__])
     paths += est_paths
-    paths.append(gen_load_traces.generate(args.out, m, sys.modules[__name__], est_input))
+    paths += gen_load_traces.generate(args.out, m, sys.modules[__name__], est_input)
     paths.append(gen_ukf_ms_traces.generate(args.out, m, sys.modules[__name__], est_input))
     paths += gen_pf_load_traces.generate(args.out, m, sys.modules[__name__], est_input)
     paths += gen_pf_ms_traces.generate(args.out, m, sys.modules[__name__], est_input)

@@ -266,10 +266,11 @@ br_app_fault_t br_app_motion_watch(br_app_t *app, int32_t d, uint32_t periods)
         return BR_APP_FAULT_NONE;
     }
     /* a still count: the speed the model predicts with the force beyond what
-     * held the axis when it last moved, friction taking up to the band
-     * (never reversing the motion) */
+     * held the axis when it last moved, friction taking up to the band and
+     * the count's quantization up to k_m BR_APP_STUCK_QUANT_ACCEL (F_hold's
+     * uncertainty; never reversing the motion) */
     float v1 = app->v_pred + (F - app->hold_N) / k_m;
-    const float brake = m->stuck_band_N / k_m;
+    const float brake = m->stuck_band_N / k_m + BR_APP_STUCK_QUANT_ACCEL;
     v1 = (v1 > brake) ? v1 - brake : ((v1 < -brake) ? v1 + brake : 0.0f);
     /* the motion at the period's end speed (the speed may have dropped at
      * its start: the least motion the model allows) */

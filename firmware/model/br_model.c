@@ -240,7 +240,8 @@ void br_model_sub_steps(const br_model_t *m, const br_model_kx_t *kx, const br_m
     float xs[BR_NX] = {x[0], x[1], x[2], x[3]};
     int s, i;
     for (s = 0; s < m->n_sub; s++) {
-        /* RK4 only where both ends of the sub-step are inside its stability region */
+        /* RK4 only where the sub-step's ends (and, but for the PF's, its
+         * stages) are inside its stability region */
         if (kx != NULL) {
             if (!br_model_kx_rk4(kx, xs, u_Nm, out)) {
                 br_model_bounded_step_x(kx, xs, u_Nm, out);

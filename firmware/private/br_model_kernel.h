@@ -73,9 +73,11 @@ static inline int br_model_k_rk4_ok(const br_model_k_t *k, float omega, float gp
 /* Classic RK4 on eq. 6 over h with u held (br_model_step's). theta does not
  * enter the right-hand side and g_p' = 0, so the stages carry (omega, z) only:
  * theta' of a stage is its omega, and g_p comes out unchanged.
- * Returns 1 when a h is inside the RK4 limit at both ends of the step
- * (the result is then the step), 0 when the caller must use the bounded
- * scheme instead. */
+ * Returns 1 when a h is inside the RK4 limit at both ends of the step and
+ * at its stages (the result is then the step), 0 when the caller must use
+ * the bounded scheme instead: a step from rest under a large torque passes
+ * through speeds far beyond the limit, where RK4 diverges, and can still
+ * end at a small omega (docs/modules/model.md). */
 BR_INLINE int br_model_k_rk4(const br_model_k_t *k, const float x[BR_NX], float u, float out[BR_NX])
 {
     const float w0 = x[BR_X_OMEGA], z0 = x[BR_X_Z], gp = x[BR_X_GP];
@@ -99,8 +101,9 @@ BR_INLINE int br_model_k_rk4(const br_model_k_t *k, const float x[BR_NX], float 
     out[BR_X_OMEGA] = w0 + k->h_6 * (wd1 + 2.0f * wd2 + 2.0f * wd3 + wd4);
     out[BR_X_Z] = z0 + k->h_6 * (zd1 + 2.0f * zd2 + 2.0f * zd3 + zd4);
     out[BR_X_GP] = gp;
-    /* & rather than &&: no branch, so that a loop over particles vectorises */
-    return br_model_k_rk4_ok(k, w0, gp) & br_model_k_rk4_ok(k, out[BR_X_OMEGA], gp);
+    /* the ends and the stages; & rather than &&: no branch */
+    return br_model_k_rk4_ok(k, w0, gp) & br_model_k_rk4_ok(k, w2, gp) & br_model_k_rk4_ok(k, w3, gp) &
+           br_model_k_rk4_ok(k, w4, gp) & br_model_k_rk4_ok(k, out[BR_X_OMEGA], gp);
 }
 
 /* ---- The particle filter's RK4 with k_p ----
@@ -187,7 +190,9 @@ static inline void br_model_kp_rk4_step(const br_model_kp_t *k, const float x[BR
 }
 
 /* RK4 of the particle (theta, omega, z, g_p) with its k_p; returns 1 when
- * a h is inside the RK4 limit at both ends of the step (as br_model_k_rk4) */
+ * a h is inside the RK4 limit at both ends of the step (the particle
+ * filter's test: the ends only, its kernels and tuned variances are its own;
+ * br_model_k_rk4 tests the stages too) */
 static inline int br_model_kp_rk4(const br_model_kp_t *k, const float x[BR_NX], float kp, float out[BR_NX])
 {
     float ah0, ah1;
@@ -298,7 +303,8 @@ static inline int br_model_kx_rk4_ok(const br_model_kx_t *k, float omega, float 
 
 /* Classic RK4 of the extended model over h with u held; theta enters the
  * right-hand side (ripple, gradient), so the stages carry it. Returns 1 when
- * a h is inside the RK4 limit at both ends (as br_model_k_rk4). */
+ * a h is inside the RK4 limit at both ends and at the stages (as
+ * br_model_k_rk4). */
 static inline int br_model_kx_rk4(const br_model_kx_t *k, const float x[BR_NX], float u, float out[BR_NX])
 {
     const float L = k->n.L, ij = k->n.inv_Jeff, hh = k->n.h_half;
@@ -320,7 +326,8 @@ static inline int br_model_kx_rk4(const br_model_kx_t *k, const float x[BR_NX], 
     out[BR_X_OMEGA] = w0 + k->n.h_6 * (wd1 + 2.0f * wd2 + 2.0f * wd3 + wd4);
     out[BR_X_Z] = z0 + k->n.h_6 * (zd1 + 2.0f * zd2 + 2.0f * zd3 + zd4);
     out[BR_X_GP] = gp;
-    return br_model_kx_rk4_ok(k, w0, gp) && br_model_kx_rk4_ok(k, out[BR_X_OMEGA], gp);
+    return br_model_kx_rk4_ok(k, w0, gp) && br_model_kx_rk4_ok(k, w2, gp) && br_model_kx_rk4_ok(k, w3, gp) &&
+           br_model_kx_rk4_ok(k, w4, gp) && br_model_kx_rk4_ok(k, out[BR_X_OMEGA], gp);
 }
 
 /* The bounded schemes of br_model_step (out of line: not reached at circle

@@ -136,6 +136,16 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->n_recover = 0u;
     ukf->n_predicted = 0u;
     ukf->n_load_acq = 0u;
+    ukf->n_load_undo = 0u;
+    ukf->alt_pending = 0;
+    ukf->alt_origin = 0;
+    ukf->alt_nu_rad = 0.0f;
+    for (int i = 0; i < NM; i++) {
+        ukf->alt_x[i] = 0.0f;
+        for (int j = 0; j < NM; j++) {
+            ukf->alt_P[i][j] = 0.0f;
+        }
+    }
     ukf->primed = 0;
     ukf->est = (br_ukf_est_t){{0.0f, 0.0f, 0.0f, cfg->est.gp0_N},
                               {cfg->p0_var[0], cfg->p0_var[1], cfg->p0_var[2], cfg->p0_var[3]},
@@ -143,6 +153,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     for (int i = 0; i < BR_MSLIP_MAX; i++) {
         ukf->el[i] = 0.0f;
         ukf->el_m[i] = 0.0f;
+        ukf->alt_el[i] = 0.0f;
     }
     ukf->ready = 1;
     return BR_OK;
@@ -407,8 +418,38 @@ static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[NM], float Pm[NM][NM
 static br_status_t fail_reset(br_ukf_t *ukf)
 {
     reset_cov(ukf, ukf->P);
+    ukf->alt_pending = 0;
     ukf->n_recover++;
     return BR_E_NUMERIC;
+}
+
+/* (x, P) -> (xd, Pd), the leading n entries */
+static void copy_mean_cov(int n, const float x[NM], const float P[NM][NM], float xd[NM], float Pd[NM][NM])
+{
+    for (int i = 0; i < n; i++) {
+        xd[i] = x[i];
+        for (int j = 0; j < n; j++) {
+            Pd[i][j] = P[i][j];
+        }
+    }
+}
+
+/* the first ne elements of e into ed */
+static void elements_copy(int ne, const float e[], float ed[])
+{
+    for (int i = 0; i < ne; i++) {
+        ed[i] = e[i];
+    }
+}
+
+/* Maxwell-slip: the predicted elements within their slip bounds at the
+ * posterior's g_p, |z_i| <= c_i g_p, into el */
+static void elements_bounded(const br_ukf_t *ukf, float gp, float el[])
+{
+    for (int i = 0; i < ukf->model.cfg.mslip.n; i++) {
+        const float d = ukf->model.ms_c_mpN[i] * gp;
+        el[i] = br_clampf(ukf->el_m[i], -d, d);
+    }
 }
 
 /* Step 4 and the commit: sigma points of (xm, Pm) (a failed Cholesky resets Pm
@@ -421,14 +462,9 @@ static int posterior(br_ukf_t *ukf, const float xm[NM], float Pm[NM][NM], int32_
     if (sigma_points(ukf, xm, Pm) != BR_OK) {
         *chol_reset = 1;
     }
-    /* Maxwell-slip: the predicted elements within their slip bounds at the
-     * posterior's g_p, |z_i| <= c_i g_p */
     const int ne = ukf->model.cfg.mslip.n;
     float el[BR_MSLIP_MAX];
-    for (int i = 0; i < ne; i++) {
-        const float d = ukf->model.ms_c_mpN[i] * xm[BR_X_GP];
-        el[i] = br_clampf(ukf->el_m[i], -d, d);
-    }
+    elements_bounded(ukf, xm[BR_X_GP], el);
     *F_hat = fnl_unscented(ukf, origin_counts, el);
     if (!isfinite(*F_hat)) {
         return 0;
@@ -512,26 +548,94 @@ static int load_reacquire(br_ukf_t *ukf, const br_meas_t *y, float u_a, float nu
         return 0;
     }
     const float keep = ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD];
+    /* the alternative, should the next innovation undo this: the first
+     * prediction as an outlier commits it (old origin, elements bounded) */
+    float alt_el[BR_MSLIP_MAX];
+    elements_bounded(ukf, xm[BR_X_GP], alt_el);
     /* P_dd += dF^2 (the last posterior's), then the period again from it */
     ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD] = keep + dF * dF;
     br_model_set_clock(&ukf->model, ukf->model.n_steps - 1u);
-    float xr[NM], Pr[NM][NM], th, nu_r, S_r;
+    float xr[NM], Pr[NM][NM], th, nu_r, S_r, el_m[BR_MSLIP_MAX];
     int reset = 0;
+    elements_copy(ukf->model.cfg.mslip.n, ukf->el_m, el_m);
     if (predict(ukf, u_a, xr, Pr, &reset) && innovate(ukf, y, xr, (const float(*)[NM])Pr, &th, &nu_r, &S_r)) {
-        for (int i = 0; i < ukf->n; i++) {
-            xm[i] = xr[i];
-            for (int j = 0; j < ukf->n; j++) {
-                Pm[i][j] = Pr[i][j];
-            }
-        }
+        copy_mean_cov(ukf->n, xm, (const float(*)[NM])Pm, ukf->alt_x, ukf->alt_P);
+        elements_copy(ukf->model.cfg.mslip.n, alt_el, ukf->alt_el);
+        ukf->alt_origin = ukf->origin_counts;
+        ukf->alt_nu_rad = nu;
+        ukf->alt_pending = 1;
+        copy_mean_cov(ukf->n, xr, (const float(*)[NM])Pr, xm, Pm);
         *chol_reset = *chol_reset || reset;
         if (ukf->n_load_acq < UINT32_MAX) {
             ukf->n_load_acq++;
         }
         return 1;
     }
-    /* not a load: the first prediction stands (its clock too: predict ticked again) */
+    /* not a load: the first prediction stands (its clock too: predict ticked
+     * again; its elements) */
     ukf->P[BR_UKF_X_LOAD][BR_UKF_X_LOAD] = keep;
+    elements_copy(ukf->model.cfg.mslip.n, el_m, ukf->el_m);
+    return 0;
+}
+
+/* The committed posterior (x, P, elements, origin) and the held alternative
+ * trade places. */
+static void alt_swap(br_ukf_t *ukf)
+{
+    float x[NM], P[NM][NM], el[BR_MSLIP_MAX];
+    const int ne = ukf->model.cfg.mslip.n;
+    copy_mean_cov(ukf->n, ukf->x, (const float(*)[NM])ukf->P, x, P);
+    copy_mean_cov(ukf->n, ukf->alt_x, (const float(*)[NM])ukf->alt_P, ukf->x, ukf->P);
+    copy_mean_cov(ukf->n, x, (const float(*)[NM])P, ukf->alt_x, ukf->alt_P);
+    elements_copy(ne, ukf->el, el);
+    elements_copy(ne, ukf->alt_el, ukf->el);
+    elements_copy(ne, el, ukf->alt_el);
+    const int32_t o = ukf->origin_counts;
+    ukf->origin_counts = ukf->alt_origin;
+    ukf->alt_origin = o;
+}
+
+/* The undo of the last step's re-acquisition (docs/modules/ukf.md, "A glitch
+ * is not a load"), for a gated innovation after it: the period predicted
+ * again from the alternative (the last step's first prediction, its clock
+ * put back first), and its innovation gated as it is (a spike: the last
+ * measurement alone was off) and with theta- moved by the last step's gated
+ * innovation nu_1 (a slip: the counter stays off by it). One that passes is
+ * taken, the smaller |nu| when both do: the alternative becomes the
+ * committed posterior and its prediction (moved for a slip) is written into
+ * xm, Pm; returns 1. Neither: returns 0 with the committed posterior and the
+ * first prediction's elements back (xm, Pm untouched). */
+static int glitch_undo(br_ukf_t *ukf, const br_meas_t *y, float u_a, float xm[NM], float Pm[NM][NM],
+                       int *chol_reset)
+{
+    float xa[NM], Pa[NM][NM], th, S, el_m[BR_MSLIP_MAX];
+    int reset = 0;
+    elements_copy(ukf->model.cfg.mslip.n, ukf->el_m, el_m);
+    alt_swap(ukf);
+    br_model_set_clock(&ukf->model, ukf->model.n_steps - 1u);
+    if (predict(ukf, u_a, xa, Pa, &reset)) {
+        /* a spike (theta- as it is) and a slip (theta- + nu_1); one S for
+         * both, so the likelier is the smaller |nu| (a slip can be within
+         * the spike's gate, the alternative being two periods old) */
+        const float th_s = xa[BR_X_THETA];
+        float nu_s, nu_l;
+        const int pass_s = innovate(ukf, y, xa, (const float(*)[NM])Pa, &th, &nu_s, &S);
+        xa[BR_X_THETA] = th_s + ukf->alt_nu_rad;
+        const int pass_l = innovate(ukf, y, xa, (const float(*)[NM])Pa, &th, &nu_l, &S);
+        const int slip = pass_l && !(pass_s && fabsf(nu_s) <= fabsf(nu_l));
+        xa[BR_X_THETA] = slip ? xa[BR_X_THETA] : th_s;
+        if ((slip || pass_s) && isfinite(slip ? nu_l : nu_s)) {
+            copy_mean_cov(ukf->n, xa, (const float(*)[NM])Pa, xm, Pm);
+            *chol_reset = *chol_reset || reset;
+            if (ukf->n_load_undo < UINT32_MAX) {
+                ukf->n_load_undo++;
+            }
+            return 1;
+        }
+    }
+    /* a load after all: the committed posterior and its prediction stand */
+    alt_swap(ukf);
+    elements_copy(ukf->model.cfg.mslip.n, el_m, ukf->el_m);
     return 0;
 }
 
@@ -558,6 +662,10 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     const int n = ukf->n;
     const float rpc = ukf->cfg.est.rad_per_count;
 
+    /* the last step's re-acquisition's alternative: for this step only */
+    const int alt = ukf->alt_pending;
+    ukf->alt_pending = 0;
+
     /* 1.-2. sigma points of the last posterior, predicted mean and covariance */
     float xm[NM], Pm[NM][NM];
     int chol_reset;
@@ -570,6 +678,10 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     int pass = innovate(ukf, y, xm, (const float(*)[NM])Pm, &theta_new, &nu, &S);
     if (!isfinite(nu) || !br_finite_pos(S)) {
         return fail_reset(ukf);
+    }
+    /* after a re-acquisition, a gated innovation that a glitch explains undoes it */
+    if (!pass && alt && glitch_undo(ukf, y, u_a, xm, Pm, &chol_reset)) {
+        pass = innovate(ukf, y, xm, (const float(*)[NM])Pm, &theta_new, &nu, &S);
     }
     /* a gated innovation that a load explains is re-acquired, not rejected (cfg.load) */
     if (!pass && load_reacquire(ukf, y, u_a, nu, xm, Pm, &chol_reset)) {
@@ -672,8 +784,10 @@ br_status_t br_ukf_predict(br_ukf_t *ukf, float u_prev_Nm)
     }
     float xm[NM], Pm[NM][NM];
     int chol_reset;
-    /* no measurement: the delay's identification starts again at the next one */
+    /* no measurement: the delay's identification starts again at the next one,
+     * and a re-acquisition is not undone across the gap */
     ukf->dlyid.primed = 0;
+    ukf->alt_pending = 0;
     if (!predict(ukf, br_est_delay_apply(&ukf->delay, u_prev_Nm), xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }

@@ -69,13 +69,19 @@ def deriv(p, x, u):
     return np.array([w, wd, zd, 0.0], dtype=np.float64)
 
 
-def rk4(p, x, u, h):
-    """Classic four-stage Runge-Kutta step of eq. 6 with u held."""
+def rk4(p, x, u, h, stages=None):
+    """Classic four-stage Runge-Kutta step of eq. 6 with u held; the omega of
+    stages 2, 3, 4 appended to the list stages when one is given."""
     x = np.asarray(x, dtype=np.float64)
     k1 = deriv(p, x, u)
-    k2 = deriv(p, x + (h / 2.0) * k1, u)
-    k3 = deriv(p, x + (h / 2.0) * k2, u)
-    k4 = deriv(p, x + h * k3, u)
+    x2 = x + (h / 2.0) * k1
+    k2 = deriv(p, x2, u)
+    x3 = x + (h / 2.0) * k2
+    k3 = deriv(p, x3, u)
+    x4 = x + h * k3
+    k4 = deriv(p, x4, u)
+    if stages is not None:
+        stages.extend((x2[1], x3[1], x4[1]))
     return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
@@ -116,18 +122,21 @@ def ah(p, w, gp, h):
     return p.lugre.sigma0 * p.L * abs(w) * h / gp
 
 
-def step(p, x, u, h):
+def step(p, x, u, h, stages=True):
     """One discretisation step of eq. 6 over h with u held.
 
     Returns (status, x_next, branch). Invalid input (a non-finite entry of x
-    or u, or g_p <= 0) gives (BR_E_INPUT, x, BRANCH_INVALID)."""
+    or u, or g_p <= 0) gives (BR_E_INPUT, x, BRANCH_INVALID). stages False:
+    the RK4 test at the two ends only (the particle filter's kernels)."""
     x = np.asarray(x, dtype=np.float64)
     if not (np.all(np.isfinite(x)) and math.isfinite(u)) or not x[3] > 0.0:
         return BR_E_INPUT, x.copy(), BRANCH_INVALID
-    x1 = rk4(p, x, u, h)
-    # RK4 only while a h <= 2 at the start and at the RK4 end point
-    # (a NaN end point compares false and falls to the bounded scheme).
-    if ah(p, x[1], x[3], h) <= RK4_AH_MAX and ah(p, x1[1], x[3], h) <= RK4_AH_MAX:
+    ws = [] if stages else None
+    x1 = rk4(p, x, u, h, ws)
+    # RK4 only while a h <= 2 at the start, at the stages (br_model_step's)
+    # and at the RK4 end point (a NaN compares false and falls to the
+    # bounded scheme).
+    if all(ah(p, w, x[3], h) <= RK4_AH_MAX for w in [x[1]] + (ws or []) + [x1[1]]):
         return BR_OK, x1, BRANCH_RK4
     return BR_OK, bounded(p, x, u, h), BRANCH_BOUNDED
 
@@ -194,13 +203,19 @@ def deriv_ext(p, c, p0, x, u, t=0.0):
     return np.array([w, (u - p.L * F) / p.Jeff, zd, 0.0], dtype=np.float64)
 
 
-def rk4_ext(p, c, p0, x, u, h, t=0.0):
-    """RK4 from time t, each stage at its own time."""
+def rk4_ext(p, c, p0, x, u, h, t=0.0, stages=None):
+    """RK4 from time t, each stage at its own time; the omega of stages 2, 3,
+    4 appended to the list stages when one is given."""
     x = np.asarray(x, dtype=np.float64)
     k1 = deriv_ext(p, c, p0, x, u, t)
-    k2 = deriv_ext(p, c, p0, x + (h / 2.0) * k1, u, t + h / 2.0)
-    k3 = deriv_ext(p, c, p0, x + (h / 2.0) * k2, u, t + h / 2.0)
-    k4 = deriv_ext(p, c, p0, x + h * k3, u, t + h)
+    x2 = x + (h / 2.0) * k1
+    k2 = deriv_ext(p, c, p0, x2, u, t + h / 2.0)
+    x3 = x + (h / 2.0) * k2
+    k3 = deriv_ext(p, c, p0, x3, u, t + h / 2.0)
+    x4 = x + h * k3
+    k4 = deriv_ext(p, c, p0, x4, u, t + h)
+    if stages is not None:
+        stages.extend((x2[1], x3[1], x4[1]))
     return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
@@ -245,7 +260,8 @@ def step_ext(p, c, p0, x, u, h, t=0.0):
     x = np.asarray(x, dtype=np.float64)
     if not (np.all(np.isfinite(x)) and math.isfinite(u) and math.isfinite(p0)) or not x[3] > 0.0:
         return BR_E_INPUT, x.copy(), BRANCH_INVALID
-    x1 = rk4_ext(p, c, p0, x, u, h, t)
-    if ah_ext(p, c, x[1], x[3], h) <= RK4_AH_MAX and ah_ext(p, c, x1[1], x[3], h) <= RK4_AH_MAX:
+    ws = []
+    x1 = rk4_ext(p, c, p0, x, u, h, t, ws)
+    if all(ah_ext(p, c, w, x[3], h) <= RK4_AH_MAX for w in [x[1]] + ws + [x1[1]]):
         return BR_OK, x1, BRANCH_RK4
     return BR_OK, bounded_ext(p, c, p0, x, u, h, t), BRANCH_BOUNDED

@@ -246,7 +246,7 @@ class Pf:
         xp, ep, fn, l = [], [], [], []
         for j in range(c.m):
             if c.mslip is None:
-                st, xn, _ = rmodel.step(c.model, self.x[j], u, c.dt)
+                st, xn, _ = rmodel.step(c.model, self.x[j], u, c.dt, stages=False)
                 xn = np.array([xn[i] + self.q_std[i] * self._n(j, i) for i in range(NX)])
                 xn[3] = self._clamp_gp(xn[3])
                 en = self.e[j]

@@ -48,6 +48,17 @@ posterior's P_dd is increased by dF^2, step 2 is repeated from it and the gate
 applied to the new innovation; passing, it is an ordinary update (BR_OK,
 counted in n_load_acq) of that prediction. Failing, the step is the outlier
 of the first prediction (P_dd not inflated).
+Undo (docs/modules/ukf.md, "A glitch is not a load"): a step that
+re-acquired holds its alternative A = (the first prediction's mean and
+covariance, its elements clipped as an outlier's, the step's origin, the
+gated innovation nu_1). At the next step only (a predict-only period or any
+error drops it), if the innovation of the ordinary prediction is gated, step
+2 is repeated from A (as if the last step had been an outlier) and gated:
+as it is (a spike) and with theta- + nu_1 (a slip: the counter stays off by
+nu_1). The passing one, the smaller |nu| when both pass (one S for both), is
+the step's prediction (an ordinary update, BR_OK, counted in n_load_undo;
+origin = counts as always). Neither:
+the ordinary prediction stands and the re-acquisition rule follows.
 
 Maxwell-slip elements (cfg.mslip, docs/modules/ukf.md "Maxwell-slip
 elements"; None: LuGre): the friction is that of element deflections e
@@ -149,6 +160,9 @@ class Ukf:
         self.n_outliers = 0
         self.n_recover = 0
         self.n_load_acq = 0
+        self.n_load_undo = 0
+        self.alt = None                # the last re-acquisition's alternative (dict) or None
+        self.load_undo = False         # this step undid the last one's re-acquisition
         self.primed = False
         self.F_hat = 0.0
         self.nu = 0.0
@@ -197,11 +211,12 @@ class Ukf:
         F = F + sum(w * Xj[NX] for w, Xj in zip(self.wm, X))
         return min(max(F, -self.cfg.load.max_N), self.cfg.load.max_N)
 
-    def _predict(self, x, P, u):
-        """Steps 1-2 from (x, P): (xm, Pm, Cholesky ok, e-), or None when a
-        model step fails or the prediction is not finite (e-: the elements'
-        prediction, empty for LuGre)."""
+    def _predict(self, x, P, u, el=None):
+        """Steps 1-2 from (x, P) and the elements el (None: self.el): (xm, Pm,
+        Cholesky ok, e-), or None when a model step fails or the prediction is
+        not finite (e-: the elements' prediction, empty for LuGre)."""
         c, n = self.cfg, self.n
+        el = self.el if el is None else el
         X, P, ok = self._sigma(x, P)
         Y, E = [], []
         for Xj in X:
@@ -213,7 +228,7 @@ class Ukf:
                     return None
             else:
                 # the Maxwell-slip step from the elements offset by the point's z
-                th1, om1, e1 = rmslip.model_step(c.model, c.mslip, Xj[0], Xj[1], Xj[3], self.el + Xj[2], uj,
+                th1, om1, e1 = rmslip.model_step(c.model, c.mslip, Xj[0], Xj[1], Xj[3], el + Xj[2], uj,
                                                  c.dt, c.ms_passes)
                 y1 = [th1, om1, Xj[2], Xj[3]]
                 E.append(e1)
@@ -228,11 +243,13 @@ class Ukf:
             return None
         return xm, Pm, ok, em
 
-    def _innovate(self, xm, Pm, counts, frac):
-        """Step 3 and the gate: (theta- in the new origin's frame, nu, S, passes)."""
+    def _innovate(self, xm, Pm, counts, frac, origin=None):
+        """Step 3 and the gate, theta- relative to origin (None: self.origin):
+        (theta- in the new origin's frame, nu, S, passes)."""
         c = self.cfg
         rpc = c.rad_per_count
-        th_new = xm[0] - wrapdiff(counts, self.origin) * rpc
+        origin = self.origin if origin is None else origin
+        th_new = xm[0] - wrapdiff(counts, origin) * rpc
         nu = frac * rpc - th_new
         S = Pm[0][0] + c.r_var
         # the gate: the innovation's variance with the encoder's quantisation rpc^2/12
@@ -258,6 +275,33 @@ class Ukf:
         inn = self._innovate(pred[0], pred[1], counts, frac)
         return (pred, inn, P) if inn[3] else None
 
+    def _bounded(self, em, gp):
+        """The elements e- clipped to their slip bounds at g_p (LuGre: as they are)."""
+        if self.cfg.mslip is None:
+            return em
+        return np.clip(em, -rmslip.bounds(self.cfg.mslip, gp), rmslip.bounds(self.cfg.mslip, gp))
+
+    def _undo(self, alt, u, counts, frac):
+        """The last step's re-acquisition undone: the prediction from its
+        alternative alt and the innovation of a spike (as it is) or of a slip
+        (theta- + nu_1), the one that passes, the smaller |nu| when both do;
+        None when neither does."""
+        pred = self._predict(alt["x"], alt["P"], u, alt["el"])
+        if pred is None:
+            return None
+        xa, Pa, ok, em = pred
+        cands = []
+        for shift in (0.0, alt["nu"]):
+            xs = [xa[0] + shift] + xa[1:]
+            inn = self._innovate(xs, Pa, counts, frac, alt["origin"])
+            if inn[3]:
+                cands.append((abs(inn[1]), (xs, Pa, ok, em), inn))
+        if not cands:
+            return None
+        # the spike on a tie (min keeps the first of equal keys)
+        _, pred, inn = min(cands, key=lambda cand: cand[0])
+        return pred, inn
+
     def step(self, counts, frac, u):
         c, n = self.cfg, self.n
         if not math.isfinite(u) or not math.isfinite(frac) or not 0.0 <= frac <= 1.0:
@@ -265,6 +309,7 @@ class Ukf:
         rpc = c.rad_per_count
         self.reanchored = False
         self.load_acq = False
+        self.load_undo = False
         if not self.primed:
             self.origin = self.prev_counts = int(counts)
             self.prev_frac = frac
@@ -278,6 +323,8 @@ class Ukf:
             self.primed = True
             return BR_OK
         status = BR_OK
+        # the last step's re-acquisition's alternative, for this step only
+        alt, self.alt, alt_new = self.alt, None, None
         # 1.-2. sigma points and prediction
         pred = self._predict(self.x, self.P, u)
         if pred is None:
@@ -288,9 +335,21 @@ class Ukf:
             self.n_recover += 1
         # 3. origin, innovation, gate
         th_new, nu, S, passes = self._innovate(xm, Pm, counts, frac)
+        if not passes and alt is not None:
+            und = self._undo(alt, u, counts, frac)
+            if und is not None:
+                (xm, Pm, ok2, em), (th_new, nu, S, passes) = und
+                self.load_undo = True
+                self.n_load_undo += 1
+                if not ok2 and status == BR_OK:
+                    status = BR_E_NUMERIC
+                    self.n_recover += 1
         if not passes:
             acq = self._reacquire(nu, u, counts, frac)
             if acq is not None:
+                # the alternative: the first prediction as an outlier commits it
+                alt_new = {"x": list(xm), "P": [list(r) for r in Pm], "el": self._bounded(em, xm[3]),
+                           "origin": self.origin, "nu": nu}
                 (xm, Pm, ok, em), (th_new, nu, S, passes), self.P = acq
                 self.load_acq = True
                 self.n_load_acq += 1
@@ -336,8 +395,7 @@ class Ukf:
             status = BR_E_NUMERIC
             self.n_recover += 1
         # the elements within their slip bounds at the new mean's g_p
-        el = np.clip(em, -rmslip.bounds(c.mslip, x_new[3]), rmslip.bounds(c.mslip, x_new[3])) \
-            if c.mslip is not None else em
+        el = self._bounded(em, x_new[3])
         F = self._fhat(X, el)
         if not math.isfinite(F):
             return BR_E_NUMERIC
@@ -346,4 +404,5 @@ class Ukf:
         self.Pm_diag = [Pm[i][i] for i in range(n)]
         self.prev_counts, self.prev_frac = int(counts), frac
         self.n_outliers = n_out
+        self.alt = alt_new
         return status if status != BR_OK else status_o

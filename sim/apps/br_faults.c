@@ -45,6 +45,7 @@
 typedef enum {
     K_ENC_STUCK,   /* the counter stops at the injection */
     K_ENC_OFFSET,  /* the counter jumps by amount counts and stays off by it */
+    K_ENC_SPIKE,   /* one read off by amount counts (a glitch), the next ones right */
     K_ENC_NOISE,   /* each read off by a uniform integer in [-amount, amount] */
     K_ENC_DROP,    /* amount reads in a row fail */
     K_LOAD_STEP,   /* an external force of amount x the actuator's force, from the injection on */
@@ -71,6 +72,9 @@ static const scenario_t k_scen[] = {
     {"enc_stuck_90", K_ENC_STUCK, 0.0, 0.9, 0, "counter stops at 90 % of max speed", 0},
     {"enc_jump_30", K_ENC_OFFSET, 2.0e5, 0.3, 0, "counter jumps 2e5 counts at 30 %", 0},
     {"enc_lie_30", K_ENC_OFFSET, 2.0e4, 0.3, 0, "counter off by 2e4 counts (below the jump limit) at 30 %", 0},
+    {"enc_spike_hold", K_ENC_SPIKE, 500.0, 0.0, 1, "one read off by 500 counts, holding", 0},
+    {"enc_spike_30", K_ENC_SPIKE, 500.0, 0.3, 1, "one read off by 500 counts at 30 %", 0},
+    {"enc_slip_30", K_ENC_OFFSET, 1000.0, 0.3, 1, "counter slips by 1000 counts for good at 30 %", 0},
     {"enc_noise_30", K_ENC_NOISE, 3.0, 0.3, 1, "each read off by up to 3 counts at 30 %", 0},
     {"enc_drop3_90", K_ENC_DROP, 3.0, 0.9, 1, "3 failed reads in a row at 90 %", 0},
     {"enc_drop5_90", K_ENC_DROP, 5.0, 0.9, 0, "5 failed reads in a row at 90 %", 0},
@@ -111,6 +115,7 @@ typedef struct {
     int active;       /* the injection has happened */
     int32_t frozen;   /* K_ENC_STUCK: the count held */
     long drops_left;  /* K_ENC_DROP */
+    int spiked;       /* K_ENC_SPIKE: the glitch has been read */
     uint64_t rng;
 } inj_t;
 
@@ -122,6 +127,10 @@ static br_status_t inj_read(void *ctx, int32_t *counts)
     switch (j->s->kind) {
     case K_ENC_STUCK: *counts = j->frozen; break;
     case K_ENC_OFFSET: *counts = (int32_t)((uint32_t)*counts + (uint32_t)(int32_t)j->s->amount); break;
+    case K_ENC_SPIKE:
+        if (!j->spiked) *counts = (int32_t)((uint32_t)*counts + (uint32_t)(int32_t)j->s->amount);
+        j->spiked = 1;
+        break;
     case K_ENC_NOISE: {
         /* xorshift64: a fixed stream per run */
         j->rng ^= j->rng << 13;
@@ -184,7 +193,7 @@ static int run_one(const scenario_t *s, br_circle_ctrl_t ctrl, const char *plant
                                   : 0.5 * ((double)mc.soft_min_m + (double)mc.soft_max_m);
     br_plant_t p;
     br_hal_sim_t port;
-    inj_t j = {{0}, s, 0, 0, 0, 0x9E3779B97F4A7C15ull};
+    inj_t j = {{0}, s, 0, 0, 0, 0, 0x9E3779B97F4A7C15ull};
     const br_plant_state_t x0 = {p0 / L, 0.0, 0.0};
     if (br_plant_init(&p, &c.plant, &x0) != 0 || br_hal_sim_init(&port, &p, dt, &j.inner) != BR_OK) return -1;
     const br_hal_t hal = {&j, inj_read, inj_pwm, inj_tick, NULL, NULL};

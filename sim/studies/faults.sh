@@ -23,18 +23,21 @@ known_realistic+=",enc_noise_30/hinf_pf,enc_drop3_90/hinf_pf,enc_drop5_90/hinf_p
 known_realistic+=",load_half_hold/hinf_ukf,load_half_hold/hinf_pf,load_half_30/hinf_ukf,load_half_30/hinf_pf"
 known_realistic+=",load_small_30/hinf_pf,cutting_30/hinf_ukf,cutting_30/hinf_pf,ref_max_speed/hinf_pf"
 known_realistic+=",ref_step_10mm/hinf_pf,ref_nan_90/hinf_pf,deadline_90/hinf_pf,ref_to_end/hinf_pf,deadline_end/hinf_pf"
+known_realistic+=",enc_spike_30/hinf_pf,enc_slip_30/hinf_pf"
 # the same with the PF's g_p along the Stribeck curve (tau 15 ms): the moves
-# run and every fault bound holds; read noise, loads and the limited step
-# still make it lose lock
+# run and every fault bound holds; read noise, loads, the limited step and
+# an encoder glitch (a 500-count spike, a 1000-count slip) still make it lose lock
 known_curve="enc_noise_30/hinf_pf,load_half_hold/hinf_ukf,load_half_hold/hinf_pf,load_half_30/hinf_ukf"
 known_curve+=",load_half_30/hinf_pf,load_small_30/hinf_pf,cutting_30/hinf_ukf,cutting_30/hinf_pf,ref_step_10mm/hinf_pf"
+known_curve+=",enc_spike_30/hinf_pf,enc_slip_30/hinf_pf"
 # hardware-like plant: with the thesis gate both estimators lost lock in the
 # run-up of every move; with the gate's transient term (outlier_transient_k = 1,
-# docs/presliding-plants.md) the moves reach their faults: the UKF keeps 13 of
-# the 17 bounds (it loses lock under the loads and after the 10 mm step), the PF
-# 4 (it still loses lock in the run-up of the others)
+# docs/presliding-plants.md) the moves reach their faults: the UKF keeps 16 of
+# the 20 bounds (it loses lock under the loads and after the 10 mm step), the PF
+# 5 (it still loses lock in the run-up of the others and after an encoder glitch
+# in a move)
 known_hw="load_half_hold/hinf_ukf,load_half_30/hinf_ukf,cutting_30/hinf_ukf,ref_step_10mm/hinf_ukf"
-for s in enc_stuck_90 enc_noise_30 enc_drop3_90 enc_drop5_90 load_half_hold load_half_30 load_small_30 cutting_30 \
+for s in enc_spike_30 enc_slip_30 enc_stuck_90 enc_noise_30 enc_drop3_90 enc_drop5_90 load_half_hold load_half_30 load_small_30 cutting_30 \
          ref_max_speed ref_step_10mm ref_nan_90 deadline_90 ref_to_end; do
   known_hw+=",$s/hinf_pf"
 done

@@ -108,7 +108,9 @@ def friction_split(recs):
     for key, _ in FRICTIONS:
         sub = [r for r in recs if friction_of(r) == key]
         through = [r for r in sub if "chain_failed" not in r]
-        named = [r["i"] for r in through if "presliding_hysteresis" in (r.get("machine", {}).get("causes") or {})]
+        # the machine file carries presliding_hysteresis as its Maxwell-slip friction_model (machine-file.md)
+        named = [r["i"] for r in through
+                 if (r.get("machine", {}).get("friction_model") or {}).get("model") == "maxwell_slip"]
         out[key] = {"n_axes": len(sub), "n_through_chain": len(through), "presliding_named": named,
                     "controllers": summarise(sub)}
     return out

@@ -27,6 +27,8 @@ CHECKS = [
      rf"FREE_LOAD_FROM = {NUM}"),
     ("test_golden_ukf.c", "ukf_ms free-run factor", rf"#define C_FREE_RUN_MS \({NUM} \* C_FREE_RUN\)", "### ukf",
      rf"C_FREE_RUN_MS = {NUM} × C_FREE_RUN"),
+    ("test_golden_ukf.c", "ukf_glitch free-run factor", rf"#define C_FREE_RUN_GLITCH \({NUM} \* C_FREE_RUN\)",
+     "### ukf", rf"C_FREE_RUN_GLITCH = {NUM} × C_FREE_RUN"),
     # ff_pred
     ("test_golden_ff_pred.c", "prediction", rf"#define C_PRED {NUM}", "### ff_pred", rf"\| dF \| {NUM}u·S"),
     # pf_ms

@@ -5,6 +5,8 @@
  * mean, covariance, F_hat, innovation per step), and with the external force
  * F_d (cfg.load, n = 5) through ukf_load.csv (its own input columns: the
  * same input with a load step; plus F_d and the load re-acquisitions), and
+ * ukf_glitch.csv (the same with est_input's encoder faults kept: the
+ * re-acquisitions of a spike and a slip undone the step after), and
  * with Maxwell-slip elements (cfg.est.model.mslip) through ukf_ms.csv (its
  * own input columns; plus the elements). The configuration comes from the
  * trace header. Tolerances: docs/golden.md.
@@ -48,12 +50,21 @@
  * until it is forgotten (docs/golden.md); steps 1..FREE_LOAD_FROM-1 are
  * compared one step at a time. */
 #define FREE_LOAD_FROM 50
+/* The free run with the encoder faults (ukf_glitch): the load-off
+ * re-acquisition at k = 1200 inflates P_dd by dF^2 again and its float32
+ * cancellation multiplies the g_p error carried into it; g_p, a slow random
+ * walk, keeps it: measured at 0.97 x C_FREE_RUN (1.12 x before the model's
+ * RK4 test covered the stages), 2 x keeps a 2.1 x margin (docs/golden.md).
+ * ukf_load stays within C_FREE_RUN: 0.88 of it at the worst (S after the
+ * load-on re-acquisition at k = 300). */
+#define C_FREE_RUN_GLITCH (2.0 * C_FREE_RUN)
 
 #define NM BR_UKF_NMAX
 #define NE BR_MSLIP_MAX
 
-/* the traces: the thesis's filter, with the external force, with the elements */
-enum { V_UKF = 0, V_LOAD = 1, V_MS = 2 };
+/* the traces: the thesis's filter, with the external force (without and with
+ * the encoder faults), with the elements */
+enum { V_UKF = 0, V_LOAD = 1, V_MS = 2, V_GLITCH = 3 };
 
 typedef struct {
     br_trace_t in, u;
@@ -63,6 +74,8 @@ typedef struct {
     int nsteps;
     int c_counts, c_frac, c_uprev;
     int c_st, c_org, c_nout, c_ra, c_acq, c_x[NM], c_P[NM][NM], c_Pm[NM], c_F, c_nu, c_S, c_e[NE];
+    /* with the external force: the undo, the held alternative (-1 otherwise) */
+    int c_undo, c_alt, c_alt_org, c_alt_nu, c_alt_x[NM], c_alt_P[NM][NM];
 } ukf_golden_t;
 
 /* ukf: est_input.csv's input and ukf.csv, n = 4; ukf_load: the input
@@ -70,8 +83,9 @@ typedef struct {
  * ukf_ms: those of ukf_ms.csv, n = 4 and the elements (ms_* in its header) */
 static void load_all(ukf_golden_t *g, int variant)
 {
-    static const char *in_name[3] = {"est_input", "ukf_load", "ukf_ms"}, *u_name[3] = {"ukf", "ukf_load", "ukf_ms"};
-    const int load = variant == V_LOAD;
+    static const char *in_name[4] = {"est_input", "ukf_load", "ukf_ms", "ukf_glitch"},
+                      *u_name[4] = {"ukf", "ukf_load", "ukf_ms", "ukf_glitch"};
+    const int load = variant == V_LOAD || variant == V_GLITCH;
     g->n = load ? BR_UKF_NMAX : BR_NX;
     br_trace_load(&g->in, in_name[variant]);
     br_trace_load(&g->u, u_name[variant]);
@@ -119,10 +133,20 @@ static void load_all(ukf_golden_t *g, int variant)
     g->c_nout = br_trace_col(t, "n_outliers");
     g->c_ra = br_trace_col(t, "reanchored");
     g->c_acq = load ? br_trace_col(t, "load_acq") : -1;
+    g->c_undo = load ? br_trace_col(t, "load_undo") : -1;
+    g->c_alt = load ? br_trace_col(t, "alt") : -1;
+    g->c_alt_org = load ? br_trace_col(t, "alt_origin") : -1;
+    g->c_alt_nu = load ? br_trace_col(t, "alt_nu") : -1;
     const char *xn[NM] = {"theta", "omega", "z", "gp", "Fd"};
     for (int i = 0; i < g->n; i++) {
         g->c_x[i] = br_trace_col(t, xn[i]);
         char name[32];
+        snprintf(name, sizeof name, "alt_%s", xn[i]);
+        g->c_alt_x[i] = load ? br_trace_col(t, name) : -1;
+        for (int j = i; j < g->n; j++) {
+            snprintf(name, sizeof name, "alt_P%d%d", i, j);
+            g->c_alt_P[i][j] = g->c_alt_P[j][i] = load ? br_trace_col(t, name) : -1;
+        }
         snprintf(name, sizeof name, "Pm%d%d", i, i);
         g->c_Pm[i] = br_trace_col(t, name);
         for (int j = i; j < g->n; j++) {
@@ -165,6 +189,18 @@ static void seed(br_ukf_t *f, const ukf_golden_t *g, int k)
     }
     f->origin_counts = (int32_t)br_trace_get(&g->u, k, g->c_org);
     f->n_outliers = (uint32_t)br_trace_get(&g->u, k, g->c_nout);
+    /* the held alternative of a re-acquisition (docs/modules/ukf.md, "A glitch is not a load") */
+    f->alt_pending = (g->c_alt >= 0) && br_trace_get(&g->u, k, g->c_alt) != 0.0;
+    if (f->alt_pending) {
+        f->alt_origin = (int32_t)br_trace_get(&g->u, k, g->c_alt_org);
+        f->alt_nu_rad = (float)br_trace_get(&g->u, k, g->c_alt_nu);
+        for (int i = 0; i < g->n; i++) {
+            f->alt_x[i] = (float)br_trace_get(&g->u, k, g->c_alt_x[i]);
+            for (int j = 0; j < g->n; j++) {
+                f->alt_P[i][j] = (float)br_trace_get(&g->u, k, g->c_alt_P[i][j]);
+            }
+        }
+    }
     const br_meas_t y = meas(g, k);
     f->prev_counts = y.counts;
     f->prev_frac = y.frac;
@@ -174,7 +210,8 @@ static void seed(br_ukf_t *f, const ukf_golden_t *g, int k)
 typedef struct {
     br_errstat_t x[NM], P[NM][NM], F, nu, S, e[NE];
     long bad_status, bad_exact;
-    uint32_t n_acq; /* the filter's n_load_acq after the last compared step */
+    uint32_t n_acq;  /* the filter's n_load_acq after the last compared step */
+    uint32_t n_undo; /* its n_load_undo */
 } ukf_err_t;
 
 static void err_init(ukf_err_t *e)
@@ -183,6 +220,7 @@ static void err_init(ukf_err_t *e)
     static const char *xu[NM] = {"rad", "rad/s", "m", "N", "N"};
     static char pn[NM][NM][8];
     e->n_acq = 0u;
+    e->n_undo = 0u;
     for (int i = 0; i < NM; i++) {
         br_errstat_init(&e->x[i], xn[i], xu[i]);
         for (int j = 0; j < NM; j++) {
@@ -222,13 +260,15 @@ static void compare_step(const br_ukf_t *f, const ukf_golden_t *g, int k, br_sta
                         br_trace_get(t, k, g->c_nout));
         }
     }
-    /* a load re-acquisition on exactly the reference's steps */
-    const int acq = (int)(f->n_load_acq - e->n_acq);
+    /* a load re-acquisition, and its undo, on exactly the reference's steps */
+    const int acq = (int)(f->n_load_acq - e->n_acq), undo = (int)(f->n_load_undo - e->n_undo);
     e->n_acq = f->n_load_acq;
-    if (g->c_acq >= 0 && (double)acq != br_trace_get(t, k, g->c_acq)) {
+    e->n_undo = f->n_load_undo;
+    if (g->c_acq >= 0 &&
+        ((double)acq != br_trace_get(t, k, g->c_acq) || (double)undo != br_trace_get(t, k, g->c_undo))) {
         if (e->bad_exact++ < 5) {
-            print_error("%s:%d: load re-acquired %d, expected %.0f\n", t->path, t->line[k], acq,
-                        br_trace_get(t, k, g->c_acq));
+            print_error("%s:%d: load re-acquired %d, undone %d, expected %.0f, %.0f\n", t->path, t->line[k], acq,
+                        undo, br_trace_get(t, k, g->c_acq), br_trace_get(t, k, g->c_undo));
         }
     }
     for (int i = 0; i < g->n; i++) {
@@ -404,17 +444,20 @@ static void run_free(int variant, const char *what, int k0)
     for (int k = k0; k < g.nsteps; k++) {
         const br_meas_t y = meas(&g, k);
         const br_status_t st = br_ukf_step(&f, &y, (float)br_trace_get(&g.in, k, g.c_uprev));
-        tolerances(&g, &uc, k, (variant == V_MS) ? C_FREE_RUN_MS : C_FREE_RUN, tx, tP, &tF, &tnu, &tS, te);
+        const double C = (variant == V_MS) ? C_FREE_RUN_MS : (variant == V_GLITCH) ? C_FREE_RUN_GLITCH : C_FREE_RUN;
+        tolerances(&g, &uc, k, C, tx, tP, &tF, &tnu, &tS, te);
         compare_step(&f, &g, k, st, &e, tx, tP, tF, tnu, tS, te);
     }
-    long n_out = 0, n_ra = 0, n_acq = 0;
+    long n_out = 0, n_ra = 0, n_acq = 0, n_undo = 0;
     for (int k = k0; k < g.nsteps; k++) {
         n_out += (int)br_trace_get(&g.u, k, g.c_st) == BR_W_OUTLIER;
         n_ra += (int)br_trace_get(&g.u, k, g.c_ra);
         n_acq += (g.c_acq >= 0) ? (int)br_trace_get(&g.u, k, g.c_acq) : 0;
+        n_undo += (g.c_undo >= 0) ? (int)br_trace_get(&g.u, k, g.c_undo) : 0;
     }
-    print_message("golden %-10s %d steps from %d (%ld outlier, %ld re-anchoring, %ld load re-acquired), statuses %s, "
-                  "origin, outlier and re-acquisition counts %s\n", what, g.nsteps - k0, k0, n_out, n_ra, n_acq,
+    print_message("golden %-10s %d steps from %d (%ld outlier, %ld re-anchoring, %ld load re-acquired, %ld undone), "
+                  "statuses %s, origin, outlier and re-acquisition counts %s\n", what, g.nsteps - k0, k0, n_out, n_ra,
+                  n_acq, n_undo,
                   e.bad_status ? "DIFFER" : "identical", e.bad_exact ? "DIFFER" : "identical");
     const long fails = err_print(&e, &g, what);
     free_all(&g);
@@ -450,6 +493,19 @@ static void test_ukf_load_free_run(void **state)
     run_free(V_LOAD, "ukf_load", FREE_LOAD_FROM);
 }
 
+/* the same with the encoder faults: the glitches' re-acquisitions undone */
+static void test_ukf_glitch_one_step(void **state)
+{
+    (void)state;
+    run_one_step(V_GLITCH, "ukf_glitch1");
+}
+
+static void test_ukf_glitch_free_run(void **state)
+{
+    (void)state;
+    run_free(V_GLITCH, "ukf_glitch", FREE_LOAD_FROM);
+}
+
 /* the Maxwell-slip elements (cfg.est.model.mslip) */
 static void test_ukf_ms_one_step(void **state)
 {
@@ -470,6 +526,8 @@ int main(void)
         cmocka_unit_test(test_ukf_free_run),
         cmocka_unit_test(test_ukf_load_one_step),
         cmocka_unit_test(test_ukf_load_free_run),
+        cmocka_unit_test(test_ukf_glitch_one_step),
+        cmocka_unit_test(test_ukf_glitch_free_run),
         cmocka_unit_test(test_ukf_ms_one_step),
         cmocka_unit_test(test_ukf_ms_free_run),
     };

@@ -17,7 +17,7 @@
 #include "bristle/br_est.h"
 #include "bristle/br_model.h"
 
-#define BR_TRACE_MAX_COLS 48
+#define BR_TRACE_MAX_COLS 64
 #define BR_TRACE_MAX_META 64
 
 typedef struct {

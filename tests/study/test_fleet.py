@@ -151,6 +151,17 @@ class Fleet(unittest.TestCase):
         self.assertEqual(fleet.unexpected_faults(summ, __import__("types").SimpleNamespace(
             md="page.md", expect_faults=False)), 1)  # the lost_lock, not the refusal
 
+    def test_friction_split(self):
+        """the axes by their plant's friction; presliding named where the diagnosis wrote the
+        Maxwell-slip friction_model into machine.json (where the machine file carries the cause)"""
+        def rec(i, presliding, model):
+            return {"i": i, "axis": {"presliding": presliding}, "traj": {}, "runs": {},
+                    "machine": {"causes": {}, **({"friction_model": {"model": model}} if model else {})}}
+        f = fleet.friction_split([rec(0, False, None), rec(1, True, "maxwell_slip"), rec(2, True, None),
+                                  rec(3, False, "maxwell_slip")])
+        self.assertEqual((f["lugre"]["n_axes"], f["maxwell_slip"]["n_axes"]), (2, 2))
+        self.assertEqual((f["lugre"]["presliding_named"], f["maxwell_slip"]["presliding_named"]), ([3], [1]))
+
     def test_axis_draw_in_range(self):
         for i in range(50):
             ax = fleet_axis.draw(SEED, i)

@@ -772,6 +772,82 @@ static void test_encoder_frozen_latches(void **st)
     assert_latched(&g, BR_APP_FAULT_ENC_FROZEN);
 }
 
+/* the rig with the machine's drive protections on an encoder so coarse for
+ * its period that the friction band plus the quantization allowance (2 k,
+ * k = mass / (counts_per_m dt^2) the force of one count per period^2) is
+ * COARSE_SHARE of the actuator's force, as on the fleet's axis 3 (0.096 um
+ * counts at 0.27 ms: k = 140 N, 36 + 280 N of 659 N); the controller on the
+ * same counts */
+#define COARSE_SHARE 0.5f
+static void rig_coarse(rig_t *g)
+{
+    rig_init(g, 0);
+    br_app_machine_t mm = BR_MACHINE_APP_MACHINE;
+    const br_app_motion_cfg_t fine = br_app_motion_cfg(&mm);
+    const float dt = g->k.dt_s, F_max = g->k.tau_max_Nm / g->k.lead_mprad;
+    const float k_N = (COARSE_SHARE * F_max - fine.stuck_band_N) / BR_APP_STUCK_QUANT_ACCEL;
+    /* counts_per_m = mass / (k dt^2) */
+    const float cpm = fine.mass_kg / (k_N * dt * dt);
+    mm.rad_per_count = 1.0f / (mm.lead_mprad * cpm);
+    g->k.rad_per_count = mm.rad_per_count;
+    g->c.motion = br_app_motion_cfg(&mm);
+    g->c.guard = br_app_guard_cfg(dt, mm.max_speed_mps * cpm);
+    assert_int_equal(br_app_init(&g->app, &g->c, &g->hal, NULL), BR_OK);
+    assert_int_equal(br_app_arm(&g->app), BR_OK);
+    assert_float_equal(g->app.mot_k_m, k_N, 1e-3f * k_N);
+    /* one count per period^2 is more than the band: the edge below matters */
+    assert_true(k_N > g->app.motion.stuck_band_N);
+}
+
+/* The stuck-encoder model on a coarse count (rig_coarse): an axis held on a
+ * count's edge reads the count and its neighbour by turns without moving
+ * (the fleet's axis 3 latched ENC_FROZEN 1.4 ms into every run that way:
+ * -1, +1, then still, F_hold taken 280 N off); the quantization allowance
+ * keeps it running. A counter that never moves under a reference far away
+ * still latches ENC_FROZEN, and one that stops while the axis moves at the
+ * first still period. */
+static void test_encoder_frozen_coarse_count(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_coarse(&g);
+    /* on the edge of count 0: the count reads 0 or -1, the reference on it */
+    static const int32_t edge[] = {0, -1, 0, 0, 0, -1, -1, 0, -1, 0, 0, 0, 0, -1};
+    const br_ref_t on_edge = {0, 0.0f, 0.0f};
+    for (int i = 0; i < 2000; i++) {
+        g.f.counts = edge[i % (int)(sizeof edge / sizeof edge[0])];
+        assert_int_equal(br_app_step(&g.app, &on_edge), BR_OK);
+    }
+    /* a counter that never moves, a reference far away: ENC_FROZEN once the
+     * drive pushes past the band and the allowance */
+    rig_coarse(&g);
+    const br_ref_t far = {100000, 0.0f, 0.0f};
+    br_status_t s = BR_OK;
+    int n = 0;
+    for (; n < 1000 && s == BR_OK; n++) {
+        s = br_app_step(&g.app, &far);
+    }
+    assert_int_equal(s, BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_FROZEN);
+    print_message("coarse count: far reference, ENC_FROZEN after %d periods\n", n);
+    /* a run-up within the limiter's acceleration to 20 counts a period, the
+     * reference on the axis; the counter stops: at the first still period
+     * (the model: 20 counts less the band and the allowance) */
+    rig_coarse(&g);
+    double pos = 0.5, v = 0.0;
+    for (int i = 0; i < 100; i++) {
+        v = fmin(v + 0.9 * (double)g.app.lim_amax, 20.0);
+        pos += v;
+        g.f.counts = (int32_t)floor(pos);
+        const br_ref_t mv = {g.f.counts, (float)(pos - floor(pos)), (float)(v * (double)g.k.rad_per_count / (double)g.k.dt_s)};
+        assert_int_equal(br_app_step(&g.app, &mv), BR_OK);
+    }
+    pos += v;
+    const br_ref_t ahead = {(int32_t)floor(pos), (float)(pos - floor(pos)), 0.0f};
+    assert_int_equal(br_app_step(&g.app, &ahead), BR_E_FAULT);
+    assert_int_equal(g.app.fault, BR_APP_FAULT_ENC_FROZEN);
+}
+
 /* The reference limiter: within the limits the reference passes bit for
  * bit; a step is limited (flagged) to the machine's speed and acceleration,
  * lands on the target and passes again; a target beyond the soft travel
@@ -1125,6 +1201,7 @@ int main(void)
         cmocka_unit_test(test_held_reads_extrapolate),
         cmocka_unit_test(test_encoder_jump_after_held_reads),
         cmocka_unit_test(test_encoder_frozen_latches),
+        cmocka_unit_test(test_encoder_frozen_coarse_count),
         cmocka_unit_test(test_reference_limiter),
         cmocka_unit_test(test_reference_to_the_end),
         cmocka_unit_test(test_motion_faults_brake),

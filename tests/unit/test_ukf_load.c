@@ -129,6 +129,95 @@ static void test_jump_not_a_load(void **st)
     assert_int_equal(u.n_load_acq, 0u);
 }
 
+/* The filter at period dt_s on an axis held still (counts 100) whose counter reads +off counts for one
+ * period (slip 0: a spike) or from then on (slip 1) from step 200 of 400.
+ * Returns the last period after the glitch that re-acquired a load (199
+ * when none did, 200 when only the glitch's own did); *acq_at the glitch's
+ * own re-acquisition (0: within the gate, an ordinary update); *fd_max the
+ * largest |F_d| from 2 periods after the glitch on, *w_max the largest
+ * |omega| there, *n_out the outlier steps. */
+static int glitch(float dt_s, int32_t off, int slip, int *acq_at, float *fd_max, float *w_max, int *n_out)
+{
+    br_ukf_t u;
+    br_ukf_cfg_t c = load_cfg();
+    c.est.model.dt_s = dt_s;
+    assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+    int last_acq = 199;
+    *acq_at = 0;
+    *fd_max = *w_max = 0.0f;
+    *n_out = 0;
+    for (int k = 0; k < 400; k++) {
+        const br_meas_t y = {100 + ((k == 200 || (slip && k > 200)) ? off : 0), 0.5f};
+        const uint32_t acq = u.n_load_acq;
+        const br_status_t st = br_ukf_step(&u, &y, 0.0f);
+        assert_true(st == BR_OK || st == BR_W_OUTLIER);
+        *n_out += st == BR_W_OUTLIER;
+        last_acq = (k >= 200 && u.n_load_acq != acq) ? k : last_acq;
+        *acq_at = (k == 200) ? (u.n_load_acq != acq) : *acq_at;
+        if (k >= 202) {
+            *fd_max = fmaxf(*fd_max, fabsf(u.est.load_N));
+            *w_max = fmaxf(*w_max, fabsf(u.est.mean[BR_X_OMEGA]));
+        }
+    }
+    return last_acq;
+}
+
+/* docs/modules/ukf.md, "A glitch is not a load": a one-period spike or a
+ * counter slip of up to 2 max_N g counts (g = L dt^2 / (2 J_eff), the load
+ * state's rad per N over one period) is, over one period, a force the
+ * re-acquisition takes for a load. Without the undo, at the control period
+ * the next innovation (-4 and -3 times the glitch) is beyond what a load
+ * explains: outliers and a re-anchoring; at 1.5 periods (the golden trace's
+ * 1.5 ms) it is within it, and the filter cycles for good (period 2, F_d
+ * about +-465 N on the reference machine). With the undo the next period's
+ * innovation undoes the re-acquisition: no re-acquisition after the
+ * glitch's own, no outlier, and from the period after on F_d and omega back
+ * at the held axis's (under 1 % of the actuator's force, under 1e-2 rad/s:
+ * measured under 1.2e-5 N, 3e-7 rad/s). The sizes are 1/32 .. 32/32 of 0.95
+ * of that window, from this machine's values. A glitch within the gate (the
+ * smallest sizes) is an ordinary update, not a re-acquisition, and not this
+ * case (ukf.md, "Known limit: a glitch within the gate": it is then
+ * re-acquired a period later, F_d off by up to 27 N on the reference
+ * machine and 656 N on machines/heavy); at least 24 sizes of each kind are
+ * re-acquired. Taking the first hypothesis that passes instead of the
+ * smaller |nu| fails here (reference machine, 1 ms: a 113-count slip is
+ * within the spike's gate a period on), and so does the model's RK4 test
+ * at the ends only (machines/heavy, 1.5 ms: a slip's sigma points of F_d
+ * beyond the actuator's force, stepped from rest). */
+static void test_glitch_undone(void **st)
+{
+    (void)st;
+    const float F_act = load_cfg().load.max_N;
+    for (int p = 0; p < 4; p++) {
+        const int slip = p & 1;
+        const float dt = (p < 2) ? DT_F : 1.5f * DT_F;
+        br_ukf_t u;
+        br_ukf_cfg_t c = load_cfg();
+        c.est.model.dt_s = dt;
+        assert_int_equal(br_ukf_init(&u, &c), BR_OK);
+        const float window = 0.95f * 2.0f * F_act * u.load_rad_per_N2 / c.est.rad_per_count;
+        int n_acq = 0;
+        for (int i = 1; i <= 32; i++) {
+            const int32_t off = (int32_t)lrintf(window * (float)i / 32.0f);
+            float fd, w;
+            int n_out, acq_at;
+            const int last = glitch(dt, off, slip, &acq_at, &fd, &w, &n_out);
+            printf("  dt %g s, %s %d: %s, last re-acquisition at %d, then max |F_d| %.3g N, |omega| %.3g rad/s, "
+                   "%d outliers\n", (double)dt, slip ? "slip" : "spike", (int)off,
+                   acq_at ? "re-acquired" : "within the gate", last, (double)fd, (double)w, n_out);
+            if (!acq_at) {
+                continue; /* within the gate: an ordinary update, no re-acquisition to undo */
+            }
+            n_acq++;
+            assert_int_equal(last, 200); /* taken for a load at the glitch, and only there */
+            assert_int_equal(n_out, 0);
+            assert_true(fd < 0.01f * F_act);
+            assert_true(w < 1.0e-2f);
+        }
+        assert_true(n_acq >= 24);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -136,6 +225,7 @@ int main(void)
         cmocka_unit_test(test_load_step_followed),
         cmocka_unit_test(test_load_bounded),
         cmocka_unit_test(test_jump_not_a_load),
+        cmocka_unit_test(test_glitch_undone),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -121,6 +121,13 @@ br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s);
 /* The stuck-encoder detector's threshold: predicted motion, in counts, that a
  * still counter must not hide. */
 #define BR_APP_STUCK_COUNTS 8.0f
+/* The stuck-encoder model's allowance for the count's quantization, counts per
+ * period^2: the speed change F_hold is taken from is the difference of two
+ * one-period count differences, each within one count of the motion, so it
+ * is off by less than 2 (F_hold by less than 2 mass / (counts_per_m dt^2):
+ * 0.5 N on the reference machine, 280 N on an axis of 0.1 um counts at
+ * 0.27 ms; docs/reliability.md, "Stuck encoder and quantization"). */
+#define BR_APP_STUCK_QUANT_ACCEL 2.0f
 /* Standstill after a braking ramp: so many periods at zero reference speed,
  * then outputs off. */
 #define BR_APP_BRAKE_SETTLE_PERIODS 20u

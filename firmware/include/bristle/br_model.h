@@ -115,7 +115,8 @@ float br_model_fcomp_N(const br_model_t *m, const float x[BR_NX], float p0_m);
 
 /* One discretisation step of dt_s with the torque u_Nm held, theta absolute:
  * n_sub sub-steps of h = dt_s / n_sub, each by RK4 where a h <=
- * BR_MODEL_RK4_AH_MAX, otherwise by the bounded scheme.
+ * BR_MODEL_RK4_AH_MAX at its ends and its stages, otherwise by the bounded
+ * scheme.
  * Non-finite input or g_p <= 0 gives BR_E_INPUT and x_next = x. */
 br_status_t br_model_step(const br_model_t *m, const float x[BR_NX], float u_Nm, float x_next[BR_NX]);
 

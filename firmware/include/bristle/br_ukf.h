@@ -23,7 +23,13 @@
  * torque in step 2 is u - L F_d), a gated innovation that a change of F_d
  * of at most 2 load.max_N explains is re-acquired (P_dd inflated, the
  * period predicted again) instead of rejected, and F_hat is friction + F_d
- * within +-load.max_N (docs/modules/ukf.md, "External force").
+ * within +-load.max_N (docs/modules/ukf.md, "External force"). A
+ * re-acquisition keeps its alternative (the period's first prediction, as an
+ * outlier would have committed it); when the next innovation is gated and
+ * that alternative, or it moved by the re-acquired innovation (a counter
+ * slip), passes the gate (the smaller innovation of the two when both do),
+ * the re-acquisition is undone: the step updates the alternative's
+ * prediction (docs/modules/ukf.md, "A glitch is not a load").
  * theta is stored relative to an integer origin (the latest accepted count),
  * as in the PF, so float32 keeps sub-count resolution at any travel.
  * See docs/modules/ukf.md. */
@@ -111,6 +117,16 @@ typedef struct {
                                         non-finite prediction or update) */
     uint32_t n_predicted;            /* predict-only steps since the last measurement */
     uint32_t n_load_acq;             /* gated innovations re-acquired as a load (cfg.load) */
+    uint32_t n_load_undo;            /* re-acquisitions undone by the next innovation (a glitch) */
+    /* The last step's re-acquisition's alternative (cfg.load; docs/modules/ukf.md,
+     * "A glitch is not a load"): that period's first prediction, as an outlier
+     * commits it, in the frame of alt_origin; alt_nu_rad the gated innovation */
+    int alt_pending;                 /* 1: the last step re-acquired, the alternative is held */
+    float alt_x[BR_UKF_NMAX];
+    float alt_P[BR_UKF_NMAX][BR_UKF_NMAX];
+    float alt_el[BR_MSLIP_MAX];
+    int32_t alt_origin;
+    float alt_nu_rad;
     int primed;                      /* x, P set from the first measurement */
     br_ukf_est_t est;
     int ready;
