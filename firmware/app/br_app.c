@@ -178,6 +178,10 @@ br_status_t br_app_init(br_app_t *app, const br_app_cfg_t *cfg, const br_hal_t *
     if (st != BR_OK) {
         return st;
     }
+    /* the stuck-encoder model's command history holds the actuator delay */
+    if (!br_est_delay_fits(cfg->motion.delay_s, cfg->ctrl->dt_s)) {
+        return BR_E_PARAM;
+    }
     app->motion = cfg->motion;
     br_app_motion_reset(app); /* the limits in counts at the controller's period */
     /* a braking ramp of bounded length, a limiter that moves in a period */
@@ -266,6 +270,7 @@ br_status_t br_app_step(br_app_t *app, const br_ref_t *ref)
         br_app_outputs_off(app);
         return BR_E_FAULT;
     }
+    br_app_motion_push(app);
     int32_t counts = 0;
     br_status_t st = hal->encoder_read(hal->ctx, &counts);
     br_status_t est_st = BR_OK;

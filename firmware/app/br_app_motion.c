@@ -21,12 +21,13 @@
 
 br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m)
 {
-    br_app_motion_cfg_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    br_app_motion_cfg_t c = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     if (m == NULL || !br_finite_pos(m->lead_mprad) || !br_finite_pos(m->rad_per_count) ||
         !br_finite_pos(m->mass_kg) || !br_finite_pos(m->inertia_kgm2) || !br_finite_pos(m->Fc_N) ||
         !br_finite_pos(m->Fs_N) || !br_finite_pos(m->max_speed_mps) || !br_finite_pos(m->max_accel_mps2) ||
         !br_finite_pos(m->max_following_m) || !br_finite_pos(m->travel_m) || !isfinite(m->travel_min_m) ||
-        !br_finite_pos(m->period_s) || (m->coast_in_stroke != 0 && m->coast_in_stroke != 1)) {
+        !br_finite_pos(m->period_s) || (m->coast_in_stroke != 0 && m->coast_in_stroke != 1) ||
+        !(m->delay_s >= 0.0f) || !isfinite(m->delay_s)) {
         return c; /* all zero: rejected by br_app_init */
     }
     c.counts_per_m = 1.0f / (m->lead_mprad * m->rad_per_count);
@@ -51,6 +52,7 @@ br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m)
     /* at standstill friction holds any force in [-Fs, Fs]: a change of 2 Fs */
     c.stuck_band_N = 2.0f * m->Fs_N;
     c.stuck_counts = BR_APP_STUCK_COUNTS;
+    c.delay_s = m->delay_s;
     return c;
 }
 
@@ -59,7 +61,8 @@ br_status_t br_app_motion_check(const br_app_motion_cfg_t *m)
     if (!br_finite_pos(m->counts_per_m) || !br_finite_pos(m->max_speed_mps) || !br_finite_pos(m->max_accel_mps2) ||
         !br_finite_pos(m->max_following_m) || !br_finite_pos(m->mass_kg) || !br_finite_pos(m->stuck_band_N) ||
         !br_finite_pos(m->stuck_counts) || !br_finite_pos(m->stop_bound_m) || !(m->brake_N >= 0.0f) ||
-        !isfinite(m->brake_N) || !(m->coast_decel_mps2 >= 0.0f) || !isfinite(m->coast_decel_mps2)) {
+        !isfinite(m->brake_N) || !(m->coast_decel_mps2 >= 0.0f) || !isfinite(m->coast_decel_mps2) ||
+        !(m->delay_s >= 0.0f) || !isfinite(m->delay_s)) {
         return BR_E_PARAM;
     }
     /* written so that a NaN fails: a speed fault at or above the limiter's
@@ -104,6 +107,8 @@ void br_app_motion_reset(br_app_t *app)
     app->hold_N = 0.0f;
     app->v_pred = 0.0f;
     app->d_pred = 0.0f;
+    br_est_delay_reset(&app->mot_delay, m->delay_s, dt, m->delay_s > 0.0f);
+    app->mot_F_N = 0.0f;
     app->brk_counts = 0;
     app->brk_frac = 0.0f;
     app->brk_v = 0.0f;
@@ -254,8 +259,9 @@ br_app_fault_t br_app_motion_watch(br_app_t *app, int32_t d, uint32_t periods)
         return BR_APP_FAULT_SPEED;
     }
     const float k_m = app->mot_k_m;
-    /* the force the drive applied over the period that ended (load side) */
-    const float F = app->last.tau_Nm / app->ctrl.cfg.lead_mprad;
+    /* the force that reached the axis over the period that ended (load side,
+     * br_app_motion_push: after the actuator delay) */
+    const float F = app->mot_F_N;
     if (d != 0 || periods != 1u) {
         /* the count moved (or a held read: no period-wise model): friction +
          * load now, F - mass a (eq. of motion), the speed the model starts from */
@@ -381,4 +387,11 @@ br_status_t br_app_brake_open_period(br_app_t *app)
     app->last = (br_ctrl_out_t){app->brk_duty * app->ctrl.cfg.tau_per_duty_Nm, app->brk_duty, 0.0f, 0.0f, 0};
     app->brk_left--;
     return BR_E_FAULT;
+}
+
+void br_app_motion_push(br_app_t *app)
+{
+    /* the command held over the period that ended; what reached the axis over
+     * it: (1 - f) u[k-1-m] + f u[k-2-m] for the delay (m + f) dt (docs/modules/est.md) */
+    app->mot_F_N = br_est_delay_apply(&app->mot_delay, app->last.tau_Nm) / app->ctrl.cfg.lead_mprad;
 }

@@ -72,6 +72,9 @@ def machine_fields(m, p):
         ("BR_MACHINE_STOP_BOUND_M", machine.stop_bound_m(m),
          "stopping distance the soft travel limits keep from the stroke's ends (machine.stop_bound_m;\n"
          " * br_app_motion_cfg derives the same in float32)"),
+        ("BR_MACHINE_ACTUATOR_DELAY_S", m.get("causes", {}).get("actuator_delay", {}).get("delay_s", 0.0),
+         "causes.actuator_delay.delay_s, 0 without it: the force a command gives reaches the axis so\n"
+         " * late (the stuck-encoder model, br_app_motion_cfg)"),
         ("BR_MACHINE_MAX_ACCEL_MPS2", machine.limit_defaults(m)[0],
          "the reference limiter's and the braking ramp's acceleration (br_app_motion_cfg)"),
         ("BR_MACHINE_MAX_FOLLOWING_M", machine.limit_defaults(m)[1],

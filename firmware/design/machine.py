@@ -515,6 +515,11 @@ def _cross_checks(m, errors):
     need(["estimator.pf.adapt.tau_s", "estimator.pf.period_s"],
          lambda: get("estimator.pf.adapt.tau_s") >= get("estimator.pf.period_s"),
          "estimator.pf.adapt.tau_s", "must be >= estimator.pf.period_s (alpha = period_s / tau_s <= 1)")
+    # the actuator delay within the command history the application's
+    # stuck-encoder model keeps at the control period (br_app_init refuses more)
+    need(["causes.actuator_delay.delay_s", "control.period_s"],
+         lambda: get("causes.actuator_delay.delay_s") <= EST_DELAY_MAX_PERIODS * get("control.period_s"),
+         "causes.actuator_delay.delay_s", "must be <= %d periods of control.period_s" % EST_DELAY_MAX_PERIODS)
     # each estimator's delay identification: its largest candidate within its command history
     for est, name in (("pf", "estimator.pf.period_s"), ("ukf", "control.period_s")):
         d = "estimator.%s.delay_id." % est

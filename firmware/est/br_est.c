@@ -96,8 +96,14 @@ int br_est_delay_fits(float delay_s, float dt_s)
 
 void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg)
 {
-    br_dlyid_periods(cfg->model.causes.delay_s, cfg->model.dt_s, &d->m, &d->f);
-    d->on = cfg->model.causes.delay_s > 0.0f || cfg->delay_id.n_cand > 0u;
+    br_est_delay_reset(d, cfg->model.causes.delay_s, cfg->model.dt_s,
+                       cfg->model.causes.delay_s > 0.0f || cfg->delay_id.n_cand > 0u);
+}
+
+void br_est_delay_reset(br_est_delay_t *d, float delay_s, float dt_s, int on)
+{
+    br_dlyid_periods(delay_s, dt_s, &d->m, &d->f);
+    d->on = on;
     d->head = 0u;
     d->n = 0u;
     for (uint32_t i = 0; i < BR_EST_DELAY_HIST; i++) {

@@ -23,6 +23,10 @@ br_status_t br_app_ref_limit(br_app_t *app, const br_ref_t *ref, int32_t counts,
 /* One good read spanning `periods` periods with delta d: the speed fault and
  * the stuck-encoder model (ENC_FROZEN), BR_APP_FAULT_NONE when neither. */
 br_app_fault_t br_app_motion_watch(br_app_t *app, int32_t d, uint32_t periods);
+/* Every period the loop runs (before the read): the last command into the
+ * actuator-delay history, the force that reached the axis over the period
+ * that ended into app->mot_F_N (the stuck-encoder model's force). */
+void br_app_motion_push(br_app_t *app);
 
 /* FOLLOWING or TRAVEL for the reference r handed to the controller and the
  * count, else BR_APP_FAULT_NONE. */

@@ -28,6 +28,6 @@
  * actuator's force (no stuck-encoder fault), no coast envelope. */
 #define BR_TEST_WIDE_MOTION                                                                       \
     br_app_motion_cfg(&(const br_app_machine_t){1.27e-3f, 6.0e-6f, 10.0f, 4e-5f, 7.0f, 1000.0f, 1.0f, 1000.0f, \
-                                                0.01f, 10.0f, -5.0f, 1e-3f, 0})
+                                                0.01f, 10.0f, -5.0f, 1e-3f, 0, 0.0f})
 
 #endif

@@ -168,12 +168,15 @@ def main():
     bad["estimator"]["pf"]["adapt"]["tau_s"] = 0.5 * bad["estimator"]["pf"]["period_s"]
     for est in ("pf", "ukf"):
         bad["estimator"][est]["delay_id"]["step_s"] = 0.1  # 7 x 0.1 s: beyond 62 periods of either period
+    bad["causes"] = {"actuator_delay": {"delay_s": 0.1}}  # beyond 62 periods of control.period_s
     expect_errors(work, "cross.json", bad, ["field friction.Fs_N: must be >= friction.Fc_N (7 N)",
                                             "field control.torque_limit_Nm: must be <= amplifier.duty_limit * "
                                             "amplifier.torque_per_duty_Nm",
                                             "field estimator.ukf.gp0_Fs: gp0_Fs * Fs_N must lie in "
                                             "[gp_min_Fc * Fc_N, gp_max_Fs * Fs_N]",
                                             "field estimator.pf.adapt.tau_s: must be >= estimator.pf.period_s (alpha = period_s / tau_s <= 1)",
+                                            "field causes.actuator_delay.delay_s: must be <= %d periods of "
+                                            "control.period_s" % machine.EST_DELAY_MAX_PERIODS,
                                             "field estimator.pf.delay_id.step_s: (candidates - 1) * step_s must be "
                                             "<= %d periods of estimator.pf.period_s" % machine.EST_DELAY_MAX_PERIODS,
                                             "field estimator.ukf.delay_id.step_s: (candidates - 1) * step_s must be "

@@ -149,6 +149,8 @@ typedef struct {
     float period_s;         /* control.period_s: a fault is seen a period late */
     int coast_in_stroke;    /* limits.coast_stop: 1 stroke (the limiter keeps a coast with the
                                outputs off inside the stroke), 0 external (no cap) */
+    float delay_s;          /* causes.actuator_delay.delay_s (0: none): a command's force reaches
+                               the axis so late */
 } br_app_machine_t;
 
 /* The drive protections of br_app_step, derived by br_app_motion_cfg
@@ -168,6 +170,8 @@ typedef struct {
     float mass_kg;           /* moved mass M + J / L^2 (the stuck-encoder model) */
     float stuck_band_N;      /* force change friction can hold without motion: 2 Fs */
     float stuck_counts;      /* predicted motion without a count that latches ENC_FROZEN */
+    float delay_s;           /* the actuator delay the stuck-encoder model's force comes after:
+                                >= 0, within br_est_delay_fits at the controller's period */
 } br_app_motion_cfg_t;
 
 /* The protections of machine m (docs/modules/app.md): speed_fault = max_speed
@@ -176,7 +180,7 @@ typedef struct {
  * speed_fault period (the period the fault is seen in) + max_following;
  * soft limits = [travel_min + stop_bound, travel_min + travel - stop_bound];
  * brake_N = max(0, mass max_accel - Fc); mass =
- * M + J / L^2; stuck band 2 Fs; BR_APP_STUCK_COUNTS; coast_decel = Fc / mass
+ * M + J / L^2; stuck band 2 Fs; BR_APP_STUCK_COUNTS; delay_s as m's; coast_decel = Fc / mass
  * with coast_in_stroke, else 0 (the coast envelope, br_app_ref_limit). Values br_app_init
  * rejects (all zero) for a NULL m or a non-finite or non-positive value. */
 br_app_motion_cfg_t br_app_motion_cfg(const br_app_machine_t *m);
@@ -232,6 +236,8 @@ typedef struct {
     float hold_N;           /* friction + load when the count last moved (model: F - m a) */
     float v_pred;           /* the model's speed since the count stopped, counts per period */
     float d_pred;           /* the model's motion since the count stopped, counts */
+    br_est_delay_t mot_delay; /* the commands over the actuator delay (motion.delay_s) */
+    float mot_F_N;          /* the force that reached the axis over the period that ended (load side) */
     /* the braking ramp */
     int32_t brk_counts;     /* the ramp's position: integer part ... */
     float brk_frac;         /* ... and fraction */

@@ -103,6 +103,10 @@ int br_est_delay_fits(float delay_s, float dt_s);
 /* Empties the history for the configuration's delay (checked by br_est_cfg_check). */
 void br_est_delay_init(br_est_delay_t *d, const br_est_cfg_t *cfg);
 
+/* Empties the history for a delay of delay_s at the period dt_s (within the
+ * history: br_est_delay_fits); on = 0: no history, the last command itself. */
+void br_est_delay_reset(br_est_delay_t *d, float delay_s, float dt_s, int on);
+
 /* Keeps u_prev_Nm, the command held over the last period, and returns the
  * torque that reached the axis over it. */
 float br_est_delay_apply(br_est_delay_t *d, float u_prev_Nm);

@@ -45,7 +45,8 @@
         .max_speed_mps = BR_MACHINE_MAX_SPEED_MPS_F, .max_accel_mps2 = BR_MACHINE_MAX_ACCEL_MPS2_F, \
         .max_following_m = BR_MACHINE_MAX_FOLLOWING_M_F, .travel_m = BR_MACHINE_TRAVEL_M_F,        \
         .travel_min_m = BR_MACHINE_TRAVEL_MIN_M_F, .period_s = BR_MACHINE_LOOP_PERIOD_S_F,         \
-        .coast_in_stroke = (int)BR_MACHINE_COAST_IN_STROKE                                         \
+        .coast_in_stroke = (int)BR_MACHINE_COAST_IN_STROKE,                                        \
+        .delay_s = BR_MACHINE_ACTUATOR_DELAY_S_F                                                   \
     }
 /* the estimators' friction: the machine file's friction_model (BR_MACHINE_MSLIP, written
  * only for maxwell_slip); without it n = 0, LuGre (eqs. 3-5) */

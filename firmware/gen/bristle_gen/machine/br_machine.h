@@ -95,6 +95,10 @@
  * br_app_motion_cfg derives the same in float32) */
 #define BR_MACHINE_STOP_BOUND_M (0.0047799999999999995)
 #define BR_MACHINE_STOP_BOUND_M_F (4.780000076e-03f)
+/* causes.actuator_delay.delay_s, 0 without it: the force a command gives reaches the axis so
+ * late (the stuck-encoder model, br_app_motion_cfg) */
+#define BR_MACHINE_ACTUATOR_DELAY_S (0.0)
+#define BR_MACHINE_ACTUATOR_DELAY_S_F (0.000000000e+00f)
 /* the reference limiter's and the braking ramp's acceleration (br_app_motion_cfg) */
 #define BR_MACHINE_MAX_ACCEL_MPS2 (2.0)
 #define BR_MACHINE_MAX_ACCEL_MPS2_F (2.000000000e+00f)
