@@ -206,7 +206,8 @@ def accepted_speed_mps(m, lo, hi):
     k = 1.0 + machine.SPEED_MARGIN
 
     def brake(room):
-        # the discrete braking curve at max_accel: v (v + a dt) / (2 a) = room, v = -a dt/2 + sqrt(a^2 dt^2/4 + 2 a room)
+        # the discrete braking curve at max_accel: v (v + a dt) / (2 a) = room,
+        # v = -a dt/2 + sqrt(a^2 dt^2/4 + 2 a room)
         return -0.5 * acc * dt + math.sqrt(0.25 * (acc * dt) ** 2 + 2.0 * acc * room)
 
     caps = [m["limits"]["max_speed_mps"], brake(soft_hi - hi), brake(lo - soft_lo)]
