@@ -56,6 +56,9 @@ P2P_MOVES = 4
 MOVE_ACC_MAX_MPS2 = 5.0    # the moves' (and the scaled EMPS reference's) acceleration at most (half a g)
 P2P_DWELL_S = 0.2
 P2P_ENDS = (0.05, 0.95)    # the moves stay between these shares of the travel
+EMPS_ENDS = (0.1, 0.9)     # the scaled EMPS reference's range, shares of the travel
+LIMIT_SHARE = 0.9          # the tracked references stay within this share of the speed and acceleration the
+                           # drive's reference limiter accepts (docs/fleet.md, "The trajectories")
 EMPS_REF = os.path.join(os.path.dirname(REPO), "shared", "data", "emps", "emps_estimation.csv")
 EMPS_SPEED_SHARE = 0.8     # the scaled EMPS reference peaks at this share of the axis's speed and force limits
 
@@ -192,16 +195,57 @@ def truth_file(ax, given):
     return m
 
 
-def p2p_reference(moves, vmax, acc, dt=1e-3):
+def accepted_speed_mps(m, lo, hi):
+    """The largest speed at which the reference limiter of machine m (the drive's, br_app_ref_limit;
+    docs/modules/app.md, "Drive protections") passes a reference anywhere in [lo, hi] toward either
+    end: limits.max_speed_mps, the braking curve to the soft limits and the coast envelope, at the
+    longest period the application runs at (both caps shrink with it). Every limit from machine.py."""
+    dt = machine.loop_period_s(m)
+    acc, e_max, x_min = machine.limit_defaults(m)
+    soft_lo, soft_hi = machine.soft_limits_m(m)
+    k = 1.0 + machine.SPEED_MARGIN
+
+    def brake(room):
+        # the discrete braking curve at max_accel: v (v + a dt) / (2 a) = room,
+        # v = -a dt/2 + sqrt(a^2 dt^2/4 + 2 a room)
+        return -0.5 * acc * dt + math.sqrt(0.25 * (acc * dt) ** 2 + 2.0 * acc * room)
+
+    caps = [m["limits"]["max_speed_mps"], brake(soft_hi - hi), brake(lo - soft_lo)]
+    if machine.coast_in_stroke(m):
+        # the coast's deceleration a_c = Fc / m_eff: the speed fault's speed v_f coasts machine.coast_m
+        vf = k * m["limits"]["max_speed_mps"]
+        ac = vf * vf / (2.0 * machine.coast_m(m))
+        b = 2.0 * k + 1.0
+        for room in (x_min + m["limits"]["travel_m"] - e_max - hi, lo - x_min - e_max):
+            # the coast envelope: k^2 v^2 / (2 a_c) + (2k + 1) v dt = room solved for v
+            caps.append(ac * dt / (k * k) * (math.sqrt(b * b + 2.0 * k * k * room / (ac * dt * dt)) - b))
+    return min(caps)
+
+
+def track_limits(ax, m):
+    """What the axis's tracked references keep to on the drive of machine m (the machine file the
+    tools are built for): the P2P_ENDS range's speed, the EMPS_ENDS range's speed (LIMIT_SHARE of
+    accepted_speed_mps), the acceleration (LIMIT_SHARE of the limiter's, move_acc at most) and the
+    sample step, half the control period: the control period and the PF's (PF_PERIOD_RATIO of it)
+    are whole multiples of it, so br_track reads the reference at its samples, never between two
+    (a 1 ms step read by linear interpolation every 0.27 ms showed the limiter 3.7 times the
+    acceleration)"""
+    acc = min(move_acc(ax), LIMIT_SHARE * machine.limit_defaults(m)[0])
+    v = [LIMIT_SHARE * accepted_speed_mps(m, e[0] * TRAVEL_M, e[1] * TRAVEL_M) for e in (P2P_ENDS, EMPS_ENDS)]
+    return {"p2p_mps": v[0], "emps_mps": v[1], "acc_mps2": acc, "dt_s": 0.5 * m["control"]["period_s"]}
+
+
+def p2p_reference(moves, vmax, vtop, acc, dt):
     """trapezoidal moves there and back from the travel's low end, each over its share of the room
-    left in its direction and followed by a dwell: (t, ref)"""
+    left in its direction and followed by a dwell, each move's speed (drawn as a share of the axis's
+    speed limit vmax) scaled to that share of vtop where vtop is below vmax: (t, ref)"""
     lo, hi = P2P_ENDS[0] * TRAVEL_M, P2P_ENDS[1] * TRAVEL_M
     x = lo
     xs = [x] * int(round(P2P_DWELL_S / dt))
     sign = 1.0
     for share, v in moves:
         dist = share * (hi - x if sign > 0 else x - lo)
-        v = min(v, vmax)
+        v = min(v, vmax) * min(1.0, vtop / vmax)
         ta = v / acc
         if acc * ta * ta > dist:  # a triangle
             ta = math.sqrt(dist / acc)
@@ -219,19 +263,19 @@ def p2p_reference(moves, vmax, acc, dt=1e-3):
     return np.arange(len(xs)) * dt, np.array(xs)
 
 
-def emps_reference(vmax, acc, dt=1e-3):
-    """the EMPS reference (../shared/data/emps/) scaled to the axis: its range to 0.8 of the travel,
-    its time so that it peaks at EMPS_SPEED_SHARE of the speed limit and of acc: (t, ref)"""
+def emps_reference(vmax, acc, dt):
+    """the EMPS reference (../shared/data/emps/) scaled to the axis: its range to EMPS_ENDS of the
+    travel, its time so that it peaks at EMPS_SPEED_SHARE of the speed vmax and of acc: (t, ref)"""
     d = np.loadtxt(EMPS_REF, delimiter=",", skiprows=1, usecols=(0, 1))
     t0, r0 = d[:, 0] - d[0, 0], d[:, 1] - d[:, 1].min()
-    kx = 0.8 * TRAVEL_M / r0.max()
+    kx = (EMPS_ENDS[1] - EMPS_ENDS[0]) * TRAVEL_M / r0.max()
     h = t0[1] - t0[0]
     v = np.gradient(r0, h)
     a = np.gradient(v, h)
     kt = max(kx * np.abs(v).max() / (EMPS_SPEED_SHARE * vmax),
              math.sqrt(kx * np.abs(a).max() / (EMPS_SPEED_SHARE * acc)))
     t = np.arange(0.0, t0[-1] * kt, dt)
-    return t, 0.1 * TRAVEL_M + kx * np.interp(t / kt, t0, r0)
+    return t, EMPS_ENDS[0] * TRAVEL_M + kx * np.interp(t / kt, t0, r0)
 
 
 def move_acc(ax):

@@ -179,7 +179,9 @@ def one_axis(a, i):
     with open(os.path.join(d, "chain.log"), "w", encoding="utf-8") as log, contextlib.redirect_stdout(log):
         try:
             truth, robust, track, rec["machine"] = chain(a, ax, d, log, sw)
-            acc = fleet_axis.move_acc(ax)
+            # the tracked references within what the drive built for machine.json accepts
+            with open(os.path.join(d, "diagnose", "machine.json"), encoding="utf-8") as f:
+                lim = fleet_axis.track_limits(ax, json.load(f))
             gms = fleet_axis.gms_options(ax)  # the truth's Maxwell-slip friction, where it has one
             for k, tr in enumerate(trajectory_set(a, ax)):
                 rec["traj"][tr["name"]] = tr
@@ -187,8 +189,9 @@ def one_axis(a, i):
                     rec["runs"][tr["name"]] = circle_runs(d, robust, truth, gms, tr, run_seed(a.seed, i, k + 1),
                                                           ax["force_noise_N"], log)
                     continue
-                t, ref = (fleet_axis.p2p_reference(tr["moves"], ax["max_speed_mps"], acc) if tr["kind"] == "p2p"
-                          else fleet_axis.emps_reference(ax["max_speed_mps"], acc))
+                t, ref = (fleet_axis.p2p_reference(tr["moves"], ax["max_speed_mps"], lim["p2p_mps"], lim["acc_mps2"],
+                                                   lim["dt_s"]) if tr["kind"] == "p2p"
+                          else fleet_axis.emps_reference(lim["emps_mps"], lim["acc_mps2"], lim["dt_s"]))
                 tr["duration_s"] = float(t[-1])
                 path = os.path.join(d, tr["name"] + ".ref.csv")
                 fleet_axis.write_reference(path, t, ref)
