@@ -25,8 +25,12 @@ int br_est_var_ok(float v, int zero_ok)
 
 float br_est_gate_f2(const br_est_cfg_t *cfg, float v)
 {
+    const float den = cfg->outlier_sigma * sqrtf(v);
+    if (!(den > 0.0f) || !isfinite(den)) {
+        return 1.0f; /* no spread (v = 0) or none to scale: the thesis gate, never a 0/0 */
+    }
     /* eq. G1: f = 1 + d / (g sqrt(v)) */
-    const float f = 1.0f + cfg->outlier_transient_rad / (cfg->outlier_sigma * sqrtf(v));
+    const float f = 1.0f + cfg->outlier_transient_rad / den;
     return f * f;
 }
 

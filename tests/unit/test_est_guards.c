@@ -9,6 +9,7 @@
 
 #include <float.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "circle/br_circle_est.h"
 #include "bristle/br_est.h"
@@ -58,6 +59,22 @@ static void test_variance_bounds(void **st)
     assert_false(br_est_var_ok(0.0f, 0));
     assert_true(br_est_var_ok(0.0f, 1));
     assert_false(br_est_var_ok(INFINITY, 1));
+}
+
+/* the gate's transient factor (eq. G1) at no spread: the thesis gate, finite, never a 0/0
+ * (fuzz_replay found the division by zero through a replay's header) */
+static void test_gate_factor_zero_spread(void **st)
+{
+    (void)st;
+    br_est_cfg_t c;
+    memset(&c, 0, sizeof c);
+    c.outlier_sigma = 8.0f;
+    c.outlier_transient_rad = 1e-3f;
+    assert_true(br_est_gate_f2(&c, 0.0f) == 1.0f);
+    c.outlier_sigma = 0.0f;
+    assert_true(br_est_gate_f2(&c, 1.0f) == 1.0f);
+    c.outlier_sigma = 8.0f;
+    assert_true(br_est_gate_f2(&c, 1.0f) > 1.0f); /* the term where there is spread */
 }
 
 static void test_pf_needs_gp_noise(void **st)
@@ -297,6 +314,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_variance_bounds),
+        cmocka_unit_test(test_gate_factor_zero_spread),
         cmocka_unit_test(test_pf_needs_gp_noise),
         cmocka_unit_test(test_mslip_refused),
         cmocka_unit_test(test_ukf_p0_bounds),
