@@ -49,7 +49,7 @@ SEED_OFFSET = {"lugre": 1, "model": 2, "ctrl": 3, "plant": 4, "plant_wrap": 5,
                "est_input": 6, "pf": 6, "pf_w": 6, "pf_x": 6, "ukf": 6,
                "ukf_load": 6, "ukf_glitch": 6,  # gen_load_traces.py: the same input, no random draw of its own
                "ukf_ms": 6,    # gen_ukf_ms_traces.py: the same input, no random draw of its own
-               "pf_load": 6, "pf_load_x": 6,  # gen_pf_load_traces.py: likewise
+               "pf_load": 6, "pf_load_x": 6, "pf_glitch": 6, "pf_glitch_x": 6,  # gen_pf_load_traces.py: likewise
                "pf_ms": 6, "pf_ms_x": 6,  # gen_pf_ms_traces.py: likewise
                # the extended model (gen_ext_traces.py)
                "model_ext": 7,

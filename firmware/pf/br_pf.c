@@ -721,6 +721,8 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
         const float omega_meas = (shift + (y->frac - pf->prev_frac) * rpc) / (periods * pf->cfg.est.model.dt_s);
         const float d_th = y_rel - sum_state(pf, BR_X_THETA) * inv_m;
         const float d_om = omega_meas - sum_state(pf, BR_X_OMEGA) * inv_m;
+        /* cfg.load: a re-acquisition of this step is not undone on a re-anchored cloud */
+        pf->load_alt = 0;
         sf = 0.0f;
         for (uint32_t j = 0; j < m; j++) {
             pf->x[BR_X_THETA][j] += d_th;

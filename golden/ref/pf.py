@@ -69,6 +69,13 @@ g = L h^2 / (2 J_eff), Phi = [1 h -g; 0 1 -2g/h; 0 0 1].
        theta_j += K0 nu, omega_j += K1 nu (each valid particle; f_nl and l_j
        made again), F_d <- clamp(F_d + K2 nu, +-max_N), P <- P - K P[0, :]
        The outlier decision and steps 3-5 then take the moved cloud.
+       A glitch is not a load: when the last step re-acquired (its correction
+       e = K nu1, nu1 its innovation, P_A the P its tick left) and this step's
+       best particle is gated, the cloud is tried moved by -(Phi e)_theta
+       (spike) and by that + nu1 (slip; the smaller |mean innovation| first),
+       omega by -(Phi e)_omega; the first whose best particle passes is taken:
+       F_d and F_d' less e2, P = Phi P_A Phi^T + diag(0, 0, q_N2), the update
+       then as for any passing step (n_load_undo + 1).
     F_hat = clamp(mean f_nl + y, +-max_N) with F_d through a notch at the
     period's Nyquist frequency (pf.md, "The period-2 mode"):
     y = clamp((1 + r)/2 (F_d + F_d') - r y', +-max_N), F_d' the value at the
@@ -175,6 +182,10 @@ class Pf:
         self.d = 0.0            # the last step's mean innovation mean(theta_j) - y (before the move)
         self.v = 0.0            # and the spread var(theta_j)
         self.Pm = None          # P before the last update (after the tick and any inflation)
+        # the last step's re-acquisition for its undo: (e, P as predicted, nu1) or None
+        self.alt = None
+        self.n_load_undo = 0
+        self.load_undo = False  # the last step undid the re-acquisition before it
         if cfg.load is not None:
             h = cfg.dt
             self.g = cfg.model.L * h * h / (2.0 * cfg.model.Jeff)
@@ -279,7 +290,7 @@ class Pf:
         # eq. G1: the gate g sqrt(R + rpc^2/12) + d in log-weight units
         l_gate = -((c.outlier_sigma * math.sqrt(c.r_var + rpc * rpc / 12.0) + c.outlier_transient) ** 2) / (2.0 * c.r_var)
         if c.load is not None:
-            lmax = self._load_update(xp, fn, l, y, lmax < l_gate)
+            lmax = self._load_update(xp, fn, l, y, l_gate)
         outlier = lmax < l_gate
         w = [0.0 if lj == -math.inf else (1.0 if outlier else math.exp(lj - lmax)) for lj in l]
         W = [int(math.floor(wj * 2.0 ** W_BITS)) for wj in w]
@@ -293,6 +304,7 @@ class Pf:
         self.n_outliers = self.n_outliers + 1 if outlier else 0
         self.reanchored = self.n_outliers >= c.reanchor_after
         if self.reanchored:
+            self.alt = None  # a re-acquisition is not undone on a re-anchored cloud
             w_meas = (shift + (frac - self.prev_frac) * rpc) / c.dt
             th = sum(xj[0] for xj in self.x) / c.m
             om = sum(xj[1] for xj in self.x) / c.m
@@ -308,18 +320,62 @@ class Pf:
         self.ess = sum(w) ** 2 / sum(wj * wj for wj in w)
         return BR_W_OUTLIER if outlier else BR_OK
 
-    def _load_update(self, xp, fn, l, y, gated):
-        """cfg.load after the weighing: F_d's Kalman update on the cloud's mean
-        innovation (a re-acquisition when gated and explained by a load), the
-        valid particles of xp moved, fn and l made again in place. Returns the
-        largest log-weight."""
+    def _load_undo(self, xp, fn, l, y, l_gate, valid):
+        """A glitch is not a load (pf.md): the last step re-acquired and this
+        step's innovation is gated. The re-acquisition's correction e carried
+        over the period is Phi e; spike: the cloud moved back by it; slip: and
+        on by the last innovation nu1 (the counter stays off). The smaller
+        |mean innovation| first; the first whose best particle passes the gate
+        is taken (F_d and F_d' without e2, P = Phi P_A Phi^T + Q, the cloud
+        moved). Returns whether one was taken."""
+        c = self.cfg
+        e, P_A, nu1 = self.alt
+        h, g = c.dt, self.g
+        s_th = e[0] + h * e[1] - g * e[2]
+        s_om = e[1] - 2.0 * g / h * e[2]
+        d = float(np.mean([xp[j][0] for j in valid])) - y
+        hyp = [-s_th, -s_th + nu1]  # spike, slip
+        if abs(d + hyp[1]) < abs(d + hyp[0]):
+            hyp.reverse()
+        for dth in hyp:
+            best = max(-((xp[j][0] + dth - y) ** 2) / (2.0 * c.r_var) for j in valid)
+            if not best >= l_gate:
+                continue
+            self.P = self.Phi @ P_A @ self.Phi.T + np.diag([0.0, 0.0, c.load.q_N2])
+            mx = c.load.max_N
+            self.Fd = min(max(self.Fd - e[2], -mx), mx)
+            self.Fd_start = min(max(self.Fd_start - e[2], -mx), mx)
+            for j in valid:
+                xj = xp[j]
+                xj[0] += dth
+                xj[1] -= s_om
+                fn[j] = rmodel.fnl(c.model, xj)
+                l[j] = -((xj[0] - y) ** 2) / (2.0 * c.r_var)
+            self.n_load_undo += 1
+            return True
+        return False
+
+    def _load_update(self, xp, fn, l, y, l_gate):
+        """cfg.load after the weighing: the last step's re-acquisition undone
+        when it explains a gated innovation as a glitch, then F_d's Kalman
+        update on the cloud's mean innovation (a re-acquisition when gated and
+        explained by a load), the valid particles of xp moved, fn and l made
+        again in place. Returns the largest log-weight."""
         c = self.cfg
         ld = c.load
         valid = [j for j in range(c.m) if l[j] != -math.inf]
+        alt, self.alt = self.alt, None
+        self.load_undo = False
+        if alt is not None and max(l) < l_gate:
+            self.alt = alt
+            self.load_undo = self._load_undo(xp, fn, l, y, l_gate, valid)
+            self.alt = None
+        gated = max(l) < l_gate
         th = np.array([xp[j][0] for j in valid])
         self.d = float(np.mean(th)) - y
         self.v = float(np.mean((th - np.mean(th)) ** 2))
         self.load_acq = False
+        P_pred = self.P.copy()
         if gated:
             k = 1.0  # periods since the last measurement (this reference measures every period)
             dF = self.d / (self.g * k * k)
@@ -335,7 +391,11 @@ class Pf:
         K = self.P[:, 0] / S
         nu = -self.d
         self.P = self.P - np.outer(K, self.P[0, :])
-        self.Fd = min(max(self.Fd + K[2] * nu, -ld.max_N), ld.max_N)
+        Fd = min(max(self.Fd + K[2] * nu, -ld.max_N), ld.max_N)
+        if self.load_acq:
+            # kept for the next step's undo: the correction as applied, P as predicted, nu1
+            self.alt = (np.array([K[0] * nu, K[1] * nu, Fd - self.Fd]), P_pred, nu)
+        self.Fd = Fd
         for j in valid:
             xj = xp[j]
             xj[0] += K[0] * nu

@@ -3,16 +3,19 @@
  * cfg.load, firmware/pf/br_pf_load.c) against the float64 reference
  * golden/ref/pf.py, through golden/traces/pf_load.csv (input and reference
  * per step) and pf_load_x.csv (the reference's particle set at the
- * re-synchronisation points, with the next step's resampling indices). The
+ * re-synchronisation points, with the next step's resampling indices), and
+ * through pf_glitch.csv / pf_glitch_x.csv (the same with est_input's encoder
+ * faults kept: each glitch re-acquired and undone at the next step). The
  * configuration comes from the trace header. Scheme and tolerances:
  * docs/golden.md ("pf_load").
  *
  * One step after each re-synchronisation: the C filter's state is set to the
  * reference's after step k (particles, float32 as the trace stores them;
  * origin, noise position, outlier run, last fraction, F_d and the common
- * error's covariance P, float32-rounded), it steps once with the input of
- * step k + 1, and its status, origin, noise position, outlier run and
- * re-acquisition (exact), F_d, P and the max log-weight (within a propagated
+ * error's covariance P and the re-acquisition kept for its undo,
+ * float32-rounded), it steps once with the input of step k + 1, and its
+ * status, origin, noise position, outlier run, re-acquisition and undo
+ * (exact), F_d, P and the max log-weight (within a propagated
  * bound) are compared; the mean state and F_hat too when its own resampling
  * indices equal the reference's (a float32 and a float64 filter may resample
  * differently where a systematic point lies on a weight boundary: reported). */
@@ -54,13 +57,16 @@ typedef struct {
     br_pf_cfg_t cfg;
     pf_consts_t c;
     double g, max_N;
-    int c_P[6], c_Pm[6];
+    int c_P[6], c_Pm[6], c_altP[6];
 } pfl_t;
 
-static void load_all(pfl_t *G)
+static void load_all(pfl_t *G, const char *name)
 {
-    br_trace_load(&G->t, "pf_load");
-    br_trace_load(&G->x, "pf_load_x");
+    char xname[32];
+    strcpy(xname, name);
+    strcat(xname, "_x");
+    br_trace_load(&G->t, name);
+    br_trace_load(&G->x, xname);
     G->cfg = pf_golden_cfg(&G->t);
     G->cfg.load.q_N2 = (float)br_trace_meta_num(&G->t, "load_q_N2");
     G->cfg.load.max_N = (float)br_trace_meta_num(&G->t, "load_max_N");
@@ -68,11 +74,13 @@ static void load_all(pfl_t *G)
     G->g = G->c.L * G->c.h * G->c.h / (2.0 * G->c.Jeff);
     G->max_N = G->cfg.load.max_N;
     for (int i = 0; i < 6; i++) {
-        char n[8] = "P", nm[8] = "Pm";
+        char n[8] = "P", nm[8] = "Pm", na[8] = "alt_P";
         strcat(n, P_NAMES[i]);
         strcat(nm, P_NAMES[i]);
+        strcat(na, P_NAMES[i]);
         G->c_P[i] = br_trace_col(&G->t, n);
         G->c_Pm[i] = br_trace_col(&G->t, nm);
+        G->c_altP[i] = br_trace_col(&G->t, na);
     }
     assert_int_equal(G->x.nrows % (int)G->cfg.n_particles, 0);
 }
@@ -96,10 +104,13 @@ static kf_tol_t kf_bounds(const pfl_t *G, int k, drift_t *D)
     const int k1 = k + 1;
     const double h = c->h, g = G->g, a = 2.0 * g / h;
     const double absPhi[3][3] = {{1.0, h, g}, {0.0, 1.0, a}, {0.0, 0.0, 1.0}};
+    /* an undo at k + 1 predicts P from the re-acquisition's P as predicted (alt_P of row k)
+     * instead of P after step k */
+    const int undo = col(G, k1, "load_undo") != 0.0;
     double P0[3][3], Pm[3][3];
     for (int i = 0; i < 3; i++) {
         for (int j = 0; j < 3; j++) {
-            P0[i][j] = fabs(br_trace_get(&G->t, k, G->c_P[tri(i, j)]));
+            P0[i][j] = fabs(br_trace_get(&G->t, k, (undo ? G->c_altP : G->c_P)[tri(i, j)]));
             Pm[i][j] = br_trace_get(&G->t, k1, G->c_Pm[tri(i, j)]);
         }
     }
@@ -119,7 +130,15 @@ static kf_tol_t kf_bounds(const pfl_t *G, int k, drift_t *D)
     /* the cloud's mean innovation d and spread v from the sums of e_j = theta_j - y and e_j^2
      * over the m particles, every theta_j off by D_theta: a float32 sum of m terms is off by
      * m u times the sum of their magnitudes, sum |e_j| <= m E and sum e_j^2 = m E^2 with E the
-     * RMS of e_j, sqrt(v + d^2) */
+     * RMS of e_j, sqrt(v + d^2). An undo moved every theta_j by -(Phi e)_theta (+ nu1 for a
+     * slip) and omega_j by -(Phi e)_omega first: e and nu1 float32-rounded from row k, the
+     * shift's few products and sums */
+    if (undo) {
+        const double e0 = fabs(col(G, k, "alt_e0")), e1 = fabs(col(G, k, "alt_e1")), e2 = fabs(col(G, k, "alt_e2"));
+        const double nu1 = fabs(col(G, k, "alt_nu1"));
+        D->d[0] += C_KF * U32 * (e0 + h * e1 + g * e2 + nu1);
+        D->d[1] += C_KF * U32 * (e1 + a * e2);
+    }
     const double d = col(G, k1, "innov_d"), v = col(G, k1, "spread_v"), m = c->m;
     const double E = sqrt(v + d * d);
     const double dd = D->d[0] + C_SUM * m * U32 * E;
@@ -150,8 +169,8 @@ static kf_tol_t kf_bounds(const pfl_t *G, int k, drift_t *D)
         T.P[e] = dPm[i][j] + dK[i] * fabs(Pm[0][j]) + fabs(K[i]) * dPm[0][j] +
                  C_KF * U32 * (fabs(Pm[i][j]) + fabs(K[i] * Pm[0][j]));
     }
-    /* F_d <- clamp(F_d + K2 nu), nu = -d; the clamp is 1-Lipschitz */
-    const double Fd0 = fabs(col(G, k, "Fd"));
+    /* F_d <- clamp(F_d + K2 nu), nu = -d (after an undo's F_d - e2); the clamp is 1-Lipschitz */
+    const double Fd0 = fabs(col(G, k, "Fd")) + (undo ? fabs(col(G, k, "alt_e2")) : 0.0);
     T.Fd = U32 * Fd0 + fabs(K[2]) * dd + fabs(d) * dK[2] + C_KF * U32 * (Fd0 + fabs(K[2] * d));
     /* the cloud moved by K0 nu and K1 nu */
     D->d[0] += fabs(K[0]) * dd + fabs(d) * dK[0] + C_KF * U32 * fabs(K[0] * d);
@@ -186,14 +205,21 @@ static void resync(br_pf_t *pf, const pfl_t *G, int k, int xrow)
     pf->load_comp_N = (float)col(G, k, "Fd_comp");
     for (int e = 0; e < 6; e++) {
         pf->load_P[e] = (float)br_trace_get(&G->t, k, G->c_P[e]);
+        pf->load_alt_P[e] = (float)br_trace_get(&G->t, k, G->c_altP[e]);
     }
+    pf->load_alt = col(G, k, "alt") != 0.0;
+    pf->load_alt_e[0] = (float)col(G, k, "alt_e0");
+    pf->load_alt_e[1] = (float)col(G, k, "alt_e1");
+    pf->load_alt_e[2] = (float)col(G, k, "alt_e2");
+    pf->load_alt_nu1 = (float)col(G, k, "alt_nu1");
 }
 
-static void test_pf_load_one_step(void **state)
+/* One trace's one-step comparisons; returns the re-acquisitions and undos it holds
+ * (acq_undo[0], [1]) */
+static void one_step(const char *name, long acq_undo[2])
 {
-    (void)state;
     pfl_t G;
-    load_all(&G);
+    load_all(&G, name);
     br_pf_t *pf = &g_pf;
     assert_int_equal(br_pf_init(pf, &G.cfg), BR_OK);
     const uint32_t m = G.cfg.n_particles;
@@ -218,27 +244,30 @@ static void test_pf_load_one_step(void **state)
     /* priming: the C filter's own */
     const br_meas_t y0 = {(int32_t)col(&G, 0, "counts"), (float)col(&G, 0, "frac")};
     assert_int_equal(br_pf_step(pf, &y0, (float)col(&G, 0, "u_prev_Nm")), BR_OK);
-    long n_steps = 0, bad_exact = 0, n_acq = 0, n_outlier = 0, n_own_equal = 0;
+    long n_steps = 0, bad_exact = 0, n_acq = 0, n_undo = 0, n_outlier = 0, n_own_equal = 0;
     for (int xrow = 0; xrow < G.x.nrows; xrow += (int)m) {
         const int k = (int)br_trace_get(&G.x, xrow, br_trace_col(&G.x, "k")), k1 = k + 1;
         resync(pf, &G, k, xrow);
-        const uint32_t acq0 = pf->n_load_acq;
+        const uint32_t acq0 = pf->n_load_acq, undo0 = pf->n_load_undo;
         const br_meas_t y = {(int32_t)col(&G, k1, "counts"), (float)col(&G, k1, "frac")};
         const double u = col(&G, k1, "u_prev_Nm");
         const br_status_t st = br_pf_step(pf, &y, (float)u);
         n_steps++;
-        const int acq = (int)col(&G, k1, "load_acq");
+        const int acq = (int)col(&G, k1, "load_acq"), undo = (int)col(&G, k1, "load_undo");
         n_acq += acq;
+        n_undo += undo;
         n_outlier += col(&G, k1, "status") == (double)BR_W_OUTLIER;
         if ((double)st != col(&G, k1, "status") || (double)pf->origin_counts != col(&G, k1, "origin_counts") ||
             (double)pf->noise_pos != col(&G, k1, "noise_pos") ||
-            (double)pf->n_outliers != col(&G, k1, "n_outliers") || (int)(pf->n_load_acq - acq0) != acq) {
+            (double)pf->n_outliers != col(&G, k1, "n_outliers") || (int)(pf->n_load_acq - acq0) != acq ||
+            (int)(pf->n_load_undo - undo0) != undo) {
             if (bad_exact++ < 5) {
-                print_error("%s:%d: step %d: status %d, origin %d, noise_pos %u, outliers %u, re-acquired %d; "
-                            "expected %.0f, %.0f, %.0f, %.0f, %d\n",
+                print_error("%s:%d: step %d: status %d, origin %d, noise_pos %u, outliers %u, re-acquired %d, "
+                            "undone %d; expected %.0f, %.0f, %.0f, %.0f, %d, %d\n",
                             G.t.path, G.t.line[k1], k1, (int)st, (int)pf->origin_counts, (unsigned)pf->noise_pos,
-                            (unsigned)pf->n_outliers, (int)(pf->n_load_acq - acq0), col(&G, k1, "status"),
-                            col(&G, k1, "origin_counts"), col(&G, k1, "noise_pos"), col(&G, k1, "n_outliers"), acq);
+                            (unsigned)pf->n_outliers, (int)(pf->n_load_acq - acq0), (int)(pf->n_load_undo - undo0),
+                            col(&G, k1, "status"), col(&G, k1, "origin_counts"), col(&G, k1, "noise_pos"),
+                            col(&G, k1, "n_outliers"), acq, undo);
             }
         }
         /* the particles' bound: a float32 copy of the reference's set, one prediction with the
@@ -299,22 +328,44 @@ static void test_pf_load_one_step(void **state)
         br_errstat_add(&e_F, &G.t, k1, (double)pf->est.F_hat_N, col(&G, k1, "F_hat"),
                        dF + C_SUM * (double)m * U32 * fmax_ + dy + 2.0 * U32 * G.max_N);
     }
-    print_message("golden pf_load    %ld one-step comparisons (%ld re-acquisitions, %ld outliers), %u particles; "
-                  "own indices == trace on %ld\n",
-                  n_steps, n_acq, n_outlier, m, n_own_equal);
+    print_message("golden %-10s %ld one-step comparisons (%ld re-acquisitions, %ld undone, %ld outliers), "
+                  "%u particles; own indices == trace on %ld\n",
+                  name, n_steps, n_acq, n_undo, n_outlier, m, n_own_equal);
     br_errstat_t *all[] = {&e_Fd, &e_P[0], &e_P[1], &e_P[2], &e_P[3], &e_P[4], &e_P[5], &e_lmax,
                            &e_mean[0], &e_mean[1], &e_mean[2], &e_mean[3], &e_F};
-    pf_golden_report(all, (int)(sizeof all / sizeof all[0]), &G.t, &G.x, "pf_load", bad_exact,
-                     "status / origin / noise position / outlier run / re-acquisition");
-    /* the trace must exercise what it is for */
-    assert_true(n_acq >= 2);
+    pf_golden_report(all, (int)(sizeof all / sizeof all[0]), &G.t, &G.x, name, bad_exact,
+                     "status / origin / noise position / outlier run / re-acquisition / undo");
     assert_true(n_own_equal * 2 > n_steps);
+    acq_undo[0] = n_acq;
+    acq_undo[1] = n_undo;
+}
+
+static void test_pf_load_one_step(void **state)
+{
+    (void)state;
+    long n[2];
+    one_step("pf_load", n);
+    /* the trace must exercise what it is for: the load step's re-acquisitions, none undone */
+    assert_true(n[0] >= 2);
+    assert_int_equal(n[1], 0);
+}
+
+/* docs/modules/pf.md, "A glitch is not a load": est_input's spike and slip each re-acquired
+ * and undone at the next step */
+static void test_pf_glitch_one_step(void **state)
+{
+    (void)state;
+    long n[2];
+    one_step("pf_glitch", n);
+    assert_true(n[0] >= 4);
+    assert_int_equal(n[1], 2);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pf_load_one_step),
+        cmocka_unit_test(test_pf_glitch_one_step),
     };
     return cmocka_run_group_tests_name("golden_pf_load", tests, NULL, NULL);
 }

@@ -104,8 +104,10 @@ typedef struct {
  * A gated innovation that a change of at most 2 max_N over the k periods
  * since the last measurement explains (theta moved by -g k^2 dF) is
  * re-acquired as a load (the covariance inflated as if F_d's variance had
- * been larger by the change squared), not rejected. The kernels are
- * untouched: only the torque they are given changes. */
+ * been larger by the change squared), not rejected; when the next step's
+ * innovation is gated, the re-acquisition is tested as a counter glitch (a
+ * spike, or a slip the counter keeps) and undone if one explains it. The
+ * kernels are untouched: only the torque they are given changes. */
 typedef struct {
     float q_N2;  /* random walk of F_d per step, N^2: a normal float <= BR_EST_VAR_MAX when on, 0: off */
     float max_N; /* |F_d| and the compensation kept <= max_N (the actuator's force); its initial
@@ -186,9 +188,15 @@ typedef struct {
      * (load_prev_N, before the update) and F_d through the compensation's notch (load_comp_N);
      * the covariance of the cloud's common
      * error [theta, omega, F_d] (rad, rad/s, N), its upper triangle P00 P01 P02 P11 P12 P22;
-     * g = L h^2 / (2 J_eff) (rad per N over one period); the re-acquisitions counted */
+     * g = L h^2 / (2 J_eff) (rad per N over one period); the re-acquisitions counted.
+     * The last step's re-acquisition kept for its undo at the next (docs/modules/pf.md,
+     * "A glitch is not a load"): load_alt set, the common error's correction it applied
+     * (load_alt_e: theta, omega, F_d), P as the period's prediction left it (load_alt_P) and
+     * its gated innovation nu1 (rad); the undone ones counted */
     float load_N, load_prev_N, load_comp_N, load_P[6], load_g_radpN;
-    uint32_t n_load_acq;
+    float load_alt_e[3], load_alt_P[6], load_alt_nu1;
+    uint32_t n_load_acq, n_load_undo;
+    int load_alt;
     int primed;                   /* particles drawn around the first measurement */
     /* particles as a structure of arrays: x[i][j] is state i of particle j.
      * One set, predicted and resampled in place (docs/modules/pf.md). */
