@@ -205,6 +205,20 @@ awk -v m="$m_hi" -v a="$mean_id" -v x="$max_id" -v i="$ci" -v t="$ct" -v a0="${m
   printf "  with the delay identification (the machine'"'"'s, on its own stream): m = %d: mean %.0f  max %.0f instructions per period; its cost %+.0f instructions per period (%.2f%% of the period at %d MHz, one cycle each)\n", m, a * i / t, x * i / t, d, 100 * d / P, mhz
 }' | tee -a "$out/cycles.txt"
 
+# The PF's shared external force (cfg.load at the fault campaign's 1e4 N^2/s, off in the
+# machine file; docs/modules/pf.md, "External force"): one run at m_hi on a stream recorded
+# with it (without the delay identification, as the scaling runs); its cost per period is
+# the difference of the means against the run without it, and per particle-step that
+# difference over m_hi (the common error's filter is a fixed part, the cloud's move a pass).
+"$host/tests/target/br_replay_record" --out "$out/stream_load.bin" --duration 1.0 --delay-id 0 --pf-load 1e4 >/dev/null
+qemu_replay "$out/stream_load.bin" "$out/target_load.bin" "$m_hi" load
+read -r _ mean_ld _ _ max_ld _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_load.bin")
+awk -v m="$m_hi" -v a="$mean_ld" -v x="$max_ld" -v i="$ci" -v t="$ct" -v a0="${mean[$m_hi]}" -v i0="${ipt[$m_hi]}" \
+    -v mhz="$mhz" -v P="$period" 'BEGIN {
+  d = a * i / t - a0 * i0
+  printf "  with the PF'"'"'s shared external force (--pf-load 1e4, on its own stream): m = %d: mean %.0f  max %.0f instructions per period; its cost %+.0f instructions per period (%+.1f per particle-step; %.2f%% of the period at %d MHz, one cycle each)\n", m, a * i / t, x * i / t, d, d / m, 100 * d / P, mhz
+}' | tee -a "$out/cycles.txt"
+
 # Two axes on one MCU: the replay image runs both axes of the X-Y table every
 # period (stream version 2) at the estimate's largest m per axis within 80 %;
 # measured instructions per period, charged as above.

@@ -77,6 +77,9 @@ void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WOR
     w[i++] = f2w(m->mslip.sigma2_Nspm);
     /* cfg.est.outlier_transient_rad (zero in a stream without it: the thesis gate) */
     w[i++] = f2w(c->pf.est.outlier_transient_rad);
+    /* cfg.load (zeros in a stream without them: off) */
+    w[i++] = f2w(c->pf.load.q_N2);
+    w[i++] = f2w(c->pf.load.max_N);
     while (i < BR_REPLAY_HDR_WORDS) w[i++] = 0u;
 }
 
@@ -135,6 +138,8 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
     for (uint32_t j = 0u; j < BR_MSLIP_MAX; ++j) m->mslip.share[j] = w2f(w[i++]);
     m->mslip.sigma2_Nspm = w2f(w[i++]);
     c->pf.est.outlier_transient_rad = w2f(w[i++]);
+    c->pf.load.q_N2 = w2f(w[i++]);
+    c->pf.load.max_N = w2f(w[i++]);
     if (c->pf.noise_len != BR_NOISE_LEN) return BR_E_PARAM;
     c->pf.noise = br_noise_table;
     return BR_OK;
