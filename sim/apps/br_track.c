@@ -205,9 +205,12 @@ static void pf_trace_row(FILE *f, double t, const br_plant_t *p, const br_pf_t *
 /* ff: 0 none, 1 the feedforward of the plant's model (friction, causes, inertia; ctrl
  * BR_CTRL_HINF_FF), 2 the estimator (ctrl BR_CTRL_HINF_PF: the PF; BR_CTRL_HINF_TRUE:
  * the oracle) plus the feedforward's inertia term */
+/* *n_limited: the periods whose reference the drive's limiter changed (br_app_ref_limit; the run-in
+ * included), 0 when the application never ran */
 static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int extended, int ff, err_t *e,
-                  br_run_report_t *rep)
+                  br_run_report_t *rep, uint32_t *n_limited)
 {
+    *n_limited = 0u;
     br_circle_cfg_t c = br_circle_cfg_thesis(ctrl);
     c.plant = *pc;
     if (extended) c.pf.est.model.causes = br_causes_from_model(pc);
@@ -313,6 +316,7 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
         }
         if (k >= 0) err_add(e, t, x_ref, pos, (double)app.last.duty * pc->tau_per_duty_Nm / L);
     }
+    *n_limited = app.n_ref_limited;
     rc = 0;
 done:
     if (refused != BR_OK) {
@@ -455,6 +459,7 @@ int main(int argc, char **argv)
             }
         }
         br_run_report_t rep = {0.0, 0.0, 0, 0, 0.0};
+        uint32_t n_limited = 0u;
         if (w == 0) {
             if (!have_pd) {
                 fprintf(stderr, "br_track: the pd controller needs --pd KP,KV,GAIN,UMAX\n");
@@ -464,7 +469,7 @@ int main(int argc, char **argv)
             const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : (w == 4 || w == 8) ? BR_CTRL_HINF_TRUE
                                           : w == 5 ? BR_CTRL_HINF_FF : w == 9 ? BR_CTRL_HINF_UKF : BR_CTRL_HINF_PF;
             const int ff = w == 5 ? 1 : (w >= 6 && w <= 8) ? 2 : 0;
-            if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &rep) != 0) rc = 1;
+            if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &rep, &n_limited) != 0) rc = 1;
         }
         if (rc != 0) break;
         rep.rms_m = e.n > 0 ? sqrt(e.sum2 / (double)e.n) : NAN;
@@ -477,9 +482,13 @@ int main(int argc, char **argv)
         }
         /* a faulted run is a fault (time, cause), never an RMS beside full runs */
         br_run_print(stdout, names[w], "tracking", &rep);
+        /* the drive's reference limiter (docs/modules/app.md, "Drive protections"): a reference it
+         * changed is another trajectory than the log's, said beside the figure */
+        if (n_limited > 0u) printf("  %s: the drive limited the reference in %u periods\n", names[w], (unsigned)n_limited);
         if (js) {
             fprintf(js, ",\n  \"%s\": {", names[w]);
             br_run_json(js, "rms_m", "max_m", &rep);
+            if (w != 0) fprintf(js, ", \"ref_limited_periods\": %u", (unsigned)n_limited);
             fprintf(js, "}");
         }
     }

@@ -116,6 +116,24 @@ def friction_split(recs):
     return out
 
 
+def ref_limited(recs):
+    """the track runs whose reference the drive's limiter changed (br_track's ref_limited_periods,
+    docs/tools.md): another trajectory than the one drawn, listed with the periods"""
+    return [{"axis": r["i"], "trajectory": name, "controller": ctrl, "periods": run_["ref_limited_periods"]}
+            for r in recs for name, rr in r["runs"].items() for ctrl, run_ in rr.items()
+            if run_.get("ref_limited_periods", 0) > 0]
+
+
+def ref_limited_lines(summ):
+    lim = summ.get("ref_limited", [])
+    n = sum(1 for r in summ["axes"] for rr in r["runs"].values() for run_ in rr.values()
+            if "ref_limited_periods" in run_)
+    L = ["", "Track runs whose reference the drive's limiter changed (`ref_limited_periods` > 0, the run-in "
+         "from rest included): %d of the %d track runs that went to the end%s" % (len(lim), n, ":" if lim else ".")]
+    return L + ["- axis %d, %s, %s: %d periods" % (x["axis"], x["trajectory"], x["controller"], x["periods"])
+                for x in lim]
+
+
 def friction_lines(summ):
     L = []
     for key, title in FRICTIONS:
@@ -233,6 +251,7 @@ def write_md(path, summ, command, out_dir=None, out_name=None):
     for kind, ctl in summ["kinds"].items():
         L += ["", "### %s" % kind, ""] + table(ctl)
     L += friction_lines(summ)
+    L += ref_limited_lines(summ)
     lines = lost_lines(summ)
     L += ["", "### Lost runs (%d)" % len(lines), "",
           "A run is lost when the firmware stopped it (its fault's cause and time), its filter re-anchored "
@@ -360,6 +379,7 @@ def main():
             "controllers": summarise(good),
             "kinds": {k: summarise(good, (k,)) for k in kinds},
             "friction": friction_split(good),
+            "ref_limited": ref_limited(good),
             "axes": [{k: v for k, v in r.items() if k != "timing"} for r in good]}
     with open(os.path.join(a.out, "summary.json"), "w", encoding="utf-8") as f:
         json.dump(summ, f, indent=1, sort_keys=True)

@@ -69,6 +69,9 @@ def result(raw, rms_key, max_key):
         return {"faulted": True, "fault_t_s": raw["fault_t_s"], "fault_cause": raw.get("fault_cause", "unknown"),
                 **({"init_status": raw["fault_status"]} if raw.get("fault_cause") == REFUSED_AT_INIT else {})}
     r = {"faulted": False, "rms_m": raw[rms_key], "max_m": raw[max_key]}
+    if "ref_limited_periods" in raw:
+        # br_track: the periods whose reference the drive's limiter changed (docs/tools.md)
+        r["ref_limited_periods"] = raw["ref_limited_periods"]
     if "outlier_steps" in raw:
         r["outlier_steps"] = raw["outlier_steps"]
         r["persistent_outliers"] = raw["outlier_steps"] > LOST_OUTLIER_FRAC * 2 * raw["n_samples"]

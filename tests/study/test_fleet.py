@@ -107,6 +107,23 @@ class Fleet(unittest.TestCase):
                     else:
                         self.assertTrue(math.isfinite(run_["rms_m"]))
 
+    def test_track_references_pass_the_drive(self):
+        """the point-to-point moves built within the limiter's accepted speed (fleet_axis.track_limits)
+        pass the drive's own reference limiter untouched on each axis's firmware: every track run
+        that went to the end reports its ref_limited_periods (br_track), and none is > 0"""
+        s = self.two
+        n = 0
+        for r in s["axes"]:
+            for name, runs in r["runs"].items():
+                if r["traj"][name]["kind"] != "p2p":
+                    continue
+                for ctrl, run_ in runs.items():
+                    if not run_["faulted"]:
+                        self.assertIn("ref_limited_periods", run_, (r["i"], name, ctrl))
+                        n += 1
+        self.assertGreater(n, 0)
+        self.assertEqual(s["ref_limited"], [])
+
     def test_why_reads_every_estimator_run(self):
         """fleet_why.py (docs/fleet.md, "Why runs are lost") sees each estimator run of the summary, with its fault"""
         want = sorted((ctrl, run_["faulted"]) for r in self.two["axes"] for runs in r.get("runs", {}).values()

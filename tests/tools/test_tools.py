@@ -187,8 +187,28 @@ class ToolsTest(unittest.TestCase):
             r = run("br_track", "--ref", ref, "--ctrl", "hinf_only", "--json", js, *extra)
             self.assertEqual(r.returncode, 0, r.stderr)
             with open(js) as f:
-                track.append(json.load(f)["hinf_only"]["rms_m"])
+                run_js = json.load(f)["hinf_only"]
+            track.append(run_js["rms_m"])
+            self.assertEqual(run_js["ref_limited_periods"], 0)  # within the drive's limits
         self.assertGreater(abs(track[1] / track[0] - 1.0), 0.01)
+
+    def test_track_reports_a_limited_reference(self):
+        """br_track says how many periods the drive's reference limiter changed (docs/tools.md): a
+        5 mm step of the reference is limited (the run tracks the limiter's ramp, not the log's
+        step), and the count is in the JSON and on stdout"""
+        ref = os.path.join(self.w, "step.csv")
+        with open(ref, "w") as f:
+            f.write("t,ref,pos,force\n")
+            for k in range(500):
+                x = 0.005 if k >= 100 else 0.0
+                f.write("%.3f,%.9g,%.9g,0\n" % (k * 1e-3, x, x))
+        js = os.path.join(self.w, "step.json")
+        r = run("br_track", "--ref", ref, "--ctrl", "hinf_only", "--json", js)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(js) as f:
+            n = json.load(f)["hinf_only"]["ref_limited_periods"]
+        self.assertGreater(n, 0)
+        self.assertIn("the drive limited the reference in %d periods" % n, r.stdout)
 
     def test_simlog_failed_run_writes_nothing(self):
         out, machine = self.existing("log.csv"), self.existing("log.machine.json")
