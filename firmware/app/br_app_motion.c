@@ -171,6 +171,25 @@ static float coast_cap(const br_app_t *app, float room)
     return a / (k * k) * (sqrtf(b * b + 2.0f * k * k * room / a) - b);
 }
 
+/* The cap on a step toward the high end (hi) or the low end from position
+ * lpos (counts): the braking curve that stops at the soft limit, the coast
+ * envelope */
+static float ref_cap(const br_app_t *app, float lpos, int hi)
+{
+    return hi ? fminf(brake_cap(app->lim_amax, app->lim_hi - lpos), coast_cap(app, app->lim_end_hi - lpos))
+              : fminf(brake_cap(app->lim_amax, lpos - app->lim_lo), coast_cap(app, lpos - app->lim_end_lo));
+}
+
+float br_app_ref_speed_cap_mps(const br_app_t *app, float pos_m, int toward_hi)
+{
+    if (app == NULL || !app->ready || !isfinite(pos_m)) {
+        return 0.0f;
+    }
+    const float cpm = app->motion.counts_per_m, dt = app->ctrl.cfg.dt_s;
+    const float v = fminf(app->lim_vmax, ref_cap(app, pos_m * cpm, toward_hi != 0));
+    return v / (cpm * dt);
+}
+
 br_status_t br_app_ref_limit(br_app_t *app, const br_ref_t *ref, int32_t counts, br_ref_t *out)
 {
     const float dt = app->ctrl.cfg.dt_s, rpc = app->ctrl.cfg.rad_per_count;
@@ -203,8 +222,8 @@ br_status_t br_app_ref_limit(br_app_t *app, const br_ref_t *ref, int32_t counts,
     /* the caps on a step toward each end: the braking curve that stops at
      * the soft limit, the coast envelope */
     const float lpos = (float)app->lim_counts + app->lim_frac;
-    const float cap_hi = fminf(brake_cap(amax, app->lim_hi - lpos), coast_cap(app, app->lim_end_hi - lpos));
-    const float cap_lo = fminf(brake_cap(amax, lpos - app->lim_lo), coast_cap(app, lpos - app->lim_end_lo));
+    const float cap_hi = ref_cap(app, lpos, 1);
+    const float cap_lo = ref_cap(app, lpos, 0);
     if (!app->lim_active && !clamped && fabsf(e) <= vmax * tol && fabsf(e - app->lim_v) <= amax * tol &&
         fabsf(vt) <= vmax * tol && e <= cap_hi && -e <= cap_lo) {
         /* within every limit: the reference as it is, bit for bit */

@@ -333,6 +333,40 @@ done:
 
 #define TOOL "br_track"
 
+/* --speed-cap LO,HI: the largest reference speed (m/s) the drive's limiter passes untouched
+ * anywhere in [LO, HI] toward either end (br_app_ref_speed_cap_mps at HI toward the high end
+ * and at LO toward the low one: its caps shrink toward each end), for the application of
+ * every controller this tool runs (their periods differ): the smallest, printed alone on
+ * stdout. The question a trajectory built for this drive asks (sim/studies/fleet_axis.py). */
+static int speed_cap(const br_plant_cfg_t *pc, double lo, double hi)
+{
+    static const br_circle_ctrl_t ctrls[] = {BR_CTRL_HINF_ONLY, BR_CTRL_HINF_PF, BR_CTRL_HINF_UKF};
+    double v = INFINITY;
+    for (size_t i = 0; i < sizeof ctrls / sizeof ctrls[0]; i++) {
+        br_circle_cfg_t c = br_circle_cfg_thesis(ctrls[i]);
+        c.plant = *pc;
+        const br_ctrl_cfg_t cc = br_circle_ctrl_cfg(&c);
+        const br_app_motion_cfg_t mc = br_app_motion_cfg(&(const br_app_machine_t)BR_MACHINE_APP_MACHINE);
+        const br_app_cfg_t ac = {&cc, BR_APP_EST_NONE, NULL, NULL, NULL,
+                                 br_app_guard_cfg(cc.dt_s, mc.max_speed_mps * mc.counts_per_m), mc};
+        const br_plant_state_t x0 = {0.0, 0.0, 0.0};
+        br_plant_t p;
+        br_hal_sim_t port;
+        br_hal_t hal;
+        br_app_t app;
+        br_app_mem_t mem = {NULL, NULL};
+        if (br_plant_init(&p, pc, &x0) != 0 || br_hal_sim_init(&port, &p, c.dt_s, &hal) != BR_OK ||
+            br_app_init(&app, &ac, &hal, &mem) != BR_OK) {
+            fprintf(stderr, "%s: --speed-cap: the application for this machine did not initialise\n", TOOL);
+            return 1;
+        }
+        v = fmin(v, fmin((double)br_app_ref_speed_cap_mps(&app, (float)hi, 1),
+                         (double)br_app_ref_speed_cap_mps(&app, (float)lo, 0)));
+    }
+    printf("%.9g\n", v);
+    return 0;
+}
+
 /* DIR/KIND_NAME.csv through br_outfile (docs/tools.md, rule 2) */
 static int open_trace(br_outfile_t *o, const char *dir, const char *kind, const char *name)
 {
@@ -352,6 +386,7 @@ static int usage(const char *argv0, FILE *to)
             "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,\n"
             "                  hinf_pf_ext_ff,hinf_true_ff,hinf_ukf] [--json OUT] [--trace DIR]\n"
             "          [--gms D1,..,DN] [--gms-zeta Z]\n"
+            "       %s --speed-cap LO,HI [--model MODEL.json]\n"
             BR_ARGS_COMMON_USAGE
             "  --ref LOG.csv       the measured log whose reference trajectory is tracked\n"
             "  --model MODEL.json  the plant from a diagnosis's saved model\n"
@@ -359,8 +394,11 @@ static int usage(const char *argv0, FILE *to)
             "  --ctrl LIST         the controllers to run, comma-separated\n"
             "  --json OUT          the runs' figures as JSON\n"
             "  --trace DIR         each run's trace as CSV into DIR (track_NAME.csv), and for\n"
-            "                      the PF runs its steps (pf_NAME.csv: truth, cloud, miss, gate)\n",
-            argv0, argv0);
+            "                      the PF runs its steps (pf_NAME.csv: truth, cloud, miss, gate)\n"
+            "  --speed-cap LO,HI   print the largest reference speed (m/s) this build's drive passes\n"
+            "                      untouched in [LO, HI] m toward either end (max speed, the braking\n"
+            "                      curve to the soft limits, the coast envelope), and run nothing\n",
+            argv0, argv0, argv0);
     br_gms_usage(to);
     return 2;
 }
@@ -368,8 +406,8 @@ static int usage(const char *argv0, FILE *to)
 int main(int argc, char **argv)
 {
     const char *ref = NULL, *model = NULL, *json = NULL, *trace = NULL, *ctrls = NULL;
-    double pd[4];
-    int have_pd = 0;
+    double pd[4], cap[2];
+    int have_pd = 0, have_cap = 0;
     br_gms_args_t gms = BR_GMS_ARGS_DEFAULT;
     static const struct option opts[] = {{"ref", required_argument, NULL, 'r'},
                                          {"model", required_argument, NULL, 'm'},
@@ -377,6 +415,7 @@ int main(int argc, char **argv)
                                          {"trace", required_argument, NULL, 't'},
                                          {"ctrl", required_argument, NULL, 'c'},
                                          {"pd", required_argument, NULL, 'p'},
+                                         {"speed-cap", required_argument, NULL, 's'},
                                          BR_GMS_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -395,6 +434,14 @@ int main(int argc, char **argv)
                 return 2;
             }
             break;
+        case 's':
+            have_cap = br_parse_numbers(val, cap, 2) == 2 && isfinite(cap[0]) && isfinite(cap[1]) && cap[0] <= cap[1] &&
+                       fabs(cap[0]) <= 1e3 && fabs(cap[1]) <= 1e3;
+            if (!have_cap) {
+                fprintf(stderr, "%s: --speed-cap needs LO,HI in m, LO <= HI, both within +-1e3: %s\n", TOOL, val);
+                return 2;
+            }
+            break;
         case BR_GMS_OPT:
             if (br_gms_arg(TOOL, p.opt, val, &gms) != 0) return usage(argv[0], stderr);
             break;
@@ -402,6 +449,15 @@ int main(int argc, char **argv)
         }
     }
     if (br_gms_args_check(TOOL, &gms) != 0) return usage(argv[0], stderr);
+    if (have_cap) {
+        br_plant_cfg_t pc = br_plant_cfg_reference();
+        char m[512];
+        if (model && br_plant_cfg_from_model_json(model, &pc, &pc, m, sizeof m) != 0) {
+            fprintf(stderr, "br_track: %s\n", m);
+            return 1;
+        }
+        return speed_cap(&pc, cap[0], cap[1]);
+    }
     if (!ref) {
         fprintf(stderr, "%s: --ref is required\n", TOOL);
         return usage(argv[0], stderr);

@@ -195,43 +195,19 @@ def truth_file(ax, given):
     return m
 
 
-def accepted_speed_mps(m, lo, hi):
-    """The largest speed at which the reference limiter of machine m (the drive's, br_app_ref_limit;
-    docs/modules/app.md, "Drive protections") passes a reference anywhere in [lo, hi] toward either
-    end: limits.max_speed_mps, the braking curve to the soft limits and the coast envelope, at the
-    longest period the application runs at (both caps shrink with it). Every limit from machine.py."""
-    dt = machine.loop_period_s(m)
-    acc, e_max, x_min = machine.limit_defaults(m)
-    soft_lo, soft_hi = machine.soft_limits_m(m)
-    k = 1.0 + machine.SPEED_MARGIN
-
-    def brake(room):
-        # the discrete braking curve at max_accel: v (v + a dt) / (2 a) = room,
-        # v = -a dt/2 + sqrt(a^2 dt^2/4 + 2 a room)
-        return -0.5 * acc * dt + math.sqrt(0.25 * (acc * dt) ** 2 + 2.0 * acc * room)
-
-    caps = [m["limits"]["max_speed_mps"], brake(soft_hi - hi), brake(lo - soft_lo)]
-    if machine.coast_in_stroke(m):
-        # the coast's deceleration a_c = Fc / m_eff: the speed fault's speed v_f coasts machine.coast_m
-        vf = k * m["limits"]["max_speed_mps"]
-        ac = vf * vf / (2.0 * machine.coast_m(m))
-        b = 2.0 * k + 1.0
-        for room in (x_min + m["limits"]["travel_m"] - e_max - hi, lo - x_min - e_max):
-            # the coast envelope: k^2 v^2 / (2 a_c) + (2k + 1) v dt = room solved for v
-            caps.append(ac * dt / (k * k) * (math.sqrt(b * b + 2.0 * k * k * room / (ac * dt * dt)) - b))
-    return min(caps)
-
-
-def track_limits(ax, m):
+def track_limits(ax, m, speed_cap):
     """What the axis's tracked references keep to on the drive of machine m (the machine file the
     tools are built for): the P2P_ENDS range's speed, the EMPS_ENDS range's speed (LIMIT_SHARE of
-    accepted_speed_mps), the acceleration (LIMIT_SHARE of the limiter's, move_acc at most) and the
+    speed_cap(lo, hi), the largest speed that drive's reference limiter passes untouched in [lo, hi]
+    toward either end: `br_track --speed-cap` of the build for m, the limiter's own caps, max speed,
+    the braking curve to the soft limits and the coast envelope, at every period the application
+    runs at), the acceleration (LIMIT_SHARE of the limiter's, move_acc at most) and the
     sample step, half the control period: the control period and the PF's (PF_PERIOD_RATIO of it)
     are whole multiples of it, so br_track reads the reference at its samples, never between two
     (a 1 ms step read by linear interpolation every 0.27 ms showed the limiter 3.7 times the
     acceleration)"""
     acc = min(move_acc(ax), LIMIT_SHARE * machine.limit_defaults(m)[0])
-    v = [LIMIT_SHARE * accepted_speed_mps(m, e[0] * TRAVEL_M, e[1] * TRAVEL_M) for e in (P2P_ENDS, EMPS_ENDS)]
+    v = [LIMIT_SHARE * speed_cap(e[0] * TRAVEL_M, e[1] * TRAVEL_M) for e in (P2P_ENDS, EMPS_ENDS)]
     return {"p2p_mps": v[0], "emps_mps": v[1], "acc_mps2": acc, "dt_s": 0.5 * m["control"]["period_s"]}
 
 

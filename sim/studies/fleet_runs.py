@@ -57,6 +57,18 @@ def tool(stage, cmd, log):
         raise ChainError(stage, (r.stderr.strip().splitlines() or ["exit %d" % r.returncode])[-1])
 
 
+def speed_cap(exe, log):
+    """(lo, hi) -> the largest reference speed the drive exe is built for passes untouched in [lo, hi]
+    (br_track --speed-cap: the firmware limiter's caps, their one home)"""
+    def cap(lo, hi):
+        r = subprocess.run([exe, "--speed-cap", "%.9g,%.9g" % (lo, hi)], capture_output=True, text=True)
+        log.write(r.stderr)
+        if r.returncode != 0:
+            raise ChainError("br_track --speed-cap", (r.stderr.strip().splitlines() or ["exit %d" % r.returncode])[-1])
+        return float(r.stdout)
+    return cap
+
+
 def run_seed(study_seed, i, k):
     """the noise seed of the axis's k-th run (independent of scheduling)"""
     return int(np.random.default_rng(fleet_axis.axis_seed(study_seed, i) + [2, k]).integers(1, 2 ** 31))
@@ -184,7 +196,7 @@ def one_axis(a, i):
             truth, robust, track, rec["machine"] = chain(a, ax, d, log, sw)
             # the tracked references within what the drive built for machine.json accepts
             with open(os.path.join(d, "diagnose", "machine.json"), encoding="utf-8") as f:
-                lim = fleet_axis.track_limits(ax, json.load(f))
+                lim = fleet_axis.track_limits(ax, json.load(f), speed_cap(track, log))
             gms = fleet_axis.gms_options(ax)  # the truth's Maxwell-slip friction, where it has one
             for k, tr in enumerate(trajectory_set(a, ax)):
                 rec["traj"][tr["name"]] = tr

@@ -8,6 +8,7 @@ byte for byte and no temporary file behind.
 Usage: test_tools.py --bin DIR --work DIR"""
 import argparse
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -209,6 +210,49 @@ class ToolsTest(unittest.TestCase):
             n = json.load(f)["hinf_only"]["ref_limited_periods"]
         self.assertGreater(n, 0)
         self.assertIn("the drive limited the reference in %d periods" % n, r.stdout)
+
+    def test_track_speed_cap_is_the_limiters(self):
+        """br_track --speed-cap (the firmware limiter's caps, br_app_ref_speed_cap_mps) against a
+        float64 oracle from the machine file the build is for (docs/modules/app.md, "Drive
+        protections"): max speed, the discrete braking curve v (v + a T) / (2 a) to the soft limit,
+        and the coast envelope k^2 v^2 / (2 a_c) + (2k + 1) v T to the stroke's end less the
+        following limit (k = 1.2, a_c = Fc / (M + J / L^2)), at the longest period the application
+        runs at; the smaller at HI toward the high end and at LO toward the low one. Mid-stroke,
+        near each end and across the whole stroke; a range with LO > HI refused."""
+        sys.path.insert(0, os.path.join(os.path.dirname(VERSION_FILE), "firmware", "design"))
+        import machine  # noqa: E402
+        m = machine.load(ARGS.machine)
+        T = machine.loop_period_s(m)
+        acc, e_max, x_min = machine.limit_defaults(m)
+        soft_lo, soft_hi = machine.soft_limits_m(m)
+        li, mech = m["limits"], m["mechanics"]
+        L = mech["lead_m_per_rev"] / (2.0 * math.pi)
+        a_c = m["friction"]["Fc_N"] / (mech["table_mass_kg"] + mech["inertia_kgm2"] / (L * L))
+        k = 1.2
+
+        def oracle(lo, hi):
+            caps = [li["max_speed_mps"]]
+            for brake_room, coast_room in ((soft_hi - hi, x_min + li["travel_m"] - e_max - hi),
+                                           (lo - soft_lo, lo - x_min - e_max)):
+                caps.append(-0.5 * acc * T + math.sqrt(0.25 * (acc * T) ** 2 + 2.0 * acc * brake_room)
+                            if brake_room > 0.0 else 0.0)
+                if machine.coast_in_stroke(m) and coast_room > 0.0:
+                    # k^2 v^2 / (2 a_c) + (2k + 1) v T = room, for v
+                    A, B = k * k / (2.0 * a_c), (2.0 * k + 1.0) * T
+                    caps.append((-B + math.sqrt(B * B + 4.0 * A * coast_room)) / (2.0 * A))
+            return min(caps)
+
+        mid = 0.5 * (soft_lo + soft_hi)
+        span = soft_hi - soft_lo
+        for lo, hi in ((mid - 0.01 * span, mid + 0.01 * span), (mid, soft_hi - 0.002 * span),
+                       (soft_lo + 0.002 * span, mid), (soft_lo + 0.2 * span, soft_hi - 0.2 * span)):
+            r = run("br_track", "--speed-cap", "%.9g,%.9g" % (lo, hi))
+            self.assertEqual(r.returncode, 0, r.stderr)
+            v, want = float(r.stdout), oracle(lo, hi)
+            self.assertGreater(want, 0.0)
+            self.assertLess(abs(v / want - 1.0), 1e-4, (lo, hi, v, want))
+        r = run("br_track", "--speed-cap", "0.1,0.0")
+        self.assert_refused(r, 2, "--speed-cap needs LO,HI")
 
     def test_simlog_failed_run_writes_nothing(self):
         out, machine = self.existing("log.csv"), self.existing("log.machine.json")
@@ -501,5 +545,6 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
     ap.add_argument("--work", required=True)
+    ap.add_argument("--machine", required=True, help="the machine file the tools are built for")
     ARGS, rest = ap.parse_known_args()
     unittest.main(argv=[sys.argv[0], *rest])

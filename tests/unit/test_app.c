@@ -1018,6 +1018,55 @@ static void test_reference_limiter(void **st)
     }
 }
 
+/* br_app_ref_speed_cap_mps is what the limiter passes (docs/modules/app.md,
+ * "Drive protections"): the speed limit mid-stroke, 0 at a soft limit, and,
+ * 3 mm and 20 mm from each soft limit (the braking curve and the coast
+ * envelope binding), a reference cruising toward the end at 0.999 of the cap
+ * passes untouched while one at 1.01 of it is limited. NULL, an application
+ * not initialised and a NaN position give 0. */
+static void test_speed_cap_is_what_passes(void **st)
+{
+    (void)st;
+    rig_t g;
+    rig_machine(&g);
+    const br_app_t *a = &g.app;
+    const float vmax = a->motion.max_speed_mps;
+    assert_true(br_app_ref_speed_cap_mps(NULL, 0.0f, 1) == 0.0f);
+    assert_true(br_app_ref_speed_cap_mps(a, NAN, 1) == 0.0f);
+    const float mid = 0.5f * (a->motion.soft_min_m + a->motion.soft_max_m);
+    assert_true(fabsf(br_app_ref_speed_cap_mps(a, mid, 1) / vmax - 1.0f) <= 1.0e-5f);
+    assert_true(fabsf(br_app_ref_speed_cap_mps(a, mid, 0) / vmax - 1.0f) <= 1.0e-5f);
+    assert_true(br_app_ref_speed_cap_mps(a, a->motion.soft_max_m, 1) == 0.0f);
+    assert_true(br_app_ref_speed_cap_mps(a, a->motion.soft_min_m, 0) == 0.0f);
+    static const float from_end_m[2] = {0.003f, 0.020f}, share[2] = {0.999f, 1.01f};
+    for (int hi = 0; hi < 2; hi++) {
+        for (int d = 0; d < 2; d++) {
+            for (int s = 0; s < 2; s++) {
+                rig_machine(&g);
+                g.app.motion.stuck_band_N = 1e9f; /* the fake axis moves without a force */
+                const float cpm = a->motion.counts_per_m, dt = a->ctrl.cfg.dt_s;
+                const float pos_m = hi ? a->motion.soft_max_m - from_end_m[d] : a->motion.soft_min_m + from_end_m[d];
+                const float cap = br_app_ref_speed_cap_mps(a, pos_m, hi);
+                assert_true(cap > 0.0f && cap < vmax);
+                /* the limiter cruising toward the end at that position, the axis on it */
+                const float p = pos_m * cpm, step = (hi ? 1.0f : -1.0f) * share[s] * cap * cpm * dt;
+                g.app.lim_primed = 1;
+                g.app.lim_active = 0;
+                g.app.lim_counts = (int32_t)floorf(p);
+                g.app.lim_frac = p - floorf(p);
+                g.app.lim_v = step;
+                g.f.counts = g.app.lim_counts;
+                const float t = p + step;
+                const br_ref_t r = {(int32_t)floorf(t), t - floorf(t), step * g.k.rad_per_count / dt};
+                assert_int_equal(br_app_step(&g.app, &r), BR_OK);
+                print_message("%s end, %.0f mm from it: cap %.4f m/s, at %.3f of it limited %d\n", hi ? "high" : "low",
+                              (double)from_end_m[d] * 1e3, (double)cap, (double)share[s], a->ref_limited);
+                assert_int_equal(a->ref_limited, s);
+            }
+        }
+    }
+}
+
 /* A reference at max speed toward the stroke's end and beyond it (the axis
  * follows the limited reference exactly): held on the braking curve that
  * stops at the soft limit (without it the reference passed the soft limit at
@@ -1308,6 +1357,7 @@ int main(void)
         cmocka_unit_test(test_encoder_frozen_coarse_count),
         cmocka_unit_test(test_encoder_frozen_actuator_delay),
         cmocka_unit_test(test_reference_limiter),
+        cmocka_unit_test(test_speed_cap_is_what_passes),
         cmocka_unit_test(test_reference_to_the_end),
         cmocka_unit_test(test_motion_faults_brake),
         cmocka_unit_test(test_motion_cfg_machine),

@@ -307,4 +307,14 @@ br_status_t br_app_fault(br_app_t *app, br_app_fault_t cause);
  * BR_E_NULL, BR_E_STATE (not initialised). */
 br_status_t br_app_step(br_app_t *app, const br_ref_t *ref);
 
+/* The largest reference speed (m/s) the drive's reference limiter passes
+ * untouched at load position pos_m moving toward the high end (toward_hi
+ * nonzero) or the low end: max_speed_mps, the braking curve that stops at the
+ * soft limit and the coast envelope, at the application's period: the caps
+ * br_app_step's limiter applies (docs/modules/app.md, "Drive protections");
+ * 0 at or beyond a soft limit, and for an application not initialised or a
+ * non-finite position. A tool's question (what a trajectory may ask of this
+ * drive), not a control-loop call. */
+float br_app_ref_speed_cap_mps(const br_app_t *app, float pos_m, int toward_hi);
+
 #endif
