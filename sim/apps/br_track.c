@@ -20,6 +20,11 @@
  *   hinf_pf_ext_ff  the same with the PF on the extended model
  *   hinf_true_ff the oracle + the inertia term: the limit of an estimator
  *                beside an acceleration feedforward
+ *   hinf_inertia, hinf_pf_inertia, hinf_ukf_inertia
+ *                H-infinity alone, + the PF, + the UKF, each with the inertia
+ *                feedforward of the build's machine file (its moving mass, not
+ *                the plant's, times the reference acceleration): what the
+ *                firmware knows, no oracle (docs/fleet.md, "The tracks")
  *
  * The firmware's configuration (gains, periods, estimator settings) is the
  * build's machine's (br_circle_cfg_thesis). The tracking error is the
@@ -28,7 +33,8 @@
  *
  * Usage: br_track --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]
  *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,
- *                        hinf_pf_ext_ff,hinf_true_ff,hinf_ukf] [--json OUT] [--trace DIR]
+ *                        hinf_pf_ext_ff,hinf_true_ff,hinf_ukf,hinf_inertia,hinf_pf_inertia,
+ *                        hinf_ukf_inertia] [--json OUT] [--trace DIR]
  * Prints one line per controller: tracking RMS and maximum error. --trace
  * writes each run's trace, and for hinf_pf and hinf_pf_ext one row per PF
  * step (pf_trace_row). */
@@ -204,7 +210,9 @@ static void pf_trace_row(FILE *f, double t, const br_plant_t *p, const br_pf_t *
 /* the firmware (br_app_step) with the build's machine configuration */
 /* ff: 0 none, 1 the feedforward of the plant's model (friction, causes, inertia; ctrl
  * BR_CTRL_HINF_FF), 2 the estimator (ctrl BR_CTRL_HINF_PF: the PF; BR_CTRL_HINF_TRUE:
- * the oracle) plus the feedforward's inertia term */
+ * the oracle) plus the feedforward's inertia term (the plant's mass), 3 the inertia term of
+ * the build's machine file (its mass) alone (ctrl BR_CTRL_HINF_ONLY) or beside the estimator
+ * (BR_CTRL_HINF_PF, BR_CTRL_HINF_UKF) */
 /* *n_limited: the periods whose reference the drive's limiter changed (br_app_ref_limit; the run-in
  * included), 0 when the application never ran */
 static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int extended, int ff, err_t *e,
@@ -212,15 +220,18 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
 {
     *n_limited = 0u;
     br_circle_cfg_t c = br_circle_cfg_thesis(ctrl);
+    const br_plant_cfg_t mach = c.plant; /* the build's machine file's plant */
     c.plant = *pc;
     if (extended) c.pf.est.model.causes = br_causes_from_model(pc);
     static pf_ff_t w; /* the feedforward (and the PF's br_est_t for ff 2) */
     if (ff) {
+        /* the feedforward from the plant's model (ff 3: the machine file's) */
+        const br_plant_cfg_t *fp = (ff == 3) ? &mach : pc;
         br_circle_cfg_t m = c;
-        br_circle_use_model(&m, pc); /* the feedforward from the plant's model */
+        br_circle_use_model(&m, fp);
         c.ff = m.ff;
-        c.ff.mass_kg = (float)(pc->J_kgm2 / (pc->lead_mprad * pc->lead_mprad) + pc->M_kg);
-        if (ff == 2) {
+        c.ff.mass_kg = (float)(fp->J_kgm2 / (fp->lead_mprad * fp->lead_mprad) + fp->M_kg);
+        if (ff >= 2) {
             /* the inertia term alone: the PF estimates the friction */
             c.ff.Fs_N = c.ff.Fc_N = 1e-20f;
             c.ff.sigma2_Nspm = 0.0f;
@@ -265,10 +276,10 @@ static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t c
     if (ctrl == BR_CTRL_HINF_PF && (mem.pf = calloc(1, sizeof *mem.pf)) == NULL) return -1;
     if (ctrl == BR_CTRL_HINF_UKF && (mem.ukf = calloc(1, sizeof *mem.ukf)) == NULL) return -1;
     br_est_t ffe = {&w.ff, br_ff_est_step, NULL, NULL};
-    if (ff == 1) {
+    if (ff == 1 || (ff == 3 && kind == BR_APP_EST_NONE)) {
         ac.est = BR_APP_EST_EXTERN;
         ac.ext = &ffe;
-    } else if (ff == 2) {
+    } else if (ff >= 2) {
         /* the PF as configured (or the oracle), behind the wrapper that adds the inertia term */
         if (ctrl == BR_CTRL_HINF_TRUE) w.inner = ext;
         else if ((refused = br_app_est_init(&ac, &mem, &w.inner)) != BR_OK) {
@@ -384,7 +395,8 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]\n"
             "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,\n"
-            "                  hinf_pf_ext_ff,hinf_true_ff,hinf_ukf] [--json OUT] [--trace DIR]\n"
+            "                  hinf_pf_ext_ff,hinf_true_ff,hinf_ukf,hinf_inertia,hinf_pf_inertia,\n"
+            "                  hinf_ukf_inertia] [--json OUT] [--trace DIR]\n"
             "          [--gms D1,..,DN] [--gms-zeta Z]\n"
             "       %s --speed-cap LO,HI [--model MODEL.json]\n"
             BR_ARGS_COMMON_USAGE
@@ -483,12 +495,15 @@ int main(int argc, char **argv)
     if (js)
         fprintf(js, "{\n  \"generator\": \"br_track (sim/apps/br_track.c); generated, do not edit\",\n"
                     "  \"duration_s\": %.6g", (double)(tr.n - 1) * tr.dt);
-    static const char *const names[] = {"pd",      "hinf_only", "hinf_pf",        "hinf_pf_ext", "hinf_true",
-                                        "hinf_ff", "hinf_pf_ff", "hinf_pf_ext_ff", "hinf_true_ff", "hinf_ukf"};
+    static const char *const names[] = {"pd",           "hinf_only",       "hinf_pf",        "hinf_pf_ext",
+                                        "hinf_true",    "hinf_ff",         "hinf_pf_ff",     "hinf_pf_ext_ff",
+                                        "hinf_true_ff", "hinf_ukf",        "hinf_inertia",   "hinf_pf_inertia",
+                                        "hinf_ukf_inertia"};
+    const int n_names = (int)(sizeof names / sizeof names[0]);
     int rc = 0;
     static br_outfile_t traces[20];
     int ntraces = 0;
-    for (int w = 0; w < 10 && rc == 0; w++) {
+    for (int w = 0; w < n_names && rc == 0; w++) {
         const size_t len = strlen(names[w]);
         const char *hit = strstr(ctrls, names[w]);
         while (hit && ((hit != ctrls && hit[-1] != ',') || (hit[len] != ',' && hit[len] != '\0')))
@@ -522,9 +537,11 @@ int main(int argc, char **argv)
                 rc = 2;
             } else if (run_pd(&tr, &plant, pd, &e) != 0) rc = 1;
         } else {
-            const br_circle_ctrl_t ctrl = w == 1 ? BR_CTRL_HINF_ONLY : (w == 4 || w == 8) ? BR_CTRL_HINF_TRUE
-                                          : w == 5 ? BR_CTRL_HINF_FF : w == 9 ? BR_CTRL_HINF_UKF : BR_CTRL_HINF_PF;
-            const int ff = w == 5 ? 1 : (w >= 6 && w <= 8) ? 2 : 0;
+            const br_circle_ctrl_t ctrl = (w == 1 || w == 10) ? BR_CTRL_HINF_ONLY
+                                          : (w == 4 || w == 8) ? BR_CTRL_HINF_TRUE
+                                          : w == 5 ? BR_CTRL_HINF_FF
+                                          : (w == 9 || w == 12) ? BR_CTRL_HINF_UKF : BR_CTRL_HINF_PF;
+            const int ff = w == 5 ? 1 : (w >= 6 && w <= 8) ? 2 : (w >= 10) ? 3 : 0;
             if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &rep, &n_limited) != 0) rc = 1;
         }
         if (rc != 0) break;

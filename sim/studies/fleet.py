@@ -34,7 +34,8 @@ from runs import refused  # noqa: E402
 
 REPO = fleet_axis.REPO
 KINDS = ("thesis_circle", "circle", "p2p", "emps")
-CONTROLLERS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")
+# the tracks also run each with the inertia feedforward of the axis's machine file (fleet_runs.TRACK_CTRLS)
+CONTROLLERS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf", "hinf_inertia", "hinf_ukf_inertia", "hinf_pf_inertia")
 FULL_N = 200  # the study's size (make fleet's default N)
 
 
@@ -151,7 +152,8 @@ def cdf_plot(recs, path, n_axes):
     import matplotlib.pyplot as plt
     import matplotlib.ticker  # noqa: F401 - the minor tick labels off
     fig, axs = plt.subplots(1, len(KINDS), figsize=(15, 4.2), sharey=True)
-    colours = {"hinf_only": "k", "hinf_ff": "tab:brown", "hinf_ukf": "tab:blue", "hinf_pf": "tab:red"}
+    colours = {"hinf_only": "k", "hinf_ff": "tab:brown", "hinf_ukf": "tab:blue", "hinf_pf": "tab:red",
+               "hinf_inertia": "tab:gray", "hinf_ukf_inertia": "tab:cyan", "hinf_pf_inertia": "tab:pink"}
     for ax, kind in zip(axs, KINDS):
         for ctrl in CONTROLLERS:
             runs = [rr[ctrl] for r in recs for name, rr in r["runs"].items()

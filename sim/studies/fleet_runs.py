@@ -30,7 +30,10 @@ from robustness import LOST_OUTLIER_FRAC  # noqa: E402
 from runs import REFUSED_AT_INIT, faulted  # noqa: E402
 
 CIRCLE_CTRLS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")  # br_robust_run, the machine file's model
-TRACK_CTRLS = ("hinf_only", "hinf_ukf", "hinf_pf")              # br_track (its feedforward is the plant's: an oracle)
+# br_track (not its _ff controllers: their feedforward is the plant's, an oracle); each also with the
+# inertia feedforward of the axis's machine file (its mass times the reference acceleration: what the
+# firmware knows), as a motion controller runs a track (docs/fleet.md, "The tracks")
+TRACK_CTRLS = ("hinf_only", "hinf_ukf", "hinf_pf", "hinf_inertia", "hinf_ukf_inertia", "hinf_pf_inertia")
 ESTIMATORS = ("hinf_ff", "hinf_ukf", "hinf_pf")
 IDENT_REVERSALS = 1  # the identification log's reversal segment: the log docs/diagnose.md asks for presliding
 

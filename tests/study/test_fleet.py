@@ -64,8 +64,9 @@ class Fleet(unittest.TestCase):
         self.assertEqual(s["friction"]["maxwell_slip"]["controllers"]["hinf_only"]["n"],
                          len(s["axes"][1]["runs"]))
         self.assertEqual(sorted(s["kinds"]), ["p2p", "thesis_circle"])
-        # br_track runs the UKF too
-        self.assertEqual(sorted(s["kinds"]["p2p"]), ["hinf_only", "hinf_pf", "hinf_ukf"])
+        # br_track runs the UKF too, and each with the machine file's inertia feedforward
+        self.assertEqual(sorted(s["kinds"]["p2p"]), ["hinf_inertia", "hinf_only", "hinf_pf", "hinf_pf_inertia",
+                                                     "hinf_ukf", "hinf_ukf_inertia"])
         for ctl in (s["controllers"], *s["kinds"].values()):
             for name, v in ctl.items():
                 self.assertIn(name, fleet.CONTROLLERS)
