@@ -198,7 +198,11 @@ def delay_id_fields(E, e, per_step):
             (P + "Q_FORCE_N2PS", per_step["dlyid_q_force_N2ps"], "friction random walk per second"),
             (P + "MEMORY_S", d.get("memory_s", 0.0), "forgetting time constant"),
             (P + "WARMUP_S", d.get("warmup_s", 0.0), "no switch before"),
-            (P + "SWITCH_RATIO", d.get("switch_ratio", 0.0), "switch below this ratio")]
+            (P + "SWITCH_RATIO", d.get("switch_ratio", 0.0), "switch below this ratio"),
+            (P + "STEADY_AFTER_S", (d.get("steady") or {}).get("after_s", 0.0),
+             "the steady phase from this time on (0: off)"),
+            (P + "STEADY_MEMORY_S", (d.get("steady") or {}).get("memory_s", 0.0), "its forgetting time constant"),
+            (P + "STEADY_SWITCH_RATIO", (d.get("steady") or {}).get("switch_ratio", 0.0), "its switch ratio")]
 
 
 def gate_fields(E, e, per_step, transient_rad):

@@ -225,6 +225,13 @@ def _gates():
             "warmup_s": Num(0.0, 100.0, "no switch before this time after the first measurement"),
             "switch_ratio": Num(0.0, 1.0, "switch when the best candidate's sum is below this times the sum "
                                 "of the delay in use", lo_open=True, hi_open=True),
+            # a fast start, a slow steady state (docs/modules/dlyid.md); absent = one phase
+            "steady": Optional({
+                "after_s": Num(0.0, 100.0, "the steady phase from this time after the first measurement on",
+                               lo_open=True),
+                "memory_s": Num(0.0, 100.0, "its time constant of the forgotten sums", lo_open=True),
+                "switch_ratio": Num(0.0, 1.0, "its switch ratio", lo_open=True, hi_open=True),
+            }),
         }),
     }
 

@@ -30,6 +30,7 @@ static int constants(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axi
     const float rpc = ax->rad_per_count;
     id->r_rad2 = ax->r_var_rad2 + rpc * rpc * (1.0f / 12.0f);
     id->forget = expf(-T / c->memory_s);
+    id->forget_steady = (c->steady_after_s > 0.0f) ? expf(-T / c->steady_memory_s) : id->forget;
     /* (dly7) the travel over which LuGre's bristles carry the friction's jump at a reversal,
      * in rad at the motor */
     const float s0L = mc->lugre.sigma0_Npm * L; /* > 0 unless the product underflows: refused below */
@@ -37,7 +38,7 @@ static int constants(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axi
     /* b0 and b1 are finite when L b0 and L b1 are (L > 0, br_model_init); R' is finite
      * where the estimator's check (br_est_cfg_check) accepts R and rpc */
     return isfinite(id->a02) && isfinite(id->a12) && isfinite(id->q_force_N2) && id->forget < 1.0f &&
-           isfinite(id->settle_rad);
+           id->forget_steady < 1.0f && isfinite(id->settle_rad);
 }
 
 void br_dlyid_periods(float delay_s, float dt_s, uint32_t *m, float *f)
@@ -58,6 +59,12 @@ int br_dlyid_cfg_ok(const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax)
         !(c->warmup_s / dt <= BR_DLYID_WARMUP_MAX_PERIODS) || !(c->switch_ratio > 0.0f && c->switch_ratio < 1.0f)) {
         return 0;
     }
+    /* the steady phase: off (0), or a time within the warm-up's bound with its memory and ratio */
+    if (!br_finite_nonneg(c->steady_after_s) || !(c->steady_after_s / dt <= BR_DLYID_WARMUP_MAX_PERIODS) ||
+        (c->steady_after_s > 0.0f && (!br_finite_pos(c->steady_memory_s) ||
+                                      !(c->steady_switch_ratio > 0.0f && c->steady_switch_ratio < 1.0f)))) {
+        return 0;
+    }
     br_dlyid_t scratch;
     return constants(&scratch, c, ax);
 }
@@ -71,6 +78,7 @@ void br_dlyid_init(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_
     id->k = 0u;
     id->cur = 0u;
     id->warmup = 0u;
+    id->steady = UINT32_MAX;
     /* off, or unchecked: nothing below is read (br_dlyid_step returns first) */
     const uint32_t n = c->n_cand;
     if (n == 0u || n > BR_DLYID_MAX_CAND) {
@@ -78,6 +86,9 @@ void br_dlyid_init(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_
     }
     (void)constants(id, c, ax); /* finite: checked by br_dlyid_cfg_ok */
     id->warmup = (uint32_t)(c->warmup_s / T + 0.5f);
+    if (c->steady_after_s > 0.0f) {
+        id->steady = (uint32_t)(c->steady_after_s / T + 0.5f);
+    }
     for (uint32_t j = 0; j <= n; j++) {
         /* the candidates j step_s; slot n the configured delay, where the estimator starts
          * (br_est_delay_init's m and f) */
@@ -203,6 +214,10 @@ int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t
     const float T = ax->model->dt_s;
     reversal(id, rpc / T, T);
     const int scored = !(id->settle_left_rad > 0.0f);
+    /* the phase: the steady one's forgetting and ratio from id->steady periods on */
+    const int steady = c->steady_after_s > 0.0f && id->k >= id->steady;
+    const float forget = steady ? id->forget_steady : id->forget;
+    const float ratio = steady ? c->steady_switch_ratio : c->switch_ratio;
     covariance(id, T, K);
     /* theta re-expressed relative to the new count (wrap-safe), the measurement frac rpc */
     const float shift = (float)br_counts_delta(counts, id->origin_counts) * rpc;
@@ -222,7 +237,7 @@ int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t
         x[1] = om + K[1] * nu;
         x[2] = x[2] + K[2] * nu;
         if (scored) {
-            id->J[j] = id->forget * id->J[j] + nu * nu;
+            id->J[j] = forget * id->J[j] + nu * nu;
         }
         finite = finite && isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(id->J[j]);
     }
@@ -246,8 +261,8 @@ int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t
         }
     }
     /* ... and the one in use explains the motion worse than the noise allows */
-    const float J_noise = BR_DLYID_NOISE_FACTOR * (id->r_rad2 + id->P[0][0]) / (1.0f - id->forget);
-    if (best == id->cur || !(id->J[best] < c->switch_ratio * id->J[id->cur]) ||
+    const float J_noise = BR_DLYID_NOISE_FACTOR * (id->r_rad2 + id->P[0][0]) / (1.0f - forget);
+    if (best == id->cur || !(id->J[best] < ratio * id->J[id->cur]) ||
         !(id->J[id->cur] > J_noise)) {
         return 0;
     }

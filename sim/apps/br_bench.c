@@ -429,9 +429,11 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
     const br_dlyid_cfg_t *d = &c->est.delay_id;
     fprintf(f,
             ", \"delay_s\": %.9g, \"delay_id\": {\"n_cand\": %u, \"step_s\": %.9g, \"q_force_N2ps\": %.9g, "
-            "\"memory_s\": %.9g, \"warmup_s\": %.9g, \"switch_ratio\": %.9g}}",
+            "\"memory_s\": %.9g, \"warmup_s\": %.9g, \"switch_ratio\": %.9g, \"steady_after_s\": %.9g, "
+            "\"steady_memory_s\": %.9g, \"steady_switch_ratio\": %.9g}}",
             (double)m->causes.delay_s, (unsigned)d->n_cand, (double)d->step_s, (double)d->q_force_N2ps,
-            (double)d->memory_s, (double)d->warmup_s, (double)d->switch_ratio);
+            (double)d->memory_s, (double)d->warmup_s, (double)d->switch_ratio, (double)d->steady_after_s,
+            (double)d->steady_memory_s, (double)d->steady_switch_ratio);
 }
 
 /* the recording into f (a br_outfile's temporary file, docs/tools.md) */

@@ -80,6 +80,11 @@ class DelayBank:
         self.settle = SETTLE_LENGTHS * self.gp_max / (F(cfg["sigma0_Npm"]) * L)
         self.ratio = F(d["switch_ratio"])
         self.warmup = int(F(d["warmup_s"]) / T + F(0.5))
+        # the steady phase from self.steady periods on (br_dlyid_cfg_t.steady_*; absent or 0: one phase)
+        after = F(d.get("steady_after_s", 0.0))
+        self.steady = int(after / T + F(0.5)) if after > F(0.0) else None
+        self.forget_steady = F(math.exp(float(-T / F(d["steady_memory_s"])))) if self.steady is not None else self.forget
+        self.ratio_steady = F(d["steady_switch_ratio"]) if self.steady is not None else self.ratio
         # the slots' delays: the candidates j step_s, then the configured delay
         mf = [periods(F(j) * F(d["step_s"]), T) for j in range(n)] + [periods(cfg.get("delay_s", 0.0), T)]
         self.cm = np.array([p[0] for p in mf])
@@ -168,10 +173,13 @@ class DelayBank:
         om = (x1 + self.a12 * x2) + self.b1 * u
         # dly5: innovation, update, the forgotten sums
         nu = y_rel - th
+        steady = self.steady is not None and self.k >= self.steady
+        forget = self.forget_steady if steady else self.forget
+        ratio = self.ratio_steady if steady else self.ratio
         with np.errstate(over="ignore", invalid="ignore"):
             self.x = np.stack((th + K[0] * nu, om + K[1] * nu, x2 + K[2] * nu))
             if scored:
-                self.J = self.forget * self.J + nu * nu
+                self.J = forget * self.J + nu * nu
         self.origin = counts
         if not (np.isfinite(self.x).all() and np.isfinite(self.J).all()):
             self.primed = False
@@ -185,8 +193,8 @@ class DelayBank:
         for j in range(self.n + 1):
             if self.J[j] < self.J[best]:
                 best = j
-        j_noise = NOISE_FACTOR * (self.r + self.P[0, 0]) / (F(1.0) - self.forget)
-        if best == self.cur or not (self.J[best] < self.ratio * self.J[self.cur]) or not (self.J[self.cur] > j_noise):
+        j_noise = NOISE_FACTOR * (self.r + self.P[0, 0]) / (F(1.0) - forget)
+        if best == self.cur or not (self.J[best] < ratio * self.J[self.cur]) or not (self.J[self.cur] > j_noise):
             return 0
         self.cur = best
         self.n_switch += 1

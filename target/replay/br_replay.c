@@ -80,6 +80,10 @@ void br_replay_hdr_encode(const br_replay_cfg_t *c, uint32_t w[BR_REPLAY_HDR_WOR
     /* cfg.load (zeros in a stream without them: off) */
     w[i++] = f2w(c->pf.load.q_N2);
     w[i++] = f2w(c->pf.load.max_N);
+    /* cfg.est.delay_id's steady phase (zeros in a stream without them: one phase) */
+    w[i++] = f2w(c->pf.est.delay_id.steady_after_s);
+    w[i++] = f2w(c->pf.est.delay_id.steady_memory_s);
+    w[i++] = f2w(c->pf.est.delay_id.steady_switch_ratio);
     while (i < BR_REPLAY_HDR_WORDS) w[i++] = 0u;
 }
 
@@ -140,6 +144,9 @@ br_status_t br_replay_hdr_decode(const uint32_t w[BR_REPLAY_HDR_WORDS], br_repla
     c->pf.est.outlier_transient_rad = w2f(w[i++]);
     c->pf.load.q_N2 = w2f(w[i++]);
     c->pf.load.max_N = w2f(w[i++]);
+    c->pf.est.delay_id.steady_after_s = w2f(w[i++]);
+    c->pf.est.delay_id.steady_memory_s = w2f(w[i++]);
+    c->pf.est.delay_id.steady_switch_ratio = w2f(w[i++]);
     if (c->pf.noise_len != BR_NOISE_LEN) return BR_E_PARAM;
     c->pf.noise = br_noise_table;
     return BR_OK;

@@ -14,7 +14,9 @@
  *           zeros there: off; the model's Maxwell-slip elements: n,
  *           k_Npm[BR_MSLIP_MAX], share[BR_MSLIP_MAX], sigma2; zeros there: LuGre;
  *           est.outlier_transient_rad; zero there: the thesis gate; the
- *           shared external force's load.q_N2, load.max_N; zeros there: off),
+ *           shared external force's load.q_N2, load.max_N; zeros there: off;
+ *           est.delay_id's steady phase: steady_after_s, steady_memory_s,
+ *           steady_switch_ratio; zeros there: one phase),
  *           floats as their bit patterns, so every value is exact;
  *   steps   n_steps records of 4 words per axis: encoder counts (int32),
  *           reference counts (int32), reference fraction (float), reference
@@ -40,7 +42,7 @@
 #define BR_REPLAY_VERSION 1u   /* one axis */
 #define BR_REPLAY_VERSION_XY 2u /* two axes */
 #define BR_REPLAY_MAX_AXES 2u
-#define BR_REPLAY_HDR_WORDS 70u
+#define BR_REPLAY_HDR_WORDS 73u
 #define BR_REPLAY_STEP_WORDS 4u
 #define BR_REPLAY_OUT_WORDS 6u
 #define BR_REPLAY_FNV_OFFSET 2166136261u

@@ -291,6 +291,22 @@ def main():
         "field estimator.ukf.load.q_N2_per_s: gives q_N2 = 1e-43 per step on this machine, outside the "
         "firmware's (0 excluded) [1.17549e-38, 1e+12]"])
 
+    # the delay identification's steady phase (estimator.<est>.delay_id.steady, docs/modules/dlyid.md):
+    # absent = 0 (one phase); present: its three values in the header; out of range: the field named
+    rc, hdr = est_header(work, "dly_one", good)
+    check(rc == 0 and "#define BR_EST_PF_DELAY_ID_STEADY_AFTER_S_F (0.000000000e+00f)" in hdr,
+          "no estimator.pf.delay_id.steady: the bank's one phase (0 in the header)")
+    withs = copy.deepcopy(good)
+    withs["estimator"]["pf"]["delay_id"]["steady"] = {"after_s": 0.3, "memory_s": 0.02, "switch_ratio": 0.5}
+    rc, hdr = est_header(work, "dly_steady", withs)
+    check(rc == 0 and "#define BR_EST_PF_DELAY_ID_STEADY_AFTER_S_F (%s)" % machine.c_float(0.3) in hdr
+          and "#define BR_EST_PF_DELAY_ID_STEADY_MEMORY_S_F (%s)" % machine.c_float(0.02) in hdr
+          and "#define BR_EST_PF_DELAY_ID_STEADY_SWITCH_RATIO_F (%s)" % machine.c_float(0.5) in hdr,
+          "dly_steady.json: gen_machine.py writes the steady phase")
+    withs["estimator"]["pf"]["delay_id"]["steady"]["switch_ratio"] = 1.0
+    expect_errors(work, "dly_steady_ratio.json", withs,
+                  ["field estimator.pf.delay_id.steady.switch_ratio: 1 is outside (0, 1)"])
+
     # the PF's shared external force (estimator.pf.load, docs/modules/pf.md): absent = no
     # BR_EST_PF_LOAD_* (br_machine_cfg.h: off) and the header of before; present: q per step =
     # q_N2_per_s * estimator.pf.period_s, the bound the actuator's force

@@ -158,7 +158,37 @@ static void test_dlyid_bounds(void **st)
     REFUSED(switch_ratio, 0.0f);
     REFUSED(switch_ratio, 1.0f);
     REFUSED(switch_ratio, NAN);
+    /* the steady phase: off at 0; a time within the warm-up's bound with a memory and a ratio */
+    REFUSED(steady_after_s, -1.0e-6f);
+    REFUSED(steady_after_s, NAN);
+    REFUSED(steady_after_s, 2.0e9f * dt);
 #undef REFUSED
+    c = ok;
+    c.delay_id.steady_after_s = 0.1f;
+    c.delay_id.steady_memory_s = 0.02f;
+    c.delay_id.steady_switch_ratio = 0.5f;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    {
+        const br_est_cfg_t on = c;
+#define REFUSED_ON(field, v)                                                                       \
+    do {                                                                                           \
+        c = on;                                                                                    \
+        c.delay_id.field = (v);                                                                    \
+        assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);                                        \
+    } while (0)
+        REFUSED_ON(steady_memory_s, 0.0f);
+        REFUSED_ON(steady_memory_s, NAN);
+        REFUSED_ON(steady_memory_s, 1.0e12f * dt); /* its forgetting rounds to 1 */
+        REFUSED_ON(steady_switch_ratio, 0.0f);
+        REFUSED_ON(steady_switch_ratio, 1.0f);
+        REFUSED_ON(steady_switch_ratio, NAN);
+#undef REFUSED_ON
+    }
+    /* off (0): its memory and ratio are not looked at */
+    c = ok;
+    c.delay_id.steady_memory_s = NAN;
+    c.delay_id.steady_switch_ratio = 7.0f;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
     /* the largest candidate at the command history's end: kept; beyond it: refused */
     c = ok;
     c.delay_id.n_cand = BR_DLYID_MAX_CAND;
@@ -249,6 +279,40 @@ static void test_dlyid_finds_delay(void **st)
     assert_int_equal(run_bank(&c, 0.0, 3000, &d, &id), 0u);
     assert_int_equal(d.m, 0u);
     assert_true(d.f == 0.0f);
+}
+
+/* The steady phase (docs/modules/dlyid.md, "A fast start, a slow steady state"): the PF's
+ * setting finds an axis's 1.5 ms within the first second; with a steady phase from after
+ * the run's end the bank is the one-phase bank bit for bit (the same switches, the same
+ * sums); with one from the first periods on whose ratio no candidate can beat (1e-6) it
+ * never switches: the phase's ratio is the one applied. And a phase whose memory is 40
+ * times the fast one's still finds the delay. */
+static void test_dlyid_steady_phase(void **st)
+{
+    (void)st;
+    br_est_cfg_t c = machine_pf();
+    c.delay_id.steady_after_s = 0.0f;
+    br_est_delay_t d;
+    br_dlyid_t one, id;
+    const uint32_t n1 = run_bank(&c, 1.5e-3, 1000, &d, &one);
+    assert_true(n1 >= 1u);
+    const double found = modelled_s(&d, &c);
+    /* after the run: one phase throughout */
+    c.delay_id.steady_after_s = 2000.0f * c.model.dt_s;
+    c.delay_id.steady_memory_s = 40.0f * c.delay_id.memory_s;
+    c.delay_id.steady_switch_ratio = 1.0e-6f;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    assert_int_equal(run_bank(&c, 1.5e-3, 1000, &d, &id), n1);
+    assert_true(modelled_s(&d, &c) == found);
+    assert_memory_equal(id.J, one.J, sizeof one.J);
+    /* from the second period on, with a ratio nothing beats: no switch at all */
+    c.delay_id.steady_after_s = c.model.dt_s;
+    assert_int_equal(run_bank(&c, 1.5e-3, 1000, &d, &id), 0u);
+    assert_true(modelled_s(&d, &c) == 0.0);
+    /* with the slow memory and the one-phase ratio: the delay found all the same */
+    c.delay_id.steady_switch_ratio = c.delay_id.switch_ratio;
+    assert_true(run_bank(&c, 1.5e-3, 1000, &d, &id) >= 1u);
+    assert_true(fabs(modelled_s(&d, &c) - 1.5e-3) <= 0.5 * (double)c.delay_id.step_s + 1e-9);
 }
 
 /* The estimator already models the axis's 1 ms: the bank keeps it. */
@@ -471,6 +535,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_dlyid_bounds),
         cmocka_unit_test(test_dlyid_finds_delay),
+        cmocka_unit_test(test_dlyid_steady_phase),
         cmocka_unit_test(test_dlyid_keeps_the_modelled_delay),
         cmocka_unit_test(test_dlyid_overflow_restarts),
         cmocka_unit_test(test_dlyid_leaves_an_off_grid_delay),

@@ -39,6 +39,13 @@ typedef struct {
     float warmup_s;         /* no decision before this time after the first measurement, >= 0 */
     float switch_ratio;     /* switch when the best sum is below this times the sum of the delay in
                                use, in (0, 1) */
+    /* The steady phase (docs/modules/dlyid.md, "A fast start, a slow steady state"): from
+     * steady_after_s after the first measurement on, the sums forget with steady_memory_s and
+     * a switch needs steady_switch_ratio (and dly6's noise floor is at that memory). 0: one
+     * phase, the settings above throughout (bit for bit as without the fields). */
+    float steady_after_s;      /* >= 0, <= 1e9 periods; 0: off */
+    float steady_memory_s;     /* > 0 when steady_after_s > 0 */
+    float steady_switch_ratio; /* in (0, 1) when steady_after_s > 0 */
 } br_dlyid_cfg_t;
 
 /* Filters of the bank: the n_cand candidates, then one for the configured
@@ -50,6 +57,7 @@ typedef struct {
     float P[BR_DLYID_NX][BR_DLYID_NX];       /* their common covariance (the delay moves only the input) */
     float J[BR_DLYID_MAX_SLOTS];             /* forgotten sums of squared innovations, rad^2 */
     float forget;                            /* e^(-dt / memory_s) */
+    float forget_steady;                     /* e^(-dt / steady_memory_s) (the steady phase) */
     float q_force_N2;                        /* per period */
     float r_rad2;                            /* R + rpc^2 / 12 */
     float settle_rad;                        /* BR_DLYID_SETTLE_LENGTHS g_p,max / (sigma0 L), rad */
@@ -63,6 +71,7 @@ typedef struct {
     int32_t origin_counts;                   /* the last measurement's count */
     uint32_t k;                              /* periods since the first measurement */
     uint32_t warmup;                         /* periods */
+    uint32_t steady;                         /* periods before the steady phase (UINT32_MAX: none) */
     uint32_t cur;                            /* the slot of the delay in use (n_cand at the start:
                                                 the configured delay) */
     uint32_t n_switch;                       /* switches so far */

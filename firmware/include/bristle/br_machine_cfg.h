@@ -60,7 +60,10 @@
         .n_cand = BR_EST_##E##_DELAY_ID_CANDIDATES, .step_s = BR_EST_##E##_DELAY_ID_STEP_S_F,      \
         .q_force_N2ps = BR_EST_##E##_DELAY_ID_Q_FORCE_N2PS_F,                                      \
         .memory_s = BR_EST_##E##_DELAY_ID_MEMORY_S_F, .warmup_s = BR_EST_##E##_DELAY_ID_WARMUP_S_F, \
-        .switch_ratio = BR_EST_##E##_DELAY_ID_SWITCH_RATIO_F                                       \
+        .switch_ratio = BR_EST_##E##_DELAY_ID_SWITCH_RATIO_F,                                      \
+        .steady_after_s = BR_EST_##E##_DELAY_ID_STEADY_AFTER_S_F,                                  \
+        .steady_memory_s = BR_EST_##E##_DELAY_ID_STEADY_MEMORY_S_F,                                \
+        .steady_switch_ratio = BR_EST_##E##_DELAY_ID_STEADY_SWITCH_RATIO_F                         \
     }
 
 /* the PF's shared external force: the machine file's estimator.pf.load (BR_EST_PF_LOAD_*,
