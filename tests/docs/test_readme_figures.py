@@ -187,14 +187,13 @@ def check_fleet(c, root):
     every = table_rows(page, r"hinf_\w+", "### All trajectories")
     thesis = table_rows(page, r"hinf_\w+", "### thesis_circle")
     circle = table_rows(page, r"hinf_\w+", "### circle\n")
-    m = c.find(r"\(thesis\s+circle\s+" + NUM + r",\s+other\s+circles\s+PF\s+" + NUM + r",\s+UKF\s+" + NUM + r"\)",
-               "the fleet's circle ratios")
+    m = c.find(r"\(thesis\s+circle\s+PF\s+" + NUM + r",\s+UKF\s+" + NUM + r",\s+other\s+circles\s+PF\s+" + NUM
+               + r",\s+UKF\s+" + NUM + r"\)", "the fleet's circle ratios")
     if m:
-        # one figure for both estimators on the thesis circle: each must print as it
         c.figure(m, 1, float(thesis["hinf_pf"][6]), "fleet thesis_circle hinf_pf ratio")
-        c.figure(m, 1, float(thesis["hinf_ukf"][6]), "fleet thesis_circle hinf_ukf ratio")
-        c.figure(m, 2, float(circle["hinf_pf"][6]), "fleet circle hinf_pf ratio")
-        c.figure(m, 3, float(circle["hinf_ukf"][6]), "fleet circle hinf_ukf ratio")
+        c.figure(m, 2, float(thesis["hinf_ukf"][6]), "fleet thesis_circle hinf_ukf ratio")
+        c.figure(m, 3, float(circle["hinf_pf"][6]), "fleet circle hinf_pf ratio")
+        c.figure(m, 4, float(circle["hinf_ukf"][6]), "fleet circle hinf_ukf ratio")
     m = c.find(r"over\s+all\s+" + NUM + r"\s+runs\s+each\s+the\s+PF\s+went\s+to\s+the\s+end\s+in\s+" + NUM
                + r"\s+and\s+the\s+UKF\s+in\s+" + NUM, "the fleet's run counts")
     if m:
