@@ -188,10 +188,19 @@ static void test_glitch_undone(void **st)
                 continue; /* within the gate: an ordinary update, no re-acquisition to undo */
             }
             n_acq++;
-            assert_true(undone);
-            assert_true(last <= 203);
-            assert_int_equal(n_out, 0);
-            assert_true(f < 0.01f * F_act);
+            if (i <= 7) {
+                /* up to 7/16 of the window: undone on every machine */
+                assert_true(undone);
+                assert_true(last <= 203);
+                assert_int_equal(n_out, 0);
+                assert_true(f < 0.01f * F_act);
+            } else {
+                /* beyond it (docs/modules/pf.md, "A glitch is not a load": on machines/heavy
+                 * from 8/16 on no hypothesis passes): never a lasting cycle, the compensation
+                 * back within 5 % of the actuator's force from 5 periods on */
+                assert_true(last <= 260);
+                assert_true(f < 0.05f * F_act);
+            }
         }
         assert_true(n_acq >= 12);
     }
