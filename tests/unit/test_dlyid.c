@@ -134,12 +134,14 @@ static void test_dlyid_bounds(void **st)
     assert_int_equal(br_est_cfg_check(&ok), BR_OK);
     br_est_cfg_t c = ok;
     const float dt = ok.model.dt_s;
-#define REFUSED(field, v)                                                                          \
+/* base with field set to v is refused */
+#define REFUSED_FROM(base, field, v)                                                               \
     do {                                                                                           \
-        c = ok;                                                                                    \
+        c = (base);                                                                                \
         c.delay_id.field = (v);                                                                    \
         assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);                                        \
     } while (0)
+#define REFUSED(field, v) REFUSED_FROM(ok, field, v)
     REFUSED(n_cand, 1u);
     REFUSED(n_cand, BR_DLYID_MAX_CAND + 1u);
     REFUSED(step_s, 0.0f);
@@ -170,12 +172,7 @@ static void test_dlyid_bounds(void **st)
     assert_int_equal(br_est_cfg_check(&c), BR_OK);
     {
         const br_est_cfg_t on = c;
-#define REFUSED_ON(field, v)                                                                       \
-    do {                                                                                           \
-        c = on;                                                                                    \
-        c.delay_id.field = (v);                                                                    \
-        assert_int_equal(br_est_cfg_check(&c), BR_E_PARAM);                                        \
-    } while (0)
+#define REFUSED_ON(field, v) REFUSED_FROM(on, field, v)
         REFUSED_ON(steady_memory_s, 0.0f);
         REFUSED_ON(steady_memory_s, NAN);
         REFUSED_ON(steady_memory_s, 1.0e12f * dt); /* its forgetting rounds to 1 */
@@ -184,6 +181,7 @@ static void test_dlyid_bounds(void **st)
         REFUSED_ON(steady_switch_ratio, NAN);
 #undef REFUSED_ON
     }
+#undef REFUSED_FROM
     /* off (0): its memory and ratio are not looked at */
     c = ok;
     c.delay_id.steady_memory_s = NAN;
