@@ -15,7 +15,10 @@ logs made from the model's own force around the reference machine
    more than half its value keeps that parameter out of machine.json (a
    smaller move is reported, the value written);
 4. a bristle damping ratio above physical.ZETA_MAX is held at the machine
-   file's value; a shape parameter on its search bound is flagged.
+   file's value; a shape parameter on its search bound is flagged;
+5. a mass on its floor (model.COEF_LOWER) is held at the machine file's
+   value, in the nominal model and in the extended (fleet axes 23, 34, 96,
+   103, 131: Meff = 1e-9 kg, a model the closed-loop check cannot run).
 """
 import math
 import os
@@ -164,6 +167,26 @@ class RulesTest(unittest.TestCase):
         self.assertIn("sigma1_Nspm", h.held)
         self.assertEqual(h.best.params()["sigma1_Nspm"], P0["sigma1_Nspm"])
 
+
+    def test_5_mass_on_its_floor_is_held(self):
+        # a force that falls with the acceleration (an apparent mass below zero): the free fit's Meff on its floor
+        truth = nominal_truth(Meff_kg=-P0["Meff_kg"])
+        prep = prepared(truth)
+        free = model.fit_nominal(prep)
+        self.assertTrue(identify._on_floor(free, "Meff_kg"))
+        diag = diagnosis(free)
+        out = identify.apply(prep, diag, P0, say=lambda m: None)
+        self.assertIn("Meff_kg", out["nominal_held"])
+        self.assertEqual(diag.nominal.params()["Meff_kg"], P0["Meff_kg"])
+        self.assertIn("Meff_kg", out["held"])
+        self.assertEqual(diag.extended.params()["Meff_kg"], P0["Meff_kg"])
+        # a fit off its floor is left as fitted
+        prep = prepared(nominal_truth())
+        free = model.fit_nominal(prep)
+        diag = diagnosis(free)
+        out = identify.apply(prep, diag, P0, say=lambda m: None)
+        self.assertEqual(out["nominal_held"], {})
+        self.assertIs(diag.nominal, free)
 
 if __name__ == "__main__":
     unittest.main()

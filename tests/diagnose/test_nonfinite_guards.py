@@ -37,6 +37,18 @@ class NonFiniteTest(unittest.TestCase):
                 closedloop.resimulate(self.prep, PARAMS, dict(CTRL, kp_1ps=kp, kv=kv, u_max=umax))
             self.assertIn("diverged", str(cm.exception))
 
+    def test_massless_model_is_a_named_divergence(self):
+        # a fit with the mass on its floor (1e-9 kg) on an encoder's log: the state turns NaN, which once reached
+        # the encoder's floor() as "cannot convert float NaN to integer" (5 fleet axes) instead of this error
+        t, pos = synthetic_log()
+        q = 1e-6
+        posq = np.floor(pos / q) * q
+        prep = signals.Prepared(logreader.Log("synthetic", t, posq, posq, np.ones_like(t), 1e-3, len(t)))
+        self.assertGreater(closedloop.position_quantum(prep.pos), 0.0)
+        with self.assertRaises(closedloop.ControllerError) as cm:
+            closedloop.resimulate(prep, dict(PARAMS, Meff_kg=1e-9, sigma1_Nspm=5e3), dict(CTRL))
+        self.assertIn("diverged at", str(cm.exception))
+
 
 if __name__ == "__main__":
     unittest.main()

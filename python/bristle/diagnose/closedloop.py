@@ -130,6 +130,9 @@ def simulate(params, ctrl, ref, pos0, vel0):
 
     q_prev = qf_prev = quant(x)
     for k in range(n):
+        if not (math.isfinite(x) and math.isfinite(v)):  # diverged: the rest is not simulated
+            q_out[k:] = f_out[k:] = x_out[k:] = math.nan
+            break
         q = quant(x)
         qf = 0.5 * (q + q_prev)
         qdot = (qf - qf_prev) / dt
@@ -182,8 +185,11 @@ def resimulate(prep, params, ctrl):
         q, f, _ = simulate(params, ctrl, prep.ref, prep.pos[0], vel0)
     except (OverflowError, ZeroDivisionError):
         q = f = np.array([np.nan])
-    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(f))):
-        raise ControllerError("the closed-loop re-simulation diverged (non-finite position or force)")
+    bad = ~(np.isfinite(q) & np.isfinite(f))
+    if np.any(bad):
+        at = f" at {int(np.argmax(bad)) * prep.dt:.4g} s" if len(q) == len(prep.ref) else ""
+        raise ControllerError(f"the closed-loop re-simulation diverged{at} (non-finite position or force; model "
+                              f"Meff_kg = {params['Meff_kg']:.4g})")
     w = prep.whole
     v_meas = np.gradient(prep.xf, prep.dt)
     v_sim = np.gradient(prep.lp(q), prep.dt)

@@ -33,6 +33,12 @@ extended model refitted with every parameter held so far:
     free fit put it on its physical bound), or it is poorly determined (the
     log shows a difference but does not fix the value): held either way,
     the report saying which;
+  - the moving mass or the Coulomb level on its floor (model.COEF_LOWER,
+    FLOOR): the log pulls a strictly positive quantity to zero or below (a
+    log whose accelerations are too small to weigh the mass: a fleet axis of
+    1.3 kg moved at under 0.5 m/s^2 fitted Meff = 1e-9 kg, a model the
+    closed-loop re-simulation cannot integrate); the nominal model too,
+    refitted with it held (apply, "nominal_held");
   - sigma1 when the bristle damping ratio is non-physical (physical.py);
   - sigma0 at a zone of ZONE_STEPS position steps when the log cannot tell
     the fit from that model (the log does not show presliding, whatever the
@@ -54,6 +60,8 @@ REL_95 = 0.5     # a parameter is identified when its 95 % interval is within +-
 H = 1e-3         # finite-difference step, in units of the scale
 HOLD_TOL = 0.05  # held-out relerr may rise 5 % (relative) when a parameter is held
 ZONE_STEPS = 0.5  # the presliding zone of the visibility test, in position steps
+# strictly positive parameters: a fit on their floor (model.COEF_LOWER) is no value (the log pulls them to <= 0)
+FLOOR = ("Meff_kg", "Fc_N")
 # the parameters assessed and the machine-file parameter that gives each its scale
 SCALE = {"Meff_kg": "Meff_kg", "sigma2_Nspm": "sigma2_Nspm", "Fc_N": "Fc_N", "Fs_N": "Fs_N", "vs_mps": "vs_mps",
          "sigma0_Npm": "sigma0_Npm", "sigma1_Nspm": "sigma1_Nspm",
@@ -180,6 +188,7 @@ def apply(prep, diag, p0, say=print):
     non-physical, a presliding zone the log does not show, moved by a
     borderline cause beyond its interval) and refits; replaces diag.extended
     and returns the report's "identifiability" block."""
+    nominal_held = _hold_nominal_floor(prep, diag, p0, say)
     fit = diag.extended
     aside, rest = assess(prep, fit, p0)
     te = prep.test
@@ -199,6 +208,7 @@ def apply(prep, diag, p0, say=print):
             why = (f"poorly determined (95 % interval ±{_pct(r)} of the machine file's value; it needs {NEEDS[k]}): "
                    f"the log's fit {h.best.params()[k]:.4g} is no measurement, the machine file's value is taken")
         h.take((k,), trial, why, r)
+    _hold_floor(h)
     _hold_unphysical(h)
     _hold_presliding(h)
     _hold_distorted(h, diag)
@@ -209,7 +219,7 @@ def apply(prep, diag, p0, say=print):
                      f"(docs/diagnose.md, Identifiability); identified when {Z:g} rse <= {REL_95:g}",
            "identified": {k: _r(v) for k, v in rest.items() if k not in h.held and k not in h.kept_out},
            "held": h.held, "kept_out": {k: v for k, v in h.kept_out.items() if k not in h.held},
-           "poorly_determined": {}, "borderline_moves": h.moves}
+           "poorly_determined": {}, "borderline_moves": h.moves, "nominal_held": nominal_held}
     for k, v in h.held.items():
         say(f"identifiability: {k} = {v['value']:.4g}, the machine file's: {v['why']}")
     for k, r in kept:
@@ -221,6 +231,44 @@ def apply(prep, diag, p0, say=print):
     if h.held:
         say(f"identifiability: extended model refitted with {', '.join(h.held)} held: held-out relerr "
             f"{free_rel:.4g} % -> {h.best.relerr(prep, te):.4g} %")
+    return out
+
+
+def _on_floor(fit, name):
+    """The fit's coefficient of a FLOOR parameter is on its lower bound (model.COEF_LOWER)."""
+    coef = model.FIXED_COEF[name][0]
+    return fit.coef.get(coef, 1.0) <= model.COEF_LOWER[coef] * (1.0 + physical.EDGE)
+
+
+def _floor_why(name, fitted):
+    return (f"on its floor ({fitted:.3g}, model.COEF_LOWER): the log pulls it to zero or below, it needs "
+            f"{NEEDS[name]}: taken from the machine file")
+
+
+def _hold_floor(h):
+    """A FLOOR parameter of the extended model on its floor held at the machine file's value."""
+    for k in FLOOR:
+        if k not in h.fixed and _on_floor(h.best, k):
+            h.take((k,), h.trial({k: h.p0[k]}), _floor_why(k, h.best.params()[k]))
+
+
+def _hold_nominal_floor(prep, diag, p0, say):
+    """The nominal model refitted with its FLOOR parameters that are on their
+    floor held at the machine file's values (replaces diag.nominal); returns
+    {param: {"value", "fitted", "relerr_percent", "why"}} of those held."""
+    nom = diag.nominal
+    on = [k for k in FLOOR if _on_floor(nom, k)]
+    if not on:
+        return {}
+    fixed = {"Fc_ref_N": p0["Fc_N"], **{k: p0[k] for k in on}}
+    held = _refit(prep, nom, fixed)
+    prep.fixed = None
+    rel = [nom.relerr(prep, prep.test), held.relerr(prep, prep.test)]
+    out = {k: {"value": p0[k], "fitted": nom.params()[k], "relerr_percent": rel,
+               "why": _floor_why(k, nom.params()[k])} for k in on}
+    for k, v in out.items():
+        say(f"identifiability: nominal {k} = {v['value']:.4g}, the machine file's: {v['why']}")
+    diag.nominal = held
     return out
 
 
