@@ -4,7 +4,9 @@
 "The image's estimator"): the estimator (the first of control.estimator the
 board can run, the rule of hal/stm32/image/br_image_main.c), its loop period, and its
 share of the period from the costs make target-bench measured
-(target/mps2/measured_cost.json).
+(target/mps2/measured_cost.json), and the friction transient over that period
+against the reference machine's (docs/fleet.md, "Goals on the fleet": the
+strongest predictor of an estimator that stops the axis).
 
   image_info.py MACHINE.json BOARD      (BOARD: stm32h7 | stm32g4)
 Exit 1 (with the reason) when the board runs none of the listed estimators."""
@@ -19,6 +21,11 @@ import machine  # noqa: E402
 # what each board's image can run (hal/stm32/image/br_image_main.c) and its core
 BOARDS = {"stm32h7": (("pf", "ukf", "none"), "cortex_m7"), "stm32g4": (("ukf", "none"), "cortex_m4")}
 COST = os.path.join(HERE, "..", "..", "target", "mps2", "measured_cost.json")
+REFERENCE = os.path.join(HERE, "..", "..", "machines", "reference.json")
+# the PF's friction transient d = Fc T^2 / (2 Meff) at this many times the reference machine's (its PF at its
+# own period) or more: the fleet's highest quartile of d for the PF, where most of its runs stopped the axis
+# (docs/fleet.md, "Goals on the fleet"; the UKF's share hardly rises with d there: no warning)
+TRANSIENT_WARN_RATIO = 7.0
 
 
 def image(m, board):
@@ -67,6 +74,20 @@ def substeps_line(m, board, est, s):
     return line
 
 
+def transient_line(m, est):
+    """(line, warn): the friction transient d over estimator est's period against the reference's"""
+    d, _ = machine.transient_m(m, est)
+    d_ref, _ = machine.transient_m(machine.load_or_exit(REFERENCE), est)
+    ratio = d / d_ref
+    line = ("friction transient over the period d = Fc T^2 / (2 Meff) = %.3g m, %.3g times the reference "
+            "machine's %.3g m" % (d, ratio, d_ref))
+    if est != "pf" or ratio < TRANSIENT_WARN_RATIO:
+        return line, False
+    return line + (": warning: on the fleet's axes with d this large the PF stopped the axis in most runs "
+                   "(docs/fleet.md, \"Goals on the fleet\"); d falls with the period squared: a shorter "
+                   "estimator period, or control.estimator none"), True
+
+
 def main():
     if len(sys.argv) != 3 or sys.argv[2] not in BOARDS:
         sys.exit("usage: image_info.py MACHINE.json stm32h7|stm32g4")
@@ -80,6 +101,7 @@ def main():
     print("  estimator: %s at %g ms; %s" % (est, period * 1e3, cost))
     if est in ("pf", "ukf"):
         print("  " + substeps_line(m, sys.argv[2], est, s))
+        print("  " + transient_line(m, est)[0])
     return 0
 
 

@@ -3,7 +3,9 @@
 "The image's estimator"): a machine file that lists only pf is refused for the
 STM32G474 with the reason, and one that puts ukf first builds an STM32H743
 image that runs the UKF at control.period_s (its PF state, br_image_pf in AXI
-SRAM, is not linked). Cross builds into WORK, never the source tree.
+SRAM, is not linked); make firmware's lines name the friction transient over
+the estimator's period and warn where the fleet's PF mostly stopped. Cross
+builds into WORK, never the source tree.
 
 Usage: test_image_estimator.py --src REPO --work DIR"""
 import argparse
@@ -63,6 +65,21 @@ def main():
                        capture_output=True, text=True)
     if r.returncode == 0 or "the stm32g4 image runs ukf, none" not in r.stderr:
         fails.append("image_info.py on the PF-only file for the G474: %r %r" % (r.stdout, r.stderr))
+    # the friction transient: the reference's d without a warning; a table 50 times lighter (d 50 times the
+    # reference's) warned about
+    r = subprocess.run([sys.executable, info, os.path.join(a.src, "machines", "reference.json"), "stm32h7"],
+                       capture_output=True, text=True)
+    if r.returncode != 0 or "1 times the reference machine's" not in r.stdout or "warning" in r.stdout:
+        fails.append("image_info.py on the reference: %r %r" % (r.stdout, r.stderr))
+    mech = ref["mechanics"]
+    light = dict(ref, name="light", mechanics=dict(mech, table_mass_kg=mech["table_mass_kg"] / 50.0,
+                                                    inertia_kgm2=mech["inertia_kgm2"] / 50.0))
+    path = os.path.join(a.work, "light.json")
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(light, f, indent=1)
+    r = subprocess.run([sys.executable, info, path, "stm32h7"], capture_output=True, text=True)
+    if r.returncode != 0 or "50 times the reference machine's" not in r.stdout or "warning: " not in r.stdout:
+        fails.append("image_info.py on a 50 times lighter table: %r %r" % (r.stdout, r.stderr))
     for f_ in fails:
         print("FAIL: " + f_, file=sys.stderr)
     print("image estimator: %d failures" % len(fails))
