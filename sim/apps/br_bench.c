@@ -530,7 +530,8 @@ static int plant_cfg(const char *name, br_circle_ctrl_t ctrl, br_circle_cfg_t *c
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
-            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N] [--plant thesis|realistic|hardware_like] [--thesis-gate]\n" BR_ARGS_COMMON_USAGE
+            "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N] [--plant thesis|realistic|hardware_like] [--thesis-gate]\n"
+            "       [--plant-delay S]\n" BR_ARGS_COMMON_USAGE
             "  --json FILE         the figures as JSON (make bench: out/bench/bench.json)\n"
             "  --record FILE       the replayed stream's per-step record (CSV)\n"
             "  --reps N            repetitions of each PF timing, 1 .. 256 (default 7)\n"
@@ -539,7 +540,9 @@ static int usage(const char *argv0, FILE *to)
             "                      default), realistic (the demo's realistic plant, docs/demo.md) or\n"
             "                      hardware_like (the demo's Maxwell-slip plant, docs/demo.md)\n"
             "  --thesis-gate       the filters' outlier gate without the machine's transient term (eq. G1):\n"
-            "                      the realistic plant's outliers then re-anchor the PF (for pf_numpy.py --check)\n",
+            "                      the realistic plant's outliers then re-anchor the PF (for pf_numpy.py --check)\n"
+            "  --plant-delay S     an actuator dead time in the recorded loop's plant, 0 .. 0.1 s (default 0):\n"
+            "                      the delay identification finds it (for pf_numpy.py --check)\n",
             argv0, argv0);
     return 2;
 }
@@ -548,6 +551,7 @@ int main(int argc, char **argv)
 {
     const char *json_path = NULL, *rec_path = NULL;
     int reps = 7, ukf_reps = 21, thesis_gate = 0;
+    double plant_delay_s = 0.0;
     const char *plant = "thesis";
     static const struct option opts[] = {{"json", required_argument, NULL, 'j'},
                                          {"record", required_argument, NULL, 'r'},
@@ -555,6 +559,7 @@ int main(int argc, char **argv)
                                          {"ukf-reps", required_argument, NULL, 'u'},
                                          {"plant", required_argument, NULL, 'p'},
                                          {"thesis-gate", no_argument, NULL, 'g'},
+                                         {"plant-delay", required_argument, NULL, 'd'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -581,6 +586,7 @@ int main(int argc, char **argv)
             }
             break;
         case 'g': thesis_gate = 1; break;
+        case 'd': bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_PLANT_DELAY_MAX_S, &plant_delay_s); break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return usage(argv[0], stderr);
@@ -614,6 +620,8 @@ int main(int argc, char **argv)
     br_circle_cfg_t cpf, cukf;
     (void)plant_cfg(plant, BR_CTRL_HINF_PF, &cpf);
     (void)plant_cfg(plant, BR_CTRL_HINF_UKF, &cukf);
+    cpf.plant.delay_s = plant_delay_s;
+    cukf.plant.delay_s = plant_delay_s;
     if (thesis_gate) {
         cpf.pf.est.outlier_transient_rad = 0.0f;
         cukf.ukf.est.outlier_transient_rad = 0.0f;
@@ -667,8 +675,8 @@ int main(int argc, char **argv)
         if (demo_cpu_s(i, &demo_s[i]) != 0) goto done;
     }
 
-    printf("PF recording: x axis of the thesis circle on the %s plant, H-inf + PF in closed loop, dt %.1f ms, %ld steps\n",
-           plant, cpf.dt_s * 1e3, rpf.n);
+    printf("PF recording: x axis of the thesis circle on the %s plant, H-inf + PF in closed loop, dt %.1f ms, %ld steps"
+           "%s\n", plant, cpf.dt_s * 1e3, rpf.n, plant_delay_s > 0.0 ? ", an actuator delay in the plant" : "");
     printf("PF  m = %u: %.1f ns per particle-step (median of %d replays of %ld steps; min %.1f, max %.1f)\n", m, pf_med,
            reps, tpf.steps_timed, pf_min, pf_max);
     printf("    in thread CPU time: %.1f ns per particle-step (min %.1f, max %.1f)\n", pf_cmed, pf_cmin, pf_cmax);

@@ -93,6 +93,7 @@ class DelayBank:
         self.A = np.array([[1.0, T, self.a02], [0.0, 1.0, self.a12], [0.0, 0.0, 1.0]], dtype=F)
         self.cur = n
         self.n_switch = 0
+        self.n_switch_steady = 0  # of them, in the steady phase
         self.primed = False
 
     def keep(self):
@@ -198,4 +199,5 @@ class DelayBank:
             return 0
         self.cur = best
         self.n_switch += 1
+        self.n_switch_steady += int(steady)
         return 1

@@ -342,7 +342,8 @@ def replay(cfg, noise, rec, n_steps=None):
     """A fresh filter over the recording; returns (F_hat per step, wall ns of each
     step k >= 1, thread CPU ns of steps 1.. together, statuses, {"adapt_active_steps":
     steps after which cfg.adapt's noise factor is above 1, "reanchor_steps": steps
-    that re-anchored the cloud, "delay_switches": the delay identification's switches})."""
+    that re-anchored the cloud, "delay_switches": the delay identification's switches,
+    "delay_switches_steady": those of its steady phase})."""
     pf = NumpyPf(cfg, noise)
     counts = [int(c) for c in rec["counts"]]
     frac = rec["frac"].astype(F)
@@ -371,7 +372,8 @@ def replay(cfg, noise, rec, n_steps=None):
     cpu = time.thread_time_ns() - c0
     return fhat, ns, cpu, st, {"adapt_active_steps": int(np.count_nonzero(adapt)),
                                "reanchor_steps": int(np.count_nonzero(anchor)),
-                               "delay_switches": pf.bank.n_switch}
+                               "delay_switches": pf.bank.n_switch,
+                               "delay_switches_steady": pf.bank.n_switch_steady}
 
 
 def rms(a):
@@ -502,6 +504,7 @@ def main():
         "adapt_active_steps": paths["adapt_active_steps"],
         "reanchor_steps": paths["reanchor_steps"],
         "delay_switches": paths["delay_switches"],
+        "delay_switches_steady": paths["delay_switches_steady"],
         "error_steps": int(np.count_nonzero((st != BR_OK) & (st != BR_W_OUTLIER))),
     }
     print("PF  numpy (float32, vectorised over particles, numpy %s): %.1f ns per particle-step "
@@ -516,7 +519,8 @@ def main():
     print("    F_hat identical to the C filter's (bit for bit) at %d of %d steps; numpy - C: RMS %.2e N, max %.2e N"
           % (same, n, res["fhat_vs_c_rms_N"], res["fhat_vs_c_max_N"]))
     print("    cfg.adapt's noise factor above 1 after %d of %d steps; %d re-anchoring steps; %d switches of the "
-          "identified delay" % (paths["adapt_active_steps"], n, paths["reanchor_steps"], paths["delay_switches"]))
+          "identified delay (%d in its steady phase)" % (paths["adapt_active_steps"], n, paths["reanchor_steps"],
+                                                         paths["delay_switches"], paths["delay_switches_steady"]))
     if same != n:
         print("pf_numpy: %s: the numpy PF is not bit-identical to the C one%s"
               % (("error", "") if a.check else ("warning", " (timing still valid if it tracks)")), file=sys.stderr)

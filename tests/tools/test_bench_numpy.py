@@ -4,9 +4,10 @@ also where the thesis circle never takes it: on the demo's realistic plant
 cfg.adapt's noise factor rises above 1 and the cloud is re-anchored after
 consecutive outliers (with the thesis gate, --thesis-gate; with the machine's
 transient term no outlier comes). br_bench records that closed loop (--plant realistic)
-both ways, and the hardware-like plant's (--plant hardware_like), where the
-PF's delay identification switches (docs/modules/dlyid.md: its setting does on
-plants without a delay) and the filter predicts with the delayed torque;
+both ways, and the hardware-like plant's with a 2.7 ms actuator delay
+(--plant hardware_like --plant-delay 0.0027), where the PF's delay
+identification switches, also in its steady phase (docs/modules/dlyid.md),
+and the filter predicts with the delayed torque;
 pf_numpy.py --check replays each and exits 1 unless every step's F_hat equals
 the C filter's. The test also requires that the recording reaches both paths
 (else it would prove nothing); --plant's refusals are in test_tools.py.
@@ -28,16 +29,27 @@ def run(cmd):
     return r.returncode, r.stdout + r.stderr
 
 
+def steady_phase(rec):
+    """the recording's PF has the delay identification's steady phase (its "# pf_cfg " header)"""
+    with open(rec, encoding="utf-8") as f:
+        for line in f:
+            if line.startswith("# pf_cfg "):
+                return json.loads(line[len("# pf_cfg "):])["delay_id"]["steady_after_s"] > 0.0
+    sys.exit("%s: no # pf_cfg line" % rec)
+
+
 def main():
     bench, work = tool_check.start("bench")
     fails = []
     # the machine's gate (its transient term, eq. G1, in the threshold and the NIS cap), then the
     # thesis gate, with which the realistic plant's encoder noise re-anchors the cloud
-    # the hardware-like plant (Maxwell-slip friction): the delay identification switches there
+    # the hardware-like plant (Maxwell-slip friction) with a 2.7 ms actuator delay: the delay identification
+    # switches there, also in its steady phase where the machine has one
     for tag, plant, extra, need in (
             ("term", "realistic", [], ("adapt_active_steps",)),
             ("thesis_gate", "realistic", ["--thesis-gate"], ("adapt_active_steps", "reanchor_steps")),
-            ("hardware_like", "hardware_like", [], ("adapt_active_steps", "delay_switches"))):
+            ("hardware_like", "hardware_like", ["--plant-delay", "0.0027"],
+             ("adapt_active_steps", "delay_switches", "delay_switches_steady"))):
         rec = os.path.join(work, "pf_input_%s.csv" % tag)
         rc, out = run([bench, "--plant", plant, "--reps", "1", "--ukf-reps", "1", "--record", rec] + extra)
         if rc != 0:
@@ -59,6 +71,9 @@ def main():
             fails.append("%s: the recording never re-anchors the cloud: that path is not compared" % tag)
         if "delay_switches" in need and r["delay_switches"] == 0:
             fails.append("%s: the delay identification never switches: the delayed torque is not compared" % tag)
+        if "delay_switches_steady" in need and steady_phase(rec) and r["delay_switches_steady"] == 0:
+            fails.append("%s: no switch in the delay identification's steady phase: its memory and ratio are not "
+                         "compared" % tag)
     return tool_check.finish(fails)
 
 if __name__ == "__main__":
