@@ -40,6 +40,7 @@
 #include "bristle/br_machine_cfg.h"
 #include "bristle/br_app.h"
 #include "tool/br_args.h"
+#include "tool/br_tool_limits.h"
 #include "tool/br_outfile.h"
 
 #define TOOL "br_bench"
@@ -430,10 +431,10 @@ static void json_pf_cfg(FILE *f, const br_pf_cfg_t *c)
     fprintf(f,
             ", \"delay_s\": %.9g, \"delay_id\": {\"n_cand\": %u, \"step_s\": %.9g, \"q_force_N2ps\": %.9g, "
             "\"memory_s\": %.9g, \"warmup_s\": %.9g, \"switch_ratio\": %.9g, \"steady_after_s\": %.9g, "
-            "\"steady_memory_s\": %.9g, \"steady_switch_ratio\": %.9g}}",
+            "\"steady_memory_s\": %.9g, \"steady_switch_ratio\": %.9g}, \"load\": {\"q_N2\": %.9g, \"max_N\": %.9g}}",
             (double)m->causes.delay_s, (unsigned)d->n_cand, (double)d->step_s, (double)d->q_force_N2ps,
             (double)d->memory_s, (double)d->warmup_s, (double)d->switch_ratio, (double)d->steady_after_s,
-            (double)d->steady_memory_s, (double)d->steady_switch_ratio);
+            (double)d->steady_memory_s, (double)d->steady_switch_ratio, (double)c->load.q_N2, (double)c->load.max_N);
 }
 
 /* the recording into f (a br_outfile's temporary file, docs/tools.md) */
@@ -531,7 +532,7 @@ static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
             "usage: %s [--json FILE] [--record FILE] [--reps N] [--ukf-reps N] [--plant thesis|realistic|hardware_like] [--thesis-gate]\n"
-            "       [--plant-delay S]\n" BR_ARGS_COMMON_USAGE
+            "       [--plant-delay S] [--pf-load Q_N2_PER_S] [--pf-gate SIGMA]\n" BR_ARGS_COMMON_USAGE
             "  --json FILE         the figures as JSON (make bench: out/bench/bench.json)\n"
             "  --record FILE       the replayed stream's per-step record (CSV)\n"
             "  --reps N            repetitions of each PF timing, 1 .. 256 (default 7)\n"
@@ -542,7 +543,11 @@ static int usage(const char *argv0, FILE *to)
             "  --thesis-gate       the filters' outlier gate without the machine's transient term (eq. G1):\n"
             "                      the realistic plant's outliers then re-anchor the PF (for pf_numpy.py --check)\n"
             "  --plant-delay S     an actuator dead time in the recorded loop's plant, 0 .. 0.1 s (default 0):\n"
-            "                      the delay identification finds it (for pf_numpy.py --check)\n",
+            "                      the delay identification finds it (for pf_numpy.py --check)\n"
+            "  --pf-load Q         the recorded PF with its shared external force, random walk Q N^2/s\n"
+            "                      (0 .. 1e9, 0: the machine's; docs/modules/pf.md; for pf_numpy.py --check)\n"
+            "  --pf-gate SIGMA     the recorded PF's outlier gate, sigmas (1 .. 1000; a narrow one gates steps:\n"
+            "                      with --pf-load they are re-acquired as a load and undone, for pf_numpy.py --check)\n",
             argv0, argv0);
     return 2;
 }
@@ -551,7 +556,7 @@ int main(int argc, char **argv)
 {
     const char *json_path = NULL, *rec_path = NULL;
     int reps = 7, ukf_reps = 21, thesis_gate = 0;
-    double plant_delay_s = 0.0;
+    double plant_delay_s = 0.0, pf_load = 0.0, pf_gate = 0.0;
     const char *plant = "thesis";
     static const struct option opts[] = {{"json", required_argument, NULL, 'j'},
                                          {"record", required_argument, NULL, 'r'},
@@ -560,6 +565,8 @@ int main(int argc, char **argv)
                                          {"plant", required_argument, NULL, 'p'},
                                          {"thesis-gate", no_argument, NULL, 'g'},
                                          {"plant-delay", required_argument, NULL, 'd'},
+                                         {"pf-load", required_argument, NULL, 'L'},
+                                         {"pf-gate", required_argument, NULL, 'G'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -587,6 +594,8 @@ int main(int argc, char **argv)
             break;
         case 'g': thesis_gate = 1; break;
         case 'd': bad = br_arg_double(TOOL, p.opt, v, 0.0, BR_PLANT_DELAY_MAX_S, &plant_delay_s); break;
+        case 'L': bad = br_arg_double(TOOL, p.opt, v, 0.0, 1.0e9, &pf_load); break;
+        case 'G': bad = br_arg_double(TOOL, p.opt, v, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &pf_gate); break;
         default: bad = 1; break; /* BR_ARGS_BAD: reported */
         }
         if (bad) return usage(argv[0], stderr);
@@ -621,6 +630,8 @@ int main(int argc, char **argv)
     (void)plant_cfg(plant, BR_CTRL_HINF_PF, &cpf);
     (void)plant_cfg(plant, BR_CTRL_HINF_UKF, &cukf);
     cpf.plant.delay_s = plant_delay_s;
+    br_circle_use_pf_load(&cpf, pf_load);
+    br_circle_use_pf_gate(&cpf, pf_gate);
     cukf.plant.delay_s = plant_delay_s;
     if (thesis_gate) {
         cpf.pf.est.outlier_transient_rad = 0.0f;

@@ -56,12 +56,14 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "firmware", "design"))
 import gen_noise  # noqa: E402
 from dlyid_numpy import DelayBank, DelayHistory  # noqa: E402
+from pf_load_numpy import LoadNumpy  # noqa: E402
 
 F = np.float32
 # constants of the C code
 RK4_AH_MAX = F(2.0)          # BR_MODEL_RK4_AH_MAX, br_model.h
 BOUNDED_PASSES = 3           # BR_MODEL_BOUNDED_PASSES, br_model.c
 W_ONE = F(1 << 16)           # 2^BR_PF_W_BITS, br_pf.h
+LOAD_NOTCH_R = F(0.2)        # BR_PF_LOAD_NOTCH_R, br_pf_load.h
 BR_OK, BR_E_NUMERIC, BR_W_OUTLIER = 0, -4, 1
 
 
@@ -147,6 +149,10 @@ class NumpyPf:
         self.bank = DelayBank(cfg)
         self.hist = DelayHistory(cfg["delay_s"], cfg["dt_s"], F(cfg["delay_s"]) > F(0.0) or self.bank.n > 0,
                                  self.bank.keep())
+        # cfg.load, the shared external force F_d (br_pf_load.c; absent or 0, 0: off)
+        ld = cfg.get("load", {})
+        self.load = LoadNumpy(F(ld.get("q_N2", 0.0)), F(ld.get("max_N", 0.0)), self.h, self.L, self.inv_jeff,
+                              LOAD_NOTCH_R, seqsum)
         self.noise = noise
         self.mask = len(noise) - 1
         self.skip = int(cfg["noise_skip"])
@@ -238,11 +244,10 @@ class NumpyPf:
         self.ess = F(self.m)
         return BR_OK
 
-    def _adapt(self, d, n_valid):
+    def _adapt(self, s1, s2, n_valid):
         """adapt_update: the NIS of the predicted cloud from the sums of d_j =
         theta_j - y (0 for an invalid particle) and d_j^2 in particle order"""
         n = F(n_valid)
-        s1, s2 = seqsum(d), seqsum(d * d)
         mean = s1 / n
         var = s2 / n - mean * mean
         nis = (mean * mean) / ((var if var > F(0.0) else F(0.0)) + self.r_gate)
@@ -265,6 +270,10 @@ class NumpyPf:
         shift = F(d) * rpc
         y_rel = frac * rpc
         x = self.x
+        ld = self.load
+        # cfg.load: P over the period, F_d at its start; the particles predicted with u - L F_d
+        ld.tick()
+        u = ld.torque(u)
         # 1. predict
         th, om, z = self._model_step_kp(x[0], x[1], x[2], x[3], u)
         n = self._noise()
@@ -286,9 +295,14 @@ class NumpyPf:
             l = np.where(valid, l, F(-np.inf))
         if n_valid == 0:
             return BR_E_NUMERIC
-        if self.nis_ref > F(0.0):
-            self._adapt(e * valid.astype(F), n_valid)
+        d = e * valid.astype(F)
+        sums = [seqsum(d), seqsum(d * d)]
         lmax = l.max()
+        if ld.on:
+            # cfg.load: F_d's update on the cloud's innovation, the cloud moved by its change
+            lmax, xp, fnl, l, valid = ld.update(self, y_rel, lmax, sums, n_valid, xp, fnl, l, valid)
+        if self.nis_ref > F(0.0):
+            self._adapt(sums[0], sums[1], n_valid)
         outlier = lmax < self.outlier_l
         # 3. weights, quantised
         w = valid.astype(F) if outlier else exp_neg(l - lmax)
@@ -304,6 +318,7 @@ class NumpyPf:
         self.n_outliers = self.n_outliers + 1 if outlier else 0
         self.reanchored = self.n_outliers >= self.reanchor_after
         if self.reanchored:
+            ld.alt = False  # a re-acquisition of this step is not undone on a re-anchored cloud
             omega_meas = (shift + (frac - self.prev_frac) * rpc) / self.h
             d_th, d_om = y_rel - s[0] * self.inv_m, omega_meas - s[1] * self.inv_m
             x[0] += d_th
@@ -316,9 +331,14 @@ class NumpyPf:
         self.origin = counts
         self.prev_frac = frac
         self.mean = s * self.inv_m
-        self.F_hat = sf * self.inv_m
+        self.F_hat = ld.comp(sf * self.inv_m)
         self.ess = sw * sw / sw2
         return BR_W_OUTLIER if outlier else BR_OK
+
+
+def pf_cfg_load_on(cfg):
+    ld = cfg.get("load", {})
+    return ld.get("q_N2", 0.0) != 0.0 or ld.get("max_N", 0.0) != 0.0
 
 
 def load_recording(path):
@@ -343,7 +363,8 @@ def replay(cfg, noise, rec, n_steps=None):
     step k >= 1, thread CPU ns of steps 1.. together, statuses, {"adapt_active_steps":
     steps after which cfg.adapt's noise factor is above 1, "reanchor_steps": steps
     that re-anchored the cloud, "delay_switches": the delay identification's switches,
-    "delay_switches_steady": those of its steady phase})."""
+    "delay_switches_steady": those of its steady phase, "load_acquisitions" and
+    "load_undos": cfg.load's re-acquisitions and those undone})."""
     pf = NumpyPf(cfg, noise)
     counts = [int(c) for c in rec["counts"]]
     frac = rec["frac"].astype(F)
@@ -373,7 +394,8 @@ def replay(cfg, noise, rec, n_steps=None):
     return fhat, ns, cpu, st, {"adapt_active_steps": int(np.count_nonzero(adapt)),
                                "reanchor_steps": int(np.count_nonzero(anchor)),
                                "delay_switches": pf.bank.n_switch,
-                               "delay_switches_steady": pf.bank.n_switch_steady}
+                               "delay_switches_steady": pf.bank.n_switch_steady,
+                               "load_acquisitions": pf.load.n_acq, "load_undos": pf.load.n_undo}
 
 
 def rms(a):
@@ -505,6 +527,8 @@ def main():
         "reanchor_steps": paths["reanchor_steps"],
         "delay_switches": paths["delay_switches"],
         "delay_switches_steady": paths["delay_switches_steady"],
+        "load_acquisitions": paths["load_acquisitions"],
+        "load_undos": paths["load_undos"],
         "error_steps": int(np.count_nonzero((st != BR_OK) & (st != BR_W_OUTLIER))),
     }
     print("PF  numpy (float32, vectorised over particles, numpy %s): %.1f ns per particle-step "
@@ -521,6 +545,9 @@ def main():
     print("    cfg.adapt's noise factor above 1 after %d of %d steps; %d re-anchoring steps; %d switches of the "
           "identified delay (%d in its steady phase)" % (paths["adapt_active_steps"], n, paths["reanchor_steps"],
                                                          paths["delay_switches"], paths["delay_switches_steady"]))
+    if pf_cfg_load_on(cfg):
+        print("    cfg.load: %d re-acquisitions as a load change, %d of them undone"
+              % (paths["load_acquisitions"], paths["load_undos"]))
     if same != n:
         print("pf_numpy: %s: the numpy PF is not bit-identical to the C one%s"
               % (("error", "") if a.check else ("warning", " (timing still valid if it tracks)")), file=sys.stderr)

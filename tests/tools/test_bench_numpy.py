@@ -7,7 +7,10 @@ transient term no outlier comes). br_bench records that closed loop (--plant rea
 both ways, and the hardware-like plant's with a 2.7 ms actuator delay
 (--plant hardware_like --plant-delay 0.0027), where the PF's delay
 identification switches, also in its steady phase (docs/modules/dlyid.md),
-and the filter predicts with the delayed torque;
+and the filter predicts with the delayed torque; and the PF with its shared
+external force (cfg.load, --pf-load 1e4) behind a 1-sigma thesis gate on the
+hardware-like plant, where gated steps are re-acquired as load changes
+(the undo of a glitch is not reached by these recordings);
 pf_numpy.py --check replays each and exits 1 unless every step's F_hat equals
 the C filter's. The test also requires that the recording reaches both paths
 (else it would prove nothing); --plant's refusals are in test_tools.py.
@@ -49,7 +52,10 @@ def main():
             ("term", "realistic", [], ("adapt_active_steps",)),
             ("thesis_gate", "realistic", ["--thesis-gate"], ("adapt_active_steps", "reanchor_steps")),
             ("hardware_like", "hardware_like", ["--plant-delay", "0.0027"],
-             ("adapt_active_steps", "delay_switches", "delay_switches_steady"))):
+             ("adapt_active_steps", "delay_switches", "delay_switches_steady")),
+            # the PF's shared external force (cfg.load) with a 1-sigma thesis gate: gated steps re-acquired
+            ("load", "hardware_like", ["--thesis-gate", "--pf-load", "1e4", "--pf-gate", "1"],
+             ("load_acquisitions",))):
         rec = os.path.join(work, "pf_input_%s.csv" % tag)
         rc, out = run([bench, "--plant", plant, "--reps", "1", "--ukf-reps", "1", "--record", rec] + extra)
         if rc != 0:
@@ -71,6 +77,8 @@ def main():
             fails.append("%s: the recording never re-anchors the cloud: that path is not compared" % tag)
         if "delay_switches" in need and r["delay_switches"] == 0:
             fails.append("%s: the delay identification never switches: the delayed torque is not compared" % tag)
+        if "load_acquisitions" in need and r["load_acquisitions"] == 0:
+            fails.append("%s: cfg.load never re-acquires a gated step: its update's gated path is not compared" % tag)
         if "delay_switches_steady" in need and steady_phase(rec) and r["delay_switches_steady"] == 0:
             fails.append("%s: no switch in the delay identification's steady phase: its memory and ratio are not "
                          "compared" % tag)

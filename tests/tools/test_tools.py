@@ -498,11 +498,14 @@ class ToolsTest(unittest.TestCase):
             r = run("br_bench", "--plant", bad)
             self.assert_refused(r, 2, "--plant")
             self.assertNotIn("PF recording", r.stdout)
-        # --plant-delay: 0 .. the plant's BR_PLANT_DELAY_MAX_S (0.1 s), a number
-        for bad in ("-0.001", "0.2", "nan", "1ms"):
-            r = run("br_bench", "--plant-delay", bad)
-            self.assert_refused(r, 2, "--plant-delay")
-            self.assertNotIn("PF recording", r.stdout)
+        # --plant-delay: 0 .. the plant's BR_PLANT_DELAY_MAX_S (0.1 s); --pf-load 0 .. 1e9 N^2/s; --pf-gate
+        # 1 .. 1000 sigmas (br_tool_limits.h)
+        for opt, bads in (("--plant-delay", ("-0.001", "0.2", "nan", "1ms")), ("--pf-load", ("-1", "2e9", "inf")),
+                          ("--pf-gate", ("0.5", "1001", "nan"))):
+            for bad in bads:
+                r = run("br_bench", opt, bad)
+                self.assert_refused(r, 2, opt)
+                self.assertNotIn("PF recording", r.stdout)
 
     def test_tune_outputs_checked_before_the_tuning(self):
         header, log = self.existing("tuned.h"), self.existing("tune.csv")
