@@ -293,7 +293,9 @@ def main():
 
     # the delay identification's steady phase (estimator.<est>.delay_id.steady, docs/modules/dlyid.md):
     # absent = 0 (one phase); present: its three values in the header; out of range: the field named
-    rc, hdr = est_header(work, "dly_one", good)
+    ones = copy.deepcopy(good)
+    ones["estimator"]["pf"]["delay_id"].pop("steady", None)
+    rc, hdr = est_header(work, "dly_one", ones)
     check(rc == 0 and "#define BR_EST_PF_DELAY_ID_STEADY_AFTER_S_F (0.000000000e+00f)" in hdr,
           "no estimator.pf.delay_id.steady: the bank's one phase (0 in the header)")
     withs = copy.deepcopy(good)

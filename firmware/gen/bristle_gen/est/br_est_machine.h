@@ -79,14 +79,14 @@
 #define BR_EST_PF_DELAY_ID_SWITCH_RATIO (0.6)
 #define BR_EST_PF_DELAY_ID_SWITCH_RATIO_F (6.000000238e-01f)
 /* the steady phase from this time on (0: off) */
-#define BR_EST_PF_DELAY_ID_STEADY_AFTER_S (0.0)
-#define BR_EST_PF_DELAY_ID_STEADY_AFTER_S_F (0.000000000e+00f)
+#define BR_EST_PF_DELAY_ID_STEADY_AFTER_S (0.3)
+#define BR_EST_PF_DELAY_ID_STEADY_AFTER_S_F (3.000000119e-01f)
 /* its forgetting time constant */
-#define BR_EST_PF_DELAY_ID_STEADY_MEMORY_S (0.0)
-#define BR_EST_PF_DELAY_ID_STEADY_MEMORY_S_F (0.000000000e+00f)
+#define BR_EST_PF_DELAY_ID_STEADY_MEMORY_S (0.02)
+#define BR_EST_PF_DELAY_ID_STEADY_MEMORY_S_F (1.999999955e-02f)
 /* its switch ratio */
-#define BR_EST_PF_DELAY_ID_STEADY_SWITCH_RATIO (0.0)
-#define BR_EST_PF_DELAY_ID_STEADY_SWITCH_RATIO_F (0.000000000e+00f)
+#define BR_EST_PF_DELAY_ID_STEADY_SWITCH_RATIO (0.5)
+#define BR_EST_PF_DELAY_ID_STEADY_SWITCH_RATIO_F (5.000000000e-01f)
 /* extra noise-table advance per step */
 #define BR_EST_PF_NOISE_SKIP 1u
 /* innovation-driven noise of omega, z and g_p (0: off) */
