@@ -32,7 +32,7 @@ def clampf(v, lo, hi):
 class LoadNumpy:
     def __init__(self, q, max_N, h, L, inv_jeff, notch_r, seqsum):
         self.seqsum = seqsum  # pf_numpy's float32 sum, left to right like the C loops
-        self.on = bool(q != F(0.0) or max_N != F(0.0))
+        self.on = bool(max_N > F(0.0))  # br_pf_load_on
         self.q, self.max_N, self.h, self.L, self.r = q, max_N, h, L, notch_r
         # g = L h^2 / (2 J_eff): theta's change over one period under one newton on the load side
         self.g = ((F(0.5) * L) * h) * h * inv_jeff
