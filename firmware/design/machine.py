@@ -194,6 +194,19 @@ def _process_noise():
     }
 
 
+def _load_fields(what):
+    """An external-force state's random walk (estimator.<est>.load): one of q_N2_per_s (N^2/s) or
+    q_Fact2_per_s (in the actuator's force squared, per second: the form that holds on another axis);
+    its initial variance and bound are the actuator's force (control.torque_limit_Nm / L), squared and
+    itself (load_q_N2_per_s)"""
+    return {
+        "q_N2_per_s": Optional(Num(0.0, 1.0e9, "random walk of %s, variance per second (N^2/s)" % what,
+                                   lo_open=True)),
+        "q_Fact2_per_s": Optional(Num(0.0, 100.0, "random walk of %s, variance per second in the actuator's "
+                                      "force squared (control.torque_limit_Nm / L)^2" % what, lo_open=True)),
+    }
+
+
 def _gates():
     return {
         "gp0_Fs": Num(0.0, 100.0, "initial g_p (the friction level the filter starts from), in Fs", lo_open=True),
@@ -326,11 +339,7 @@ SCHEMA = {
             }),
             # the shared external force (docs/modules/pf.md, "External force"); absent = off,
             # the thesis filter
-            "load": Optional({
-                "q_N2_per_s": Num(0.0, 1.0e9, "random walk of the shared external force F_d, variance per "
-                                  "second (N^2/s); its initial variance and bound are the actuator's force "
-                                  "(control.torque_limit_Nm / L), squared and itself", lo_open=True),
-            }),
+            "load": Optional(_load_fields("the shared external force F_d")),
         }, **_gates()),
         "ukf": dict({
             "process_noise": _process_noise(),
@@ -346,11 +355,7 @@ SCHEMA = {
             "kappa": Num(-3.0, 100.0, "secondary scaling (n + kappa > 0, n = 4, 5 with load)", lo_open=True),
             # the external-force state (docs/modules/ukf.md, "External force"); absent = off,
             # the thesis's four states
-            "load": Optional({
-                "q_N2_per_s": Num(0.0, 1.0e9, "random walk of the external force F_d, variance per second "
-                                  "(N^2/s); its initial variance and bound are the actuator's force "
-                                  "(control.torque_limit_Nm / L), squared and itself", lo_open=True),
-            }),
+            "load": Optional(_load_fields("the external force F_d")),
         }, **_gates()),
     },
     "limits": {
@@ -826,17 +831,40 @@ def est_per_step(m, est):
     return out
 
 
+def load_q_N2_per_s(m, est):
+    """Estimator est's external-force random walk in N^2/s from its machine file's
+    estimator.<est>.load: q_N2_per_s, or q_Fact2_per_s times the actuator's force squared;
+    None when the block is absent; ValueError unless exactly one of the two is given."""
+    ld = m["estimator"][est].get("load")
+    if ld is None:
+        return None
+    given = [k for k in ("q_N2_per_s", "q_Fact2_per_s") if k in ld]
+    if len(given) != 1:
+        raise ValueError("needs exactly one of q_N2_per_s (N^2/s) and q_Fact2_per_s (the actuator's force "
+                         "squared, per second)")
+    if given[0] == "q_N2_per_s":
+        return ld["q_N2_per_s"]
+    F_act = actuator_force_N(m)
+    return ld["q_Fact2_per_s"] * F_act * F_act
+
+
+def load_field(m, est):
+    """the field estimator.<est>.load's random walk is given by (for messages)"""
+    ld = m["estimator"][est].get("load") or {}
+    return "estimator.%s.load.%s" % (est, "q_Fact2_per_s" if "q_Fact2_per_s" in ld else "q_N2_per_s")
+
+
 def ukf_load(m):
     """The UKF's external-force state as the firmware takes it (br_ukf_load_t,
-    docs/modules/ukf.md, "External force"): {"q_N2" per step (q_N2_per_s times
+    docs/modules/ukf.md, "External force"): {"q_N2" per step (load_q_N2_per_s times
     control.period_s), "p0_N2" and "max_N" from the actuator's force
     control.torque_limit_Nm / L, squared and itself}; all 0 (off) when
     estimator.ukf.load is absent."""
-    ld = m["estimator"]["ukf"].get("load")
-    if not ld:
+    q = load_q_N2_per_s(m, "ukf")
+    if q is None:
         return {"q_N2": 0.0, "p0_N2": 0.0, "max_N": 0.0}
     F_act = actuator_force_N(m)
-    return {"q_N2": ld["q_N2_per_s"] * m["control"]["period_s"], "p0_N2": F_act * F_act, "max_N": F_act}
+    return {"q_N2": q * m["control"]["period_s"], "p0_N2": F_act * F_act, "max_N": F_act}
 
 
 def actuator_force_N(m):
@@ -847,13 +875,13 @@ def actuator_force_N(m):
 
 def pf_load(m):
     """The PF's shared external force as the firmware takes it (br_pf_load_t,
-    docs/modules/pf.md, "External force"): {"q_N2" per step (q_N2_per_s times
+    docs/modules/pf.md, "External force"): {"q_N2" per step (load_q_N2_per_s times
     estimator.pf.period_s), "max_N" the actuator's force}; None (off: the
     generated header leaves it out) when estimator.pf.load is absent."""
-    ld = m["estimator"]["pf"].get("load")
-    if not ld:
+    q = load_q_N2_per_s(m, "pf")
+    if q is None:
         return None
-    return {"q_N2": ld["q_N2_per_s"] * m["estimator"]["pf"]["period_s"], "max_N": actuator_force_N(m)}
+    return {"q_N2": q * m["estimator"]["pf"]["period_s"], "max_N": actuator_force_N(m)}
 
 
 def pf_gp_curve_rho(m):
@@ -976,19 +1004,26 @@ FLOAT32_MIN_NORMAL = 1.1754943508222875e-38
 def _per_step_checks(m, errors):
     """Each per-step value within the firmware's bounds, a normal float32 (no
     subnormal) when not 0; a problem is named by the file's field it comes from."""
-    if m["estimator"]["ukf"].get("load"):
+    bad = set()
+    for est in ("pf", "ukf"):
+        try:
+            load_q_N2_per_s(m, est)
+        except ValueError as e:
+            errors.append(("estimator.%s.load" % est, str(e)))
+            bad.add(est)
+    if m["estimator"]["ukf"].get("load") and "ukf" not in bad:
         # br_ukf_init: q 0 or a normal float, P0 a normal float, both <= BR_EST_VAR_MAX
         ld = ukf_load(m)
         for key, x in (("q_N2", ld["q_N2"]), ("p0_N2", ld["p0_N2"])):
             if not FLOAT32_MIN_NORMAL <= x <= 1.0e12:
-                errors.append(("estimator.ukf.load.q_N2_per_s", "gives %s = %.6g per step on this machine, "
+                errors.append((load_field(m, "ukf"), "gives %s = %.6g per step on this machine, "
                                "outside the firmware's (0 excluded) [%g, %g]" % (key, x, FLOAT32_MIN_NORMAL, 1.0e12)))
-    pld = pf_load(m)
+    pld = pf_load(m) if "pf" not in bad else None
     if pld:
         # br_pf_init: q a normal float <= BR_EST_VAR_MAX, 4 max_N^2 finite (max_N is the
         # actuator's force, bounded by the schema)
         if not FLOAT32_MIN_NORMAL <= pld["q_N2"] <= 1.0e12:
-            errors.append(("estimator.pf.load.q_N2_per_s", "gives q_N2 = %.6g per step on this machine, "
+            errors.append((load_field(m, "pf"), "gives q_N2 = %.6g per step on this machine, "
                            "outside the firmware's (0 excluded) [%g, %g]" % (pld["q_N2"], FLOAT32_MIN_NORMAL, 1.0e12)))
         # br_pf_init: the thesis model only (the cloud is moved and weighed again with eq. 6)
         extended = sorted(c for c, v in m.get("causes", {}).items() if c in FORCE_CAUSES and any(v.values()))

@@ -318,6 +318,28 @@ def main():
     check(rc == 0 and "#define BR_EST_PF_LOAD_Q_N2_F (%s)" % machine.c_float(1.0e4 * good["estimator"]["pf"]["period_s"])
           in hdr and "#define BR_EST_PF_LOAD_MAX_N_F (%s)" % machine.c_float(F_act) in hdr,
           "pf_load.json: gen_machine.py writes the PF's external force (q per PF step, the actuator's force)")
+    # the same random walk as a share of the actuator's force (q_Fact2_per_s, the form that holds on another
+    # axis): the same header, to the float; both forms, or neither, refused with the field named
+    withf = copy.deepcopy(good)
+    withf["estimator"]["pf"]["load"] = {"q_Fact2_per_s": 1.0e4 / (F_act * F_act)}
+    withf["estimator"]["ukf"]["load"] = {"q_Fact2_per_s": 1.0e4 / (F_act * F_act)}
+    rc, hdr = est_header(work, "pf_load_fact", withf)
+    check(rc == 0 and "#define BR_EST_PF_LOAD_Q_N2_F (%s)" % machine.c_float(1.0e4 * good["estimator"]["pf"]["period_s"])
+          in hdr and "#define BR_EST_UKF_LOAD_Q_N2_F (%s)" % machine.c_float(1.0e4 * good["control"]["period_s"]) in hdr,
+          "pf_load_fact.json: q_Fact2_per_s times the actuator's force squared gives the q_N2_per_s header")
+    for name, ld in (("both", {"q_N2_per_s": 1.0e4, "q_Fact2_per_s": 0.04}), ("neither", {})):
+        withf["estimator"]["pf"]["load"] = ld
+        withf["estimator"]["ukf"]["load"] = {"q_Fact2_per_s": 0.04}
+        expect_errors(work, "pf_load_%s.json" % name, withf, [
+            "field estimator.pf.load: needs exactly one of q_N2_per_s (N^2/s) and q_Fact2_per_s (the actuator's "
+            "force squared, per second)"])
+    withf["estimator"]["pf"]["load"] = {"q_Fact2_per_s": 1.0e-48}
+    expect_errors(work, "pf_load_fact_sub.json", withf, [
+        "field estimator.pf.load.q_Fact2_per_s: gives q_N2 = %.6g per step on this machine, outside the "
+        "firmware's (0 excluded) [1.17549e-38, 1e+12]" % (1.0e-48 * F_act * F_act * good["estimator"]["pf"]["period_s"])])
+    withf["estimator"]["pf"]["load"] = {"q_Fact2_per_s": 200.0}
+    expect_errors(work, "pf_load_fact_big.json", withf,
+                  ["field estimator.pf.load.q_Fact2_per_s: 200 is outside (0, 100]"])
     rc, hdr = est_header(work, "pf_noload", good)
     check(rc == 0 and machine.pf_load(good) is None and "BR_EST_PF_LOAD" not in hdr,
           "no estimator.pf.load: the PF's external force is off, nothing in the header")
