@@ -527,6 +527,7 @@ def main():
         "reanchor_steps": paths["reanchor_steps"],
         "delay_switches": paths["delay_switches"],
         "delay_switches_steady": paths["delay_switches_steady"],
+        "delay_id_steady_phase": cfg["delay_id"]["steady_after_s"] > 0.0,
         "load_acquisitions": paths["load_acquisitions"],
         "load_undos": paths["load_undos"],
         "error_steps": int(np.count_nonzero((st != BR_OK) & (st != BR_W_OUTLIER))),

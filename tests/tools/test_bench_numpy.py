@@ -32,15 +32,6 @@ def run(cmd):
     return r.returncode, r.stdout + r.stderr
 
 
-def steady_phase(rec):
-    """the recording's PF has the delay identification's steady phase (its "# pf_cfg " header)"""
-    with open(rec, encoding="utf-8") as f:
-        for line in f:
-            if line.startswith("# pf_cfg "):
-                return json.loads(line[len("# pf_cfg "):])["delay_id"]["steady_after_s"] > 0.0
-    sys.exit("%s: no # pf_cfg line" % rec)
-
-
 def main():
     bench, work = tool_check.start("bench")
     fails = []
@@ -79,7 +70,7 @@ def main():
             fails.append("%s: the delay identification never switches: the delayed torque is not compared" % tag)
         if "load_acquisitions" in need and r["load_acquisitions"] == 0:
             fails.append("%s: cfg.load never re-acquires a gated step: its update's gated path is not compared" % tag)
-        if "delay_switches_steady" in need and steady_phase(rec) and r["delay_switches_steady"] == 0:
+        if "delay_switches_steady" in need and r["delay_id_steady_phase"] and r["delay_switches_steady"] == 0:
             fails.append("%s: no switch in the delay identification's steady phase: its memory and ratio are not "
                          "compared" % tag)
     return tool_check.finish(fails)
