@@ -173,7 +173,7 @@ class RulesTest(unittest.TestCase):
         truth = nominal_truth(Meff_kg=-P0["Meff_kg"])
         prep = prepared(truth)
         free = model.fit_nominal(prep)
-        self.assertTrue(identify._on_floor(free, "Meff_kg"))
+        self.assertTrue(identify._at_bound(free, "Meff_kg"))
         diag = diagnosis(free)
         out = identify.apply(prep, diag, P0, say=lambda m: None)
         self.assertIn("Meff_kg", out["nominal_held"])

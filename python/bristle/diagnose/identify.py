@@ -234,12 +234,6 @@ def apply(prep, diag, p0, say=print):
     return out
 
 
-def _on_floor(fit, name):
-    """The fit's coefficient of a FLOOR parameter is on its lower bound (model.COEF_LOWER)."""
-    coef = model.FIXED_COEF[name][0]
-    return fit.coef.get(coef, 1.0) <= model.COEF_LOWER[coef] * (1.0 + physical.EDGE)
-
-
 def _floor_why(name, fitted):
     return (f"on its floor ({fitted:.3g}, model.COEF_LOWER): the log pulls it to zero or below, it needs "
             f"{NEEDS[name]}: taken from the machine file")
@@ -248,7 +242,7 @@ def _floor_why(name, fitted):
 def _hold_floor(h):
     """A FLOOR parameter of the extended model on its floor held at the machine file's value."""
     for k in FLOOR:
-        if k not in h.fixed and _on_floor(h.best, k):
+        if k not in h.fixed and _at_bound(h.best, k):
             h.take((k,), h.trial({k: h.p0[k]}), _floor_why(k, h.best.params()[k]))
 
 
@@ -257,7 +251,7 @@ def _hold_nominal_floor(prep, diag, p0, say):
     floor held at the machine file's values (replaces diag.nominal); returns
     {param: {"value", "fitted", "relerr_percent", "why"}} of those held."""
     nom = diag.nominal
-    on = [k for k in FLOOR if _on_floor(nom, k)]
+    on = [k for k in FLOOR if _at_bound(nom, k)]
     if not on:
         return {}
     fixed = {"Fc_ref_N": p0["Fc_N"], **{k: p0[k] for k in on}}
