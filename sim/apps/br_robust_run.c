@@ -13,7 +13,8 @@
  *
  * Usage: br_robust_run [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N]
  *                      [--enc-noise P] [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT]
- *                      [--pf-dt S] [--pf-n M] [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--ahead P]
+ *                      [--pf-dt S] [--pf-n M] [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S]
+ *                      [--ahead P]
  *                      [--delay-id 0|1]
  *                      [--radius-m R] [--feed-mm-min F] [--direction cw|ccw]
  * --radius-m, --feed-mm-min, --direction: the circle (br_circle_args.h;
@@ -26,6 +27,8 @@
  * (br_pf_cfg_t.load; 0, the default: the machine's).
  * --pf-gate: the PF's outlier gate in sigmas (a study, docs/presliding-plants.md,
  * "The PF's gate"; the default: the machine's).
+ * --pf-adapt-max: the PF's cfg.adapt.max_scale, its largest variance factor (1: no
+ * inflation, the thesis filter; a study, docs/fleet.md; the default: the machine's).
  * --ahead: every estimator's est.comp_ahead_periods (docs/modules/est.md).
  * --delay-id 0: the estimators without the machine's delay identification
  * (est.delay_id, docs/modules/dlyid.md); 1: with it (the default).
@@ -72,7 +75,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N] [--enc-noise P]\n"
             "       [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT] [--pf-dt S] [--pf-n M]\n"
-            "       [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--ahead P] [--delay-id 0|1] [--radius-m R] [--feed-mm-min F]\n"
+            "       [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S] [--ahead P] [--delay-id 0|1] [--radius-m R] [--feed-mm-min F]\n"
             "       [--direction cw|ccw] [--gms D1,..,DN] [--gms-zeta Z]\n"
             BR_ARGS_COMMON_USAGE
             "  --plant PLANT.json  the simulated plant (a model.json; default the reference machine)\n"
@@ -91,6 +94,7 @@ static int usage(const char *argv0, FILE *to)
             "                      noise held over the period (docs/modules/pf.md)\n"
             "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9; docs/modules/pf.md)\n"
             "  --pf-gate SIGMA     the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
+            "  --pf-adapt-max S    the PF's largest noise-variance factor of cfg.adapt (1 .. 1e12; 1: none; a study, docs/fleet.md)\n"
             "  --ahead P           the estimators' compensation lead, periods past the delay (docs/modules/est.md)\n"
             "  --delay-id 0|1      the estimators' delay identification off / as the machine has it (docs/modules/dlyid.md)\n"
             BR_CIRCLE_USAGE("--direction cw|ccw "),
@@ -138,7 +142,7 @@ int main(int argc, char **argv)
 {
     const char *plant_path = NULL, *model_path = NULL, *json = NULL, *only = NULL, *dir = NULL;
     br_circle_real_t real = {0.0, 0.0, 0.0, 0u};
-    double veps = -1.0, pf_dt = -1.0, ahead = -1.0, pf_load = 0.0, pf_gate = 0.0;
+    double veps = -1.0, pf_dt = -1.0, ahead = -1.0, pf_load = 0.0, pf_gate = 0.0, pf_adapt_max = 0.0;
     long pf_n = 0, pf_prop = -1, delay_id = -1;
     br_circle_path_t path = BR_CIRCLE_PATH_DEFAULT;
     br_gms_args_t gms = BR_GMS_ARGS_DEFAULT;
@@ -151,7 +155,8 @@ int main(int argc, char **argv)
         {"pf-n", required_argument, NULL, 'n'},   {"seed", required_argument, NULL, 's'},
         {"pf-proposal", required_argument, NULL, 'p'}, {"ahead", required_argument, NULL, 'a'},
         {"delay-id", required_argument, NULL, 'i'}, {"pf-load", required_argument, NULL, 'L'},
-        {"pf-gate", required_argument, NULL, 'G'}, BR_CIRCLE_LONGOPTS BR_GMS_LONGOPTS{NULL, 0, NULL, 0}};
+        {"pf-gate", required_argument, NULL, 'G'}, {"pf-adapt-max", required_argument, NULL, 'X'},
+        BR_CIRCLE_LONGOPTS BR_GMS_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t ap;
     if (br_args_start(&ap, TOOL, argc, argv, usage)) return 0;
     const char *val;
@@ -177,6 +182,7 @@ int main(int argc, char **argv)
         case 'G':
             bad = br_arg_double(TOOL, ap.opt, val, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &pf_gate);
             break;
+        case 'X': bad = br_arg_double(TOOL, ap.opt, val, 1.0, 1.0e12, &pf_adapt_max); break;
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, ap.opt, val, 0, &path); break;
         case BR_GMS_OPT: bad = br_gms_arg(TOOL, ap.opt, val, &gms); break;
         case 's':
@@ -252,6 +258,7 @@ int main(int argc, char **argv)
         if (runs[r].identified) br_circle_use_model(&c, &model);
         br_circle_use_pf_load(&c, pf_load);
         br_circle_use_pf_gate(&c, pf_gate);
+        br_circle_use_pf_adapt_max(&c, pf_adapt_max);
         br_outfile_t tr = {0}, hi = {0};
         sinks_t k = {NULL, NULL};
         if (dir) {

@@ -6,9 +6,11 @@ force noise and seeds as the study's runs (fleet_runs.circle_runs), so that
 a change of the settings machine.py derives is compared on the same axes
 without the chain's identification and diagnosis. Prints, per estimator,
 the runs that faulted before (the study's JSON) and now, and the median of
-RMS / H-inf only over the runs that went to the end.
+RMS / H-inf only over the runs that went to the end. --pf-adapt-max S runs
+the PF with that largest noise-variance factor of cfg.adapt instead of the
+machine file's (docs/fleet.md, "The PF's start on the fleet's axes").
 
-    python sim/studies/fleet_rerun.py out/fleet OUT [--axes 63,67]"""
+    python sim/studies/fleet_rerun.py out/fleet OUT [--axes 63,67] [--pf-adapt-max S]"""
 import argparse
 import glob
 import json
@@ -65,7 +67,9 @@ def main():
     ap.add_argument("out", help="where the builds and runs go")
     ap.add_argument("--seed", type=int, default=20261201, help="the study's seed")
     ap.add_argument("--axes", help="comma-separated axis indices (default: every axis the chain finished)")
+    ap.add_argument("--pf-adapt-max", type=float, help="br_robust_run --pf-adapt-max (1: no inflation)")
     a = ap.parse_args()
+    extra = () if a.pf_adapt_max is None else ("--pf-adapt-max", repr(a.pf_adapt_max))
     src = os.path.dirname(os.path.dirname(HERE))
     dirs = sorted(glob.glob(os.path.join(a.study, "axes", "*", "diagnose", "machine.json")))
     idx = [int(p.split(os.sep)[-3]) for p in dirs]
@@ -87,7 +91,7 @@ def main():
             for k, tr in circles:
                 if tr["name"] in names:
                     fleet_runs.circle_runs(od, exe, os.path.join(d, "truth-model.json"), fleet_axis.gms_options(ax), tr,
-                                           fleet_runs.run_seed(a.seed, i, k + 1), ax["force_noise_N"], log)
+                                           fleet_runs.run_seed(a.seed, i, k + 1), ax["force_noise_N"], log, extra)
         for key, r in records(d, names).items():
             before[(i,) + key] = r
         for key, r in records(od, names).items():

@@ -93,12 +93,13 @@ def result(raw, rms_key, max_key):
     return r
 
 
-def circle_runs(d, exe, truth, gms, tr, seed, noise, log):
+def circle_runs(d, exe, truth, gms, tr, seed, noise, log, extra=()):
+    """each circle controller on br_robust_run (extra: more of its options, a study's: fleet_rerun.py)"""
     out = {}
     for k, ctrl in enumerate(CIRCLE_CTRLS):
         js = os.path.join(d, "%s_%s.json" % (tr["name"], ctrl))
         cmd = [exe, "--plant", truth, *gms, "--only", ctrl, "--force-noise", "%.6g" % noise, "--seed", str(seed),
-               "--json", js]
+               "--json", js, *extra]
         if tr["kind"] == "circle":
             cmd += ["--radius-m", "%.6g" % tr["radius_m"], "--feed-mm-min", "%.6g" % tr["feed_mm_min"],
                     "--direction", tr["direction"]]

@@ -172,6 +172,11 @@ void br_circle_use_pf_gate(br_circle_cfg_t *c, double sigma)
     if (sigma > 0.0) c->pf.est.outlier_sigma = (float)sigma;
 }
 
+void br_circle_use_pf_adapt_max(br_circle_cfg_t *c, double s)
+{
+    if (s > 0.0) c->pf.adapt.max_scale = (float)s;
+}
+
 double br_circle_feed_mps(const br_circle_cfg_t *c)
 {
     return 2.0 * BR_PI * c->radius_m / c->period_s;

@@ -169,6 +169,11 @@ void br_circle_use_pf_gp_curve(br_circle_cfg_t *c, double tau_s);
  * setting (docs/presliding-plants.md, "The PF's gate"). */
 void br_circle_use_pf_gate(br_circle_cfg_t *c, double sigma);
 
+/* The tools' --pf-adapt-max: cfg.adapt's largest variance factor (docs/modules/pf.md,
+ * "Keeping lock"); 1 keeps the factor at 1, the thesis filter; s <= 0 leaves the
+ * machine file's. A study setting (docs/fleet.md, "The PF's noise inflation"). */
+void br_circle_use_pf_adapt_max(br_circle_cfg_t *c, double s);
+
 /* The tools' --delay-id: 0 turns both estimators' delay identification off
  * (est.delay_id, docs/modules/dlyid.md); any other value leaves the machine's. */
 void br_circle_use_delay_id(br_circle_cfg_t *c, long on);
