@@ -14,7 +14,7 @@
  * Usage: br_robust_run [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N]
  *                      [--enc-noise P] [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT]
  *                      [--pf-dt S] [--pf-n M] [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S]
- *                      [--ahead P]
+ *                      [--ahead P] [--machine-causes]
  *                      [--delay-id 0|1]
  *                      [--radius-m R] [--feed-mm-min F] [--direction cw|ccw]
  * --radius-m, --feed-mm-min, --direction: the circle (br_circle_args.h;
@@ -29,6 +29,9 @@
  * "The PF's gate"; the default: the machine's).
  * --pf-adapt-max: the PF's cfg.adapt.max_scale, its largest variance factor (1: no
  * inflation, the thesis filter; a study, docs/fleet.md; the default: the machine's).
+ * --machine-causes: the estimators of the runs on the machine's model (not the *_id
+ * ones) carry the machine file's causes, as the image does (br_machine_causes;
+ * docs/fleet.md, "The estimators as the image has them"), not the thesis model.
  * --ahead: every estimator's est.comp_ahead_periods (docs/modules/est.md).
  * --delay-id 0: the estimators without the machine's delay identification
  * (est.delay_id, docs/modules/dlyid.md); 1: with it (the default).
@@ -75,7 +78,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N] [--enc-noise P]\n"
             "       [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT] [--pf-dt S] [--pf-n M]\n"
-            "       [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S] [--ahead P] [--delay-id 0|1] [--radius-m R] [--feed-mm-min F]\n"
+            "       [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S] [--ahead P] [--delay-id 0|1] [--machine-causes] [--radius-m R] [--feed-mm-min F]\n"
             "       [--direction cw|ccw] [--gms D1,..,DN] [--gms-zeta Z]\n"
             BR_ARGS_COMMON_USAGE
             "  --plant PLANT.json  the simulated plant (a model.json; default the reference machine)\n"
@@ -95,6 +98,7 @@ static int usage(const char *argv0, FILE *to)
             "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9; docs/modules/pf.md)\n"
             "  --pf-gate SIGMA     the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
             "  --pf-adapt-max S    the PF's largest noise-variance factor of cfg.adapt (1 .. 1e12; 1: none; a study, docs/fleet.md)\n"
+            "  --machine-causes    the estimators with the machine file's causes, as the image has them\n"
             "  --ahead P           the estimators' compensation lead, periods past the delay (docs/modules/est.md)\n"
             "  --delay-id 0|1      the estimators' delay identification off / as the machine has it (docs/modules/dlyid.md)\n"
             BR_CIRCLE_USAGE("--direction cw|ccw "),
@@ -144,6 +148,7 @@ int main(int argc, char **argv)
     br_circle_real_t real = {0.0, 0.0, 0.0, 0u};
     double veps = -1.0, pf_dt = -1.0, ahead = -1.0, pf_load = 0.0, pf_gate = 0.0, pf_adapt_max = 0.0;
     long pf_n = 0, pf_prop = -1, delay_id = -1;
+    int machine_causes = 0;
     br_circle_path_t path = BR_CIRCLE_PATH_DEFAULT;
     br_gms_args_t gms = BR_GMS_ARGS_DEFAULT;
     static const struct option opts[] = {
@@ -156,6 +161,7 @@ int main(int argc, char **argv)
         {"pf-proposal", required_argument, NULL, 'p'}, {"ahead", required_argument, NULL, 'a'},
         {"delay-id", required_argument, NULL, 'i'}, {"pf-load", required_argument, NULL, 'L'},
         {"pf-gate", required_argument, NULL, 'G'}, {"pf-adapt-max", required_argument, NULL, 'X'},
+        {"machine-causes", no_argument, NULL, 'M'},
         BR_CIRCLE_LONGOPTS BR_GMS_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t ap;
     if (br_args_start(&ap, TOOL, argc, argv, usage)) return 0;
@@ -182,6 +188,7 @@ int main(int argc, char **argv)
         case 'G':
             bad = br_arg_double(TOOL, ap.opt, val, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &pf_gate);
             break;
+        case 'M': machine_causes = 1; break;
         case 'X': bad = br_arg_double(TOOL, ap.opt, val, 1.0, 1.0e12, &pf_adapt_max); break;
         case BR_CIRCLE_OPT: bad = br_circle_arg(TOOL, ap.opt, val, 0, &path); break;
         case BR_GMS_OPT: bad = br_gms_arg(TOOL, ap.opt, val, &gms); break;
@@ -237,6 +244,8 @@ int main(int argc, char **argv)
         fprintf(js.f, "{\n  \"generator\": \"br_robust_run (sim/apps/br_robust_run.c)\",\n");
         fprintf(js.f, "  \"circle\": {\"radius_m\": %.9g, \"period_s\": %.9g, \"direction\": \"%s\"},\n", c0.radius_m,
                 c0.period_s, c0.dir < 0.0 ? "ccw" : "cw");
+        /* the causes the estimators of the runs on the machine's model carry (the *_id runs: the model's) */
+        fprintf(js.f, "  \"estimator_causes\": \"%s\",\n", machine_causes ? "machine" : "thesis");
         fprintf(js.f, "  \"controllers\": {");
     }
     int first = 1, rc = 0;
@@ -256,6 +265,7 @@ int main(int argc, char **argv)
         br_circle_use_ahead(&c, ahead);
         br_circle_use_delay_id(&c, delay_id);
         if (runs[r].identified) br_circle_use_model(&c, &model);
+        else if (machine_causes) br_circle_use_machine_causes(&c);
         br_circle_use_pf_load(&c, pf_load);
         br_circle_use_pf_gate(&c, pf_gate);
         br_circle_use_pf_adapt_max(&c, pf_adapt_max);

@@ -34,7 +34,10 @@
  * Usage: br_track --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]
  *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,
  *                        hinf_pf_ext_ff,hinf_true_ff,hinf_ukf,hinf_inertia,hinf_pf_inertia,
- *                        hinf_ukf_inertia] [--json OUT] [--trace DIR]
+ *                        hinf_ukf_inertia] [--json OUT] [--trace DIR] [--machine-causes]
+ * --machine-causes: the estimators of the runs not on the extended model carry
+ * the build's machine file's causes, as the image does (br_machine_causes;
+ * docs/fleet.md, "The estimators as the image has them"), not the thesis model.
  * Prints one line per controller: tracking RMS and maximum error. --trace
  * writes each run's trace, and for hinf_pf and hinf_pf_ext one row per PF
  * step (pf_trace_row). */
@@ -215,14 +218,16 @@ static void pf_trace_row(FILE *f, double t, const br_plant_t *p, const br_pf_t *
  * (BR_CTRL_HINF_PF, BR_CTRL_HINF_UKF) */
 /* *n_limited: the periods whose reference the drive's limiter changed (br_app_ref_limit; the run-in
  * included), 0 when the application never ran */
-static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int extended, int ff, err_t *e,
+/* causes: 0 the thesis model, 1 the plant's causes (the _ext runs), 2 the machine file's (--machine-causes) */
+static int run_fw(const traj_t *tr, const br_plant_cfg_t *pc, br_circle_ctrl_t ctrl, int causes, int ff, err_t *e,
                   br_run_report_t *rep, uint32_t *n_limited)
 {
     *n_limited = 0u;
     br_circle_cfg_t c = br_circle_cfg_thesis(ctrl);
     const br_plant_cfg_t mach = c.plant; /* the build's machine file's plant */
     c.plant = *pc;
-    if (extended) c.pf.est.model.causes = br_causes_from_model(pc);
+    if (causes == 1) c.pf.est.model.causes = br_causes_from_model(pc);
+    if (causes == 2) br_circle_use_machine_causes(&c);
     static pf_ff_t w; /* the feedforward (and the PF's br_est_t for ff 2) */
     if (ff) {
         /* the feedforward from the plant's model (ff 3: the machine file's) */
@@ -396,7 +401,7 @@ static int usage(const char *argv0, FILE *to)
             "usage: %s --ref LOG.csv [--model MODEL.json] [--pd KP,KV,GAIN,UMAX]\n"
             "          [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,\n"
             "                  hinf_pf_ext_ff,hinf_true_ff,hinf_ukf,hinf_inertia,hinf_pf_inertia,\n"
-            "                  hinf_ukf_inertia] [--json OUT] [--trace DIR]\n"
+            "                  hinf_ukf_inertia] [--json OUT] [--trace DIR] [--machine-causes]\n"
             "          [--gms D1,..,DN] [--gms-zeta Z]\n"
             "       %s --speed-cap LO,HI [--model MODEL.json]\n"
             BR_ARGS_COMMON_USAGE
@@ -407,6 +412,7 @@ static int usage(const char *argv0, FILE *to)
             "  --json OUT          the runs' figures as JSON\n"
             "  --trace DIR         each run's trace as CSV into DIR (track_NAME.csv), and for\n"
             "                      the PF runs its steps (pf_NAME.csv: truth, cloud, miss, gate)\n"
+            "  --machine-causes    the estimators with the machine file's causes, as the image has them\n"
             "  --speed-cap LO,HI   print the largest reference speed (m/s) this build's drive passes\n"
             "                      untouched in [LO, HI] m toward either end (max speed, the braking\n"
             "                      curve to the soft limits, the coast envelope), and run nothing\n",
@@ -419,7 +425,7 @@ int main(int argc, char **argv)
 {
     const char *ref = NULL, *model = NULL, *json = NULL, *trace = NULL, *ctrls = NULL;
     double pd[4], cap[2];
-    int have_pd = 0, have_cap = 0;
+    int have_pd = 0, have_cap = 0, machine_causes = 0;
     br_gms_args_t gms = BR_GMS_ARGS_DEFAULT;
     static const struct option opts[] = {{"ref", required_argument, NULL, 'r'},
                                          {"model", required_argument, NULL, 'm'},
@@ -428,6 +434,7 @@ int main(int argc, char **argv)
                                          {"ctrl", required_argument, NULL, 'c'},
                                          {"pd", required_argument, NULL, 'p'},
                                          {"speed-cap", required_argument, NULL, 's'},
+                                         {"machine-causes", no_argument, NULL, 'M'},
                                          BR_GMS_LONGOPTS{NULL, 0, NULL, 0}};
     br_args_t p;
     if (br_args_start(&p, TOOL, argc, argv, usage)) return 0;
@@ -439,6 +446,7 @@ int main(int argc, char **argv)
         case 'j': json = val; break;
         case 't': trace = val; break;
         case 'c': ctrls = val; break;
+        case 'M': machine_causes = 1; break;
         case 'p':
             have_pd = br_parse_numbers(val, pd, 4) == 4 && pd[0] > 0.0 && pd[1] > 0.0 && pd[2] > 0.0 && pd[3] > 0.0;
             if (!have_pd) {
@@ -494,7 +502,8 @@ int main(int argc, char **argv)
     FILE *js = out.f;
     if (js)
         fprintf(js, "{\n  \"generator\": \"br_track (sim/apps/br_track.c); generated, do not edit\",\n"
-                    "  \"duration_s\": %.6g", (double)(tr.n - 1) * tr.dt);
+                    "  \"duration_s\": %.6g,\n  \"estimator_causes\": \"%s\"", (double)(tr.n - 1) * tr.dt,
+                machine_causes ? "machine" : "thesis");
     static const char *const names[] = {"pd",           "hinf_only",       "hinf_pf",        "hinf_pf_ext",
                                         "hinf_true",    "hinf_ff",         "hinf_pf_ff",     "hinf_pf_ext_ff",
                                         "hinf_true_ff", "hinf_ukf",        "hinf_inertia",   "hinf_pf_inertia",
@@ -542,7 +551,8 @@ int main(int argc, char **argv)
                                           : w == 5 ? BR_CTRL_HINF_FF
                                           : (w == 9 || w == 12) ? BR_CTRL_HINF_UKF : BR_CTRL_HINF_PF;
             const int ff = w == 5 ? 1 : (w >= 6 && w <= 8) ? 2 : (w >= 10) ? 3 : 0;
-            if (run_fw(&tr, &plant, ctrl, w == 3 || w == 7, ff, &e, &rep, &n_limited) != 0) rc = 1;
+            const int causes = (w == 3 || w == 7) ? 1 : machine_causes ? 2 : 0;
+            if (run_fw(&tr, &plant, ctrl, causes, ff, &e, &rep, &n_limited) != 0) rc = 1;
         }
         if (rc != 0) break;
         rep.rms_m = e.n > 0 ? sqrt(e.sum2 / (double)e.n) : NAN;

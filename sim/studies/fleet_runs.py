@@ -29,8 +29,11 @@ import machine_chain  # noqa: E402
 from robustness import LOST_OUTLIER_FRAC  # noqa: E402
 from runs import REFUSED_AT_INIT, faulted  # noqa: E402
 
-CIRCLE_CTRLS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")  # br_robust_run, the machine file's model
-# br_track (not its _ff controllers: their feedforward is the plant's, an oracle); each also with the
+# br_robust_run, the machine file's model; the estimators with its causes (--machine-causes), as the
+# image built for machine.json has them (docs/fleet.md, "The estimators as the image has them")
+CIRCLE_CTRLS = ("hinf_only", "hinf_ff", "hinf_ukf", "hinf_pf")
+# br_track (not its _ff controllers: their feedforward is the plant's, an oracle; the estimators with the
+# machine file's causes, --machine-causes); each also with the
 # inertia feedforward of the axis's machine file (its mass times the reference acceleration: what the
 # firmware knows), as a motion controller runs a track (docs/fleet.md, "The tracks")
 TRACK_CTRLS = ("hinf_only", "hinf_ukf", "hinf_pf", "hinf_inertia", "hinf_ukf_inertia", "hinf_pf_inertia")
@@ -99,7 +102,7 @@ def circle_runs(d, exe, truth, gms, tr, seed, noise, log, extra=()):
     for k, ctrl in enumerate(CIRCLE_CTRLS):
         js = os.path.join(d, "%s_%s.json" % (tr["name"], ctrl))
         cmd = [exe, "--plant", truth, *gms, "--only", ctrl, "--force-noise", "%.6g" % noise, "--seed", str(seed),
-               "--json", js, *extra]
+               "--json", js, "--machine-causes", *extra]
         if tr["kind"] == "circle":
             cmd += ["--radius-m", "%.6g" % tr["radius_m"], "--feed-mm-min", "%.6g" % tr["feed_mm_min"],
                     "--direction", tr["direction"]]
@@ -118,7 +121,8 @@ def track_runs(d, exe, truth, gms, ref, name, log):
     for ctrl in TRACK_CTRLS:
         js = os.path.join(d, "%s_%s.json" % (name, ctrl))
         try:
-            tool("br_track", [exe, "--ref", ref, "--model", truth, *gms, "--ctrl", ctrl, "--json", js], log)
+            tool("br_track", [exe, "--ref", ref, "--model", truth, *gms, "--ctrl", ctrl, "--json", js,
+                              "--machine-causes"], log)
         except ChainError as e:
             out[ctrl] = {"faulted": True, "fault_t_s": None, "fault_cause": "tool failed: " + e.msg}
             continue

@@ -89,7 +89,7 @@ def run(cmd, env=None):
 
 
 def one_plant(job):
-    i, seed, binp, out, diagnose, only, pf_proposal, ahead, delay_id, pf_load, pf_gate = job
+    i, seed, binp, out, diagnose, only, pf_proposal, ahead, delay_id, pf_load, pf_gate, pf_adapt_max = job
     ref = reference()
     p = draw(seed, ref)
     d = os.path.join(out, "plants", f"{i:04d}")
@@ -133,6 +133,8 @@ def one_plant(job):
         cmd += ["--pf-load", repr(pf_load)]
     if pf_gate is not None:
         cmd += ["--pf-gate", repr(pf_gate)]
+    if pf_adapt_max is not None:
+        cmd += ["--pf-adapt-max", repr(pf_adapt_max)]
     if delay_id is not None:
         cmd += ["--delay-id", str(delay_id)]
     rc, _, err = run(cmd)
@@ -385,6 +387,8 @@ def main():
                     help="the PF's shared external force, random walk N^2/s (br_robust_run --pf-load; docs/modules/pf.md)")
     ap.add_argument("--pf-gate", type=float,
                     help="the PF's outlier gate, sigmas (br_robust_run --pf-gate; docs/presliding-plants.md)")
+    ap.add_argument("--pf-adapt-max", type=float,
+                    help="the PF's largest noise-variance factor of cfg.adapt (br_robust_run --pf-adapt-max; docs/fleet.md)")
     ap.add_argument("--ahead", type=float,
                     help="the estimators' compensation lead (br_robust_run --ahead; docs/modules/est.md)")
     ap.add_argument("--delay-id", type=int, choices=(0, 1),
@@ -415,8 +419,8 @@ def main():
         if bad_names:
             ap.error(f"--only: unknown controllers {bad_names}")
         only = ",".join(["hinf_only"] + [k for k in names if k != "hinf_only"])
-    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only, a.pf_proposal, a.ahead, a.delay_id, a.pf_load, a.pf_gate)
-            for i in range(a.n)]
+    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only, a.pf_proposal, a.ahead, a.delay_id, a.pf_load, a.pf_gate,
+             a.pf_adapt_max) for i in range(a.n)]
     recs, t0 = [], time.time()
     progress(0, a.n, t0)
     with Pool(a.jobs) as pool:

@@ -74,6 +74,22 @@ class Fleet(unittest.TestCase):
                     self.assertIn(k, v)
         self.assertTrue(os.path.isfile(os.path.join(ARGS.work, "two", "cdf.png")))
 
+    def test_estimators_carry_the_machine_causes(self):
+        """every run's estimators as the image built for the axis's machine.json has them, with its
+        causes (br_robust_run / br_track --machine-causes; docs/fleet.md, "The estimators as the image
+        has them"), not the thesis model the tools run by default"""
+        seen = 0
+        for r in self.two["axes"]:
+            for name in r.get("runs", {}):
+                for ctrl in ("hinf_ukf", "hinf_pf"):
+                    path = os.path.join(ARGS.work, "two", "axes", "%04d" % r["i"], "%s_%s.json" % (name, ctrl))
+                    if not os.path.exists(path):
+                        continue  # a run whose tool failed writes nothing (listed as lost)
+                    with open(path, encoding="utf-8") as f:
+                        self.assertEqual(json.load(f).get("estimator_causes"), "machine", path)
+                    seen += 1
+        self.assertGreater(seen, 0)
+
     def test_hinf_only_finite(self):
         """H-inf only went to the end on every axis whose chain went through, with a finite RMS"""
         for r in self.two["axes"]:

@@ -177,6 +177,12 @@ void br_circle_use_pf_adapt_max(br_circle_cfg_t *c, double s)
     if (s > 0.0) c->pf.adapt.max_scale = (float)s;
 }
 
+void br_circle_use_machine_causes(br_circle_cfg_t *c)
+{
+    c->pf.est.model.causes = br_machine_causes();
+    c->ukf.est.model.causes = br_machine_causes();
+}
+
 double br_circle_feed_mps(const br_circle_cfg_t *c)
 {
     return 2.0 * BR_PI * c->radius_m / c->period_s;

@@ -174,6 +174,12 @@ void br_circle_use_pf_gate(br_circle_cfg_t *c, double sigma);
  * machine file's. A study setting (docs/fleet.md, "The PF's noise inflation"). */
 void br_circle_use_pf_adapt_max(br_circle_cfg_t *c, double s);
 
+/* The tools' --machine-causes: the PF's and the UKF's estimation model with the
+ * machine file's causes (br_machine_causes), the estimator the image built for
+ * the machine runs, instead of the thesis model (docs/fleet.md, "The estimators
+ * as the image has them"). */
+void br_circle_use_machine_causes(br_circle_cfg_t *c);
+
 /* The tools' --delay-id: 0 turns both estimators' delay identification off
  * (est.delay_id, docs/modules/dlyid.md); any other value leaves the machine's. */
 void br_circle_use_delay_id(br_circle_cfg_t *c, long on);

@@ -5,7 +5,9 @@
  * STM32H743 image uses too. The image takes the machine file's causes
  * (BR_MACHINE_CAUSES); here the estimators are on the thesis model, so that
  * "nominal" stays nominal for any machine: the tools that run the extended
- * model set est.model.causes themselves (br_circle_ext, br_track). */
+ * model set est.model.causes themselves (br_circle_ext, br_track), and
+ * --machine-causes (br_robust_run, br_track) puts the machine file's back, as
+ * the image has them (br_machine_causes). */
 #include "br_circle_est.h"
 
 #include "bristle/br_machine_cfg.h"
@@ -16,6 +18,12 @@ br_model_cfg_t br_machine_model_cfg(float dt_s)
     br_model_cfg_t m = BR_MACHINE_MODEL_CFG(dt_s);
     m.causes = (br_causes_t){0}; /* the thesis model */
     return m;
+}
+
+br_causes_t br_machine_causes(void)
+{
+    const br_causes_t c = BR_MACHINE_CAUSES;
+    return c;
 }
 
 br_pf_cfg_t br_circle_pf_cfg_default(float dt_s)

@@ -12,6 +12,11 @@
 /* The eq. 6 estimation model of the machine at period dt_s. */
 br_model_cfg_t br_machine_model_cfg(float dt_s);
 
+/* The machine file's causes (BR_MACHINE_CAUSES: what a diagnosis found, the
+ * actuator delay among them), which the image's estimators carry; the
+ * configurations below clear them (the thesis model). */
+br_causes_t br_machine_causes(void);
+
 /* The PF of thesis section 5 at period dt_s with the machine file's settings
  * (particles, hand-tuned noise variances, gates): the start of the
  * Nelder-Mead tuning. */
