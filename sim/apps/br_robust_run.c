@@ -29,9 +29,10 @@
  * "The PF's gate"; the default: the machine's).
  * --pf-adapt-max: the PF's cfg.adapt.max_scale, its largest variance factor (1: no
  * inflation, the thesis filter; a study, docs/fleet.md; the default: the machine's).
- * --machine-causes: the estimators of the runs on the machine's model (not the *_id
- * ones) carry the machine file's causes, as the image does (br_machine_causes;
- * docs/fleet.md, "The estimators as the image has them"), not the thesis model.
+ * --machine-causes: the UKF and the PF of the runs on the machine's model (not the
+ * *_id ones) carry the machine file's causes, as the image does (br_machine_causes;
+ * docs/fleet.md, "The estimators as the image has them"), not the thesis model; the
+ * feedforward runs keep theirs (the image has none).
  * --ahead: every estimator's est.comp_ahead_periods (docs/modules/est.md).
  * --delay-id 0: the estimators without the machine's delay identification
  * (est.delay_id, docs/modules/dlyid.md); 1: with it (the default).
@@ -78,7 +79,8 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N] [--enc-noise P]\n"
             "       [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT] [--pf-dt S] [--pf-n M]\n"
-            "       [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S] [--ahead P] [--delay-id 0|1] [--machine-causes] [--radius-m R] [--feed-mm-min F]\n"
+            "       [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S] [--ahead P] [--delay-id 0|1]\n"
+            "       [--machine-causes] [--radius-m R] [--feed-mm-min F]\n"
             "       [--direction cw|ccw] [--gms D1,..,DN] [--gms-zeta Z]\n"
             BR_ARGS_COMMON_USAGE
             "  --plant PLANT.json  the simulated plant (a model.json; default the reference machine)\n"
@@ -97,8 +99,9 @@ static int usage(const char *argv0, FILE *to)
             "                      noise held over the period (docs/modules/pf.md)\n"
             "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9; docs/modules/pf.md)\n"
             "  --pf-gate SIGMA     the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
-            "  --pf-adapt-max S    the PF's largest noise-variance factor of cfg.adapt (1 .. 1e12; 1: none; a study, docs/fleet.md)\n"
-            "  --machine-causes    the estimators with the machine file's causes, as the image has them\n"
+            "  --pf-adapt-max S    the PF's largest noise-variance factor of cfg.adapt (1 .. 1e12; 1: none; no\n"
+            "                      effect where the machine has cfg.adapt off; a study, docs/fleet.md)\n"
+            "  --machine-causes    the UKF and the PF with the machine file's causes, as the image has them\n"
             "  --ahead P           the estimators' compensation lead, periods past the delay (docs/modules/est.md)\n"
             "  --delay-id 0|1      the estimators' delay identification off / as the machine has it (docs/modules/dlyid.md)\n"
             BR_CIRCLE_USAGE("--direction cw|ccw "),

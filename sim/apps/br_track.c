@@ -35,8 +35,8 @@
  *                 [--ctrl pd,hinf_only,hinf_pf,hinf_pf_ext,hinf_true,hinf_ff,hinf_pf_ff,
  *                        hinf_pf_ext_ff,hinf_true_ff,hinf_ukf,hinf_inertia,hinf_pf_inertia,
  *                        hinf_ukf_inertia] [--json OUT] [--trace DIR] [--machine-causes]
- * --machine-causes: the estimators of the runs not on the extended model carry
- * the build's machine file's causes, as the image does (br_machine_causes;
+ * --machine-causes: the UKF and the PF of the runs not on the extended model (the
+ * _ext ones keep the plant's) carry the build's machine file's causes, as the image does (br_machine_causes;
  * docs/fleet.md, "The estimators as the image has them"), not the thesis model.
  * Prints one line per controller: tracking RMS and maximum error. --trace
  * writes each run's trace, and for hinf_pf and hinf_pf_ext one row per PF
@@ -412,7 +412,8 @@ static int usage(const char *argv0, FILE *to)
             "  --json OUT          the runs' figures as JSON\n"
             "  --trace DIR         each run's trace as CSV into DIR (track_NAME.csv), and for\n"
             "                      the PF runs its steps (pf_NAME.csv: truth, cloud, miss, gate)\n"
-            "  --machine-causes    the estimators with the machine file's causes, as the image has them\n"
+            "  --machine-causes    the UKF and the PF with the machine file's causes, as the image has them\n"
+            "                      (not the _ext runs: the plant's)\n"
             "  --speed-cap LO,HI   print the largest reference speed (m/s) this build's drive passes\n"
             "                      untouched in [LO, HI] m toward either end (max speed, the braking\n"
             "                      curve to the soft limits, the coast envelope), and run nothing\n",

@@ -8,7 +8,9 @@ without the chain's identification and diagnosis. Prints, per estimator,
 the runs that faulted before (the study's JSON) and now, and the median of
 RMS / H-inf only over the runs that went to the end. --pf-adapt-max S runs
 the PF with that largest noise-variance factor of cfg.adapt instead of the
-machine file's (docs/fleet.md, "The PF's start on the fleet's axes").
+machine file's (docs/fleet.md, "The PF's start on the fleet's axes"). The
+rerun's estimators carry machine.json's causes (fleet_runs.circle_runs); a
+study whose runs did not (before that change) is named as such per axis.
 
     python sim/studies/fleet_rerun.py out/fleet OUT [--axes 63,67] [--pf-adapt-max S]"""
 import argparse
@@ -39,6 +41,18 @@ def records(d, names):
                     out[(name, ctrl)] = fleet_runs.result(json.load(f)["controllers"][ctrl], "contour_rms_m",
                                                           "max_err_m")
     return out
+
+
+def estimator_causes(d, names):
+    """the causes the study's UKF and PF runs in d carried ("thesis" where the JSON predates the key)"""
+    seen = set()
+    for name in names:
+        for ctrl in CTRLS[1:]:
+            path = os.path.join(d, "%s_%s.json" % (name, ctrl))
+            if os.path.exists(path):
+                with open(path, encoding="utf-8") as f:
+                    seen.add(json.load(f).get("estimator_causes", "thesis"))
+    return seen
 
 
 def tally(recs):
@@ -92,6 +106,11 @@ def main():
                 if tr["name"] in names:
                     fleet_runs.circle_runs(od, exe, os.path.join(d, "truth-model.json"), fleet_axis.gms_options(ax), tr,
                                            fleet_runs.run_seed(a.seed, i, k + 1), ax["force_noise_N"], log, extra)
+        before_causes = estimator_causes(d, names) - {"machine"}
+        if before_causes:
+            # the rerun's estimators carry machine.json's causes (fleet_runs.circle_runs): a change of its own
+            print("axis %d: the study's estimators ran on the %s model, the rerun's carry machine.json's causes"
+                  % (i, "/".join(sorted(before_causes))))
         for key, r in records(d, names).items():
             before[(i,) + key] = r
         for key, r in records(od, names).items():

@@ -8,6 +8,7 @@
   listed with its stage.
 - Axis 0 alone on 1 worker: its record is the same (the axes do
   not depend on the scheduling, the worker count or N).
+- Every UKF and PF run's JSON says its estimators carried machine.json's causes.
 - The statistics on records made here: a faulted run stays out of the RMS
   figures and is lost with its cause; a run worse than H-inf only is lost.
 

@@ -338,7 +338,7 @@ class ToolsTest(unittest.TestCase):
     def test_robust_run_bad_options_touch_nothing(self):
         keep = self.existing("robust.json")
         for bad in (["--drift", "0.6"], ["--drift", "nan"], ["--force-noise", "-1"], ["--enc-noise", "1.5"],
-                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--delay-id", "2"], ["--delay-id", "-1"], ["--pf-gate", "0"], ["--pf-gate", "1e4"], ["--pf-adapt-max", "0.5"], ["--pf-adapt-max", "nan"], ["--pf-adapt-max", "1e13"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
+                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--delay-id", "2"], ["--delay-id", "-1"], ["--pf-gate", "0"], ["--pf-gate", "1e4"], ["--pf-adapt-max", "0.5"], ["--pf-adapt-max", "nan"], ["--pf-adapt-max", "1e13"], ["--machine-causes=1"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
                     ["--bogus", "1"], ["--drift"]):
             r = run("br_robust_run", "--json", keep, *bad)
             self.assert_refused(r, 2)
@@ -351,17 +351,21 @@ class ToolsTest(unittest.TestCase):
         self.assert_untouched(keep)
 
     def test_robust_run_pf_adapt_max_takes_effect(self):
-        """--pf-adapt-max (docs/fleet.md, "The PF's noise inflation"): 1 is the PF without cfg.adapt's
-        inflation, the machine's own factor gives the default run to the digit; under force noise
-        the reference's PF inflates, so the two differ"""
+        """--pf-adapt-max (docs/fleet.md, "The PF's start on the fleet's axes"): 1 is the PF without
+        cfg.adapt's inflation, the machine's own factor gives the default run to the digit; under force
+        noise the reference's PF inflates, so the two differ (a machine with cfg.adapt off, nis_ref 0:
+        the same run whatever the factor)"""
         def rms(*extra):
             r = run("br_robust_run", "--only", "hinf_pf", "--force-noise", "0.2", "--seed", "3", *extra)
             self.assertEqual(r.returncode, 0, r.stderr)
             return re.search(r"contour RMS (\S+) m", r.stdout).group(1)
         with open(ARGS.machine, encoding="utf-8") as f:
-            own = json.load(f)["estimator"]["pf"]["adapt"]["max_scale"]
+            adapt = json.load(f)["estimator"]["pf"].get("adapt", {})
         default = rms()
-        self.assertEqual(rms("--pf-adapt-max", repr(float(own))), default)
+        if adapt.get("nis_ref", 0.0) == 0.0:
+            self.assertEqual(rms("--pf-adapt-max", "1"), default)
+            return
+        self.assertEqual(rms("--pf-adapt-max", repr(float(adapt["max_scale"]))), default)
         self.assertNotEqual(rms("--pf-adapt-max", "1"), default)
 
     def test_circle_ext_output_checked_before_the_runs(self):

@@ -171,7 +171,8 @@ void br_circle_use_pf_gate(br_circle_cfg_t *c, double sigma);
 
 /* The tools' --pf-adapt-max: cfg.adapt's largest variance factor (docs/modules/pf.md,
  * "Keeping lock"); 1 keeps the factor at 1, the thesis filter; s <= 0 leaves the
- * machine file's. A study setting (docs/fleet.md, "The PF's noise inflation"). */
+ * machine file's; no effect where cfg.adapt is off (nis_ref 0). A study setting
+ * (docs/fleet.md, "The PF's start on the fleet's axes"). */
 void br_circle_use_pf_adapt_max(br_circle_cfg_t *c, double s);
 
 /* The tools' --machine-causes: the PF's and the UKF's estimation model with the
