@@ -831,10 +831,9 @@ def est_per_step(m, est):
     return out
 
 
-def load_q_N2_per_s(m, est):
-    """Estimator est's external-force random walk in N^2/s from its machine file's
-    estimator.<est>.load: q_N2_per_s, or q_Fact2_per_s times the actuator's force squared;
-    None when the block is absent; ValueError unless exactly one of the two is given."""
+def _load_given(m, est):
+    """(key, value) of the random walk estimator.<est>.load gives; None when the block is
+    absent; ValueError unless exactly one of q_N2_per_s and q_Fact2_per_s is given."""
     ld = m["estimator"][est].get("load")
     if ld is None:
         return None
@@ -842,16 +841,24 @@ def load_q_N2_per_s(m, est):
     if len(given) != 1:
         raise ValueError("needs exactly one of q_N2_per_s (N^2/s) and q_Fact2_per_s (the actuator's force "
                          "squared, per second)")
-    if given[0] == "q_N2_per_s":
-        return ld["q_N2_per_s"]
+    return given[0], ld[given[0]]
+
+
+def load_q_N2_per_s(m, est):
+    """Estimator est's external-force random walk in N^2/s from its machine file's
+    estimator.<est>.load: q_N2_per_s, or q_Fact2_per_s times the actuator's force squared;
+    None when the block is absent; ValueError unless exactly one of the two is given."""
+    given = _load_given(m, est)
+    if given is None:
+        return None
+    key, q = given
     F_act = actuator_force_N(m)
-    return ld["q_Fact2_per_s"] * F_act * F_act
+    return q if key == "q_N2_per_s" else q * F_act * F_act
 
 
 def load_field(m, est):
-    """the field estimator.<est>.load's random walk is given by (for messages)"""
-    ld = m["estimator"][est].get("load") or {}
-    return "estimator.%s.load.%s" % (est, "q_Fact2_per_s" if "q_Fact2_per_s" in ld else "q_N2_per_s")
+    """the field estimator.<est>.load's random walk is given by (for messages; a valid block)"""
+    return "estimator.%s.load.%s" % (est, _load_given(m, est)[0])
 
 
 def ukf_load(m):

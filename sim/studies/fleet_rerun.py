@@ -31,28 +31,19 @@ CTRLS = ("hinf_only", "hinf_ukf", "hinf_pf")
 
 
 def records(d, names):
-    """{(traj, ctrl): the run's record} from the circle JSONs in d"""
-    out = {}
+    """({(traj, ctrl): the run's record} from the circle JSONs in d, the causes their UKF and PF runs
+    carried: "thesis" where the JSON predates the key)"""
+    out, causes = {}, set()
     for name in names:
         for ctrl in CTRLS:
             path = os.path.join(d, "%s_%s.json" % (name, ctrl))
             if os.path.exists(path):
                 with open(path, encoding="utf-8") as f:
-                    out[(name, ctrl)] = fleet_runs.result(json.load(f)["controllers"][ctrl], "contour_rms_m",
-                                                          "max_err_m")
-    return out
-
-
-def estimator_causes(d, names):
-    """the causes the study's UKF and PF runs in d carried ("thesis" where the JSON predates the key)"""
-    seen = set()
-    for name in names:
-        for ctrl in CTRLS[1:]:
-            path = os.path.join(d, "%s_%s.json" % (name, ctrl))
-            if os.path.exists(path):
-                with open(path, encoding="utf-8") as f:
-                    seen.add(json.load(f).get("estimator_causes", "thesis"))
-    return seen
+                    js = json.load(f)
+                out[(name, ctrl)] = fleet_runs.result(js["controllers"][ctrl], "contour_rms_m", "max_err_m")
+                if ctrl != "hinf_only":
+                    causes.add(js.get("estimator_causes", "thesis"))
+    return out, causes
 
 
 def tally(recs):
@@ -106,14 +97,14 @@ def main():
                 if tr["name"] in names:
                     fleet_runs.circle_runs(od, exe, os.path.join(d, "truth-model.json"), fleet_axis.gms_options(ax), tr,
                                            fleet_runs.run_seed(a.seed, i, k + 1), ax["force_noise_N"], log, extra)
-        before_causes = estimator_causes(d, names) - {"machine"}
-        if before_causes:
+        recs_before, causes_before = records(d, names)
+        if causes_before - {"machine"}:
             # the rerun's estimators carry machine.json's causes (fleet_runs.circle_runs): a change of its own
             print("axis %d: the study's estimators ran on the %s model, the rerun's carry machine.json's causes"
-                  % (i, "/".join(sorted(before_causes))))
-        for key, r in records(d, names).items():
+                  % (i, "/".join(sorted(causes_before - {"machine"}))))
+        for key, r in recs_before.items():
             before[(i,) + key] = r
-        for key, r in records(od, names).items():
+        for key, r in records(od, names)[0].items():
             now[(i,) + key] = r
         for name in names:
             print("axis %d %s: %s" % (i, name, "  ".join(

@@ -89,7 +89,7 @@ def run(cmd, env=None):
 
 
 def one_plant(job):
-    i, seed, binp, out, diagnose, only, pf_proposal, ahead, delay_id, pf_load, pf_gate, pf_adapt_max = job
+    i, seed, binp, out, diagnose, only, run_opts = job
     ref = reference()
     p = draw(seed, ref)
     d = os.path.join(out, "plants", f"{i:04d}")
@@ -125,19 +125,7 @@ def one_plant(job):
         cmd += ["--model", model]
     if only:
         cmd += ["--only", only]
-    if pf_proposal is not None:
-        cmd += ["--pf-proposal", str(pf_proposal)]
-    if ahead is not None:
-        cmd += ["--ahead", repr(ahead)]
-    if pf_load is not None:
-        cmd += ["--pf-load", repr(pf_load)]
-    if pf_gate is not None:
-        cmd += ["--pf-gate", repr(pf_gate)]
-    if pf_adapt_max is not None:
-        cmd += ["--pf-adapt-max", repr(pf_adapt_max)]
-    if delay_id is not None:
-        cmd += ["--delay-id", str(delay_id)]
-    rc, _, err = run(cmd)
+    rc, _, err = run(cmd + list(run_opts))
     if rc != 0:
         rec["error"] = err.strip()
     else:
@@ -419,8 +407,12 @@ def main():
         if bad_names:
             ap.error(f"--only: unknown controllers {bad_names}")
         only = ",".join(["hinf_only"] + [k for k in names if k != "hinf_only"])
-    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only, a.pf_proposal, a.ahead, a.delay_id, a.pf_load, a.pf_gate,
-             a.pf_adapt_max) for i in range(a.n)]
+    # the study's settings passed to every plant's br_robust_run, as given
+    run_opts = tuple(x for opt, v in (("--pf-proposal", a.pf_proposal), ("--ahead", a.ahead),
+                                      ("--pf-load", a.pf_load), ("--pf-gate", a.pf_gate),
+                                      ("--pf-adapt-max", a.pf_adapt_max), ("--delay-id", a.delay_id))
+                     if v is not None for x in (opt, repr(v)))
+    jobs = [(i, a.seed + i, a.bin, a.out, i < kd, only, run_opts) for i in range(a.n)]
     recs, t0 = [], time.time()
     progress(0, a.n, t0)
     with Pool(a.jobs) as pool:
