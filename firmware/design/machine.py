@@ -46,6 +46,10 @@ FORMAT_VERSION = 2
 FORMAT_UPGRADE = "python firmware/design/upgrade_machine.py OLD.json NEW.json"
 # BR_PF_MAX_PARTICLES of firmware/include/bristle/br_pf.h
 PF_MAX_PARTICLES = 2048
+# BR_PF_MS_SLOTS of firmware/include/bristle/br_pf.h (its default, 4 BR_PF_MAX_PARTICLES): the
+# Maxwell-slip element deflections the PF's particles carry, elements x particles at most
+PF_MS_SLOTS_PER_PARTICLE = 4
+PF_MS_SLOTS = PF_MS_SLOTS_PER_PARTICLE * PF_MAX_PARTICLES
 # BR_EST_AHEAD_MAX_PERIODS of firmware/include/bristle/br_est.h
 EST_AHEAD_MAX_PERIODS = 2.0
 # BR_DLYID_MAX_CAND of firmware/include/bristle/br_dlyid.h
@@ -606,6 +610,16 @@ def _friction_model_checks(get, errors):
         errors.append(("friction_model.share", "has %d entries, breakaway_m %d" % (len(a), len(d))))
     elif abs(math.fsum(a) - 1.0) > MSLIP_SHARE_TOL:
         errors.append(("friction_model.share", "sums to %.9g, must be 1 (within %g)" % (math.fsum(a), MSLIP_SHARE_TOL)))
+    n_p = get("estimator.pf.n_particles")
+    if isinstance(n_p, int) and n_p >= 1 and len(d) > pf_mslip_max(n_p):
+        errors.append(("friction_model.breakaway_m", "has %d elements; the PF's %d particles carry at most %d "
+                       "(BR_PF_MS_SLOTS %d deflections: elements x estimator.pf.n_particles)"
+                       % (len(d), n_p, pf_mslip_max(n_p), PF_MS_SLOTS)))
+
+
+def pf_mslip_max(n_particles):
+    """The most Maxwell-slip elements the PF carries at n_particles (BR_PF_MS_SLOTS), at most MSLIP_MAX."""
+    return min(MSLIP_MAX, PF_MS_SLOTS // n_particles)
 
 
 def mslip_elements(m):

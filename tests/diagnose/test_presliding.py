@@ -210,6 +210,54 @@ class MachineFileTest(unittest.TestCase):
         # k_i = share_i Fs / d_i (docs/modules/mslip.md)
         self.assertAlmostEqual(k[0][0] / (fm["share"][0] * loaded["friction"]["Fs_N"] / 1e-6), 1.0, delta=1e-12)
 
+    def test_more_elements_than_the_pf_carries(self):
+        """7 elements at 1500 particles (fleet axis 30: br_pf_init refused the
+        image's PF): machine.json gets the closest 5-element set, which loads;
+        the 7 written as they are, the loader names the field."""
+        causes = (ps.NAME, "actuator_delay")
+        d7 = list(np.geomspace(0.5e-6, 25e-6, 7))
+        fit = self.fit(causes)
+        fit.nl = dict(fit.nl, **ps.from_elements({"breakaway_m": d7, "share": [1 / 7] * 7}))
+        m, notes, prov = self.machine(causes), [], {}
+        m["estimator"]["pf"]["n_particles"] = 1500
+        loader = machinejson._loader()
+        n_max = loader.PF_MS_SLOTS // 1500
+        self.assertEqual(loader.pf_mslip_max(1500), n_max)
+        machinejson._friction_model(m, Diag(fit), prov, notes)
+        fm = m["friction_model"]
+        self.assertEqual(len(fm["breakaway_m"]), n_max)
+        self.assertTrue(set(fm["breakaway_m"]) <= {float("%.6g" % x) for x in d7})
+        self.assertEqual(prov["friction_model.share"], "derived")
+        self.assertTrue(any("reduced to %d" % n_max in n for n in notes), notes)
+        # the curve stays close: within 5 % of Fs everywhere, presliding_m within 5 %
+        x = np.geomspace(0.1e-6, 50e-6, 400)
+        diff = np.abs(ps.virgin_curve(fm["breakaway_m"], fm["share"], x) - ps.virgin_curve(d7, [1 / 7] * 7, x))
+        self.assertLess(float(diff.max()), 0.05)
+        self.assertAlmostEqual(ps.presliding_m(fm["breakaway_m"], fm["share"]) / ps.presliding_m(d7, [1 / 7] * 7),
+                               1.0, delta=0.05)
+        m["causes"] = {"actuator_delay": {"delay_s": 0.002}}
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "machine.json")
+            with open(path, "w") as f:
+                json.dump(m, f)
+            loader.load(path)
+            m["friction_model"] = {"model": "maxwell_slip", "breakaway_m": d7,
+                                   "share": [round(1 / 7, 6)] * 6 + [round(1 - 6 * round(1 / 7, 6), 6)]}
+            with open(path, "w") as f:
+                json.dump(m, f)
+            with self.assertRaises(loader.MachineError) as cm:
+                loader.load(path)
+            self.assertIn("field friction_model.breakaway_m: has 7 elements; the PF's 1500 particles carry at "
+                          "most %d" % n_max, "\n".join(cm.exception.lines))
+
+    def test_fewer_elements_keeps_a_set_that_fits(self):
+        d, a, err = ps.fewer_elements([1e-6, 4e-6], [0.25, 0.75], 2)
+        self.assertEqual((d, a, err), ((1e-6, 4e-6), (0.25, 0.75), 0.0))
+        # one element left: the single breakaway closest to the curve, share 1
+        d, a, err = ps.fewer_elements([1e-6, 4e-6, 1.6e-5], [0.1, 0.8, 0.1], 1)
+        self.assertEqual((d, a), ((4e-6,), (1.0,)))
+        self.assertGreater(err, 0.0)
+
     def test_not_written_beside_a_cause_the_firmware_does_not_combine(self):
         causes = (ps.NAME, "offset")
         m, notes = self.machine(causes), []

@@ -161,6 +161,11 @@ def main():
             m = re.search(r"#define\s+%s\s+([0-9.]+)u?f?\b" % name, f.read())
         check(m is not None and float(m.group(1)) == float(value),
               "%s: %s is %s, the machine schema's %s" % (header, name, m and m.group(1), value))
+    with open(os.path.join(REPO, "firmware", "include", "bristle", "br_pf.h")) as f:
+        m = re.search(r"#define\s+BR_PF_MS_SLOTS\s+\(([0-9]+)u \* BR_PF_MAX_PARTICLES\)", f.read())
+    check(m is not None and int(m.group(1)) == machine.PF_MS_SLOTS_PER_PARTICLE,
+          "br_pf.h: BR_PF_MS_SLOTS is %s BR_PF_MAX_PARTICLES, the machine schema's %d"
+          % (m and m.group(1), machine.PF_MS_SLOTS_PER_PARTICLE))
     bad = copy.deepcopy(good)
     bad["friction"]["Fs_N"] = 0.5 * bad["friction"]["Fc_N"]
     bad["control"]["torque_limit_Nm"] = 2.0 * bad["amplifier"]["torque_per_duty_Nm"]

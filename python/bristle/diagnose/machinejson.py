@@ -24,7 +24,9 @@ marked "assumed"; what follows from the log and the rest is "derived". The
                    base's Fs/Fc if the base's would be below Fc)
   causes           model.json's causes and their parameters, same names ("identified")
   friction_model   presliding_hysteresis's element set as maxwell_slip ("identified"),
-                   when the other causes are ones the estimators combine with it
+                   when the other causes are ones the estimators combine with it; with
+                   more elements than the PF's particles carry (BR_PF_MS_SLOTS), the
+                   closest smaller set ("derived", presliding_hysteresis.fewer_elements)
   control.hinf     the base's weights, unless they admit no acceptable H-inf design on
                    the identified machine, or hinf_rule asks, or they are derived (the
                    rule's for the base's friction): then the weights from the machine
@@ -319,12 +321,23 @@ def _friction_model(m, diag, prov, notes):
                          "estimation model does not combine maxwell_slip with %s yet; model.json has it"
                          % ", ".join(others))
             return
-        el = modelfile.presliding_elements(diag.extended.nl)
+        nl = diag.extended.nl
+        n_max = _loader().pf_mslip_max(m["estimator"]["pf"]["n_particles"])
+        d, a, err = ps.fewer_elements(nl["ps_breakaway"], nl["ps_share"], n_max)
+        el = modelfile.presliding_elements(dict(nl, ps_breakaway=d, ps_share=a))
         m["friction_model"] = {"model": "maxwell_slip", "breakaway_m": el["breakaway_m"], "share": el["share"]}
         for f in ("model", "breakaway_m", "share"):
-            prov["friction_model." + f] = "identified"
+            prov["friction_model." + f] = "identified" if err == 0.0 else "derived"
         notes.append("presliding_hysteresis: friction_model maxwell_slip with %d elements, presliding_m %.3g m"
                      % (len(el["share"]), ps.presliding_m(el["breakaway_m"], el["share"])))
+        if err > 0.0:
+            # the PF's element storage (BR_PF_MS_SLOTS) holds fewer at its particle count: the
+            # closest smaller set (presliding_hysteresis.fewer_elements); model.json keeps the log's
+            notes.append("presliding_hysteresis: the log's %d elements reduced to %d, the most the PF's %d "
+                         "particles carry; the force-travel curve differs by at most %.3g %% of Fs_N "
+                         "(model.json keeps the %d)" % (len(nl["ps_share"]), len(el["share"]),
+                                                        m["estimator"]["pf"]["n_particles"], 100.0 * err,
+                                                        len(nl["ps_share"])))
     elif (m.get("friction_model") or {}).get("model") == "maxwell_slip" and others:
         m.pop("friction_model")
         notes.append("the given friction_model maxwell_slip is dropped: the log shows %s, which the firmware's "

@@ -44,9 +44,11 @@ from steady sliding at which the force has covered 90 % of its swing from
 {breakaway_m, share}. The element set goes into model.json's "presliding"
 object and machine.json's friction_model (maxwell_slip), which the firmware
 estimators read (docs/modules/mslip.md)."""
+import itertools
 import math
 
 import numpy as np
+from scipy import optimize
 
 from .. import lugre
 
@@ -193,6 +195,42 @@ def presliding_m(breakaway, share):
         if c1 >= 1.8:
             return float(x0 + (1.8 - c0) * (x1 - x0) / (c1 - c0))
     return float(knots[-1])
+
+
+def virgin_curve(breakaway, share, x):
+    """The element set's force from undeflected elements over the travel x,
+    in Fs: sum_i alpha_i min(x / d_i, 1) (the clamp form at a slow move; the
+    curve after a reversal from sliding is twice this one, Masing's rule)."""
+    d = np.asarray(breakaway, dtype=float)
+    return np.minimum(np.asarray(x, dtype=float)[:, None] / d[None, :], 1.0) @ np.asarray(share, dtype=float)
+
+
+def fewer_elements(breakaway, share, n_max, n_x=256):
+    """The element set with at most n_max elements whose force-travel curve is
+    closest to the given set's: over every subset of n_max of the given
+    breakaway displacements, the shares by non-negative least squares on the
+    virgin curve (n_x travels, geometric from d_min / 4 to 2 d_max; the sum 1
+    held by a heavy row, then exact), the subset with the smallest largest
+    difference kept. Returns (breakaway, share, the largest difference in Fs);
+    the set itself, difference 0, when it has n_max elements or fewer."""
+    d = np.asarray(breakaway, dtype=float)
+    a = np.asarray(share, dtype=float) / math.fsum(share)
+    if len(d) <= n_max:
+        return tuple(d), tuple(a), 0.0
+    x = np.geomspace(d.min() / 4.0, 2.0 * d.max(), n_x)
+    target = virgin_curve(d, a, x)
+    best = None
+    for sub in itertools.combinations(range(len(d)), n_max):
+        cols = np.minimum(x[:, None] / d[None, list(sub)], 1.0)
+        w, _ = optimize.nnls(np.vstack([cols, np.full(n_max, 1.0e3)]), np.append(target, 1.0e3))
+        if not w.sum() > 0.0:
+            continue
+        w = w / w.sum()
+        err = float(np.max(np.abs(cols @ w - target)))
+        if best is None or err < best[2]:
+            best = (d[list(sub)], w, err)
+    keep = best[1] > 0.0
+    return tuple(best[0][keep]), tuple(best[1][keep]), best[2]
 
 
 def initial_stiffness_Npm(nl, Fs):
