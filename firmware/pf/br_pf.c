@@ -658,6 +658,15 @@ static void adapt_update(br_pf_t *pf, float s1, float s2, uint32_t n_valid)
     pf->q_scale_std = (s > 1.0f) ? sqrtf((s < ad->max_scale) ? s : ad->max_scale) : 1.0f;
 }
 
+/* eq. D2 (docs/modules/model.md): the position's share of the delay in use that
+ * the period's mean torque misses, dt^2 / (2 J_eff) u_p, rad; 0 without a
+ * delay's fraction (bit for bit: the shift less 0) */
+static float delay_pos_rad(const br_pf_t *pf)
+{
+    const float dt = pf->cfg.est.model.dt_s;
+    return 0.5f * dt * dt * pf->model.inv_Jeff * br_est_delay_pos_torque(&pf->delay, pf->delay.m, pf->delay.f);
+}
+
 br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
 {
     if (pf == NULL || y == NULL) {
@@ -672,6 +681,9 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     }
     /* the torque that reached the axis over the last period (the command itself without a delay) */
     const float u_a = br_est_delay_apply(&pf->delay, u_prev_Nm);
+    /* eq. D2: the position's share of the torque's step within the period, which the
+     * period's mean torque u_a misses; the same for every particle: theta's shift */
+    const float th_d = delay_pos_rad(pf);
     /* the delay's identification (off unless cfg.est.delay_id.n_cand): from the next period on,
      * the torque with the delay it finds */
     br_est_dlyid_step(&pf->dlyid, &pf->cfg.est, y, &pf->delay);
@@ -687,7 +699,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     float lmax, sums[2];
     br_pf_load_tick(pf);
     /* with cfg.load the particles are predicted with u - L F_d */
-    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), shift, y_rel, 1, &lmax, sums);
+    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), shift - th_d, y_rel, 1, &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         pf->weighed = BR_PF_WEIGHED_NONE;
@@ -771,8 +783,10 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     /* no measurement: the delay's identification starts again at the next one */
     pf->dlyid.primed = 0;
     br_pf_load_tick(pf);
-    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, br_est_delay_apply(&pf->delay, u_prev_Nm)),
-                                               0.0f, 0.0f, 0, &lmax, sums);
+    const float u_a = br_est_delay_apply(&pf->delay, u_prev_Nm);
+    /* eq. D2 as in br_pf_step: theta moved by th_d (the origin kept) */
+    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), 0.0f - delay_pos_rad(pf), 0.0f, 0,
+                                               &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         pf->weighed = BR_PF_WEIGHED_NONE;
