@@ -107,14 +107,8 @@ void br_app_motion_reset(br_app_t *app)
     app->hold_N = 0.0f;
     app->v_pred = 0.0f;
     app->d_pred = 0.0f;
-    /* the history always: the tolerance reads commands older than the delay's */
-    br_est_delay_reset(&app->mot_delay, m->delay_s, dt, 1);
-    const uint32_t tol = (uint32_t)ceilf(BR_APP_STUCK_DELAY_TOL_S / dt);
-    const uint32_t room = BR_EST_DELAY_HIST - 2u - app->mot_delay.m; /* m <= HIST - 2: br_app_init */
-    app->mot_tol_periods = (tol < room) ? tol : room;
+    br_est_delay_reset(&app->mot_delay, m->delay_s, dt, m->delay_s > 0.0f);
     app->mot_F_N = 0.0f;
-    app->mot_F_lo_N = 0.0f;
-    app->mot_F_hi_N = 0.0f;
     app->brk_counts = 0;
     app->brk_frac = 0.0f;
     app->brk_v = 0.0f;
@@ -299,12 +293,8 @@ br_app_fault_t br_app_motion_watch(br_app_t *app, int32_t d, uint32_t periods)
     /* a still count: the speed the model predicts with the force beyond what
      * held the axis when it last moved, friction taking up to the band and
      * the count's quantization up to k_m BR_APP_STUCK_QUANT_ACCEL (F_hold's
-     * uncertainty; never reversing the motion); the force of the delays up to
-     * BR_APP_STUCK_DELAY_TOL_S longer that is closest to F_hold (0 beyond it
-     * when F_hold lies among them) */
-    const float h = app->hold_N;
-    const float push = (app->mot_F_lo_N > h) ? app->mot_F_lo_N - h : ((app->mot_F_hi_N < h) ? app->mot_F_hi_N - h : 0.0f);
-    float v1 = app->v_pred + push / k_m;
+     * uncertainty; never reversing the motion) */
+    float v1 = app->v_pred + (F - app->hold_N) / k_m;
     const float brake = m->stuck_band_N / k_m + BR_APP_STUCK_QUANT_ACCEL;
     v1 = (v1 > brake) ? v1 - brake : ((v1 < -brake) ? v1 + brake : 0.0f);
     /* the motion at the period's end speed (the speed may have dropped at
@@ -422,17 +412,5 @@ void br_app_motion_push(br_app_t *app)
 {
     /* the command held over the period that ended; what reached the axis over
      * it: (1 - f) u[k-1-m] + f u[k-2-m] for the delay (m + f) dt (docs/modules/est.md) */
-    const float L = app->ctrl.cfg.lead_mprad;
-    app->mot_F_N = br_est_delay_apply(&app->mot_delay, app->last.tau_Nm) / L;
-    /* what a delay up to BR_APP_STUCK_DELAY_TOL_S longer would bring: the same fraction, whole
-     * periods more (bounded: mot_tol_periods <= BR_EST_DELAY_HIST) */
-    float lo = app->mot_F_N, hi = app->mot_F_N;
-    const br_est_delay_t *d = &app->mot_delay;
-    for (uint32_t i = 1u; i <= app->mot_tol_periods; i++) {
-        const float F = br_est_delay_torque(d, d->m + i, d->f) / L;
-        lo = fminf(lo, F);
-        hi = fmaxf(hi, F);
-    }
-    app->mot_F_lo_N = lo;
-    app->mot_F_hi_N = hi;
+    app->mot_F_N = br_est_delay_apply(&app->mot_delay, app->last.tau_Nm) / app->ctrl.cfg.lead_mprad;
 }

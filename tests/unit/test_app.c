@@ -952,34 +952,6 @@ static void test_encoder_frozen_actuator_delay(void **st)
     assert_int_equal(br_app_init(&g.app, &g.c, &g.hal, NULL), BR_OK);
 }
 
-/* An actuator delay the model was not told (a diagnosis missed 1.3-2.8 ms on
- * four fleet axes, whose healthy starts latched ENC_FROZEN within 1.4 ms):
- * up to BR_APP_STUCK_DELAY_TOL_S the model takes, of the forces such delays
- * bring, the one closest to F_hold, so a force BR_APP_STUCK_DELAY_TOL_S
- * less 0.1 period late runs the start and the axis moves (with a tolerance
- * of 0 it latches); a counter that never moves still latches, by
- * BR_APP_STUCK_DELAY_TOL_S later at most (test_encoder_frozen_actuator_delay,
- * above). */
-static void test_encoder_frozen_unmodelled_delay(void **st)
-{
-    (void)st;
-    const float dt = ctrl_cfg().dt_s;
-    const float late = BR_APP_STUCK_DELAY_TOL_S / dt - 0.1f;
-    assert_true(late > 1.0f); /* more than a period: the still start the fix is for */
-    int32_t moved = 0;
-    const int n = delayed_start_periods(late, 0.0f, &moved);
-    print_message("unmodelled delay of %.1f periods: %d periods run, the axis at %d counts\n", (double)late, n,
-                  (int)moved);
-    assert_int_equal(n, DELAY_RUN_PERIODS);
-    assert_true(moved > 100);
-    /* the force never arrives (later than the run): ENC_FROZEN within the tolerance's periods
-     * after the model without a tolerance would (3 periods on this rig's still start) */
-    const int never = delayed_start_periods((float)DELAY_RUN_PERIODS, 0.0f, &moved);
-    assert_true(never < DELAY_RUN_PERIODS);
-    assert_true((float)never <= 3.0f + ceilf(BR_APP_STUCK_DELAY_TOL_S / dt));
-    assert_int_equal(moved, 0);
-}
-
 /* The reference limiter: within the limits the reference passes bit for
  * bit; a step is limited (flagged) to the machine's speed and acceleration,
  * lands on the target and passes again; a target beyond the soft travel
@@ -1384,7 +1356,6 @@ int main(void)
         cmocka_unit_test(test_encoder_frozen_latches),
         cmocka_unit_test(test_encoder_frozen_coarse_count),
         cmocka_unit_test(test_encoder_frozen_actuator_delay),
-        cmocka_unit_test(test_encoder_frozen_unmodelled_delay),
         cmocka_unit_test(test_reference_limiter),
         cmocka_unit_test(test_speed_cap_is_what_passes),
         cmocka_unit_test(test_reference_to_the_end),

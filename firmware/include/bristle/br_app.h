@@ -128,13 +128,6 @@ br_app_guard_cfg_t br_app_guard_cfg(float dt_s, float max_speed_counts_per_s);
  * 0.5 N on the reference machine, 280 N on an axis of 0.1 um counts at
  * 0.27 ms; docs/reliability.md, "Stuck encoder and quantization"). */
 #define BR_APP_STUCK_QUANT_ACCEL 2.0f
-/* The actuator delay beyond motion.delay_s the stuck-encoder model tolerates,
- * s: with the count still, the force it predicts motion from is, of the forces
- * that delays from delay_s to delay_s + this would bring, the one closest to
- * F_hold (docs/reliability.md, "Stuck encoder and an unmodelled delay": the
- * fleet's axes have delays up to 3 ms, and a diagnosis missed 1.3-2.8 ms on
- * four of them, whose healthy starts latched ENC_FROZEN within 1.4 ms). */
-#define BR_APP_STUCK_DELAY_TOL_S 3.0e-3f
 /* Standstill after a braking ramp: so many periods at zero reference speed,
  * then outputs off. */
 #define BR_APP_BRAKE_SETTLE_PERIODS 20u
@@ -245,9 +238,6 @@ typedef struct {
     float d_pred;           /* the model's motion since the count stopped, counts */
     br_est_delay_t mot_delay; /* the commands over the actuator delay (motion.delay_s) */
     float mot_F_N;          /* the force that reached the axis over the period that ended (load side) */
-    float mot_F_lo_N;       /* the least and the largest force delays from motion.delay_s to */
-    float mot_F_hi_N;       /* BR_APP_STUCK_DELAY_TOL_S more would bring (load side) */
-    uint32_t mot_tol_periods; /* BR_APP_STUCK_DELAY_TOL_S in whole periods, within the history */
     /* the braking ramp */
     int32_t brk_counts;     /* the ramp's position: integer part ... */
     float brk_frac;         /* ... and fraction */
