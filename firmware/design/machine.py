@@ -610,8 +610,10 @@ def _friction_model_checks(get, errors):
         errors.append(("friction_model.share", "has %d entries, breakaway_m %d" % (len(a), len(d))))
     elif abs(math.fsum(a) - 1.0) > MSLIP_SHARE_TOL:
         errors.append(("friction_model.share", "sums to %.9g, must be 1 (within %g)" % (math.fsum(a), MSLIP_SHARE_TOL)))
+    # the PF's element storage binds when the image may run the PF (control.estimator)
     n_p = get("estimator.pf.n_particles")
-    if isinstance(n_p, int) and n_p >= 1 and len(d) > pf_mslip_max(n_p):
+    runs_pf = "pf" in str(get("control.estimator") or "").split(",")
+    if runs_pf and isinstance(n_p, int) and n_p >= 1 and len(d) > pf_mslip_max(n_p):
         errors.append(("friction_model.breakaway_m", "has %d elements; the PF's %d particles carry at most %d "
                        "(BR_PF_MS_SLOTS %d deflections: elements x estimator.pf.n_particles)"
                        % (len(d), n_p, pf_mslip_max(n_p), PF_MS_SLOTS)))

@@ -142,8 +142,8 @@ float br_est_delay_torque(const br_est_delay_t *d, uint32_t m, float f)
 
 float br_est_delay_pos_torque(const br_est_delay_t *d, uint32_t m, float f)
 {
-    if (!d->on) {
-        return 0.0f;
+    if (!d->on || f == 0.0f) {
+        return 0.0f; /* exactly (no -0, no 0 inf from an overflowing difference) */
     }
     /* eq. D2: u_p = f (1 - f) (u[k-2-m] - u[k-1-m]) */
     return f * (1.0f - f) * (cmd_ago(d, m + 1u) - cmd_ago(d, m));

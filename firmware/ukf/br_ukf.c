@@ -328,13 +328,6 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
     return BR_OK;
 }
 
-/* Steps 1-2: sigma points of the posterior (x, P) of the last step and their
- * prediction through eq. 6 discretised, Y_j = f_d(X_j, u_{k-1}), into the
- * predicted mean xm and covariance Pm. With the external force F_d (cfg.load)
- * the torque is u - L F_d_j (eq. 1 with the load beside the friction) and
- * F_d_j carries over (a random walk). *chol_reset is set when a failed
- * Cholesky reset P (kept in ukf->P: the recovery outlives a later failure).
- * Returns 0 when the prediction is not finite. */
 /* eq. D2 (docs/modules/model.md): the position's share of the delay in use that
  * the period's mean torque misses, dt^2 / (2 J_eff) u_p, rad (0 without a
  * delay's fraction); predict adds it to theta's mean */
@@ -344,6 +337,13 @@ static float delay_pos_rad(const br_ukf_t *ukf)
     return 0.5f * dt * dt * ukf->model.inv_Jeff * br_est_delay_pos_torque(&ukf->delay, ukf->delay.m, ukf->delay.f);
 }
 
+/* Steps 1-2: sigma points of the posterior (x, P) of the last step and their
+ * prediction through eq. 6 discretised, Y_j = f_d(X_j, u_{k-1}), into the
+ * predicted mean xm and covariance Pm. With the external force F_d (cfg.load)
+ * the torque is u - L F_d_j (eq. 1 with the load beside the friction) and
+ * F_d_j carries over (a random walk). *chol_reset is set when a failed
+ * Cholesky reset P (kept in ukf->P: the recovery outlives a later failure).
+ * Returns 0 when the prediction is not finite. */
 static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[NM], float Pm[NM][NM], int *chol_reset)
 {
     const int n = ukf->n, nsig = 2 * n + 1;

@@ -54,7 +54,8 @@ class DelayHistory:
         within the period; 0 without the history"""
         if not self.on:
             return F(0.0) * f
-        return (f * (F(1.0) - f)) * (self.u[m + 1] - self.u[m])
+        # +0 exactly where f = 0 (br_est_delay_pos_torque)
+        return np.where(f == F(0.0), F(0.0), (f * (F(1.0) - f)) * (self.u[m + 1] - self.u[m])).astype(F)
 
     def apply(self, u):
         """the command u of the last period joins the history; returns the torque that reached

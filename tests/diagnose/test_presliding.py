@@ -249,6 +249,17 @@ class MachineFileTest(unittest.TestCase):
                 loader.load(path)
             self.assertIn("field friction_model.breakaway_m: has 7 elements; the PF's 1500 particles carry at "
                           "most %d" % n_max, "\n".join(cm.exception.lines))
+            # an image that runs no PF (control.estimator ukf): the 7 load, and the diagnosis keeps them
+            m["control"]["estimator"] = "ukf"
+            with open(path, "w") as f:
+                json.dump(m, f)
+            loader.load(path)
+        m, notes, prov = self.machine(causes), [], {}
+        m["estimator"]["pf"]["n_particles"] = 1500
+        m["control"]["estimator"] = "ukf"
+        machinejson._friction_model(m, Diag(fit), prov, notes)
+        self.assertEqual(len(m["friction_model"]["breakaway_m"]), 7)
+        self.assertEqual(prov["friction_model.share"], "identified")
 
     def test_fewer_elements_keeps_a_set_that_fits(self):
         d, a, err = ps.fewer_elements([1e-6, 4e-6], [0.25, 0.75], 2)

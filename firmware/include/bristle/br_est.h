@@ -120,8 +120,8 @@ float br_est_delay_torque(const br_est_delay_t *d, uint32_t m, float f);
  * torque misses (eq. D2, docs/modules/model.md): the torque steps from
  * u[k-2-m] to u[k-1-m] at f dt into the period, so the position moves by
  * dt^2 / (2 J_eff) (u_a + u_p), u_p = f (1 - f) (u[k-2-m] - u[k-1-m]); returns
- * u_p (call after br_est_delay_apply). 0 without the history (d->on 0) and
- * for f = 0. */
+ * u_p (call after br_est_delay_apply). +0 exactly without the history (d->on
+ * 0) and for f = 0. */
 float br_est_delay_pos_torque(const br_est_delay_t *d, uint32_t m, float f);
 
 

@@ -322,15 +322,18 @@ def _friction_model(m, diag, prov, notes):
                          % ", ".join(others))
             return
         nl = diag.extended.nl
-        n_max = _loader().pf_mslip_max(m["estimator"]["pf"]["n_particles"])
+        # the PF's element storage (BR_PF_MS_SLOTS) binds when the image may run the PF
+        n_max = (_loader().pf_mslip_max(m["estimator"]["pf"]["n_particles"])
+                 if "pf" in m["control"]["estimator"].split(",") else len(nl["ps_share"]))
         d, a, err = ps.fewer_elements(nl["ps_breakaway"], nl["ps_share"], n_max)
-        el = modelfile.presliding_elements(dict(nl, ps_breakaway=d, ps_share=a))
+        reduced = len(d) < len(nl["ps_share"])
+        el = modelfile.presliding_elements(dict(nl, ps_breakaway=d, ps_share=a) if reduced else nl)
         m["friction_model"] = {"model": "maxwell_slip", "breakaway_m": el["breakaway_m"], "share": el["share"]}
         for f in ("model", "breakaway_m", "share"):
-            prov["friction_model." + f] = "identified" if err == 0.0 else "derived"
+            prov["friction_model." + f] = "derived" if reduced else "identified"
         notes.append("presliding_hysteresis: friction_model maxwell_slip with %d elements, presliding_m %.3g m"
                      % (len(el["share"]), ps.presliding_m(el["breakaway_m"], el["share"])))
-        if err > 0.0:
+        if reduced:
             # the PF's element storage (BR_PF_MS_SLOTS) holds fewer at its particle count: the
             # closest smaller set (presliding_hysteresis.fewer_elements); model.json keeps the log's
             notes.append("presliding_hysteresis: the log's %d elements reduced to %d, the most the PF's %d "
