@@ -571,11 +571,11 @@ static void test_dlyid_keeps_the_delay_at_command_steps(void **st)
 }
 
 /* the PF (g_p along the Stribeck curve, which follows the breakaway) and the UKF with that
- * delay, the identification off, follow a start from rest at 30 Coulomb torques: no step of
- * either is an outlier over 40 periods (without D2: PF 31, UKF 37) */
-static void test_estimators_follow_delayed_steps(void **st)
+ * delay, the identification off, on a start from rest at GO_FC Coulomb torques over
+ * STEP_PERIODS periods; the reads of periods [held_from, held_from + held_n) held (the
+ * estimators predict without a measurement). Their outlier steps in *out_pf, *out_ukf. */
+static void delayed_start_outliers(int held_from, int held_n, uint32_t *out_pf, uint32_t *out_ukf)
 {
-    (void)st;
     br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
     const double delay_s = 1.7 * (double)cp.est.model.dt_s;
     cp.est.model.causes.delay_s = (float)delay_s;
@@ -593,21 +593,42 @@ static void test_estimators_follow_delayed_steps(void **st)
     axis_t a;
     axis_init(&a, &cp.est, delay_s);
     float u_prev = 0.0f;
-    uint32_t out_pf = 0u, out_ukf = 0u;
+    *out_pf = 0u;
+    *out_ukf = 0u;
     for (int k = 0; k < STEP_PERIODS; k++) {
         const br_meas_t y = axis_step(&a, u_prev, cp.est.rad_per_count);
-        const br_status_t sp = br_pf_step(pf, &y, u_prev);
-        const br_status_t su = br_ukf_step(&ukf, &y, u_prev);
-        assert_false(BR_FAILED(sp));
-        assert_false(BR_FAILED(su));
-        out_pf += (sp == BR_W_OUTLIER) ? 1u : 0u;
-        out_ukf += (su == BR_W_OUTLIER) ? 1u : 0u;
+        if (k >= held_from && k < held_from + held_n) {
+            assert_false(BR_FAILED(br_pf_predict(pf, u_prev)));
+            assert_false(BR_FAILED(br_ukf_predict(&ukf, u_prev)));
+        } else {
+            const br_status_t sp = br_pf_step(pf, &y, u_prev);
+            const br_status_t su = br_ukf_step(&ukf, &y, u_prev);
+            assert_false(BR_FAILED(sp));
+            assert_false(BR_FAILED(su));
+            *out_pf += (sp == BR_W_OUTLIER) ? 1u : 0u;
+            *out_ukf += (su == BR_W_OUTLIER) ? 1u : 0u;
+        }
         u_prev = (float)(GO_FC * a.L * a.Fc);
     }
+    free(pf);
+}
+
+/* that start: no step of either estimator is an outlier over 40 periods (without D2: PF 31,
+ * UKF 37); and the same with the reads of the periods the step reaches the axis in held
+ * (br_pf_predict, br_ukf_predict: D2 on the predict-only path too) */
+static void test_estimators_follow_delayed_steps(void **st)
+{
+    (void)st;
+    uint32_t out_pf, out_ukf;
+    delayed_start_outliers(0, 0, &out_pf, &out_ukf);
     print_message("delayed steps: PF outliers %u, UKF outliers %u\n", (unsigned)out_pf, (unsigned)out_ukf);
     assert_int_equal(out_pf, 0u);
     assert_int_equal(out_ukf, 0u);
-    free(pf);
+    delayed_start_outliers(2, 2, &out_pf, &out_ukf);
+    print_message("delayed steps, reads 2-3 held: PF outliers %u, UKF outliers %u\n", (unsigned)out_pf,
+                  (unsigned)out_ukf);
+    assert_int_equal(out_pf, 0u);
+    assert_int_equal(out_ukf, 0u);
 }
 
 int main(void)
