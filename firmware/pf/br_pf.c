@@ -209,6 +209,17 @@ static float elements_move(br_pf_t *pf, uint32_t j, float dx_m)
     return f;
 }
 
+/* Every particle's elements moved by dx_m (elements_move); the sum of their
+ * forces, in particle order */
+static float elements_move_all(br_pf_t *pf, float dx_m)
+{
+    float sf = 0.0f;
+    for (uint32_t j = 0; j < pf->cfg.n_particles; j++) {
+        sf += elements_move(pf, j, dx_m);
+    }
+    return sf;
+}
+
 /* Estimate of the freshly drawn set: the mean of f_nl (eq. 6; with elements
  * sum_i k_i e_ji, eq. MS2) (its weights all alike: pf->weighed as init left it) */
 static void estimate_current(br_pf_t *pf)
@@ -724,6 +735,10 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     /* the kernel's (the reference's on the scalar reference path) */
     const int outlier = verdict == BR_W_OUTLIER;
     float sf = pf->cfg.scalar_path ? br_pf_kref_resample(pf, lmax, outlier) : br_pf_kernel_resample(pf, lmax, outlier);
+    if (has_elements(pf) && th_d != 0.0f) {
+        /* eq. D2 for the elements: they follow the position's share too (eq. MS1) */
+        sf = elements_move_all(pf, pf->model.cfg.lead_mprad * th_d);
+    }
     const float inv_m = 1.0f / (float)m;
     pf->n_outliers = (verdict == BR_W_OUTLIER) ? pf->n_outliers + 1u : 0u;
     if (pf->n_outliers >= pf->cfg.est.reanchor_after) {
@@ -785,8 +800,8 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     br_pf_load_tick(pf);
     const float u_a = br_est_delay_apply(&pf->delay, u_prev_Nm);
     /* eq. D2 as in br_pf_step: theta moved by th_d (the origin kept) */
-    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), 0.0f - delay_pos_rad(pf), 0.0f, 0,
-                                               &lmax, sums);
+    const float th_d = delay_pos_rad(pf);
+    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), 0.0f - th_d, 0.0f, 0, &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         pf->weighed = BR_PF_WEIGHED_NONE;
@@ -796,7 +811,10 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     for (uint32_t j = 0; j < m; j++) {
         pf->idx[j] = (uint16_t)j;
     }
-    pf->est.F_hat_N = br_pf_load_comp_N(pf, sum_set(pf) * (1.0f / (float)m));
+    /* eq. D2 for the elements as in br_pf_step */
+    const float sf = (has_elements(pf) && th_d != 0.0f) ? elements_move_all(pf, pf->model.cfg.lead_mprad * th_d)
+                                                        : sum_set(pf);
+    pf->est.F_hat_N = br_pf_load_comp_N(pf, sf * (1.0f / (float)m));
     pf->weighed = BR_PF_WEIGHED_EQUAL;
     if (pf->n_predicted < UINT32_MAX) {
         pf->n_predicted++;
