@@ -199,7 +199,7 @@ static void reversal(br_dlyid_t *id, float w_min, float T)
 }
 
 int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax, int32_t counts, float frac,
-                  const float u_Nm[BR_DLYID_MAX_SLOTS], const float up_Nm[BR_DLYID_MAX_SLOTS])
+                  const float u_Nm[BR_DLYID_MAX_SLOTS])
 {
     const uint32_t n = c->n_cand;
     if (n == 0u || n > BR_DLYID_MAX_CAND) {
@@ -227,10 +227,9 @@ int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t
     for (uint32_t j = 0; j <= n; j++) {
         float *x = id->x[j];
         /* (dly4) candidate j's prediction with the torque its delay brings: u_j = (1 - f_j)
-         * u[k-1-m_j] + f_j u[k-2-m_j] (the caller's, from its command history); the
-         * position with the torque's step within the period, u_p,j (eq. D2) */
+         * u[k-1-m_j] + f_j u[k-2-m_j] (the caller's, from its command history) */
         const float u = u_Nm[j];
-        const float th = x[0] + T * x[1] + id->a02 * x[2] + id->b0 * (u + up_Nm[j]) - shift;
+        const float th = x[0] + T * x[1] + id->a02 * x[2] + id->b0 * u - shift;
         const float om = x[1] + id->a12 * x[2] + id->b1 * u;
         /* (dly5) innovation nu_j = y - theta-_j, update x+ = x- + K nu_j, J_j <- forget J_j + nu_j^2 */
         const float nu = y_rel - th;

@@ -140,15 +140,6 @@ float br_est_delay_torque(const br_est_delay_t *d, uint32_t m, float f)
     return (1.0f - f) * cmd_ago(d, m) + f * cmd_ago(d, m + 1u);
 }
 
-float br_est_delay_pos_torque(const br_est_delay_t *d, uint32_t m, float f)
-{
-    if (!d->on || f == 0.0f) {
-        return 0.0f; /* exactly (no -0, no 0 inf from an overflowing difference) */
-    }
-    /* eq. D2: u_p = f (1 - f) (u[k-2-m] - u[k-1-m]) */
-    return f * (1.0f - f) * (cmd_ago(d, m + 1u) - cmd_ago(d, m));
-}
-
 /* u[k + i], the command of period k + i (u[k - 1] = u_prev, the newest):
  * from the history for i < -1, u_prev for the ones not yet computed (i >= -1) */
 static float cmd_at(const br_est_delay_t *d, int32_t i, float u_prev_Nm)
@@ -215,15 +206,13 @@ void br_est_dlyid_step(br_dlyid_t *id, const br_est_cfg_t *cfg, const br_meas_t 
     if (n == 0u || n > BR_DLYID_MAX_CAND) {
         return; /* off (or a configuration no check has seen): the history is not read */
     }
-    /* (dly4) each slot's torque: u_j = (1 - f_j) u[k-1-m_j] + f_j u[k-2-m_j], and its
-     * position's share u_p,j (eq. D2) */
-    float u[BR_DLYID_MAX_SLOTS], up[BR_DLYID_MAX_SLOTS];
+    /* (dly4) each slot's torque: u_j = (1 - f_j) u[k-1-m_j] + f_j u[k-2-m_j] */
+    float u[BR_DLYID_MAX_SLOTS];
     for (uint32_t j = 0; j <= n; j++) {
         u[j] = br_est_delay_torque(d, id->cm[j], id->cf[j]);
-        up[j] = br_est_delay_pos_torque(d, id->cm[j], id->cf[j]);
     }
     const br_dlyid_axis_t ax = dlyid_axis(cfg);
-    if (br_dlyid_step(id, &cfg->delay_id, &ax, y->counts, y->frac, u, up)) {
+    if (br_dlyid_step(id, &cfg->delay_id, &ax, y->counts, y->frac, u)) {
         d->m = id->cm[id->cur];
         d->f = id->cf[id->cur]; /* d->on: set by br_est_delay_init for the bank */
     }

@@ -209,17 +209,6 @@ static float elements_move(br_pf_t *pf, uint32_t j, float dx_m)
     return f;
 }
 
-/* Every particle's elements moved by dx_m (elements_move); the sum of their
- * forces, in particle order */
-static float elements_move_all(br_pf_t *pf, float dx_m)
-{
-    float sf = 0.0f;
-    for (uint32_t j = 0; j < pf->cfg.n_particles; j++) {
-        sf += elements_move(pf, j, dx_m);
-    }
-    return sf;
-}
-
 /* Estimate of the freshly drawn set: the mean of f_nl (eq. 6; with elements
  * sum_i k_i e_ji, eq. MS2) (its weights all alike: pf->weighed as init left it) */
 static void estimate_current(br_pf_t *pf)
@@ -669,15 +658,6 @@ static void adapt_update(br_pf_t *pf, float s1, float s2, uint32_t n_valid)
     pf->q_scale_std = (s > 1.0f) ? sqrtf((s < ad->max_scale) ? s : ad->max_scale) : 1.0f;
 }
 
-/* eq. D2 (docs/modules/model.md): the position's share of the delay in use that
- * the period's mean torque misses, dt^2 / (2 J_eff) u_p, rad; 0 without a
- * delay's fraction (bit for bit: the shift less 0) */
-static float delay_pos_rad(const br_pf_t *pf)
-{
-    const float dt = pf->cfg.est.model.dt_s;
-    return 0.5f * dt * dt * pf->model.inv_Jeff * br_est_delay_pos_torque(&pf->delay, pf->delay.m, pf->delay.f);
-}
-
 br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
 {
     if (pf == NULL || y == NULL) {
@@ -692,9 +672,6 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     }
     /* the torque that reached the axis over the last period (the command itself without a delay) */
     const float u_a = br_est_delay_apply(&pf->delay, u_prev_Nm);
-    /* eq. D2: the position's share of the torque's step within the period, which the
-     * period's mean torque u_a misses; the same for every particle: theta's shift */
-    const float th_d = delay_pos_rad(pf);
     /* the delay's identification (off unless cfg.est.delay_id.n_cand): from the next period on,
      * the torque with the delay it finds */
     br_est_dlyid_step(&pf->dlyid, &pf->cfg.est, y, &pf->delay);
@@ -710,7 +687,7 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     float lmax, sums[2];
     br_pf_load_tick(pf);
     /* with cfg.load the particles are predicted with u - L F_d */
-    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), shift - th_d, y_rel, 1, &lmax, sums);
+    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), shift, y_rel, 1, &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         pf->weighed = BR_PF_WEIGHED_NONE;
@@ -735,10 +712,6 @@ br_status_t br_pf_step(br_pf_t *pf, const br_meas_t *y, float u_prev_Nm)
     /* the kernel's (the reference's on the scalar reference path) */
     const int outlier = verdict == BR_W_OUTLIER;
     float sf = pf->cfg.scalar_path ? br_pf_kref_resample(pf, lmax, outlier) : br_pf_kernel_resample(pf, lmax, outlier);
-    if (has_elements(pf) && th_d != 0.0f) {
-        /* eq. D2 for the elements: they follow the position's share too (eq. MS1) */
-        sf = elements_move_all(pf, pf->model.cfg.lead_mprad * th_d);
-    }
     const float inv_m = 1.0f / (float)m;
     pf->n_outliers = (verdict == BR_W_OUTLIER) ? pf->n_outliers + 1u : 0u;
     if (pf->n_outliers >= pf->cfg.est.reanchor_after) {
@@ -798,10 +771,8 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     /* no measurement: the delay's identification starts again at the next one */
     pf->dlyid.primed = 0;
     br_pf_load_tick(pf);
-    const float u_a = br_est_delay_apply(&pf->delay, u_prev_Nm);
-    /* eq. D2 as in br_pf_step: theta moved by th_d (the origin kept) */
-    const float th_d = delay_pos_rad(pf);
-    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, u_a), 0.0f - th_d, 0.0f, 0, &lmax, sums);
+    const uint32_t n_valid = predict_and_weigh(pf, br_pf_load_torque(pf, br_est_delay_apply(&pf->delay, u_prev_Nm)),
+                                               0.0f, 0.0f, 0, &lmax, sums);
     noise_advance(pf);
     if (n_valid == 0u) {
         pf->weighed = BR_PF_WEIGHED_NONE;
@@ -811,10 +782,7 @@ br_status_t br_pf_predict(br_pf_t *pf, float u_prev_Nm)
     for (uint32_t j = 0; j < m; j++) {
         pf->idx[j] = (uint16_t)j;
     }
-    /* eq. D2 for the elements as in br_pf_step */
-    const float sf = (has_elements(pf) && th_d != 0.0f) ? elements_move_all(pf, pf->model.cfg.lead_mprad * th_d)
-                                                        : sum_set(pf);
-    pf->est.F_hat_N = br_pf_load_comp_N(pf, sf * (1.0f / (float)m));
+    pf->est.F_hat_N = br_pf_load_comp_N(pf, sum_set(pf) * (1.0f / (float)m));
     pf->weighed = BR_PF_WEIGHED_EQUAL;
     if (pf->n_predicted < UINT32_MAX) {
         pf->n_predicted++;

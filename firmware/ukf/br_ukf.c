@@ -135,7 +135,6 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->n_outliers = 0u;
     ukf->n_recover = 0u;
     ukf->n_predicted = 0u;
-    ukf->th_delay_rad = 0.0f;
     ukf->n_load_acq = 0u;
     ukf->n_load_undo = 0u;
     ukf->alt_pending = 0;
@@ -328,15 +327,6 @@ static br_status_t prime(br_ukf_t *ukf, const br_meas_t *y)
     return BR_OK;
 }
 
-/* eq. D2 (docs/modules/model.md): the position's share of the delay in use that
- * the period's mean torque misses, dt^2 / (2 J_eff) u_p, rad (0 without a
- * delay's fraction); predict adds it to theta's mean */
-static float delay_pos_rad(const br_ukf_t *ukf)
-{
-    const float dt = ukf->cfg.est.model.dt_s;
-    return 0.5f * dt * dt * ukf->model.inv_Jeff * br_est_delay_pos_torque(&ukf->delay, ukf->delay.m, ukf->delay.f);
-}
-
 /* Steps 1-2: sigma points of the posterior (x, P) of the last step and their
  * prediction through eq. 6 discretised, Y_j = f_d(X_j, u_{k-1}), into the
  * predicted mean xm and covariance Pm. With the external force F_d (cfg.load)
@@ -393,9 +383,6 @@ static int predict(br_ukf_t *ukf, float u_prev_Nm, float xm[NM], float Pm[NM][NM
         mdev[i] = ukf->wi * d;
         xm[i] = ukf->Y[0][i] + mdev[i];
     }
-    /* eq. D2: theta with the position's share of the delay's torque step within the
-     * period (the same for every sigma point: the mean only, P- unchanged) */
-    xm[BR_X_THETA] += ukf->th_delay_rad;
     /* predicted covariance P- = sum_j Wc_j (Y_j - x-)(Y_j - x-)^T + Q, evaluated about
      * the central point (d_j = Y_j - Y_0) as the algebraically equal
      *   P- = sum_{j>=1} W d_j d_j^T + (beta - alpha^2) m m^T + Q,
@@ -666,7 +653,6 @@ br_status_t br_ukf_step(br_ukf_t *ukf, const br_meas_t *y, float u_prev_Nm)
     }
     /* the torque that reached the axis over the last period (the command itself without a delay) */
     const float u_a = br_est_delay_apply(&ukf->delay, u_prev_Nm);
-    ukf->th_delay_rad = delay_pos_rad(ukf);
     /* the delay's identification (off unless cfg.est.delay_id.n_cand): from the next period on,
      * the torque with the delay it finds */
     br_est_dlyid_step(&ukf->dlyid, &ukf->cfg.est, y, &ukf->delay);
@@ -802,9 +788,7 @@ br_status_t br_ukf_predict(br_ukf_t *ukf, float u_prev_Nm)
      * and a re-acquisition is not undone across the gap */
     ukf->dlyid.primed = 0;
     ukf->alt_pending = 0;
-    const float u_a = br_est_delay_apply(&ukf->delay, u_prev_Nm);
-    ukf->th_delay_rad = delay_pos_rad(ukf);
-    if (!predict(ukf, u_a, xm, Pm, &chol_reset)) {
+    if (!predict(ukf, br_est_delay_apply(&ukf->delay, u_prev_Nm), xm, Pm, &chol_reset)) {
         return fail_reset(ukf);
     }
     clamp_mean(ukf, xm);

@@ -9,9 +9,7 @@ their three terms in order, from 0, one array operation per term.
 
   history  u_a = (1 - f) u[k-1-m] + f u[k-2-m] for the delay (m + f) periods,
            0 for a command before the first; without a delay and without the
-           identification u_a is the command itself; the position's share of
-           the torque's step within the period u_p = f (1 - f) (u[k-2-m] -
-           u[k-1-m]) (eq. D2)
+           identification u_a is the command itself
   bank     slots j = 0 .. N-1 at delays j step_s, slot N at the configured
            delay (the one in use at the start); per measurement:
            dly7 (the reversal rule), dly3 (covariance and gain), dly4 and dly5
@@ -48,14 +46,6 @@ class DelayHistory:
     def torque(self, m, f):
         """u_a = (1 - f) u[k-1-m] + f u[k-2-m]; m and f arrays (one per slot) or scalars"""
         return (F(1.0) - f) * self.u[m] + f * self.u[m + 1]
-
-    def pos_torque(self, m, f):
-        """eq. D2: u_p = f (1 - f) (u[k-2-m] - u[k-1-m]), the position's share of the torque's step
-        within the period; 0 without the history"""
-        if not self.on:
-            return F(0.0) * f
-        # +0 exactly where f = 0 (br_est_delay_pos_torque)
-        return np.where(f == F(0.0), F(0.0), (f * (F(1.0) - f)) * (self.u[m + 1] - self.u[m])).astype(F)
 
     def apply(self, u):
         """the command u of the last period joins the history; returns the torque that reached
@@ -179,9 +169,8 @@ class DelayBank:
         y_rel = frac * self.rpc
         # dly4: each slot's prediction with the torque its delay brings
         u = hist.torque(self.cm, self.cf)
-        up = hist.pos_torque(self.cm, self.cf)
         x0, x1, x2 = self.x
-        th = (((x0 + T * x1) + self.a02 * x2) + self.b0 * (u + up)) - shift
+        th = (((x0 + T * x1) + self.a02 * x2) + self.b0 * u) - shift
         om = (x1 + self.a12 * x2) + self.b1 * u
         # dly5: innovation, update, the forgotten sums
         nu = y_rel - th

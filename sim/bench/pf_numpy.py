@@ -261,8 +261,6 @@ class NumpyPf:
         # the torque that reached the axis over the last period: u with the delay in use; then the
         # delay identification takes the measurement, its switch acting from the next period on
         u = self.hist.apply(u)
-        # eq. D2: theta's shift by the position's share of the delay's torque step (0 without one)
-        th_d = ((F(0.5) * self.h) * self.h) * self.inv_jeff * self.hist.pos_torque(self.hist.m, self.hist.f)
         if self.bank.step(counts, frac, self.hist):
             self.hist.m, self.hist.f = self.bank.cm[self.bank.cur], self.bank.cf[self.bank.cur]
         if not self.primed:
@@ -283,7 +281,7 @@ class NumpyPf:
         om = om + (self.q_std[1] * self.q_scale) * n[1]
         z = z + (self.q_std[2] * self.q_scale) * n[2]
         gp = np.fmin(np.fmax(x[3] + (self.q_std[3] * self.q_scale) * n[3], self.gp_min), self.gp_max)
-        th = th - (shift - th_d)
+        th = th - shift
         fnl = self._fnl(om, z, gp)
         valid = np.isfinite(th) & np.isfinite(om) & np.isfinite(z) & np.isfinite(gp) & np.isfinite(fnl)
         # 2. log-likelihood

@@ -18,13 +18,11 @@ out=${2:-}
 # realistic plant, the machine's PF: the PF loses lock in the run-up of every
 # move (half max_accel) before anything is injected; the UKF loses lock under
 # a load step of half the actuator's force and under the cutting-like load
-# (since eq. D2, docs/modules/model.md, the PF holds the bounds of the stuck, jumping, lying and
-# dropping counter, the limited reference, the NaN reference, the deadlines and the run to the
-# travel's end: its losses there were the run-ups after the delay identification's switch)
-known_realistic="enc_noise_30/hinf_pf"
+known_realistic="enc_stuck_30/hinf_pf,enc_stuck_90/hinf_pf,enc_jump_30/hinf_pf,enc_lie_30/hinf_pf"
+known_realistic+=",enc_noise_30/hinf_pf,enc_drop3_90/hinf_pf,enc_drop5_90/hinf_pf"
 known_realistic+=",load_half_hold/hinf_ukf,load_half_hold/hinf_pf,load_half_30/hinf_ukf,load_half_30/hinf_pf"
-known_realistic+=",load_small_30/hinf_pf,cutting_30/hinf_ukf,cutting_30/hinf_pf"
-known_realistic+=",ref_step_10mm/hinf_pf"
+known_realistic+=",load_small_30/hinf_pf,cutting_30/hinf_ukf,cutting_30/hinf_pf,ref_max_speed/hinf_pf"
+known_realistic+=",ref_step_10mm/hinf_pf,ref_nan_90/hinf_pf,deadline_90/hinf_pf,ref_to_end/hinf_pf,deadline_end/hinf_pf"
 known_realistic+=",enc_spike_30/hinf_pf,enc_slip_30/hinf_pf"
 # the same with the PF's g_p along the Stribeck curve (tau 15 ms): the moves
 # run and every fault bound holds; read noise, loads, the limited step and
@@ -32,10 +30,6 @@ known_realistic+=",enc_spike_30/hinf_pf,enc_slip_30/hinf_pf"
 known_curve="enc_noise_30/hinf_pf,load_half_hold/hinf_ukf,load_half_hold/hinf_pf,load_half_30/hinf_ukf"
 known_curve+=",load_half_30/hinf_pf,load_small_30/hinf_pf,cutting_30/hinf_ukf,cutting_30/hinf_pf,ref_step_10mm/hinf_pf"
 known_curve+=",enc_spike_30/hinf_pf,enc_slip_30/hinf_pf"
-# since eq. D2 the delay identification no longer switches to 0.5 ms for 7-8 periods at a move's
-# start (its candidates' step positions are exact now); without that switch the PF with g_p on the
-# curve loses lock in the 90 % moves' run-up (3 failed reads, the cruise at max_speed_mps)
-known_curve+=",enc_drop3_90/hinf_pf,ref_max_speed/hinf_pf"
 # hardware-like plant: with the thesis gate both estimators lost lock in the
 # run-up of every move; with the gate's transient term (outlier_transient_k = 1,
 # docs/presliding-plants.md) the moves reach their faults: the UKF keeps 16 of
@@ -43,9 +37,7 @@ known_curve+=",enc_drop3_90/hinf_pf,ref_max_speed/hinf_pf"
 # 5 (it still loses lock in the run-up of the others and after an encoder glitch
 # in a move)
 known_hw="load_half_hold/hinf_ukf,load_half_30/hinf_ukf,cutting_30/hinf_ukf,ref_step_10mm/hinf_ukf"
-# (since eq. D2, without the identification's false switch at a move's start that carried it, the
-# PF also loses lock in the 30 % moves' run-up and in the run toward the stroke's end)
-for s in enc_stuck_30 enc_jump_30 enc_lie_30 deadline_end enc_spike_30 enc_slip_30 enc_stuck_90 enc_noise_30 enc_drop3_90 enc_drop5_90 load_half_hold load_half_30 load_small_30 cutting_30 \
+for s in enc_spike_30 enc_slip_30 enc_stuck_90 enc_noise_30 enc_drop3_90 enc_drop5_90 load_half_hold load_half_30 load_small_30 cutting_30 \
          ref_max_speed ref_step_10mm ref_nan_90 deadline_90 ref_to_end; do
   known_hw+=",$s/hinf_pf"
 done

@@ -3,8 +3,7 @@
  * its configuration is checked at init; on an axis of the test's own (a rigid
  * body with a smooth Coulomb and a viscous friction, integrated finely in
  * double, the torque delayed to the instant) it finds the delay the axis has
- * and keeps the one the estimator already models (also at command steps, eq.
- * D2, where the PF and the UKF follow a start from rest); a bank that overflows
+ * and keeps the one the estimator already models; a bank that overflows
  * starts again and still finds it; a step without a measurement restarts it;
  * with no switch the estimators are bit for bit those without it. The
  * machine's settings are read from the machine's configuration. */
@@ -531,106 +530,6 @@ static void test_dlyid_finds_delay_at_reversals(void **st)
     assert_true(fabs(modelled_s(&d, &c) - 1.5e-3) <= 0.5 * (double)c.delay_id.step_s + 1e-9);
 }
 
-/* Eq. D2 (docs/modules/model.md): a torque step reaches the axis f dt into a period, so
- * the position moves by dt^2 / (2 J_eff) f (1 - f) (u_old - u_new) less than the period's
- * mean torque says. The test's axis with a delay of 1.7 periods, which the estimators model
- * (f = 0.7), under steps of 12 Coulomb torques from rest, reversed every 40 periods. */
-#define STEP_PERIODS 40
-#define STEP_FC 12.0
-#define GO_FC 30.0
-static float step_command(const axis_t *a, int k)
-{
-    return (float)(((k / STEP_PERIODS) % 2 == 0 ? STEP_FC : -STEP_FC) * a->L * a->Fc);
-}
-
-/* the bank keeps the delay it models: no switch in 0.6 s of steps (without D2 the step's
- * position favours a longer delay at every step and the bank switches) */
-static void test_dlyid_keeps_the_delay_at_command_steps(void **st)
-{
-    (void)st;
-    br_est_cfg_t c = machine_pf();
-    const double delay_s = 1.7 * (double)c.model.dt_s;
-    c.model.causes.delay_s = (float)delay_s;
-    assert_int_equal(br_est_cfg_check(&c), BR_OK);
-    axis_t a;
-    axis_init(&a, &c, delay_s);
-    br_est_delay_t d;
-    br_dlyid_t id;
-    br_est_delay_init(&d, &c);
-    br_est_dlyid_init(&id, &c);
-    assert_true(d.f > 0.69f && d.f < 0.71f);
-    float u_prev = 0.0f;
-    for (int k = 0; k < (int)(0.6 / PF_DT_S); k++) {
-        const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
-        (void)br_est_delay_apply(&d, u_prev);
-        br_est_dlyid_step(&id, &c, &y, &d);
-        u_prev = step_command(&a, k + 1);
-    }
-    assert_int_equal(id.n_switch, 0u);
-    assert_true(fabs(modelled_s(&d, &c) - delay_s) < 1e-9);
-}
-
-/* the PF (g_p along the Stribeck curve, which follows the breakaway) and the UKF with that
- * delay, the identification off, on a start from rest at GO_FC Coulomb torques over
- * STEP_PERIODS periods; the reads of periods [held_from, held_from + held_n) held (the
- * estimators predict without a measurement). Their outlier steps in *out_pf, *out_ukf. */
-static void delayed_start_outliers(int held_from, int held_n, uint32_t *out_pf, uint32_t *out_ukf)
-{
-    br_pf_cfg_t cp = br_circle_pf_cfg_tuned(PF_DT_S);
-    const double delay_s = 1.7 * (double)cp.est.model.dt_s;
-    cp.est.model.causes.delay_s = (float)delay_s;
-    cp.est.delay_id.n_cand = 0u;
-    cp.gp_curve.on = 1u; /* g_p along the Stribeck curve: the breakaway from Fs to Fc followed (pf.md) */
-    cp.gp_curve.rho = 0.9f;
-    br_pf_t *pf = calloc(1, sizeof *pf);
-    assert_non_null(pf);
-    assert_int_equal(br_pf_init(pf, &cp), BR_OK);
-    br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(PF_DT_S);
-    cu.est.model.causes.delay_s = (float)delay_s;
-    cu.est.delay_id.n_cand = 0u;
-    br_ukf_t ukf;
-    assert_int_equal(br_ukf_init(&ukf, &cu), BR_OK);
-    axis_t a;
-    axis_init(&a, &cp.est, delay_s);
-    float u_prev = 0.0f;
-    *out_pf = 0u;
-    *out_ukf = 0u;
-    for (int k = 0; k < STEP_PERIODS; k++) {
-        const br_meas_t y = axis_step(&a, u_prev, cp.est.rad_per_count);
-        if (k >= held_from && k < held_from + held_n) {
-            assert_false(BR_FAILED(br_pf_predict(pf, u_prev)));
-            assert_false(BR_FAILED(br_ukf_predict(&ukf, u_prev)));
-        } else {
-            const br_status_t sp = br_pf_step(pf, &y, u_prev);
-            const br_status_t su = br_ukf_step(&ukf, &y, u_prev);
-            assert_false(BR_FAILED(sp));
-            assert_false(BR_FAILED(su));
-            *out_pf += (sp == BR_W_OUTLIER) ? 1u : 0u;
-            *out_ukf += (su == BR_W_OUTLIER) ? 1u : 0u;
-        }
-        u_prev = (float)(GO_FC * a.L * a.Fc);
-    }
-    free(pf);
-}
-
-/* that start: no step of either estimator is an outlier over 40 periods (without D2: PF 31,
- * UKF 37); and the same with the reads of the periods the step reaches the axis in held
- * (br_pf_predict, br_ukf_predict: D2 on the predict-only path too) */
-static void test_estimators_follow_delayed_steps(void **st)
-{
-    (void)st;
-    uint32_t out_pf, out_ukf;
-    delayed_start_outliers(0, 0, &out_pf, &out_ukf);
-    print_message("delayed steps: PF outliers %u, UKF outliers %u\n", (unsigned)out_pf, (unsigned)out_ukf);
-    assert_int_equal(out_pf, 0u);
-    assert_int_equal(out_ukf, 0u);
-    delayed_start_outliers(2, 2, &out_pf, &out_ukf);
-    print_message("delayed steps, reads 2-3 held: PF outliers %u, UKF outliers %u\n", (unsigned)out_pf,
-                  (unsigned)out_ukf);
-    assert_int_equal(out_pf, 0u);
-    assert_int_equal(out_ukf, 0u);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -644,8 +543,6 @@ int main(void)
         cmocka_unit_test(test_dlyid_predict_restarts),
         cmocka_unit_test(test_dlyid_on_without_switch_is_off),
         cmocka_unit_test(test_dlyid_no_false_switch),
-        cmocka_unit_test(test_dlyid_keeps_the_delay_at_command_steps),
-        cmocka_unit_test(test_estimators_follow_delayed_steps),
         cmocka_unit_test(test_dlyid_no_switch_at_reversals),
         cmocka_unit_test(test_dlyid_finds_delay_at_reversals),
     };

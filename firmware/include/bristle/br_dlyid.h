@@ -105,8 +105,7 @@ void br_dlyid_init(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_
 
 /* One period's measurement (counts + frac counts): every slot's filter
  * predicts with u_Nm[j], the torque its delay (cm[j] + cf[j] periods) brought
- * over the last period (from the caller's command history), its position with
- * up_Nm[j] more (the torque's step within the period, eq. D2), and takes the
+ * over the last period (from the caller's command history), and takes the
  * measurement (dly2-dly5). Once past the warm-up, when the best slot's
  * forgotten sum of squared innovations is below switch_ratio times that of
  * the slot in use and the one in use explains the motion worse than the noise
@@ -115,6 +114,6 @@ void br_dlyid_init(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_
  * not finite restarts the bank at the next measurement, nothing switched.
  * Off (n_cand = 0): 0, nothing read. */
 int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t *ax, int32_t counts, float frac,
-                  const float u_Nm[BR_DLYID_MAX_SLOTS], const float up_Nm[BR_DLYID_MAX_SLOTS]);
+                  const float u_Nm[BR_DLYID_MAX_SLOTS]);
 
 #endif

@@ -116,14 +116,6 @@ float br_est_delay_apply(br_est_delay_t *d, float u_prev_Nm);
  * after br_est_delay_apply): (1 - f) u[k-1-m] + f u[k-2-m]. */
 float br_est_delay_torque(const br_est_delay_t *d, uint32_t m, float f);
 
-/* The position's share of a delay of m + f periods that the period's mean
- * torque misses (eq. D2, docs/modules/model.md): the torque steps from
- * u[k-2-m] to u[k-1-m] at f dt into the period, so the position moves by
- * dt^2 / (2 J_eff) (u_a + u_p), u_p = f (1 - f) (u[k-2-m] - u[k-1-m]); returns
- * u_p (call after br_est_delay_apply). +0 exactly without the history (d->on
- * 0) and for f = 0. */
-float br_est_delay_pos_torque(const br_est_delay_t *d, uint32_t m, float f);
-
 
 /* The force to compensate (docs/modules/est.md, "Compensating ahead").
  * With cfg->comp_ahead_periods = lambda = 0 it is F_hat_N itself. Otherwise

@@ -116,7 +116,6 @@ typedef struct {
     uint32_t n_recover;              /* covariance resets since init (failed Cholesky, or a
                                         non-finite prediction or update) */
     uint32_t n_predicted;            /* predict-only steps since the last measurement */
-    float th_delay_rad;              /* eq. D2: this period's position share of the delay's torque step */
     uint32_t n_load_acq;             /* gated innovations re-acquired as a load (cfg.load) */
     uint32_t n_load_undo;            /* re-acquisitions undone by the next innovation (a glitch) */
     /* The last step's re-acquisition's alternative (cfg.load; docs/modules/ukf.md,
