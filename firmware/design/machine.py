@@ -610,17 +610,21 @@ def _friction_model_checks(get, errors):
         errors.append(("friction_model.share", "has %d entries, breakaway_m %d" % (len(a), len(d))))
     elif abs(math.fsum(a) - 1.0) > MSLIP_SHARE_TOL:
         errors.append(("friction_model.share", "sums to %.9g, must be 1 (within %g)" % (math.fsum(a), MSLIP_SHARE_TOL)))
-    # the PF's element storage binds when the image may run the PF (control.estimator)
     n_p = get("estimator.pf.n_particles")
-    runs_pf = "pf" in str(get("control.estimator") or "").split(",")
-    if runs_pf and isinstance(n_p, int) and n_p >= 1 and len(d) > pf_mslip_max(n_p):
-        errors.append(("friction_model.breakaway_m", "has %d elements; the PF's %d particles carry at most %d "
-                       "(BR_PF_MS_SLOTS %d deflections: elements x estimator.pf.n_particles)"
-                       % (len(d), n_p, pf_mslip_max(n_p), PF_MS_SLOTS)))
+    if isinstance(n_p, int) and n_p >= 1:
+        lim = mslip_max(str(get("control.estimator") or ""), n_p)
+        if len(d) > lim and lim < MSLIP_MAX:  # beyond MSLIP_MAX the list's own range says so
+            errors.append(("friction_model.breakaway_m", "has %d elements; the PF's %d particles carry at most %d "
+                           "(BR_PF_MS_SLOTS %d deflections: elements x estimator.pf.n_particles)"
+                           % (len(d), n_p, lim, PF_MS_SLOTS)))
 
 
-def pf_mslip_max(n_particles):
-    """The most Maxwell-slip elements the PF carries at n_particles (BR_PF_MS_SLOTS), at most MSLIP_MAX."""
+def mslip_max(estimators, n_particles):
+    """The most Maxwell-slip elements a machine's estimators carry: MSLIP_MAX, and when the image
+    may run the PF (pf in control.estimator, comma-separated) what its element storage holds at
+    n_particles (BR_PF_MS_SLOTS)."""
+    if "pf" not in estimators.split(","):
+        return MSLIP_MAX
     return min(MSLIP_MAX, PF_MS_SLOTS // n_particles)
 
 

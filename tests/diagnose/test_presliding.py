@@ -222,7 +222,8 @@ class MachineFileTest(unittest.TestCase):
         m["estimator"]["pf"]["n_particles"] = 1500
         loader = machinejson._loader()
         n_max = loader.PF_MS_SLOTS // 1500
-        self.assertEqual(loader.pf_mslip_max(1500), n_max)
+        self.assertEqual(loader.mslip_max("pf,ukf", 1500), n_max)
+        self.assertEqual(loader.mslip_max("ukf", 1500), loader.MSLIP_MAX)
         machinejson._friction_model(m, Diag(fit), prov, notes)
         fm = m["friction_model"]
         self.assertEqual(len(fm["breakaway_m"]), n_max)

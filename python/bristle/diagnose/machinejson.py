@@ -323,8 +323,7 @@ def _friction_model(m, diag, prov, notes):
             return
         nl = diag.extended.nl
         # the PF's element storage (BR_PF_MS_SLOTS) binds when the image may run the PF
-        n_max = (_loader().pf_mslip_max(m["estimator"]["pf"]["n_particles"])
-                 if "pf" in m["control"]["estimator"].split(",") else len(nl["ps_share"]))
+        n_max = _loader().mslip_max(m["control"]["estimator"], m["estimator"]["pf"]["n_particles"])
         d, a, err = ps.fewer_elements(nl["ps_breakaway"], nl["ps_share"], n_max)
         reduced = len(d) < len(nl["ps_share"])
         el = modelfile.presliding_elements(dict(nl, ps_breakaway=d, ps_share=a) if reduced else nl)

@@ -222,9 +222,8 @@ def fewer_elements(breakaway, share, n_max, n_x=256):
     best = None
     for sub in itertools.combinations(range(len(d)), n_max):
         cols = np.minimum(x[:, None] / d[None, list(sub)], 1.0)
+        # the heavy row holds the sum near 1, so it is > 0
         w, _ = optimize.nnls(np.vstack([cols, np.full(n_max, 1.0e3)]), np.append(target, 1.0e3))
-        if not w.sum() > 0.0:
-            continue
         w = w / w.sum()
         err = float(np.max(np.abs(cols @ w - target)))
         if best is None or err < best[2]:
