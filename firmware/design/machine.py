@@ -894,6 +894,22 @@ def ukf_load(m):
     return {"q_N2": q * m["control"]["period_s"], "p0_N2": F_act * F_act, "max_N": F_act}
 
 
+def pf_load_blockers(m):
+    """Why machine m's PF cannot carry its shared external force (estimator.pf.load), one
+    message each; [] when it can. br_pf_init refuses the load with the extended model (the
+    cloud is moved and weighed again with eq. 6) and with Maxwell-slip elements (the move
+    makes each particle's f_nl again from the LuGre state)."""
+    why = []
+    extended = sorted(c for c, v in m.get("causes", {}).items() if c in FORCE_CAUSES and any(v.values()))
+    if extended:
+        why.append("needs the thesis model; the causes %s make the estimators' model the extended one"
+                   % ", ".join(extended))
+    if (m.get("friction_model") or {}).get("model") == "maxwell_slip":
+        why.append("needs the LuGre model; with friction_model maxwell_slip the PF's particles carry elements, "
+                   "which the load's move of the cloud does not")
+    return why
+
+
 def actuator_force_N(m):
     """The actuator's force on the table, control.torque_limit_Nm / L (N): the
     external-force states' bound."""
@@ -1052,11 +1068,8 @@ def _per_step_checks(m, errors):
         if not FLOAT32_MIN_NORMAL <= pld["q_N2"] <= 1.0e12:
             errors.append((load_field(m, "pf"), "gives q_N2 = %.6g per step on this machine, "
                            "outside the firmware's (0 excluded) [%g, %g]" % (pld["q_N2"], FLOAT32_MIN_NORMAL, 1.0e12)))
-        # br_pf_init: the thesis model only (the cloud is moved and weighed again with eq. 6)
-        extended = sorted(c for c, v in m.get("causes", {}).items() if c in FORCE_CAUSES and any(v.values()))
-        if extended:
-            errors.append(("estimator.pf.load", "needs the thesis model; the causes %s make the estimators' "
-                           "model the extended one" % ", ".join(extended)))
+        for why in pf_load_blockers(m):
+            errors.append(("estimator.pf.load", why))
     for est in ("pf", "ukf"):
         v = est_per_step(m, est)
         # br_est_cfg_check bounds the gate's transient term in counts (BR_EST_GATE_MAX_TRANSIENT_COUNTS)

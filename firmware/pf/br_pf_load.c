@@ -43,9 +43,10 @@ br_status_t br_pf_load_init(br_pf_t *pf)
     }
     /* on: q a normal float, max_N > 0 with 4 max_N^2 finite; the thesis model with the
      * bootstrap proposal (the cloud is moved and weighed again with eq. 6's f_nl and the
-     * Gaussian likelihood) */
+     * Gaussian likelihood), without Maxwell-slip elements (whose particles keep their
+     * f_nl where the move makes the LuGre one again) */
     if (!br_est_var_ok(ld->q_N2, 0) || !br_est_var_ok(4.0f * ld->max_N * ld->max_N, 0) || !(ld->max_N > 0.0f) ||
-        pf->model.extended || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR) {
+        pf->model.extended || pf->model.cfg.mslip.n > 0 || pf->cfg.proposal != BR_PF_PROPOSAL_PRIOR) {
         return BR_E_PARAM;
     }
     const float h = pf->cfg.est.model.dt_s;
@@ -161,8 +162,9 @@ static float probe_lmax(const br_pf_t *pf, float y_rel, float dth)
  * the filter would have had with the last measurement rejected. Spike: only the last
  * measurement was off, the cloud moved back by Phi e; slip: the counter stays off by the
  * last innovation nu1, theta (in the counter's frame) moved on by nu1 as well. The
- * smaller |mean innovation| first; the first whose best particle passes the gate is
- * taken: F_d and its value at the period's start without e2, P as the prediction left
+ * smaller |mean innovation| first; the first whose best particle lies within twice
+ * the gate's distance (BR_PF_LOAD_UNDO_GATE2: the glitch period's compensation moved
+ * the real axis as well as the model knows the plant) is taken: F_d and its value at the period's start without e2, P as the prediction left
  * it carried over this period, the cloud moved (its lmax returned, sums made again).
  * Neither passing: lmax unchanged (the re-acquisition stands). */
 static float load_undo(br_pf_t *pf, float y_rel, float lmax, float sums[2], uint32_t n_valid)
@@ -176,7 +178,7 @@ static float load_undo(br_pf_t *pf, float y_rel, float lmax, float sums[2], uint
     const int slip_first = fabsf(d + dth_slip) < fabsf(d + dth_spike);
     const float dth[2] = {slip_first ? dth_slip : dth_spike, slip_first ? dth_spike : dth_slip};
     for (int i = 0; i < 2; i++) {
-        if (!(probe_lmax(pf, y_rel, dth[i]) >= pf->outlier_l)) {
+        if (!(probe_lmax(pf, y_rel, dth[i]) >= BR_PF_LOAD_UNDO_GATE2 * pf->outlier_l)) {
             continue;
         }
         float P[6];

@@ -15,6 +15,12 @@
  * r <= 0.3) */
 #define BR_PF_LOAD_NOTCH_R 0.2f
 
+/* A glitch's hypotheses (spike, slip) are tested at twice the gate's distance:
+ * their log-weight >= this times the gate's (docs/modules/pf.md, "A glitch is
+ * not a load": the glitch period's compensation moves the real axis as the
+ * model knows the plant, on the hardware-like plant 1.44 gates off) */
+#define BR_PF_LOAD_UNDO_GATE2 4.0f
+
 /* 1 when cfg.load is on */
 static inline int br_pf_load_on(const br_pf_t *pf) { return pf->cfg.load.max_N > 0.0f; }
 

@@ -97,6 +97,7 @@ BR_W_OUTLIER = 1  # a warning (positive): the step predicted only
 
 W_BITS = 16
 LOAD_NOTCH_R = 0.2  # the compensation's notch: its pole at -r (pf.md, "The period-2 mode")
+LOAD_UNDO_GATE2 = 4.0  # a glitch's hypotheses at twice the gate's distance (pf.md, "A glitch is not a load")
 NX = 4
 
 
@@ -325,8 +326,8 @@ class Pf:
         step's innovation is gated. The re-acquisition's correction e carried
         over the period is Phi e; spike: the cloud moved back by it; slip: and
         on by the last innovation nu1 (the counter stays off). The smaller
-        |mean innovation| first; the first whose best particle passes the gate
-        is taken (F_d and F_d' without e2, P = Phi P_A Phi^T + Q, the cloud
+        |mean innovation| first; the first whose best particle is within twice
+        the gate's distance (l >= LOAD_UNDO_GATE2 x the gate's l) is taken (F_d and F_d' without e2, P = Phi P_A Phi^T + Q, the cloud
         moved). Returns whether one was taken."""
         c = self.cfg
         e, P_A, nu1 = self.alt
@@ -339,7 +340,7 @@ class Pf:
             hyp.reverse()
         for dth in hyp:
             best = max(-((xp[j][0] + dth - y) ** 2) / (2.0 * c.r_var) for j in valid)
-            if not best >= l_gate:
+            if not best >= LOAD_UNDO_GATE2 * l_gate:
                 continue
             self.P = self.Phi @ P_A @ self.Phi.T + np.diag([0.0, 0.0, c.load.q_N2])
             mx = c.load.max_N

@@ -545,7 +545,7 @@ static int usage(const char *argv0, FILE *to)
             "  --plant-delay S     an actuator dead time in the recorded loop's plant, 0 .. 0.1 s (default 0):\n"
             "                      the delay identification finds it (for pf_numpy.py --check)\n"
             "  --pf-load Q         the recorded PF with its shared external force, random walk Q N^2/s\n"
-            "                      (0 .. 1e9, 0: the machine's; docs/modules/pf.md; for pf_numpy.py --check)\n"
+            "                      (0 .. 1e9, 0: off; default the machine's; docs/modules/pf.md; for pf_numpy.py --check)\n"
             "  --pf-gate SIGMA     the recorded PF's outlier gate, sigmas (1 .. 1000; a narrow one gates steps:\n"
             "                      with --pf-load they are re-acquired as a load and undone, for pf_numpy.py --check)\n",
             argv0, argv0);
@@ -556,7 +556,7 @@ int main(int argc, char **argv)
 {
     const char *json_path = NULL, *rec_path = NULL;
     int reps = 7, ukf_reps = 21, thesis_gate = 0;
-    double plant_delay_s = 0.0, pf_load = 0.0, pf_gate = 0.0;
+    double plant_delay_s = 0.0, pf_load = -1.0, pf_gate = 0.0;
     const char *plant = "thesis";
     static const struct option opts[] = {{"json", required_argument, NULL, 'j'},
                                          {"record", required_argument, NULL, 'r'},

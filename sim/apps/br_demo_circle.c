@@ -149,12 +149,12 @@ typedef struct {
     long nsub;
     long pf_prop; /* -1: the machine's */
     double ahead; /* < 0: the machine's */
-    double ukf_load; /* the UKF's external force's random walk, N^2/s (0: the machine's) */
+    double ukf_load; /* the UKF's external force's random walk, N^2/s (0: off; < 0: the machine's) */
     int ukf_mslip;   /* the UKF predicts with the hardware-like plant's element set */
     int pf_mslip;    /* the PF's particles carry the hardware-like plant's element set (every plant) */
     float ukf_qs[2]; /* factors on the UKF's z and g_p process noise (0: 1) */
     float pf_qs[2];  /* factors on the PF's z and g_p process noise (0: 1) */
-    double pf_load;  /* the PF's shared external force's random walk, N^2/s (0: the machine's) */
+    double pf_load;  /* the PF's shared external force's random walk, N^2/s (0: off; < 0: the machine's) */
     double pf_gp_tau; /* the PF's g_p along the Stribeck curve, time constant s (0: the machine's) */
     double pf_gate;   /* the PF's outlier gate, sigmas (0: the machine's) */
     br_circle_path_t path; /* the circle (default the thesis's) */
@@ -183,11 +183,13 @@ static int usage(const char *argv0, FILE *to)
             "                      noise held over the period (docs/modules/pf.md)\n"
             "  --ahead P           the estimators' compensation lead, periods past the delay\n"
             "                      (est.comp_ahead_periods, 0 .. %g; docs/modules/est.md)\n"
-            "  --ukf-load Q        the UKF's external-force state, random walk Q N^2/s (0 .. 1e9; docs/modules/ukf.md)\n"
+            "  --ukf-load Q        the UKF's external-force state, random walk Q N^2/s (0 .. 1e9, 0: off;\n"
+            "                      default the machine file's; docs/modules/ukf.md)\n"
             "  --ukf-mslip         on the hardware-like plant, the UKF predicts with its Maxwell-slip\n"
             "                      elements (clamp form, docs/modules/ukf.md)\n"
             "  --ukf-q-scale FZ,FG the UKF's z and g_p process noise times FZ and FG (1e-6 .. 1e6)\n"
-            "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9; docs/modules/pf.md)\n"
+            "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9, 0: off;\n"
+            "                      default the machine file's; docs/modules/pf.md)\n"
             "  --pf-mslip          on every plant, the PF's particles carry the hardware-like plant's\n"
             "                      Maxwell-slip elements (clamp form, docs/modules/pf.md)\n"
             "  --pf-q-scale FZ,FG  the PF's z and g_p process noise times FZ and FG (1e-6 .. 1e6)\n"
@@ -414,7 +416,7 @@ static void hw_describe(FILE *js, const opts_t *o)
 
 int main(int argc, char **argv)
 {
-    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, 0.0, 0, 0, {0.0f, 0.0f}, {0.0f, 0.0f}, 0.0, 0.0, 0.0,
+    opts_t opt = {NULL, NULL, 0, {0.0f, 0.0f, 0.0f}, 0.0, 0, -1, -1.0, -1.0, 0, 0, {0.0f, 0.0f}, {0.0f, 0.0f}, -1.0, 0.0, 0.0,
                   BR_CIRCLE_PATH_DEFAULT, 0, 0.0, BR_CIRCLE_FF_EL_NONE, 0.0, 1, 0};
     const int p = parse(argc, argv, &opt);
     if (p == 1) return 0; /* --help or --version answered */

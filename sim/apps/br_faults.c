@@ -310,6 +310,18 @@ static void judge(const scenario_t *s, const br_app_motion_cfg_t *mc, double dt_
     else o->broken[0] = '\0';
 }
 
+/* An external-force state for the report's first line: "on (Q N^2/s)" or "off",
+ * ", the machine's" when no option set it */
+static void load_text(char *buf, size_t n, double q_N2ps, int machines)
+{
+    const char *whose = machines ? ", the machine's" : "";
+    if (q_N2ps > 0.0) {
+        snprintf(buf, n, "on (%.4g N^2/s%s)", q_N2ps, whose);
+    } else {
+        snprintf(buf, n, "off%s", machines ? " (the machine's)" : "");
+    }
+}
+
 static int usage(const char *argv0, FILE *to)
 {
     fprintf(to,
@@ -320,8 +332,8 @@ static int usage(const char *argv0, FILE *to)
             "  --only LIST   the scenarios to run, comma-separated (default all)\n"
             "  --ctrl LIST   hinf_only,hinf_ukf,hinf_pf (default all)\n"
             "  --pf-gp-curve TAU_S  the PF's g_p along the Stribeck curve, time constant (0: off, the machine's)\n"
-            "  --pf-load Q_N2_PER_S  the PF's shared external force with this random walk, N^2/s (0: off, the machine's)\n"
-            "  --ukf-load Q_N2_PER_S  the UKF's external-force state with this random walk, N^2/s (0: off, the machine's)\n"
+            "  --pf-load Q_N2_PER_S  the PF's shared external force with this random walk, N^2/s (0: off; default the machine's)\n"
+            "  --ukf-load Q_N2_PER_S  the UKF's external-force state with this random walk, N^2/s (0: off; default the machine's)\n"
             "  --pf-gate SIGMA  the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
             "  --md OUT.md   the table as markdown\n"
             "  --expect LIST scenario/controller pairs (enc_stuck_90/hinf_pf) whose bound is known broken\n",
@@ -347,7 +359,7 @@ static void print_row(FILE *f, const scenario_t *s, br_circle_ctrl_t ctrl, const
 int main(int argc, char **argv)
 {
     const char *plant = "realistic", *only = NULL, *ctrls = NULL, *md = NULL, *expect = NULL;
-    double gp_tau_s = 0.0, load_q = 0.0, pf_load_q = 0.0, pf_gate = 0.0;
+    double gp_tau_s = 0.0, load_q = -1.0, pf_load_q = -1.0, pf_gate = 0.0; /* -1: the machine's */
     static const struct option opts[] = {{"plant", required_argument, NULL, 'p'}, {"only", required_argument, NULL, 'o'},
                                          {"ctrl", required_argument, NULL, 'c'},  {"md", required_argument, NULL, 'm'},
                                          {"expect", required_argument, NULL, 'e'},
@@ -409,10 +421,16 @@ int main(int argc, char **argv)
     const br_app_machine_t mm = BR_MACHINE_APP_MACHINE;
     const br_app_motion_cfg_t mc = br_app_motion_cfg(&mm);
     FILE *f = md ? out.f : stdout;
-    char ld[64] = "off (the machine's)";
-    if (load_q > 0.0) snprintf(ld, sizeof ld, "on (%g N^2/s)", load_q);
-    char pld[64] = "off (the machine's)";
-    if (pf_load_q > 0.0) snprintf(pld, sizeof pld, "on (%g N^2/s)", pf_load_q);
+    /* the external forces as the runs have them: the option's, or the machine file's */
+    br_circle_cfg_t lc = br_circle_cfg_thesis(BR_CTRL_HINF_UKF);
+    br_circle_use_ukf_load(&lc, load_q);
+    const double uq = br_circle_ukf_load_q_N2ps(&lc);
+    lc = br_circle_cfg_thesis(BR_CTRL_HINF_PF);
+    br_circle_use_pf_load(&lc, pf_load_q);
+    const double pq = br_circle_pf_load_q_N2ps(&lc);
+    char ld[64], pld[64];
+    load_text(ld, sizeof ld, uq, load_q < 0.0);
+    load_text(pld, sizeof pld, pq, pf_load_q < 0.0);
     char gt[64] = "";
     if (pf_gate > 0.0) snprintf(gt, sizeof gt, "; PF gate %g sigma (a study)", pf_gate);
     fprintf(f, "Plant: %s; PF g_p curve %s; PF external force %s; UKF external force %s%s. Stop bound %.1f mm (coast %.1f mm), speed fault %.4f m/s, stroke [%.4f, %.4f] m, soft limits [%.4f, %.4f] m.\n\n",

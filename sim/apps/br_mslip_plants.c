@@ -107,7 +107,7 @@ static int usage(const char *argv0, FILE *f)
             "  --at T1,T2,..     ascending times, s (at most %d)\n"
             "  --pf-q-scale FZ,FG  the PF's z and g_p process noise times FZ and FG (1e-6 .. 1e6; a study)\n"
             "  --pf-gate SIGMA   the PF's outlier gate, sigmas (1 .. 1000; a study)\n"
-            "  --pf-load Q       the PF's shared external force, random walk Q N^2/s (0 .. 1e9; 0: the machine's;\n"
+            "  --pf-load Q       the PF's shared external force, random walk Q N^2/s (0 .. 1e9; 0: off; default the machine's;\n"
             "                    a study, docs/modules/pf.md)\n" BR_ARGS_COMMON_USAGE,
             argv0, MAX_N, MAX_FIRST, (double)BR_FF_PRED_MAX_S, BR_PFTRACE_MAX_AT, argv0);
     return f == stdout ? 0 : 2;
@@ -137,7 +137,7 @@ int main(int argc, char **argv)
     double pred_s = 0.0;
     float qs[2] = {1.0f, 1.0f};
     double gate = 0.0; /* 0: the machine file's */
-    double pf_load = 0.0; /* 0: the machine file's */
+    double pf_load = -1.0; /* 0: off; < 0: the machine file's */
     static br_pftrace_t tr;
     static const struct option opts[] = {{"ff-el", required_argument, NULL, 'E'},
                                          {"pred", required_argument, NULL, 'P'},

@@ -24,7 +24,7 @@
  * --pf-proposal: the PF's br_pf_cfg_t.proposal (0 the thesis's, 1 OPT, 2
  * OPT_HELD; docs/modules/pf.md).
  * --pf-load: the PF's shared external force with this random walk, N^2/s
- * (br_pf_cfg_t.load; 0, the default: the machine's).
+ * (br_pf_cfg_t.load; 0: off; the default: the machine's).
  * --pf-gate: the PF's outlier gate in sigmas (a study, docs/presliding-plants.md,
  * "The PF's gate"; the default: the machine's).
  * --pf-adapt-max: the PF's cfg.adapt.max_scale, its largest variance factor (1: no
@@ -97,7 +97,8 @@ static int usage(const char *argv0, FILE *to)
             "  --pf-n M            the PF runs' particle count\n"
             "  --pf-proposal K     the PF runs' proposal: 0 the prior (thesis), 1 optimal for theta, 2 with omega's\n"
             "                      noise held over the period (docs/modules/pf.md)\n"
-            "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9; docs/modules/pf.md)\n"
+            "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9, 0: off;\n"
+            "                      default the machine file's; docs/modules/pf.md)\n"
             "  --pf-gate SIGMA     the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
             "  --pf-adapt-max S    the PF's largest noise-variance factor of cfg.adapt (1 .. 1e12; 1: none; no\n"
             "                      effect where the machine has cfg.adapt off; a study, docs/fleet.md)\n"
@@ -149,7 +150,7 @@ int main(int argc, char **argv)
 {
     const char *plant_path = NULL, *model_path = NULL, *json = NULL, *only = NULL, *dir = NULL;
     br_circle_real_t real = {0.0, 0.0, 0.0, 0u};
-    double veps = -1.0, pf_dt = -1.0, ahead = -1.0, pf_load = 0.0, pf_gate = 0.0, pf_adapt_max = 0.0;
+    double veps = -1.0, pf_dt = -1.0, ahead = -1.0, pf_load = -1.0, pf_gate = 0.0, pf_adapt_max = 0.0;
     long pf_n = 0, pf_prop = -1, delay_id = -1;
     int machine_causes = 0;
     br_circle_path_t path = BR_CIRCLE_PATH_DEFAULT;

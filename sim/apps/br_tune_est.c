@@ -5,7 +5,7 @@
  *
  * Usage: br_tune_est --est pf|ukf --out HEADER [--log CSV] [--max-fev N]
  *                    [--plants P1.json,P2.json,... [--stat median|p90]] [--guard-noise F]
- *                    [--guard-outliers K] [--mslip-target R]
+ *                    [--guard-outliers K] [--mslip-target R] [--pf-load Q]
  * --plants: the robust objective (docs/robustness.md, "Robust tuning"): the
  * penalised contour RMS on each plant (model.json files, e.g. the robustness
  * study's plant.json), and its median or 90th percentile (nearest rank) over
@@ -278,8 +278,10 @@ static int usage(const char *argv0, FILE *to)
             "  --guard-outliers K  PF: the objective x (1 + K x the guard plants' outlier steps) (default %g)\n"
             "  --mslip-target R    the objective x (1 + the Maxwell-slip guard plants' worst contour RMS\n"
             "                      / H-inf only's / R) (default UKF %g, PF %g; 0: no such guard; the PF's goal: 0.068)\n"
+            "  --pf-load Q         PF: its shared external force's random walk, N^2/s (0: off, the thesis\n"
+            "                      filter; default the machine file's; docs/modules/pf.md)\n"
             "bounds: --max-fev 1 .. %d (docs/tools.md), at most %d plants, --guard-noise 0 .. %g,\n"
-            "        --guard-outliers 0 .. %g, --mslip-target 0 .. 1\n",
+            "        --guard-outliers 0 .. %g, --mslip-target 0 .. 1, --pf-load 0 .. 1e9\n",
             argv0, argv0, BR_TUNE_CHECKPOINT_FEV, BR_TUNE_GUARD_FORCE_NOISE_N, BR_TUNE_GUARD_OUTLIERS_PF, BR_TUNE_MSLIP_TARGET_UKF,
             BR_TUNE_MSLIP_TARGET_PF, BR_TOOL_MAX_FEV, MAX_PLANTS, BR_TUNE_GUARD_NOISE_MAX_N, BR_TUNE_GUARD_OUTLIERS_MAX);
     return 2;
@@ -292,6 +294,7 @@ int main(int argc, char **argv)
     double guard_noise_N = BR_TUNE_GUARD_FORCE_NOISE_N, guard_outliers = BR_TUNE_GUARD_OUTLIERS_PF;
     int guard_opt = 0; /* --guard-noise or --guard-outliers given */
     double mslip_target = -1.0; /* --mslip-target; < 0: the estimator's default */
+    double pf_load = -1.0;      /* --pf-load; < 0: the machine file's */
     int checkpoint = 0;         /* --checkpoint */
     static const struct option opts[] = {{"est", required_argument, NULL, 'e'},
                                          {"out", required_argument, NULL, 'o'},
@@ -302,6 +305,7 @@ int main(int argc, char **argv)
                                          {"guard-noise", required_argument, NULL, 'g'},
                                          {"guard-outliers", required_argument, NULL, 'k'},
                                          {"mslip-target", required_argument, NULL, 'm'},
+                                         {"pf-load", required_argument, NULL, 'L'},
                                          {"checkpoint", no_argument, NULL, 'c'},
                                          {NULL, 0, NULL, 0}};
     br_args_t p;
@@ -325,6 +329,7 @@ int main(int argc, char **argv)
             break;
         case 'c': checkpoint = 1; break;
         case 'm': bad = br_arg_double(TOOL, p.opt, v, 0.0, 1.0, &mslip_target); break;
+        case 'L': bad = br_arg_double(TOOL, p.opt, v, 0.0, 1.0e9, &pf_load); break;
         case 's':
             if (strcmp(v, "median") == 0 || strcmp(v, "p90") == 0) {
                 stat = v;
@@ -341,6 +346,10 @@ int main(int argc, char **argv)
     /* the guard plants belong to the PF's nominal objective: elsewhere the options would do nothing */
     if (guard_opt && (strcmp(est, "pf") != 0 || plants)) {
         fprintf(stderr, "%s: --guard-noise and --guard-outliers need --est pf without --plants\n", TOOL);
+        return 2;
+    }
+    if (pf_load >= 0.0 && strcmp(est, "pf") != 0) {
+        fprintf(stderr, "%s: --pf-load needs --est pf\n", TOOL);
         return 2;
     }
     /* the Maxwell-slip guards belong to the nominal objective too */
@@ -419,6 +428,8 @@ int main(int argc, char **argv)
      * on it (the UKF retuned with it: 1.34-1.44 times worse on the realistic plant, docs/tuning.md) */
     t.base.pf.est.outlier_transient_rad = 0.0f;
     t.base.ukf.est.outlier_transient_rad = 0.0f;
+    /* --pf-load: the PF's shared external force other than the machine file's (0: off) */
+    br_circle_use_pf_load(&t.base, pf_load);
     t.log = log_file.f;
     const int n = br_tune_n_params(t.pf);
     double x0[MAX_P], lo[MAX_P], hi[MAX_P];
@@ -527,6 +538,9 @@ int main(int argc, char **argv)
     if (t.n_plants > 0) fprintf(h, "/* robust objective: the %s over %d plants (--plants) */\n", stat, t.n_plants);
     if (t.pf && t.n_plants == 0 && guard_outliers > 0.0) {
         fprintf(h, "/* objective x (1 + %g x the guard plants' outlier steps) (--guard-outliers) */\n", guard_outliers);
+    }
+    if (t.pf && pf_load >= 0.0) {
+        fprintf(h, "/* the PF's shared external force %g N^2/s (--pf-load; 0: off), not the machine file's */\n", pf_load);
     }
     if (t.mslip_target > 0.0) {
         fprintf(h, "/* objective x (1 + the Maxwell-slip guard plants' worst RMS / H-inf only's / %g) (--mslip-target): */\n",

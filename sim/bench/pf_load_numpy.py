@@ -30,10 +30,11 @@ def clampf(v, lo, hi):
 
 
 class LoadNumpy:
-    def __init__(self, q, max_N, h, L, inv_jeff, notch_r, seqsum):
+    def __init__(self, q, max_N, h, L, inv_jeff, notch_r, seqsum, undo_gate2):
         self.seqsum = seqsum  # pf_numpy's float32 sum, left to right like the C loops
         self.on = bool(max_N > F(0.0))  # br_pf_load_on
         self.q, self.max_N, self.h, self.L, self.r = q, max_N, h, L, notch_r
+        self.undo_gate2 = undo_gate2
         # g = L h^2 / (2 J_eff): theta's change over one period under one newton on the load side
         self.g = ((F(0.5) * L) * h) * h * inv_jeff
         self.N = self.prev = self.comp_N = F(0.0)
@@ -111,7 +112,7 @@ class LoadNumpy:
         order = (dth_slip, dth_spike) if slip_first else (dth_spike, dth_slip)
         xp, fnl, l, valid = state
         for dth in order:
-            if not (self._probe(pf, y_rel, dth, xp, valid) >= pf.outlier_l):
+            if not (self._probe(pf, y_rel, dth, xp, valid) >= self.undo_gate2 * pf.outlier_l):
                 continue
             P = self._cov_predict(self.alt_P)
             if not np.all(np.isfinite(P)):

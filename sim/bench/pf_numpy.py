@@ -64,6 +64,7 @@ RK4_AH_MAX = F(2.0)          # BR_MODEL_RK4_AH_MAX, br_model.h
 BOUNDED_PASSES = 3           # BR_MODEL_BOUNDED_PASSES, br_model.c
 W_ONE = F(1 << 16)           # 2^BR_PF_W_BITS, br_pf.h
 LOAD_NOTCH_R = F(0.2)        # BR_PF_LOAD_NOTCH_R, br_pf_load.h
+LOAD_UNDO_GATE2 = F(4.0)     # BR_PF_LOAD_UNDO_GATE2, br_pf_load.h
 BR_OK, BR_E_NUMERIC, BR_W_OUTLIER = 0, -4, 1
 
 
@@ -152,7 +153,7 @@ class NumpyPf:
         # cfg.load, the shared external force F_d (br_pf_load.c; absent or 0, 0: off)
         ld = cfg.get("load", {})
         self.load = LoadNumpy(F(ld.get("q_N2", 0.0)), F(ld.get("max_N", 0.0)), self.h, self.L, self.inv_jeff,
-                              LOAD_NOTCH_R, seqsum)
+                              LOAD_NOTCH_R, seqsum, LOAD_UNDO_GATE2)
         self.noise = noise
         self.mask = len(noise) - 1
         self.skip = int(cfg["noise_skip"])

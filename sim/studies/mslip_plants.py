@@ -13,8 +13,8 @@ Usage:
   mslip_plants.py --bin BUILD/sim --out DIR [--n N] [--first J] [--seed S] [--jobs J]
                   [--pf-load Q] [--md PAGE --command CMD [--expect-faults]]
 
---pf-load Q runs the PF with its shared external force at Q N^2/s
-(br_mslip_plants --pf-load; docs/modules/pf.md), a study."""
+--pf-load Q runs the PF with its shared external force at Q N^2/s, 0 without it
+(br_mslip_plants --pf-load; default the machine file's; docs/modules/pf.md)."""
 import argparse
 import json
 import math
@@ -142,7 +142,8 @@ def main():
     ap.add_argument("--md", help="docs page: its part after %s is rewritten" % BEGIN)
     ap.add_argument("--command", default="make mslip-plants")
     ap.add_argument("--pf-load", type=float,
-                    help="the PF's shared external force, random walk N^2/s (br_mslip_plants --pf-load; a study)")
+                    help="the PF's shared external force, random walk N^2/s, 0: off (br_mslip_plants --pf-load; "
+                         "default the machine file's)")
     ap.add_argument("--expect-faults", action="store_true",
                     help="with --md: the page may list faulted runs; without it a fault makes the study exit 1 "
                          "after writing the page")

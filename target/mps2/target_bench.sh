@@ -39,7 +39,7 @@ command -v "$qemu" >/dev/null || { echo "target-bench: $qemu not found (make dep
 mkdir -p "$out"
 # the PF's scaling: streams without the delay identification (docs/modules/dlyid.md), replayed at
 # other m than recorded; its own cost per period is measured at m_hi on a stream with it, below
-"$host/tests/target/br_replay_record" --out "$out/stream.bin" --duration 1.0 --delay-id 0 >/dev/null
+"$host/tests/target/br_replay_record" --out "$out/stream.bin" --duration 1.0 --delay-id 0 --pf-load 0 >/dev/null
 
 # qemu_replay STREAM OUT M NAME: the image replays STREAM at m = M into OUT; the log is kept
 # as $out/qemu_NAME.log, and log, ci, ct (its calibration: instructions, SysTick ticks) are set
@@ -87,7 +87,7 @@ BEGIN {
 # Replayed at m_lo the filter with elements loses lock (the stream's counts
 # are m_hi's loop) and the application stops the replay (code -4): the mean
 # is then over the periods before the stop, which must be at least 100.
-"$host/tests/target/br_replay_record" --out "$out/stream_ms.bin" --duration 1.0 --delay-id 0 --mslip >/dev/null
+"$host/tests/target/br_replay_record" --out "$out/stream_ms.bin" --duration 1.0 --delay-id 0 --pf-load 0 --mslip >/dev/null
 declare -A mean_ms ipt_ms n_ms
 for m in "$m_hi" "$m_lo"; do
   qemu_replay "$out/stream_ms.bin" "$out/target_ms_m$m.bin" "$m" "ms_m$m" || true
@@ -139,8 +139,8 @@ fi
 # closed loop, a prefix of the 20-period stream); per period k >= 1 that is at
 # m_hi and at m_lo, whose slope is the count per particle-step and whose
 # intercept the fixed part's, as for the instructions above.
-"$host/tests/target/br_replay_record" --out "$out/stream_prof.bin" --duration 0.03 --delay-id 0 >/dev/null
-"$host/tests/target/br_replay_record" --out "$out/stream_prime.bin" --duration 0.0001 --delay-id 0 >/dev/null  # k = 0 only
+"$host/tests/target/br_replay_record" --out "$out/stream_prof.bin" --duration 0.03 --delay-id 0 --pf-load 0 >/dev/null
+"$host/tests/target/br_replay_record" --out "$out/stream_prime.bin" --duration 0.0001 --delay-id 0 --pf-load 0 >/dev/null  # k = 0 only
 # trace STREAM M NAME: runs the image on STREAM at m = M with the block log $out/qemu_NAME.log
 trace() {
   "$qemu" -M "$machine" -nographic -monitor none -serial none -icount shift=0 \
@@ -196,7 +196,7 @@ BEGIN {
 # The machine's delay identification (docs/modules/dlyid.md) on: one run at m_hi on a stream
 # recorded with it (the closed loop's own commands, so the replay is that loop); its cost per
 # period is the difference of the means, instructions, against the run without it above.
-"$host/tests/target/br_replay_record" --out "$out/stream_id.bin" --duration 1.0 >/dev/null
+"$host/tests/target/br_replay_record" --out "$out/stream_id.bin" --duration 1.0 --pf-load 0 >/dev/null
 qemu_replay "$out/stream_id.bin" "$out/target_id.bin" "$m_hi" id
 read -r _ mean_id _ _ max_id _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_id.bin")
 awk -v m="$m_hi" -v a="$mean_id" -v x="$max_id" -v i="$ci" -v t="$ct" -v a0="${mean[$m_hi]}" -v i0="${ipt[$m_hi]}" \
@@ -205,18 +205,19 @@ awk -v m="$m_hi" -v a="$mean_id" -v x="$max_id" -v i="$ci" -v t="$ct" -v a0="${m
   printf "  with the delay identification (the machine'"'"'s, on its own stream): m = %d: mean %.0f  max %.0f instructions per period; its cost %+.0f instructions per period (%.2f%% of the period at %d MHz, one cycle each)\n", m, a * i / t, x * i / t, d, 100 * d / P, mhz
 }' | tee -a "$out/cycles.txt"
 
-# The PF's shared external force (cfg.load at the fault campaign's 1e4 N^2/s, off in the
-# machine file; docs/modules/pf.md, "External force"): one run at m_hi on a stream recorded
-# with it (without the delay identification, as the scaling runs); its cost per period is
+# The PF's shared external force (cfg.load as the machine file has it, estimator.pf.load; the
+# thesis filter's streams above are recorded with --pf-load 0; docs/modules/pf.md, "External
+# force"): one run at m_hi on a stream recorded with it (without the delay identification, as
+# the scaling runs); its cost per period is
 # the difference of the means against the run without it, and per particle-step that
 # difference over m_hi (the common error's filter is a fixed part, the cloud's move a pass).
-"$host/tests/target/br_replay_record" --out "$out/stream_load.bin" --duration 1.0 --delay-id 0 --pf-load 1e4 >/dev/null
+"$host/tests/target/br_replay_record" --out "$out/stream_load.bin" --duration 1.0 --delay-id 0 >/dev/null
 qemu_replay "$out/stream_load.bin" "$out/target_load.bin" "$m_hi" load
 read -r _ mean_ld _ _ max_ld _ < <("$host/tests/target/br_replay_cmp" --cost "$out/target_load.bin")
 awk -v m="$m_hi" -v a="$mean_ld" -v x="$max_ld" -v i="$ci" -v t="$ct" -v a0="${mean[$m_hi]}" -v i0="${ipt[$m_hi]}" \
     -v mhz="$mhz" -v P="$period" 'BEGIN {
   d = a * i / t - a0 * i0
-  printf "  with the PF'"'"'s shared external force (--pf-load 1e4, on its own stream): m = %d: mean %.0f  max %.0f instructions per period; its cost %+.0f instructions per period (%+.1f per particle-step; %.2f%% of the period at %d MHz, one cycle each)\n", m, a * i / t, x * i / t, d, d / m, 100 * d / P, mhz
+  printf "  with the PF'"'"'s shared external force (as the machine file sets it, on its own stream): m = %d: mean %.0f  max %.0f instructions per period; its cost %+.0f instructions per period (%+.1f per particle-step; %.2f%% of the period at %d MHz, one cycle each)\n", m, a * i / t, x * i / t, d, d / m, 100 * d / P, mhz
 }' | tee -a "$out/cycles.txt"
 
 # Two axes on one MCU: the replay image runs both axes of the X-Y table every
@@ -224,7 +225,7 @@ awk -v m="$m_hi" -v a="$mean_ld" -v x="$max_ld" -v i="$ci" -v t="$ct" -v a0="${m
 # measured instructions per period, charged as above.
 m2=$(sed -n 's/^long_ops_summary .* m_two_axes_80=\([0-9]*\) .*/\1/p' "$out/cycles.txt")
 lfix=$(sed -n 's/^long_ops_summary .* long_fixed=\([0-9.]*\)$/\1/p' "$out/cycles.txt")  # fixed long instructions per axis and period
-"$host/tests/target/br_replay_record" --out "$out/stream_xy.bin" --duration 1.0 --axes 2 --delay-id 0 >/dev/null
+"$host/tests/target/br_replay_record" --out "$out/stream_xy.bin" --duration 1.0 --axes 2 --delay-id 0 --pf-load 0 >/dev/null
 # run_xy M: prints "M mean_instructions max_instructions cycles_mean cycles_max periods"
 run_xy() {
   local m=$1 log ci ct nxy axy xxy

@@ -195,6 +195,11 @@ class MachineFileTest(unittest.TestCase):
         causes = (ps.NAME, "actuator_delay")
         m, notes = self.machine(causes), []
         machinejson._friction_model(m, Diag(self.fit(causes)), {}, notes)
+        # the base's PF external force (the reference machine's) is LuGre-only: dropped, said
+        had_load = "load" in m["estimator"]["pf"]
+        machinejson._pf_load(m, notes)
+        self.assertNotIn("load", m["estimator"]["pf"])
+        self.assertEqual(had_load, any("estimator.pf.load" in n for n in notes), notes)
         fm = m["friction_model"]
         self.assertEqual(fm["model"], "maxwell_slip")
         self.assertEqual(fm["breakaway_m"], [1e-6, 4e-6, 1.3e-5])
@@ -225,6 +230,7 @@ class MachineFileTest(unittest.TestCase):
         self.assertEqual(loader.mslip_max("pf,ukf", 1500), n_max)
         self.assertEqual(loader.mslip_max("ukf", 1500), loader.MSLIP_MAX)
         machinejson._friction_model(m, Diag(fit), prov, notes)
+        machinejson._pf_load(m, notes)
         fm = m["friction_model"]
         self.assertEqual(len(fm["breakaway_m"]), n_max)
         self.assertTrue(set(fm["breakaway_m"]) <= {float("%.6g" % x) for x in d7})

@@ -67,6 +67,7 @@ def friction_model_cases(work, good):
     valid set's header (BR_MACHINE_MSLIP: k_i = share_i Fs / d_i)."""
     def fm(**kw):
         b = copy.deepcopy(good)
+        b["estimator"]["pf"].pop("load", None)  # the PF's load is LuGre-only (pf_load_mslip.json below)
         b["friction_model"] = dict({"model": "maxwell_slip", "breakaway_m": [2e-6, 5e-6, 1e-5, 2e-5],
                                     "share": [0.25, 0.25, 0.25, 0.25]}, **kw)
         return b
@@ -263,6 +264,7 @@ def main():
     # the causes a diagnosis found reach the firmware's model configuration
     # (BR_MACHINE_CAUSES, br_machine_cfg.h); a cause left out is 0 (off)
     withc = copy.deepcopy(good)
+    withc["estimator"]["pf"].pop("load", None)  # the PF's load needs the thesis model (pf_load_ext.json below)
     withc["causes"] = {"friction_drift": {"drift_per_s": 0.01}, "offset": {"offset_N": -1.5}}
     path = write(work, "causes.json", withc)
     rc, err = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, "causes_gen"))
@@ -287,7 +289,8 @@ def main():
           and "#define BR_EST_UKF_LOAD_P0_N2_F (%s)" % machine.c_float(F_act * F_act) in hdr
           and "#define BR_EST_UKF_LOAD_MAX_N_F (%s)" % machine.c_float(F_act) in hdr,
           "load.json: gen_machine.py writes the UKF's external force (q per step, the actuator's force)")
-    off = machine.ukf_load(machine.load(machine.REFERENCE_MACHINE))
+    withl["estimator"]["ukf"].pop("load")
+    off = machine.ukf_load(machine.load(write(work, "ukf_noload.json", withl)))
     check(off == {"q_N2": 0.0, "p0_N2": 0.0, "max_N": 0.0}, "no estimator.ukf.load: the external force is off")
     withl["estimator"]["ukf"]["load"] = {"q_N2_per_s": 0.0}
     expect_errors(work, "load0.json", withl, ["field estimator.ukf.load.q_N2_per_s: 0 is outside (0, 1e+09]"])
@@ -345,8 +348,10 @@ def main():
     withf["estimator"]["pf"]["load"] = {"q_Fact2_per_s": 200.0}
     expect_errors(work, "pf_load_fact_big.json", withf,
                   ["field estimator.pf.load.q_Fact2_per_s: 200 is outside (0, 100]"])
-    rc, hdr = est_header(work, "pf_noload", good)
-    check(rc == 0 and machine.pf_load(good) is None and "BR_EST_PF_LOAD" not in hdr,
+    noload = copy.deepcopy(good)
+    noload["estimator"]["pf"].pop("load", None)
+    rc, hdr = est_header(work, "pf_noload", noload)
+    check(rc == 0 and machine.pf_load(noload) is None and "BR_EST_PF_LOAD" not in hdr,
           "no estimator.pf.load: the PF's external force is off, nothing in the header")
     withp["estimator"]["pf"]["load"] = {"q_N2_per_s": 0.0}
     expect_errors(work, "pf_load0.json", withp, ["field estimator.pf.load.q_N2_per_s: 0 is outside (0, 1e+09]"])
@@ -366,6 +371,14 @@ def main():
     path = write(work, "pf_load_delay.json", withp)
     rc, err = run("gen_machine.py", "--machine", path, "--gen-root", os.path.join(work, "pf_load_delay_gen"))
     check(rc == 0, "pf_load_delay.json: an actuator delay keeps the thesis model (%r)" % err.strip())
+    # nor Maxwell-slip elements in the PF's particles (br_pf_init refuses them with the load)
+    withp["causes"] = {}
+    withp["friction_model"] = {"model": "maxwell_slip", "breakaway_m": [2e-6, 5e-6, 1e-5, 2e-5],
+                               "share": [0.25, 0.25, 0.25, 0.25]}
+    expect_errors(work, "pf_load_mslip.json", withp, [
+        "field estimator.pf.load: needs the LuGre model; with friction_model maxwell_slip the PF's particles carry "
+        "elements, which the load's move of the cloud does not"])
+    withp.pop("friction_model")
 
     # weights that make the sampled loop unstable: no design, a clear message
     bad = copy.deepcopy(good)

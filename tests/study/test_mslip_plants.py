@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The drawn Maxwell-slip plants study (docs/presliding-plants.md), small:
-3 plants (166-168 of seed 1: the PF stops on 167) on 2 processes and again on 1. Checks that the summary is the same
+3 plants (166-168 of seed 1: the PF without its shared external force, --pf-load 0, stops on 167)
+on 2 processes and again on 1. Checks that the summary is the same
 for any split, that every count is the per-plant runs' own, that a faulted
 run is listed with its time and cause and has no figure, and that the page
 writer exits 1 on a fault it was not told to expect (docs/tools.md).
@@ -24,8 +25,9 @@ FIRST = STOP - 1
 
 
 def study(a, out, jobs, *extra):
+    # the PF without its shared external force (the machine file's since 2026-11-28), which stops on STOP
     return subprocess.run([sys.executable, STUDY, "--bin", a.bin, "--out", out, "--n", str(N), "--first", str(FIRST),
-                           "--jobs", str(jobs)]
+                           "--jobs", str(jobs), "--pf-load", "0"]
                           + list(extra), capture_output=True, text=True)
 
 

@@ -8,7 +8,8 @@
  *
  *   br_replay_record --out stream.bin [--expect expect.bin] [--duration 1.0] [--axes 1|2] [--ahead L]
  *                    [--delay-id 0|1] [--mslip] [--pf-load Q]
- * --pf-load Q: the PF's shared external force with the random walk Q N^2/s (docs/modules/pf.md)
+ * --pf-load Q: the PF's shared external force with the random walk Q N^2/s (docs/modules/pf.md;
+ * 0: off; default the machine file's)
  * --mslip: the PF's particles carry the hardware-like plant's Maxwell-slip elements
  * (docs/modules/pf.md), in the circle and the stream (on the thesis plant).
  * --ahead: the PF's est.comp_ahead_periods (docs/modules/est.md), in the circle and the stream.
@@ -78,7 +79,7 @@ int main(int argc, char **argv)
     double ahead = 0.0;
     int delay_id = 1;
     int mslip = 0;
-    double pf_load = 0.0;
+    double pf_load = -1.0; /* the machine's */
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
         else if (!strcmp(argv[i], "--expect") && i + 1 < argc) expect = argv[++i];
@@ -95,7 +96,7 @@ int main(int argc, char **argv)
         }
     }
     if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u || !(ahead >= 0.0 && ahead <= (double)BR_EST_AHEAD_MAX_PERIODS) ||
-        (delay_id != 0 && delay_id != 1) || !(pf_load >= 0.0 && pf_load <= 1.0e9)) {
+        (delay_id != 0 && delay_id != 1) || !(pf_load >= -1.0 && pf_load <= 1.0e9)) {
         fprintf(stderr, "br_replay_record: --out is required, duration > 0, axes 1 or 2, ahead in [0, 2], delay-id 0 or 1, "
                         "pf-load in [0, 1e9]\n");
         return 2;
@@ -105,7 +106,7 @@ int main(int argc, char **argv)
     br_circle_use_ahead(&c, ahead);
     br_circle_use_delay_id(&c, delay_id);
     br_circle_use_pf_mslip(&c, mslip);
-    br_circle_use_pf_load(&c, pf_load); /* 0: off */
+    br_circle_use_pf_load(&c, pf_load); /* 0: off; < 0: the machine's */
     rec_t r = {&c, tmpfile(), NULL, 0u, n_axes};
     if (r.steps == NULL) return 1;
     if (expect && (r.expect = fopen(expect, "wb")) == NULL) {

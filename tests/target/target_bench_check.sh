@@ -28,7 +28,7 @@ dps=$(sed -n 's/^    divisions per particle-step \([0-9.]*\),.*/\1/p' <<<"$log")
 awk -v d="$dps" 'BEGIN { exit !(d >= 0.99 && d <= 1.01) }' || fail "divisions per particle-step $dps, expected 1"
 for pat in "per particle-step (slope of the means):" "fixed per period (intercept):" "per period at m = 1500:" \
   "two axes on one core (the replay" "flash/code:" "on the stack: br_replay_t" \
-  "with 4 Maxwell-slip elements (the hardware-like set" "with the PF's shared external force (--pf-load 1e4" \
+  "with 4 Maxwell-slip elements (the hardware-like set" "with the PF's shared external force (as the machine file sets it" \
   "deadline: worst period"; do
   grep -qF "$pat" <<<"$log" || fail "no line '$pat'"
 done

@@ -3,11 +3,13 @@
 also where the thesis circle never takes it: on the demo's realistic plant
 cfg.adapt's noise factor rises above 1 and the cloud is re-anchored after
 consecutive outliers (with the thesis gate, --thesis-gate; with the machine's
-transient term no outlier comes). br_bench records that closed loop (--plant realistic)
-both ways, and the hardware-like plant's with a 2.7 ms actuator delay
+transient term no outlier comes). br_bench
+records that closed loop (--plant realistic) both ways, and the hardware-like plant's with a 2.7 ms actuator delay
 (--plant hardware_like --plant-delay 0.0027), where the PF's delay
 identification switches, also in its steady phase (docs/modules/dlyid.md),
-and the filter predicts with the delayed torque; and the PF with its shared
+and the filter predicts with the delayed torque (all three with --pf-load 0:
+the machine's shared external force takes the misfit up and none of these
+paths is reached); and the PF with its shared
 external force (cfg.load, --pf-load 1e4) behind a 1-sigma thesis gate on the
 hardware-like plant, where gated steps are re-acquired as load changes
 (the undo of a glitch is not reached by these recordings);
@@ -40,9 +42,9 @@ def main():
     # the hardware-like plant (Maxwell-slip friction) with a 2.7 ms actuator delay: the delay identification
     # switches there, also in its steady phase where the machine has one
     for tag, plant, extra, need in (
-            ("term", "realistic", [], ("adapt_active_steps",)),
-            ("thesis_gate", "realistic", ["--thesis-gate"], ("adapt_active_steps", "reanchor_steps")),
-            ("hardware_like", "hardware_like", ["--plant-delay", "0.0027"],
+            ("term", "realistic", ["--pf-load", "0"], ("adapt_active_steps",)),
+            ("thesis_gate", "realistic", ["--thesis-gate", "--pf-load", "0"], ("adapt_active_steps", "reanchor_steps")),
+            ("hardware_like", "hardware_like", ["--plant-delay", "0.0027", "--pf-load", "0"],
              ("adapt_active_steps", "delay_switches", "delay_switches_steady")),
             # the PF's shared external force (cfg.load) with a 1-sigma thesis gate: gated steps re-acquired
             ("load", "hardware_like", ["--thesis-gate", "--pf-load", "1e4", "--pf-gate", "1"],

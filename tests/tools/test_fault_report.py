@@ -65,7 +65,10 @@ class FaultReport(unittest.TestCase):
         self.assertTrue(e["faulted"])
         self.assertIsNone(e["contour_rms_m"])
         self.assertIsNone(e["max_err_m"])
-        self.assertEqual(e["fault_cause"], "lost_lock")
+        # a 20 ms delay the nominal model does not know: the PF loses lock, or (with its shared
+        # external force, machines/reference.json) takes the misfit for a load until a motion
+        # guard latches (docs/modules/pf.md, "On in the reference machine")
+        self.assertIn(e["fault_cause"], ("lost_lock", "speed", "following"))
         self.assertGreater(e["fault_t_s"], 0.0)
         self.assert_fault_line(r.stdout, "est_nominal")
 

@@ -86,6 +86,7 @@ static void test_stop_is_failure(void **st)
         const double v_max_mps = br_circle_feed_mps(&c); /* each axis's largest speed */
         const double limit_N = BR_MACHINE_TORQUE_LIMIT_NM / BR_MACHINE_LEAD_MPRAD;
         est_of(&c, ests[e])->model.causes.dsigma2_neg_Nspm = (float)(4.0 * limit_N / v_max_mps);
+        c.pf.load = (br_pf_load_t){0.0f, 0.0f}; /* the extended model: the PF's load needs the thesis one */
         double expected = 0.0;
         for (int k = 0; k < BR_TUNE_DELAY_N; k++) {
             br_circle_cfg_t p = g.plant[k];

@@ -75,6 +75,7 @@ static br_pf_t *pf_with_lead(float lead, int extended, br_pf_cfg_t *cp)
     cp->est.comp_ahead_periods = lead;
     if (extended) {
         with_position_causes(&cp->est.model);
+        cp->load = (br_pf_load_t){0.0f, 0.0f}; /* the shared external force needs the thesis model */
     }
     assert_int_equal(br_pf_init(pf, cp), BR_OK);
     return pf;

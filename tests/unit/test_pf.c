@@ -23,10 +23,12 @@
 #define TEST_Q_OMEGA 1.0e-5f
 #define TEST_Q_GP 0.09f
 
-/* The machine file's PF (br_circle_pf_cfg_default) with m particles at the test's period. */
+/* The machine file's PF (br_circle_pf_cfg_default) with m particles at the test's period,
+ * the thesis filter: its shared external force off (cfg.load, test_pf_load.c) */
 static br_pf_cfg_t cfg(uint32_t m)
 {
     br_pf_cfg_t c = br_circle_pf_cfg_default(TEST_DT_S);
+    c.load = (br_pf_load_t){0.0f, 0.0f};
     c.n_particles = m;
     c.est.q_var[BR_X_OMEGA] = TEST_Q_OMEGA;
     c.est.q_var[BR_X_GP] = TEST_Q_GP;
@@ -1001,7 +1003,9 @@ static void test_adapt_is_thesis_filter_below_ref(void **st)
     br_pf_t *a = calloc(1, sizeof *a), *b = calloc(1, sizeof *b);
     assert_non_null(a);
     assert_non_null(b);
-    br_pf_cfg_t ca = br_circle_pf_cfg_tuned(BR_EST_PF_PERIOD_S), cb = ca;
+    br_pf_cfg_t ca = br_circle_pf_cfg_tuned(BR_EST_PF_PERIOD_S);
+    ca.load = (br_pf_load_t){0.0f, 0.0f}; /* the thesis filter (test_pf_load.c has the load's) */
+    br_pf_cfg_t cb = ca;
     ca.n_particles = cb.n_particles = 300;
     assert_true(ca.adapt.nis_ref > 0.0f); /* the reference machine's file has it on */
     cb.adapt.nis_ref = 0.0f;
@@ -1051,6 +1055,7 @@ static br_circle_cfg_t robust_plant0(br_circle_ctrl_t ctrl, float nis_ref)
     p->M_kg *= 1.0064866030910873;
     c.real = (br_circle_real_t){-0.0843537, 0.169206, 0.000105894, 20261123u};
     c.pf.adapt.nis_ref = nis_ref;
+    c.pf.load = (br_pf_load_t){0.0f, 0.0f}; /* adapt alone (the machine's load: below) */
     return c;
 }
 
@@ -1077,12 +1082,22 @@ static void test_adapt_keeps_lock_under_force_noise(void **st)
     /* the thesis filter stopped, or ran with at least five times the outliers and a larger error */
     assert_true(r_off.fault_status != 0 ||
                 (5 * r_on.outlier_steps < r_off.outlier_steps && r_on.contour_rms_m < r_off.contour_rms_m));
+    /* the machine's PF as it ships (adapt and the shared external force): the same */
+    br_circle_result_t r_mach;
+    c = robust_plant0(BR_CTRL_HINF_PF, base.pf.adapt.nis_ref);
+    c.pf.load = base.pf.load;
+    assert_int_equal(br_circle_run(&c, NULL, NULL, &r_mach), 0);
+    assert_int_equal(r_mach.fault_status, 0);
+    assert_true((double)r_mach.outlier_steps < 0.01 * 2.0 * (double)r_mach.n_samples);
+    print_message("plant 0, the machine's PF (load %s): %.3e m, %d outliers\n", base.pf.load.max_N > 0.0f ? "on" : "off",
+                  r_mach.contour_rms_m, r_mach.outlier_steps);
     c = robust_plant0(BR_CTRL_HINF_ONLY, 0.0f);
     assert_int_equal(br_circle_run(&c, NULL, NULL, &r_hinf), 0);
     print_message("plant 0: adapt off: fault %d at %.3f s, %.3e m, %d outliers; on: %.3e m, %d outliers of %ld "
                   "periods; H-inf only %.3e m\n", r_off.fault_status, r_off.fault_t_s, r_off.contour_rms_m,
                   r_off.outlier_steps, r_on.contour_rms_m, r_on.outlier_steps, r_on.n_samples, r_hinf.contour_rms_m);
     assert_true(r_on.contour_rms_m < r_hinf.contour_rms_m);
+    assert_true(r_mach.contour_rms_m < r_hinf.contour_rms_m);
 }
 
 #endif /* BR_TEST_THESIS_MACHINE */

@@ -312,6 +312,7 @@ static void stream_ms(int ne)
     br_pf_t *src = calloc(1, sizeof *src);
     assert_non_null(src);
     br_pf_cfg_t cfg = br_circle_pf_cfg_default(1.5e-3f);
+    cfg.load = (br_pf_load_t){0.0f, 0.0f}; /* the shared external force is LuGre-only */
     cfg.n_particles = M;
     br_circle_est_mslip(&cfg.est);
     if (ne != cfg.est.model.mslip.n) {

@@ -13,6 +13,7 @@
 
 #include "bristle_gen/est/br_est_machine.h"
 #include "bristle_gen/machine/br_machine.h"
+#include "circle/br_circle.h"
 #include "circle/br_circle_est.h"
 #include "bristle/br_pf.h"
 
@@ -21,9 +22,18 @@
 /* the filters are large: one, static to the test (not a mutable global of the firmware) */
 static br_pf_t g_pf;
 
-static br_pf_cfg_t load_cfg(void)
+/* the machine's tuned PF with the load off (whatever the machine file says) */
+static br_pf_cfg_t off_cfg(void)
 {
     br_pf_cfg_t c = br_circle_pf_cfg_tuned(DT_F);
+    c.load.q_N2 = 0.0f;
+    c.load.max_N = 0.0f;
+    return c;
+}
+
+static br_pf_cfg_t load_cfg(void)
+{
+    br_pf_cfg_t c = off_cfg();
     c.load.q_N2 = 1.0e4f * DT_F; /* 1e4 N^2/s, the campaign's */
     c.load.max_N = BR_MACHINE_TORQUE_LIMIT_NM_F / c.est.model.lead_mprad;
     return c;
@@ -38,11 +48,11 @@ static void test_load_guards(void **st)
     assert_int_equal(init_with(c), BR_OK);
     assert_true(g_pf.load_g_radpN > 0.0f);
     assert_true(g_pf.load_P[5] == c.load.max_N * c.load.max_N);
-    c = br_circle_pf_cfg_tuned(DT_F);
+    c = off_cfg();
     assert_int_equal(init_with(c), BR_OK); /* all 0: off */
     /* off needs both 0 */
-    c = br_circle_pf_cfg_tuned(DT_F); c.load.q_N2 = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
-    c = br_circle_pf_cfg_tuned(DT_F); c.load.max_N = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = off_cfg(); c.load.q_N2 = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = off_cfg(); c.load.max_N = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
     const float bad[] = {NAN, INFINITY, -1.0f, 1.0e-40f, 2.0f * BR_EST_VAR_MAX, 0.0f};
     for (unsigned b = 0; b < sizeof bad / sizeof bad[0]; b++) {
         c = load_cfg(); c.load.q_N2 = bad[b]; assert_int_equal(init_with(c), BR_E_PARAM);
@@ -53,6 +63,9 @@ static void test_load_guards(void **st)
      * the bootstrap proposal of the thesis model only */
     c = load_cfg(); c.proposal = BR_PF_PROPOSAL_OPT; assert_int_equal(init_with(c), BR_E_PARAM);
     c = load_cfg(); c.est.model.causes.offset_N = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    /* nor with Maxwell-slip elements (the move would make their f_nl the LuGre one) */
+    c = load_cfg(); br_circle_est_mslip(&c.est); assert_int_equal(init_with(c), BR_E_PARAM);
+    c = off_cfg(); br_circle_est_mslip(&c.est); assert_int_equal(init_with(c), BR_OK);
 }
 
 /* Counts of an axis held still for 0.1 s, then pushed by an external force
@@ -91,8 +104,7 @@ static void test_load_step_followed(void **st)
      * goes on growing with the speed (1.4 F at twice the push's time on both) */
     assert_true(comp > 0.5 * F && comp < 1.5 * F);
     /* without it the same push is a run of outliers (the lock monitor's trip) */
-    br_pf_cfg_t off = br_circle_pf_cfg_tuned(DT_F);
-    assert_int_equal(init_with(off), BR_OK);
+    assert_int_equal(init_with(off_cfg()), BR_OK);
     assert_true(run_pushed(F, 250, &comp) > 10);
 }
 
@@ -130,7 +142,16 @@ static void test_jump_not_a_load(void **st)
  * within the gate, an ordinary update), *undone whether step 201 undid it,
  * *f_max the largest |compensation| from step 205 on (the held axis's is
  * the model's friction around 0), *n_out the outlier steps. */
+static int glitch_moved(int32_t off, int slip, int32_t moved, int *acq_at, int *undone, float *f_max, int *n_out);
+
 static int glitch(int32_t off, int slip, int *acq_at, int *undone, float *f_max, int *n_out)
+{
+    return glitch_moved(off, slip, 0, acq_at, undone, f_max, n_out);
+}
+
+/* glitch() with the axis itself moved by `moved` counts from step 201 on (the spike's
+ * period's compensation moving a real axis otherwise than the model predicts) */
+static int glitch_moved(int32_t off, int slip, int32_t moved, int *acq_at, int *undone, float *f_max, int *n_out)
 {
     br_pf_cfg_t c = load_cfg();
     assert_int_equal(init_with(c), BR_OK);
@@ -138,7 +159,7 @@ static int glitch(int32_t off, int slip, int *acq_at, int *undone, float *f_max,
     *acq_at = *undone = *n_out = 0;
     *f_max = 0.0f;
     for (int k = 0; k < 400; k++) {
-        const br_meas_t y = {100 + ((k == 200 || (slip && k > 200)) ? off : 0), 0.5f};
+        const br_meas_t y = {100 + ((k == 200 || (slip && k > 200)) ? off : 0) + ((k > 200) ? moved : 0), 0.5f};
         const uint32_t acq = g_pf.n_load_acq, undo = g_pf.n_load_undo;
         const br_status_t st = br_pf_step(&g_pf, &y, 0.0f);
         assert_true(st == BR_OK || st == BR_W_OUTLIER);
@@ -203,6 +224,50 @@ static void test_glitch_undone(void **st)
             }
         }
         assert_true(n_acq >= 12);
+    }
+}
+
+/* docs/modules/pf.md, "A glitch is not a load": in closed loop the glitch period's
+ * compensation moves the real axis, which the model predicts only as well as it
+ * knows the plant (on the hardware-like plant a 500-count spike's -60 N moved the
+ * table 287 counts, the spike hypothesis's best particle 1.44 gates off). A spike
+ * followed by a move of `moved` counts the model does not predict, 1.05 and
+ * 1.1 gates either way (the hypotheses' test at twice the gate's distance,
+ * BR_PF_LOAD_UNDO_GATE2): the spike is undone at the next step, the moved axis
+ * is then re-acquired for at most 12 periods (measured: up to 6) and the
+ * compensation stays within 5 % of the actuator's force (measured: 3.2 N). With
+ * the plain gate for the hypotheses the + moves are not undone, on the reference
+ * and on machines/heavy (on the hardware-like plant in closed loop F_d then swung
+ * +-460 N period by period and the held axis latched ENC_FROZEN, br_faults
+ * enc_spike_hold). The spike hypothesis misses by itself, toward +: on the
+ * reference +1.5 gates is still undone, on machines/heavy from +1.2 it is not
+ * (its own miss about 0.85 gate; the - moves are undone at every size, with the
+ * plain gate too). */
+static void test_glitch_undone_moved(void **st)
+{
+    (void)st;
+    const br_pf_cfg_t c = load_cfg();
+    assert_int_equal(init_with(c), BR_OK);
+    const float F_act = c.load.max_N;
+    /* the gate's distance in counts: l >= outlier_l <=> |e| <= sqrt(-2 R outlier_l) */
+    const float gate = sqrtf(-2.0f * c.est.r_var_rad2 * g_pf.outlier_l) / c.est.rad_per_count;
+    const float window = 0.95f * 2.0f * F_act * g_pf.load_g_radpN / c.est.rad_per_count;
+    const int32_t off = (int32_t)lrintf(window * 5.0f / 16.0f);
+    static const float share[] = {1.05f, 1.1f};
+    for (unsigned i = 0; i < sizeof share / sizeof share[0]; i++) {
+        for (int sign = -1; sign <= 1; sign += 2) {
+            const int32_t moved = (int32_t)sign * (int32_t)lrintf(share[i] * gate);
+            int acq_at, undone, n_out;
+            float f;
+            const int last = glitch_moved(off, 0, moved, &acq_at, &undone, &f, &n_out);
+            printf("  spike %d, then moved %d (%.2f gates): %s%s, last re-acquisition at %d, max |F_hat| %.3g N\n",
+                   (int)off, (int)moved, (double)share[i], acq_at ? "re-acquired" : "within the gate",
+                   undone ? ", undone" : "", last, (double)f);
+            assert_true(acq_at);
+            assert_true(undone);
+            assert_true(last <= 212);
+            assert_true(f < 0.05f * F_act);
+        }
     }
 }
 
@@ -287,6 +352,7 @@ int main(void)
         cmocka_unit_test(test_load_bounded),
         cmocka_unit_test(test_jump_not_a_load),
         cmocka_unit_test(test_glitch_undone),
+        cmocka_unit_test(test_glitch_undone_moved),
         cmocka_unit_test(test_delay_loop_no_ring),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

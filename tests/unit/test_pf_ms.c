@@ -27,6 +27,7 @@ static br_pf_t *new_pf(void)
 static br_pf_cfg_t ms_cfg(uint32_t m)
 {
     br_pf_cfg_t c = br_circle_pf_cfg_tuned(DT_F);
+    c.load = (br_pf_load_t){0.0f, 0.0f}; /* the shared external force is LuGre-only */
     c.n_particles = m;
     br_circle_est_mslip(&c.est);
     return c;
@@ -183,7 +184,9 @@ static void test_ms_reanchor_moves_elements(void **st)
     const uint32_t m = c.n_particles;
     br_meas_t y = {0, 0.5f};
     for (int k = 0; k < 20; k++) assert_int_equal(br_pf_step(pf, &y, 0.0f), BR_OK);
-    y.counts = 4000; /* 4000 counts: far beyond every breakaway */
+    /* 8000 counts (61 um): beyond twice every breakaway at the largest g_p (1.5 Fs: the
+     * 20 um element's 30 um; 4000 counts left it short on a particle with g_p near there) */
+    y.counts = 8000;
     br_status_t s = BR_OK;
     for (uint32_t k = 0; k < c.est.reanchor_after; k++) s = br_pf_step(pf, &y, 0.0f);
     assert_int_equal(s, BR_W_OUTLIER);

@@ -20,7 +20,14 @@
 
 /* the machine file's UKF (the circle's hand-tuned start, docs/modules/ukf.md)
  * at the control period */
-static br_ukf_cfg_t ref_cfg(void) { return br_circle_ukf_cfg_default(BR_MACHINE_CTRL_PERIOD_S_F); }
+/* the machine file's UKF, the four-state filter: its external-force state off
+ * (cfg.load, test_ukf_load.c) */
+static br_ukf_cfg_t ref_cfg(void)
+{
+    br_ukf_cfg_t c = br_circle_ukf_cfg_default(BR_MACHINE_CTRL_PERIOD_S_F);
+    c.load = (br_ukf_load_t){0.0f, 0.0f, 0.0f};
+    return c;
+}
 
 /* the same with the thesis gate, g sqrt(S + rpc^2 / 12) alone: the gate tests'
  * (the machine's transient term d, eq. G1, has its own, test_gate_transient) */

@@ -17,9 +17,17 @@
 
 #define DT_F BR_MACHINE_CTRL_PERIOD_S_F
 
-static br_ukf_cfg_t load_cfg(void)
+/* the machine's tuned UKF with the state off (whatever the machine file says) */
+static br_ukf_cfg_t off_cfg(void)
 {
     br_ukf_cfg_t c = br_circle_ukf_cfg_tuned(DT_F);
+    c.load = (br_ukf_load_t){0.0f, 0.0f, 0.0f};
+    return c;
+}
+
+static br_ukf_cfg_t load_cfg(void)
+{
+    br_ukf_cfg_t c = off_cfg();
     const float F_act = BR_MACHINE_TORQUE_LIMIT_NM_F / c.est.model.lead_mprad;
     c.load.q_N2 = 1.0e4f * DT_F; /* 1e4 N^2/s, the campaign's */
     c.load.p0_N2 = F_act * F_act;
@@ -40,12 +48,12 @@ static void test_load_guards(void **st)
     br_ukf_cfg_t c = load_cfg();
     assert_int_equal(br_ukf_init(&u, &c), BR_OK);
     assert_int_equal(u.n, BR_UKF_NMAX);
-    c = br_circle_ukf_cfg_tuned(DT_F);
+    c = off_cfg();
     assert_int_equal(br_ukf_init(&u, &c), BR_OK);
     assert_int_equal(u.n, BR_NX); /* all 0: off */
     /* off needs all three 0 */
-    c = br_circle_ukf_cfg_tuned(DT_F); c.load.q_N2 = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
-    c = br_circle_ukf_cfg_tuned(DT_F); c.load.max_N = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = off_cfg(); c.load.q_N2 = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = off_cfg(); c.load.max_N = 1.0f; assert_int_equal(init_with(c), BR_E_PARAM);
     const float bad[] = {NAN, INFINITY, -1.0f, 1.0e-40f, 2.0f * BR_EST_VAR_MAX};
     for (unsigned b = 0; b < sizeof bad / sizeof bad[0]; b++) {
         c = load_cfg(); c.load.p0_N2 = bad[b]; assert_int_equal(init_with(c), BR_E_PARAM);
@@ -57,7 +65,7 @@ static void test_load_guards(void **st)
     c = load_cfg(); c.load.max_N = NAN; assert_int_equal(init_with(c), BR_E_PARAM);
     /* n + kappa > 0 with n = 5: kappa = -4.5 passes with the state, not without */
     c = load_cfg(); c.kappa = -4.5f; assert_int_equal(init_with(c), BR_OK);
-    c = br_circle_ukf_cfg_tuned(DT_F); c.kappa = -4.5f; assert_int_equal(init_with(c), BR_E_PARAM);
+    c = off_cfg(); c.kappa = -4.5f; assert_int_equal(init_with(c), BR_E_PARAM);
 }
 
 /* Counts of an axis held still for 0.1 s, then pushed by an external force
@@ -95,7 +103,7 @@ static void test_load_step_followed(void **st)
            (double)u.est.load_N, u.n_load_acq);
     assert_true(comp > 0.9 * F && comp < 1.1 * F);
     /* without the state the same push is a run of outliers (the lock monitor's trip) */
-    br_ukf_cfg_t off = br_circle_ukf_cfg_tuned(DT_F);
+    br_ukf_cfg_t off = off_cfg();
     assert_int_equal(br_ukf_init(&u, &off), BR_OK);
     assert_true(run_pushed(&u, F, 250, &comp) > 10);
 }

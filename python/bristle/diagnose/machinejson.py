@@ -31,7 +31,9 @@ marked "assumed"; what follows from the log and the rest is "derived". The
                    the identified machine, or hinf_rule asks, or they are derived (the
                    rule's for the base's friction): then the weights from the machine
                    for the identified one (firmware/design/hinf_weights.py, "derived")
-  estimator        the base's, as they are: format 2 states them in the
+  estimator        the base's, as they are (but estimator.pf.load where the PF cannot
+                   carry it: a force cause or the Maxwell-slip elements found,
+                   machine.pf_load_blockers): format 2 states them in the
                    machine's own units (per second, in metres, in Fs, Fc and
                    Fs/sigma0), so they follow the identified friction and
                    encoder by themselves (docs/machine-file.md); and when the
@@ -292,6 +294,7 @@ def build(prep, diag, given=None, log_path=None, hinf_rule=False):
                  "assumed" if q.name in held else "identified")
 
     _friction_model(m, diag, prov, notes)
+    _pf_load(m, notes)
     _hinf(m, prov, notes, hinf_rule)
 
     log_name = os.path.basename(log_path or prep.path)
@@ -344,6 +347,19 @@ def _friction_model(m, diag, prov, notes):
         m.pop("friction_model")
         notes.append("the given friction_model maxwell_slip is dropped: the log shows %s, which the firmware's "
                      "estimation model does not combine with it yet" % ", ".join(others))
+
+
+def _pf_load(m, notes):
+    """The base's estimator.pf.load (the reference machine's among them) dropped where the
+    diagnosed machine's PF cannot carry it (machine.pf_load_blockers: a force cause, the
+    Maxwell-slip elements), and said so; the UKF's state stays."""
+    if "load" not in m["estimator"]["pf"]:
+        return
+    why = _loader().pf_load_blockers(m)
+    if why:
+        del m["estimator"]["pf"]["load"]
+        notes.append("the PF's shared external force (estimator.pf.load) is not written: it %s"
+                     % "; it ".join(why))
 
 
 def write(out_dir, prep, diag, given=None, log_path=None, say=print, hinf_rule=False):

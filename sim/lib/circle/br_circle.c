@@ -148,6 +148,11 @@ void br_circle_use_ukf_load(br_circle_cfg_t *c, double q_N2ps)
         c->ukf.load.q_N2 = (float)(q_N2ps * c->dt_s);
         c->ukf.load.p0_N2 = (float)(F_act * F_act);
         c->ukf.load.max_N = (float)F_act;
+    } else if (q_N2ps == 0.0) {
+        /* off: br_ukf_load_t all 0 */
+        c->ukf.load.q_N2 = 0.0f;
+        c->ukf.load.p0_N2 = 0.0f;
+        c->ukf.load.max_N = 0.0f;
     }
 }
 
@@ -156,7 +161,21 @@ void br_circle_use_pf_load(br_circle_cfg_t *c, double q_N2ps)
     if (q_N2ps > 0.0) {
         c->pf.load.q_N2 = (float)(q_N2ps * (double)c->pf.est.model.dt_s);
         c->pf.load.max_N = (float)((double)BR_MACHINE_TORQUE_LIMIT_NM_F / c->plant.lead_mprad);
+    } else if (q_N2ps == 0.0) {
+        /* off: br_pf_load_t all 0 */
+        c->pf.load.q_N2 = 0.0f;
+        c->pf.load.max_N = 0.0f;
     }
+}
+
+double br_circle_ukf_load_q_N2ps(const br_circle_cfg_t *c)
+{
+    return (c->ukf.load.max_N > 0.0f) ? (double)c->ukf.load.q_N2 / c->dt_s : 0.0;
+}
+
+double br_circle_pf_load_q_N2ps(const br_circle_cfg_t *c)
+{
+    return (c->pf.load.max_N > 0.0f) ? (double)c->pf.load.q_N2 / (double)c->pf.est.model.dt_s : 0.0;
 }
 
 void br_circle_use_pf_gp_curve(br_circle_cfg_t *c, double tau_s)

@@ -149,15 +149,21 @@ void br_circle_use_ahead(br_circle_cfg_t *c, double lead_periods);
 /* The tools' --ukf-load: the UKF's external-force state (docs/modules/ukf.md,
  * "External force") with the random walk q_N2ps (N^2/s) at the run's period,
  * P0 = the actuator's force squared and |F_d| <= the actuator's force, as
- * machine.py derives them from estimator.ukf.load; q_N2ps <= 0 leaves the
- * machine file's. */
+ * machine.py derives them from estimator.ukf.load; q_N2ps = 0 turns it off,
+ * q_N2ps < 0 leaves the machine file's. */
 void br_circle_use_ukf_load(br_circle_cfg_t *c, double q_N2ps);
 
 /* The tools' --pf-load: the PF's shared external force (docs/modules/pf.md,
  * "External force") with the random walk q_N2ps (N^2/s) at the PF's period
  * and |F_d| <= the actuator's force, as machine.py derives them from
- * estimator.pf.load; q_N2ps <= 0 leaves the machine file's. */
+ * estimator.pf.load; q_N2ps = 0 turns it off, q_N2ps < 0 leaves the machine
+ * file's. */
 void br_circle_use_pf_load(br_circle_cfg_t *c, double q_N2ps);
+
+/* The external-force states' random walks as c runs them, N^2/s (0: off):
+ * for the tools' reports */
+double br_circle_ukf_load_q_N2ps(const br_circle_cfg_t *c);
+double br_circle_pf_load_q_N2ps(const br_circle_cfg_t *c);
 
 /* The tools' --pf-gp-curve: the PF's g_p along the Stribeck curve
  * (docs/modules/pf.md, "Fast moves") with the time constant tau_s at the PF's

@@ -194,4 +194,11 @@
 #define BR_EST_UKF_LOAD_MAX_N (0.0)
 #define BR_EST_UKF_LOAD_MAX_N_F (0.000000000e+00f)
 
+/* the PF's shared external force: random walk per step */
+#define BR_EST_PF_LOAD_Q_N2 (15.0)
+#define BR_EST_PF_LOAD_Q_N2_F (1.500000000e+01f)
+/* its bound, and the compensation's (the actuator's force) */
+#define BR_EST_PF_LOAD_MAX_N (502.65482457436696)
+#define BR_EST_PF_LOAD_MAX_N_F (5.026548157e+02f)
+
 #endif
