@@ -164,8 +164,9 @@ static float probe_lmax(const br_pf_t *pf, float y_rel, float dth)
  * last innovation nu1, theta (in the counter's frame) moved on by nu1 as well. The
  * smaller |mean innovation| first; the first whose best particle lies within twice
  * the gate's distance (BR_PF_LOAD_UNDO_GATE2: the glitch period's compensation moved
- * the real axis as well as the model knows the plant) is taken: F_d and its value at the period's start without e2, P as the prediction left
- * it carried over this period, the cloud moved (its lmax returned, sums made again).
+ * the real axis as well as the model knows the plant) is taken: F_d and its value
+ * at the period's start without e2, P as the prediction left it carried over this
+ * period, the cloud moved (its lmax returned, sums made again).
  * Neither passing: lmax unchanged (the re-acquisition stands). */
 static float load_undo(br_pf_t *pf, float y_rel, float lmax, float sums[2], uint32_t n_valid)
 {

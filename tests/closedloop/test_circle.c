@@ -315,7 +315,7 @@ static void test_diverged_estimate_stops_safe(void **st)
     assert_int_equal(r.fault_cause, BR_APP_FAULT_LOST_LOCK);
     /* with it (the machine's), the delay's misfit is re-acquired as a load and the lock
      * monitor sees too few outliers: the loop runs away until a motion guard latches
-     * (measured: SPEED at 1.128 s, 8.1e-5 m of contour error; docs/modules/pf.md, "On in
+     * (measured: FAULT SPEED at 1.128 s; docs/modules/pf.md, "On in
      * the reference machine"). Still a latched stop, never a run to the end */
     if (pl.pf.load.max_N > 0.0f) {
         assert_int_equal(br_circle_run(&pl, NULL, NULL, &r), 1);

@@ -96,7 +96,7 @@ int main(int argc, char **argv)
         }
     }
     if (out == NULL || !(duration > 0.0) || n_axes < 1u || n_axes > 2u || !(ahead >= 0.0 && ahead <= (double)BR_EST_AHEAD_MAX_PERIODS) ||
-        (delay_id != 0 && delay_id != 1) || !(pf_load >= -1.0 && pf_load <= 1.0e9)) {
+        (delay_id != 0 && delay_id != 1) || !(pf_load == -1.0 || (pf_load >= 0.0 && pf_load <= 1.0e9))) {
         fprintf(stderr, "br_replay_record: --out is required, duration > 0, axes 1 or 2, ahead in [0, 2], delay-id 0 or 1, "
                         "pf-load in [0, 1e9]\n");
         return 2;

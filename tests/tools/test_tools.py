@@ -551,6 +551,11 @@ class ToolsTest(unittest.TestCase):
                            ("pf", ["--guard-outliers", "0.1", "--plants", os.path.join(self.w, "none.json")])):
             r = run("br_tune_est", "--est", est, "--out", header, "--max-fev", "6", *extra)
             self.assert_refused(r, 2, "--guard-noise and --guard-outliers")
+        # the PF's shared external force: bounded, and for the PF only (the UKF's runs would ignore it)
+        for bad in (["--pf-load", "-1"], ["--pf-load", "2e9"], ["--pf-load", "nan"]):
+            self.assert_refused(run("br_tune_est", "--est", "pf", "--out", header, *bad), 2)
+        r = run("br_tune_est", "--est", "ukf", "--out", header, "--max-fev", "6", "--pf-load", "0")
+        self.assert_refused(r, 2, "--pf-load needs --est pf")
         # the Maxwell-slip guards' target: bounded, the nominal objective only; the checkpoint has its budget
         for bad in (["--mslip-target", "-0.1"], ["--mslip-target", "1.5"], ["--mslip-target", "nan"]):
             self.assert_refused(run("br_tune_est", "--est", "ukf", "--out", header, *bad), 2)
