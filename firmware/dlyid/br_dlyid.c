@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Actuator-delay identification while the axis runs. See br_dlyid.h and
- * docs/modules/dlyid.md (equations dly1-dly7). */
+ * docs/modules/dlyid.md (equations dly1-dly8). */
 #include "bristle/br_dlyid.h"
 
 #include <math.h>
@@ -255,14 +255,48 @@ int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t
     /* (dly6) the best candidate takes over when its sum is below switch_ratio times the
      * sum of the one in use ... */
     uint32_t best = id->cur;
-    for (uint32_t j = 0; j <= n; j++) {
-        if (id->J[j] < id->J[best]) {
-            best = j;
+    if (!steady) {
+        for (uint32_t j = 0; j <= n; j++) {
+            if (id->J[j] < id->J[best]) {
+                best = j;
+            }
+        }
+        if (!(id->J[best] < ratio * id->J[id->cur])) {
+            return 0;
+        }
+    } else {
+        /* (dly8) ... in the steady phase below rho^d_j times it for a candidate d_j steps along
+         * the grid from the delay in use (the configured delay: from the candidate nearest it,
+         * within half a step, which it may refine to: d_j = 0), the best the one of the smallest
+         * J_j / rho^d_j: a far jump needs a far better sum. A
+         * delay does not jump, and in a closed loop whose command follows the innovations, or
+         * at a load's onset, a far candidate wins a sum by chance (docs/modules/dlyid.md, "One
+         * step at a time"). The configured delay's slot is where the bank starts, not a step. */
+        uint32_t at = id->cur;
+        if (at == n) {
+            const float g = ((float)id->cm[n] + id->cf[n]) * T / c->step_s + 0.5f;
+            at = (g < (float)(n - 1u)) ? (uint32_t)g : n - 1u;
+        }
+        float w_best = 1.0f;
+        for (uint32_t j = 0; j < n; j++) {
+            const uint32_t d = (j > at) ? j - at : at - j;
+            float w = 1.0f;
+            for (uint32_t i = 0; i < d; i++) {
+                w *= ratio;
+            }
+            /* J_j / w < J_best / w_best, without the division */
+            if (j != id->cur && id->J[j] * w_best < id->J[best] * w) {
+                best = j;
+                w_best = w;
+            }
+        }
+        if (best == id->cur) {
+            return 0;
         }
     }
     /* ... and the one in use explains the motion worse than the noise allows */
     const float J_noise = BR_DLYID_NOISE_FACTOR * (id->r_rad2 + id->P[0][0]) / (1.0f - forget);
-    if (best == id->cur || !(id->J[best] < ratio * id->J[id->cur]) ||
+    if (best == id->cur ||
         !(id->J[id->cur] > J_noise)) {
         return 0;
     }

@@ -148,7 +148,7 @@ static float cmd_at(const br_est_delay_t *d, int32_t i, float u_prev_Nm)
 }
 
 float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_delay_t *d,
-                    const float x[BR_NX], float p0_m, float u_prev_Nm, float F_hat_N)
+                    const float x[BR_NX], float p0_m, float u_prev_Nm, float F_ext_N, float F_hat_N)
 {
     const float lambda = cfg->comp_ahead_periods;
     /* no lead; and, for a caller whose configuration br_est_cfg_check did not see,
@@ -168,13 +168,16 @@ float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_d
     for (int i = 0; i < BR_NX; i++) {
         cur[i] = x[i];
     }
+    /* the external force's torque at the motor, held over the carry */
+    const float u_ext = m->cfg.lead_mprad * F_ext_N;
     /* (ahead 2) the whole periods, then the part-period's end when fr > 0 (at least one
      * step: H > 0; the first checks x) */
     const uint32_t steps = n + ((fr > 0.0f) ? 1u : 0u);
     for (uint32_t j = 0; j < steps; j++) {
-        /* (ahead 3) the torque reaching the axis over period k + j: (1 - f) u[k+j-m] + f u[k+j-m-1] */
+        /* (ahead 3) the torque reaching the axis over period k + j: (1 - f) u[k+j-m] + f u[k+j-m-1],
+         * less the external force's L F_ext */
         const int32_t a = (int32_t)j - dm;
-        const float u = (1.0f - df) * cmd_at(d, a, u_prev_Nm) + df * cmd_at(d, a - 1, u_prev_Nm);
+        const float u = (1.0f - df) * cmd_at(d, a, u_prev_Nm) + df * cmd_at(d, a - 1, u_prev_Nm) - u_ext;
         if (br_model_step_at(m, cur, p0_m, u, nxt) != BR_OK) {
             return F_hat_N;
         }

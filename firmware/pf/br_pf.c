@@ -845,7 +845,7 @@ br_status_t br_pf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, float
             float mean[BR_NX];
             set_mean(pf, mean);
             *F_hat_N = br_est_comp_N(&pf->cfg.est, &pf->model, &pf->delay, mean, origin_pos_m(pf), u_prev_Nm,
-                                     pf->est.F_hat_N);
+                                     pf->load_N, pf->est.F_hat_N);
         }
     }
     return st;

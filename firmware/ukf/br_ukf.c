@@ -137,6 +137,7 @@ br_status_t br_ukf_init(br_ukf_t *ukf, const br_ukf_cfg_t *cfg)
     ukf->n_predicted = 0u;
     ukf->n_load_acq = 0u;
     ukf->n_load_undo = 0u;
+    ukf->n_repair = 0u;
     ukf->alt_pending = 0;
     ukf->alt_origin = 0;
     ukf->alt_nu_rad = 0.0f;
@@ -221,13 +222,47 @@ static void reset_cov(const br_ukf_t *ukf, float P[NM][NM])
     }
 }
 
-/* Sigma points of (x, P) into ukf->X, factor into ukf->S. On a failed Cholesky
- * P is reset to P0 (x kept) and BR_E_NUMERIC returned; the points are
- * then those of the reset P, so they are always usable. */
+/* 1 when every entry of P (leading n x n) is finite: a covariance float32's
+ * rounding made indefinite, not a broken one */
+static int cov_finite(const float P[NM][NM], int n)
+{
+    int ok = 1;
+    for (int i = 0; i < n; i++) {
+        for (int j = 0; j < n; j++) {
+            ok = ok && isfinite(P[i][j]);
+        }
+    }
+    return ok;
+}
+
+/* Sigma points of (x, P) into ukf->X, factor into ukf->S. A failed Cholesky
+ * of a finite P is repaired (U9): its correlations dropped, each positive
+ * variance times n (P <= n diag(P) for every covariance with that diagonal),
+ * a variance that is not positive P0's, counted in n_repair, BR_OK.
+ * Otherwise P is reset to P0 (x kept) and BR_E_NUMERIC returned; the points
+ * are then those of the reset P, so they are always usable. */
 static br_status_t sigma_points(br_ukf_t *ukf, const float x[NM], float P[NM][NM])
 {
     const int n = ukf->n;
     br_status_t st = chol_n((const float(*)[NM])P, ukf->S, n);
+    if (st != BR_OK && cov_finite((const float(*)[NM])P, n)) {
+        /* (U9) states almost perfectly correlated (theta, omega and F_d after a
+         * load re-acquisition's inflation, updated with a small R) come out of
+         * float32's update indefinite, a variance even negative: the
+         * correlations dropped, the variances times n (P0's where one is not
+         * positive), whose factor is the diagonal's root (docs/modules/ukf.md,
+         * "Cholesky and recovery") */
+        const float fn = (float)n;
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < n; j++) {
+                P[i][j] = (i != j) ? 0.0f : ((P[i][i] > 0.0f) ? fn * P[i][i] : p0_of(&ukf->cfg, i));
+            }
+        }
+        st = chol_n((const float(*)[NM])P, ukf->S, n);
+        if (st == BR_OK && ukf->n_repair < UINT32_MAX) {
+            ukf->n_repair++;
+        }
+    }
     if (st != BR_OK) {
         /* recovery: P <- P0, whose factor is diag(sqrt(P0)) */
         reset_cov(ukf, P);
@@ -816,7 +851,8 @@ br_status_t br_ukf_est_step(void *ctx, const br_meas_t *y, float u_prev_Nm, floa
     if (!BR_FAILED(st)) { /* an outlier step still predicts */
         /* the compensation: F_hat, or the force predicted ahead (cfg.est.comp_ahead_periods) */
         *F_hat_N = br_est_comp_N(&ukf->cfg.est, &ukf->model, &ukf->delay, ukf->x,
-                                 (float)ukf->origin_counts * ukf->m_per_count, u_prev_Nm, ukf->est.F_hat_N);
+                                 (float)ukf->origin_counts * ukf->m_per_count, u_prev_Nm, ukf->est.load_N,
+                                 ukf->est.F_hat_N);
     }
     return st;
 }

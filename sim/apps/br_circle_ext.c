@@ -115,8 +115,7 @@ int main(int argc, char **argv)
         if (runs[r].extended) {
             /* the estimator predicts and compensates with the diagnosed causes */
             const br_causes_t causes = br_causes_from_model(&saved);
-            c.pf.est.model.causes = causes;
-            c.ukf.est.model.causes = causes;
+            br_circle_use_causes(&c, &causes);
         }
         br_circle_result_t res;
         /* 1: the firmware stopped the axis safe (a fault), part of the result */

@@ -13,7 +13,8 @@
  *
  * Usage: br_robust_run [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N]
  *                      [--enc-noise P] [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT]
- *                      [--pf-dt S] [--pf-n M] [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S]
+ *                      [--pf-dt S] [--pf-n M] [--pf-proposal K] [--pf-load Q] [--ukf-load Q]
+ *                      [--pf-gate SIGMA] [--pf-adapt-max S]
  *                      [--ahead P] [--machine-causes]
  *                      [--delay-id 0|1]
  *                      [--radius-m R] [--feed-mm-min F] [--direction cw|ccw]
@@ -25,6 +26,8 @@
  * OPT_HELD; docs/modules/pf.md).
  * --pf-load: the PF's shared external force with this random walk, N^2/s
  * (br_pf_cfg_t.load; 0: off; the default: the machine's).
+ * --ukf-load: the UKF's external-force state with this random walk, N^2/s
+ * (br_ukf_cfg_t.load; 0: off; the default: the machine's).
  * --pf-gate: the PF's outlier gate in sigmas (a study, docs/presliding-plants.md,
  * "The PF's gate"; the default: the machine's).
  * --pf-adapt-max: the PF's cfg.adapt.max_scale, its largest variance factor (1: no
@@ -79,7 +82,7 @@ static int usage(const char *argv0, FILE *to)
     fprintf(to,
             "usage: %s [--plant PLANT.json] [--model MODEL.json] [--drift F] [--force-noise N] [--enc-noise P]\n"
             "       [--seed N] [--only a,b,...] [--ff-veps V] [--dir DIR] [--json OUT] [--pf-dt S] [--pf-n M]\n"
-            "       [--pf-proposal K] [--pf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S] [--ahead P] [--delay-id 0|1]\n"
+            "       [--pf-proposal K] [--pf-load Q] [--ukf-load Q] [--pf-gate SIGMA] [--pf-adapt-max S] [--ahead P] [--delay-id 0|1]\n"
             "       [--machine-causes] [--radius-m R] [--feed-mm-min F]\n"
             "       [--direction cw|ccw] [--gms D1,..,DN] [--gms-zeta Z]\n"
             BR_ARGS_COMMON_USAGE
@@ -99,6 +102,8 @@ static int usage(const char *argv0, FILE *to)
             "                      noise held over the period (docs/modules/pf.md)\n"
             "  --pf-load Q         the PF's shared external force, random walk Q N^2/s (0 .. 1e9, 0: off;\n"
             "                      default the machine file's; docs/modules/pf.md)\n"
+            "  --ukf-load Q        the UKF's external-force state, random walk Q N^2/s (0 .. 1e9, 0: off;\n"
+            "                      default the machine file's; docs/modules/ukf.md)\n"
             "  --pf-gate SIGMA     the PF's outlier gate, sigmas (%g .. %g; a study, docs/presliding-plants.md)\n"
             "  --pf-adapt-max S    the PF's largest noise-variance factor of cfg.adapt (1 .. 1e12; 1: none; no\n"
             "                      effect where the machine has cfg.adapt off; a study, docs/fleet.md)\n"
@@ -150,7 +155,7 @@ int main(int argc, char **argv)
 {
     const char *plant_path = NULL, *model_path = NULL, *json = NULL, *only = NULL, *dir = NULL;
     br_circle_real_t real = {0.0, 0.0, 0.0, 0u};
-    double veps = -1.0, pf_dt = -1.0, ahead = -1.0, pf_load = -1.0, pf_gate = 0.0, pf_adapt_max = 0.0;
+    double veps = -1.0, pf_dt = -1.0, ahead = -1.0, pf_load = -1.0, ukf_load = -1.0, pf_gate = 0.0, pf_adapt_max = 0.0;
     long pf_n = 0, pf_prop = -1, delay_id = -1;
     int machine_causes = 0;
     br_circle_path_t path = BR_CIRCLE_PATH_DEFAULT;
@@ -164,6 +169,7 @@ int main(int argc, char **argv)
         {"pf-n", required_argument, NULL, 'n'},   {"seed", required_argument, NULL, 's'},
         {"pf-proposal", required_argument, NULL, 'p'}, {"ahead", required_argument, NULL, 'a'},
         {"delay-id", required_argument, NULL, 'i'}, {"pf-load", required_argument, NULL, 'L'},
+        {"ukf-load", required_argument, NULL, 'U'},
         {"pf-gate", required_argument, NULL, 'G'}, {"pf-adapt-max", required_argument, NULL, 'X'},
         {"machine-causes", no_argument, NULL, 'M'},
         BR_CIRCLE_LONGOPTS BR_GMS_LONGOPTS{NULL, 0, NULL, 0}};
@@ -189,6 +195,7 @@ int main(int argc, char **argv)
         case 'a': bad = br_arg_double(TOOL, ap.opt, val, 0.0, (double)BR_EST_AHEAD_MAX_PERIODS, &ahead); break;
         case 'i': bad = br_arg_long(TOOL, ap.opt, val, 0, 1, &delay_id); break;
         case 'L': bad = br_arg_double(TOOL, ap.opt, val, 0.0, 1.0e9, &pf_load); break;
+        case 'U': bad = br_arg_double(TOOL, ap.opt, val, 0.0, 1.0e9, &ukf_load); break;
         case 'G':
             bad = br_arg_double(TOOL, ap.opt, val, BR_TOOL_GATE_MIN_SIGMA, BR_TOOL_GATE_MAX_SIGMA, &pf_gate);
             break;
@@ -271,6 +278,7 @@ int main(int argc, char **argv)
         if (runs[r].identified) br_circle_use_model(&c, &model);
         else if (machine_causes) br_circle_use_machine_causes(&c);
         br_circle_use_pf_load(&c, pf_load);
+        br_circle_use_ukf_load(&c, ukf_load);
         br_circle_use_pf_gate(&c, pf_gate);
         br_circle_use_pf_adapt_max(&c, pf_adapt_max);
         br_outfile_t tr = {0}, hi = {0};

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The PF's actuator delay for make bench's numpy PF (pf_numpy.py): the
 command history and the delay identification's bank, written from
-docs/modules/dlyid.md (equations dly1-dly7) and docs/modules/model.md ("the
+docs/modules/dlyid.md (equations dly1-dly8) and docs/modules/model.md ("the
 delay is the estimators'"), in float32 like the firmware. The slots' filters
 are a float32 array over the slots (each slot's operations are the same
 elementwise), the common covariance a 3 x 3 float32 array whose products sum
@@ -13,8 +13,9 @@ their three terms in order, from 0, one array operation per term.
   bank     slots j = 0 .. N-1 at delays j step_s, slot N at the configured
            delay (the one in use at the start); per measurement:
            dly7 (the reversal rule), dly3 (covariance and gain), dly4 and dly5
-           for every slot, then after the warm-up dly6 (the switch), which
-           hands the new slot's delay to the history from the next period on.
+           for every slot, then after the warm-up dly6 (the switch; dly8: in
+           the steady phase a far one needs a far better sum), which hands the new slot's
+           delay to the history from the next period on.
 
 Used by NumpyPf.step in the order of a period: the command joins the history,
 the torque of the delay in use is taken, then the bank takes the measurement."""
@@ -58,13 +59,14 @@ class DelayHistory:
 
 
 class DelayBank:
-    """The bank of dly1-dly7: one Kalman filter of the rigid axis per slot."""
+    """The bank of dly1-dly8: one Kalman filter of the rigid axis per slot."""
 
     def __init__(self, cfg):
         d = cfg["delay_id"]
         self.n = n = int(d["n_cand"])
         T, L = F(cfg["dt_s"]), F(cfg["lead_mprad"])
         self.T = T
+        self.step_s = F(d["step_s"])
         self.rpc = F(cfg["rad_per_count"])
         self.gp_max = F(cfg["gp_max_N"])
         # dly1: the rigid body over a period with u - L F held
@@ -191,11 +193,31 @@ class DelayBank:
         # dly6: the best slot (the first of equal sums), decisively better than the one in use,
         # which explains the motion worse than the noise allows
         best = self.cur
-        for j in range(self.n + 1):
-            if self.J[j] < self.J[best]:
-                best = j
+        if not steady:
+            for j in range(self.n + 1):
+                if self.J[j] < self.J[best]:
+                    best = j
+            if not (self.J[best] < ratio * self.J[self.cur]):
+                return 0
+        else:
+            # dly8: a candidate d steps along the grid from the delay in use (the configured one:
+            # from its nearest candidate, d = 0 for that one) below rho^d times its sum; the best
+            # of J_j / rho^d
+            at = self.cur
+            if at == self.n:
+                g = (F(self.cm[self.n]) + self.cf[self.n]) * self.T / self.step_s + F(0.5)
+                at = int(g) if g < F(self.n - 1) else self.n - 1
+            w_best = F(1.0)
+            for j in range(self.n):
+                w = F(1.0)
+                for _ in range(abs(j - at)):
+                    w = F(w * ratio)
+                if j != self.cur and F(self.J[j] * w_best) < F(self.J[best] * w):
+                    best, w_best = j, w
+            if best == self.cur:
+                return 0
         j_noise = NOISE_FACTOR * (self.r + self.P[0, 0]) / (F(1.0) - forget)
-        if best == self.cur or not (self.J[best] < ratio * self.J[self.cur]) or not (self.J[self.cur] > j_noise):
+        if not (self.J[self.cur] > j_noise):
             return 0
         self.cur = best
         self.n_switch += 1

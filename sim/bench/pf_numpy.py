@@ -6,7 +6,7 @@ in numpy, vectorised over the particles, timed on the recording br_bench made
 
 Same model and algorithm as br_pf.c, in float32 throughout (as the firmware):
   delay     the torque u_a the command history gives for the delay in use, and
-            the delay identification's bank (dly1-dly7, dlyid_numpy.py), whose
+            the delay identification's bank (dly1-dly8, dlyid_numpy.py), whose
             switch changes the delay from the next period on
   predict   eq. 6 by the PF's RK4 (br_model_kp_rk4) on every particle,
             then, per particle (a mask on the a h <= 2 test at both ends of

@@ -23,8 +23,16 @@ delay, the identified delay within 0.3 ms of it (the identification's step
 is 0.5 ms). The axis' own pair at 1 (a free mass) is in every spectrum; a
 mode beyond 1 is the ring.
 
-Usage: pf_load_map.py [--q Q ...] [--spread S] [--check]
-  --spread S   the cloud's spread var theta_j in units of R (default 1)
+The UKF's external-force state (--est ukf, docs/modules/ukf.md, "On in the
+reference machine") has the same loop at the control period with the
+UKF's R and no cloud spread; its identification's candidates are on the
+same 0.5 ms grid. --unknown adds the map with the model's delay 0 (the
+identification off or not yet decided).
+
+Usage: pf_load_map.py [--est pf|ukf] [--q Q ...] [--spread S] [--unknown] [--check]
+  --est E      the filter: pf (default; its period and R) or ukf (the control period, its R)
+  --spread S   the cloud's spread var theta_j in units of R (default 1; the PF only)
+  --unknown    also the largest |eigenvalue| with the model's delay 0
   --check      exit 1 unless: the plain loop holds (<= 1) at delays 0 .. 1.5 ms
                and rings (< -1) at 2 ms, at q = 1e4 N^2/s; the notch (its r
                read from firmware/private/br_pf_load.h) holds at every delay
@@ -46,13 +54,13 @@ ID_NEAR_MS = 0.3   # the identified delay: a candidate within this of the plant'
 TOL = 1e-6         # the free mass' double eigenvalue 1 (a Jordan pair: 1 +- ~1e-8 in floating point)
 
 
-def machine():
+def machine(est="pf"):
     with open(os.path.join(REPO, "machines", "reference.json")) as f:
         mm = json.load(f)
     L = mm["mechanics"]["lead_m_per_rev"] / (2.0 * math.pi)
-    pf = mm["estimator"]["pf"]
+    e = mm["estimator"][est]
     return {"M": mm["mechanics"]["inertia_kgm2"] / L ** 2 + mm["mechanics"]["table_mass_kg"],
-            "h": pf["period_s"], "R": pf["position_noise_m2"],
+            "h": e["period_s"] if est == "pf" else mm["control"]["period_s"], "R": e["position_noise_m2"],
             "rpc": mm["mechanics"]["lead_m_per_rev"] / mm["encoder"]["counts_per_rev"]}
 
 
@@ -143,12 +151,17 @@ def worst(mc, K, D, r):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--est", choices=("pf", "ukf"), default="pf")
     ap.add_argument("--q", type=float, nargs="*", default=[1e3, 1e4, 1e5, 3e5])
     ap.add_argument("--spread", type=float, default=1.0)
+    ap.add_argument("--unknown", action="store_true")
     ap.add_argument("--check", action="store_true")
     a = ap.parse_args()
-    mc, r = machine(), notch_r()
-    s = a.spread * mc["R"] + mc["R"] + mc["rpc"] ** 2 / 12.0
+    if a.check and a.est != "pf":
+        ap.error("--check is the PF's (its notch)")
+    mc, r = machine(a.est), notch_r()
+    spread = a.spread if a.est == "pf" else 0.0
+    s = spread * mc["R"] + mc["R"] + mc["rpc"] ** 2 / 12.0
     ok = True
     print(f"M_eff {mc['M']:.4g} kg, h {mc['h'] * 1e3:g} ms, notch r {r:g}; largest |eigenvalue| "
           f"(its value) over identified delays within {ID_NEAR_MS} ms")
@@ -159,8 +172,12 @@ def main():
         for D in DELAYS_MS:
             p, pe = worst(mc, K, D, None)
             nn, ne = worst(mc, K, D, r)
+            unk = ""
+            if a.unknown:
+                ev = np.linalg.eigvals(loop(mc, K, D * 1e-3, 0.0, None))
+                unk = f"   model's delay 0: {float(np.max(np.abs(ev))):.3f}"
             print(f"  delay {D:5.3f} ms: plain {p:.3f} ({pe.real:+.3f}{pe.imag:+.3f}j)   "
-                  f"notch {nn:.3f} ({ne.real:+.3f}{ne.imag:+.3f}j)")
+                  f"notch {nn:.3f} ({ne.real:+.3f}{ne.imag:+.3f}j){unk}")
             if a.check:
                 if q <= 3e5 and nn > 1.0 + TOL:
                     ok = False

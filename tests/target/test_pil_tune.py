@@ -9,11 +9,14 @@ evaluations, after the shipped setting's evaluation 0):
    values in its filter's configuration (br_pil_tune --sim), and the
    evaluations with different variances have different duty sequences;
 2. a faulted evaluation is counted as one: the run writes a narrow outlier
-   gate before every evaluation (--set outlier_sigma=0.6 and the gate's
+   gate before every evaluation (--set outlier_sigma=0.35 and the gate's
    transient term 0: a gate that loses
    lock within 0.1 s for some of these settings and not for others: found
-   with --sim); each run that stopped is printed as a FAULT with no figure,
-   counted in the summary line, and has no figure in evals.csv;
+   with --sim; since the machine's UKF carries its external force
+   (2026-11-28) it re-acquires as a load what 0.6 used to reject, and 0.6
+   stops none, 0.3 all, 0.35 one of the six); each run that stopped is
+   printed as a FAULT with no figure, counted in the summary line, and has
+   no figure in evals.csv;
 3. the best is reported: the smallest objective of the evaluations that ran
    to the end, with its variances.
 
@@ -29,7 +32,7 @@ import sys
 
 SEGMENT_S = "0.1"
 MAX_FEV = "6"         # the UKF's five variances: the first simplex
-GATE = "outlier_sigma=0.6"
+GATE = "outlier_sigma=0.35"
 # the gate's transient term off (the thesis gate, eq. G1): the machine's 20.8 counts would accept every step
 NO_TERM = "outlier_transient_counts=0"
 

@@ -338,7 +338,7 @@ class ToolsTest(unittest.TestCase):
     def test_robust_run_bad_options_touch_nothing(self):
         keep = self.existing("robust.json")
         for bad in (["--drift", "0.6"], ["--drift", "nan"], ["--force-noise", "-1"], ["--enc-noise", "1.5"],
-                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--delay-id", "2"], ["--delay-id", "-1"], ["--pf-gate", "0"], ["--pf-gate", "1e4"], ["--pf-adapt-max", "0.5"], ["--pf-adapt-max", "nan"], ["--pf-adapt-max", "1e13"], ["--machine-causes=1"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
+                    ["--seed", "-1"], ["--ff-veps", "0"], ["--pf-dt", "1"], ["--pf-n", "0"], ["--pf-proposal", "3"], ["--ahead", "2.5"], ["--ahead", "inf"], ["--delay-id", "2"], ["--delay-id", "-1"], ["--pf-gate", "0"], ["--pf-gate", "1e4"], ["--pf-adapt-max", "0.5"], ["--pf-adapt-max", "nan"], ["--pf-adapt-max", "1e13"], ["--ukf-load", "-1"], ["--ukf-load", "2e9"], ["--ukf-load", "nan"], ["--machine-causes=1"], ["--only", "nope"], ["--only", "hinf_only,hinf_pf_id"],
                     ["--bogus", "1"], ["--drift"]):
             r = run("br_robust_run", "--json", keep, *bad)
             self.assert_refused(r, 2)
@@ -349,6 +349,45 @@ class ToolsTest(unittest.TestCase):
         r = run("br_robust_run", "--json", keep, "--plant", os.path.join(self.w, "none.json"))
         self.assert_refused(r, 1, "cannot open")
         self.assert_untouched(keep)
+
+    def test_robust_run_ukf_load_takes_effect(self):
+        """--ukf-load (docs/modules/ukf.md, "External force"): absent is the machine file's state, 0
+        turns it off and another random walk is another filter; with the reference's state on
+        (estimator.ukf.load) its own q gives the default run to the digit"""
+        def rms(*extra):
+            r = run("br_robust_run", "--only", "hinf_ukf", *extra)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            # the figure and the largest error (q 1e3 and 1e4 agree in the RMS to 5 digits here)
+            return re.search(r"contour RMS \S+ m, max \S+ m|FAULT at \S+ s \(\w+", r.stdout).group(0)
+        with open(ARGS.machine, encoding="utf-8") as f:
+            q = json.load(f)["estimator"]["ukf"].get("load", {}).get("q_N2_per_s", 0.0)
+        default = rms()
+        self.assertEqual(rms("--ukf-load", repr(float(q))), default)
+        self.assertNotEqual(rms("--ukf-load", repr(float(q) * 10.0 if q > 0 else 1e3)), default)
+
+    def test_robust_run_identified_force_cause_runs_the_pf(self):
+        """an identified model with a force cause (offset_N) makes the estimators' model the
+        extended one, which the PF's shared external force cannot carry (br_pf_init refuses it):
+        the *_id runs switch it off as a diagnosis's machine.json does (br_circle_use_causes), so
+        the PF runs instead of being refused at init; with the force forced on it is refused"""
+        with open(ARGS.machine, encoding="utf-8") as f:
+            mm = json.load(f)
+        fr, me = mm["friction"], mm["mechanics"]
+        lead = me["lead_m_per_rev"] / (2.0 * math.pi)
+        params = {k: fr[k] for k in ("sigma2_Nspm", "Fc_N", "Fs_N", "vs_mps", "sigma0_Npm", "sigma1_Nspm")}
+        params["Meff_kg"] = me["inertia_kgm2"] / lead ** 2 + me["table_mass_kg"]
+        params["offset_N"] = 2.5
+        model = os.path.join(self.w, "model.json")
+        with open(model, "w", encoding="utf-8") as f:
+            json.dump({"params": params}, f)
+        r = run("br_robust_run", "--plant", model, "--model", model, "--only", "hinf_pf_id")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("contour RMS", r.stdout)  # measured: 4.6e-8 m
+        self.assertNotIn("REFUSED", r.stdout)
+        if "load" in mm["estimator"]["pf"]:
+            r = run("br_robust_run", "--plant", model, "--model", model, "--only", "hinf_pf_id", "--pf-load", "1e4")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("REFUSED at init", r.stdout)
 
     def test_robust_run_pf_adapt_max_takes_effect(self):
         """--pf-adapt-max (docs/fleet.md, "The PF's start on the fleet's axes"): 1 is the PF without

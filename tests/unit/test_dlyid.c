@@ -184,6 +184,7 @@ static void test_dlyid_bounds(void **st)
 #undef REFUSED_FROM
     /* off (0): its memory and ratio are not looked at */
     c = ok;
+    c.delay_id.steady_after_s = 0.0f;
     c.delay_id.steady_memory_s = NAN;
     c.delay_id.steady_switch_ratio = 7.0f;
     assert_int_equal(br_est_cfg_check(&c), BR_OK);
@@ -333,7 +334,11 @@ static void test_dlyid_keeps_the_modelled_delay(void **st)
 static void test_dlyid_overflow_restarts(void **st)
 {
     (void)st;
-    const br_est_cfg_t c = machine_ukf();
+    /* the one-phase bank: the restart's own start phase is short of this axis's weak evidence,
+     * and the steady phase's far steps (dly8) need a far better sum (docs/modules/dlyid.md,
+     * "One step at a time") */
+    br_est_cfg_t c = machine_ukf();
+    c.delay_id.steady_after_s = 0.0f;
     br_est_delay_t d;
     br_dlyid_t id;
     br_est_delay_init(&d, &c);
@@ -530,6 +535,129 @@ static void test_dlyid_finds_delay_at_reversals(void **st)
     assert_true(fabs(modelled_s(&d, &c) - 1.5e-3) <= 0.5 * (double)c.delay_id.step_s + 1e-9);
 }
 
+/* One step at a time (dly8; docs/modules/dlyid.md, "One step at a time"): in the steady phase a
+ * candidate d steps along the grid from the delay in use takes over only when its sum is below
+ * rho^d times the one in use's: a far candidate just decisive enough for a neighbour does not
+ * take over (in a closed loop slot 0 won so by chance and the UKF's external force ran away), a
+ * far one far better does, and so does a neighbour; the configured delay's slot is not a step.
+ * Before the steady phase the one-phase rule (dly6): a far candidate below rho takes over. */
+static uint32_t bank_then(br_est_cfg_t c, int low, float J_low, uint32_t *c0_out)
+{
+    const uint32_t n = c.delay_id.n_cand;
+    br_est_delay_t d;
+    br_dlyid_t id;
+    axis_t a;
+    axis_init(&a, &c, 2.0e-3);
+    br_est_delay_init(&d, &c);
+    br_est_dlyid_init(&id, &c);
+    float u_prev = 0.0f;
+    for (int k = 0; k < 1000; k++) {
+        const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
+        (void)br_est_delay_apply(&d, u_prev);
+        br_est_dlyid_step(&id, &c, &y, &d);
+        u_prev = command(&a, k + 1);
+    }
+    /* the first switch left the configured slot n for a candidate 2 or more from either end */
+    assert_true(id.n_switch >= 1u && id.cur >= 2u && id.cur + 2u < n);
+    *c0_out = id.cur;
+    /* every sum 1 (far above the noise floor) but slot low's */
+    for (uint32_t j = 0; j <= n; j++) {
+        id.J[j] = ((int)j == low) ? J_low : 1.0f;
+    }
+    const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
+    (void)br_est_delay_apply(&d, u_prev);
+    br_est_dlyid_step(&id, &c, &y, &d);
+    /* the history models the delay in use */
+    assert_true(fabs(modelled_s(&d, &c) - (double)id.cur * (double)c.delay_id.step_s) < 1e-9);
+    return id.cur;
+}
+
+static void test_dlyid_one_step_at_a_time(void **st)
+{
+    (void)st;
+    br_est_cfg_t c = machine_ukf();
+    const uint32_t n = c.delay_id.n_cand;
+    assert_true(n >= 6u);
+    /* a steady phase from 0.5 s on (the first 1000 periods reach it) */
+    const float rho = 0.5f;
+    c.delay_id.steady_after_s = 0.5f;
+    c.delay_id.steady_memory_s = 0.1f;
+    c.delay_id.steady_switch_ratio = rho;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    assert_true(1000.0f * c.model.dt_s > c.delay_id.steady_after_s);
+    uint32_t c0 = 0u, got;
+    got = bank_then(c, -1, 1.0f, &c0);
+    assert_int_equal(got, c0);
+    const uint32_t start = c0;
+    /* slot 0, start steps away, 0.9 rho^(start - 1) of the sum in use: kept */
+    const float far = 0.9f * powf(rho, (float)(start - 1u));
+    got = bank_then(c, 0, far, &c0);
+    assert_int_equal(got, start);
+    /* 0.9 rho^start: taken */
+    got = bank_then(c, 0, 0.9f * powf(rho, (float)start), &c0);
+    assert_int_equal(got, 0u);
+    /* the configured delay's slot (0 ms here, as slot 0), far best: kept */
+    got = bank_then(c, (int)n, 1.0e-30f, &c0);
+    assert_int_equal(got, start);
+    /* a neighbour either side at 0.9 rho: taken */
+    got = bank_then(c, (int)start - 1, 0.9f * rho, &c0);
+    assert_int_equal(got, start - 1u);
+    got = bank_then(c, (int)start + 1, 0.9f * rho, &c0);
+    assert_int_equal(got, start + 1u);
+    /* before the steady phase: slot 0 at 0.9 rho^(start - 1) taken */
+    c.delay_id.steady_after_s = 2.0f;
+    got = bank_then(c, 0, far, &c0);
+    assert_int_equal(c0, start);
+    assert_int_equal(got, 0u);
+}
+
+/* dly8 from a configured delay off the grid (0.2 ms; its nearest candidate 0): in the steady
+ * phase that candidate, within half a step, is taken when it fits better at all (a refinement,
+ * d = 0); the next one, a step from it, only below rho times the configured one's sum. */
+static void test_dlyid_off_grid_start_refined(void **st)
+{
+    (void)st;
+    br_est_cfg_t c = machine_ukf();
+    c.model.causes.delay_s = 0.2e-3f;
+    /* the steady phase from the 300th period on: the manipulated period is in it */
+    c.delay_id.steady_after_s = 300.0f * c.model.dt_s;
+    c.delay_id.steady_memory_s = 0.1f;
+    c.delay_id.steady_switch_ratio = 0.5f;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    const uint32_t n = c.delay_id.n_cand;
+    /* (slot, its sum against the configured one's 1, the slot in use after the period) */
+    static const struct {
+        uint32_t slot;
+        float J;
+        int taken;
+    } cases[] = {{0u, 0.9f, 1}, {1u, 0.9f, 0}, {1u, 0.45f, 1}};
+    for (unsigned t = 0; t < sizeof cases / sizeof cases[0]; t++) {
+        br_est_delay_t d;
+        br_dlyid_t id;
+        axis_t a;
+        axis_init(&a, &c, 0.2e-3); /* the axis's delay the configured one: nothing better before */
+        br_est_delay_init(&d, &c);
+        br_est_dlyid_init(&id, &c);
+        float u_prev = 0.0f;
+        for (int k = 0; k < 301; k++) {
+            const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
+            (void)br_est_delay_apply(&d, u_prev);
+            br_est_dlyid_step(&id, &c, &y, &d);
+            u_prev = command(&a, k + 1);
+        }
+        assert_int_equal(id.cur, n); /* still the configured delay */
+        assert_true(id.k >= id.steady); /* the next period is in the steady phase */
+        for (uint32_t j = 0; j <= n; j++) {
+            id.J[j] = 1.0f;
+        }
+        id.J[cases[t].slot] = cases[t].J;
+        const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
+        (void)br_est_delay_apply(&d, u_prev);
+        br_est_dlyid_step(&id, &c, &y, &d);
+        assert_int_equal(id.cur, cases[t].taken ? cases[t].slot : n);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -545,6 +673,8 @@ int main(void)
         cmocka_unit_test(test_dlyid_no_false_switch),
         cmocka_unit_test(test_dlyid_no_switch_at_reversals),
         cmocka_unit_test(test_dlyid_finds_delay_at_reversals),
+        cmocka_unit_test(test_dlyid_one_step_at_a_time),
+        cmocka_unit_test(test_dlyid_off_grid_start_refined),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

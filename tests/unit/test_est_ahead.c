@@ -125,6 +125,11 @@ static void run_carry_case(float delay_periods, float lead, int extended)
     br_ukf_cfg_t cu = br_circle_ukf_cfg_tuned(UKF_DT_S);
     cu.est.model.causes.delay_s = delay_periods * UKF_DT_S;
     cu.est.delay_id.n_cand = 0u; /* the delay is the test's, not identified */
+    if (cu.load.max_N == 0.0f) {
+        /* the external-force state on whatever the machine file says (its carry is under test) */
+        const float F_act = 10.0f * cu.est.gp_max_N;
+        cu.load = (br_ukf_load_t){1.0e3f * UKF_DT_S, F_act * F_act, F_act};
+    }
     if (extended) {
         with_position_causes(&cu.est.model);
     }
@@ -136,7 +141,7 @@ static void run_carry_case(float delay_periods, float lead, int extended)
     br_est_delay_t dd;
     br_est_delay_init(&dd, &cu.est);
     float sent[N_STEPS];
-    float worst = 0.0f, moved = 0.0f;
+    float worst = 0.0f, moved = 0.0f, fd_max = 0.0f;
     for (int k = 0; k < N_STEPS; k++) {
         const br_meas_t y = {counts_at(k), 0.5f};
         sent[k] = cmd_at(k);
@@ -158,11 +163,14 @@ static void run_carry_case(float delay_periods, float lead, int extended)
         float cur[BR_NX], nxt[BR_NX];
         memcpy(cur, u.x, sizeof cur);
         const float f0 = br_model_fcomp_N(&m, u.x, p0);
+        /* the external force F_d the UKF carries, held over the carry (0 with the state off) */
+        const float u_ext = cu.est.model.lead_mprad * br_ukf_estimate(&u)->load_N;
+        fd_max = fmaxf(fd_max, fabsf(br_ukf_estimate(&u)->load_N));
         for (int j = 0; j < n; j++) {
-            assert_int_equal(br_model_step_at(&m, cur, p0, reaching(sent, k, j, dm, df), nxt), BR_OK);
+            assert_int_equal(br_model_step_at(&m, cur, p0, reaching(sent, k, j, dm, df) - u_ext, nxt), BR_OK);
             memcpy(cur, nxt, sizeof cur);
         }
-        assert_int_equal(br_model_step_at(&m, cur, p0, reaching(sent, k, n, dm, df), nxt), BR_OK);
+        assert_int_equal(br_model_step_at(&m, cur, p0, reaching(sent, k, n, dm, df) - u_ext, nxt), BR_OK);
         const float fa = br_model_fcomp_N(&m, cur, p0), fb = br_model_fcomp_N(&m, nxt, p0);
         const float want = F_hat + (fa + (h - (float)n) * (fb - fa) - f0);
         assert_true(isfinite(F));
@@ -172,6 +180,10 @@ static void run_carry_case(float delay_periods, float lead, int extended)
     /* float rounding of the same sums only; the lead itself moves F by far more */
     assert_true(worst <= 1.0e-5f);
     assert_true(moved > 1.0e-2f);
+    /* with the external-force state on, F_d moved: the carry's L F_d was exercised */
+    if (cu.load.max_N > 0.0f) {
+        assert_true(fd_max > 0.1f);
+    }
 }
 
 static void test_lead_without_delay(void **st)
@@ -214,7 +226,9 @@ static void run_pf_case(int extended)
         assert_int_equal(br_pf_stats(pf, &s), BR_OK);
         const float p0 = (float)br_pf_estimate(pf)->origin_counts * pf->m_per_count;
         float nxt[BR_NX];
-        assert_int_equal(br_model_step_at(&m, s.mean, p0, cmd_at(k), nxt), BR_OK);
+        /* less the shared external force's torque (0 with it off) */
+        const float u_ext = cp.est.model.lead_mprad * pf->load_N;
+        assert_int_equal(br_model_step_at(&m, s.mean, p0, cmd_at(k) - u_ext, nxt), BR_OK);
         const float want = br_pf_estimate(pf)->F_hat_N +
                            (br_model_fcomp_N(&m, nxt, p0) - br_model_fcomp_N(&m, s.mean, p0));
         BR_ASSERT_NEAR(F, want, 1.0e-5);
@@ -244,35 +258,35 @@ static void test_failed_carry_gives_the_estimate(void **st)
     br_est_delay_init(&d, &cu.est);
     const float F_hat = 3.25f;
     const float bad_gp[BR_NX] = {0.0f, 1.0f, 0.0f, 0.0f}; /* g_p = 0: outside the model */
-    assert_true(br_est_comp_N(&cu.est, &m, &d, bad_gp, 0.0f, 0.1f, F_hat) == F_hat);
+    assert_true(br_est_comp_N(&cu.est, &m, &d, bad_gp, 0.0f, 0.1f, 0.0f, F_hat) == F_hat);
     const float nan_x[BR_NX] = {0.0f, NAN, 0.0f, 5.0f};
-    assert_true(br_est_comp_N(&cu.est, &m, &d, nan_x, 0.0f, 0.1f, F_hat) == F_hat);
+    assert_true(br_est_comp_N(&cu.est, &m, &d, nan_x, 0.0f, 0.1f, 0.0f, F_hat) == F_hat);
     /* a speed the model's step refuses */
     const float faster[BR_NX] = {0.0f, 3.0e38f, 0.0f, 5.0f};
-    assert_true(br_est_comp_N(&cu.est, &m, &d, faster, 0.0f, 0.1f, F_hat) == F_hat);
+    assert_true(br_est_comp_N(&cu.est, &m, &d, faster, 0.0f, 0.1f, 0.0f, F_hat) == F_hat);
     /* finite steps whose force is not (1e36 rad/s: f_c is infinite or NaN) */
     const float fast[BR_NX] = {0.0f, 1.0e36f, 0.0f, 5.0f};
     float x1[BR_NX];
     assert_int_equal(br_model_step_at(&m, fast, 0.0f, 0.1f, x1), BR_OK);
-    assert_true(br_est_comp_N(&cu.est, &m, &d, fast, 0.0f, 0.1f, F_hat) == F_hat);
+    assert_true(br_est_comp_N(&cu.est, &m, &d, fast, 0.0f, 0.1f, 0.0f, F_hat) == F_hat);
     /* a sane state moves it */
     const float ok[BR_NX] = {0.0f, 1.0f, 0.0f, 5.0f};
-    const float lead = br_est_comp_N(&cu.est, &m, &d, ok, 0.0f, 0.1f, 0.0f);
+    const float lead = br_est_comp_N(&cu.est, &m, &d, ok, 0.0f, 0.1f, 0.0f, 0.0f);
     assert_true(isfinite(lead) && lead != 0.0f);
     /* a lead no check has seen: none at all, not a loop of 2^32 steps */
     br_est_cfg_t wild = cu.est;
     wild.comp_ahead_periods = INFINITY;
-    assert_true(br_est_comp_N(&wild, &m, &d, ok, 0.0f, 0.1f, F_hat) == F_hat);
+    assert_true(br_est_comp_N(&wild, &m, &d, ok, 0.0f, 0.1f, 0.0f, F_hat) == F_hat);
     wild.comp_ahead_periods = 2.5f;
-    assert_true(br_est_comp_N(&wild, &m, &d, ok, 0.0f, 0.1f, F_hat) == F_hat);
+    assert_true(br_est_comp_N(&wild, &m, &d, ok, 0.0f, 0.1f, 0.0f, F_hat) == F_hat);
     /* nor a delay longer than the history */
     br_est_delay_t far = d;
     far.on = 1;
     far.m = BR_EST_DELAY_HIST - 1u;
     far.f = 0.0f;
-    assert_true(br_est_comp_N(&cu.est, &m, &far, ok, 0.0f, 0.1f, F_hat) == F_hat);
+    assert_true(br_est_comp_N(&cu.est, &m, &far, ok, 0.0f, 0.1f, 0.0f, F_hat) == F_hat);
     far.m = BR_EST_DELAY_HIST - 2u; /* the longest one: carried */
-    assert_true(br_est_comp_N(&cu.est, &m, &far, ok, 0.0f, 0.1f, F_hat) != F_hat);
+    assert_true(br_est_comp_N(&cu.est, &m, &far, ok, 0.0f, 0.1f, 0.0f, F_hat) != F_hat);
 }
 
 int main(void)

@@ -25,11 +25,16 @@ static br_ukf_cfg_t off_cfg(void)
     return c;
 }
 
+/* the machine's tuned UKF with its external-force state (machines/reference.json's
+ * estimator.ukf.load); a machine file without one: 1e4 N^2/s, F_act^2, F_act */
 static br_ukf_cfg_t load_cfg(void)
 {
-    br_ukf_cfg_t c = off_cfg();
+    br_ukf_cfg_t c = br_circle_ukf_cfg_tuned(DT_F);
+    if (c.load.max_N > 0.0f) {
+        return c;
+    }
     const float F_act = BR_MACHINE_TORQUE_LIMIT_NM_F / c.est.model.lead_mprad;
-    c.load.q_N2 = 1.0e4f * DT_F; /* 1e4 N^2/s, the campaign's */
+    c.load.q_N2 = 1.0e4f * DT_F;
     c.load.p0_N2 = F_act * F_act;
     c.load.max_N = F_act;
     return c;

@@ -122,14 +122,16 @@ float br_est_delay_torque(const br_est_delay_t *d, uint32_t m, float f);
  * the estimate x (theta relative to p0_m) is carried by the model over
  * H = delay / dt + lambda periods, each period with the torque that will
  * reach the axis over it (from d's history; u_prev_Nm, the newest command,
- * stands in for the ones not yet computed), and
+ * stands in for the ones not yet computed) less L F_ext_N (the external force
+ * the estimator carries, held over H: its random walk's prediction; 0
+ * without one), and
  *   F_comp = F_hat + f_c(x(t + H dt)) - f_c(x)
  * with f_c(x(t + H dt)) interpolated linearly inside its last period. A step
  * the model refuses (a state out of its range) gives F_hat_N, no lead; the
  * controller refuses a compensation out of range (br_ctrl). Call after the
  * estimator's step (d then holds u_prev_Nm). */
 float br_est_comp_N(const br_est_cfg_t *cfg, const br_model_t *m, const br_est_delay_t *d,
-                    const float x[BR_NX], float p0_m, float u_prev_Nm, float F_hat_N);
+                    const float x[BR_NX], float p0_m, float u_prev_Nm, float F_ext_N, float F_hat_N);
 
 /* Encoder measurement: position = (counts + frac) counts. For a plain
  * quadrature encoder (floor quantisation) pass frac = 0.5, the centre of the

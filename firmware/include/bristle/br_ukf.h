@@ -115,6 +115,7 @@ typedef struct {
     uint32_t n_outliers;             /* consecutive outlier steps */
     uint32_t n_recover;              /* covariance resets since init (failed Cholesky, or a
                                         non-finite prediction or update) */
+    uint32_t n_repair;               /* failed factorisations of a finite P repaired (U9) */
     uint32_t n_predicted;            /* predict-only steps since the last measurement */
     uint32_t n_load_acq;             /* gated innovations re-acquired as a load (cfg.load) */
     uint32_t n_load_undo;            /* re-acquisitions undone by the next innovation (a glitch) */

@@ -238,6 +238,19 @@ void br_circle_use_delay_id(br_circle_cfg_t *c, long on)
     }
 }
 
+void br_circle_use_causes(br_circle_cfg_t *c, const br_causes_t *causes)
+{
+    c->pf.est.model.causes = *causes;
+    c->ukf.est.model.causes = *causes;
+    /* the PF's shared external force needs the thesis model (br_pf_init refuses it with the
+     * extended one): off where the causes make the model extended, as a diagnosis writes its
+     * machine.json (firmware/design/machine.py, pf_load_blockers) */
+    br_model_t mm;
+    if (br_model_init(&mm, &c->pf.est.model) == BR_OK && mm.extended) {
+        br_circle_use_pf_load(c, 0.0);
+    }
+}
+
 void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *m)
 {
     br_model_cfg_t *ms[2] = {&c->pf.est.model, &c->ukf.est.model};
@@ -250,8 +263,9 @@ void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *m)
         ms[i]->lugre.Fc_N = (float)m->Fc_N;
         ms[i]->lugre.Fs_N = (float)m->Fs_N;
         ms[i]->lugre.vs_mps = (float)m->vs_mps;
-        ms[i]->causes = br_causes_from_model(m);
     }
+    const br_causes_t causes = br_causes_from_model(m);
+    br_circle_use_causes(c, &causes);
     c->ff.Fc_N = (float)m->Fc_N;
     c->ff.Fs_N = (float)m->Fs_N;
     c->ff.vs_mps = (float)m->vs_mps;

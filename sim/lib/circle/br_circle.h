@@ -138,8 +138,14 @@ void br_circle_use_pred(br_circle_cfg_t *c, double ahead_s, int anchor);
 
 /* The estimators' and the feedforward's model from an identified one (a
  * diagnosis's model.json loaded as a plant configuration): its mass, LuGre
- * and viscous parameters and its causes (br_causes_from_model). */
+ * and viscous parameters and its causes (br_causes_from_model, through
+ * br_circle_use_causes). */
 void br_circle_use_model(br_circle_cfg_t *c, const br_plant_cfg_t *model);
+
+/* Both estimators' causes; where they make the model the extended one the PF's
+ * shared external force is switched off, as a diagnosis's machine.json has it
+ * (br_pf_init refuses the force with the extended model). */
+void br_circle_use_causes(br_circle_cfg_t *c, const br_causes_t *causes);
 
 /* The tools' --ahead: both estimators' compensation lead
  * (est.comp_ahead_periods, docs/modules/est.md); lead < 0 leaves the

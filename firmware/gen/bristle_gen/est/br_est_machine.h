@@ -167,14 +167,14 @@
 #define BR_EST_UKF_DELAY_ID_SWITCH_RATIO (0.5)
 #define BR_EST_UKF_DELAY_ID_SWITCH_RATIO_F (5.000000000e-01f)
 /* the steady phase from this time on (0: off) */
-#define BR_EST_UKF_DELAY_ID_STEADY_AFTER_S (0.0)
-#define BR_EST_UKF_DELAY_ID_STEADY_AFTER_S_F (0.000000000e+00f)
+#define BR_EST_UKF_DELAY_ID_STEADY_AFTER_S (0.1)
+#define BR_EST_UKF_DELAY_ID_STEADY_AFTER_S_F (1.000000015e-01f)
 /* its forgetting time constant */
-#define BR_EST_UKF_DELAY_ID_STEADY_MEMORY_S (0.0)
-#define BR_EST_UKF_DELAY_ID_STEADY_MEMORY_S_F (0.000000000e+00f)
+#define BR_EST_UKF_DELAY_ID_STEADY_MEMORY_S (0.1)
+#define BR_EST_UKF_DELAY_ID_STEADY_MEMORY_S_F (1.000000015e-01f)
 /* its switch ratio */
-#define BR_EST_UKF_DELAY_ID_STEADY_SWITCH_RATIO (0.0)
-#define BR_EST_UKF_DELAY_ID_STEADY_SWITCH_RATIO_F (0.000000000e+00f)
+#define BR_EST_UKF_DELAY_ID_STEADY_SWITCH_RATIO (0.5)
+#define BR_EST_UKF_DELAY_ID_STEADY_SWITCH_RATIO_F (5.000000000e-01f)
 /* sigma-point spread */
 #define BR_EST_UKF_ALPHA (1.0)
 #define BR_EST_UKF_ALPHA_F (1.000000000e+00f)
@@ -185,14 +185,14 @@
 #define BR_EST_UKF_KAPPA (0.0)
 #define BR_EST_UKF_KAPPA_F (0.000000000e+00f)
 /* external force: random walk per step (0 with P0: off) */
-#define BR_EST_UKF_LOAD_Q_N2 (0.0)
-#define BR_EST_UKF_LOAD_Q_N2_F (0.000000000e+00f)
+#define BR_EST_UKF_LOAD_Q_N2 (1.0)
+#define BR_EST_UKF_LOAD_Q_N2_F (1.000000000e+00f)
 /* its initial (and recovery) variance; 0: no external force */
-#define BR_EST_UKF_LOAD_P0_N2 (0.0)
-#define BR_EST_UKF_LOAD_P0_N2_F (0.000000000e+00f)
+#define BR_EST_UKF_LOAD_P0_N2 (252661.87266788763)
+#define BR_EST_UKF_LOAD_P0_N2_F (2.526618750e+05f)
 /* its bound, and the compensation's (the actuator's force) */
-#define BR_EST_UKF_LOAD_MAX_N (0.0)
-#define BR_EST_UKF_LOAD_MAX_N_F (0.000000000e+00f)
+#define BR_EST_UKF_LOAD_MAX_N (502.65482457436696)
+#define BR_EST_UKF_LOAD_MAX_N_F (5.026548157e+02f)
 
 /* the PF's shared external force: random walk per step */
 #define BR_EST_PF_LOAD_Q_N2 (15.0)
