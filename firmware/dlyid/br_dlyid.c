@@ -267,11 +267,11 @@ int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t
     } else {
         /* (dly8) ... in the steady phase below rho^d_j times it for a candidate d_j steps along
          * the grid from the delay in use (the configured delay: from the candidate nearest it,
-         * within half a step, which it may refine to: d_j = 0), the best the one of the smallest
-         * J_j / rho^d_j: a far jump needs a far better sum. A
-         * delay does not jump, and in a closed loop whose command follows the innovations, or
-         * at a load's onset, a far candidate wins a sum by chance (docs/modules/dlyid.md, "One
-         * step at a time"). The configured delay's slot is where the bank starts, not a step. */
+         * the last one for a delay beyond the grid, which it may refine to: d_j = 0), the best
+         * the one of the smallest J_j / rho^d_j: a far jump needs a far better sum. A delay
+         * does not jump, and in a closed loop whose command follows the innovations, or at a
+         * load's onset, a far candidate wins a sum by chance (docs/modules/dlyid.md, "One step
+         * at a time"). The configured delay's slot is where the bank starts, not a step. */
         uint32_t at = id->cur;
         if (at == n) {
             const float g = ((float)id->cm[n] + id->cf[n]) * T / c->step_s + 0.5f;

@@ -1,10 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """The UKF's external-force state against an actuator delay (docs/modules/ukf.md,
-"The load loop with a delay"; issue 31 item 3).
+"On in the reference machine (2026-11-28, issue 31 item 3)").
 
 The reference machine's plant with a dead time D (0 .. 3.5 ms, the delay
 identification's range) on the thesis circle, H-inf + UKF with its
-external-force state F_d at random walks q (0: off, the machine's), two ways:
+external-force state F_d at random walks q (0: off), two ways:
 
   known        the estimator's model has the plant's delay (a model.json with
                delay_s, br_robust_run --model, run hinf_ukf_id, --delay-id 0):

@@ -217,7 +217,7 @@ static void run_pf_case(int extended)
     br_pf_t *pf = pf_with_lead(1.0f, extended, &cp);
     br_model_t m;
     assert_int_equal(br_model_init(&m, &cp.est.model), BR_OK);
-    float moved = 0.0f;
+    float moved = 0.0f, fd_max = 0.0f;
     for (int k = 0; k < N_STEPS; k++) {
         const br_meas_t y = {counts_at(k), 0.5f};
         float F = NAN;
@@ -228,6 +228,7 @@ static void run_pf_case(int extended)
         float nxt[BR_NX];
         /* less the shared external force's torque (0 with it off) */
         const float u_ext = cp.est.model.lead_mprad * pf->load_N;
+        fd_max = fmaxf(fd_max, fabsf(pf->load_N));
         assert_int_equal(br_model_step_at(&m, s.mean, p0, cmd_at(k) - u_ext, nxt), BR_OK);
         const float want = br_pf_estimate(pf)->F_hat_N +
                            (br_model_fcomp_N(&m, nxt, p0) - br_model_fcomp_N(&m, s.mean, p0));
@@ -235,6 +236,10 @@ static void run_pf_case(int extended)
         moved = fmaxf(moved, fabsf(F - br_pf_estimate(pf)->F_hat_N));
     }
     assert_true(moved > 1.0e-2f);
+    /* with the shared external force on, F_d moved: the carry's L F_d was exercised */
+    if (cp.load.max_N > 0.0f) {
+        assert_true(fd_max > 0.1f);
+    }
     free(pf);
 }
 

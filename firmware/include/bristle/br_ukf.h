@@ -113,8 +113,9 @@ typedef struct {
     int32_t prev_counts;             /* last measurement (accepted or not): the measured */
     float prev_frac;                 /*   velocity for a re-anchoring */
     uint32_t n_outliers;             /* consecutive outlier steps */
-    uint32_t n_recover;              /* covariance resets since init (failed Cholesky, or a
-                                        non-finite prediction or update) */
+    uint32_t n_recover;              /* covariance resets to P0 since init (a failed Cholesky
+                                        the repair (n_repair) could not mend, or a non-finite
+                                        prediction or update) */
     uint32_t n_repair;               /* failed factorisations of a finite P repaired (U9) */
     uint32_t n_predicted;            /* predict-only steps since the last measurement */
     uint32_t n_load_acq;             /* gated innovations re-acquired as a load (cfg.load) */
