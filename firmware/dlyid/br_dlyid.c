@@ -296,8 +296,7 @@ int br_dlyid_step(br_dlyid_t *id, const br_dlyid_cfg_t *c, const br_dlyid_axis_t
     }
     /* ... and the one in use explains the motion worse than the noise allows */
     const float J_noise = BR_DLYID_NOISE_FACTOR * (id->r_rad2 + id->P[0][0]) / (1.0f - forget);
-    if (best == id->cur ||
-        !(id->J[id->cur] > J_noise)) {
+    if (!(id->J[id->cur] > J_noise)) {
         return 0;
     }
     id->cur = best;

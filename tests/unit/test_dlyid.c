@@ -535,6 +535,31 @@ static void test_dlyid_finds_delay_at_reversals(void **st)
     assert_true(fabs(modelled_s(&d, &c) - 1.5e-3) <= 0.5 * (double)c.delay_id.step_s + 1e-9);
 }
 
+/* the bank on the test's axis (delay_s) from rest over `periods` periods, a, d and id left
+ * where they are for a further period (bank_period); *u_prev the next command */
+static void bank_run(const br_est_cfg_t *c, double delay_s, int periods, axis_t *a, br_est_delay_t *d,
+                     br_dlyid_t *id, float *u_prev)
+{
+    axis_init(a, c, delay_s);
+    br_est_delay_init(d, c);
+    br_est_dlyid_init(id, c);
+    *u_prev = 0.0f;
+    for (int k = 0; k < periods; k++) {
+        const br_meas_t y = axis_step(a, *u_prev, c->rad_per_count);
+        (void)br_est_delay_apply(d, *u_prev);
+        br_est_dlyid_step(id, c, &y, d);
+        *u_prev = command(a, k + 1);
+    }
+}
+
+/* one period more of bank_run's axis and bank */
+static void bank_period(const br_est_cfg_t *c, axis_t *a, br_est_delay_t *d, br_dlyid_t *id, float u_prev)
+{
+    const br_meas_t y = axis_step(a, u_prev, c->rad_per_count);
+    (void)br_est_delay_apply(d, u_prev);
+    br_est_dlyid_step(id, c, &y, d);
+}
+
 /* One step at a time (dly8; docs/modules/dlyid.md, "One step at a time"): in the steady phase a
  * candidate d steps along the grid from the delay in use takes over only when its sum is below
  * rho^d times the one in use's: a far candidate just decisive enough for a neighbour does not
@@ -547,16 +572,8 @@ static uint32_t bank_then(br_est_cfg_t c, int low, float J_low, uint32_t *c0_out
     br_est_delay_t d;
     br_dlyid_t id;
     axis_t a;
-    axis_init(&a, &c, 2.0e-3);
-    br_est_delay_init(&d, &c);
-    br_est_dlyid_init(&id, &c);
-    float u_prev = 0.0f;
-    for (int k = 0; k < 1000; k++) {
-        const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
-        (void)br_est_delay_apply(&d, u_prev);
-        br_est_dlyid_step(&id, &c, &y, &d);
-        u_prev = command(&a, k + 1);
-    }
+    float u_prev;
+    bank_run(&c, 2.0e-3, 1000, &a, &d, &id, &u_prev);
     /* the first switch left the configured slot n for a candidate 2 or more from either end */
     assert_true(id.n_switch >= 1u && id.cur >= 2u && id.cur + 2u < n);
     *c0_out = id.cur;
@@ -564,9 +581,7 @@ static uint32_t bank_then(br_est_cfg_t c, int low, float J_low, uint32_t *c0_out
     for (uint32_t j = 0; j <= n; j++) {
         id.J[j] = ((int)j == low) ? J_low : 1.0f;
     }
-    const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
-    (void)br_est_delay_apply(&d, u_prev);
-    br_est_dlyid_step(&id, &c, &y, &d);
+    bank_period(&c, &a, &d, &id, u_prev);
     /* the history models the delay in use */
     assert_true(fabs(modelled_s(&d, &c) - (double)id.cur * (double)c.delay_id.step_s) < 1e-9);
     return id.cur;
@@ -635,25 +650,16 @@ static void test_dlyid_off_grid_start_refined(void **st)
         br_est_delay_t d;
         br_dlyid_t id;
         axis_t a;
-        axis_init(&a, &c, 0.2e-3); /* the axis's delay the configured one: nothing better before */
-        br_est_delay_init(&d, &c);
-        br_est_dlyid_init(&id, &c);
-        float u_prev = 0.0f;
-        for (int k = 0; k < 301; k++) {
-            const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
-            (void)br_est_delay_apply(&d, u_prev);
-            br_est_dlyid_step(&id, &c, &y, &d);
-            u_prev = command(&a, k + 1);
-        }
+        float u_prev;
+        /* the axis's delay the configured one: nothing better before */
+        bank_run(&c, 0.2e-3, 301, &a, &d, &id, &u_prev);
         assert_int_equal(id.cur, n); /* still the configured delay */
         assert_true(id.k >= id.steady); /* the next period is in the steady phase */
         for (uint32_t j = 0; j <= n; j++) {
             id.J[j] = 1.0f;
         }
         id.J[cases[t].slot] = cases[t].J;
-        const br_meas_t y = axis_step(&a, u_prev, c.rad_per_count);
-        (void)br_est_delay_apply(&d, u_prev);
-        br_est_dlyid_step(&id, &c, &y, &d);
+        bank_period(&c, &a, &d, &id, u_prev);
         assert_int_equal(id.cur, cases[t].taken ? cases[t].slot : n);
     }
 }
