@@ -22,8 +22,8 @@ K = 0.1
 
 def start2(tuner, out, extra):
     # the thesis filter (--pf-load 0): with the machine's shared external force the guard plants'
-    # runs have no outlier step to count
-    r = subprocess.run([tuner, "--est", "pf", "--out", out, "--max-fev", "5", "--pf-load", "0"] + extra,
+    # runs have no outlier step to count; no Maxwell-slip guard (its factor is the same for every K)
+    r = subprocess.run([tuner, "--est", "pf", "--out", out, "--max-fev", "5", "--pf-load", "0", "--mslip-target", "0"] + extra,
                        capture_output=True, text=True)
     m = re.search(r"start 2, contour RMS (\S+) m", r.stdout)
     if r.returncode != 0 or not m:
