@@ -664,6 +664,44 @@ static void test_dlyid_off_grid_start_refined(void **st)
     }
 }
 
+/* The noise floor (dly6; docs/modules/dlyid.md, "False switches"): a candidate far better than
+ * the delay in use is not taken while the one in use explains the motion within the noise, its
+ * sum at most BR_DLYID_NOISE_FACTOR (R' + P_00) / (1 - forget); above it, the same candidate
+ * is. The one-phase rule, the axis on time (the configured delay, slot n, in use). */
+static void test_dlyid_noise_floor(void **st)
+{
+    (void)st;
+    br_est_cfg_t c = machine_ukf();
+    c.delay_id.steady_after_s = 0.0f;
+    assert_int_equal(br_est_cfg_check(&c), BR_OK);
+    const uint32_t n = c.delay_id.n_cand;
+    const int low = 1; /* a neighbour of 0 ms, the axis's delay */
+    /* (the sums of every slot but low's, in units of the floor; the slot in use after) */
+    static const struct {
+        float of_floor;
+        int taken;
+    } cases[] = {{0.5f, 0}, {4.0f, 1}};
+    for (unsigned t = 0; t < sizeof cases / sizeof cases[0]; t++) {
+        br_est_delay_t d;
+        br_dlyid_t id;
+        axis_t a;
+        float u_prev;
+        /* past the warm-up, no switch yet */
+        const int periods = (int)(c.delay_id.warmup_s / c.model.dt_s) + 40;
+        bank_run(&c, 0.0, periods, &a, &d, &id, &u_prev);
+        assert_true(id.k >= id.warmup);
+        assert_int_equal(id.n_switch, 0u);
+        assert_int_equal(id.cur, n);
+        const float floor_rad2 = BR_DLYID_NOISE_FACTOR * (id.r_rad2 + id.P[0][0]) / (1.0f - id.forget);
+        for (uint32_t j = 0; j <= n; j++) {
+            id.J[j] = cases[t].of_floor * floor_rad2;
+        }
+        id.J[low] = 0.0f; /* after the period: one squared innovation, far below the others */
+        bank_period(&c, &a, &d, &id, u_prev);
+        assert_int_equal(id.cur, cases[t].taken ? (uint32_t)low : n);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -681,6 +719,7 @@ int main(void)
         cmocka_unit_test(test_dlyid_finds_delay_at_reversals),
         cmocka_unit_test(test_dlyid_one_step_at_a_time),
         cmocka_unit_test(test_dlyid_off_grid_start_refined),
+        cmocka_unit_test(test_dlyid_noise_floor),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -544,7 +544,7 @@ static void test_cholesky_failure_recovers(void **st)
  * (U9, counted in n_repair), so after every step P has a factor. Without the
  * repair or the reset in sigma_points the unfactorable Pm was committed (P
  * had no factor after one step: the audit's surviving mutant). */
-static void test_posterior_cholesky_failure_resets(void **st)
+static void test_posterior_cholesky_failure_repaired(void **st)
 {
     (void)st;
     br_ukf_t u;
@@ -912,7 +912,7 @@ int main(void)
         cmocka_unit_test(test_reanchor_after_lost_lock),
         cmocka_unit_test(test_chol4),
         cmocka_unit_test(test_cholesky_failure_recovers),
-        cmocka_unit_test(test_posterior_cholesky_failure_resets),
+        cmocka_unit_test(test_posterior_cholesky_failure_repaired),
         cmocka_unit_test(test_nonfinite_result_keeps_state),
         cmocka_unit_test(test_gp_clamped),
         cmocka_unit_test(test_converges_open_loop),
