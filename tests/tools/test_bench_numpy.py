@@ -4,8 +4,8 @@ also where the thesis circle never takes it: on the demo's realistic plant
 cfg.adapt's noise factor rises above 1 and the cloud is re-anchored after
 consecutive outliers (with the thesis gate, --thesis-gate; with the machine's
 transient term no outlier comes). br_bench
-records that closed loop (--plant realistic) both ways, and the hardware-like plant's with a 2.7 ms actuator delay
-(--plant hardware_like --plant-delay 0.0027), where the PF's delay
+records that closed loop (--plant realistic) both ways, and the hardware-like plant's with a 3.1 ms actuator delay
+(--plant hardware_like --plant-delay 0.0031), where the PF's delay
 identification switches, also in its steady phase (docs/modules/dlyid.md),
 and the filter predicts with the delayed torque (all three with --pf-load 0:
 the machine's shared external force takes the misfit up and none of these
@@ -39,12 +39,13 @@ def main():
     fails = []
     # the machine's gate (its transient term, eq. G1, in the threshold and the NIS cap), then the
     # thesis gate, with which the realistic plant's encoder noise re-anchors the cloud
-    # the hardware-like plant (Maxwell-slip friction) with a 2.7 ms actuator delay: the delay identification
-    # switches there, also in its steady phase where the machine has one
+    # the hardware-like plant (Maxwell-slip friction) with a 3.1 ms actuator delay: the delay identification
+    # switches there, also in its steady phase where the machine has one (with the PF tuned with its
+    # Maxwell-slip guards, 2026-11-28, the 2.7 ms of before had no switch in the steady phase)
     for tag, plant, extra, need in (
             ("term", "realistic", ["--pf-load", "0"], ("adapt_active_steps",)),
             ("thesis_gate", "realistic", ["--thesis-gate", "--pf-load", "0"], ("adapt_active_steps", "reanchor_steps")),
-            ("hardware_like", "hardware_like", ["--plant-delay", "0.0027", "--pf-load", "0"],
+            ("hardware_like", "hardware_like", ["--plant-delay", "0.0031", "--pf-load", "0"],
              ("adapt_active_steps", "delay_switches", "delay_switches_steady")),
             # the PF's shared external force (cfg.load) with a 1-sigma thesis gate: gated steps re-acquired
             ("load", "hardware_like", ["--thesis-gate", "--pf-load", "1e4", "--pf-gate", "1"],
