@@ -79,19 +79,34 @@ static br_meas_t axis_step(axis_t *a, float u, double rpc)
     return y;
 }
 
-/* runs the bank on axis a for n periods; returns the switches */
+/* one period of axis a and the bank with the command u_prev (the last period's) */
+static void bank_period(const br_est_cfg_t *c, axis_t *a, br_est_delay_t *d, br_dlyid_t *id, float u_prev)
+{
+    const br_meas_t y = axis_step(a, u_prev, c->rad_per_count);
+    (void)br_est_delay_apply(d, u_prev);
+    br_est_dlyid_step(id, c, &y, d);
+}
+
+/* the bank from its start on axis a over n periods, a, d and id left where they are for a
+ * further period (bank_period); *u_prev the next command */
+static void bank_periods(const br_est_cfg_t *c, int n, axis_t *a, br_est_delay_t *d, br_dlyid_t *id,
+                         float *u_prev)
+{
+    br_est_delay_init(d, c);
+    br_est_dlyid_init(id, c);
+    *u_prev = 0.0f;
+    for (int k = 0; k < n; k++) {
+        bank_period(c, a, d, id, *u_prev);
+        *u_prev = command(a, k + 1);
+    }
+}
+
+/* runs the bank on a copy of axis a0 for n periods; returns the switches */
 static uint32_t run_bank_on(axis_t *a0, const br_est_cfg_t *c, int n, br_est_delay_t *d, br_dlyid_t *id)
 {
     axis_t a = *a0;
-    br_est_delay_init(d, c);
-    br_est_dlyid_init(id, c);
-    float u_prev = 0.0f;
-    for (int k = 0; k < n; k++) {
-        const br_meas_t y = axis_step(&a, u_prev, c->rad_per_count);
-        (void)br_est_delay_apply(d, u_prev);
-        br_est_dlyid_step(id, c, &y, d);
-        u_prev = command(&a, k + 1);
-    }
+    float u_prev;
+    bank_periods(c, n, &a, d, id, &u_prev);
     return id->n_switch;
 }
 
@@ -535,29 +550,12 @@ static void test_dlyid_finds_delay_at_reversals(void **st)
     assert_true(fabs(modelled_s(&d, &c) - 1.5e-3) <= 0.5 * (double)c.delay_id.step_s + 1e-9);
 }
 
-/* the bank on the test's axis (delay_s) from rest over `periods` periods, a, d and id left
- * where they are for a further period (bank_period); *u_prev the next command */
+/* the bank on the test's axis (delay_s) from rest over `periods` periods (bank_periods) */
 static void bank_run(const br_est_cfg_t *c, double delay_s, int periods, axis_t *a, br_est_delay_t *d,
                      br_dlyid_t *id, float *u_prev)
 {
     axis_init(a, c, delay_s);
-    br_est_delay_init(d, c);
-    br_est_dlyid_init(id, c);
-    *u_prev = 0.0f;
-    for (int k = 0; k < periods; k++) {
-        const br_meas_t y = axis_step(a, *u_prev, c->rad_per_count);
-        (void)br_est_delay_apply(d, *u_prev);
-        br_est_dlyid_step(id, c, &y, d);
-        *u_prev = command(a, k + 1);
-    }
-}
-
-/* one period more of bank_run's axis and bank */
-static void bank_period(const br_est_cfg_t *c, axis_t *a, br_est_delay_t *d, br_dlyid_t *id, float u_prev)
-{
-    const br_meas_t y = axis_step(a, u_prev, c->rad_per_count);
-    (void)br_est_delay_apply(d, u_prev);
-    br_est_dlyid_step(id, c, &y, d);
+    bank_periods(c, periods, a, d, id, u_prev);
 }
 
 /* One step at a time (dly8; docs/modules/dlyid.md, "One step at a time"): in the steady phase a
