@@ -7,7 +7,7 @@ run on Dask's local cluster, or on an existing one (--scheduler).
 Usage:
   fleet.py --out DIR [--n N] [--seed S] [--workers W | --scheduler ADDRESS]
            [--kinds thesis_circle,circle,p2p,emps] [--md DOC] [--command CMD] [--keep-builds]
-           [--hinf-weights reference|rule]
+           [--hinf-weights reference|rule] [--load-q reference|scaled] [--axes I,J --merge BASE]
 
 Writes DIR/summary.json (the same for the same N, seed and kinds, whatever the
 workers: no time in it), DIR/timing.json (wall times), DIR/cdf.png, DIR/axes/NNNN/.
@@ -241,6 +241,9 @@ def write_md(path, summ, command, out_dir=None, out_name=None):
          "## Measured: %d axes" % summ["n_axes"], "",
          "Command: `%s` (seed %d, trajectory kinds %s; the axes, the chain and the definitions above)."
          % (command, summ["seed"], ", ".join(summ["kinds_run"])), ""]
+    if "merged" in summ:
+        L += ["Run again on this tree: axes %s; the other axes' records are those of `%s` (`--merge`)."
+              % (", ".join(str(i) for i in summ["merged"]["axes_run_again"]), summ["merged"]["base"]), ""]
     if summ["n_axes"] < FULL_N:
         L += ["**Provisional**: %d axes, not the study's %d." % (summ["n_axes"], FULL_N), ""]
     fails = summ["axes_chain_failed"]
@@ -337,6 +340,13 @@ def main():
                     help="the given files' control.hinf: the reference's, replaced by the weights from the "
                          "machine (firmware/design/hinf_weights.py) where they admit no acceptable design "
                          "(default); or the weights from the machine on every axis")
+    ap.add_argument("--load-q", choices=("reference", "scaled"), default="reference",
+                    help="the given files' estimator.<est>.load: the reference's random walk in N^2/s "
+                         "(default), or the same share of each axis's actuator force (q_Fact2_per_s)")
+    ap.add_argument("--merge", metavar="BASE",
+                    help="with --axes: a study of BASE's axes (BASE/summary.json, the same seed and kinds) with "
+                         "these axes run again; the summary, table and plot over them all (a change that alters "
+                         "the machine files of some axes only, measured without running the rest again)")
     ap.add_argument("--expect-faults", action="store_true",
                     help="with --md: the page may tabulate faulted runs (listed with time and cause); "
                          "without it a faulted run makes the study exit 1 after writing the page")
@@ -366,17 +376,39 @@ def main():
         a.n = len(a.axes)
     if not (1 <= a.n <= 100000) or a.workers < 1 or not kinds or set(kinds) - set(KINDS):
         ap.error("--n in 1..100000, --workers >= 1, --kinds from %s" % ",".join(KINDS))
+    base = None
+    if a.merge:
+        if a.axes is None:
+            ap.error("--merge needs --axes")
+        try:
+            with open(os.path.join(a.merge, "summary.json"), encoding="utf-8") as f:
+                base = json.load(f)
+        except (OSError, ValueError) as e:
+            sys.exit("fleet.py: --merge %s/summary.json: %s" % (a.merge, e))
+        if base.get("seed") != a.seed or base.get("kinds_run") != kinds:
+            sys.exit("fleet.py: --merge %s: seed %s, kinds %s: not this study's (seed %d, kinds %s)"
+                     % (a.merge, base.get("seed"), base.get("kinds_run"), a.seed, kinds))
+        if set(a.axes) - {r["i"] for r in base["axes"]}:
+            sys.exit("fleet.py: --merge %s: axes %s are not in it" % (
+                a.merge, sorted(set(a.axes) - {r["i"] for r in base["axes"]})))
     os.makedirs(a.out, exist_ok=True)
     args = {"src": REPO, "out": os.path.abspath(a.out), "seed": a.seed, "kinds": kinds, "keep": a.keep_builds,
-            "hinf_rule": a.hinf_weights == "rule"}
+            "hinf_rule": a.hinf_weights == "rule", "load_q": a.load_q}
     t0 = time.time()
     recs = distribute(a, args)
     wall = time.time() - t0
     errors = [r for r in recs if "error" in r]
     good = [r for r in recs if "error" not in r]
+    n_run = a.n
+    if base is not None:
+        # the base's records of the axes not run again, this run's of the rest
+        good = sorted([r for r in base["axes"] if r["i"] not in set(a.axes)] + good, key=lambda r: r["i"])
+        a.n = base["n_axes"]
     summ = {"generator": "sim/studies/fleet.py", "n_axes": a.n, "seed": a.seed, "kinds_run": kinds,
-            "hinf_weights": a.hinf_weights,
-            **({"axes_run": a.axes} if a.axes is not None else {}),
+            "hinf_weights": a.hinf_weights, "load_q": a.load_q,
+            **({"merged": {"base": a.merge, "axes_run_again": a.axes},
+                **({"axes_run": base["axes_run"]} if "axes_run" in base else {})} if base is not None else
+               {"axes_run": a.axes} if a.axes is not None else {}),
             "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],
             "controllers": summarise(good),
             "kinds": {k: summarise(good, (k,)) for k in kinds},
@@ -395,7 +427,7 @@ def main():
     if a.md:
         write_md(a.md, summ, a.command, a.out)
     print("%d axes in %.0f s (an axis: median %.1f s wall, %.1f s CPU); chain failed on %d"
-          % (a.n, wall, timing["axis_median"]["wall_s"]["total"], timing["axis_median"]["cpu_s"]["total"],
+          % (n_run, wall, timing["axis_median"]["wall_s"]["total"], timing["axis_median"]["cpu_s"]["total"],
              len(summ["axes_chain_failed"])))
     for line in table(summ["controllers"]):
         print(line)

@@ -140,12 +140,17 @@ def trajectories(rng, vmax):
     return out
 
 
+def reference_file():
+    """machines/reference.json, which a user's first machine file starts from"""
+    with open(os.path.join(REPO, "machines", "reference.json"), encoding="utf-8") as f:
+        return json.load(f)
+
+
 def given_file(ax, name):
     """The machine file the user writes before any log: machines/reference.json
     with the data sheets' values (lead, inertia, table mass, encoder, amplifier,
     the loop's period, the limits) and its friction kept and marked assumed."""
-    with open(os.path.join(REPO, "machines", "reference.json"), encoding="utf-8") as f:
-        m = json.load(f)
+    m = reference_file()
     L = ax["lead_m_per_rev"] / (2.0 * math.pi)
     m["name"] = name
     m["source"] = "sim/studies/fleet.py: a drawn axis (docs/fleet.md); friction from machines/reference.json, assumed"
@@ -163,6 +168,18 @@ def given_file(ax, name):
     set_stroke(m)
     m["provenance"] = {"friction." + k: "assumed" for k in m["friction"]}
     return m
+
+
+def scale_load_q(m, ref):
+    """estimator.<est>.load of the given file m in the actuator's force squared per second
+    (q_Fact2_per_s, docs/machine-file.md) where ref, the machine file m copies it from, has it in
+    N^2/s: the same random walk relative to the actuator as on ref, instead of the same one in
+    N^2/s on an actuator of tens or thousands of N"""
+    F_ref = machine.actuator_force_N(ref)
+    for est, blk in m["estimator"].items():
+        ld = blk.get("load") if isinstance(blk, dict) else None
+        if ld is not None and "q_N2_per_s" in ld:
+            blk["load"] = {"q_Fact2_per_s": float(ld["q_N2_per_s"]) / (F_ref * F_ref)}
 
 
 def use_hinf_rule(m, always=False):

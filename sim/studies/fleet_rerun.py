@@ -8,11 +8,15 @@ without the chain's identification and diagnosis. Prints, per estimator,
 the runs that faulted before (the study's JSON) and now, and the median of
 RMS / H-inf only over the runs that went to the end. --pf-adapt-max S runs
 the PF with that largest noise-variance factor of cfg.adapt instead of the
-machine file's (docs/fleet.md, "The PF's start on the fleet's axes"). The
+machine file's (docs/fleet.md, "The PF's start on the fleet's axes").
+--machine truth builds it for the axis's truth.json instead (the plant's own
+friction and delay, the given file's settings): a diagnosis without error, so
+that a loss that stays is the estimator's, one that goes the diagnosis's
+(docs/fleet.md, "Why runs end worse than H-inf only"). The
 rerun's estimators carry machine.json's causes (fleet_runs.circle_runs); a
 study whose runs did not (before that change) is named as such per axis.
 
-    python sim/studies/fleet_rerun.py out/fleet OUT [--axes 63,67] [--pf-adapt-max S]"""
+    python sim/studies/fleet_rerun.py out/fleet OUT [--axes 63,67] [--pf-adapt-max S] [--machine truth]"""
 import argparse
 import glob
 import json
@@ -40,7 +44,9 @@ def records(d, names):
             if os.path.exists(path):
                 with open(path, encoding="utf-8") as f:
                     js = json.load(f)
-                out[(name, ctrl)] = fleet_runs.result(js["controllers"][ctrl], "contour_rms_m", "max_err_m")
+                # br_robust_run nests its controllers and names the contour RMS; br_track does neither
+                out[(name, ctrl)] = (fleet_runs.result(js["controllers"][ctrl], "contour_rms_m", "max_err_m")
+                                     if "controllers" in js else fleet_runs.result(js[ctrl], "rms_m", "max_m"))
                 if ctrl != "hinf_only":
                     causes.add(js.get("estimator_causes", "thesis"))
     return out, causes
@@ -73,6 +79,10 @@ def main():
     ap.add_argument("--seed", type=int, default=20261201, help="the study's seed")
     ap.add_argument("--axes", help="comma-separated axis indices (default: every axis the chain finished)")
     ap.add_argument("--pf-adapt-max", type=float, help="br_robust_run --pf-adapt-max (1: no inflation)")
+    ap.add_argument("--tracks", action="store_true",
+                    help="also the point-to-point and EMPS tracks (br_track, on the study's references)")
+    ap.add_argument("--machine", choices=("diagnosed", "truth"), default="diagnosed",
+                    help="the machine file the tool is built for: diagnose/machine.json (default) or truth.json")
     a = ap.parse_args()
     extra = () if a.pf_adapt_max is None else ("--pf-adapt-max", repr(a.pf_adapt_max))
     src = os.path.dirname(os.path.dirname(HERE))
@@ -89,14 +99,22 @@ def main():
         os.makedirs(od, exist_ok=True)
         ax = fleet_axis.draw(a.seed, i)
         circles = [(k, t) for k, t in enumerate(ax["traj"]) if t["kind"] in ("thesis_circle", "circle")]
+        tracks = [t for t in ax["traj"] if a.tracks and t["kind"] in ("p2p", "emps")
+                  and os.path.exists(os.path.join(d, "%s.ref.csv" % t["name"]))]
         names = [t["name"] for _, t in circles if os.path.exists(os.path.join(d, "%s_hinf_only.json" % t["name"]))]
-        exe = machine_chain.host_build(build, os.path.join(d, "diagnose", "machine.json"),
-                                       os.path.join(od, "host"), "br_robust_run")
+        names += [t["name"] for t in tracks]
+        mfile = os.path.join(d, "diagnose", "machine.json") if a.machine == "diagnosed" else os.path.join(d, "truth.json")
+        exe = machine_chain.host_build(build, mfile, os.path.join(od, "host"), "br_robust_run")
         with open(os.path.join(od, "runs.log"), "w", encoding="utf-8") as log:
             for k, tr in circles:
                 if tr["name"] in names:
                     fleet_runs.circle_runs(od, exe, os.path.join(d, "truth-model.json"), fleet_axis.gms_options(ax), tr,
                                            fleet_runs.run_seed(a.seed, i, k + 1), ax["force_noise_N"], log, extra)
+            if tracks:
+                trk = machine_chain.host_build(build, mfile, os.path.join(od, "host"), "br_track")
+            for tr in tracks:
+                fleet_runs.track_runs(od, trk, os.path.join(d, "truth-model.json"), fleet_axis.gms_options(ax),
+                                      os.path.join(d, "%s.ref.csv" % tr["name"]), tr["name"], log)
         recs_before, causes_before = records(d, names)
         if causes_before - {"machine"}:
             # the rerun's estimators carry machine.json's causes (fleet_runs.circle_runs): a change of its own
@@ -110,10 +128,14 @@ def main():
             print("axis %d %s: %s" % (i, name, "  ".join(
                 "%s %s -> %s" % (c, fmt(before.get((i, name, c))), fmt(now.get((i, name, c)))) for c in CTRLS)))
     for label, recs in (("before", before), ("now", now)):
-        for ctrl, t in tally(recs).items():
-            print("%s %s: %d runs, %d faulted, median RMS / H-inf only %s, %d worse than H-inf only" % (
-                label, ctrl, t["runs"], len(t["faulted"]),
-                "%.3g" % t["median_ratio"] if t["median_ratio"] is not None else "-", t["worse"]))
+        for group, names in (("", None), (" circles", ("thesis_circle", "circle")), (" tracks", ("p2p", "emps"))):
+            sel = recs if names is None else {k: r for k, r in recs.items() if k[1].rstrip("0123456789") in names}
+            if names is not None and not (a.tracks and sel):
+                continue
+            for ctrl, t in tally(sel).items():
+                print("%s%s %s: %d runs, %d faulted, median RMS / H-inf only %s, %d worse than H-inf only" % (
+                    label, group, ctrl, t["runs"], len(t["faulted"]),
+                    "%.3g" % t["median_ratio"] if t["median_ratio"] is not None else "-", t["worse"]))
     return 0
 
 

@@ -150,6 +150,8 @@ def chain(a, ax, d, log, sw):
     given, truth = os.path.join(d, "given.json"), os.path.join(d, "truth.json")
     g = fleet_axis.given_file(ax, "fleet-%04d" % ax["i"])
     why = fleet_axis.use_hinf_rule(g, a.hinf_rule)
+    if a.load_q == "scaled":
+        fleet_axis.scale_load_q(g, fleet_axis.reference_file())
     for path, m in ((given, g), (truth, fleet_axis.truth_file(ax, g))):
         with open(path, "w", encoding="utf-8") as f:
             json.dump(m, f, indent=1)

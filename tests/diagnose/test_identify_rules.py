@@ -18,7 +18,10 @@ logs made from the model's own force around the reference machine
    file's value; a shape parameter on its search bound is flagged;
 5. a mass on its floor (model.COEF_LOWER) is held at the machine file's
    value, in the nominal model and in the extended (fleet axes 23, 34, 96,
-   103, 131: Meff = 1e-9 kg, a model the closed-loop check cannot run).
+   103, 131: Meff = 1e-9 kg, a model the closed-loop check cannot run);
+6. a held Fs goes into machine.json as the model holds it, the file's
+   Fs/Fc at the identified Fc, not the file's value in N (fleet axis 62:
+   Fs = 18 N on 0.39 N of Coulomb).
 """
 import math
 import os
@@ -187,6 +190,25 @@ class RulesTest(unittest.TestCase):
         out = identify.apply(prep, diag, P0, say=lambda m: None)
         self.assertEqual(out["nominal_held"], {})
         self.assertIs(diag.nominal, free)
+
+    def test_6_held_shape_keeps_the_files_ratio_to_fc(self):
+        # an axis with a tenth of the file's Coulomb friction and the file's Stribeck ratio: Fs held
+        fc = 0.1 * P0["Fc_N"]
+        prep = prepared(nominal_truth(Fc_N=fc, Fs_N=fc * P0["Fs_N"] / P0["Fc_N"], sigma0_Npm=fc * P0["sigma0_Npm"] / P0["Fc_N"]))
+        free = model.fit_nominal(prep)
+        h = identify._Holder(prep, free, P0)
+        h.take(("Fs_N",), h.trial({"Fs_N": P0["Fs_N"]}), "held for the test")
+        prep.fixed = None
+        p = h.best.params()
+        self.assertLess(p["Fc_N"], 0.2 * P0["Fc_N"])
+        # the model holds the file's Fs/Fc (model.FIXED_SHAPE), not its Fs in N
+        self.assertAlmostEqual(p["Fs_N"] / p["Fc_N"], P0["Fs_N"] / P0["Fc_N"])
+        diag = diagnosis(h.best)
+        diag.identifiability = {"held": h.held, "kept_out": {}}
+        m, _ = machinejson.build(prep, diag)
+        # machine.json writes what the model holds: before, the file's 18 N on this 0.7 N axis (Fs/Fc 26)
+        self.assertAlmostEqual(m["friction"]["Fs_N"] / p["Fs_N"], 1.0, places=9)
+        self.assertEqual(m["provenance"]["friction.Fs_N"], "assumed")
 
 if __name__ == "__main__":
     unittest.main()

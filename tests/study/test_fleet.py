@@ -6,8 +6,9 @@
   positive on every run that went to the end; every faulted run listed in
   "lost" with its cause and time and never carrying an RMS; a chain failure
   listed with its stage.
-- Axis 0 alone on 1 worker: its record is the same (the axes do
-  not depend on the scheduling, the worker count or N).
+- Axis 0 alone on 1 worker, merged into the two-axis study (--merge): its
+  record is the same (the axes do not depend on the scheduling, the worker
+  count or N), and so is the merged summary.
 - Every UKF and PF run's JSON says its estimators carried machine.json's causes.
 - The statistics on records made here: a faulted run stays out of the RMS
   figures and is lost with its cause; a run worse than H-inf only is lost.
@@ -29,6 +30,7 @@ sys.path.insert(0, os.path.join(REPO, "sim", "studies"))
 import fleet  # noqa: E402
 import fleet_axis  # noqa: E402
 import fleet_why  # noqa: E402
+import fleet_worse  # noqa: E402
 
 ARGS = None
 SEED = 7
@@ -38,11 +40,12 @@ SEED = 7
 TWO_AXES = (0, 7)
 
 
-def study(out, axes, workers):
+def study(out, axes, workers, merge=None):
     shutil.rmtree(out, ignore_errors=True)
     r = subprocess.run([sys.executable, os.path.join(REPO, "sim", "studies", "fleet.py"), "--out", out,
                         "--axes", ",".join(str(i) for i in axes),
-                        "--seed", str(SEED), "--workers", str(workers), "--kinds", "thesis_circle,p2p"],
+                        "--seed", str(SEED), "--workers", str(workers), "--kinds", "thesis_circle,p2p",
+                        *(("--merge", merge) if merge else ())],
                        capture_output=True, text=True, timeout=500)
     if r.returncode != 0:
         raise AssertionError("fleet.py exit %d\n%s\n%s" % (r.returncode, r.stdout[-3000:], r.stderr[-3000:]))
@@ -54,7 +57,8 @@ class Fleet(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.two, cls.out2 = study(os.path.join(ARGS.work, "two"), TWO_AXES, 2)
-        cls.one, _ = study(os.path.join(ARGS.work, "one"), TWO_AXES[:1], 1)
+        # axis 0 again alone, on 1 worker, merged into the two-axis study (fleet.py --merge)
+        cls.one, _ = study(os.path.join(ARGS.work, "one"), TWO_AXES[:1], 1, merge=os.path.join(ARGS.work, "two"))
 
     def test_structure(self):
         s = self.two
@@ -149,8 +153,36 @@ class Fleet(unittest.TestCase):
         self.assertEqual(got, want)
         self.assertTrue(all(r["d_m"] > 0.0 and math.isfinite(r["d_m"]) for r in fleet_why.runs(os.path.join(ARGS.work, "two"))))
 
+    def test_worse_reads_every_run(self):
+        """fleet_worse.py (docs/fleet.md, "Why runs end worse than H-inf only") sees each estimator run
+        whose H-inf only went to the end: faulted where the summary says so, else its RMS over H-inf only's"""
+        n, seen = 0, 0
+        for r in self.two["axes"]:
+            got = fleet_worse.verdicts(os.path.join(ARGS.work, "two", "axes", "%04d" % r["i"]))
+            seen += len(got)
+            for name, runs in r["runs"].items():
+                if runs["hinf_only"]["faulted"]:
+                    continue
+                for ctrl in fleet_worse.CTRLS:
+                    run_ = runs[ctrl]
+                    want = "faulted" if run_["faulted"] else run_["rms_m"] / runs["hinf_only"]["rms_m"]
+                    if want == "faulted":
+                        self.assertEqual(got[(name, ctrl)], want)
+                    else:
+                        self.assertAlmostEqual(got[(name, ctrl)] / want, 1.0, places=5)
+                    n += 1
+        self.assertEqual(seen, n)  # no run beside the summary's
+        self.assertGreater(n, 0)
+
     def test_independent_of_workers_and_n(self):
         self.assertEqual(self.two["axes"][0], self.one["axes"][0])
+
+    def test_merge(self):
+        """axis 0 run again and merged into the two-axis study: the same study, axis 7's record the
+        base's, the statistics over both, and the merge named"""
+        self.assertEqual(self.one["merged"], {"base": os.path.join(ARGS.work, "two"), "axes_run_again": [0]})
+        self.assertEqual(self.one["axes"][1], self.two["axes"][1])
+        self.assertEqual({k: v for k, v in self.one.items() if k != "merged"}, self.two)
 
     def test_page_with_faults_fails_unless_expected(self):
         """--md with a faulted run: exit 1 unless --expect-faults; a run only worse than H-inf only is no fault"""
@@ -186,6 +218,24 @@ class Fleet(unittest.TestCase):
         self.assertEqual(fleet.refused_lines(summ), ["hinf_pf: axis 3, status -2: c"])
         self.assertEqual(fleet.unexpected_faults(summ, __import__("types").SimpleNamespace(
             md="page.md", expect_faults=False)), 1)  # the lost_lock, not the refusal
+
+    def test_load_q_scaled(self):
+        """--load-q scaled: the reference's external-force random walks as the same share of each axis's
+        actuator force (q_Fact2_per_s): on the reference itself the same N^2/s, on an axis with a tenth
+        of its actuator force a hundredth"""
+        import copy
+        sys.path.insert(0, os.path.join(REPO, "firmware", "design"))
+        import machine
+        ref = fleet_axis.reference_file()
+        m = copy.deepcopy(ref)
+        fleet_axis.scale_load_q(m, ref)
+        for est in ("pf", "ukf"):
+            self.assertEqual(list(m["estimator"][est]["load"]), ["q_Fact2_per_s"])
+            self.assertAlmostEqual(machine.load_q_N2_per_s(m, est) / ref["estimator"][est]["load"]["q_N2_per_s"],
+                                   1.0, places=12)
+        m["control"]["torque_limit_Nm"] *= 0.1
+        self.assertAlmostEqual(machine.load_q_N2_per_s(m, "pf") / ref["estimator"]["pf"]["load"]["q_N2_per_s"],
+                               0.01, places=12)
 
     def test_friction_split(self):
         """the axes by their plant's friction; presliding named where the diagnosis wrote the
