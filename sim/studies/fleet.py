@@ -385,9 +385,12 @@ def main():
                 base = json.load(f)
         except (OSError, ValueError) as e:
             sys.exit("fleet.py: --merge %s/summary.json: %s" % (a.merge, e))
-        if base.get("seed") != a.seed or base.get("kinds_run") != kinds:
-            sys.exit("fleet.py: --merge %s: seed %s, kinds %s: not this study's (seed %d, kinds %s)"
-                     % (a.merge, base.get("seed"), base.get("kinds_run"), a.seed, kinds))
+        same = {"seed": a.seed, "kinds_run": sorted(kinds), "hinf_weights": a.hinf_weights, "load_q": a.load_q}
+        # a base from before --load-q ran the reference's random walks
+        theirs = {"seed": base.get("seed"), "kinds_run": sorted(base.get("kinds_run", [])),
+                  "hinf_weights": base.get("hinf_weights"), "load_q": base.get("load_q", "reference")}
+        if theirs != same:
+            sys.exit("fleet.py: --merge %s: %s: not this study's (%s)" % (a.merge, theirs, same))
         if set(a.axes) - {r["i"] for r in base["axes"]}:
             sys.exit("fleet.py: --merge %s: axes %s are not in it" % (
                 a.merge, sorted(set(a.axes) - {r["i"] for r in base["axes"]})))
@@ -401,12 +404,22 @@ def main():
     good = [r for r in recs if "error" not in r]
     n_run = a.n
     if base is not None:
-        # the base's records of the axes not run again, this run's of the rest
-        good = sorted([r for r in base["axes"] if r["i"] not in set(a.axes)] + good, key=lambda r: r["i"])
+        # the base's records of the axes not run again, this run's of the rest; the base's axis
+        # folders linked beside this run's, so that the folder readers (fleet_why.py,
+        # fleet_worse.py, fleet_rerun.py) see every axis
+        kept = [r for r in base["axes"] if r["i"] not in set(a.axes)]
+        os.makedirs(os.path.join(a.out, "axes"), exist_ok=True)
+        for r in kept:
+            src = os.path.abspath(os.path.join(a.merge, "axes", "%04d" % r["i"]))
+            dst = os.path.join(a.out, "axes", "%04d" % r["i"])
+            if os.path.isdir(src) and not os.path.lexists(dst):
+                os.symlink(src, dst)
+        good = sorted(kept + good, key=lambda r: r["i"])
         a.n = base["n_axes"]
     summ = {"generator": "sim/studies/fleet.py", "n_axes": a.n, "seed": a.seed, "kinds_run": kinds,
             "hinf_weights": a.hinf_weights, "load_q": a.load_q,
-            **({"merged": {"base": a.merge, "axes_run_again": a.axes},
+            **({"merged": {"base": a.merge, "axes_run_again": a.axes,
+                           **({"base_merged": base["merged"]} if "merged" in base else {})},
                 **({"axes_run": base["axes_run"]} if "axes_run" in base else {})} if base is not None else
                {"axes_run": a.axes} if a.axes is not None else {}),
             "axes_chain_failed": [{"axis": r["i"], **r["chain_failed"]} for r in good if "chain_failed" in r],

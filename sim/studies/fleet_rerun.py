@@ -78,7 +78,8 @@ def main():
     ap.add_argument("out", help="where the builds and runs go")
     ap.add_argument("--seed", type=int, default=20261201, help="the study's seed")
     ap.add_argument("--axes", help="comma-separated axis indices (default: every axis the chain finished)")
-    ap.add_argument("--pf-adapt-max", type=float, help="br_robust_run --pf-adapt-max (1: no inflation)")
+    ap.add_argument("--pf-adapt-max", type=float,
+                    help="br_robust_run --pf-adapt-max (1: no inflation); the circles only")
     ap.add_argument("--tracks", action="store_true",
                     help="also the point-to-point and EMPS tracks (br_track, on the study's references)")
     ap.add_argument("--machine", choices=("diagnosed", "truth"), default="diagnosed",
@@ -103,15 +104,16 @@ def main():
                   and os.path.exists(os.path.join(d, "%s.ref.csv" % t["name"]))]
         names = [t["name"] for _, t in circles if os.path.exists(os.path.join(d, "%s_hinf_only.json" % t["name"]))]
         names += [t["name"] for t in tracks]
-        mfile = os.path.join(d, "diagnose", "machine.json") if a.machine == "diagnosed" else os.path.join(d, "truth.json")
-        exe = machine_chain.host_build(build, mfile, os.path.join(od, "host"), "br_robust_run")
+        mfile = os.path.join(d, *(("diagnose", "machine.json") if a.machine == "diagnosed" else ("truth.json",)))
+        # one build folder per machine file kind: host_build configures a folder once
+        exe = machine_chain.host_build(build, mfile, os.path.join(od, "host-" + a.machine), "br_robust_run")
         with open(os.path.join(od, "runs.log"), "w", encoding="utf-8") as log:
             for k, tr in circles:
                 if tr["name"] in names:
                     fleet_runs.circle_runs(od, exe, os.path.join(d, "truth-model.json"), fleet_axis.gms_options(ax), tr,
                                            fleet_runs.run_seed(a.seed, i, k + 1), ax["force_noise_N"], log, extra)
             if tracks:
-                trk = machine_chain.host_build(build, mfile, os.path.join(od, "host"), "br_track")
+                trk = machine_chain.host_build(build, mfile, os.path.join(od, "host-" + a.machine), "br_track")
             for tr in tracks:
                 fleet_runs.track_runs(od, trk, os.path.join(d, "truth-model.json"), fleet_axis.gms_options(ax),
                                       os.path.join(d, "%s.ref.csv" % tr["name"]), tr["name"], log)

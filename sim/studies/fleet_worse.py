@@ -19,6 +19,9 @@ import json
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from runs import refused  # noqa: E402
+
 CTRLS = ("hinf_ukf", "hinf_pf")
 NAMES = ("thesis_circle", "circle0", "circle1", "p2p", "emps")
 BANDS = ((1.0, 1.01, "up to 1 % worse"), (1.01, 1.1, "1-10 % worse"), (1.1, 2.0, "10-100 % worse"),
@@ -26,13 +29,16 @@ BANDS = ((1.0, 1.01, "up to 1 % worse"), (1.01, 1.1, "1-10 % worse"), (1.1, 2.0,
 
 
 def run(d, name, ctrl):
-    """one run's figure from its JSON in d: its RMS, "faulted", or None (not run)"""
+    """one run's figure from its JSON in d: its RMS, "faulted", or None (not run, or refused at
+    init: fleet.py counts those apart, neither lost nor a figure)"""
     path = os.path.join(d, "%s_%s.json" % (name, ctrl))
     if not os.path.exists(path):
         return None
     with open(path, encoding="utf-8") as f:
         js = json.load(f)
     r = js["controllers"][ctrl] if "controllers" in js else js[ctrl]  # br_robust_run nests, br_track not
+    if refused(r):
+        return None
     if r.get("faulted"):
         return "faulted"
     return r.get("contour_rms_m", r.get("rms_m"))

@@ -19,9 +19,10 @@ logs made from the model's own force around the reference machine
 5. a mass on its floor (model.COEF_LOWER) is held at the machine file's
    value, in the nominal model and in the extended (fleet axes 23, 34, 96,
    103, 131: Meff = 1e-9 kg, a model the closed-loop check cannot run);
-6. a held Fs goes into machine.json as the model holds it, the file's
-   Fs/Fc at the identified Fc, not the file's value in N (fleet axis 62:
-   Fs = 18 N on 0.39 N of Coulomb).
+6. a held Fs the machine file assumes goes into machine.json as the model
+   holds it, the file's Fs/Fc at the identified Fc, not the file's value
+   in N (fleet axis 62: Fs = 18 N on an identified Fc of 0.39 N); one the
+   file gives stays as given.
 """
 import math
 import os
@@ -194,7 +195,8 @@ class RulesTest(unittest.TestCase):
     def test_6_held_shape_keeps_the_files_ratio_to_fc(self):
         # an axis with a tenth of the file's Coulomb friction and the file's Stribeck ratio: Fs held
         fc = 0.1 * P0["Fc_N"]
-        prep = prepared(nominal_truth(Fc_N=fc, Fs_N=fc * P0["Fs_N"] / P0["Fc_N"], sigma0_Npm=fc * P0["sigma0_Npm"] / P0["Fc_N"]))
+        ratio = lambda k: fc * P0[k] / P0["Fc_N"]  # noqa: E731
+        prep = prepared(nominal_truth(Fc_N=fc, Fs_N=ratio("Fs_N"), sigma0_Npm=ratio("sigma0_Npm")))
         free = model.fit_nominal(prep)
         h = identify._Holder(prep, free, P0)
         h.take(("Fs_N",), h.trial({"Fs_N": P0["Fs_N"]}), "held for the test")
@@ -209,6 +211,9 @@ class RulesTest(unittest.TestCase):
         # machine.json writes what the model holds: before, the file's 18 N on this 0.7 N axis (Fs/Fc 26)
         self.assertAlmostEqual(m["friction"]["Fs_N"] / p["Fs_N"], 1.0, places=9)
         self.assertEqual(m["provenance"]["friction.Fs_N"], "assumed")
+        # a stiction the machine file gives (no provenance block: every value given) stays as given
+        m, _ = machinejson.build(prep, diag, given=machinejson._loader().REFERENCE_MACHINE)
+        self.assertEqual(m["friction"]["Fs_N"], P0["Fs_N"])
 
 if __name__ == "__main__":
     unittest.main()

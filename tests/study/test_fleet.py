@@ -183,6 +183,18 @@ class Fleet(unittest.TestCase):
         self.assertEqual(self.one["merged"], {"base": os.path.join(ARGS.work, "two"), "axes_run_again": [0]})
         self.assertEqual(self.one["axes"][1], self.two["axes"][1])
         self.assertEqual({k: v for k, v in self.one.items() if k != "merged"}, self.two)
+        # axis 0 ran here (its folder written by this run), axis 7's folder is the base's, linked
+        one, two = os.path.join(ARGS.work, "one", "axes"), os.path.join(ARGS.work, "two", "axes")
+        self.assertFalse(os.path.islink(os.path.join(one, "0000")))
+        self.assertTrue(os.path.isfile(os.path.join(one, "0000", "thesis_circle_hinf_pf.json")))
+        self.assertEqual(os.path.realpath(os.path.join(one, "0007")), os.path.realpath(os.path.join(two, "0007")))
+        # a base of another study is refused with the reason
+        r = subprocess.run([sys.executable, os.path.join(REPO, "sim", "studies", "fleet.py"), "--out",
+                            os.path.join(ARGS.work, "refused"), "--axes", "0", "--seed", str(SEED + 1),
+                            "--kinds", "thesis_circle,p2p", "--merge", os.path.join(ARGS.work, "two")],
+                           capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("not this study's", r.stderr)
 
     def test_page_with_faults_fails_unless_expected(self):
         """--md with a faulted run: exit 1 unless --expect-faults; a run only worse than H-inf only is no fault"""

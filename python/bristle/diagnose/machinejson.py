@@ -20,8 +20,8 @@ marked "assumed"; what follows from the log and the rest is "derived". The
                    the log cannot resolve: vs_mps below its velocity resolution
                    (quantum / dt), and with it Fs_N; sigma0_Npm whose presliding
                    length Fc/sigma0 is under 2 quanta, and with it sigma1_Nspm:
-                   these keep the base's values ("assumed"; Fs_N the base's
-                   Fs/Fc times this Fc, as the model holds it)
+                   these keep the base's values ("assumed"; an assumed Fs_N
+                   as the base's Fs/Fc times this Fc, the model's form)
   causes           model.json's causes and their parameters, same names ("identified")
   friction_model   presliding_hysteresis's element set as maxwell_slip ("identified"),
                    when the other causes are ones the estimators combine with it; with
@@ -263,6 +263,7 @@ def build(prep, diag, given=None, log_path=None, hinf_rule=False):
                      "sigma1_Nspm are not identified" % (p["Fc_N"] / p["sigma0_Npm"], PRESLIDING_MIN_QUANTA))
     held = from_file
     unresolved |= held & set(fr)
+    fs_given = kind("friction.Fs_N") == "given"  # a stiction the user measured stays as given
     for q in params.NOMINAL:
         if q.name not in fr:
             continue  # Meff_kg: above
@@ -272,13 +273,16 @@ def build(prep, diag, given=None, log_path=None, hinf_rule=False):
             prov["friction." + q.name] = "assumed"
         else:
             _set(m, "friction." + q.name, p[q.name], prov, "identified")
-    # Fs the log cannot resolve keeps the base's Stribeck ratio Fs/Fc, as the diagnosis's model
-    # holds it (beta: model.FIXED_SHAPE), not the base's Fs in N: the reference's 18 N would be
-    # 46 Fc on an axis of 0.39 N, a breakaway the estimators then expect and the axis never shows
-    # (docs/fleet.md, "Why runs end worse than H-inf only"). sigma0 keeps the base's value: its
-    # ratio to Fc gained nothing on the fleet and stiffened a 140 N axis's bristle into lost lock
-    if "Fs_N" in held or "Fs_N" in unresolved:
+    # an Fs the log does not identify (held, kept out, below the velocity resolution) and the base
+    # only assumes keeps the base's Stribeck ratio Fs/Fc at this Fc, as the model holds a held Fs
+    # (beta: model.FIXED_SHAPE), not the base's Fs in N: the reference's 18 N was 46 times the
+    # identified Fc of a fleet axis, a breakaway the estimators then expect and the axis never
+    # shows (docs/fleet.md, "Why runs end worse than H-inf only"). sigma0 keeps the base's value:
+    # its ratio to Fc gained nothing on the fleet and stiffened a 140 N axis's bristle into lost lock
+    if ("Fs_N" in held or "Fs_N" in unresolved) and not fs_given:
         fr["Fs_N"] = base_fr["Fs_N"] * fr["Fc_N"] / base_fr["Fc_N"]
+        notes.append("Fs_N %.4g N: the machine file's Fs/Fc %.4g (%.4g N / %.4g N) at this Fc %.4g N"
+                     % (fr["Fs_N"], base_fr["Fs_N"] / base_fr["Fc_N"], base_fr["Fs_N"], base_fr["Fc_N"], fr["Fc_N"]))
 
     # the PF's g_p along the Stribeck curve (docs/modules/pf.md, "Fast moves"), when the log
     # identified the curve (Fs_N and vs_mps) and the base does not state it: without it g_p
