@@ -44,9 +44,7 @@ def records(d, names):
             if os.path.exists(path):
                 with open(path, encoding="utf-8") as f:
                     js = json.load(f)
-                # br_robust_run nests its controllers and names the contour RMS; br_track does neither
-                out[(name, ctrl)] = (fleet_runs.result(js["controllers"][ctrl], "contour_rms_m", "max_err_m")
-                                     if "controllers" in js else fleet_runs.result(js[ctrl], "rms_m", "max_m"))
+                out[(name, ctrl)] = fleet_runs.tool_record(js, ctrl)
                 if ctrl != "hinf_only":
                     causes.add(js.get("estimator_causes", "thesis"))
     return out, causes

@@ -96,6 +96,14 @@ def result(raw, rms_key, max_key):
     return r
 
 
+def tool_record(js, ctrl):
+    """result() of controller ctrl in a tool's JSON js: br_robust_run nests its controllers and names
+    the contour RMS, br_track does neither"""
+    if "controllers" in js:
+        return result(js["controllers"][ctrl], "contour_rms_m", "max_err_m")
+    return result(js[ctrl], "rms_m", "max_m")
+
+
 def circle_runs(d, exe, truth, gms, tr, seed, noise, log, extra=()):
     """each circle controller on br_robust_run (extra: more of its options, a study's: fleet_rerun.py)"""
     out = {}

@@ -20,6 +20,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fleet_runs import tool_record  # noqa: E402
 from runs import refused  # noqa: E402
 
 CTRLS = ("hinf_ukf", "hinf_pf")
@@ -36,12 +37,10 @@ def run(d, name, ctrl):
         return None
     with open(path, encoding="utf-8") as f:
         js = json.load(f)
-    r = js["controllers"][ctrl] if "controllers" in js else js[ctrl]  # br_robust_run nests, br_track not
+    r = tool_record(js, ctrl)
     if refused(r):
         return None
-    if r.get("faulted"):
-        return "faulted"
-    return r.get("contour_rms_m", r.get("rms_m"))
+    return "faulted" if r["faulted"] else r["rms_m"]
 
 
 def verdicts(d):
