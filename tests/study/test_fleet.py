@@ -174,6 +174,19 @@ class Fleet(unittest.TestCase):
         self.assertEqual(seen, n)  # no run beside the summary's
         self.assertGreater(n, 0)
 
+    def test_worse_leaves_refusals_out(self):
+        """fleet_worse.py: a run the firmware refused at init is neither lost nor a figure (as fleet.py
+        counts it); a faulted run is "faulted", never a ratio"""
+        import tempfile
+        d = tempfile.mkdtemp(dir=ARGS.work)
+        runs = {"hinf_only": {"fault_status": 0, "contour_rms_m": 2e-6, "max_err_m": 4e-6},
+                "hinf_ukf": {"fault_status": -6, "fault_t_s": 0.1, "fault_cause": "lost_lock"},
+                "hinf_pf": {"fault_status": -2, "fault_t_s": 0.0, "fault_cause": "refused_at_init"}}
+        for ctrl, r in runs.items():
+            with open(os.path.join(d, "thesis_circle_%s.json" % ctrl), "w", encoding="utf-8") as f:
+                json.dump({"controllers": {ctrl: r}}, f)
+        self.assertEqual(fleet_worse.verdicts(d), {("thesis_circle", "hinf_ukf"): "faulted"})
+
     def test_independent_of_workers_and_n(self):
         self.assertEqual(self.two["axes"][0], self.one["axes"][0])
 
